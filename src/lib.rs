@@ -1,0 +1,15 @@
+//! betr: turn a robot instruction into a behavior tree that people can read, step, verify
+//! and trust, and repair it when the world differs from what the planner knew.
+//!
+//! Data flows one way: `domain` (conditions, skills, scenarios) and `goal` (formulas) are
+//! plain data; `bt` runs trees against any leaf executor; `world` simulates; `planner` grows
+//! trees by ticking them in a simulated world. Front ends sit on top and are never imported
+//! by these modules.
+#![forbid(unsafe_code)]
+
+pub mod bt;
+pub mod dataset;
+pub mod domain;
+pub mod goal;
+pub mod planner;
+pub mod world;
