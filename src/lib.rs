@@ -12,4 +12,5 @@ pub mod dataset;
 pub mod domain;
 pub mod goal;
 pub mod planner;
+pub mod store;
 pub mod world;

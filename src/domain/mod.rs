@@ -5,3 +5,10 @@ pub mod condition;
 
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};
+pub mod scenario;
+pub mod skill;
+pub mod vocabulary;
+
+pub use scenario::{Example, Scenario, ScenarioError, SourceFile};
+pub use skill::{AtomPattern, Domain, GroundSkill, Param, Skill, ValueParam};
+pub use vocabulary::{Object, Predicate, Vocabulary, VocabularyError};

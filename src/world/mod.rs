@@ -1,1 +1,77 @@
-//! (being written)
+//! Simulated worlds the planner ticks trees against, and that stand in for the robot.
+//!
+//! A world answers whether a condition holds, advances an action by one tick (Running,
+//! Success, or Failure with the error text the skill reports), and can be copied so the
+//! planner can try a tree without touching the world it will run in. It knows nothing of
+//! behavior trees or language models.
+
+pub mod symbolic;
+
+use std::any::Any;
+
+use crate::domain::{ActionCall, Condition, Scenario, ScenarioError};
+
+pub use symbolic::SymbolicWorld;
+
+/// The result of advancing an action by one tick.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Step {
+    /// The action needs more ticks.
+    Running,
+    /// The action completed.
+    Success,
+    /// The action failed; the text is what the skill reports ("No collision free path found").
+    Failure(String),
+}
+
+/// An opaque copy of a world's state, for `World::restore`.
+pub struct Snapshot(Box<dyn Any + Send>);
+
+impl Snapshot {
+    pub fn new<T: Any + Send>(state: T) -> Self {
+        Snapshot(Box::new(state))
+    }
+
+    pub fn get<T: Any>(&self) -> Option<&T> {
+        self.0.downcast_ref()
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum WorldError {
+    #[error("this snapshot was taken from a different kind of world")]
+    ForeignSnapshot,
+}
+
+pub trait World: Send {
+    /// A short name of the simulator (`symbolic`, `cell`).
+    fn kind(&self) -> &'static str;
+    /// Whether the condition holds now (`"any object"`: for some object; negated: for none).
+    fn check(&self, condition: &Condition) -> bool;
+    /// Advance `action` by one tick. `started` is true on the first tick of a new run of it.
+    fn step(&mut self, action: &ActionCall, started: bool) -> Step;
+    /// Stop `action` if it is running; harmless otherwise.
+    fn halt(&mut self, action: &ActionCall);
+    /// An independent copy, for trying trees without side effects.
+    fn fork(&self) -> Box<dyn World>;
+    fn snapshot(&self) -> Snapshot;
+    fn restore(&mut self, snapshot: &Snapshot) -> Result<(), WorldError>;
+    /// The atoms true now, as conditions, in a stable order (for display and prompts).
+    fn facts(&self) -> Vec<Condition>;
+}
+
+/// Build the world a scenario describes.
+pub fn load(scenario: &Scenario) -> Result<Box<dyn World>, ScenarioError> {
+    match scenario.world_kind.as_str() {
+        "symbolic" => Ok(Box::new(SymbolicWorld::from_scenario(scenario)?)),
+        other => {
+            let file = scenario.files.last().map(|f| f.path.clone()).unwrap_or_default();
+            Err(ScenarioError {
+                file,
+                line: 0,
+                column: 0,
+                message: format!("unknown world kind {other:?} (known: symbolic)"),
+            })
+        }
+    }
+}

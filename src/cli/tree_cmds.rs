@@ -1,0 +1,196 @@
+//! `betr plan`, `betr run`, `betr repair`.
+
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+
+use betr::bt::{self, Glyphs, NodeKind, TickRecord, Tree};
+use betr::domain::{ActionCall, Condition, Scenario};
+use betr::planner::{self, Outcome, Plan, Planner, RunEnd, path_text, run_tree};
+use betr::world::{self, World};
+
+const WORLD_FAILED: u8 = 1;
+
+pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<ExitCode> {
+    let goal = super::goal_of(scenario, goal)?;
+    let world = world::load(scenario)?;
+    let dnf = goal.to_dnf();
+    println!("Scenario: {}", scenario.name);
+    println!("Goal:     {goal}");
+    let started = Instant::now();
+    let plan = Planner::new(&scenario.domain).plan(&dnf, world.as_ref())?;
+    let elapsed = started.elapsed();
+    println!(
+        "Planned in {:.2} ms: {} expansion(s), {} reordering(s), {} simulated tick(s)\n",
+        elapsed.as_secs_f64() * 1e3,
+        plan.expansions,
+        plan.reorders,
+        plan.simulated_ticks
+    );
+    let record = final_record(scenario, &plan.tree, world.as_ref());
+    print_tree(&plan.tree, record.as_ref(), glyphs);
+    Ok(report_outcome(&plan))
+}
+
+pub fn run(scenario: &Scenario, tree_file: Option<&Path>, trace: bool, max_ticks: u64, glyphs: &Glyphs) -> Result<ExitCode> {
+    let world = world::load(scenario)?;
+    let tree = match tree_file {
+        Some(path) => load_tree(scenario, path)?,
+        None => {
+            let goal = super::goal_of(scenario, None)?;
+            Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?.tree
+        }
+    };
+    let mut exec = world.fork();
+    let report = run_tree(&tree, exec.as_mut(), &scenario.domain, max_ticks, |r| {
+        if trace {
+            print_trace(&tree, r);
+        }
+        true
+    });
+    print_tree(&tree, report.last.as_ref(), glyphs);
+    match report.end {
+        RunEnd::Success => {
+            println!("\nSUCCESS after {} tick(s)", report.ticks);
+            Ok(ExitCode::SUCCESS)
+        }
+        RunEnd::Failure { action: Some((node, error)) } => {
+            println!(
+                "\nFAILED after {} tick(s) at {} (node {}): {error}",
+                report.ticks,
+                leaf_text(&tree, node),
+                path_text(&tree.path(node).unwrap_or_default())
+            );
+            Ok(ExitCode::from(WORLD_FAILED))
+        }
+        RunEnd::Failure { action: None } => {
+            println!("\nFAILED after {} tick(s): the tree's conditions do not hold and nothing it can do changes that", report.ticks);
+            Ok(ExitCode::from(WORLD_FAILED))
+        }
+        RunEnd::TickLimit => {
+            println!("\nSTILL RUNNING after {} tick(s); stopped", report.ticks);
+            Ok(ExitCode::from(WORLD_FAILED))
+        }
+    }
+}
+
+pub fn repair(
+    scenario: &Scenario,
+    additions: &[Vec<Condition>],
+    at: Option<&ActionCall>,
+    tree_file: Option<&Path>,
+    save: Option<&Path>,
+    glyphs: &Glyphs,
+) -> Result<ExitCode> {
+    let world = world::load(scenario)?;
+    let planner = Planner::new(&scenario.domain);
+    let mut plan = match tree_file {
+        Some(path) => planner.grow(load_tree(scenario, path)?, world.as_ref()),
+        None => planner.plan(&super::goal_of(scenario, None)?.to_dnf(), world.as_ref())?,
+    };
+    for (i, conditions) in additions.iter().enumerate() {
+        let names = conditions.iter().map(ToString::to_string).collect::<Vec<_>>().join(" & ");
+        let at_action = if i == 0 { at } else { None };
+        plan = match (&plan.outcome, at_action) {
+            (_, Some(action)) => {
+                println!("Inserting {names} before {action}!");
+                planner.repair_at(plan.tree, action, conditions, world.as_ref())?
+            }
+            (Outcome::ActionFailed { node, action, error }, None) => {
+                println!("{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)");
+                planner.repair(plan.tree, *node, conditions, world.as_ref())?
+            }
+            (Outcome::Success, None) => bail!("the tree already succeeds before --add {names:?}: nothing fails to repair"),
+            (other, None) => bail!("cannot repair: {}", describe(other, &plan.tree)),
+        };
+        println!("  added {} node(s), {} expansion(s)", plan.new_nodes.len(), plan.expansions);
+    }
+    println!();
+    let mut exec = world.fork();
+    let report = run_tree(&plan.tree, exec.as_mut(), &scenario.domain, planner.options.max_ticks, |_| true);
+    print_tree(&plan.tree, report.last.as_ref(), glyphs);
+    println!("\n{}", bt::to_text(&plan.tree));
+    if let Some(path) = save {
+        betr::store::write_atomic(path, bt::to_text(&plan.tree).as_bytes())
+            .with_context(|| format!("saving the repaired tree to {}", path.display()))?;
+        println!("Saved to {}", path.display());
+    }
+    match report.end {
+        RunEnd::Success => {
+            println!("SUCCESS after {} tick(s)", report.ticks);
+            Ok(ExitCode::SUCCESS)
+        }
+        _ => {
+            println!("The repaired tree still fails: {}", describe(&plan.outcome, &plan.tree));
+            Ok(ExitCode::from(WORLD_FAILED))
+        }
+    }
+}
+
+fn load_tree(scenario: &Scenario, path: &Path) -> Result<Tree> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading tree file {}", path.display()))?;
+    let tree = bt::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    planner::check_tree(&scenario.domain, &tree).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(tree)
+}
+
+/// The statuses of a full run of `tree` in a fresh copy of the scenario's world.
+fn final_record(scenario: &Scenario, tree: &Tree, world: &dyn World) -> Option<TickRecord> {
+    let mut sim = world.fork();
+    run_tree(tree, sim.as_mut(), &scenario.domain, Planner::new(&scenario.domain).options.max_ticks, |_| true).last
+}
+
+fn print_tree(tree: &Tree, record: Option<&TickRecord>, glyphs: &Glyphs) {
+    for line in bt::render(tree, record, glyphs) {
+        println!("{line}");
+    }
+}
+
+fn print_trace(tree: &Tree, record: &TickRecord) {
+    let running = record.running_action().map(|n| leaf_text(tree, n));
+    let mut line = format!("tick {:>4}: {:?}", record.tick, record.root);
+    if let Some(r) = running {
+        line.push_str(&format!(", running {r}"));
+    }
+    for (node, error) in &record.failures {
+        line.push_str(&format!(", {} failed: {error}", leaf_text(tree, *node)));
+    }
+    for node in &record.halted {
+        line.push_str(&format!(", halted {}", leaf_text(tree, *node)));
+    }
+    println!("{line}");
+}
+
+fn leaf_text(tree: &Tree, node: bt::NodeId) -> String {
+    match tree.kind(node) {
+        Ok(NodeKind::Action(a)) => format!("{a}!"),
+        Ok(NodeKind::Condition(c)) => format!("{c}?"),
+        Ok(NodeKind::Sequence) => "sequence".into(),
+        Ok(NodeKind::Fallback) => "fallback".into(),
+        Err(_) => format!("{node:?}"),
+    }
+}
+
+fn describe(outcome: &Outcome, tree: &Tree) -> String {
+    match outcome {
+        Outcome::Success => "the tree succeeds in simulation".into(),
+        Outcome::ActionFailed { node, action, error } => format!(
+            "{action}! (node {}) failed in simulation: {error}",
+            path_text(&tree.path(*node).unwrap_or_default())
+        ),
+        Outcome::Unreachable {
+            condition, path, reason, ..
+        } => format!("{condition}? (node {}) cannot be achieved: {reason}", path_text(path)),
+        Outcome::Exhausted { reason } => reason.clone(),
+    }
+}
+
+fn report_outcome(plan: &Plan) -> ExitCode {
+    println!("\n{}", describe(&plan.outcome, &plan.tree));
+    match plan.outcome {
+        Outcome::Success => ExitCode::SUCCESS,
+        _ => ExitCode::from(WORLD_FAILED),
+    }
+}

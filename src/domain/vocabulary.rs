@@ -1,0 +1,207 @@
+//! The condition vocabulary of a scenario: typed objects and predicates with one-line
+//! descriptions. Everything that reaches a tree (from a file, a person or an LLM) is checked
+//! against it, and the prompts of later stages are written from it.
+
+use super::condition::{ANY_OBJECT, Atom, Condition};
+
+/// A named object and the types it belongs to (`Coffee` is an `item` and a `makable`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    pub name: String,
+    pub types: Vec<String>,
+}
+
+/// A predicate with the types each argument slot accepts (a union: `place|item`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Predicate {
+    pub name: String,
+    pub arg_types: Vec<Vec<String>>,
+    pub description: String,
+}
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Vocabulary {
+    pub objects: Vec<Object>,
+    pub predicates: Vec<Predicate>,
+}
+
+/// Why a condition does not fit the vocabulary.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum VocabularyError {
+    #[error("unknown predicate {predicate:?} in {atom} (known: {known})")]
+    UnknownPredicate {
+        atom: String,
+        predicate: String,
+        known: String,
+    },
+    #[error("{atom}: {predicate:?} takes {expected} argument(s), found {found}")]
+    Arity {
+        atom: String,
+        predicate: String,
+        expected: usize,
+        found: usize,
+    },
+    #[error("unknown object {object:?} in {atom}")]
+    UnknownObject { atom: String, object: String },
+    #[error("{atom}: argument {position} of {predicate:?} must be {expected}, but {object:?} is {actual}")]
+    WrongType {
+        atom: String,
+        predicate: String,
+        position: usize,
+        object: String,
+        expected: String,
+        actual: String,
+    },
+}
+
+impl Vocabulary {
+    pub fn object(&self, name: &str) -> Option<&Object> {
+        self.objects.iter().find(|o| o.name == name)
+    }
+
+    pub fn predicate(&self, name: &str) -> Option<&Predicate> {
+        self.predicates.iter().find(|p| p.name == name)
+    }
+
+    /// True when `name` is a type some object has.
+    pub fn is_type(&self, name: &str) -> bool {
+        self.objects.iter().any(|o| o.types.iter().any(|t| t == name))
+    }
+
+    /// Whether `object` fits a slot that accepts `types` (type names, or object names
+    /// standing for themselves).
+    pub fn fits(&self, object: &str, types: &[String]) -> bool {
+        types.iter().any(|t| t == object)
+            || self
+                .object(object)
+                .is_some_and(|o| o.types.iter().any(|ot| types.contains(ot)))
+    }
+
+    /// The objects that fit a slot, in declaration order.
+    pub fn objects_fitting<'a>(&'a self, types: &'a [String]) -> impl Iterator<Item = &'a str> + 'a {
+        self.objects
+            .iter()
+            .filter(move |o| self.fits(&o.name, types))
+            .map(|o| o.name.as_str())
+    }
+
+    /// Check that an atom names a known predicate with the right number of arguments, each
+    /// a known object of an accepted type (or the `"any object"` wildcard).
+    pub fn check_atom(&self, atom: &Atom) -> Result<(), VocabularyError> {
+        let text = atom.to_string();
+        let Some(pred) = self.predicate(&atom.predicate) else {
+            return Err(VocabularyError::UnknownPredicate {
+                atom: text,
+                predicate: atom.predicate.clone(),
+                known: self
+                    .predicates
+                    .iter()
+                    .map(|p| p.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        };
+        if pred.arg_types.len() != atom.args.len() {
+            return Err(VocabularyError::Arity {
+                atom: text,
+                predicate: pred.name.clone(),
+                expected: pred.arg_types.len(),
+                found: atom.args.len(),
+            });
+        }
+        for (position, (arg, types)) in atom.args.iter().zip(&pred.arg_types).enumerate() {
+            if arg == ANY_OBJECT {
+                continue;
+            }
+            let Some(object) = self.object(arg) else {
+                if types.iter().any(|t| t == arg) {
+                    continue;
+                }
+                return Err(VocabularyError::UnknownObject {
+                    atom: text,
+                    object: arg.clone(),
+                });
+            };
+            if !self.fits(arg, types) {
+                return Err(VocabularyError::WrongType {
+                    atom: text,
+                    predicate: pred.name.clone(),
+                    position: position + 1,
+                    object: arg.clone(),
+                    expected: types.join(" or "),
+                    actual: object.types.join(", "),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    pub fn check_condition(&self, condition: &Condition) -> Result<(), VocabularyError> {
+        self.check_atom(&condition.atom)
+    }
+
+    /// Every ground atom the vocabulary can form (used by exhaustive checks and prompts).
+    pub fn ground_atoms(&self) -> Vec<Atom> {
+        let mut out = Vec::new();
+        for pred in &self.predicates {
+            let mut partial: Vec<Vec<String>> = vec![Vec::new()];
+            for types in &pred.arg_types {
+                let choices: Vec<&str> = self.objects_fitting(types).collect();
+                partial = partial
+                    .into_iter()
+                    .flat_map(|p| {
+                        choices.iter().map(move |c| {
+                            let mut next = p.clone();
+                            next.push((*c).to_string());
+                            next
+                        })
+                    })
+                    .collect();
+            }
+            out.extend(partial.into_iter().map(|args| Atom {
+                predicate: pred.name.clone(),
+                args,
+            }));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cafe() -> Vocabulary {
+        Vocabulary {
+            objects: vec![
+                Object { name: "Coffee".into(), types: vec!["item".into(), "makable".into()] },
+                Object { name: "Table1".into(), types: vec!["place".into()] },
+            ],
+            predicates: vec![Predicate {
+                name: "On".into(),
+                arg_types: vec![vec!["item".into()], vec!["place".into()]],
+                description: "the item is at the place".into(),
+            }],
+        }
+    }
+
+    #[test]
+    fn accepts_well_typed_atoms() {
+        let v = cafe();
+        assert!(v.check_atom(&Atom::parse("On_Coffee_Table1").unwrap()).is_ok());
+        assert_eq!(v.ground_atoms().len(), 1);
+    }
+
+    #[test]
+    fn names_what_is_wrong() {
+        let v = cafe();
+        let e = v.check_atom(&Atom::parse("On_Table1_Coffee").unwrap()).unwrap_err();
+        assert!(matches!(e, VocabularyError::WrongType { position: 1, .. }), "{e}");
+        let e = v.check_atom(&Atom::parse("On_Fries_Table1").unwrap()).unwrap_err();
+        assert!(e.to_string().contains("\"Fries\""), "{e}");
+        let e = v.check_atom(&Atom::parse("Under_Coffee_Table1").unwrap()).unwrap_err();
+        assert!(e.to_string().contains("known: On"), "{e}");
+        let e = v.check_atom(&Atom::parse("On_Coffee").unwrap()).unwrap_err();
+        assert!(matches!(e, VocabularyError::Arity { expected: 2, found: 1, .. }));
+    }
+}

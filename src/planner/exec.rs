@@ -1,0 +1,102 @@
+//! Running a tree in a world: the leaf executor that connects `bt` to a `World`, and a
+//! run-to-completion loop used by the planner's simulation and by `betr run`.
+//!
+//! The executor also monitors postconditions: an action that completes without its
+//! declared effects (a mop-less sweep) is reported as a failure with the text
+//! `Postcondition IsClean_Floor not met after Sweep action completion`, because a reactive
+//! tree would otherwise re-run it forever.
+
+use crate::bt::{ActionStep, Leaves, NodeId, Outcome, TickRecord, Ticker, Tree};
+use crate::domain::{ActionCall, Condition, Domain};
+use crate::world::{Step, World};
+
+pub struct WorldLeaves<'a> {
+    pub world: &'a mut dyn World,
+    pub domain: &'a Domain,
+}
+
+impl Leaves for WorldLeaves<'_> {
+    fn check(&mut self, condition: &Condition) -> bool {
+        self.world.check(condition)
+    }
+
+    fn step(&mut self, _node: NodeId, action: &ActionCall, started: bool) -> ActionStep {
+        match self.world.step(action, started) {
+            Step::Running => ActionStep::Running,
+            Step::Failure(error) => ActionStep::Failure(error),
+            Step::Success => match unmet_postcondition(self.domain, &*self.world, action) {
+                Some(unmet) => ActionStep::Failure(format!(
+                    "Postcondition {unmet} not met after {} action completion",
+                    action.skill
+                )),
+                None => ActionStep::Success,
+            },
+        }
+    }
+
+    fn halt(&mut self, _node: NodeId, action: &ActionCall) {
+        self.world.halt(action);
+    }
+}
+
+/// The first declared effect of `action` that does not hold in `world`.
+pub fn unmet_postcondition(domain: &Domain, world: &dyn World, action: &ActionCall) -> Option<Condition> {
+    let ground = domain.resolve(action)?;
+    ground.postconditions().into_iter().find(|c| !world.check(c))
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunEnd {
+    Success,
+    /// The tree failed; when an action failed on the last tick, which and with what text.
+    Failure { action: Option<(NodeId, String)> },
+    /// Still running after the tick budget.
+    TickLimit,
+}
+
+/// The result of ticking a tree until it stops running.
+pub struct RunReport {
+    pub end: RunEnd,
+    pub ticks: u64,
+    pub last: Option<TickRecord>,
+}
+
+/// Tick `tree` in `world` until the root returns Success or Failure, or `max_ticks` pass.
+/// `on_tick` sees every record (for tracing and conflict detection); returning `false`
+/// from it stops the run early.
+pub fn run_tree(
+    tree: &Tree,
+    world: &mut dyn World,
+    domain: &Domain,
+    max_ticks: u64,
+    mut on_tick: impl FnMut(&TickRecord) -> bool,
+) -> RunReport {
+    let mut ticker = Ticker::new();
+    let mut leaves = WorldLeaves { world, domain };
+    let mut last = None;
+    for n in 1..=max_ticks {
+        let record = ticker.tick(tree, &mut leaves);
+        let keep_going = on_tick(&record);
+        let end = match record.root {
+            Outcome::Running => None,
+            Outcome::Success => Some(RunEnd::Success),
+            Outcome::Failure => Some(RunEnd::Failure {
+                action: record.failures.first().cloned(),
+            }),
+        };
+        last = Some(record);
+        if let Some(end) = end {
+            return RunReport { end, ticks: n, last };
+        }
+        if !keep_going {
+            break;
+        }
+    }
+    ticker.halt_all(tree, &mut leaves);
+    RunReport {
+        end: RunEnd::TickLimit,
+        ticks: ticker.tick_count(),
+        last,
+    }
+}

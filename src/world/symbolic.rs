@@ -1,0 +1,235 @@
+//! A world of facts: skills apply their declared effects after their number of ticks, and
+//! hidden rules — requirements the skills do not declare — make an action fail with its
+//! error text, or finish without its effect.
+//!
+//! Scenario syntax (`[world]` table, merged base first when a scenario `extends` another):
+//!
+//! ```toml
+//! [world]
+//! kind = "symbolic"
+//! initial = ["Holding_Nothing", "RobotNear_Bar2", "On_Chips_Bar"]
+//!
+//! [[world.rules]]
+//! action = 'MoveTo "Coffee"'   # a skill name alone matches every use of the skill
+//! requires = "Exists_Coffee"   # a goal formula that must hold when the action starts
+//! error = "Coffee not found"   # what the skill reports when it does not
+//! # otherwise = "no effect"    # instead: the action completes without its effects
+//! ```
+
+use std::collections::{BTreeSet, HashMap};
+use std::sync::Arc;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::{Snapshot, Step, World, WorldError};
+use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain, Scenario, ScenarioError};
+use crate::goal::Formula;
+
+/// What happens when a rule's requirement does not hold.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Violation {
+    /// The action fails at its first tick with this error text.
+    Fail(String),
+    /// The action runs to completion but changes nothing.
+    NoEffect,
+}
+
+/// A requirement of the world that the planner's skill model may not know.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rule {
+    pub skill: String,
+    /// `None`: every use of the skill.
+    pub args: Option<Vec<String>>,
+    pub requires: Formula,
+    pub violation: Violation,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct State {
+    facts: BTreeSet<Atom>,
+    /// Ticks done so far by each running action (keyed by its text).
+    progress: HashMap<String, u32>,
+}
+
+#[derive(Clone)]
+pub struct SymbolicWorld {
+    domain: Arc<Domain>,
+    rules: Arc<Vec<Rule>>,
+    state: State,
+}
+
+#[derive(Deserialize)]
+struct WorldTable {
+    world: Option<RawWorld>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWorld {
+    #[allow(dead_code)]
+    kind: Option<String>,
+    initial: Option<Vec<Spanned<String>>>,
+    #[serde(default)]
+    rules: Vec<RawRule>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRule {
+    action: Spanned<String>,
+    requires: Spanned<String>,
+    error: Option<String>,
+    otherwise: Option<Spanned<String>>,
+}
+
+impl Rule {
+    fn applies_to(&self, action: &ActionCall) -> bool {
+        self.skill == action.skill && self.args.as_ref().is_none_or(|a| *a == action.args)
+    }
+}
+
+impl SymbolicWorld {
+    pub fn new(domain: Arc<Domain>, initial: impl IntoIterator<Item = Atom>, rules: Vec<Rule>) -> Self {
+        SymbolicWorld {
+            domain,
+            rules: Arc::new(rules),
+            state: State {
+                facts: initial.into_iter().collect(),
+                progress: HashMap::new(),
+            },
+        }
+    }
+
+    /// Read the `[world]` tables of a scenario's files: the last `initial` list wins, rules
+    /// accumulate from base to child.
+    pub fn from_scenario(scenario: &Scenario) -> Result<Self, ScenarioError> {
+        let vocabulary = &scenario.domain.vocabulary;
+        let mut initial = BTreeSet::new();
+        let mut rules = Vec::new();
+        for file in &scenario.files {
+            let table: WorldTable = file.parse()?;
+            let Some(world) = table.world else { continue };
+            if let Some(facts) = world.initial {
+                initial.clear();
+                for f in facts {
+                    let c = Condition::parse(f.get_ref())
+                        .map_err(|e| file.error_in_string(&f.span(), e.at, format!("expected {}, found {}", e.expected, e.found)))?;
+                    if c.negated || c.atom.has_wildcard() {
+                        return Err(file.error_in_string(&f.span(), 0, "initial facts are plain atoms: no `~`, no \"any object\" (unlisted atoms are false)"));
+                    }
+                    vocabulary
+                        .check_atom(&c.atom)
+                        .map_err(|e| file.error_in_string(&f.span(), 0, e.to_string()))?;
+                    initial.insert(c.atom);
+                }
+            }
+            for r in world.rules {
+                let action = ActionCall::parse(r.action.get_ref())
+                    .map_err(|e| file.error_in_string(&r.action.span(), e.at, format!("expected {}, found {}", e.expected, e.found)))?;
+                if !scenario.domain.skills.iter().any(|s| s.name == action.skill) {
+                    return Err(file.error_in_string(&r.action.span(), 0, format!("no skill named {:?} in this scenario", action.skill)));
+                }
+                let requires = scenario
+                    .parse_goal(r.requires.get_ref())
+                    .map_err(|m| file.error_in_string(&r.requires.span(), 0, m))?;
+                let violation = match r.otherwise.as_ref().map(|o| o.get_ref().as_str()) {
+                    None | Some("fail") => match r.error {
+                        Some(e) if !e.trim().is_empty() => Violation::Fail(e),
+                        _ => return Err(file.error_in_string(&r.action.span(), 0, "a failing rule needs `error`, the text the skill reports")),
+                    },
+                    Some("no effect") => Violation::NoEffect,
+                    Some(other) => {
+                        let span = r.otherwise.as_ref().map(Spanned::span).unwrap_or_default();
+                        return Err(file.error_in_string(&span, 0, format!("expected \"fail\" or \"no effect\", found {other:?}")));
+                    }
+                };
+                rules.push(Rule {
+                    skill: action.skill,
+                    args: (!action.args.is_empty()).then_some(action.args),
+                    requires,
+                    violation,
+                });
+            }
+        }
+        Ok(SymbolicWorld::new(Arc::new(scenario.domain.clone()), initial, rules))
+    }
+
+    fn holds(&self, atom: &Atom) -> bool {
+        if atom.has_wildcard() {
+            self.state.facts.iter().any(|f| {
+                f.predicate == atom.predicate
+                    && f.args.len() == atom.args.len()
+                    && f.args.iter().zip(&atom.args).all(|(x, y)| y == ANY_OBJECT || x == y)
+            })
+        } else {
+            self.state.facts.contains(atom)
+        }
+    }
+
+    fn violated(&self, action: &ActionCall) -> Option<&Rule> {
+        self.rules
+            .iter()
+            .find(|r| r.applies_to(action) && !r.requires.eval(&|a: &Atom| self.holds(a)))
+    }
+}
+
+impl World for SymbolicWorld {
+    fn kind(&self) -> &'static str {
+        "symbolic"
+    }
+
+    fn check(&self, condition: &Condition) -> bool {
+        self.holds(&condition.atom) != condition.negated
+    }
+
+    fn step(&mut self, action: &ActionCall, started: bool) -> Step {
+        let Some(ground) = self.domain.resolve(action) else {
+            return Step::Failure(format!("Unknown action {action}"));
+        };
+        let key = action.to_string();
+        if started || !self.state.progress.contains_key(&key) {
+            if let Some(unmet) = ground.pre.iter().find(|c| !self.check(c)) {
+                return Step::Failure(format!("Precondition {unmet} of {action} not met"));
+            }
+            if let Some(Violation::Fail(error)) = self.violated(action).map(|r| &r.violation) {
+                return Step::Failure(error.clone());
+            }
+            self.state.progress.insert(key.clone(), 0);
+        }
+        let done = self.state.progress.entry(key.clone()).or_insert(0);
+        *done += 1;
+        if *done < ground.ticks {
+            return Step::Running;
+        }
+        self.state.progress.remove(&key);
+        if matches!(self.violated(action).map(|r| &r.violation), Some(Violation::NoEffect)) {
+            return Step::Success;
+        }
+        self.state.facts.retain(|f| !ground.del.iter().any(|d| d.matches(f)));
+        self.state.facts.extend(ground.add.iter().cloned());
+        Step::Success
+    }
+
+    fn halt(&mut self, action: &ActionCall) {
+        self.state.progress.remove(&action.to_string());
+    }
+
+    fn fork(&self) -> Box<dyn World> {
+        Box::new(self.clone())
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        Snapshot::new(self.state.clone())
+    }
+
+    fn restore(&mut self, snapshot: &Snapshot) -> Result<(), WorldError> {
+        let state = snapshot.get::<State>().ok_or(WorldError::ForeignSnapshot)?;
+        self.state = state.clone();
+        Ok(())
+    }
+
+    fn facts(&self) -> Vec<Condition> {
+        self.state.facts.iter().cloned().map(Condition::pos).collect()
+    }
+}
