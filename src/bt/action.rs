@@ -1,10 +1,11 @@
 //! Action leaf (drawn `-->`, written `... !`): run one step of a skill.
 //!
 //! Returns what `Leaves::step` reports: `Running` while the skill is under way, `Success`
-//! when it finished, `Failure` (with the skill's error text) when it gave up. The node itself
-//! is memoryless; the only thing the ticker remembers is whether it was `Running` in the
-//! previous tick, which decides `started` (a fresh start) and whether it must be halted
-//! when a tick no longer reaches it.
+//! when it finished, `Failure` (with the skill's error text) when it gave up. Reactive and
+//! memoryless: the node keeps no state; the only thing the ticker remembers is whether it
+//! was `Running` in the previous tick, which decides `started` (a fresh start) and whether
+//! it must be halted when a tick no longer reaches it (its guard failed, or a
+//! higher-priority fallback child succeeded).
 
 use super::status::Outcome;
 use super::tick::Leaves;

@@ -1,8 +1,9 @@
 //! Condition leaf (drawn `-->`, written `... ?`): ask the world whether a literal holds.
 //!
 //! Returns `Success` when `Leaves::check` says the condition holds and `Failure` otherwise;
-//! never `Running`. Memoryless: it is re-checked on every tick that reaches it, and nothing
-//! about earlier ticks is kept.
+//! never `Running`. Reactive and memoryless: it is re-checked on every tick that reaches it
+//! (so a guard that stops holding stops its sequence at once), and nothing about earlier
+//! ticks is kept.
 
 use super::status::Outcome;
 use super::tick::Leaves;
