@@ -1,1 +1,26 @@
-//! (being written)
+//! Behavior trees: an arena tree, reactive ticking against any leaf executor, a text
+//! format that round-trips, and a renderer.
+//!
+//! Control nodes are reactive and memoryless (like BT.CPP's `ReactiveSequence` /
+//! `ReactiveFallback` and py_trees' `Sequence(memory=False)`): every tick starts again at
+//! the first child, so a condition that stops holding halts the action it guards.
+
+pub mod action;
+pub mod condition;
+pub mod fallback;
+pub mod render;
+pub mod sequence;
+pub mod status;
+pub mod text;
+pub mod tick;
+pub mod tree;
+
+#[cfg(test)]
+mod test_util;
+
+pub use action::ActionStep;
+pub use render::{ASCII, Glyphs, UNICODE, render};
+pub use status::{Outcome, Status};
+pub use text::{ParseError, parse, to_text};
+pub use tick::{Leaves, TickRecord, Ticker};
+pub use tree::{NodeId, NodeKind, Tree, TreeError};

@@ -1,0 +1,110 @@
+//! What a tick returns (`Outcome`) and what a node showed during one tick (`Status`).
+//!
+//! `Outcome` is the three-valued result every node hands to its parent. `Status` adds the
+//! two things an observer of a tick needs besides that result: whether the tick reached the
+//! node at all (`Idle`), and whether a previously running action was stopped (`Halted`).
+
+use std::fmt;
+
+/// The result of ticking a node once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Outcome {
+    /// The node has not finished yet; tick again to make progress.
+    Running,
+    /// The node achieved what it stands for (condition holds, action done, all children done).
+    Success,
+    /// The node could not achieve what it stands for.
+    Failure,
+}
+
+/// What a node showed in one tick.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// Not reached by this tick.
+    #[default]
+    Idle,
+    /// Ticked and returned `Running`.
+    Running,
+    /// Ticked and returned `Success`.
+    Success,
+    /// Ticked and returned `Failure`.
+    Failure,
+    /// Was `Running` in the previous tick and was stopped because this tick no longer
+    /// reached it.
+    Halted,
+}
+
+impl From<Outcome> for Status {
+    fn from(outcome: Outcome) -> Self {
+        match outcome {
+            Outcome::Running => Status::Running,
+            Outcome::Success => Status::Success,
+            Outcome::Failure => Status::Failure,
+        }
+    }
+}
+
+impl Status {
+    /// True for `Running`.
+    pub fn is_active(self) -> bool {
+        matches!(self, Status::Running)
+    }
+
+    /// True for `Success` and `Failure`.
+    pub fn is_completed(self) -> bool {
+        matches!(self, Status::Success | Status::Failure)
+    }
+}
+
+impl fmt::Display for Outcome {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Outcome::Running => "running",
+            Outcome::Success => "success",
+            Outcome::Failure => "failure",
+        })
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Status::Idle => "idle",
+            Status::Running => "running",
+            Status::Success => "success",
+            Status::Failure => "failure",
+            Status::Halted => "halted",
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn outcome_maps_to_status() {
+        assert_eq!(Status::from(Outcome::Running), Status::Running);
+        assert_eq!(Status::from(Outcome::Success), Status::Success);
+        assert_eq!(Status::from(Outcome::Failure), Status::Failure);
+    }
+
+    #[test]
+    fn predicates() {
+        assert!(Status::Running.is_active());
+        for s in [
+            Status::Idle,
+            Status::Success,
+            Status::Failure,
+            Status::Halted,
+        ] {
+            assert!(!s.is_active(), "{s}");
+        }
+        assert!(Status::Success.is_completed());
+        assert!(Status::Failure.is_completed());
+        for s in [Status::Idle, Status::Running, Status::Halted] {
+            assert!(!s.is_completed(), "{s}");
+        }
+        assert_eq!(Status::default(), Status::Idle);
+    }
+}
