@@ -12,7 +12,11 @@ use betr::domain::{Condition, Scenario};
 use betr::goal::Formula;
 
 #[derive(Parser)]
-#[command(name = "betr", version, about = "Instruction → goal → behavior tree, repaired when the world disagrees")]
+#[command(
+    name = "betr",
+    version,
+    about = "Instruction → goal → behavior tree, repaired when the world disagrees"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -64,9 +68,15 @@ pub enum Command {
 }
 
 pub fn run(cli: Cli) -> Result<ExitCode> {
-    let glyphs = if cli.ascii { &betr::bt::ASCII } else { &betr::bt::UNICODE };
+    let glyphs = if cli.ascii {
+        &betr::bt::ASCII
+    } else {
+        &betr::bt::UNICODE
+    };
     match cli.command {
-        Command::Plan { scenario, goal } => tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs),
+        Command::Plan { scenario, goal } => {
+            tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
+        }
         Command::Run {
             scenario,
             tree,
@@ -86,9 +96,20 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 .map(|a| parse_conditions(&scenario, a))
                 .collect::<Result<Vec<_>>>()?;
             let at = at
-                .map(|a| betr::domain::ActionCall::parse(&a).with_context(|| format!("--at {a:?} is not an action like 'PickUp \"Chips\"'")))
+                .map(|a| {
+                    betr::domain::ActionCall::parse(&a).with_context(|| {
+                        format!("--at {a:?} is not an action like 'PickUp \"Chips\"'")
+                    })
+                })
                 .transpose()?;
-            tree_cmds::repair(&scenario, &additions, at.as_ref(), tree.as_deref(), save.as_deref(), glyphs)
+            tree_cmds::repair(
+                &scenario,
+                &additions,
+                at.as_ref(),
+                tree.as_deref(),
+                save.as_deref(),
+                glyphs,
+            )
         }
     }
 }
@@ -101,25 +122,39 @@ fn load(arg: &Path) -> Result<Scenario> {
         Path::new("scenarios").join(arg).with_extension("toml"),
     ];
     let Some(path) = candidates.iter().find(|p| p.is_file()) else {
-        bail!("scenario {} not found (tried {})", arg.display(), candidates.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+        bail!(
+            "scenario {} not found (tried {})",
+            arg.display(),
+            candidates
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
     };
     Ok(Scenario::load(path)?)
 }
 
 /// `A & ~B` → the literals, checked against the scenario's vocabulary.
 fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>> {
-    let formula = scenario.parse_goal(text).map_err(|e| anyhow::anyhow!("--add {text:?}: {e}"))?;
+    let formula = scenario
+        .parse_goal(text)
+        .map_err(|e| anyhow::anyhow!("--add {text:?}: {e}"))?;
     let dnf = formula.to_dnf();
     match dnf.0.as_slice() {
         [one] if !one.is_empty() => Ok(one.clone()),
-        _ => bail!("--add {text:?}: expected one condition or a conjunction ('A & ~B'), found {formula}"),
+        _ => bail!(
+            "--add {text:?}: expected one condition or a conjunction ('A & ~B'), found {formula}"
+        ),
     }
 }
 
 /// The goal to plan: `--goal`, else the scenario's.
 fn goal_of(scenario: &Scenario, goal: Option<&str>) -> Result<Formula> {
     match goal {
-        Some(text) => scenario.parse_goal(text).map_err(|e| anyhow::anyhow!("--goal {text:?}: {e}")),
+        Some(text) => scenario
+            .parse_goal(text)
+            .map_err(|e| anyhow::anyhow!("--goal {text:?}: {e}")),
         None => scenario
             .goal
             .clone()

@@ -34,13 +34,21 @@ pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<
     Ok(report_outcome(&plan))
 }
 
-pub fn run(scenario: &Scenario, tree_file: Option<&Path>, trace: bool, max_ticks: u64, glyphs: &Glyphs) -> Result<ExitCode> {
+pub fn run(
+    scenario: &Scenario,
+    tree_file: Option<&Path>,
+    trace: bool,
+    max_ticks: u64,
+    glyphs: &Glyphs,
+) -> Result<ExitCode> {
     let world = world::load(scenario)?;
     let tree = match tree_file {
         Some(path) => load_tree(scenario, path)?,
         None => {
             let goal = super::goal_of(scenario, None)?;
-            Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?.tree
+            Planner::new(&scenario.domain)
+                .plan(&goal.to_dnf(), world.as_ref())?
+                .tree
         }
     };
     let mut exec = world.fork();
@@ -56,7 +64,9 @@ pub fn run(scenario: &Scenario, tree_file: Option<&Path>, trace: bool, max_ticks
             println!("\nSUCCESS after {} tick(s)", report.ticks);
             Ok(ExitCode::SUCCESS)
         }
-        RunEnd::Failure { action: Some((node, error)) } => {
+        RunEnd::Failure {
+            action: Some((node, error)),
+        } => {
             println!(
                 "\nFAILED after {} tick(s) at {} (node {}): {error}",
                 report.ticks,
@@ -66,7 +76,10 @@ pub fn run(scenario: &Scenario, tree_file: Option<&Path>, trace: bool, max_ticks
             Ok(ExitCode::from(WORLD_FAILED))
         }
         RunEnd::Failure { action: None } => {
-            println!("\nFAILED after {} tick(s): the tree's conditions do not hold and nothing it can do changes that", report.ticks);
+            println!(
+                "\nFAILED after {} tick(s): the tree's conditions do not hold and nothing it can do changes that",
+                report.ticks
+            );
             Ok(ExitCode::from(WORLD_FAILED))
         }
         RunEnd::TickLimit => {
@@ -91,25 +104,50 @@ pub fn repair(
         None => planner.plan(&super::goal_of(scenario, None)?.to_dnf(), world.as_ref())?,
     };
     for (i, conditions) in additions.iter().enumerate() {
-        let names = conditions.iter().map(ToString::to_string).collect::<Vec<_>>().join(" & ");
+        let names = conditions
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(" & ");
         let at_action = if i == 0 { at } else { None };
         plan = match (&plan.outcome, at_action) {
             (_, Some(action)) => {
                 println!("Inserting {names} before {action}!");
                 planner.repair_at(plan.tree, action, conditions, world.as_ref())?
             }
-            (Outcome::ActionFailed { node, action, error }, None) => {
-                println!("{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)");
+            (
+                Outcome::ActionFailed {
+                    node,
+                    action,
+                    error,
+                },
+                None,
+            ) => {
+                println!(
+                    "{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)"
+                );
                 planner.repair(plan.tree, *node, conditions, world.as_ref())?
             }
-            (Outcome::Success, None) => bail!("the tree already succeeds before --add {names:?}: nothing fails to repair"),
+            (Outcome::Success, None) => {
+                bail!("the tree already succeeds before --add {names:?}: nothing fails to repair")
+            }
             (other, None) => bail!("cannot repair: {}", describe(other, &plan.tree)),
         };
-        println!("  added {} node(s), {} expansion(s)", plan.new_nodes.len(), plan.expansions);
+        println!(
+            "  added {} node(s), {} expansion(s)",
+            plan.new_nodes.len(),
+            plan.expansions
+        );
     }
     println!();
     let mut exec = world.fork();
-    let report = run_tree(&plan.tree, exec.as_mut(), &scenario.domain, planner.options.max_ticks, |_| true);
+    let report = run_tree(
+        &plan.tree,
+        exec.as_mut(),
+        &scenario.domain,
+        planner.options.max_ticks,
+        |_| true,
+    );
     print_tree(&plan.tree, report.last.as_ref(), glyphs);
     println!("\n{}", bt::to_text(&plan.tree));
     if let Some(path) = save {
@@ -123,23 +161,35 @@ pub fn repair(
             Ok(ExitCode::SUCCESS)
         }
         _ => {
-            println!("The repaired tree still fails: {}", describe(&plan.outcome, &plan.tree));
+            println!(
+                "The repaired tree still fails: {}",
+                describe(&plan.outcome, &plan.tree)
+            );
             Ok(ExitCode::from(WORLD_FAILED))
         }
     }
 }
 
 fn load_tree(scenario: &Scenario, path: &Path) -> Result<Tree> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading tree file {}", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading tree file {}", path.display()))?;
     let tree = bt::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    planner::check_tree(&scenario.domain, &tree).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    planner::check_tree(&scenario.domain, &tree)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok(tree)
 }
 
 /// The statuses of a full run of `tree` in a fresh copy of the scenario's world.
 fn final_record(scenario: &Scenario, tree: &Tree, world: &dyn World) -> Option<TickRecord> {
     let mut sim = world.fork();
-    run_tree(tree, sim.as_mut(), &scenario.domain, Planner::new(&scenario.domain).options.max_ticks, |_| true).last
+    run_tree(
+        tree,
+        sim.as_mut(),
+        &scenario.domain,
+        Planner::new(&scenario.domain).options.max_ticks,
+        |_| true,
+    )
+    .last
 }
 
 fn print_tree(tree: &Tree, record: Option<&TickRecord>, glyphs: &Glyphs) {
@@ -176,13 +226,23 @@ fn leaf_text(tree: &Tree, node: bt::NodeId) -> String {
 fn describe(outcome: &Outcome, tree: &Tree) -> String {
     match outcome {
         Outcome::Success => "the tree succeeds in simulation".into(),
-        Outcome::ActionFailed { node, action, error } => format!(
+        Outcome::ActionFailed {
+            node,
+            action,
+            error,
+        } => format!(
             "{action}! (node {}) failed in simulation: {error}",
             path_text(&tree.path(*node).unwrap_or_default())
         ),
         Outcome::Unreachable {
-            condition, path, reason, ..
-        } => format!("{condition}? (node {}) cannot be achieved: {reason}", path_text(path)),
+            condition,
+            path,
+            reason,
+            ..
+        } => format!(
+            "{condition}? (node {}) cannot be achieved: {reason}",
+            path_text(path)
+        ),
         Outcome::Exhausted { reason } => reason.clone(),
     }
 }

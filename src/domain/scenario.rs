@@ -89,7 +89,12 @@ impl SourceFile {
 
     /// An error inside a quoted TOML string whose span is `span`, `inner` bytes into its
     /// contents (the opening quote is skipped).
-    pub fn error_in_string(&self, span: &std::ops::Range<usize>, inner: usize, message: impl Into<String>) -> ScenarioError {
+    pub fn error_in_string(
+        &self,
+        span: &std::ops::Range<usize>,
+        inner: usize,
+        message: impl Into<String>,
+    ) -> ScenarioError {
         let quote = match self.text.get(span.start..span.start + 3) {
             Some("'''") | Some("\"\"\"") => 3,
             _ => 1,
@@ -219,7 +224,11 @@ impl Scenario {
             if let Some(base) = &raw.extends {
                 let base_path = p.parent().unwrap_or(Path::new(".")).join(base.get_ref());
                 if !base_path.exists() {
-                    return Err(file.error_in_string(&base.span(), 0, format!("the extended file {} does not exist", base_path.display())));
+                    return Err(file.error_in_string(
+                        &base.span(),
+                        0,
+                        format!("the extended file {} does not exist", base_path.display()),
+                    ));
                 }
                 next = Some(base_path);
             }
@@ -243,7 +252,11 @@ impl Scenario {
                 for name in names {
                     let n = name.get_ref().trim();
                     if n.is_empty() || n.contains('"') {
-                        return Err(file.error_in_string(&name.span(), 0, "an object name must be non-empty and contain no quote"));
+                        return Err(file.error_in_string(
+                            &name.span(),
+                            0,
+                            "an object name must be non-empty and contain no quote",
+                        ));
                     }
                     match vocabulary.objects.iter_mut().find(|o| o.name == n) {
                         Some(o) if !o.types.contains(ty) => o.types.push(ty.clone()),
@@ -263,7 +276,11 @@ impl Scenario {
                     let types = split_types(a.get_ref());
                     for t in &types {
                         if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
-                            return Err(file.error_in_string(&a.span(), 0, format!("unknown type {t:?} (no object has it)")));
+                            return Err(file.error_in_string(
+                                &a.span(),
+                                0,
+                                format!("unknown type {t:?} (no object has it)"),
+                            ));
                         }
                     }
                     arg_types.push(types);
@@ -273,7 +290,11 @@ impl Scenario {
                     arg_types,
                     description: p.description.clone(),
                 };
-                match vocabulary.predicates.iter_mut().find(|q| q.name == predicate.name) {
+                match vocabulary
+                    .predicates
+                    .iter_mut()
+                    .find(|q| q.name == predicate.name)
+                {
                     Some(q) => *q = predicate,
                     None => vocabulary.predicates.push(predicate),
                 }
@@ -283,7 +304,11 @@ impl Scenario {
         // A skill name defined in a later file replaces that name from earlier files.
         let mut sources: Vec<SkillSource> = Vec::new();
         for (raw, file) in raws.iter().zip(&files) {
-            let names: Vec<&str> = raw.skills.iter().map(|s| s.name.get_ref().as_str()).collect();
+            let names: Vec<&str> = raw
+                .skills
+                .iter()
+                .map(|s| s.name.get_ref().as_str())
+                .collect();
             sources.retain(|s| !names.contains(&s.raw.name.get_ref().as_str()));
             sources.extend(raw.skills.iter().map(|raw| SkillSource { raw, file }));
         }
@@ -324,7 +349,11 @@ impl Scenario {
             description: meta.description.clone(),
             instruction: meta.instruction.clone(),
             goal,
-            expected_fix: meta.expected_fix.iter().map(|f| f.get_ref().clone()).collect(),
+            expected_fix: meta
+                .expected_fix
+                .iter()
+                .map(|f| f.get_ref().clone())
+                .collect(),
             examples,
             domain: Domain { vocabulary, skills },
             world_kind,
@@ -336,14 +365,22 @@ impl Scenario {
     pub fn parse_goal(&self, text: &str) -> Result<Formula, String> {
         let f = Formula::parse(text).map_err(|e| e.to_string())?;
         for atom in f.atoms() {
-            self.domain.vocabulary.check_atom(&atom).map_err(|e| e.to_string())?;
+            self.domain
+                .vocabulary
+                .check_atom(&atom)
+                .map_err(|e| e.to_string())?;
         }
         Ok(f)
     }
 }
 
-fn parse_goal(file: &SourceFile, text: &Spanned<String>, vocabulary: &Vocabulary) -> Result<Formula, ScenarioError> {
-    let f = Formula::parse(text.get_ref()).map_err(|e| file.error_in_string(&text.span(), e.at, e.to_string()))?;
+fn parse_goal(
+    file: &SourceFile,
+    text: &Spanned<String>,
+    vocabulary: &Vocabulary,
+) -> Result<Formula, ScenarioError> {
+    let f = Formula::parse(text.get_ref())
+        .map_err(|e| file.error_in_string(&text.span(), e.at, e.to_string()))?;
     for atom in f.atoms() {
         vocabulary
             .check_atom(&atom)
@@ -354,15 +391,25 @@ fn parse_goal(file: &SourceFile, text: &Spanned<String>, vocabulary: &Vocabulary
 
 /// `place|item` → [place, item]; `item except makable` keeps the exclusion for `Param`.
 fn split_types(spec: &str) -> Vec<String> {
-    spec.split('|').map(|t| t.trim().to_string()).filter(|t| !t.is_empty()).collect()
+    spec.split('|')
+        .map(|t| t.trim().to_string())
+        .filter(|t| !t.is_empty())
+        .collect()
 }
 
 fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, ScenarioError> {
     let raw = source.raw;
     let file = source.file;
     let name = raw.name.get_ref().trim();
-    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') || !name.starts_with(|c: char| c.is_ascii_alphabetic()) {
-        return Err(file.error_in_string(&raw.name.span(), 0, "a skill name is letters, digits and _ (starting with a letter)"));
+    if name.is_empty()
+        || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        || !name.starts_with(|c: char| c.is_ascii_alphabetic())
+    {
+        return Err(file.error_in_string(
+            &raw.name.span(),
+            0,
+            "a skill name is letters, digits and _ (starting with a letter)",
+        ));
     }
     let mut params = Vec::new();
     for p in &raw.params {
@@ -375,7 +422,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
         };
         for t in types.iter().chain(&except) {
             if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
-                return Err(file.error_in_string(&p.span(), 0, format!("unknown type or object {t:?}")));
+                return Err(file.error_in_string(
+                    &p.span(),
+                    0,
+                    format!("unknown type or object {t:?}"),
+                ));
             }
         }
         params.push(Param {
@@ -385,8 +436,10 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
         });
     }
     let literal = |s: &Spanned<String>| {
-        let t = parse_template(s.get_ref(), &params).map_err(|m| file.error_in_string(&s.span(), 0, m))?;
-        check_template(&t.atom, &params, vocabulary).map_err(|m| file.error_in_string(&s.span(), 0, m))?;
+        let t = parse_template(s.get_ref(), &params)
+            .map_err(|m| file.error_in_string(&s.span(), 0, m))?;
+        check_template(&t.atom, &params, vocabulary)
+            .map_err(|m| file.error_in_string(&s.span(), 0, m))?;
         Ok::<_, ScenarioError>(t)
     };
     let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
@@ -394,7 +447,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
     for s in &raw.add {
         let t = literal(s)?;
         if t.negated || t.atom.args.contains(&super::skill::Term::Every) {
-            return Err(file.error_in_string(&s.span(), 0, "`add` lists atoms that become true: no `~` and no {*} (put removals in `del`)"));
+            return Err(file.error_in_string(
+                &s.span(),
+                0,
+                "`add` lists atoms that become true: no `~` and no {*} (put removals in `del`)",
+            ));
         }
         add.push(t.atom);
     }
@@ -402,7 +459,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
     for s in &raw.del {
         let t = literal(s)?;
         if t.negated {
-            return Err(file.error_in_string(&s.span(), 0, "`del` lists atoms that become false: write them without `~`"));
+            return Err(file.error_in_string(
+                &s.span(),
+                0,
+                "`del` lists atoms that become false: write them without `~`",
+            ));
         }
         del.push(t.atom);
     }
@@ -432,7 +493,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
 }
 
 /// A template's predicate must exist with the right arity, and its constants must fit.
-fn check_template(t: &super::skill::AtomTemplate, params: &[Param], vocabulary: &Vocabulary) -> Result<(), String> {
+fn check_template(
+    t: &super::skill::AtomTemplate,
+    params: &[Param],
+    vocabulary: &Vocabulary,
+) -> Result<(), String> {
     use super::skill::Term;
     let Some(pred) = vocabulary.predicate(&t.predicate) else {
         return Err(format!("unknown predicate {:?}", t.predicate));
@@ -448,7 +513,10 @@ fn check_template(t: &super::skill::AtomTemplate, params: &[Param], vocabulary: 
     for (term, types) in t.args.iter().zip(&pred.arg_types) {
         match term {
             Term::Const(c) if c != super::condition::ANY_OBJECT && !vocabulary.fits(c, types) => {
-                return Err(format!("{c:?} is not a known object of type {}", types.join(" or ")));
+                return Err(format!(
+                    "{c:?} is not a known object of type {}",
+                    types.join(" or ")
+                ));
             }
             Term::Param(i) => {
                 let p = &params[*i];

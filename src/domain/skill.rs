@@ -47,7 +47,10 @@ impl Param {
     }
 
     /// The objects that may stand for this parameter, in declaration order.
-    pub fn candidates<'a>(&'a self, vocabulary: &'a Vocabulary) -> impl Iterator<Item = &'a str> + 'a {
+    pub fn candidates<'a>(
+        &'a self,
+        vocabulary: &'a Vocabulary,
+    ) -> impl Iterator<Item = &'a str> + 'a {
         vocabulary
             .objects_fitting(&self.types)
             .filter(move |o| !vocabulary.fits(o, &self.except))
@@ -154,7 +157,10 @@ impl GroundSkill {
         self.add.iter().any(|a| {
             a.predicate == atom.predicate
                 && a.args.len() == atom.args.len()
-                && a.args.iter().zip(&atom.args).all(|(x, y)| y == ANY_OBJECT || x == y)
+                && a.args
+                    .iter()
+                    .zip(&atom.args)
+                    .all(|(x, y)| y == ANY_OBJECT || x == y)
         })
     }
 
@@ -182,14 +188,10 @@ impl GroundSkill {
 fn covers(pattern: &AtomPattern, atom: &Atom) -> bool {
     pattern.predicate == atom.predicate
         && pattern.args.len() == atom.args.len()
-        && pattern
-            .args
-            .iter()
-            .zip(&atom.args)
-            .all(|(p, a)| match p {
-                None => true,
-                Some(p) => a != ANY_OBJECT && p == a,
-            })
+        && pattern.args.iter().zip(&atom.args).all(|(p, a)| match p {
+            None => true,
+            Some(p) => a != ANY_OBJECT && p == a,
+        })
 }
 
 impl Skill {
@@ -328,23 +330,30 @@ pub fn parse_template(text: &str, params: &[Param]) -> Result<LiteralTemplate, S
         rest = &rest[open + close + 1..];
     }
     substituted.push_str(rest);
-    let condition = Condition::parse(&substituted).map_err(|e| format!("in {text:?}: expected {}, found {}", e.expected, e.found))?;
+    let condition = Condition::parse(&substituted)
+        .map_err(|e| format!("in {text:?}: expected {}, found {}", e.expected, e.found))?;
     if condition.atom.predicate.contains("ZzParam") {
-        return Err(format!("in {text:?}: a parameter cannot stand for the predicate"));
+        return Err(format!(
+            "in {text:?}: a parameter cannot stand for the predicate"
+        ));
     }
     let args = condition
         .atom
         .args
         .iter()
-        .map(|a| match a.strip_prefix("ZzParam").and_then(|r| r.strip_suffix("zZ")) {
-            Some(i) => i
-                .parse::<usize>()
-                .ok()
-                .and_then(|i| terms.get(i).cloned())
-                .ok_or_else(|| format!("in {text:?}: a parameter must be a whole argument")),
-            None if a.contains("ZzParam") => Err(format!("in {text:?}: a parameter must be a whole argument")),
-            None => Ok(Term::Const(a.clone())),
-        })
+        .map(
+            |a| match a.strip_prefix("ZzParam").and_then(|r| r.strip_suffix("zZ")) {
+                Some(i) => i
+                    .parse::<usize>()
+                    .ok()
+                    .and_then(|i| terms.get(i).cloned())
+                    .ok_or_else(|| format!("in {text:?}: a parameter must be a whole argument")),
+                None if a.contains("ZzParam") => {
+                    Err(format!("in {text:?}: a parameter must be a whole argument"))
+                }
+                None => Ok(Term::Const(a.clone())),
+            },
+        )
         .collect::<Result<Vec<_>, _>>()?;
     Ok(LiteralTemplate {
         atom: AtomTemplate {
@@ -396,7 +405,11 @@ mod tests {
         assert_eq!(t.atom.args, vec![Term::Param(0), Term::Every]);
         let t = parse_template("\"{a}\" on \"table\"", &ps).unwrap();
         assert_eq!(t.atom.args[1], Term::Const("table".into()));
-        assert!(parse_template("On_{c}_x", &ps).unwrap_err().contains("not a parameter"));
+        assert!(
+            parse_template("On_{c}_x", &ps)
+                .unwrap_err()
+                .contains("not a parameter")
+        );
         assert!(parse_template("\"{a} cube\" on \"x\"", &ps).is_err());
     }
 
@@ -419,6 +432,9 @@ mod tests {
         assert_eq!(b, vec![vec![Some("Chips".to_string())]]);
         let b = s.bindings_for(&Condition::parse("~On_Chips_Bar").unwrap());
         assert_eq!(b, vec![vec![Some("Chips".to_string())]]);
-        assert!(s.bindings_for(&Condition::parse("Active_AC").unwrap()).is_empty());
+        assert!(
+            s.bindings_for(&Condition::parse("Active_AC").unwrap())
+                .is_empty()
+        );
     }
 }

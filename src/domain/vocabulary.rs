@@ -43,7 +43,9 @@ pub enum VocabularyError {
     },
     #[error("unknown object {object:?} in {atom}")]
     UnknownObject { atom: String, object: String },
-    #[error("{atom}: argument {position} of {predicate:?} must be {expected}, but {object:?} is {actual}")]
+    #[error(
+        "{atom}: argument {position} of {predicate:?} must be {expected}, but {object:?} is {actual}"
+    )]
     WrongType {
         atom: String,
         predicate: String,
@@ -65,7 +67,9 @@ impl Vocabulary {
 
     /// True when `name` is a type some object has.
     pub fn is_type(&self, name: &str) -> bool {
-        self.objects.iter().any(|o| o.types.iter().any(|t| t == name))
+        self.objects
+            .iter()
+            .any(|o| o.types.iter().any(|t| t == name))
     }
 
     /// Whether `object` fits a slot that accepts `types` (type names, or object names
@@ -78,7 +82,10 @@ impl Vocabulary {
     }
 
     /// The objects that fit a slot, in declaration order.
-    pub fn objects_fitting<'a>(&'a self, types: &'a [String]) -> impl Iterator<Item = &'a str> + 'a {
+    pub fn objects_fitting<'a>(
+        &'a self,
+        types: &'a [String],
+    ) -> impl Iterator<Item = &'a str> + 'a {
         self.objects
             .iter()
             .filter(move |o| self.fits(&o.name, types))
@@ -174,8 +181,14 @@ mod tests {
     fn cafe() -> Vocabulary {
         Vocabulary {
             objects: vec![
-                Object { name: "Coffee".into(), types: vec!["item".into(), "makable".into()] },
-                Object { name: "Table1".into(), types: vec!["place".into()] },
+                Object {
+                    name: "Coffee".into(),
+                    types: vec!["item".into(), "makable".into()],
+                },
+                Object {
+                    name: "Table1".into(),
+                    types: vec!["place".into()],
+                },
             ],
             predicates: vec![Predicate {
                 name: "On".into(),
@@ -188,20 +201,41 @@ mod tests {
     #[test]
     fn accepts_well_typed_atoms() {
         let v = cafe();
-        assert!(v.check_atom(&Atom::parse("On_Coffee_Table1").unwrap()).is_ok());
+        assert!(
+            v.check_atom(&Atom::parse("On_Coffee_Table1").unwrap())
+                .is_ok()
+        );
         assert_eq!(v.ground_atoms().len(), 1);
     }
 
     #[test]
     fn names_what_is_wrong() {
         let v = cafe();
-        let e = v.check_atom(&Atom::parse("On_Table1_Coffee").unwrap()).unwrap_err();
-        assert!(matches!(e, VocabularyError::WrongType { position: 1, .. }), "{e}");
-        let e = v.check_atom(&Atom::parse("On_Fries_Table1").unwrap()).unwrap_err();
+        let e = v
+            .check_atom(&Atom::parse("On_Table1_Coffee").unwrap())
+            .unwrap_err();
+        assert!(
+            matches!(e, VocabularyError::WrongType { position: 1, .. }),
+            "{e}"
+        );
+        let e = v
+            .check_atom(&Atom::parse("On_Fries_Table1").unwrap())
+            .unwrap_err();
         assert!(e.to_string().contains("\"Fries\""), "{e}");
-        let e = v.check_atom(&Atom::parse("Under_Coffee_Table1").unwrap()).unwrap_err();
+        let e = v
+            .check_atom(&Atom::parse("Under_Coffee_Table1").unwrap())
+            .unwrap_err();
         assert!(e.to_string().contains("known: On"), "{e}");
-        let e = v.check_atom(&Atom::parse("On_Coffee").unwrap()).unwrap_err();
-        assert!(matches!(e, VocabularyError::Arity { expected: 2, found: 1, .. }));
+        let e = v
+            .check_atom(&Atom::parse("On_Coffee").unwrap())
+            .unwrap_err();
+        assert!(matches!(
+            e,
+            VocabularyError::Arity {
+                expected: 2,
+                found: 1,
+                ..
+            }
+        ));
     }
 }

@@ -26,7 +26,11 @@ pub struct Candidate {
 
 /// Objects that make the positive form of a wildcard condition true now: for
 /// `~"any object" on "blue cube"` these are the objects lying on the blue cube.
-pub fn wildcard_witnesses(domain: &Domain, world: &dyn World, condition: &Condition) -> Vec<Condition> {
+pub fn wildcard_witnesses(
+    domain: &Domain,
+    world: &dyn World,
+    condition: &Condition,
+) -> Vec<Condition> {
     let Some(slot) = condition.atom.args.iter().position(|a| a == ANY_OBJECT) else {
         return Vec::new();
     };
@@ -46,17 +50,24 @@ pub fn wildcard_witnesses(domain: &Domain, world: &dyn World, condition: &Condit
                 predicate: condition.atom.predicate.clone(),
                 args,
             };
-            world.check(&Condition::pos(atom.clone())).then(|| Condition {
-                atom,
-                negated: condition.negated,
-            })
+            world
+                .check(&Condition::pos(atom.clone()))
+                .then(|| Condition {
+                    atom,
+                    negated: condition.negated,
+                })
         })
         .collect()
 }
 
 /// Every grounded skill whose declared effects make `condition` true, best first.
 /// `protected` are conditions the tree has already achieved.
-pub fn rank(domain: &Domain, world: &dyn World, condition: &Condition, protected: &[Condition]) -> Vec<Candidate> {
+pub fn rank(
+    domain: &Domain,
+    world: &dyn World,
+    condition: &Condition,
+    protected: &[Condition],
+) -> Vec<Candidate> {
     let mut out: Vec<Candidate> = Vec::new();
     for skill in &domain.skills {
         for binding in skill.bindings_for(condition) {
@@ -82,8 +93,12 @@ pub fn rank(domain: &Domain, world: &dyn World, condition: &Condition, protected
                 }
                 let unmet = ground.pre.iter().filter(|p| !world.check(p)).count() as f64;
                 let undone = protected.iter().filter(|p| ground.undoes(p)).count() as f64;
-                let score = ground.cost + UNMET_PRECONDITION_COST * unmet + UNDO_PROTECTED_COST * undone;
-                out.push(Candidate { skill: ground, score });
+                let score =
+                    ground.cost + UNMET_PRECONDITION_COST * unmet + UNDO_PROTECTED_COST * undone;
+                out.push(Candidate {
+                    skill: ground,
+                    score,
+                });
             }
         }
     }

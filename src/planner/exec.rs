@@ -40,9 +40,16 @@ impl Leaves for WorldLeaves<'_> {
 }
 
 /// The first declared effect of `action` that does not hold in `world`.
-pub fn unmet_postcondition(domain: &Domain, world: &dyn World, action: &ActionCall) -> Option<Condition> {
+pub fn unmet_postcondition(
+    domain: &Domain,
+    world: &dyn World,
+    action: &ActionCall,
+) -> Option<Condition> {
     let ground = domain.resolve(action)?;
-    ground.postconditions().into_iter().find(|c| !world.check(c))
+    ground
+        .postconditions()
+        .into_iter()
+        .find(|c| !world.check(c))
 }
 
 /// How a run ended.
@@ -50,7 +57,9 @@ pub fn unmet_postcondition(domain: &Domain, world: &dyn World, action: &ActionCa
 pub enum RunEnd {
     Success,
     /// The tree failed; when an action failed on the last tick, which and with what text.
-    Failure { action: Option<(NodeId, String)> },
+    Failure {
+        action: Option<(NodeId, String)>,
+    },
     /// Still running after the tick budget.
     TickLimit,
 }
@@ -87,7 +96,11 @@ pub fn run_tree(
         };
         last = Some(record);
         if let Some(end) = end {
-            return RunReport { end, ticks: n, last };
+            return RunReport {
+                end,
+                ticks: n,
+                last,
+            };
         }
         if !keep_going {
             break;

@@ -10,6 +10,26 @@ use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree, to_text};
 use crate::domain::{Condition, GroundSkill};
 use crate::world::World;
 
+/// The expansion Fallback whose condition is `condition`, if it has been expanded.
+pub(super) fn expansion_of(tree: &Tree, condition: NodeId) -> Option<NodeId> {
+    let parent = tree.parent(condition).ok().flatten()?;
+    let children = tree.children(parent).ok()?;
+    let achiever = |n: &NodeId| match tree.kind(*n) {
+        Ok(NodeKind::Action(_)) => true,
+        Ok(NodeKind::Sequence) => tree
+            .children(*n)
+            .ok()
+            .and_then(|c| c.last())
+            .is_some_and(|last| matches!(tree.kind(*last), Ok(NodeKind::Action(_)))),
+        _ => false,
+    };
+    (matches!(tree.kind(parent), Ok(NodeKind::Fallback))
+        && children.len() > 1
+        && children[0] == condition
+        && children[1..].iter().all(achiever))
+    .then_some(parent)
+}
+
 /// A later sibling subtree undid what an earlier one achieved: move it in front.
 struct Conflict {
     sequence: NodeId,
@@ -67,7 +87,12 @@ impl<'p, 'd> Growth<'p, 'd> {
                 }
             }
         }
-        let new_nodes = self.tree.preorder().into_iter().filter(|n| n.index() >= self.before).collect();
+        let new_nodes = self
+            .tree
+            .preorder()
+            .into_iter()
+            .filter(|n| n.index() >= self.before)
+            .collect();
         Plan {
             tree: self.tree,
             outcome,
@@ -83,10 +108,16 @@ impl<'p, 'd> Growth<'p, 'd> {
         let mut sim = world.fork();
         let mut conflict = None;
         let mut detector = FlipDetector::default();
-        let report = run_tree(&self.tree, sim.as_mut(), domain, self.planner.options.max_ticks, |record| {
-            conflict = detector.observe(&self.tree, domain, record);
-            conflict.is_none()
-        });
+        let report = run_tree(
+            &self.tree,
+            sim.as_mut(),
+            domain,
+            self.planner.options.max_ticks,
+            |record| {
+                conflict = detector.observe(&self.tree, domain, record);
+                conflict.is_none()
+            },
+        );
         self.ticks += report.ticks;
         if let Some(c) = conflict {
             return self.reorder(c);
@@ -104,7 +135,9 @@ impl<'p, 'd> Growth<'p, 'd> {
                     self.planner.options.max_ticks
                 ),
             }),
-            RunEnd::Failure { action: Some((node, error)) } => match self.tree.kind(node) {
+            RunEnd::Failure {
+                action: Some((node, error)),
+            } => match self.tree.kind(node) {
                 Ok(NodeKind::Action(a)) => Next::Done(Outcome::ActionFailed {
                     node,
                     action: a.clone(),
@@ -122,7 +155,10 @@ impl<'p, 'd> Growth<'p, 'd> {
             .visited
             .iter()
             .copied()
-            .filter(|n| last.status(*n) == Status::Failure && matches!(self.tree.kind(*n), Ok(NodeKind::Condition(_))))
+            .filter(|n| {
+                last.status(*n) == Status::Failure
+                    && matches!(self.tree.kind(*n), Ok(NodeKind::Condition(_)))
+            })
             .collect();
         let protected: Vec<Condition> = last
             .visited
@@ -140,6 +176,7 @@ impl<'p, 'd> Growth<'p, 'd> {
             match self.expand(node, sim, &protected) {
                 Ok(()) => return Next::Continue,
                 Err(reason) => {
+                    tracing::debug!(node = %node, %reason, "cannot expand");
                     self.dead.insert(node, reason);
                     if self.try_alternative(node) {
                         return Next::Continue;
@@ -148,7 +185,11 @@ impl<'p, 'd> Growth<'p, 'd> {
             }
         }
         // Nothing left to expand: report the first dead condition the tick reached.
-        let culprit = last.visited.iter().find(|n| self.dead.contains_key(n)).copied();
+        let culprit = last
+            .visited
+            .iter()
+            .find(|n| self.dead.contains_key(n))
+            .copied();
         match culprit.and_then(|n| Some((n, self.condition(n)?))) {
             Some((node, condition)) => Next::Done(Outcome::Unreachable {
                 path: self.tree.path(node).unwrap_or_default(),
@@ -169,15 +210,15 @@ impl<'p, 'd> Growth<'p, 'd> {
         }
     }
 
-    /// A condition is expanded when it is the first child of a Fallback with more children.
+    /// A condition is expanded when it is the first child of a Fallback whose other children
+    /// are ways to achieve it: actions, or sequences ending in an action. (The goal's root
+    /// Fallback also starts with a condition, but its other children are goal conditions.)
     fn is_expanded(&self, node: NodeId) -> bool {
         self.expansion_of(node).is_some()
     }
 
     fn expansion_of(&self, condition: NodeId) -> Option<NodeId> {
-        let parent = self.tree.parent(condition).ok().flatten()?;
-        let children = self.tree.children(parent).ok()?;
-        (matches!(self.tree.kind(parent), Ok(NodeKind::Fallback)) && children.len() > 1 && children[0] == condition).then_some(parent)
+        expansion_of(&self.tree, condition)
     }
 
     /// The conditions being achieved above `node` (the first children of enclosing
@@ -198,20 +239,31 @@ impl<'p, 'd> Growth<'p, 'd> {
         out
     }
 
-    fn expand(&mut self, node: NodeId, sim: &dyn World, protected: &[Condition]) -> Result<(), String> {
+    fn expand(
+        &mut self,
+        node: NodeId,
+        sim: &dyn World,
+        protected: &[Condition],
+    ) -> Result<(), String> {
         let domain = self.planner.domain;
         let Some(condition) = self.condition(node) else {
             return Err("not a condition".into());
         };
         let above = self.goals_above(node);
         if above.len() >= self.planner.options.max_depth {
-            return Err(format!("expansion depth bound ({}) reached", self.planner.options.max_depth));
+            return Err(format!(
+                "expansion depth bound ({}) reached",
+                self.planner.options.max_depth
+            ));
         }
         // A wildcard condition is achieved through the object that falsifies it now.
         let mut target = condition.clone();
         let mut candidates = achievers::rank(domain, sim, &target, protected);
         if candidates.is_empty() && condition.atom.has_wildcard() {
-            if let Some(witness) = achievers::wildcard_witnesses(domain, sim, &condition).into_iter().next() {
+            if let Some(witness) = achievers::wildcard_witnesses(domain, sim, &condition)
+                .into_iter()
+                .next()
+            {
                 target = witness.negate();
                 candidates = achievers::rank(domain, sim, &target, protected);
             }
@@ -223,15 +275,24 @@ impl<'p, 'd> Growth<'p, 'd> {
         let total = candidates.len();
         let usable: Vec<Candidate> = candidates
             .into_iter()
-            .filter(|c| !c.skill.pre.iter().any(|p| above.contains(p) || *p == condition))
+            .filter(|c| {
+                !c.skill
+                    .pre
+                    .iter()
+                    .any(|p| above.contains(p) || *p == condition)
+            })
             .collect();
         let Some((first, rest)) = usable.split_first() else {
             return Err(format!(
                 "all {total} skill(s) achieving {target} need a condition that is itself being achieved above it"
             ));
         };
-        let fallback = self.tree.wrap(node, NodeKind::Fallback).map_err(|e| e.to_string())?;
+        let fallback = self
+            .tree
+            .wrap(node, NodeKind::Fallback)
+            .map_err(|e| e.to_string())?;
         self.attach(fallback, &first.skill)?;
+        tracing::debug!(condition = %condition, skill = %first.skill.call, score = first.score, "expanded");
         self.alternatives
             .insert(fallback, rest.iter().map(|c| c.skill.clone()).collect());
         self.expansions += 1;
@@ -244,13 +305,17 @@ impl<'p, 'd> Growth<'p, 'd> {
         let parent = if skill.pre.is_empty() {
             fallback
         } else {
-            let seq = tree.add_child(fallback, NodeKind::Sequence).map_err(|e| e.to_string())?;
+            let seq = tree
+                .add_child(fallback, NodeKind::Sequence)
+                .map_err(|e| e.to_string())?;
             for p in &skill.pre {
-                tree.add_child(seq, NodeKind::Condition(p.clone())).map_err(|e| e.to_string())?;
+                tree.add_child(seq, NodeKind::Condition(p.clone()))
+                    .map_err(|e| e.to_string())?;
             }
             seq
         };
-        tree.add_child(parent, NodeKind::Action(skill.call.clone())).map_err(|e| e.to_string())?;
+        tree.add_child(parent, NodeKind::Action(skill.call.clone()))
+            .map_err(|e| e.to_string())?;
         Ok(())
     }
 
@@ -262,7 +327,11 @@ impl<'p, 'd> Growth<'p, 'd> {
                 && !list.is_empty()
             {
                 let next = list.remove(0);
-                let old: Vec<NodeId> = self.tree.children(p).map(|c| c[1..].to_vec()).unwrap_or_default();
+                let old: Vec<NodeId> = self
+                    .tree
+                    .children(p)
+                    .map(|c| c[1..].to_vec())
+                    .unwrap_or_default();
                 for child in old {
                     if self.tree.remove_subtree(child).is_err() {
                         return false;
@@ -277,15 +346,22 @@ impl<'p, 'd> Growth<'p, 'd> {
     }
 
     fn reorder(&mut self, c: Conflict) -> Next {
-        if self.tree.move_child(c.sequence, c.later, c.earlier).is_err() {
+        if self
+            .tree
+            .move_child(c.sequence, c.later, c.earlier)
+            .is_err()
+        {
             return Next::Done(Outcome::Exhausted {
                 reason: "internal: a conflict named a child that is not there".into(),
             });
         }
         self.reorders += 1;
+        tracing::debug!(sequence = %c.sequence, from = c.later, to = c.earlier, "reordered a conflict");
         if !self.orders.insert(to_text(&self.tree)) {
             return Next::Done(Outcome::Exhausted {
-                reason: "sibling subtrees keep undoing each other's conditions in every order tried".into(),
+                reason:
+                    "sibling subtrees keep undoing each other's conditions in every order tried"
+                        .into(),
             });
         }
         Next::Continue
@@ -303,7 +379,12 @@ struct FlipDetector {
 }
 
 impl FlipDetector {
-    fn observe(&mut self, tree: &Tree, domain: &crate::domain::Domain, record: &TickRecord) -> Option<Conflict> {
+    fn observe(
+        &mut self,
+        tree: &Tree,
+        domain: &crate::domain::Domain,
+        record: &TickRecord,
+    ) -> Option<Conflict> {
         let mut found = None;
         for &node in &record.visited {
             let Ok(NodeKind::Condition(condition)) = tree.kind(node) else {
@@ -323,11 +404,19 @@ impl FlipDetector {
                 Status::Idle | Status::Running | Status::Halted => {}
             }
         }
-        self.completed.extend(record.completed.iter().map(|a| (record.tick, *a)));
+        self.completed
+            .extend(record.completed.iter().map(|a| (record.tick, *a)));
         found
     }
 
-    fn culprit(&self, tree: &Tree, domain: &crate::domain::Domain, node: NodeId, condition: &Condition, since: u64) -> Option<Conflict> {
+    fn culprit(
+        &self,
+        tree: &Tree,
+        domain: &crate::domain::Domain,
+        node: NodeId,
+        condition: &Condition,
+        since: u64,
+    ) -> Option<Conflict> {
         for &(_, action) in self.completed.iter().filter(|(t, _)| *t >= since) {
             let Ok(NodeKind::Action(call)) = tree.kind(action) else {
                 continue;
@@ -335,14 +424,18 @@ impl FlipDetector {
             if !domain.resolve(call).is_some_and(|g| g.undoes(condition)) {
                 continue;
             }
-            let Ok(Some(lca)) = tree.lowest_common_ancestor(node, action) else {
+            let Ok(lca) = tree.lowest_common_ancestor(node, action) else {
                 continue;
             };
             if !matches!(tree.kind(lca), Ok(NodeKind::Sequence)) {
                 continue;
             }
             let children = tree.children(lca).ok()?;
-            let position = |n: NodeId| children.iter().position(|c| *c == n || tree.is_ancestor(*c, n));
+            let position = |n: NodeId| {
+                children
+                    .iter()
+                    .position(|c| *c == n || tree.is_ancestor(*c, n).unwrap_or(false))
+            };
             let (Some(earlier), Some(later)) = (position(node), position(action)) else {
                 continue;
             };

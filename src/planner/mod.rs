@@ -104,26 +104,27 @@ impl<'a> Planner<'a> {
 
     /// The tree that states the goal before any expansion.
     pub fn goal_tree(dnf: &Dnf) -> Result<Tree, RepairError> {
-        let conjunction = |tree: &mut Tree, parent: Option<NodeId>, literals: &[Condition]| -> NodeId {
-            let single = literals.len() == 1;
-            match (parent, single) {
-                (None, true) => tree.root(),
-                (None, false) => {
-                    for l in literals {
-                        add(tree, tree.root(), NodeKind::Condition(l.clone()));
+        let conjunction =
+            |tree: &mut Tree, parent: Option<NodeId>, literals: &[Condition]| -> NodeId {
+                let single = literals.len() == 1;
+                match (parent, single) {
+                    (None, true) => tree.root(),
+                    (None, false) => {
+                        for l in literals {
+                            add(tree, tree.root(), NodeKind::Condition(l.clone()));
+                        }
+                        tree.root()
                     }
-                    tree.root()
-                }
-                (Some(p), true) => add(tree, p, NodeKind::Condition(literals[0].clone())),
-                (Some(p), false) => {
-                    let seq = add(tree, p, NodeKind::Sequence);
-                    for l in literals {
-                        add(tree, seq, NodeKind::Condition(l.clone()));
+                    (Some(p), true) => add(tree, p, NodeKind::Condition(literals[0].clone())),
+                    (Some(p), false) => {
+                        let seq = add(tree, p, NodeKind::Sequence);
+                        for l in literals {
+                            add(tree, seq, NodeKind::Condition(l.clone()));
+                        }
+                        seq
                     }
-                    seq
                 }
-            }
-        };
+            };
         match dnf.0.as_slice() {
             [] => Err(RepairError::FalseGoal),
             [only] if only.len() == 1 => Ok(Tree::new(NodeKind::Condition(only[0].clone()))),
@@ -156,14 +157,27 @@ impl<'a> Planner<'a> {
 
     /// Insert `conditions` as the FIRST preconditions of `action`, then expand them like
     /// any other precondition. This is how a proposal from an LLM or a person enters.
-    pub fn repair(&self, mut tree: Tree, action: NodeId, conditions: &[Condition], world: &dyn World) -> Result<Plan, RepairError> {
+    pub fn repair(
+        &self,
+        mut tree: Tree,
+        action: NodeId,
+        conditions: &[Condition],
+        world: &dyn World,
+    ) -> Result<Plan, RepairError> {
         if !matches!(tree.kind(action), Ok(NodeKind::Action(_))) {
             return Err(RepairError::NotAnAction(action));
         }
         let parent = tree.parent(action).ok().flatten();
         let seq = match parent {
-            Some(p) if matches!(tree.kind(p), Ok(NodeKind::Sequence)) && tree.children(p).ok().and_then(|c| c.last().copied()) == Some(action) => p,
-            _ => tree.wrap(action, NodeKind::Sequence).map_err(|_| RepairError::NotAnAction(action))?,
+            Some(p)
+                if matches!(tree.kind(p), Ok(NodeKind::Sequence))
+                    && tree.children(p).ok().and_then(|c| c.last().copied()) == Some(action) =>
+            {
+                p
+            }
+            _ => tree
+                .wrap(action, NodeKind::Sequence)
+                .map_err(|_| RepairError::NotAnAction(action))?,
         };
         let existing: Vec<Condition> = tree
             .children(seq)
@@ -175,7 +189,10 @@ impl<'a> Planner<'a> {
                 _ => None,
             })
             .collect();
-        let fresh: Vec<&Condition> = conditions.iter().filter(|c| !existing.contains(c)).collect();
+        let fresh: Vec<&Condition> = conditions
+            .iter()
+            .filter(|c| !existing.contains(c))
+            .collect();
         if fresh.is_empty() {
             let names: Vec<String> = conditions.iter().map(ToString::to_string).collect();
             return Err(RepairError::NothingNew(names.join(", ")));
@@ -186,7 +203,12 @@ impl<'a> Planner<'a> {
                 .map_err(|_| RepairError::NotAnAction(action))?;
         }
         let mut plan = self.grow(tree, world);
-        let mut added: Vec<NodeId> = plan.tree.preorder().into_iter().filter(|n| n.index() >= before).collect();
+        let mut added: Vec<NodeId> = plan
+            .tree
+            .preorder()
+            .into_iter()
+            .filter(|n| n.index() >= before)
+            .collect();
         added.retain(|n| !plan.new_nodes.contains(n));
         added.extend(plan.new_nodes.iter().copied());
         plan.new_nodes = added;
@@ -194,8 +216,15 @@ impl<'a> Planner<'a> {
     }
 
     /// Repair at the first action of the tree whose text is `action` (`--at` on the CLI).
-    pub fn repair_at(&self, tree: Tree, action: &ActionCall, conditions: &[Condition], world: &dyn World) -> Result<Plan, RepairError> {
-        let node = find_action(&tree, action).ok_or_else(|| RepairError::NoSuchAction(action.to_string()))?;
+    pub fn repair_at(
+        &self,
+        tree: Tree,
+        action: &ActionCall,
+        conditions: &[Condition],
+        world: &dyn World,
+    ) -> Result<Plan, RepairError> {
+        let node = find_action(&tree, action)
+            .ok_or_else(|| RepairError::NoSuchAction(action.to_string()))?;
         self.repair(tree, node, conditions, world)
     }
 }
@@ -226,7 +255,10 @@ pub fn path_text(path: &[usize]) -> String {
     if path.is_empty() {
         "root".to_string()
     } else {
-        path.iter().map(ToString::to_string).collect::<Vec<_>>().join(".")
+        path.iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(".")
     }
 }
 
@@ -249,7 +281,10 @@ pub fn check_tree(domain: &Domain, tree: &Tree) -> Result<(), TreeCheckError> {
                     let known: Vec<&str> = domain.skills.iter().map(|s| s.name.as_str()).collect();
                     return Err(error(
                         format!("{a}!"),
-                        format!("no skill of this name accepts these objects (skills: {})", known.join(", ")),
+                        format!(
+                            "no skill of this name accepts these objects (skills: {})",
+                            known.join(", ")
+                        ),
                     ));
                 }
             }

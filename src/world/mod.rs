@@ -65,7 +65,11 @@ pub fn load(scenario: &Scenario) -> Result<Box<dyn World>, ScenarioError> {
     match scenario.world_kind.as_str() {
         "symbolic" => Ok(Box::new(SymbolicWorld::from_scenario(scenario)?)),
         other => {
-            let file = scenario.files.last().map(|f| f.path.clone()).unwrap_or_default();
+            let file = scenario
+                .files
+                .last()
+                .map(|f| f.path.clone())
+                .unwrap_or_default();
             Err(ScenarioError {
                 file,
                 line: 0,

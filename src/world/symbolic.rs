@@ -8,6 +8,8 @@
 //! [world]
 //! kind = "symbolic"
 //! initial = ["Holding_Nothing", "RobotNear_Bar2", "On_Chips_Bar"]
+//! set = ["RobotNear_Bar2"]     # applied after `initial` (a child changing its base's state)
+//! unset = ["RobotNear_Bar"]
 //!
 //! [[world.rules]]
 //! action = 'MoveTo "Coffee"'   # a skill name alone matches every use of the skill
@@ -71,6 +73,10 @@ struct RawWorld {
     kind: Option<String>,
     initial: Option<Vec<Spanned<String>>>,
     #[serde(default)]
+    set: Vec<Spanned<String>>,
+    #[serde(default)]
+    unset: Vec<Spanned<String>>,
+    #[serde(default)]
     rules: Vec<RawRule>,
 }
 
@@ -90,7 +96,11 @@ impl Rule {
 }
 
 impl SymbolicWorld {
-    pub fn new(domain: Arc<Domain>, initial: impl IntoIterator<Item = Atom>, rules: Vec<Rule>) -> Self {
+    pub fn new(
+        domain: Arc<Domain>,
+        initial: impl IntoIterator<Item = Atom>,
+        rules: Vec<Rule>,
+    ) -> Self {
         SymbolicWorld {
             domain,
             rules: Arc::new(rules),
@@ -110,25 +120,50 @@ impl SymbolicWorld {
         for file in &scenario.files {
             let table: WorldTable = file.parse()?;
             let Some(world) = table.world else { continue };
-            if let Some(facts) = world.initial {
-                initial.clear();
-                for f in facts {
-                    let c = Condition::parse(f.get_ref())
-                        .map_err(|e| file.error_in_string(&f.span(), e.at, format!("expected {}, found {}", e.expected, e.found)))?;
-                    if c.negated || c.atom.has_wildcard() {
-                        return Err(file.error_in_string(&f.span(), 0, "initial facts are plain atoms: no `~`, no \"any object\" (unlisted atoms are false)"));
-                    }
-                    vocabulary
-                        .check_atom(&c.atom)
-                        .map_err(|e| file.error_in_string(&f.span(), 0, e.to_string()))?;
-                    initial.insert(c.atom);
+            let fact = |f: &Spanned<String>| {
+                let c = Condition::parse(f.get_ref()).map_err(|e| {
+                    file.error_in_string(
+                        &f.span(),
+                        e.at,
+                        format!("expected {}, found {}", e.expected, e.found),
+                    )
+                })?;
+                if c.negated || c.atom.has_wildcard() {
+                    return Err(file.error_in_string(&f.span(), 0, "facts are plain atoms: no `~`, no \"any object\" (unlisted atoms are false)"));
                 }
+                vocabulary
+                    .check_atom(&c.atom)
+                    .map_err(|e| file.error_in_string(&f.span(), 0, e.to_string()))?;
+                Ok(c.atom)
+            };
+            if let Some(facts) = &world.initial {
+                initial = facts.iter().map(fact).collect::<Result<_, _>>()?;
+            }
+            for f in &world.unset {
+                initial.remove(&fact(f)?);
+            }
+            for f in &world.set {
+                initial.insert(fact(f)?);
             }
             for r in world.rules {
-                let action = ActionCall::parse(r.action.get_ref())
-                    .map_err(|e| file.error_in_string(&r.action.span(), e.at, format!("expected {}, found {}", e.expected, e.found)))?;
-                if !scenario.domain.skills.iter().any(|s| s.name == action.skill) {
-                    return Err(file.error_in_string(&r.action.span(), 0, format!("no skill named {:?} in this scenario", action.skill)));
+                let action = ActionCall::parse(r.action.get_ref()).map_err(|e| {
+                    file.error_in_string(
+                        &r.action.span(),
+                        e.at,
+                        format!("expected {}, found {}", e.expected, e.found),
+                    )
+                })?;
+                if !scenario
+                    .domain
+                    .skills
+                    .iter()
+                    .any(|s| s.name == action.skill)
+                {
+                    return Err(file.error_in_string(
+                        &r.action.span(),
+                        0,
+                        format!("no skill named {:?} in this scenario", action.skill),
+                    ));
                 }
                 let requires = scenario
                     .parse_goal(r.requires.get_ref())
@@ -136,12 +171,22 @@ impl SymbolicWorld {
                 let violation = match r.otherwise.as_ref().map(|o| o.get_ref().as_str()) {
                     None | Some("fail") => match r.error {
                         Some(e) if !e.trim().is_empty() => Violation::Fail(e),
-                        _ => return Err(file.error_in_string(&r.action.span(), 0, "a failing rule needs `error`, the text the skill reports")),
+                        _ => {
+                            return Err(file.error_in_string(
+                                &r.action.span(),
+                                0,
+                                "a failing rule needs `error`, the text the skill reports",
+                            ));
+                        }
                     },
                     Some("no effect") => Violation::NoEffect,
                     Some(other) => {
                         let span = r.otherwise.as_ref().map(Spanned::span).unwrap_or_default();
-                        return Err(file.error_in_string(&span, 0, format!("expected \"fail\" or \"no effect\", found {other:?}")));
+                        return Err(file.error_in_string(
+                            &span,
+                            0,
+                            format!("expected \"fail\" or \"no effect\", found {other:?}"),
+                        ));
                     }
                 };
                 rules.push(Rule {
@@ -152,7 +197,11 @@ impl SymbolicWorld {
                 });
             }
         }
-        Ok(SymbolicWorld::new(Arc::new(scenario.domain.clone()), initial, rules))
+        Ok(SymbolicWorld::new(
+            Arc::new(scenario.domain.clone()),
+            initial,
+            rules,
+        ))
     }
 
     fn holds(&self, atom: &Atom) -> bool {
@@ -160,7 +209,10 @@ impl SymbolicWorld {
             self.state.facts.iter().any(|f| {
                 f.predicate == atom.predicate
                     && f.args.len() == atom.args.len()
-                    && f.args.iter().zip(&atom.args).all(|(x, y)| y == ANY_OBJECT || x == y)
+                    && f.args
+                        .iter()
+                        .zip(&atom.args)
+                        .all(|(x, y)| y == ANY_OBJECT || x == y)
             })
         } else {
             self.state.facts.contains(atom)
@@ -203,10 +255,15 @@ impl World for SymbolicWorld {
             return Step::Running;
         }
         self.state.progress.remove(&key);
-        if matches!(self.violated(action).map(|r| &r.violation), Some(Violation::NoEffect)) {
+        if matches!(
+            self.violated(action).map(|r| &r.violation),
+            Some(Violation::NoEffect)
+        ) {
             return Step::Success;
         }
-        self.state.facts.retain(|f| !ground.del.iter().any(|d| d.matches(f)));
+        self.state
+            .facts
+            .retain(|f| !ground.del.iter().any(|d| d.matches(f)));
         self.state.facts.extend(ground.add.iter().cloned());
         Step::Success
     }
@@ -230,6 +287,11 @@ impl World for SymbolicWorld {
     }
 
     fn facts(&self) -> Vec<Condition> {
-        self.state.facts.iter().cloned().map(Condition::pos).collect()
+        self.state
+            .facts
+            .iter()
+            .cloned()
+            .map(Condition::pos)
+            .collect()
     }
 }
