@@ -52,7 +52,7 @@ pub fn run(
         }
     };
     let mut exec = world.fork();
-    let report = run_tree(&tree, exec.as_mut(), &scenario.domain, max_ticks, |r| {
+    let report = run_tree(&tree, exec.as_mut(), &scenario.domain, max_ticks, |r, _| {
         if trace {
             print_trace(&tree, r);
         }
@@ -146,7 +146,7 @@ pub fn repair(
         exec.as_mut(),
         &scenario.domain,
         planner.options.max_ticks,
-        |_| true,
+        |_, _| true,
     );
     print_tree(&plan.tree, report.last.as_ref(), glyphs);
     println!("\n{}", bt::to_text(&plan.tree));
@@ -187,7 +187,7 @@ fn final_record(scenario: &Scenario, tree: &Tree, world: &dyn World) -> Option<T
         sim.as_mut(),
         &scenario.domain,
         Planner::new(&scenario.domain).options.max_ticks,
-        |_| true,
+        |_, _| true,
     )
     .last
 }

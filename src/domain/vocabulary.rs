@@ -130,14 +130,14 @@ impl Vocabulary {
                 });
             };
             if !self.fits(arg, types) {
-                return Err(VocabularyError::WrongType {
+                return Err(VocabularyError::WrongType(Box::new(WrongType {
                     atom: text,
                     predicate: pred.name.clone(),
                     position: position + 1,
                     object: arg.clone(),
                     expected: types.join(" or "),
                     actual: object.types.join(", "),
-                });
+                })));
             }
         }
         Ok(())

@@ -52,7 +52,7 @@ pub fn wildcard_witnesses(
             };
             world
                 .check(&Condition::pos(atom.clone()))
-                .then(|| Condition {
+                .then_some(Condition {
                     atom,
                     negated: condition.negated,
                 })
@@ -61,14 +61,58 @@ pub fn wildcard_witnesses(
 }
 
 /// Every grounded skill whose declared effects make `condition` true, best first.
-/// `protected` are conditions the tree has already achieved.
+/// `protected` are conditions the tree has already achieved; `above` are the conditions
+/// being achieved by the expansions enclosing this one. A candidate is left out when one
+/// of its unmet preconditions can only be achieved through `condition` or `above` (putting
+/// down a coffee the robot does not hold, to empty its hand, would first need an empty
+/// hand to pick the coffee up).
 pub fn rank(
     domain: &Domain,
     world: &dyn World,
     condition: &Condition,
     protected: &[Condition],
+    above: &[Condition],
 ) -> Vec<Candidate> {
+    let mut forbidden: Vec<&Condition> = above.iter().collect();
+    forbidden.push(condition);
     let mut out: Vec<Candidate> = Vec::new();
+    for ground in groundings(domain, condition) {
+        if ground.pre.contains(condition) || out.iter().any(|c| c.skill.call == ground.call) {
+            continue;
+        }
+        let unmet: Vec<&Condition> = ground.pre.iter().filter(|p| !world.check(p)).collect();
+        if unmet
+            .iter()
+            .any(|p| forbidden.contains(p) || !achievable_without(domain, p, &forbidden))
+        {
+            continue;
+        }
+        let undone = protected.iter().filter(|p| ground.undoes(p)).count() as f64;
+        let score = ground.cost
+            + UNMET_PRECONDITION_COST * unmet.len() as f64
+            + UNDO_PROTECTED_COST * undone;
+        out.push(Candidate {
+            skill: ground,
+            score,
+        });
+    }
+    // Stable sort: equal scores keep declaration order.
+    out.sort_by(|a, b| a.score.total_cmp(&b.score));
+    out
+}
+
+/// Whether some skill achieves `condition` without needing any of `forbidden`.
+fn achievable_without(domain: &Domain, condition: &Condition, forbidden: &[&Condition]) -> bool {
+    groundings(domain, condition).into_iter().any(|g| {
+        !g.pre
+            .iter()
+            .any(|p| p == condition || forbidden.contains(&p))
+    })
+}
+
+/// Every grounding of every skill whose declared effects make `condition` true.
+fn groundings(domain: &Domain, condition: &Condition) -> Vec<GroundSkill> {
+    let mut out = Vec::new();
     for skill in &domain.skills {
         for binding in skill.bindings_for(condition) {
             let choices: Vec<Vec<&str>> = skill
@@ -81,29 +125,15 @@ pub fn rank(
                 })
                 .collect();
             for args in cartesian(&choices, MAX_GROUNDINGS_PER_SKILL) {
-                if !skill.accepts(&domain.vocabulary, &args) {
-                    continue;
+                if skill.accepts(&domain.vocabulary, &args) {
+                    let ground = skill.ground(&args);
+                    if ground.achieves(condition) {
+                        out.push(ground);
+                    }
                 }
-                let ground = skill.ground(&args);
-                if !ground.achieves(condition) || ground.pre.contains(condition) {
-                    continue;
-                }
-                if out.iter().any(|c| c.skill.call == ground.call) {
-                    continue;
-                }
-                let unmet = ground.pre.iter().filter(|p| !world.check(p)).count() as f64;
-                let undone = protected.iter().filter(|p| ground.undoes(p)).count() as f64;
-                let score =
-                    ground.cost + UNMET_PRECONDITION_COST * unmet + UNDO_PROTECTED_COST * undone;
-                out.push(Candidate {
-                    skill: ground,
-                    score,
-                });
             }
         }
     }
-    // Stable sort: equal scores keep declaration order.
-    out.sort_by(|a, b| a.score.total_cmp(&b.score));
     out
 }
 

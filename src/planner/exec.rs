@@ -72,24 +72,29 @@ pub struct RunReport {
 }
 
 /// Tick `tree` in `world` until the root returns Success or Failure, or `max_ticks` pass.
-/// `on_tick` sees every record (for tracing and conflict detection); returning `false`
-/// from it stops the run early.
+///
+/// Success counts only from a tick in which no action completed: an action that completes
+/// late in a tick can undo a condition the same tick already checked (moving to the cup
+/// leaves the window table), so such a tick is followed by one that checks again.
+/// `on_tick` sees every record and the world after that tick (for tracing and conflict
+/// detection); returning `false` from it stops the run early.
 pub fn run_tree(
     tree: &Tree,
     world: &mut dyn World,
     domain: &Domain,
     max_ticks: u64,
-    mut on_tick: impl FnMut(&TickRecord) -> bool,
+    mut on_tick: impl FnMut(&TickRecord, &dyn World) -> bool,
 ) -> RunReport {
     let mut ticker = Ticker::new();
     let mut leaves = WorldLeaves { world, domain };
     let mut last = None;
     for n in 1..=max_ticks {
         let record = ticker.tick(tree, &mut leaves);
-        let keep_going = on_tick(&record);
+        let keep_going = on_tick(&record, &*leaves.world);
         let end = match record.root {
             Outcome::Running => None,
-            Outcome::Success => Some(RunEnd::Success),
+            Outcome::Success if record.completed.is_empty() => Some(RunEnd::Success),
+            Outcome::Success => None,
             Outcome::Failure => Some(RunEnd::Failure {
                 action: record.failures.first().cloned(),
             }),

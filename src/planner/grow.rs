@@ -113,8 +113,8 @@ impl<'p, 'd> Growth<'p, 'd> {
             sim.as_mut(),
             domain,
             self.planner.options.max_ticks,
-            |record| {
-                conflict = detector.observe(&self.tree, domain, record);
+            |record, now| {
+                conflict = detector.observe(&self.tree, domain, record, now);
                 conflict.is_none()
             },
         );
@@ -258,15 +258,15 @@ impl<'p, 'd> Growth<'p, 'd> {
         }
         // A wildcard condition is achieved through the object that falsifies it now.
         let mut target = condition.clone();
-        let mut candidates = achievers::rank(domain, sim, &target, protected);
-        if candidates.is_empty() && condition.atom.has_wildcard() {
-            if let Some(witness) = achievers::wildcard_witnesses(domain, sim, &condition)
+        let mut candidates = achievers::rank(domain, sim, &target, protected, &above);
+        if candidates.is_empty()
+            && condition.negated
+            && let Some(witness) = achievers::wildcard_witnesses(domain, sim, &condition)
                 .into_iter()
                 .next()
-            {
-                target = witness.negate();
-                candidates = achievers::rank(domain, sim, &target, protected);
-            }
+        {
+            target = witness;
+            candidates = achievers::rank(domain, sim, &target, protected, &above);
         }
         if candidates.is_empty() {
             return Err(format!("no skill has an effect that makes {target} true"));
@@ -368,8 +368,10 @@ impl<'p, 'd> Growth<'p, 'd> {
     }
 }
 
-/// Watches a simulated run for a condition that held, then failed because an action in a
-/// later sibling subtree undid it.
+/// Watches a simulated run for a condition that held, then stopped holding because an
+/// action in a later sibling subtree undid it: either seen when the condition is ticked
+/// again and fails, or at the end of the very tick that checked it (a stale success that
+/// an action later in that tick invalidated, before anything re-checked it).
 #[derive(Default)]
 struct FlipDetector {
     /// Condition node → the tick at which it last succeeded.
@@ -384,15 +386,24 @@ impl FlipDetector {
         tree: &Tree,
         domain: &crate::domain::Domain,
         record: &TickRecord,
+        now: &dyn World,
     ) -> Option<Conflict> {
+        self.completed
+            .extend(record.completed.iter().map(|a| (record.tick, *a)));
         let mut found = None;
         for &node in &record.visited {
             let Ok(NodeKind::Condition(condition)) = tree.kind(node) else {
                 continue;
             };
             match record.status(node) {
-                Status::Success => {
+                Status::Success if now.check(condition) => {
                     self.held_since.insert(node, record.tick);
+                }
+                Status::Success => {
+                    self.held_since.remove(&node);
+                    if found.is_none() {
+                        found = self.culprit(tree, domain, node, condition, record.tick);
+                    }
                 }
                 Status::Failure => {
                     if let Some(since) = self.held_since.remove(&node)
@@ -404,8 +415,6 @@ impl FlipDetector {
                 Status::Idle | Status::Running | Status::Halted => {}
             }
         }
-        self.completed
-            .extend(record.completed.iter().map(|a| (record.tick, *a)));
         found
     }
 
