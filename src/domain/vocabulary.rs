@@ -43,17 +43,22 @@ pub enum VocabularyError {
     },
     #[error("unknown object {object:?} in {atom}")]
     UnknownObject { atom: String, object: String },
-    #[error(
-        "{atom}: argument {position} of {predicate:?} must be {expected}, but {object:?} is {actual}"
-    )]
-    WrongType {
-        atom: String,
-        predicate: String,
-        position: usize,
-        object: String,
-        expected: String,
-        actual: String,
-    },
+    #[error(transparent)]
+    WrongType(Box<WrongType>),
+}
+
+/// An object in a slot of the wrong type (boxed: it is the largest error here).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{atom}: argument {position} of {predicate:?} must be {expected}, but {object:?} is {actual}"
+)]
+pub struct WrongType {
+    pub atom: String,
+    pub predicate: String,
+    pub position: usize,
+    pub object: String,
+    pub expected: String,
+    pub actual: String,
 }
 
 impl Vocabulary {
@@ -215,7 +220,7 @@ mod tests {
             .check_atom(&Atom::parse("On_Table1_Coffee").unwrap())
             .unwrap_err();
         assert!(
-            matches!(e, VocabularyError::WrongType { position: 1, .. }),
+            matches!(&e, VocabularyError::WrongType(w) if w.position == 1),
             "{e}"
         );
         let e = v
