@@ -314,7 +314,16 @@ impl<'p, 'd> Growth<'p, 'd> {
             }
             seq
         };
-        tree.add_child(parent, NodeKind::Action(skill.call.clone()))
+        // Values already set for this skill and object (grasp force of the egg) carry over.
+        let mut call = skill.call.clone();
+        if let Some((_, known)) = tree
+            .actions()
+            .into_iter()
+            .find(|(_, a)| a.same_invocation(&call) && !a.values.is_empty())
+        {
+            call.values = known.values.clone();
+        }
+        tree.add_child(parent, NodeKind::Action(call))
             .map_err(|e| e.to_string())?;
         Ok(())
     }

@@ -293,3 +293,27 @@ pub fn check_tree(domain: &Domain, tree: &Tree) -> Result<(), TreeCheckError> {
     }
     Ok(())
 }
+
+/// Set a value parameter (grasp force, speed, tool) on every action of `tree` that uses
+/// `skill` with `object` as its first argument; returns how many nodes changed. Later
+/// expansions copy values from these nodes (see `grow`), so the value reaches every node
+/// that ever uses that skill with that object.
+pub fn set_value(
+    tree: &mut Tree,
+    skill: &str,
+    object: &str,
+    name: &str,
+    value: &crate::domain::Value,
+) -> usize {
+    let mut changed = 0;
+    for node in tree.preorder() {
+        if let Ok(NodeKind::Action(a)) = tree.kind_mut(node)
+            && a.skill == skill
+            && a.args.first().is_some_and(|o| o == object)
+        {
+            a.set_value(name, value.clone());
+            changed += 1;
+        }
+    }
+    changed
+}
