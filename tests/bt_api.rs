@@ -1,6 +1,7 @@
 //! The `bt` public API as the planner and front ends use it: parse a policy, tick it
 //! against a tiny world, repair it with `wrap`, render it.
 
+#![allow(clippy::unwrap_used)] // tests may panic on what they check
 use betr::bt::{
     ASCII, ActionStep, Leaves, NodeId, NodeKind, Outcome, Status, Ticker, Tree, UNICODE, parse,
     render, to_text,

@@ -2,6 +2,7 @@
 //! state: the planner builds a tree that succeeds in the symbolic world, or says precisely
 //! why the goal is unreachable. Only contradictory goals may be unreachable.
 
+#![allow(clippy::unwrap_used)] // tests may panic on what they check
 use std::path::Path;
 
 use betr::dataset::{self, Case};

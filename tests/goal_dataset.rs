@@ -1,5 +1,6 @@
 //! The goal parser, minimal DNF and goal comparison on the 100 gold goals of LLM-OBTEA.
 
+#![allow(clippy::unwrap_used)] // tests may panic on what they check
 use std::path::PathBuf;
 
 use betr::dataset::{self, Case, Difficulty};

@@ -207,10 +207,24 @@ struct SkillSource<'a> {
 impl Scenario {
     /// Read a scenario file (and the files it extends).
     pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        Self::load_chain(SourceFile::read(path)?)
+    }
+
+    /// A scenario from text, as if read from `path` (which names it in errors and anchors
+    /// `extends`).
+    pub fn from_text(path: &Path, text: impl Into<String>) -> Result<Scenario, ScenarioError> {
+        Self::load_chain(SourceFile {
+            path: path.to_path_buf(),
+            text: text.into(),
+        })
+    }
+
+    fn load_chain(first: SourceFile) -> Result<Scenario, ScenarioError> {
         let mut files = Vec::new();
         let mut raws = Vec::new();
-        let mut next = Some(path.to_path_buf());
-        while let Some(p) = next.take() {
+        let mut pending = Some(first);
+        while let Some(file) = pending.take() {
+            let p = file.path.clone();
             if files.iter().any(|f: &SourceFile| f.path == p) || files.len() > 8 {
                 return Err(ScenarioError {
                     file: p,
@@ -219,7 +233,6 @@ impl Scenario {
                     message: "`extends` forms a cycle or a chain longer than 8 files".into(),
                 });
             }
-            let file = SourceFile::read(&p)?;
             let raw: RawFile = file.parse()?;
             if let Some(base) = &raw.extends {
                 let base_path = p.parent().unwrap_or(Path::new(".")).join(base.get_ref());
@@ -230,7 +243,7 @@ impl Scenario {
                         format!("the extended file {} does not exist", base_path.display()),
                     ));
                 }
-                next = Some(base_path);
+                pending = Some(SourceFile::read(&base_path)?);
             }
             files.push(file);
             raws.push(raw);

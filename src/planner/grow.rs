@@ -10,6 +10,15 @@ use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree, to_text};
 use crate::domain::{Condition, GroundSkill};
 use crate::world::World;
 
+/// The condition an expansion Fallback achieves.
+pub(super) fn expansion_condition(tree: &Tree, fallback: NodeId) -> Option<Condition> {
+    let first = *tree.children(fallback).ok()?.first()?;
+    match tree.kind(first).ok()? {
+        NodeKind::Condition(c) if expansion_of(tree, first) == Some(fallback) => Some(c.clone()),
+        _ => None,
+    }
+}
+
 /// The expansion Fallback whose condition is `condition`, if it has been expanded.
 pub(super) fn expansion_of(tree: &Tree, condition: NodeId) -> Option<NodeId> {
     let parent = tree.parent(condition).ok().flatten()?;
@@ -355,6 +364,11 @@ impl<'p, 'd> Growth<'p, 'd> {
     }
 
     fn reorder(&mut self, c: Conflict) -> Next {
+        let lead = |tree: &Tree, index: usize| {
+            let child = tree.children(c.sequence).ok()?.get(index).copied()?;
+            lead_condition(tree, child)
+        };
+        let (earlier, later) = (lead(&self.tree, c.earlier), lead(&self.tree, c.later));
         if self
             .tree
             .move_child(c.sequence, c.later, c.earlier)
@@ -366,14 +380,36 @@ impl<'p, 'd> Growth<'p, 'd> {
         }
         self.reorders += 1;
         tracing::debug!(sequence = %c.sequence, from = c.later, to = c.earlier, "reordered a conflict");
-        if !self.orders.insert(to_text(&self.tree)) {
-            return Next::Done(Outcome::Exhausted {
+        if self.orders.insert(to_text(&self.tree)) {
+            return Next::Continue;
+        }
+        match (earlier, later) {
+            (Some((node, condition)), Some((_, other))) => Next::Done(Outcome::Unreachable {
+                path: self.tree.path(node).unwrap_or_default(),
+                reason: format!(
+                    "{condition} and {other} undo each other: achieving either one makes the other false, in every order tried"
+                ),
+                node,
+                condition,
+            }),
+            _ => Next::Done(Outcome::Exhausted {
                 reason:
                     "sibling subtrees keep undoing each other's conditions in every order tried"
                         .into(),
-            });
+            }),
         }
-        Next::Continue
+    }
+}
+
+/// The condition a subtree stands for: the node itself, or the first condition down its
+/// first children (an expansion's condition, a conjunction's first goal).
+pub(super) fn lead_condition(tree: &Tree, node: NodeId) -> Option<(NodeId, Condition)> {
+    match tree.kind(node).ok()? {
+        NodeKind::Condition(c) => Some((node, c.clone())),
+        NodeKind::Sequence | NodeKind::Fallback => {
+            lead_condition(tree, *tree.children(node).ok()?.first()?)
+        }
+        NodeKind::Action(_) => None,
     }
 }
 

@@ -179,13 +179,15 @@ impl<'a> Planner<'a> {
                 .wrap(action, NodeKind::Sequence)
                 .map_err(|_| RepairError::NotAnAction(action))?,
         };
+        // Preconditions already there, whether plain or already expanded.
         let existing: Vec<Condition> = tree
             .children(seq)
             .map(|c| c.to_vec())
             .unwrap_or_default()
             .into_iter()
-            .filter_map(|c| match tree.kind(c) {
+            .filter_map(|child| match tree.kind(child) {
                 Ok(NodeKind::Condition(c)) => Some(c.clone()),
+                Ok(NodeKind::Fallback) => grow::expansion_condition(&tree, child),
                 _ => None,
             })
             .collect();
@@ -317,3 +319,6 @@ pub fn set_value(
     }
     changed
 }
+
+#[cfg(test)]
+mod tests;

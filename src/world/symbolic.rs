@@ -295,3 +295,117 @@ impl World for SymbolicWorld {
             .collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+    use crate::domain::Scenario;
+
+    const TEXT: &str = r#"
+[scenario]
+name = "t"
+[objects]
+item = ["Cup", "Mop"]
+nothing = ["Nothing"]
+furniture = ["Floor"]
+[[predicates]]
+name = "Holding"
+args = ["item|nothing"]
+description = "holds"
+[[predicates]]
+name = "IsClean"
+args = ["furniture"]
+description = "clean"
+[[skills]]
+name = "Grab"
+params = ["i: item"]
+pre = ["Holding_Nothing"]
+add = ["Holding_{i}"]
+del = ["Holding_Nothing"]
+ticks = 3
+[[skills]]
+name = "Sweep"
+params = ["f: furniture"]
+add = ["IsClean_{f}"]
+[world]
+initial = ["Holding_Nothing"]
+[[world.rules]]
+action = 'Grab "Cup"'
+requires = "~IsClean_Floor"
+error = "Cup is stuck"
+[[world.rules]]
+action = "Sweep"
+requires = "Holding_Mop"
+otherwise = "no effect"
+"#;
+
+    fn world() -> SymbolicWorld {
+        let s = Scenario::from_text(Path::new("t.toml"), TEXT).unwrap();
+        SymbolicWorld::from_scenario(&s).unwrap()
+    }
+
+    fn c(text: &str) -> Condition {
+        Condition::parse(text).unwrap()
+    }
+
+    #[test]
+    fn actions_take_their_ticks_then_apply_effects() {
+        let mut w = world();
+        let grab = ActionCall::new("Grab", ["Mop"]);
+        assert_eq!(w.step(&grab, true), Step::Running);
+        assert_eq!(w.step(&grab, false), Step::Running);
+        assert!(w.check(&c("Holding_Nothing")));
+        assert_eq!(w.step(&grab, false), Step::Success);
+        assert!(w.check(&c("Holding_Mop")) && w.check(&c("~Holding_Nothing")));
+    }
+
+    #[test]
+    fn halting_restarts_the_count_and_forks_are_independent() {
+        let mut w = world();
+        let grab = ActionCall::new("Grab", ["Mop"]);
+        let fork = w.fork();
+        let snap = w.snapshot();
+        w.step(&grab, true);
+        w.step(&grab, false);
+        w.halt(&grab);
+        assert_eq!(w.step(&grab, true), Step::Running);
+        w.step(&grab, false);
+        assert_eq!(w.step(&grab, false), Step::Success);
+        assert!(fork.check(&c("Holding_Nothing")));
+        w.restore(&snap).unwrap();
+        assert!(w.check(&c("Holding_Nothing")));
+        assert_eq!(
+            w.restore(&Snapshot::new(5u8)),
+            Err(WorldError::ForeignSnapshot)
+        );
+    }
+
+    #[test]
+    fn hidden_rules_fail_with_their_text_or_remove_the_effect() {
+        let mut w = world();
+        let sweep = ActionCall::new("Sweep", ["Floor"]);
+        assert_eq!(w.step(&sweep, true), Step::Success);
+        assert!(w.check(&c("~IsClean_Floor")), "no mop, no effect");
+        let mut w2 = world();
+        w2.state.facts.insert(Atom::parse("IsClean_Floor").unwrap());
+        assert_eq!(
+            w2.step(&ActionCall::new("Grab", ["Cup"]), true),
+            Step::Failure("Cup is stuck".into())
+        );
+    }
+
+    #[test]
+    fn undeclared_preconditions_and_unknown_actions_fail() {
+        let mut w = world();
+        w.state.facts.clear();
+        assert_eq!(
+            w.step(&ActionCall::new("Grab", ["Mop"]), true),
+            Step::Failure("Precondition Holding_Nothing of Grab \"Mop\" not met".into())
+        );
+        assert!(
+            matches!(w.step(&ActionCall::new("Fly", ["Mop"]), true), Step::Failure(e) if e.starts_with("Unknown action"))
+        );
+    }
+}
