@@ -44,12 +44,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ));
     }
 
-    println!("planning time per goal (median of {REPETITIONS} runs each), {} goals", rows.len());
-    println!("{:<8} {:>6} {:>12} {:>12} {:>10}", "set", "goals", "median", "max", "succeeded");
+    println!(
+        "planning time per goal (median of {REPETITIONS} runs each), {} goals",
+        rows.len()
+    );
+    println!(
+        "{:<8} {:>6} {:>12} {:>12} {:>10}",
+        "set", "goals", "median", "max", "succeeded"
+    );
     for d in Difficulty::ALL.iter().copied().map(Some).chain([None]) {
-        let mut times: Vec<Duration> = rows.iter().filter(|r| d.is_none_or(|d| r.0 == d)).map(|r| r.2).collect();
+        let mut times: Vec<Duration> = rows
+            .iter()
+            .filter(|r| d.is_none_or(|d| r.0 == d))
+            .map(|r| r.2)
+            .collect();
         times.sort();
-        let ok = rows.iter().filter(|r| d.is_none_or(|d| r.0 == d) && r.4).count();
+        let ok = rows
+            .iter()
+            .filter(|r| d.is_none_or(|d| r.0 == d) && r.4)
+            .count();
         let (Some(max), Some(median)) = (times.last(), times.get(times.len() / 2)) else {
             continue;
         };
@@ -65,7 +78,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     rows.sort_by(|a, b| b.2.cmp(&a.2));
     println!("\nslowest goals:");
     for (d, gold, t, nodes, _) in rows.iter().take(5) {
-        println!("  {:>8.3} ms  {:>3} nodes  [{}] {gold}", t.as_secs_f64() * 1e3, nodes, d.as_str());
+        println!(
+            "  {:>8.3} ms  {:>3} nodes  [{}] {gold}",
+            t.as_secs_f64() * 1e3,
+            nodes,
+            d.as_str()
+        );
     }
     Ok(())
 }
