@@ -75,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ok
         );
     }
-    rows.sort_by(|a, b| b.2.cmp(&a.2));
+    rows.sort_by_key(|r| std::cmp::Reverse(r.2));
     println!("\nslowest goals:");
     for (d, gold, t, nodes, _) in rows.iter().take(5) {
         println!(
