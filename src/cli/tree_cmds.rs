@@ -19,6 +19,12 @@ pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<
     let dnf = goal.to_dnf();
     println!("Scenario: {}", scenario.name);
     println!("Goal:     {goal}");
+    if dnf.is_false() {
+        println!(
+            "\nThe goal is contradictory: no state of the world satisfies it, so no tree can achieve it."
+        );
+        return Ok(ExitCode::from(WORLD_FAILED));
+    }
     let started = Instant::now();
     let plan = Planner::new(&scenario.domain).plan(&dnf, world.as_ref())?;
     let elapsed = started.elapsed();
