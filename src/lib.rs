@@ -11,6 +11,7 @@ pub mod bt;
 pub mod dataset;
 pub mod domain;
 pub mod goal;
+pub mod model;
 pub mod planner;
 pub mod store;
 pub mod world;

@@ -1,5 +1,6 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
+mod model_cmd;
 mod tree_cmds;
 
 use std::path::{Path, PathBuf};
@@ -27,6 +28,11 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Embedded model files: fetch them into the cache, list them.
+    Model {
+        #[command(subcommand)]
+        action: ModelAction,
+    },
     /// Plan a tree for the scenario's goal (or --goal) and print it with its statuses.
     Plan {
         /// Scenario file, e.g. scenarios/cafe/no_coffee.toml (or cafe/no_coffee).
@@ -67,6 +73,22 @@ pub enum Command {
     },
 }
 
+#[derive(Subcommand)]
+pub enum ModelAction {
+    /// Download, verify and install a model (the default LLM unless --model).
+    Fetch {
+        #[arg(long)]
+        model: Option<String>,
+    },
+    /// Known models, their sizes and whether they are in the cache.
+    List,
+    /// Check the cached file's SHA-256 against the expected one.
+    Verify {
+        #[arg(long)]
+        model: Option<String>,
+    },
+}
+
 pub fn run(cli: Cli) -> Result<ExitCode> {
     let glyphs = if cli.ascii {
         &betr::bt::ASCII
@@ -74,6 +96,15 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         &betr::bt::UNICODE
     };
     match cli.command {
+        Command::Model {
+            action: ModelAction::Fetch { model },
+        } => model_cmd::fetch(model.as_deref()),
+        Command::Model {
+            action: ModelAction::List,
+        } => model_cmd::list(),
+        Command::Model {
+            action: ModelAction::Verify { model },
+        } => model_cmd::verify(model.as_deref()),
         Command::Plan { scenario, goal } => {
             tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
         }

