@@ -11,6 +11,9 @@ pub mod bt;
 pub mod dataset;
 pub mod domain;
 pub mod goal;
+pub mod llm {
+    pub mod grammar;
+}
 pub mod model;
 pub mod planner;
 pub mod store;

@@ -1,0 +1,285 @@
+//! The embedded llama.cpp runtime (through `llama-cpp-2`).
+//!
+//! One worker thread owns the backend, the model and one context; calls reach it over a
+//! channel. (A context borrows its model and is not `Send`, so a thread that owns both is
+//! simpler and safer than a self-referential struct.) The worker keeps the tokens already
+//! in the key-value cache: a call whose prompt starts like the previous one (same role
+//! text, vocabulary, objects and examples) only evaluates the tokens that differ.
+
+use std::num::NonZeroU32;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use llama_cpp_2::context::params::LlamaContextParams;
+use llama_cpp_2::llama_backend::LlamaBackend;
+use llama_cpp_2::llama_batch::LlamaBatch;
+use llama_cpp_2::model::params::LlamaModelParams;
+use llama_cpp_2::model::{LlamaChatMessage, LlamaModel};
+use llama_cpp_2::sampling::LlamaSampler;
+use llama_cpp_2::token::LlamaToken;
+
+/// How the engine runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EngineOptions {
+    pub model_path: PathBuf,
+    /// CPU threads for generation and prompt evaluation.
+    pub threads: u32,
+    /// Context length in tokens.
+    pub context: u32,
+}
+
+/// One generation request, already in chat form.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generation {
+    /// (role, content) pairs: `system`, `user`, `assistant`.
+    pub messages: Vec<(String, String)>,
+    pub max_tokens: u32,
+    /// 0 = greedy.
+    pub temperature: f32,
+    pub seed: u32,
+    /// Generation stops before any of these.
+    pub stop: Vec<String>,
+    /// A GBNF grammar the reply must follow (root rule `root`).
+    pub grammar: Option<String>,
+}
+
+/// What a generation produced, with its timings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generated {
+    pub text: String,
+    pub prompt_tokens: u32,
+    /// Prompt tokens that were already in the cache and not evaluated again.
+    pub cached_tokens: u32,
+    pub completion_tokens: u32,
+    pub prompt_time: Duration,
+    pub generation_time: Duration,
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EngineError {
+    #[error("model file {0} does not exist (run `betr model fetch`, or pass --model-path)")]
+    Missing(PathBuf),
+    #[error("cannot load model {path}: {detail}")]
+    Load { path: PathBuf, detail: String },
+    #[error("the model has no usable chat template: {0}")]
+    Template(String),
+    #[error("the prompt has {tokens} tokens but the context holds {context}")]
+    PromptTooLong { tokens: usize, context: u32 },
+    #[error("invalid grammar: {0}")]
+    Grammar(String),
+    #[error("llama.cpp failed: {0}")]
+    Runtime(String),
+    #[error("the model worker stopped")]
+    WorkerGone,
+}
+
+type Reply = mpsc::Sender<Result<Generated, EngineError>>;
+
+/// A loaded model, ready for generations.
+pub struct Engine {
+    jobs: mpsc::Sender<(Generation, Reply)>,
+    load_time: Duration,
+}
+
+/// llama.cpp's backend may be initialised once per process.
+static BACKEND: OnceLock<Result<LlamaBackend, String>> = OnceLock::new();
+
+fn backend() -> Result<&'static LlamaBackend, EngineError> {
+    let b = BACKEND.get_or_init(|| {
+        LlamaBackend::init()
+            .map(|mut b| {
+                b.void_logs();
+                b
+            })
+            .map_err(|e| e.to_string())
+    });
+    b.as_ref().map_err(|e| EngineError::Runtime(e.clone()))
+}
+
+impl Engine {
+    /// Load the model in a new worker thread; returns when it is ready (or failed).
+    pub fn load(options: EngineOptions) -> Result<Engine, EngineError> {
+        if !Path::new(&options.model_path).is_file() {
+            return Err(EngineError::Missing(options.model_path));
+        }
+        let (jobs, queue) = mpsc::channel::<(Generation, Reply)>();
+        let (ready_tx, ready) = mpsc::channel::<Result<Duration, EngineError>>();
+        std::thread::Builder::new()
+            .name("betr-llm".into())
+            .spawn(move || worker(options, ready_tx, queue))
+            .map_err(|e| EngineError::Runtime(format!("cannot start the model thread: {e}")))?;
+        let load_time = ready.recv().map_err(|_| EngineError::WorkerGone)??;
+        Ok(Engine { jobs, load_time })
+    }
+
+    pub fn load_time(&self) -> Duration {
+        self.load_time
+    }
+
+    /// Run one generation (blocking; call from a blocking-friendly thread).
+    pub fn generate(&self, generation: Generation) -> Result<Generated, EngineError> {
+        let (tx, rx) = mpsc::channel();
+        self.jobs.send((generation, tx)).map_err(|_| EngineError::WorkerGone)?;
+        rx.recv().map_err(|_| EngineError::WorkerGone)?
+    }
+}
+
+fn worker(options: EngineOptions, ready: mpsc::Sender<Result<Duration, EngineError>>, queue: mpsc::Receiver<(Generation, Reply)>) {
+    let started = Instant::now();
+    let setup = (|| {
+        let backend = backend()?;
+        let model = LlamaModel::load_from_file(backend, &options.model_path, &LlamaModelParams::default()).map_err(|e| EngineError::Load {
+            path: options.model_path.clone(),
+            detail: e.to_string(),
+        })?;
+        Ok::<_, EngineError>((backend, model))
+    })();
+    let (backend, model) = match setup {
+        Ok(x) => x,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let threads = i32::try_from(options.threads.max(1)).unwrap_or(1);
+    let params = LlamaContextParams::default()
+        .with_n_ctx(NonZeroU32::new(options.context.max(512)))
+        .with_n_batch(512)
+        .with_n_threads(threads)
+        .with_n_threads_batch(threads);
+    let mut ctx = match model.new_context(backend, params) {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = ready.send(Err(EngineError::Load {
+                path: options.model_path.clone(),
+                detail: e.to_string(),
+            }));
+            return;
+        }
+    };
+    let template = match model.chat_template(None) {
+        Ok(t) => t,
+        Err(e) => {
+            let _ = ready.send(Err(EngineError::Template(e.to_string())));
+            return;
+        }
+    };
+    if ready.send(Ok(started.elapsed())).is_err() {
+        return;
+    }
+    // Tokens whose keys and values are in the cache, in order.
+    let mut cached: Vec<LlamaToken> = Vec::new();
+    while let Ok((job, reply)) = queue.recv() {
+        let result = (|| {
+            let chat = job
+                .messages
+                .iter()
+                .map(|(role, content)| LlamaChatMessage::new(role.clone(), content.clone()))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| EngineError::Template(e.to_string()))?;
+            let prompt = model
+                .apply_chat_template(&template, &chat, true)
+                .map_err(|e| EngineError::Template(e.to_string()))?;
+            // The template already wrote the special tokens; parse them as such.
+            let tokens = model.vocab().tokenize(prompt.as_bytes(), false, true);
+            generate(&model, &mut ctx, &mut cached, &tokens, &job)
+        })();
+        if result.is_err() {
+            // After a failure the cache contents are unknown: start clean next time.
+            cached.clear();
+            let _ = ctx.clear_kv_cache_seq(None, None, None);
+        }
+        if reply.send(result).is_err() {
+            break;
+        }
+    }
+}
+
+fn generate(
+    model: &LlamaModel,
+    ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+    cached: &mut Vec<LlamaToken>,
+    tokens: &[LlamaToken],
+    job: &Generation,
+) -> Result<Generated, EngineError> {
+    let n_ctx = ctx.n_ctx();
+    if tokens.len() + job.max_tokens as usize > n_ctx as usize {
+        return Err(EngineError::PromptTooLong {
+            tokens: tokens.len() + job.max_tokens as usize,
+            context: n_ctx,
+        });
+    }
+    let runtime = |e: &dyn std::fmt::Display| EngineError::Runtime(e.to_string());
+    // Reuse the cached prefix; always evaluate at least the last prompt token, whose
+    // logits start the reply.
+    let common = cached.iter().zip(tokens).take_while(|(a, b)| a == b).count();
+    let keep = common.min(tokens.len().saturating_sub(1));
+    ctx.clear_kv_cache_seq(Some(0), Some(keep as u32), None).map_err(|e| runtime(&e))?;
+    cached.truncate(keep);
+
+    let prompt_started = Instant::now();
+    let batch_size = ctx.n_batch() as usize;
+    let mut batch = LlamaBatch::new(batch_size.max(1), 1);
+    let rest = &tokens[keep..];
+    for (chunk_index, chunk) in rest.chunks(batch_size.max(1)).enumerate() {
+        batch.clear();
+        let base = keep + chunk_index * batch_size;
+        for (i, t) in chunk.iter().enumerate() {
+            let pos = (base + i) as i32;
+            let last = base + i == tokens.len() - 1;
+            batch.add(*t, pos, &[0], last).map_err(|e| runtime(&e))?;
+        }
+        ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
+        cached.extend_from_slice(chunk);
+    }
+    let prompt_time = prompt_started.elapsed();
+
+    let mut samplers = Vec::new();
+    if let Some(g) = &job.grammar {
+        samplers.push(LlamaSampler::grammar(model, g, "root").map_err(|e| EngineError::Grammar(e.to_string()))?);
+    }
+    if job.temperature > 0.0 {
+        samplers.push(LlamaSampler::temp(job.temperature));
+        samplers.push(LlamaSampler::dist(job.seed));
+    } else {
+        samplers.push(LlamaSampler::greedy());
+    }
+    let mut sampler = LlamaSampler::chain_simple(samplers);
+
+    let generation_started = Instant::now();
+    let vocab = model.vocab();
+    // Pieces are bytes; a character may span two tokens, so decode the whole reply.
+    let mut bytes: Vec<u8> = Vec::new();
+    let mut text = String::new();
+    let mut produced = 0u32;
+    let mut logits_at = batch.n_tokens() - 1;
+    while produced < job.max_tokens {
+        // `sample` also accepts the token into the chain (grammar state included).
+        let token = sampler.sample(ctx, logits_at);
+        if vocab.is_eog(token) {
+            break;
+        }
+        produced += 1;
+        bytes.extend(vocab.token_to_piece(token, false, None));
+        text = String::from_utf8_lossy(&bytes).into_owned();
+        if let Some(cut) = job.stop.iter().filter_map(|s| text.find(s.as_str())).min() {
+            text.truncate(cut);
+            break;
+        }
+        batch.clear();
+        batch.add(token, cached.len() as i32, &[0], true).map_err(|e| runtime(&e))?;
+        ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
+        cached.push(token);
+        logits_at = 0;
+    }
+    Ok(Generated {
+        text,
+        prompt_tokens: tokens.len() as u32,
+        cached_tokens: keep as u32,
+        completion_tokens: produced,
+        prompt_time,
+        generation_time: generation_started.elapsed(),
+    })
+}
