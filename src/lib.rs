@@ -10,6 +10,7 @@
 pub mod bt;
 pub mod dataset;
 pub mod domain;
+pub mod eval;
 pub mod goal;
 pub mod llm {
     pub mod grammar;

@@ -1,5 +1,6 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
+mod eval_cmd;
 mod model_cmd;
 mod tree_cmds;
 
@@ -28,6 +29,11 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Reproduce the paper's experiments.
+    Eval {
+        #[command(subcommand)]
+        experiment: EvalExperiment,
+    },
     /// Embedded model files: fetch them into the cache, list them.
     Model {
         #[command(subcommand)]
@@ -74,6 +80,26 @@ pub enum Command {
 }
 
 #[derive(Subcommand)]
+pub enum EvalExperiment {
+    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions.
+    Goals {
+        /// The dataset directory (easy.txt, medium.txt, hard.txt).
+        #[arg(long, default_value = "../shared/datasets/llm-obtea")]
+        dataset: std::path::PathBuf,
+        /// Score these recorded answers (one line per case, easy then medium then hard)
+        /// instead of asking a model.
+        #[arg(long)]
+        answers: std::path::PathBuf,
+        /// The scenario whose vocabulary answers must use.
+        #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
+        scenario: std::path::PathBuf,
+        /// Where to write results.json, results.csv, table.md and accuracy.png.
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
 pub enum ModelAction {
     /// Download, verify and install a model (the default LLM unless --model).
     Fetch {
@@ -96,6 +122,15 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         &betr::bt::UNICODE
     };
     match cli.command {
+        Command::Eval {
+            experiment:
+                EvalExperiment::Goals {
+                    dataset,
+                    answers,
+                    scenario,
+                    out,
+                },
+        } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, out.as_deref()),
         Command::Model {
             action: ModelAction::Fetch { model },
         } => model_cmd::fetch(model.as_deref()),

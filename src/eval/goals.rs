@@ -1,0 +1,294 @@
+//! The goal-interpretation experiment: score answers against the 100 gold goals of the
+//! LLM-OBTEA dataset by the published rule (minimal DNF compared as sets of sets of
+//! literals). An answer that does not parse, or names an atom outside the vocabulary, is
+//! wrong — never an error that stops a run.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::dataset::{Case, Difficulty};
+use crate::domain::Vocabulary;
+use crate::goal::{Formula, same_dnf};
+
+/// One scored case, as written to `results.json` and `results.csv`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseResult {
+    pub difficulty: String,
+    pub index: usize,
+    pub instruction: String,
+    pub gold: String,
+    /// The answer as given (`None`: no answer).
+    pub answer: Option<String>,
+    pub correct: bool,
+    /// Why a wrong answer is wrong when it is not merely a different goal.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub problem: Option<String>,
+    /// LLM accounting, when the answer came from a model in this run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prompt_tokens: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub completion_tokens: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub latency_ms: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Tally {
+    pub correct: usize,
+    pub total: usize,
+}
+
+impl Tally {
+    pub fn percent(&self) -> f64 {
+        if self.total == 0 {
+            0.0
+        } else {
+            100.0 * self.correct as f64 / self.total as f64
+        }
+    }
+}
+
+/// The `results.json` document.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GoalsResults {
+    pub easy: Tally,
+    pub medium: Tally,
+    pub hard: Tally,
+    pub cases: Vec<CaseResult>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum AnswersError {
+    #[error("{path}: {source}")]
+    Read {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(
+        "{path}: expected {expected} lines (one answer per case, in the order easy, medium, hard), found {found}"
+    )]
+    Count {
+        path: String,
+        expected: usize,
+        found: usize,
+    },
+}
+
+/// The formula in an answer line as a model may have written it: an optional `Goal:`
+/// label, code ticks and surrounding spaces are not part of it.
+pub fn answer_formula(line: &str) -> &str {
+    let t = line.trim().trim_matches('`').trim();
+    match t.find("Goal:") {
+        Some(i) => t[i + "Goal:".len()..].trim().trim_matches('`').trim(),
+        None => t,
+    }
+}
+
+/// Score one answer against its gold goal.
+pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> CaseResult {
+    let (correct, problem) = judge(vocabulary, &case.gold, answer);
+    CaseResult {
+        difficulty: case.difficulty.as_str().to_string(),
+        index: case.index,
+        instruction: case.instruction.clone(),
+        gold: case.gold.clone(),
+        answer: answer.map(str::to_string),
+        correct,
+        problem,
+        prompt_tokens: None,
+        completion_tokens: None,
+        latency_ms: None,
+    }
+}
+
+fn judge(vocabulary: &Vocabulary, gold: &str, answer: Option<&str>) -> (bool, Option<String>) {
+    let Some(text) = answer.map(answer_formula).filter(|t| !t.is_empty()) else {
+        return (false, Some("no answer".into()));
+    };
+    let formula = match Formula::parse(text) {
+        Ok(f) => f,
+        Err(e) => return (false, Some(format!("does not parse: {e}"))),
+    };
+    if let Some(e) = formula
+        .atoms()
+        .iter()
+        .find_map(|a| vocabulary.check_atom(a).err())
+    {
+        return (false, Some(format!("outside the vocabulary: {e}")));
+    }
+    match Formula::parse(gold) {
+        Ok(g) => (same_dnf(&formula, &g), None),
+        Err(e) => (false, Some(format!("the gold goal does not parse: {e}"))),
+    }
+}
+
+/// Read an answers file: exactly one line per case (an empty line = no answer).
+pub fn read_answers(path: &Path, expected: usize) -> Result<Vec<Option<String>>, AnswersError> {
+    let text = std::fs::read_to_string(path).map_err(|source| AnswersError::Read {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let mut lines: Vec<&str> = text
+        .split('\n')
+        .map(|l| l.strip_suffix('\r').unwrap_or(l))
+        .collect();
+    // A final newline ends the last line; it does not start an extra one.
+    if text.ends_with('\n') {
+        lines.pop();
+    }
+    if lines.len() != expected {
+        return Err(AnswersError::Count {
+            path: path.display().to_string(),
+            expected,
+            found: lines.len(),
+        });
+    }
+    Ok(lines
+        .into_iter()
+        .map(|l| (!l.trim().is_empty()).then(|| l.to_string()))
+        .collect())
+}
+
+impl GoalsResults {
+    pub fn from_cases(cases: Vec<CaseResult>) -> Self {
+        let tally = |d: Difficulty| Tally {
+            correct: cases
+                .iter()
+                .filter(|c| c.difficulty == d.as_str() && c.correct)
+                .count(),
+            total: cases.iter().filter(|c| c.difficulty == d.as_str()).count(),
+        };
+        GoalsResults {
+            easy: tally(Difficulty::Easy),
+            medium: tally(Difficulty::Medium),
+            hard: tally(Difficulty::Hard),
+            cases,
+        }
+    }
+
+    pub fn overall(&self) -> Tally {
+        Tally {
+            correct: self.easy.correct + self.medium.correct + self.hard.correct,
+            total: self.easy.total + self.medium.total + self.hard.total,
+        }
+    }
+
+    /// The table in the paper's layout (accuracy per difficulty), one row per system.
+    pub fn table(&self, system: &str) -> String {
+        let cell = |t: &Tally| format!("{:.1}% ({}/{})", t.percent(), t.correct, t.total);
+        let mut out = String::new();
+        out.push_str("| system | easy | medium | hard | overall |\n|---|---|---|---|---|\n");
+        out.push_str(&format!(
+            "| {system} | {} | {} | {} | {} |\n",
+            cell(&self.easy),
+            cell(&self.medium),
+            cell(&self.hard),
+            cell(&self.overall())
+        ));
+        out
+    }
+
+    /// Every case as CSV (RFC 4180 quoting).
+    pub fn csv(&self) -> String {
+        let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
+        let mut out = String::from("difficulty,index,instruction,gold,answer,correct,problem\n");
+        for c in &self.cases {
+            out.push_str(&format!(
+                "{},{},{},{},{},{},{}\n",
+                c.difficulty,
+                c.index,
+                q(&c.instruction),
+                q(&c.gold),
+                q(c.answer.as_deref().unwrap_or("")),
+                c.correct,
+                q(c.problem.as_deref().unwrap_or(""))
+            ));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(gold: &str) -> Case {
+        Case {
+            difficulty: Difficulty::Easy,
+            index: 0,
+            instruction: "x".into(),
+            gold: gold.into(),
+        }
+    }
+
+    fn vocab() -> Vocabulary {
+        use crate::domain::{Object, Predicate};
+        Vocabulary {
+            objects: vec![
+                Object {
+                    name: "AC".into(),
+                    types: vec!["appliance".into()],
+                },
+                Object {
+                    name: "TubeLight".into(),
+                    types: vec!["appliance".into()],
+                },
+            ],
+            predicates: vec![Predicate {
+                name: "Active".into(),
+                arg_types: vec![vec!["appliance".into()]],
+                description: String::new(),
+            }],
+        }
+    }
+
+    #[test]
+    fn equal_dnfs_are_correct_whatever_the_spelling() {
+        let v = vocab();
+        let c = case("Active_AC & ~Active_TubeLight");
+        assert!(score(&v, &c, Some("~Active_TubeLight&Active_AC")).correct);
+        assert!(score(&v, &c, Some("Goal: (Active_AC) & ~(Active_TubeLight)")).correct);
+        assert!(score(&v, &c, Some("`Goal: Active_AC & ~Active_TubeLight`")).correct);
+        assert!(!score(&v, &c, Some("Active_AC")).correct);
+    }
+
+    #[test]
+    fn bad_answers_are_wrong_with_a_reason() {
+        let v = vocab();
+        let c = case("Active_AC");
+        let r = score(&v, &c, Some("Active_AC &"));
+        assert!(
+            !r.correct
+                && r.problem
+                    .as_deref()
+                    .is_some_and(|p| p.starts_with("does not parse"))
+        );
+        let r = score(&v, &c, Some("Active_Fan"));
+        assert!(
+            !r.correct
+                && r.problem
+                    .as_deref()
+                    .is_some_and(|p| p.contains("outside the vocabulary"))
+        );
+        let r = score(&v, &c, None);
+        assert_eq!(r.problem.as_deref(), Some("no answer"));
+    }
+
+    #[test]
+    fn csv_quotes_fields() {
+        let v = vocab();
+        let mut c = case("Active_AC");
+        c.instruction = "say \"hi\", please".into();
+        let results = GoalsResults::from_cases(vec![score(&v, &c, Some("Active_AC"))]);
+        assert!(results.csv().contains("\"say \"\"hi\"\", please\""));
+        assert_eq!(
+            results.easy,
+            Tally {
+                correct: 1,
+                total: 1
+            }
+        );
+    }
+}
