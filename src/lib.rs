@@ -11,6 +11,8 @@ pub mod bt;
 pub mod dataset;
 pub mod domain;
 pub mod goal;
+pub mod llm;
 pub mod planner;
+pub mod session;
 pub mod store;
 pub mod world;
