@@ -284,7 +284,7 @@ impl Settings {
                 let api_key = self
                     .api_key_env
                     .as_deref()
-                    .and_then(|name| var(name))
+                    .and_then(var)
                     .filter(|k| !k.is_empty())
                     .map(ApiKey::new);
                 let api_key_env = self.api_key_env.as_ref().map(|n| match api_key {

@@ -179,7 +179,7 @@ pub fn conditions(
                     .iter()
                     .map(json_literal)
                     .collect::<Result<Vec<_>, _>>()?,
-                Some(Json::String(s)) => read_condition_items(&[s.clone()])?,
+                Some(Json::String(s)) => read_condition_items(std::slice::from_ref(s))?,
                 _ => return Err(missing("conditions", text)),
             };
             (items, json_reasoning(&obj))
