@@ -1,0 +1,5 @@
+//! Test support: a fake OpenAI-compatible server and the hand-written fixture replies.
+#![allow(dead_code)]
+
+pub mod fake_openai;
+pub mod fixtures;
