@@ -3,6 +3,8 @@
 //! malformed JSON, no choices, or a reply naming an unknown object. Each case gives the
 //! expected result or error, and no failed call changes the tree.
 
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
 mod support;
 
 use std::path::Path;
@@ -270,9 +272,12 @@ fn resolve_with(
     (r, events)
 }
 
+/// Whether an error is the one a case expects.
+type Expect = fn(&LlmError) -> bool;
+
 #[test]
 fn failed_calls_leave_the_tree_unchanged() {
-    let cases: Vec<(Behavior, fn(&LlmError) -> bool)> = vec![
+    let cases: Vec<(Behavior, Expect)> = vec![
         (Behavior::Slow(Duration::from_secs(3), "late".into()), |e| {
             matches!(e, LlmError::Timeout { .. })
         }),
