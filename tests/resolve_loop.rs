@@ -40,11 +40,12 @@ fn resolvable_scenarios() -> Vec<PathBuf> {
     scenario_files(&fixtures::root().join("scenarios"), &mut all);
     all.sort();
     all.into_iter()
-        .filter(|p| {
-            p.components().any(|c| c.as_os_str() == "params")
-                || Scenario::load(p).is_ok_and(|s| !s.expected_fix.is_empty())
-        })
+        .filter(|p| is_param(p) || Scenario::load(p).is_ok_and(|s| !s.expected_fix.is_empty()))
         .collect()
+}
+
+fn is_param(p: &Path) -> bool {
+    p.components().any(|c| c.as_os_str() == "params")
 }
 
 fn relative(p: &Path) -> String {
@@ -133,6 +134,8 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
             ],
         );
         let log = text(&out);
+        // Shown with `cargo test --test resolve_loop -- --nocapture`.
+        println!("$ betr resolve {rel} --yes ...\n{log}");
         assert_eq!(out.status.code(), Some(0), "{rel}:\n{log}");
         assert!(log.contains("SUCCESS in simulation"), "{rel}:\n{log}");
         assert!(
@@ -143,6 +146,12 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
             !log.contains("reply from model"),
             "a fixture shown as a model's answer:\n{log}"
         );
+        if is_param(path) {
+            assert!(
+                log.contains("Proposal: set "),
+                "{rel}: expected a value:\n{log}"
+            );
+        }
         for fix in &scenario.expected_fix {
             assert!(
                 log.contains(&format!("Proposal: insert {fix}")),
@@ -185,10 +194,7 @@ fn the_library_loop_applies_the_expected_fixes() {
         .enable_all()
         .build()
         .unwrap();
-    for path in resolvable_scenarios()
-        .iter()
-        .filter(|p| !p.components().any(|c| c.as_os_str() == "params"))
-    {
+    for path in &resolvable_scenarios() {
         let scenario = Scenario::load(path).unwrap();
         let mut approved: Vec<Proposal> = Vec::new();
         let mut events = Vec::new();
@@ -235,6 +241,16 @@ fn the_library_loop_applies_the_expected_fixes() {
             })
             .collect();
         assert_eq!(inserted, scenario.expected_fix, "{}", scenario.name);
+        let values = approved
+            .iter()
+            .filter(|p| matches!(p, Proposal::Value { .. }))
+            .count();
+        assert_eq!(
+            values > 0,
+            is_param(path),
+            "{}: {approved:?}",
+            scenario.name
+        );
     }
 }
 

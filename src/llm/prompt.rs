@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use super::{ChatRequest, Message};
-use crate::domain::{ActionCall, Condition, Example, Scenario, ValueParam, Vocabulary};
+use crate::domain::{ANY_OBJECT, ActionCall, Condition, Example, Scenario, ValueParam, Vocabulary};
 
 /// Which ablation of the prompt to write.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -246,8 +246,26 @@ pub fn fill(
     Ok(cleaned)
 }
 
-/// One line per predicate: its written form with argument types, and its description.
+/// One line per predicate: its written form with argument types, and its description;
+/// for quoted-form vocabularies, a line on the `"any object"` wildcard.
 pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
+    let mut text = predicate_lines(vocabulary, descriptions);
+    let binary = vocabulary
+        .predicates
+        .iter()
+        .find(|p| crate::domain::condition::is_word_predicate(&p.name) && p.arg_types.len() == 2);
+    if let Some(p) = binary
+        && let Some(object) = vocabulary.objects_fitting(&p.arg_types[1]).next()
+    {
+        text.push_str(&format!(
+            "\n\"{ANY_OBJECT}\" stands for some object, and negated for none: ~\"{ANY_OBJECT}\" {} \"{object}\" means that no object is {} \"{object}\".",
+            p.name, p.name
+        ));
+    }
+    text
+}
+
+fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
     vocabulary
         .predicates
         .iter()
