@@ -1,24 +1,20 @@
 //! End to end: every failure scenario (a scenario file with `expected_fix`) and every
 //! parameter scenario resolves through `betr resolve --yes` against the fake OpenAI server
 //! answering with hand-written fixture replies: prompt → reply → validation → repair →
-//! success in simulation → saved tree. Also through the library, through record/replay, and
-//! with a secret key in the environment that must appear in no file the run wrote.
+//! success in simulation → saved tree. Also through the library and through record/replay.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use betr::domain::Scenario;
 use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
 use betr::session::{self, Ending, Event, Options, Proposal};
+use support::cli::{KEY_VAR, betr, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
-
-const KEY_VAR: &str = "BETR_TEST_SECRET_KEY";
-const KEY: &str = "sk-betr-e2e-SECRET-5f3c9a1e7d";
 
 fn scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -55,41 +51,6 @@ fn relative(p: &Path) -> String {
         .replace('\\', "/")
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("betr-e2e-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run the binary in `dir` with HOME and XDG dirs inside it, so every file it writes lands
-/// there.
-fn betr(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_betr"))
-        .args(args)
-        .current_dir(dir)
-        .env("HOME", dir)
-        .env("XDG_STATE_HOME", dir.join("state"))
-        .env("XDG_CONFIG_HOME", dir.join("config"))
-        .env(KEY_VAR, KEY)
-        .env_remove("BETR_CONFIG")
-        .env_remove("BETR_BACKEND")
-        .env_remove("BETR_MODEL")
-        .env_remove("BETR_BASE_URL")
-        .env_remove("BETR_API_KEY_ENV")
-        .env_remove("BETR_CASSETTE")
-        .output()
-        .unwrap()
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
 #[test]
 fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
     let scenarios = resolvable_scenarios();
@@ -97,6 +58,7 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
     let files = fixtures::all();
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let dir = tmp("cli");
+    let mut calls = 0;
     for path in &scenarios {
         let rel = relative(path);
         assert!(
@@ -134,6 +96,7 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
             ],
         );
         let log = text(&out);
+        calls += log.matches("\n→ asking for ").count();
         // Shown with `cargo test --test resolve_loop -- --nocapture`.
         println!("$ betr resolve {rel} --yes ...\n{log}");
         assert_eq!(out.status.code(), Some(0), "{rel}:\n{log}");
@@ -169,7 +132,8 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
     }
     // Every call was accounted.
     let usage = std::fs::read_to_string(dir.join("usage.jsonl")).unwrap();
-    assert_eq!(usage.lines().count(), 2 * scenarios.len(), "{usage}");
+    assert!(calls >= 2 * scenarios.len());
+    assert_eq!(usage.lines().count(), calls, "{usage}");
     assert!(usage.contains("\"source\":\"hand-written\""));
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -326,113 +290,4 @@ fn a_recorded_cassette_replays_without_a_server_and_misses_loudly() {
         text(&out)
     );
     std::fs::remove_dir_all(&dir).unwrap();
-}
-
-#[test]
-fn the_api_key_appears_in_no_file_the_run_wrote() {
-    let dir = tmp("key");
-    std::fs::write(
-        dir.join("betr.toml"),
-        format!("[llm]\nmodel = \"fake-model\"\napi_key_env = \"{KEY_VAR}\"\n"),
-    )
-    .unwrap();
-    let scenario = fixtures::root().join("scenarios/cafe/no_coffee.toml");
-    let scenario_s = scenario.to_string_lossy().to_string();
-    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
-    let base = server.base_url();
-    // Default paths: ./betr.toml is read, the usage log goes to $XDG_STATE_HOME, the tree to policies/.
-    let out = betr(
-        &dir,
-        &[
-            "resolve",
-            &scenario_s,
-            "--yes",
-            "--base-url",
-            &base,
-            "--cassette",
-            "rec.jsonl",
-        ],
-    );
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
-    let out = betr(
-        &dir,
-        &[
-            "interpret",
-            &scenario_s,
-            "--base-url",
-            &base,
-            "--show-replies",
-        ],
-    );
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
-    assert!(!text(&out).contains(KEY));
-    // A server that rejects the key (and echoes it back): the error names the variable only,
-    // and an existing tree file is left as it was.
-    std::fs::write(dir.join("keep.bt"), "unchanged").unwrap();
-    let bad = FakeServer::start(vec![], Behavior::Unauthorized);
-    let bad_base = bad.base_url();
-    let out = betr(
-        &dir,
-        &[
-            "resolve",
-            &scenario_s,
-            "--yes",
-            "--base-url",
-            &bad_base,
-            "--save",
-            "keep.bt",
-        ],
-    );
-    let log = text(&out);
-    assert_eq!(out.status.code(), Some(2), "{log}");
-    assert!(log.contains(KEY_VAR) && !log.contains(KEY), "{log}");
-    assert_eq!(
-        std::fs::read_to_string(dir.join("keep.bt")).unwrap(),
-        "unchanged"
-    );
-    // The key really was sent, so its absence from the files means something.
-    let sent = server.received();
-    assert!(
-        sent.iter()
-            .all(|r| r.header("authorization") == Some(format!("Bearer {KEY}").as_str()))
-    );
-
-    let mut written = Vec::new();
-    scenario_files_all(&dir, &mut written);
-    let names: Vec<String> = written.iter().map(|p| relative_to(p, &dir)).collect();
-    for expected in [
-        "betr.toml",
-        "rec.jsonl",
-        "state/betr/usage.jsonl",
-        "policies/no_coffee.bt",
-    ] {
-        assert!(
-            names.iter().any(|n| n == expected),
-            "{expected} not written; files: {names:?}"
-        );
-    }
-    for file in &written {
-        let bytes = std::fs::read(file).unwrap();
-        let hay = String::from_utf8_lossy(&bytes);
-        assert!(!hay.contains(KEY), "the key is in {}", file.display());
-    }
-    std::fs::remove_dir_all(&dir).unwrap();
-}
-
-fn scenario_files_all(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap().filter_map(Result::ok) {
-        let p = e.path();
-        if p.is_dir() {
-            scenario_files_all(&p, out);
-        } else {
-            out.push(p);
-        }
-    }
-}
-
-fn relative_to(p: &Path, base: &Path) -> String {
-    p.strip_prefix(base)
-        .unwrap_or(p)
-        .to_string_lossy()
-        .replace('\\', "/")
 }

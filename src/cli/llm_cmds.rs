@@ -22,7 +22,8 @@ pub struct LlmFlags {
     /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Which model answers: openai (any OpenAI-compatible server), local (issue 5), replay.
+    /// Which model answers: openai (any OpenAI-compatible server), local (issue 5), replay
+    /// [env: BETR_BACKEND].
     #[arg(long, value_name = "openai|local|replay")]
     pub backend: Option<String>,
     /// Server base URL including /v1, e.g. http://127.0.0.1:8080/v1 [env: BETR_BASE_URL].
@@ -31,16 +32,19 @@ pub struct LlmFlags {
     /// Model name [env: BETR_MODEL].
     #[arg(long, value_name = "NAME")]
     pub model: Option<String>,
-    /// NAME of the environment variable holding the API key (default OPENAI_API_KEY).
+    /// NAME of the environment variable holding the API key (default OPENAI_API_KEY)
+    /// [env: BETR_API_KEY_ENV].
     #[arg(long, value_name = "VAR")]
     pub api_key_env: Option<String>,
-    /// Cassette: replayed with --backend replay, else every exchange is recorded to it.
+    /// Cassette: replayed with --backend replay, else every exchange is recorded to it
+    /// [env: BETR_CASSETTE].
     #[arg(long, value_name = "FILE")]
     pub cassette: Option<PathBuf>,
-    /// Constrain replies to the vocabulary with a JSON schema (servers with response_format).
+    /// Constrain replies to the vocabulary with a JSON schema (servers with response_format)
+    /// [env: BETR_STRUCTURED].
     #[arg(long)]
     pub structured: bool,
-    /// Append usage records here instead of $XDG_STATE_HOME/betr/usage.jsonl.
+    /// Append usage records here instead of $XDG_STATE_HOME/betr/usage.jsonl [env: BETR_USAGE_LOG].
     #[arg(long, value_name = "FILE")]
     pub usage_log: Option<PathBuf>,
     /// Request timeout in seconds.
@@ -366,7 +370,16 @@ fn print_event_line(event: &Event) {
         }
         Event::Approved => {}
         Event::Rejected => println!("Not approved; stopping."),
-        Event::Repaired { added_nodes } => println!("Repaired: {added_nodes} node(s) added"),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes: 0,
+        } => println!("Repaired: {added_nodes} node(s) added"),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes,
+        } => {
+            println!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
+        }
         Event::DidNotHelp { reason } => {
             println!("The change did not help and was undone: {reason}")
         }

@@ -337,6 +337,16 @@ mod tests {
     }
 
     #[test]
+    fn the_documented_example_is_valid() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("betr.example.toml");
+        let file = FileConfig::read(&path).unwrap();
+        assert_eq!(file.llm.backend, Some(Backend::Openai));
+        assert!(file.prices.price("gpt-4o-2024-08-06").is_some());
+        let s = Settings::resolve(Some((&path, file)), Layer::default(), Layer::default()).unwrap();
+        assert_eq!(s.retry.max_retries, 3);
+    }
+
+    #[test]
     fn keys_and_bad_values_are_refused() {
         let dir = std::env::temp_dir().join(format!("betr-config-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

@@ -87,7 +87,7 @@ pub async fn resolve(
             break Ending::Rejected;
         }
         emit(&Event::Approved);
-        let next = match apply(&planner, &plan.tree, &proposal, world.as_ref()) {
+        let (next, valued_nodes) = match apply(&planner, &plan.tree, &proposal, world.as_ref()) {
             Ok(next) => next,
             Err(e) => {
                 emit(&Event::DidNotHelp {
@@ -100,6 +100,7 @@ pub async fn resolve(
             Ok(()) => {
                 emit(&Event::Repaired {
                     added_nodes: next.new_nodes.len(),
+                    valued_nodes,
                 });
                 repairs += 1;
                 plan = next;
@@ -128,11 +129,11 @@ fn apply(
     tree: &Tree,
     proposal: &Proposal,
     world: &dyn World,
-) -> Result<Plan, RepairError> {
+) -> Result<(Plan, usize), RepairError> {
     match proposal {
         Proposal::Conditions {
             node, conditions, ..
-        } => planner.repair(tree.clone(), *node, conditions, world),
+        } => Ok((planner.repair(tree.clone(), *node, conditions, world)?, 0)),
         Proposal::Value {
             skill,
             object,
@@ -140,8 +141,8 @@ fn apply(
             value,
         } => {
             let mut tree = tree.clone();
-            crate::planner::set_value(&mut tree, skill, object, param, value);
-            Ok(planner.grow(tree, world))
+            let changed = crate::planner::set_value(&mut tree, skill, object, param, value);
+            Ok((planner.grow(tree, world), changed))
         }
     }
 }

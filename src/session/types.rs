@@ -123,9 +123,11 @@ pub enum Event {
     },
     Approved,
     Rejected,
-    /// The tree was changed: how many nodes were added.
+    /// The tree was changed: how many nodes were added, and on how many actions a value
+    /// was set.
     Repaired {
         added_nodes: usize,
+        valued_nodes: usize,
     },
     /// The approved proposal did not change the failure; it was undone.
     DidNotHelp {
