@@ -12,10 +12,9 @@ pub mod dataset;
 pub mod domain;
 pub mod eval;
 pub mod goal;
-pub mod llm {
-    pub mod grammar;
-}
+pub mod llm;
 pub mod model;
 pub mod planner;
+pub mod session;
 pub mod store;
 pub mod world;

@@ -1,6 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
 mod eval_cmd;
+mod llm_cmds;
 mod model_cmd;
 mod tree_cmds;
 
@@ -77,6 +78,34 @@ pub enum Command {
         #[arg(long)]
         save: Option<PathBuf>,
     },
+    /// Ask a language model for the goal an instruction means in the scenario.
+    Interpret {
+        scenario: PathBuf,
+        /// The instruction (default: the scenario's).
+        instruction: Option<String>,
+        #[command(flatten)]
+        llm: llm_cmds::LlmFlags,
+    },
+    /// Interpret the scenario's instruction, plan, simulate; on each failure ask the model
+    /// for the missing preconditions (or parameter value), ask for approval, repair, re-run;
+    /// save the tree that succeeds.
+    Resolve {
+        scenario: PathBuf,
+        /// An instruction instead of the scenario's.
+        #[arg(long)]
+        instruction: Option<String>,
+        /// Approve every proposal without asking.
+        #[arg(long, short = 'y')]
+        yes: bool,
+        /// Questions about failures before giving up.
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// Where to save the final tree (default: policies/<scenario>.bt on success).
+        #[arg(long)]
+        save: Option<PathBuf>,
+        #[command(flatten)]
+        llm: llm_cmds::LlmFlags,
+    },
 }
 
 #[derive(Subcommand)]
@@ -140,6 +169,30 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Model {
             action: ModelAction::Verify { model },
         } => model_cmd::verify(model.as_deref()),
+        Command::Interpret {
+            scenario,
+            instruction,
+            llm,
+        } => llm_cmds::interpret(&load(&scenario)?, instruction.as_deref(), &llm),
+        Command::Resolve {
+            scenario,
+            instruction,
+            yes,
+            max_rounds,
+            save,
+            llm,
+        } => llm_cmds::resolve(
+            &load(&scenario)?,
+            &llm_cmds::ResolveArgs {
+                instruction: instruction.as_deref(),
+                yes,
+                max_rounds,
+                save: save.as_deref(),
+                scenario_path: &scenario,
+            },
+            &llm,
+            glyphs,
+        ),
         Command::Plan { scenario, goal } => {
             tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
         }

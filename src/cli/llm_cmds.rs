@@ -1,0 +1,398 @@
+//! `betr interpret` and `betr resolve`: the commands that ask a language model.
+
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context as _, Result};
+use clap::Args;
+
+use betr::bt::{self, Glyphs};
+use betr::domain::{Example, Scenario};
+use betr::llm::LanguageModel;
+use betr::llm::config::{Backend, FileConfig, Layer, Settings};
+use betr::llm::prompt::{Templates, Variant};
+use betr::llm::usage::{Ledger, Metered};
+use betr::session::{self, Ending, Event, Options};
+
+/// Flags shared by every command that asks a language model. Each overrides the
+/// matching `BETR_*` variable, which overrides `betr.toml`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct LlmFlags {
+    /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Which model answers: openai (any OpenAI-compatible server), local (issue 5), replay
+    /// [env: BETR_BACKEND].
+    #[arg(long, value_name = "openai|local|replay")]
+    pub backend: Option<String>,
+    /// Server base URL including /v1, e.g. http://127.0.0.1:8080/v1 [env: BETR_BASE_URL].
+    #[arg(long, value_name = "URL")]
+    pub base_url: Option<String>,
+    /// Model name [env: BETR_MODEL].
+    #[arg(long, value_name = "NAME")]
+    pub model: Option<String>,
+    /// NAME of the environment variable holding the API key (default OPENAI_API_KEY)
+    /// [env: BETR_API_KEY_ENV].
+    #[arg(long, value_name = "VAR")]
+    pub api_key_env: Option<String>,
+    /// Cassette: replayed with --backend replay, else every exchange is recorded to it
+    /// [env: BETR_CASSETTE].
+    #[arg(long, value_name = "FILE")]
+    pub cassette: Option<PathBuf>,
+    /// Constrain replies to the vocabulary with a JSON schema (servers with response_format)
+    /// [env: BETR_STRUCTURED].
+    #[arg(long)]
+    pub structured: bool,
+    /// Append usage records here instead of $XDG_STATE_HOME/betr/usage.jsonl [env: BETR_USAGE_LOG].
+    #[arg(long, value_name = "FILE")]
+    pub usage_log: Option<PathBuf>,
+    /// Request timeout in seconds.
+    #[arg(long, value_name = "SECS")]
+    pub timeout: Option<f64>,
+    /// Retries of HTTP 429 / 5xx replies.
+    #[arg(long, value_name = "N")]
+    pub max_retries: Option<u32>,
+    /// Sampling temperature.
+    #[arg(long)]
+    pub temperature: Option<f32>,
+    /// Ablation: leave the condition descriptions out of the prompt.
+    #[arg(long)]
+    pub no_descriptions: bool,
+    /// Ablation: leave out the rule that only listed objects may be used.
+    #[arg(long)]
+    pub no_object_rule: bool,
+    /// Ablation: ask for reasoning before the goal (chain of thought).
+    #[arg(long)]
+    pub cot: bool,
+    /// Ablation: examples from this TOML file ([[examples]] instruction, goal) instead of
+    /// the scenario's, e.g. the original prompt's examples.
+    #[arg(long, value_name = "FILE")]
+    pub examples: Option<PathBuf>,
+    /// Read goal.md, resolve.md and value.md from this directory instead of the built-in prompts.
+    #[arg(long, value_name = "DIR")]
+    pub prompts: Option<PathBuf>,
+    /// Print each reply's raw text too.
+    #[arg(long)]
+    pub show_replies: bool,
+}
+
+/// The configured model and its ledger.
+struct Llm {
+    model: Metered<Box<dyn LanguageModel>>,
+    options: Options,
+}
+
+fn setup(flags: &LlmFlags) -> Result<Llm> {
+    let var = |k: &str| std::env::var(k).ok();
+    let file = match FileConfig::locate(flags.config.as_deref(), &var) {
+        Some(path) => Some((FileConfig::read(&path)?, path)),
+        None => None,
+    };
+    let flag_layer = Layer {
+        backend: flags
+            .backend
+            .as_deref()
+            .map(str::parse::<Backend>)
+            .transpose()
+            .map_err(|e| anyhow::anyhow!("--backend: {e}"))?,
+        base_url: flags.base_url.clone(),
+        model: flags.model.clone(),
+        api_key_env: flags.api_key_env.clone(),
+        structured: flags.structured.then_some(true),
+        temperature: flags.temperature,
+        timeout_secs: flags.timeout,
+        max_retries: flags.max_retries,
+        cassette: flags.cassette.clone(),
+        usage_log: flags.usage_log.clone(),
+        ..Layer::default()
+    };
+    let settings = Settings::resolve(
+        file.as_ref().map(|(f, p)| (p.as_path(), f.clone())),
+        Layer::from_env(&var)?,
+        flag_layer,
+    )?;
+    let ledger = Ledger::new(settings.usage_log.clone());
+    let model = settings.build(ledger, &var)?;
+    let examples = flags.examples.as_deref().map(read_examples).transpose()?;
+    let templates = match &flags.prompts {
+        Some(dir) => Templates::from_dir(dir)?,
+        None => Templates::builtin(),
+    };
+    let options = Options {
+        temperature: settings.temperature,
+        max_tokens: settings.max_tokens,
+        structured: settings.structured,
+        templates,
+        variant: Variant {
+            no_descriptions: flags.no_descriptions,
+            no_object_rule: flags.no_object_rule,
+            chain_of_thought: flags.cot,
+            examples,
+        },
+        ..Options::default()
+    };
+    Ok(Llm { model, options })
+}
+
+fn read_examples(path: &Path) -> Result<Vec<Example>> {
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct File {
+        examples: Vec<Raw>,
+    }
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Raw {
+        instruction: String,
+        goal: String,
+    }
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let file: File = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
+    Ok(file
+        .examples
+        .into_iter()
+        .map(|r| Example {
+            instruction: r.instruction,
+            goal: r.goal,
+        })
+        .collect())
+}
+
+fn runtime() -> Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the async runtime")
+}
+
+pub fn interpret(
+    scenario: &Scenario,
+    instruction: Option<&str>,
+    flags: &LlmFlags,
+) -> Result<ExitCode> {
+    let llm = setup(flags)?;
+    let instruction = instruction
+        .map(str::to_string)
+        .or_else(|| scenario.instruction.clone())
+        .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
+    let world = betr::world::load(scenario)?;
+    llm.model.set_purpose("interpret");
+    println!("Scenario:    {}", scenario.name);
+    println!("Instruction: {instruction}");
+    let mut emit = |e: &Event| print_event(e, flags.show_replies);
+    let result = runtime()?.block_on(session::interpret(
+        scenario,
+        &world.facts(),
+        &instruction,
+        &llm.model,
+        &llm.options,
+        &mut emit,
+    ));
+    print_usage(&llm.model);
+    result?;
+    Ok(ExitCode::SUCCESS)
+}
+
+pub struct ResolveArgs<'a> {
+    pub instruction: Option<&'a str>,
+    pub yes: bool,
+    pub max_rounds: usize,
+    pub save: Option<&'a Path>,
+    pub scenario_path: &'a Path,
+}
+
+pub fn resolve(
+    scenario: &Scenario,
+    args: &ResolveArgs,
+    flags: &LlmFlags,
+    glyphs: &Glyphs,
+) -> Result<ExitCode> {
+    let mut llm = setup(flags)?;
+    llm.options.max_rounds = args.max_rounds;
+    llm.model.set_purpose("resolve");
+    println!("Scenario:    {}", scenario.name);
+    if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
+        println!("Instruction: {i}");
+    }
+    let mut emit = |e: &Event| print_event(e, flags.show_replies);
+    let yes = args.yes;
+    let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
+    let result = runtime()?.block_on(session::resolve(
+        scenario,
+        args.instruction,
+        &llm.model,
+        &llm.options,
+        &mut approve,
+        &mut emit,
+    ));
+    let resolved = match result {
+        Ok(r) => r,
+        Err(e) => {
+            print_usage(&llm.model);
+            return Err(e.into());
+        }
+    };
+    println!();
+    let world = betr::world::load(scenario)?;
+    let mut sim = world.fork();
+    let report = betr::planner::run_tree(
+        &resolved.tree,
+        sim.as_mut(),
+        &scenario.domain,
+        10_000,
+        |_, _| true,
+    );
+    for line in bt::render(&resolved.tree, report.last.as_ref(), glyphs) {
+        println!("{line}");
+    }
+    let success = matches!(resolved.ending, Ending::Success { .. });
+    let save = match args.save {
+        Some(p) => Some(p.to_path_buf()),
+        None if success => Some(default_policy_path(args.scenario_path)),
+        None => None,
+    };
+    match save {
+        Some(path) if success || resolved.repairs > 0 => {
+            betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
+                .with_context(|| format!("saving the tree to {}", path.display()))?;
+            let note = if success { "" } else { " (it still fails)" };
+            println!("\nSaved the tree to {}{note}", path.display());
+        }
+        _ => println!("\nNothing saved: no change was kept."),
+    }
+    println!(
+        "{} question(s) about failures, {} change(s) kept",
+        resolved.rounds, resolved.repairs
+    );
+    print_usage(&llm.model);
+    Ok(if success {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn default_policy_path(scenario: &Path) -> PathBuf {
+    let stem = scenario
+        .file_stem()
+        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+    Path::new("policies").join(format!("{stem}.bt"))
+}
+
+fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {
+    if yes {
+        println!("Approve? yes (--yes)");
+        return true;
+    }
+    print!("Approve: {proposal}? [y/N] ");
+    let _ = std::io::stdout().flush();
+    let mut line = String::new();
+    match std::io::stdin().lock().read_line(&mut line) {
+        Ok(0) | Err(_) => {
+            println!("(no answer: not approved)");
+            false
+        }
+        Ok(_) => matches!(line.trim().to_ascii_lowercase().as_str(), "y" | "yes"),
+    }
+}
+
+fn print_event(event: &Event, show_replies: bool) {
+    match event {
+        Event::Replied { text, .. } if show_replies => {
+            print_event_line(event);
+            println!("  ┌ reply text\n{}\n  └", indent(text));
+        }
+        _ => print_event_line(event),
+    }
+}
+
+fn indent(text: &str) -> String {
+    text.lines()
+        .map(|l| format!("  │ {l}"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn print_event_line(event: &Event) {
+    match event {
+        Event::Asking { what } => println!("\n→ asking for {what}"),
+        Event::Replied {
+            attribution,
+            prompt_tokens,
+            completion_tokens,
+            latency_ms,
+            ..
+        } => println!(
+            "  reply from {attribution}: {prompt_tokens} prompt + {completion_tokens} completion tokens, {:.2} s",
+            *latency_ms as f64 / 1000.0
+        ),
+        Event::InvalidReply { error } => println!("  unusable reply: {error}"),
+        Event::Goal {
+            goal,
+            reasoning,
+            substitutions,
+            matches_expected,
+        } => {
+            if let Some(r) = reasoning {
+                println!("Reasoning: {r}");
+            }
+            for s in substitutions {
+                println!("  note: {s}");
+            }
+            let check = match matches_expected {
+                Some(true) => "  (equivalent to the scenario's goal)",
+                Some(false) => "  (differs from the scenario's goal)",
+                None => "",
+            };
+            println!("Goal: {goal}{check}");
+        }
+        Event::ActionFailed {
+            action,
+            node_path,
+            error,
+        } => {
+            println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
+        }
+        Event::Proposal {
+            proposal,
+            reasoning,
+            substitutions,
+        } => {
+            if let Some(r) = reasoning {
+                println!("Reasoning: {r}");
+            }
+            for s in substitutions {
+                println!("  note: {s}");
+            }
+            println!("Proposal: {proposal}");
+        }
+        Event::Approved => {}
+        Event::Rejected => println!("Not approved; stopping."),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes: 0,
+        } => println!("Repaired: {added_nodes} node(s) added"),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes,
+        } => {
+            println!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
+        }
+        Event::DidNotHelp { reason } => {
+            println!("The change did not help and was undone: {reason}")
+        }
+        Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
+        Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+    }
+}
+
+fn print_usage(model: &Metered<Box<dyn LanguageModel>>) {
+    let ledger = model.ledger();
+    let log = ledger
+        .log_path()
+        .map(|p| format!("; logged to {}", p.display()))
+        .unwrap_or_default();
+    println!("LLM usage: {}{log}", ledger.totals());
+}

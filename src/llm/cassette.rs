@@ -1,0 +1,260 @@
+//! Record and replay. A cassette is a JSONL file; each line holds one request and its
+//! reply, keyed by (model, prompt hash), and names the model that produced the reply (or
+//! says the reply was hand-written). Recording wraps a live backend and appends; replay
+//! answers from the file and fails loudly on a miss, never calling a model.
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use super::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, ReplySource, TokenUsage};
+
+/// One line of a cassette.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Entry {
+    /// The model the request was made for.
+    pub model: String,
+    /// The model the reply says produced it.
+    #[serde(default)]
+    pub reply_model: String,
+    pub prompt_hash: String,
+    pub request: ChatRequest,
+    pub reply: String,
+    pub usage: TokenUsage,
+    pub latency_ms: u64,
+    pub source: ReplySource,
+    pub recorded_unix: u64,
+}
+
+/// The key of a request: the SHA-256 of its canonical JSON (messages, temperature, token
+/// limit, stop sequences and output constraint), in hex.
+pub fn prompt_hash(request: &ChatRequest) -> String {
+    let canonical = serde_json::to_string(request).unwrap_or_default();
+    let digest = Sha256::digest(canonical.as_bytes());
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Wraps a backend and appends every successful exchange to a cassette.
+pub struct Recorder<M> {
+    inner: M,
+    path: PathBuf,
+    lock: std::sync::Mutex<()>,
+}
+
+impl<M: LanguageModel> Recorder<M> {
+    pub fn new(inner: M, path: impl Into<PathBuf>) -> Self {
+        Recorder {
+            inner,
+            path: path.into(),
+            lock: std::sync::Mutex::new(()),
+        }
+    }
+
+    async fn call(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
+        let reply = self.inner.chat(request).await?;
+        let entry = Entry {
+            model: self.inner.model().to_string(),
+            reply_model: reply.model.clone(),
+            prompt_hash: prompt_hash(request),
+            request: request.clone(),
+            reply: reply.text.clone(),
+            usage: reply.usage,
+            latency_ms: u64::try_from(reply.latency.as_millis()).unwrap_or(u64::MAX),
+            source: reply.source.clone(),
+            recorded_unix: super::usage::unix_now(),
+        };
+        self.append(&entry)?;
+        Ok(reply)
+    }
+
+    fn append(&self, entry: &Entry) -> Result<(), LlmError> {
+        let err = |e: String| LlmError::Cassette {
+            path: self.path.display().to_string(),
+            detail: e,
+        };
+        let line = serde_json::to_string(entry).map_err(|e| err(e.to_string()))?;
+        let _guard = self.lock.lock().map_err(|_| err("lock poisoned".into()))?;
+        if let Some(dir) = self.path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
+        }
+        let mut f = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&self.path)
+            .map_err(|e| err(e.to_string()))?;
+        writeln!(f, "{line}").map_err(|e| err(e.to_string()))
+    }
+}
+
+impl<M: LanguageModel> LanguageModel for Recorder<M> {
+    fn model(&self) -> &str {
+        self.inner.model()
+    }
+    fn supports_constraint(&self) -> bool {
+        self.inner.supports_constraint()
+    }
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(self.call(request))
+    }
+}
+
+/// Answers from a cassette.
+#[derive(Debug)]
+pub struct Replay {
+    path: PathBuf,
+    model: String,
+    structured: bool,
+    entries: HashMap<(String, String), Entry>,
+}
+
+impl Replay {
+    /// Read a cassette. `model` selects the recordings of that model; without it, the
+    /// cassette must hold exactly one model.
+    pub fn open(path: &Path, model: Option<&str>, structured: bool) -> Result<Replay, LlmError> {
+        let err = |detail: String| LlmError::Cassette {
+            path: path.display().to_string(),
+            detail,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let mut entries = HashMap::new();
+        for (i, line) in text.lines().enumerate() {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let entry: Entry =
+                serde_json::from_str(line).map_err(|e| err(format!("line {}: {e}", i + 1)))?;
+            entries.insert((entry.model.clone(), entry.prompt_hash.clone()), entry);
+        }
+        let mut models: Vec<&str> = entries.keys().map(|(m, _)| m.as_str()).collect();
+        models.sort_unstable();
+        models.dedup();
+        let model = match (model, models.as_slice()) {
+            (Some(m), _) => m.to_string(),
+            (None, [only]) => (*only).to_string(),
+            (None, []) => return Err(err("the cassette is empty".into())),
+            (None, many) => {
+                return Err(err(format!(
+                    "the cassette holds several models ({}); choose one with --model",
+                    many.join(", ")
+                )));
+            }
+        };
+        Ok(Replay {
+            path: path.to_path_buf(),
+            model,
+            structured,
+            entries,
+        })
+    }
+
+    fn answer(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
+        let started = Instant::now();
+        let hash = prompt_hash(request);
+        let Some(entry) = self.entries.get(&(self.model.clone(), hash.clone())) else {
+            return Err(LlmError::CassetteMiss {
+                path: self.path.display().to_string(),
+                model: self.model.clone(),
+                hash,
+            });
+        };
+        let source = match &entry.source {
+            ReplySource::Model | ReplySource::Recorded => ReplySource::Recorded,
+            hand @ ReplySource::HandWritten { .. } => hand.clone(),
+        };
+        Ok(ChatReply {
+            text: entry.reply.clone(),
+            model: if entry.reply_model.is_empty() {
+                entry.model.clone()
+            } else {
+                entry.reply_model.clone()
+            },
+            usage: entry.usage,
+            latency: started.elapsed(),
+            source,
+        })
+    }
+}
+
+impl LanguageModel for Replay {
+    fn model(&self) -> &str {
+        &self.model
+    }
+    fn supports_constraint(&self) -> bool {
+        self.structured
+    }
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(std::future::ready(self.answer(request)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::llm::Message;
+    use std::time::Duration;
+
+    struct Echo;
+    impl LanguageModel for Echo {
+        fn model(&self) -> &str {
+            "echo-1"
+        }
+        fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+            let text = request.messages[0].content.to_uppercase();
+            Box::pin(async move {
+                Ok(ChatReply {
+                    text,
+                    model: "echo-1".into(),
+                    usage: TokenUsage {
+                        prompt_tokens: 4,
+                        completion_tokens: 2,
+                    },
+                    latency: Duration::from_millis(3),
+                    source: ReplySource::Model,
+                })
+            })
+        }
+    }
+
+    fn block<F: std::future::Future>(f: F) -> F::Output {
+        tokio::runtime::Builder::new_current_thread()
+            .build()
+            .unwrap()
+            .block_on(f)
+    }
+
+    #[test]
+    fn records_then_replays_and_misses_loudly() {
+        let dir = std::env::temp_dir().join(format!("betr-cassette-{}", std::process::id()));
+        let path = dir.join("c.jsonl");
+        let _ = std::fs::remove_file(&path);
+        let a = ChatRequest::new(vec![Message::user("goal please")]);
+        let b = ChatRequest::new(vec![Message::user("other")]);
+        let rec = Recorder::new(Echo, &path);
+        assert_eq!(block(rec.chat(&a)).unwrap().text, "GOAL PLEASE");
+        let replay = Replay::open(&path, None, false).unwrap();
+        assert_eq!(replay.model(), "echo-1");
+        let r = block(replay.chat(&a)).unwrap();
+        assert_eq!(r.text, "GOAL PLEASE");
+        assert_eq!(r.source, ReplySource::Recorded);
+        assert!(r.attribution().contains("echo-1"));
+        let miss = block(replay.chat(&b)).unwrap_err();
+        assert!(matches!(miss, LlmError::CassetteMiss { .. }), "{miss}");
+        let other = Replay::open(&path, Some("gpt-x"), false).unwrap();
+        assert!(block(other.chat(&a)).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn hash_depends_on_the_whole_request() {
+        let a = ChatRequest::new(vec![Message::user("x")]);
+        let mut b = a.clone();
+        b.temperature = 0.5;
+        assert_ne!(prompt_hash(&a), prompt_hash(&b));
+        assert_eq!(prompt_hash(&a), prompt_hash(&a.clone()));
+        assert_eq!(prompt_hash(&a).len(), 64);
+    }
+}

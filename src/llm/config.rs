@@ -1,0 +1,371 @@
+//! Settings of the language-model layer, from four layers, later ones overriding earlier
+//! ones: built-in defaults, a TOML file (`betr.toml`; see `betr.example.toml`), `BETR_*`
+//! environment variables, and command-line flags.
+//!
+//! The API key itself is never configured here: only the NAME of the environment variable
+//! that holds it. A file that contains a key is refused.
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use serde::Deserialize;
+
+use super::cassette::{Recorder, Replay};
+use super::openai::{ApiKey, AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
+use super::usage::{Ledger, Metered, PriceTable};
+use super::{LanguageModel, LlmError};
+
+/// Which backend answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// An OpenAI-compatible HTTP server.
+    Openai,
+    /// The embedded model (issue 5, not built yet).
+    Local,
+    /// Answers from a cassette only.
+    Replay,
+}
+
+impl std::str::FromStr for Backend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "openai" => Ok(Backend::Openai),
+            "local" => Ok(Backend::Local),
+            "replay" => Ok(Backend::Replay),
+            other => Err(format!(
+                "unknown backend {other:?} (expected openai, local or replay)"
+            )),
+        }
+    }
+}
+
+/// One layer of settings: every field optional, `merge` lets a later layer win.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    pub backend: Option<Backend>,
+    pub base_url: Option<String>,
+    pub model: Option<String>,
+    pub api_key_env: Option<String>,
+    pub auth_header: Option<AuthHeader>,
+    pub structured: Option<bool>,
+    pub temperature: Option<f32>,
+    pub max_tokens: Option<u32>,
+    pub max_tokens_field: Option<String>,
+    pub timeout_secs: Option<f64>,
+    pub connect_timeout_secs: Option<f64>,
+    pub max_retries: Option<u32>,
+    pub initial_backoff_ms: Option<u64>,
+    pub max_backoff_ms: Option<u64>,
+    pub cassette: Option<PathBuf>,
+    pub usage_log: Option<PathBuf>,
+    /// Refused: keys belong in the environment.
+    pub api_key: Option<toml::Value>,
+}
+
+macro_rules! merge_fields {
+    ($self:ident, $other:ident, $($f:ident),*) => { $( if $other.$f.is_some() { $self.$f = $other.$f; } )* };
+}
+
+impl Layer {
+    pub fn merge(&mut self, other: Layer) {
+        merge_fields!(
+            self,
+            other,
+            backend,
+            base_url,
+            model,
+            api_key_env,
+            auth_header,
+            structured,
+            temperature,
+            max_tokens,
+            max_tokens_field,
+            timeout_secs,
+            connect_timeout_secs,
+            max_retries,
+            initial_backoff_ms,
+            max_backoff_ms,
+            cassette,
+            usage_log,
+            api_key
+        );
+    }
+
+    /// The `BETR_*` variables, read through `var`.
+    pub fn from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<Layer, LlmError> {
+        let get = |k: &str| var(k).filter(|v| !v.trim().is_empty());
+        let bool_var = |k: &str| -> Result<Option<bool>, LlmError> {
+            get(k)
+                .map(|v| match v.trim().to_ascii_lowercase().as_str() {
+                    "1" | "true" | "yes" => Ok(true),
+                    "0" | "false" | "no" => Ok(false),
+                    _ => Err(LlmError::Config(format!("{k}={v:?} is not true or false"))),
+                })
+                .transpose()
+        };
+        Ok(Layer {
+            backend: get("BETR_BACKEND")
+                .map(|b| {
+                    b.parse()
+                        .map_err(|e| LlmError::Config(format!("BETR_BACKEND: {e}")))
+                })
+                .transpose()?,
+            base_url: get("BETR_BASE_URL"),
+            model: get("BETR_MODEL"),
+            api_key_env: get("BETR_API_KEY_ENV"),
+            structured: bool_var("BETR_STRUCTURED")?,
+            cassette: get("BETR_CASSETTE").map(PathBuf::from),
+            usage_log: get("BETR_USAGE_LOG").map(PathBuf::from),
+            ..Layer::default()
+        })
+    }
+}
+
+/// The contents of `betr.toml`.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FileConfig {
+    #[serde(default)]
+    pub llm: Layer,
+    #[serde(default)]
+    pub prices: PriceTable,
+}
+
+impl FileConfig {
+    pub fn read(path: &Path) -> Result<FileConfig, LlmError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| LlmError::Config(format!("cannot read {}: {e}", path.display())))?;
+        let file: FileConfig = toml::from_str(&text)
+            .map_err(|e| LlmError::Config(format!("{}: {e}", path.display())))?;
+        if file.llm.api_key.is_some() {
+            return Err(LlmError::Config(format!(
+                "{}: `api_key` is not allowed in a file; put the key in an environment variable and name it with `api_key_env`",
+                path.display()
+            )));
+        }
+        Ok(file)
+    }
+
+    /// The file to read: `explicit`, else `$BETR_CONFIG`, else `./betr.toml`, else
+    /// `$XDG_CONFIG_HOME/betr/betr.toml` (or `~/.config/betr/betr.toml`), if it exists.
+    pub fn locate(
+        explicit: Option<&Path>,
+        var: &dyn Fn(&str) -> Option<String>,
+    ) -> Option<PathBuf> {
+        if let Some(p) = explicit {
+            return Some(p.to_path_buf());
+        }
+        if let Some(p) = var("BETR_CONFIG").filter(|v| !v.is_empty()) {
+            return Some(PathBuf::from(p));
+        }
+        let local = PathBuf::from("betr.toml");
+        if local.is_file() {
+            return Some(local);
+        }
+        let config_home = var("XDG_CONFIG_HOME")
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+            .or_else(|| var("HOME").map(|h| Path::new(&h).join(".config")))?;
+        Some(config_home.join("betr").join("betr.toml")).filter(|p| p.is_file())
+    }
+}
+
+/// Resolved settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub backend: Backend,
+    pub base_url: String,
+    pub model: Option<String>,
+    pub api_key_env: Option<String>,
+    pub auth_header: AuthHeader,
+    pub structured: bool,
+    pub temperature: f32,
+    pub max_tokens: u32,
+    pub max_tokens_field: String,
+    pub timeout: Duration,
+    pub connect_timeout: Duration,
+    pub retry: RetryPolicy,
+    pub cassette: Option<PathBuf>,
+    pub usage_log: Option<PathBuf>,
+    pub prices: PriceTable,
+    /// The file the settings came from, if any.
+    pub file: Option<PathBuf>,
+}
+
+impl Settings {
+    /// Defaults, then `file`, then `env`, then `flags`.
+    pub fn resolve(
+        file: Option<(&Path, FileConfig)>,
+        env: Layer,
+        flags: Layer,
+    ) -> Result<Settings, LlmError> {
+        let mut layer = Layer::default();
+        let (path, prices) = match file {
+            Some((p, f)) => {
+                layer.merge(f.llm);
+                (Some(p.to_path_buf()), f.prices)
+            }
+            None => (None, PriceTable::default()),
+        };
+        layer.merge(env);
+        layer.merge(flags);
+        let secs = |v: Option<f64>, default: f64, what: &str| {
+            let s = v.unwrap_or(default);
+            if s.is_finite() && s > 0.0 {
+                Ok(Duration::from_secs_f64(s))
+            } else {
+                Err(LlmError::Config(format!(
+                    "{what} must be a positive number of seconds"
+                )))
+            }
+        };
+        Ok(Settings {
+            backend: layer.backend.unwrap_or(Backend::Openai),
+            base_url: layer
+                .base_url
+                .unwrap_or_else(|| "https://api.openai.com/v1".into()),
+            model: layer.model,
+            api_key_env: match layer.api_key_env {
+                Some(v) if v.is_empty() => None,
+                Some(v) => Some(v),
+                None => Some("OPENAI_API_KEY".into()),
+            },
+            auth_header: layer.auth_header.unwrap_or(AuthHeader::Bearer),
+            structured: layer.structured.unwrap_or(false),
+            temperature: layer.temperature.unwrap_or(0.0),
+            max_tokens: layer.max_tokens.unwrap_or(800),
+            max_tokens_field: layer
+                .max_tokens_field
+                .unwrap_or_else(|| "max_tokens".into()),
+            timeout: secs(layer.timeout_secs, 60.0, "timeout_secs")?,
+            connect_timeout: secs(layer.connect_timeout_secs, 10.0, "connect_timeout_secs")?,
+            retry: RetryPolicy {
+                max_retries: layer.max_retries.unwrap_or(3),
+                initial_backoff: Duration::from_millis(layer.initial_backoff_ms.unwrap_or(500)),
+                max_backoff: Duration::from_millis(layer.max_backoff_ms.unwrap_or(20_000)),
+            },
+            cassette: layer.cassette,
+            usage_log: layer.usage_log.or_else(super::usage::default_log_path),
+            prices,
+            file: path,
+        })
+    }
+
+    /// Build the configured model, metered into `ledger`: a live backend records to the
+    /// cassette when one is set; replay answers only from it.
+    pub fn build(
+        &self,
+        ledger: Ledger,
+        var: &dyn Fn(&str) -> Option<String>,
+    ) -> Result<Metered<Box<dyn LanguageModel>>, LlmError> {
+        let model: Box<dyn LanguageModel> = match self.backend {
+            Backend::Local => return Err(LlmError::LocalNotBuilt),
+            Backend::Replay => {
+                let Some(cassette) = &self.cassette else {
+                    return Err(LlmError::Config(
+                        "--backend replay needs --cassette FILE (or BETR_CASSETTE)".into(),
+                    ));
+                };
+                Box::new(Replay::open(
+                    cassette,
+                    self.model.as_deref(),
+                    self.structured,
+                )?)
+            }
+            Backend::Openai => {
+                let Some(model) = self.model.clone() else {
+                    return Err(LlmError::Config(
+                        "no model configured: pass --model NAME, set BETR_MODEL, or set `model` under [llm] in betr.toml".into(),
+                    ));
+                };
+                let api_key = self
+                    .api_key_env
+                    .as_deref()
+                    .and_then(var)
+                    .filter(|k| !k.is_empty())
+                    .map(ApiKey::new);
+                let api_key_env = self.api_key_env.as_ref().map(|n| match api_key {
+                    Some(_) => n.clone(),
+                    None => format!("{n}, which is not set"),
+                });
+                let client = OpenAiClient::new(OpenAiSettings {
+                    base_url: self.base_url.clone(),
+                    model,
+                    api_key_env,
+                    api_key,
+                    auth_header: self.auth_header,
+                    timeout: self.timeout,
+                    connect_timeout: self.connect_timeout,
+                    retry: self.retry,
+                    structured: self.structured,
+                    max_tokens_field: self.max_tokens_field.clone(),
+                })?;
+                match &self.cassette {
+                    Some(path) => Box::new(Recorder::new(client, path)),
+                    None => Box::new(client),
+                }
+            }
+        };
+        Ok(Metered::new(model, ledger, self.prices.clone()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn later_layers_win() {
+        let file: FileConfig = toml::from_str(
+            "[llm]\nmodel = \"a\"\nbase_url = \"http://f/v1\"\nstructured = true\n[prices.a]\nprompt_per_mtok = 1.0\ncompletion_per_mtok = 2.0\n",
+        )
+        .unwrap();
+        let env = Layer::from_env(&|k| (k == "BETR_MODEL").then(|| "b".to_string())).unwrap();
+        let flags = Layer {
+            base_url: Some("http://flag/v1".into()),
+            ..Layer::default()
+        };
+        let s = Settings::resolve(Some((Path::new("betr.toml"), file)), env, flags).unwrap();
+        assert_eq!(s.model.as_deref(), Some("b"));
+        assert_eq!(s.base_url, "http://flag/v1");
+        assert!(s.structured);
+        assert!(s.prices.price("a").is_some());
+        assert_eq!(s.api_key_env.as_deref(), Some("OPENAI_API_KEY"));
+    }
+
+    #[test]
+    fn the_documented_example_is_valid() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("betr.example.toml");
+        let file = FileConfig::read(&path).unwrap();
+        assert_eq!(file.llm.backend, Some(Backend::Openai));
+        assert!(file.prices.price("gpt-4o-2024-08-06").is_some());
+        let s = Settings::resolve(Some((&path, file)), Layer::default(), Layer::default()).unwrap();
+        assert_eq!(s.retry.max_retries, 3);
+    }
+
+    #[test]
+    fn keys_and_bad_values_are_refused() {
+        let dir = std::env::temp_dir().join(format!("betr-config-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("betr.toml");
+        std::fs::write(&path, "[llm]\napi_key = \"sk-x\"\n").unwrap();
+        let e = FileConfig::read(&path).unwrap_err().to_string();
+        assert!(e.contains("api_key_env") && !e.contains("sk-x"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(Layer::from_env(&|k| (k == "BETR_BACKEND").then(|| "gpt".into())).is_err());
+        let local = Settings::resolve(
+            None,
+            Layer::default(),
+            Layer {
+                backend: Some(Backend::Local),
+                ..Layer::default()
+            },
+        )
+        .unwrap();
+        let e = local.build(Ledger::default(), &|_| None).err().unwrap();
+        assert!(e.to_string().contains("issue 5"));
+    }
+}

@@ -1,0 +1,364 @@
+//! Prompts: the three templates of `prompts/` (goal interpretation, failure resolution,
+//! parameter value) filled from a scenario, the facts true in the world now, and the
+//! failure being resolved.
+//!
+//! Every template has the same parts, following the BETR-XP-LLM paper's findings: a short
+//! role statement, the condition vocabulary with one-line descriptions, the objects and the
+//! rule that only listed objects may be used, a few examples, the scene as text and a strict
+//! answer format. [`Variant`] switches parts off for the ablations of the paper's Table III.
+
+use std::path::Path;
+
+use super::{ChatRequest, Message};
+use crate::domain::{ANY_OBJECT, ActionCall, Condition, Example, Scenario, ValueParam, Vocabulary};
+
+/// Which ablation of the prompt to write.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Variant {
+    /// Leave out the one-line descriptions of the conditions.
+    pub no_descriptions: bool,
+    /// Leave out the rule that only listed objects may be used.
+    pub no_object_rule: bool,
+    /// Ask for reasoning before the goal (the resolution and value prompts always do).
+    pub chain_of_thought: bool,
+    /// Examples to use instead of the scenario's (e.g. the original prompt's examples).
+    pub examples: Option<Vec<Example>>,
+}
+
+/// The three templates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Templates {
+    pub goal: String,
+    pub resolve: String,
+    pub value: String,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PromptError {
+    #[error("cannot read prompt template {path}: {detail}")]
+    Read { path: String, detail: String },
+    #[error("template {template}: unknown placeholder {{{{{name}}}}}")]
+    UnknownPlaceholder { template: String, name: String },
+    #[error("template {template}: unclosed {{{{ at byte {at}")]
+    Unclosed { template: String, at: usize },
+}
+
+impl Templates {
+    /// The templates shipped in `prompts/`, built into the program.
+    pub fn builtin() -> Templates {
+        Templates {
+            goal: include_str!("../../prompts/goal.md").to_string(),
+            resolve: include_str!("../../prompts/resolve.md").to_string(),
+            value: include_str!("../../prompts/value.md").to_string(),
+        }
+    }
+
+    /// `goal.md`, `resolve.md` and `value.md` from a directory (to edit prompts without
+    /// rebuilding).
+    pub fn from_dir(dir: &Path) -> Result<Templates, PromptError> {
+        let read = |name: &str| {
+            let path = dir.join(name);
+            std::fs::read_to_string(&path).map_err(|e| PromptError::Read {
+                path: path.display().to_string(),
+                detail: e.to_string(),
+            })
+        };
+        Ok(Templates {
+            goal: read("goal.md")?,
+            resolve: read("resolve.md")?,
+            value: read("value.md")?,
+        })
+    }
+}
+
+/// What every prompt is written from.
+pub struct Context<'a> {
+    pub scenario: &'a Scenario,
+    /// The conditions true in the world now.
+    pub facts: &'a [Condition],
+    pub instruction: &'a str,
+    pub variant: &'a Variant,
+}
+
+/// The role statement shared by all prompts (the system message).
+pub const ROLE: &str = "You are the reasoning part of a robot that plans with behavior trees. You answer in the exact format asked for, using only the conditions and objects you are given.";
+
+impl Context<'_> {
+    fn common(&self) -> Vec<(&'static str, String)> {
+        let vocabulary = &self.scenario.domain.vocabulary;
+        let examples = self
+            .variant
+            .examples
+            .as_deref()
+            .unwrap_or(&self.scenario.examples);
+        vec![
+            (
+                "vocabulary",
+                vocabulary_text(vocabulary, !self.variant.no_descriptions),
+            ),
+            ("objects", objects_text(vocabulary)),
+            (
+                "object_rule",
+                if self.variant.no_object_rule {
+                    String::new()
+                } else {
+                    OBJECT_RULE.to_string()
+                },
+            ),
+            ("examples", examples_text(examples)),
+            ("scene", scene_text(self.facts)),
+            ("instruction", self.instruction.trim().to_string()),
+        ]
+    }
+
+    /// The goal-interpretation request.
+    pub fn goal(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
+        let mut values = self.common();
+        values.push((
+            "answer_format",
+            if self.variant.chain_of_thought {
+                "First think about what the person wants, then give the goal, exactly like this:\nReasoning: <a few sentences>\nGoal: <formula>".into()
+            } else {
+                "Answer with exactly one line and nothing else:\nGoal: <formula>".into()
+            },
+        ));
+        Ok(messages(fill("goal.md", &templates.goal, &values)?))
+    }
+
+    /// The failure-resolution request for `action`, which failed with `error`.
+    pub fn resolve(
+        &self,
+        templates: &Templates,
+        action: &ActionCall,
+        error: &str,
+    ) -> Result<Vec<Message>, PromptError> {
+        let mut values = self.common();
+        let pre: Vec<String> = self
+            .scenario
+            .domain
+            .resolve(action)
+            .map(|g| g.pre.iter().map(ToString::to_string).collect())
+            .unwrap_or_default();
+        values.push(("action", action.to_string()));
+        values.push((
+            "action_preconditions",
+            if pre.is_empty() {
+                ", which the robot believed needs no preconditions".into()
+            } else {
+                format!(", which the robot believed needs only: {}", pre.join(", "))
+            },
+        ));
+        values.push(("error", error.trim().to_string()));
+        values.push((
+            "answer_format",
+            "Explain the cause first, then list the missing conditions, one per line, exactly like this:\nReasoning: <a few sentences>\nConditions:\n<condition>\n<condition, only if more than one is needed>".into(),
+        ));
+        Ok(messages(fill("resolve.md", &templates.resolve, &values)?))
+    }
+
+    /// The parameter-value request for `param` of `action` (`error`: what it reported).
+    pub fn value(
+        &self,
+        templates: &Templates,
+        action: &ActionCall,
+        param: &ValueParam,
+        error: &str,
+    ) -> Result<Vec<Message>, PromptError> {
+        let mut values = self.common();
+        values.push(("action", action.to_string()));
+        values.push((
+            "error_line",
+            if error.trim().is_empty() {
+                String::new()
+            } else {
+                format!("It reported: \"{}\"", error.trim())
+            },
+        ));
+        values.push(("parameter", parameter_text(param)));
+        let format = match &param.unit {
+            Some(unit) => format!(
+                "Explain your choice first, then give one number in {unit}, exactly like this:\nReasoning: <a few sentences>\nParameter value: <number> {unit}"
+            ),
+            None => format!(
+                "Explain your choice first, then give one of: {}, exactly like this:\nReasoning: <a few sentences>\nParameter value: <choice>",
+                param.categories.join(", ")
+            ),
+        };
+        values.push(("answer_format", format));
+        Ok(messages(fill("value.md", &templates.value, &values)?))
+    }
+}
+
+const OBJECT_RULE: &str = "Use only the objects listed above, spelled exactly as listed. If the person names something that is not listed, use the listed object most similar to it (for example, if they ask for fries and only Chips is listed, use Chips).";
+
+fn messages(user: String) -> Vec<Message> {
+    vec![Message::system(ROLE), Message::user(user)]
+}
+
+/// A request for `messages` with the given sampling settings.
+pub fn request(messages: Vec<Message>, temperature: f32, max_tokens: u32) -> ChatRequest {
+    let mut r = ChatRequest::new(messages);
+    r.temperature = temperature;
+    r.max_tokens = max_tokens;
+    r
+}
+
+/// Replace each `{{name}}` by its value; a name with no value is an error.
+pub fn fill(
+    template_name: &str,
+    template: &str,
+    values: &[(&str, String)],
+) -> Result<String, PromptError> {
+    let mut out = String::with_capacity(template.len() * 2);
+    let mut rest = template;
+    let mut offset = 0;
+    while let Some(open) = rest.find("{{") {
+        out.push_str(&rest[..open]);
+        let Some(close) = rest[open..].find("}}") else {
+            return Err(PromptError::Unclosed {
+                template: template_name.into(),
+                at: offset + open,
+            });
+        };
+        let name = rest[open + 2..open + close].trim();
+        let Some((_, value)) = values.iter().find(|(n, _)| *n == name) else {
+            return Err(PromptError::UnknownPlaceholder {
+                template: template_name.into(),
+                name: name.into(),
+            });
+        };
+        out.push_str(value);
+        offset += open + close + 2;
+        rest = &rest[open + close + 2..];
+    }
+    out.push_str(rest);
+    // An empty optional part leaves a blank line; keep at most one in a row.
+    let mut cleaned = String::with_capacity(out.len());
+    let mut blank = false;
+    for line in out.lines() {
+        let is_blank = line.trim().is_empty();
+        if !(is_blank && blank) {
+            cleaned.push_str(line);
+            cleaned.push('\n');
+        }
+        blank = is_blank;
+    }
+    Ok(cleaned)
+}
+
+/// One line per predicate: its written form with argument types, and its description;
+/// for quoted-form vocabularies, a line on the `"any object"` wildcard.
+pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
+    let mut text = predicate_lines(vocabulary, descriptions);
+    let binary = vocabulary
+        .predicates
+        .iter()
+        .find(|p| crate::domain::condition::is_word_predicate(&p.name) && p.arg_types.len() == 2);
+    if let Some(p) = binary
+        && let Some(object) = vocabulary.objects_fitting(&p.arg_types[1]).next()
+    {
+        text.push_str(&format!(
+            "\n\"{ANY_OBJECT}\" stands for some object, and negated for none: ~\"{ANY_OBJECT}\" {} \"{object}\" means that no object is {} \"{object}\".",
+            p.name, p.name
+        ));
+    }
+    text
+}
+
+fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
+    vocabulary
+        .predicates
+        .iter()
+        .map(|p| {
+            let slots: Vec<String> = p.arg_types.iter().map(|t| t.join("|")).collect();
+            let form = if crate::domain::condition::is_word_predicate(&p.name) {
+                let mut s = String::new();
+                if let Some(first) = slots.first() {
+                    s.push_str(&format!("\"<{first}>\" "));
+                }
+                s.push_str(&p.name);
+                for t in slots.iter().skip(1) {
+                    s.push_str(&format!(" \"<{t}>\""));
+                }
+                s
+            } else {
+                let mut s = p.name.clone();
+                for t in &slots {
+                    s.push_str(&format!("_<{t}>"));
+                }
+                s
+            };
+            if descriptions && !p.description.is_empty() {
+                format!("- {form}: {}", p.description)
+            } else {
+                format!("- {form}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The objects grouped by type, types in first-seen order.
+pub fn objects_text(vocabulary: &Vocabulary) -> String {
+    let mut types: Vec<&str> = Vec::new();
+    for o in &vocabulary.objects {
+        for t in &o.types {
+            if !types.contains(&t.as_str()) {
+                types.push(t);
+            }
+        }
+    }
+    types
+        .iter()
+        .map(|t| {
+            let names: Vec<&str> = vocabulary
+                .objects
+                .iter()
+                .filter(|o| o.types.iter().any(|ot| ot == t))
+                .map(|o| o.name.as_str())
+                .collect();
+            format!("- {t}: {}", names.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn examples_text(examples: &[Example]) -> String {
+    if examples.is_empty() {
+        return "(none)".into();
+    }
+    examples
+        .iter()
+        .map(|e| format!("Instruction: {}\nGoal: {}", e.instruction, e.goal))
+        .collect::<Vec<_>>()
+        .join("\n\n")
+}
+
+/// The facts true now, one per line; everything else is false.
+pub fn scene_text(facts: &[Condition]) -> String {
+    if facts.is_empty() {
+        return "No condition holds now.".into();
+    }
+    let lines: Vec<String> = facts.iter().map(|f| format!("- {f}")).collect();
+    format!(
+        "These conditions hold now; every other condition is false:\n{}",
+        lines.join("\n")
+    )
+}
+
+fn parameter_text(param: &ValueParam) -> String {
+    let mut s = format!("\"{}\"", param.name);
+    if let Some(unit) = &param.unit {
+        s.push_str(&format!(" (a number in {unit})"));
+    } else if !param.categories.is_empty() {
+        s.push_str(&format!(" (one of: {})", param.categories.join(", ")));
+    }
+    if !param.description.is_empty() {
+        s.push_str(&format!(": {}", param.description));
+    }
+    s
+}
+
+#[cfg(test)]
+#[path = "prompt_tests.rs"]
+mod tests;

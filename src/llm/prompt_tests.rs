@@ -1,0 +1,80 @@
+use super::*;
+use std::path::PathBuf;
+
+fn scenario() -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/no_coffee.toml");
+    Scenario::load(&path).unwrap()
+}
+
+#[test]
+fn goal_prompt_has_every_part() {
+    let s = scenario();
+    let facts = vec![Condition::parse("Holding_Nothing").unwrap()];
+    let variant = Variant::default();
+    let ctx = Context {
+        scenario: &s,
+        facts: &facts,
+        instruction: "Bring coffee to table six",
+        variant: &variant,
+    };
+    let m = ctx.goal(&Templates::builtin()).unwrap();
+    let text = &m[1].content;
+    for part in [
+        "On_<item>_<place>: the item is at the place",
+        "Bar, Bar2, WaterStation",
+        "most similar",
+        "Instruction: Could you put some water",
+        "- Holding_Nothing",
+        "Bring coffee to table six",
+        "Goal: <formula>",
+    ] {
+        assert!(text.contains(part), "missing {part:?} in\n{text}");
+    }
+    assert!(!text.contains("{{"));
+    let bare = Variant {
+        no_descriptions: true,
+        no_object_rule: true,
+        chain_of_thought: true,
+        examples: Some(vec![]),
+    };
+    let ctx = Context {
+        variant: &bare,
+        ..ctx
+    };
+    let text = ctx.goal(&Templates::builtin()).unwrap()[1].content.clone();
+    assert!(!text.contains("the item is at the place"));
+    assert!(!text.contains("most similar"));
+    assert!(text.contains("Reasoning:"));
+}
+
+#[test]
+fn resolve_prompt_names_the_failure() {
+    let s = scenario();
+    let variant = Variant::default();
+    let ctx = Context {
+        scenario: &s,
+        facts: &[],
+        instruction: "Bring coffee to table six",
+        variant: &variant,
+    };
+    let action = ActionCall::new("MoveTo", ["Coffee"]);
+    let text = ctx
+        .resolve(&Templates::builtin(), &action, "Coffee not found")
+        .unwrap()[1]
+        .content
+        .clone();
+    assert!(text.contains("`MoveTo \"Coffee\"`"));
+    assert!(text.contains("\"Coffee not found\""));
+    assert!(text.contains("Conditions:"));
+}
+
+#[test]
+fn fill_reports_unknown_placeholders() {
+    let e = fill("t", "a {{x}} b", &[]).unwrap_err();
+    assert!(e.to_string().contains("{{x}}"), "{e}");
+    assert!(fill("t", "a {{x", &[]).is_err());
+    assert_eq!(
+        fill("t", "a {{ x }}", &[("x", "1".into())]).unwrap(),
+        "a 1\n"
+    );
+}

@@ -1,0 +1,180 @@
+//! The vocabulary of sessions: options, proposals, events, endings and errors.
+
+use crate::bt::{NodeId, Tree};
+use crate::domain::{ActionCall, Condition, ScenarioError, Value};
+use crate::goal::Formula;
+use crate::llm::LlmError;
+use crate::llm::prompt::{PromptError, Templates, Variant};
+use crate::llm::reply::{self, ReplyError, Substitution};
+use crate::planner::RepairError;
+
+/// How the loop asks and how long it keeps trying.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Questions about failures (each reply, valid or not, is one round).
+    pub max_rounds: usize,
+    /// Attempts at reading the instruction as a goal.
+    pub interpret_attempts: usize,
+    pub temperature: f32,
+    pub max_tokens: u32,
+    pub min_similarity: f64,
+    pub variant: Variant,
+    pub templates: Templates,
+    /// Constrain replies with a JSON schema when the model supports it.
+    pub structured: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            max_rounds: 5,
+            interpret_attempts: 2,
+            temperature: 0.0,
+            max_tokens: 800,
+            min_similarity: reply::MIN_SIMILARITY,
+            variant: Variant::default(),
+            templates: Templates::builtin(),
+            structured: false,
+        }
+    }
+}
+
+/// What a model proposes for a failure.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Proposal {
+    /// Insert these as the first preconditions of the failing action.
+    Conditions {
+        action: ActionCall,
+        node: NodeId,
+        conditions: Vec<Condition>,
+    },
+    /// Set a value parameter on every node of `skill` acting on `object`.
+    Value {
+        skill: String,
+        object: String,
+        param: String,
+        value: Value,
+    },
+}
+
+impl std::fmt::Display for Proposal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Proposal::Conditions {
+                action, conditions, ..
+            } => {
+                let c: Vec<String> = conditions.iter().map(ToString::to_string).collect();
+                write!(
+                    f,
+                    "insert {} as the first precondition(s) of {action}!",
+                    c.join(" & ")
+                )
+            }
+            Proposal::Value {
+                skill,
+                object,
+                param,
+                value,
+            } => {
+                write!(f, "set {param} = {value} on every {skill} \"{object}\"")
+            }
+        }
+    }
+}
+
+/// What the loop reports, in order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// A question goes to the model (`what`: goal, conditions, or a parameter value).
+    Asking {
+        what: String,
+    },
+    /// A reply came back: who answered, its tokens and latency.
+    Replied {
+        attribution: String,
+        prompt_tokens: u64,
+        completion_tokens: u64,
+        latency_ms: u64,
+        /// The reply's text as received.
+        text: String,
+    },
+    /// A reply that could not be used; the loop asks again while rounds remain.
+    InvalidReply {
+        error: String,
+    },
+    /// The instruction read as a goal; `matches_expected` compares with the scenario's goal.
+    Goal {
+        goal: Formula,
+        reasoning: Option<String>,
+        substitutions: Vec<Substitution>,
+        matches_expected: Option<bool>,
+    },
+    /// An action failed in simulation.
+    ActionFailed {
+        action: ActionCall,
+        node_path: String,
+        error: String,
+    },
+    /// The model's proposal, before approval.
+    Proposal {
+        proposal: Proposal,
+        reasoning: Option<String>,
+        substitutions: Vec<Substitution>,
+    },
+    Approved,
+    Rejected,
+    /// The tree was changed: how many nodes were added, and on how many actions a value
+    /// was set.
+    Repaired {
+        added_nodes: usize,
+        valued_nodes: usize,
+    },
+    /// The approved proposal did not change the failure; it was undone.
+    DidNotHelp {
+        reason: String,
+    },
+    /// The tree succeeds in a fresh simulation.
+    Success {
+        ticks: u64,
+    },
+    /// The loop stopped without success.
+    GaveUp {
+        reason: String,
+    },
+}
+
+/// How the loop ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    Success { ticks: u64 },
+    Rejected,
+    GaveUp { reason: String },
+}
+
+/// The loop's result: the final tree (with every change that helped) and how it ended.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    pub goal: Formula,
+    pub tree: Tree,
+    pub ending: Ending,
+    /// Failure questions asked.
+    pub rounds: usize,
+    /// Approved changes kept in the tree.
+    pub repairs: usize,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SessionError {
+    #[error(transparent)]
+    Llm(#[from] LlmError),
+    #[error(transparent)]
+    Prompt(#[from] PromptError),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Plan(#[from] RepairError),
+    #[error("scenario {0:?} has no instruction; give one")]
+    NoInstruction(String),
+    #[error("no usable goal after {attempts} attempt(s); last reply: {last}")]
+    NoGoal { attempts: usize, last: ReplyError },
+}

@@ -1,0 +1,100 @@
+//! A secret API key set in the environment during a run appears in no file the run wrote:
+//! not the cassette, the usage log, the saved tree or the config file, and not in an error.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use support::cli::{KEY, KEY_VAR, betr, files_under, relative_to, text, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures;
+
+#[test]
+fn the_api_key_appears_in_no_file_the_run_wrote() {
+    let dir = tmp("key");
+    std::fs::write(
+        dir.join("betr.toml"),
+        format!("[llm]\nmodel = \"fake-model\"\napi_key_env = \"{KEY_VAR}\"\n"),
+    )
+    .unwrap();
+    let scenario = fixtures::root().join("scenarios/cafe/no_coffee.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let base = server.base_url();
+    // Default paths: ./betr.toml is read, the usage log goes to $XDG_STATE_HOME, the tree to policies/.
+    let out = betr(
+        &dir,
+        &[
+            "resolve",
+            &scenario_s,
+            "--yes",
+            "--base-url",
+            &base,
+            "--cassette",
+            "rec.jsonl",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let out = betr(
+        &dir,
+        &[
+            "interpret",
+            &scenario_s,
+            "--base-url",
+            &base,
+            "--show-replies",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(!text(&out).contains(KEY));
+    // A server that rejects the key (and echoes it back): the error names the variable only,
+    // and an existing tree file is left as it was.
+    std::fs::write(dir.join("keep.bt"), "unchanged").unwrap();
+    let bad = FakeServer::start(vec![], Behavior::Unauthorized);
+    let bad_base = bad.base_url();
+    let out = betr(
+        &dir,
+        &[
+            "resolve",
+            &scenario_s,
+            "--yes",
+            "--base-url",
+            &bad_base,
+            "--save",
+            "keep.bt",
+        ],
+    );
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(log.contains(KEY_VAR) && !log.contains(KEY), "{log}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("keep.bt")).unwrap(),
+        "unchanged"
+    );
+    // The key really was sent, so its absence from the files means something.
+    let sent = server.received();
+    assert!(
+        sent.iter()
+            .all(|r| r.header("authorization") == Some(format!("Bearer {KEY}").as_str()))
+    );
+
+    let written = files_under(&dir);
+    let names: Vec<String> = written.iter().map(|p| relative_to(p, &dir)).collect();
+    for expected in [
+        "betr.toml",
+        "rec.jsonl",
+        "state/betr/usage.jsonl",
+        "policies/no_coffee.bt",
+    ] {
+        assert!(
+            names.iter().any(|n| n == expected),
+            "{expected} not written; files: {names:?}"
+        );
+    }
+    for file in &written {
+        let bytes = std::fs::read(file).unwrap();
+        let hay = String::from_utf8_lossy(&bytes);
+        assert!(!hay.contains(KEY), "the key is in {}", file.display());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

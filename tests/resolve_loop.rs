@@ -1,0 +1,293 @@
+//! End to end: every failure scenario (a scenario file with `expected_fix`) and every
+//! parameter scenario resolves through `betr resolve --yes` against the fake OpenAI server
+//! answering with hand-written fixture replies: prompt → reply → validation → repair →
+//! success in simulation → saved tree. Also through the library and through record/replay.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use std::path::{Path, PathBuf};
+
+use betr::domain::Scenario;
+use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
+use betr::session::{self, Ending, Event, Options, Proposal};
+use support::cli::{KEY_VAR, betr, text, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures;
+
+fn scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.filter_map(Result::ok) {
+        let p = e.path();
+        if p.is_dir() {
+            scenario_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "toml") {
+            out.push(p);
+        }
+    }
+}
+
+/// Failure scenarios (with `expected_fix`) and parameter scenarios (under `params/`).
+fn resolvable_scenarios() -> Vec<PathBuf> {
+    let mut all = Vec::new();
+    scenario_files(&fixtures::root().join("scenarios"), &mut all);
+    all.sort();
+    all.into_iter()
+        .filter(|p| is_param(p) || Scenario::load(p).is_ok_and(|s| !s.expected_fix.is_empty()))
+        .collect()
+}
+
+fn is_param(p: &Path) -> bool {
+    p.components().any(|c| c.as_os_str() == "params")
+}
+
+fn relative(p: &Path) -> String {
+    p.strip_prefix(fixtures::root())
+        .unwrap_or(p)
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
+#[test]
+fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
+    let scenarios = resolvable_scenarios();
+    assert!(scenarios.len() >= 3, "found {scenarios:?}");
+    let files = fixtures::all();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("cli");
+    let mut calls = 0;
+    for path in &scenarios {
+        let rel = relative(path);
+        assert!(
+            files.iter().any(|(_, f)| f.scenario == rel),
+            "no fixture replies for {rel} in tests/fixtures/replies/"
+        );
+        let scenario = Scenario::load(path).unwrap();
+        let save = dir.join(format!(
+            "{}.bt",
+            path.file_stem().unwrap().to_string_lossy()
+        ));
+        let path_s = path.to_string_lossy().to_string();
+        let save_s = save.to_string_lossy().to_string();
+        let base = server.base_url();
+        let out = betr(
+            &dir,
+            &[
+                "resolve",
+                &path_s,
+                "--yes",
+                "--backend",
+                "openai",
+                "--base-url",
+                &base,
+                "--model",
+                "fake-model",
+                "--api-key-env",
+                KEY_VAR,
+                "--save",
+                &save_s,
+                "--cassette",
+                "cassette.jsonl",
+                "--usage-log",
+                "usage.jsonl",
+            ],
+        );
+        let log = text(&out);
+        calls += log.matches("\n→ asking for ").count();
+        // Shown with `cargo test --test resolve_loop -- --nocapture`.
+        println!("$ betr resolve {rel} --yes ...\n{log}");
+        assert_eq!(out.status.code(), Some(0), "{rel}:\n{log}");
+        assert!(log.contains("SUCCESS in simulation"), "{rel}:\n{log}");
+        assert!(
+            log.contains("hand-written fixture, not a model's answer"),
+            "{rel}:\n{log}"
+        );
+        assert!(
+            !log.contains("reply from model"),
+            "a fixture shown as a model's answer:\n{log}"
+        );
+        if is_param(path) {
+            assert!(
+                log.contains("Proposal: set "),
+                "{rel}: expected a value:\n{log}"
+            );
+        }
+        for fix in &scenario.expected_fix {
+            assert!(
+                log.contains(&format!("Proposal: insert {fix}")),
+                "{rel}: expected the fix {fix}:\n{log}"
+            );
+        }
+        // The saved tree runs to success on its own, without any model.
+        let run = betr(&dir, &["run", &path_s, "--tree", &save_s]);
+        assert_eq!(
+            run.status.code(),
+            Some(0),
+            "{rel}: saved tree:\n{}",
+            text(&run)
+        );
+    }
+    // Every call was accounted.
+    let usage = std::fs::read_to_string(dir.join("usage.jsonl")).unwrap();
+    assert!(calls >= 2 * scenarios.len());
+    assert_eq!(usage.lines().count(), calls, "{usage}");
+    assert!(usage.contains("\"source\":\"hand-written\""));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_library_loop_applies_the_expected_fixes() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let client = OpenAiClient::new(OpenAiSettings {
+        base_url: server.base_url(),
+        model: "fake-model".into(),
+        api_key_env: None,
+        api_key: None,
+        auth_header: AuthHeader::Bearer,
+        timeout: std::time::Duration::from_secs(5),
+        connect_timeout: std::time::Duration::from_secs(1),
+        retry: RetryPolicy::default(),
+        structured: false,
+        max_tokens_field: "max_tokens".into(),
+    })
+    .unwrap();
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    for path in &resolvable_scenarios() {
+        let scenario = Scenario::load(path).unwrap();
+        let mut approved: Vec<Proposal> = Vec::new();
+        let mut events = Vec::new();
+        let r = rt
+            .block_on(session::resolve(
+                &scenario,
+                None,
+                &client,
+                &Options::default(),
+                &mut |p| {
+                    approved.push(p.clone());
+                    true
+                },
+                &mut |e| events.push(e.clone()),
+            ))
+            .unwrap();
+        assert!(
+            matches!(r.ending, Ending::Success { .. }),
+            "{}: {:?}",
+            scenario.name,
+            r.ending
+        );
+        let goal_ok = events.iter().any(|e| {
+            matches!(
+                e,
+                Event::Goal {
+                    matches_expected: Some(true),
+                    ..
+                }
+            )
+        });
+        assert!(
+            goal_ok,
+            "{}: the interpreted goal differs from the scenario's",
+            scenario.name
+        );
+        let inserted: Vec<String> = approved
+            .iter()
+            .flat_map(|p| match p {
+                Proposal::Conditions { conditions, .. } => {
+                    conditions.iter().map(ToString::to_string).collect()
+                }
+                Proposal::Value { .. } => vec![],
+            })
+            .collect();
+        assert_eq!(inserted, scenario.expected_fix, "{}", scenario.name);
+        let values = approved
+            .iter()
+            .filter(|p| matches!(p, Proposal::Value { .. }))
+            .count();
+        assert_eq!(
+            values > 0,
+            is_param(path),
+            "{}: {approved:?}",
+            scenario.name
+        );
+    }
+}
+
+#[test]
+fn a_recorded_cassette_replays_without_a_server_and_misses_loudly() {
+    let dir = tmp("replay");
+    let scenario = fixtures::root().join("scenarios/cafe/sweep.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    {
+        let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+        let base = server.base_url();
+        let out = betr(
+            &dir,
+            &[
+                "resolve",
+                &scenario_s,
+                "--yes",
+                "--base-url",
+                &base,
+                "--model",
+                "fake-model",
+                "--api-key-env",
+                KEY_VAR,
+                "--cassette",
+                "c.jsonl",
+                "--save",
+                "a.bt",
+            ],
+        );
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    }
+    let out = betr(
+        &dir,
+        &[
+            "resolve",
+            &scenario_s,
+            "--yes",
+            "--backend",
+            "replay",
+            "--cassette",
+            "c.jsonl",
+            "--save",
+            "b.bt",
+        ],
+    );
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        log.contains("hand-written fixture"),
+        "replay keeps the origin:\n{log}"
+    );
+    assert_eq!(
+        std::fs::read(dir.join("a.bt")).unwrap(),
+        std::fs::read(dir.join("b.bt")).unwrap()
+    );
+    // A different prompt (an ablation) is not in the cassette: replay refuses, exit 2.
+    let out = betr(
+        &dir,
+        &[
+            "interpret",
+            &scenario_s,
+            "--backend",
+            "replay",
+            "--cassette",
+            "c.jsonl",
+            "--no-descriptions",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(
+        text(&out).contains("has no reply for model \"fake-model\""),
+        "{}",
+        text(&out)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,68 @@
+//! Running the `betr` binary in a scratch directory that holds everything it writes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The variable the tests put the API key in, and the key.
+pub const KEY_VAR: &str = "BETR_TEST_SECRET_KEY";
+pub const KEY: &str = "sk-betr-e2e-SECRET-5f3c9a1e7d";
+
+pub fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("betr-e2e-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Run the binary in `dir` with HOME and XDG dirs inside it, so every file it writes lands
+/// there.
+pub fn betr(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_betr"))
+        .args(args)
+        .current_dir(dir)
+        .env("HOME", dir)
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .env("XDG_CONFIG_HOME", dir.join("config"))
+        .env(KEY_VAR, KEY)
+        .env_remove("BETR_CONFIG")
+        .env_remove("BETR_BACKEND")
+        .env_remove("BETR_MODEL")
+        .env_remove("BETR_BASE_URL")
+        .env_remove("BETR_API_KEY_ENV")
+        .env_remove("BETR_CASSETTE")
+        .output()
+        .unwrap()
+}
+
+pub fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// Every file under `dir`.
+pub fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    walk(dir, &mut out);
+    out
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap().filter_map(Result::ok) {
+        let p = e.path();
+        if p.is_dir() {
+            walk(&p, out);
+        } else {
+            out.push(p);
+        }
+    }
+}
+
+pub fn relative_to(p: &Path, base: &Path) -> String {
+    p.strip_prefix(base)
+        .unwrap_or(p)
+        .to_string_lossy()
+        .replace('\\', "/")
+}

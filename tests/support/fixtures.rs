@@ -1,0 +1,86 @@
+//! Hand-written replies under `tests/fixtures/replies/`, used to test the plumbing. Each
+//! file says so in its `source`, names its scenario, and lists replies with the strings a
+//! prompt must contain for the reply to be given.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+pub const SOURCE: &str = "hand-written for plumbing tests";
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixtureFile {
+    pub source: String,
+    /// The scenario file (relative to the crate root) the replies are for.
+    pub scenario: String,
+    pub reply: Vec<RawReply>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawReply {
+    pub when: Vec<String>,
+    pub text: String,
+}
+
+/// A reply ready for the fake server.
+#[derive(Debug, Clone)]
+pub struct FixtureReply {
+    pub when: Vec<String>,
+    pub text: String,
+    /// What the `x-betr-fixture` header says.
+    pub note: String,
+}
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Every fixture file, by path.
+pub fn all() -> Vec<(PathBuf, FixtureFile)> {
+    let dir = root().join("tests/fixtures/replies");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("fixture dir")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    files
+        .into_iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(&p).expect("fixture");
+            let f: FixtureFile =
+                toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            assert_eq!(
+                f.source,
+                SOURCE,
+                "{} must say it is hand-written",
+                p.display()
+            );
+            (p, f)
+        })
+        .collect()
+}
+
+/// The replies of one file, labelled with their origin.
+pub fn replies(path: &Path, file: &FixtureFile) -> Vec<FixtureReply> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    file.reply
+        .iter()
+        .map(|r| FixtureReply {
+            when: r.when.clone(),
+            text: r.text.clone(),
+            note: format!("{SOURCE}: tests/fixtures/replies/{name}"),
+        })
+        .collect()
+}
+
+/// Every reply of every file (prompts of different scenarios differ in their instruction).
+pub fn every_reply() -> Vec<FixtureReply> {
+    all().iter().flat_map(|(p, f)| replies(p, f)).collect()
+}
