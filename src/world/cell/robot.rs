@@ -59,23 +59,24 @@ impl Robot {
         self.nearest_shoulder(base, point).0 <= self.reach
     }
 
-    /// Where the base must drive (in the floor plane, along the line towards the point)
-    /// so that the nearest shoulder ends `drive_margin * reach` from `point`; `None` when
-    /// the point is too high or low to reach from any base position.
+    /// Where the base must drive, along its y axis (the table's edge), so that the
+    /// nearest shoulder ends `drive_margin * reach` from `point`; `None` when the point is
+    /// too far from the edge, too high or too low to reach from anywhere along it.
     pub fn base_to_reach(&self, base: Vector2<f32>, point: &Point3<f32>) -> Option<Vector2<f32>> {
-        let (_, shoulder) = self.nearest_shoulder(base, point);
-        let d = point - shoulder;
-        let want = self.reach * self.drive_margin;
-        if d.z.abs() >= want {
-            return None;
-        }
-        let horizontal = Vector2::new(d.x, d.y);
-        let keep = (want * want - d.z * d.z).sqrt();
-        let dist = horizontal.norm();
-        if dist <= keep {
+        if self.reaches(base, point) {
             return Some(base);
         }
-        Some(base + horizontal / dist * (dist - keep))
+        let want = self.reach * self.drive_margin;
+        self.shoulders_at(base)
+            .filter_map(|s| {
+                let d = point - s;
+                let across = want * want - d.x * d.x - d.z * d.z;
+                (across >= 0.0).then(|| {
+                    let dy = d.y - d.y.signum() * across.sqrt();
+                    Vector2::new(base.x, base.y + dy)
+                })
+            })
+            .min_by(|a, b| (a.y - base.y).abs().total_cmp(&(b.y - base.y).abs()))
     }
 
     /// The gripper's parts in the frame of its tool centre point (between the finger
@@ -134,14 +135,15 @@ pub(crate) mod tests {
     #[test]
     fn driving_brings_a_far_point_into_reach() {
         let r = yumi();
-        let far = Point3::new(0.5, 1.2, 0.02);
+        let far = Point3::new(0.4, 1.2, 0.02);
         let base = r.base_to_reach(Vector2::zeros(), &far).unwrap();
         assert!(r.reaches(base, &far));
-        assert!(base.y > 0.5);
+        assert!(base.y > 0.5 && base.x == 0.0);
+        // Too far from the edge to reach by driving along it.
+        assert_eq!(r.base_to_reach(Vector2::zeros(), &Point3::new(1.5, 0.0, 0.02)), None);
         // Nothing to do when it is already close.
         let near = Point3::new(0.3, 0.1, 0.02);
         assert_eq!(r.base_to_reach(Vector2::zeros(), &near), Some(Vector2::zeros()));
-        assert_eq!(r.base_to_reach(Vector2::zeros(), &Point3::new(0.3, 0.0, 3.0)), None);
     }
 
     #[test]

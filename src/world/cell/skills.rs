@@ -276,7 +276,12 @@ impl CellWorld {
         let Some((cavity, half, opening)) = self.scene.solids[c].body.cavity_at(&self.state.poses[c]) else {
             return Err(format!("{:?} has no opening to put things in", self.name(c)));
         };
-        let floor = cavity * Point3::new(0.0, 0.0, -half.z);
+        // The lowest point of the cavity in the world, whichever way the container is turned.
+        let r = cavity.rotation.to_rotation_matrix();
+        let m = r.matrix();
+        let depth = m[(2, 0)].abs() * half.x + m[(2, 1)].abs() * half.y + m[(2, 2)].abs() * half.z;
+        let centre = cavity.translation.vector;
+        let floor = Point3::new(centre.x, centre.y, centre.z - depth);
         let pose = self.scene.solids[x].body.resting(self.state.poses[x].rotation, floor.x, floor.y, floor.z);
         let approach = self.scene.robot.gripper.approach;
         Ok(match opening {
