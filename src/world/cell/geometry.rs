@@ -260,17 +260,29 @@ pub struct Obstacle<'a> {
     pub body: &'a Body,
 }
 
-/// Counts narrow-phase tests, shared by every fork of a world (for checks per second).
+/// Counts collision tests, shared by every fork of a world (for checks per second):
+/// `narrow` are exact tests of two convex parts (a shape cast or an intersection test),
+/// `broad` are box-against-box tests of whole solids that decide which pairs get one.
 #[derive(Debug, Default)]
-pub struct Counter(AtomicU64);
+pub struct Counter {
+    narrow: AtomicU64,
+    broad: AtomicU64,
+}
 
 impl Counter {
-    pub fn add(&self, n: u64) {
-        self.0.fetch_add(n, Ordering::Relaxed);
+    pub fn add(&self, narrow: u64, broad: u64) {
+        self.narrow.fetch_add(narrow, Ordering::Relaxed);
+        self.broad.fetch_add(broad, Ordering::Relaxed);
     }
 
+    /// Exact tests of part pairs.
     pub fn get(&self) -> u64 {
-        self.0.load(Ordering::Relaxed)
+        self.narrow.load(Ordering::Relaxed)
+    }
+
+    /// Box tests of whole solids.
+    pub fn broad(&self) -> u64 {
+        self.broad.load(Ordering::Relaxed)
     }
 }
 
@@ -295,7 +307,9 @@ pub fn path_collides(
         compute_impact_geometry_on_penetration: false,
     };
     let mut hit = false;
+    let mut broad = 0;
     'outer: for o in obstacles {
+        broad += 1;
         if !o.body.aabb(&o.pose).intersects(&swept) {
             continue;
         }
@@ -325,7 +339,7 @@ pub fn path_collides(
             }
         }
     }
-    counter.add(checks);
+    counter.add(checks, broad);
     hit
 }
 
@@ -334,7 +348,9 @@ pub fn overlaps_any(part: &Part, obstacles: &[Obstacle], counter: &Counter) -> b
     let bound = part.shape.compute_aabb(&part.local);
     let mut checks = 0;
     let mut hit = false;
+    let mut broad = 0;
     'outer: for o in obstacles {
+        broad += 1;
         if !o.body.aabb(&o.pose).intersects(&bound) {
             continue;
         }
@@ -352,7 +368,7 @@ pub fn overlaps_any(part: &Part, obstacles: &[Obstacle], counter: &Counter) -> b
             }
         }
     }
-    counter.add(checks);
+    counter.add(checks, broad);
     hit
 }
 
@@ -419,7 +435,7 @@ mod tests {
             std::slice::from_ref(&below),
             &counter
         ));
-        assert!(counter.get() >= 1);
+        assert!(counter.get() >= 1 && counter.broad() >= 2);
     }
 
     #[test]

@@ -17,6 +17,8 @@ pub mod geometry;
 pub mod robot;
 pub mod scene;
 mod skills;
+#[cfg(test)]
+mod tests;
 pub mod values;
 
 use std::collections::HashMap;
@@ -105,9 +107,15 @@ impl CellWorld {
         })
     }
 
-    /// Narrow-phase collision tests made so far by this world and all its forks.
+    /// Exact collision tests (of two convex parts) made so far by this world and all
+    /// its forks.
     pub fn collision_checks(&self) -> u64 {
         self.counter.get()
+    }
+
+    /// Box tests of whole solids made so far (the broad phase before the exact tests).
+    pub fn broad_checks(&self) -> u64 {
+        self.counter.broad()
     }
 
     /// The pose of a solid by name (for tests and display).
