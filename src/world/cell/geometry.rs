@@ -9,6 +9,7 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -62,11 +63,21 @@ pub struct Body {
 /// The shapes a scenario can ask for (all sizes in metres).
 #[derive(Debug, Clone, PartialEq)]
 pub enum ShapeSpec {
-    Box { size: [f32; 3] },
-    Cylinder { radius: f32, height: f32 },
-    Ball { radius: f32 },
+    Box {
+        size: [f32; 3],
+    },
+    Cylinder {
+        radius: f32,
+        height: f32,
+    },
+    Ball {
+        radius: f32,
+    },
     /// Lying along x (a banana, a hammer handle).
-    Capsule { radius: f32, length: f32 },
+    Capsule {
+        radius: f32,
+        length: f32,
+    },
     /// A round cup: a bottom disc and a ring of wall slabs, open at the top.
     Cup {
         radius: f32,
@@ -102,7 +113,10 @@ impl Body {
             }
             ShapeSpec::Cylinder { radius, height } => vec![Part {
                 // parry's cylinder stands along y; turn it to stand along z.
-                local: Pose::new(Vector3::new(0.0, 0.0, height / 2.0), Vector3::x() * FRAC_PI_2),
+                local: Pose::new(
+                    Vector3::new(0.0, 0.0, height / 2.0),
+                    Vector3::x() * FRAC_PI_2,
+                ),
                 shape: SharedShape::cylinder(height / 2.0, radius),
             }],
             ShapeSpec::Ball { radius } => vec![Part {
@@ -120,7 +134,10 @@ impl Body {
                 bottom,
             } => {
                 let mut parts = vec![Part {
-                    local: Pose::new(Vector3::new(0.0, 0.0, bottom / 2.0), Vector3::x() * FRAC_PI_2),
+                    local: Pose::new(
+                        Vector3::new(0.0, 0.0, bottom / 2.0),
+                        Vector3::x() * FRAC_PI_2,
+                    ),
                     shape: SharedShape::cylinder(bottom / 2.0, radius),
                 }];
                 let wall_h = (height - bottom) / 2.0;
@@ -160,15 +177,25 @@ impl Body {
                 ];
                 let top = match opening {
                     Opening::Top => {
-                        parts.push(cuboid_at(Vector3::new(-hx + t, 0.0, hz), Vector3::new(t, hy, hz)));
+                        parts.push(cuboid_at(
+                            Vector3::new(-hx + t, 0.0, hz),
+                            Vector3::new(t, hy, hz),
+                        ));
                         sz
                     }
                     Opening::Front => {
-                        parts.push(cuboid_at(Vector3::new(0.0, 0.0, sz - t), Vector3::new(hx, hy, t)));
+                        parts.push(cuboid_at(
+                            Vector3::new(0.0, 0.0, sz - t),
+                            Vector3::new(hx, hy, t),
+                        ));
                         sz - wall
                     }
                 };
-                let front = if opening == Opening::Front { -hx } else { -hx + wall };
+                let front = if opening == Opening::Front {
+                    -hx
+                } else {
+                    -hx + wall
+                };
                 let (x0, x1) = (front, hx - wall);
                 cavity = Some(Cavity {
                     center: Point3::new((x0 + x1) / 2.0, 0.0, (wall + top) / 2.0),
@@ -209,7 +236,11 @@ impl Body {
     /// The cavity as a world-space box (pose and half extents), if the body has one.
     pub fn cavity_at(&self, pose: &Pose) -> Option<(Pose, Vector3<f32>, Opening)> {
         let c = self.cavity?;
-        Some((pose * Pose::translation(c.center.x, c.center.y, c.center.z), c.half, c.opening))
+        Some((
+            pose * Pose::translation(c.center.x, c.center.y, c.center.z),
+            c.half,
+            c.opening,
+        ))
     }
 
     /// Whether a world point lies inside the cavity.
@@ -263,16 +294,33 @@ pub struct Obstacle<'a> {
 /// Counts collision tests, shared by every fork of a world (for checks per second):
 /// `narrow` are exact tests of two convex parts (a shape cast or an intersection test),
 /// `broad` are box-against-box tests of whole solids that decide which pairs get one.
+/// `queries` are whole questions (is this path free? is this region empty?) and `nanos`
+/// the time spent answering them.
 #[derive(Debug, Default)]
 pub struct Counter {
     narrow: AtomicU64,
     broad: AtomicU64,
+    queries: AtomicU64,
+    nanos: AtomicU64,
 }
 
 impl Counter {
-    pub fn add(&self, narrow: u64, broad: u64) {
+    pub fn add(&self, narrow: u64, broad: u64, since: Instant) {
         self.narrow.fetch_add(narrow, Ordering::Relaxed);
         self.broad.fetch_add(broad, Ordering::Relaxed);
+        self.queries.fetch_add(1, Ordering::Relaxed);
+        let nanos = u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX);
+        self.nanos.fetch_add(nanos, Ordering::Relaxed);
+    }
+
+    /// Questions answered (paths and regions).
+    pub fn queries(&self) -> u64 {
+        self.queries.load(Ordering::Relaxed)
+    }
+
+    /// Seconds spent answering them.
+    pub fn seconds(&self) -> f64 {
+        self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     /// Exact tests of part pairs.
@@ -297,6 +345,7 @@ pub fn path_collides(
     obstacles: &[Obstacle],
     counter: &Counter,
 ) -> bool {
+    let since = Instant::now();
     let swept = aabb_of(moving, start).merged(&aabb_of(moving, end));
     let travel = end.translation.vector - start.translation.vector;
     let mut checks = 0;
@@ -339,12 +388,13 @@ pub fn path_collides(
             }
         }
     }
-    counter.add(checks, broad);
+    counter.add(checks, broad, since);
     hit
 }
 
 /// Whether a part (already in world space) overlaps any obstacle.
 pub fn overlaps_any(part: &Part, obstacles: &[Obstacle], counter: &Counter) -> bool {
+    let since = Instant::now();
     let bound = part.shape.compute_aabb(&part.local);
     let mut checks = 0;
     let mut hit = false;
@@ -368,7 +418,7 @@ pub fn overlaps_any(part: &Part, obstacles: &[Obstacle], counter: &Counter) -> b
             }
         }
     }
-    counter.add(checks, broad);
+    counter.add(checks, broad, since);
     hit
 }
 
@@ -392,9 +442,7 @@ mod tests {
     use super::*;
 
     pub(crate) fn cube(size: f32) -> Body {
-        Body::new(&ShapeSpec::Box {
-            size: [size; 3],
-        })
+        Body::new(&ShapeSpec::Box { size: [size; 3] })
     }
 
     #[test]
@@ -426,7 +474,13 @@ mod tests {
         let start = Pose::translation(0.0, 0.0, 0.3);
         let end = Pose::translation(0.0, 0.0, 0.01);
         let parts = b.parts.as_ref().clone();
-        assert!(path_collides(&parts, &start, &end, std::slice::from_ref(&below), &counter));
+        assert!(path_collides(
+            &parts,
+            &start,
+            &end,
+            std::slice::from_ref(&below),
+            &counter
+        ));
         let aside = Pose::translation(0.1, 0.0, 0.0);
         assert!(!path_collides(
             &parts,

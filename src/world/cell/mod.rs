@@ -46,9 +46,15 @@ struct Held {
 enum Effect {
     Grasp(Held),
     /// Put the held object at this pose and let go.
-    Release { id: usize, pose: Pose },
+    Release {
+        id: usize,
+        pose: Pose,
+    },
     /// Move an object that is not held (flipping a cup, scooping sand).
-    Move { id: usize, pose: Pose },
+    Move {
+        id: usize,
+        pose: Pose,
+    },
     Open(usize),
     Unlock(usize),
     Know(usize),
@@ -85,10 +91,18 @@ pub struct CellWorld {
 
 impl CellWorld {
     /// Build the cell a scenario describes; `variant` applies a `[world.variants.NAME]`.
-    pub fn from_scenario(scenario: &Scenario, variant: Option<&str>) -> Result<Self, ScenarioError> {
+    pub fn from_scenario(
+        scenario: &Scenario,
+        variant: Option<&str>,
+    ) -> Result<Self, ScenarioError> {
         let scene = scene::read(scenario, variant)?;
         let i = scene.initial.clone();
-        let index = scene.solids.iter().enumerate().map(|(n, s)| (s.name.clone(), n)).collect();
+        let index = scene
+            .solids
+            .iter()
+            .enumerate()
+            .map(|(n, s)| (s.name.clone(), n))
+            .collect();
         Ok(CellWorld {
             state: State {
                 poses: i.poses,
@@ -118,6 +132,12 @@ impl CellWorld {
         self.counter.broad()
     }
 
+    /// Collision questions answered so far (is this path free, is this opening clear),
+    /// and the seconds spent answering them.
+    pub fn collision_queries(&self) -> (u64, f64) {
+        (self.counter.queries(), self.counter.seconds())
+    }
+
     /// The pose of a solid by name (for tests and display).
     pub fn pose_of(&self, name: &str) -> Option<Pose> {
         self.index.get(name).map(|i| self.state.poses[*i])
@@ -144,13 +164,23 @@ impl CellWorld {
         let mut out = Vec::with_capacity(self.scene.solids.len() + 2);
         for (i, s) in self.scene.solids.iter().enumerate() {
             if let Some(lid) = &s.lid {
-                let rel = if self.state.lid_open[i] { lid.open } else { lid.closed };
-                out.push(Obstacle { pose: self.state.poses[i] * rel, body: &lid.body });
+                let rel = if self.state.lid_open[i] {
+                    lid.open
+                } else {
+                    lid.closed
+                };
+                out.push(Obstacle {
+                    pose: self.state.poses[i] * rel,
+                    body: &lid.body,
+                });
             }
             if exclude.contains(&i) || self.is_held(i) {
                 continue;
             }
-            out.push(Obstacle { pose: self.state.poses[i], body: &s.body });
+            out.push(Obstacle {
+                pose: self.state.poses[i],
+                body: &s.body,
+            });
         }
         out
     }
@@ -168,7 +198,10 @@ impl CellWorld {
         if let Some(region) = s.body.opening_region(pose) {
             return Point3::from(region.local.translation.vector);
         }
-        let (_, shoulder) = self.scene.robot.nearest_shoulder(self.state.base, &b.center());
+        let (_, shoulder) = self
+            .scene
+            .robot
+            .nearest_shoulder(self.state.base, &b.center());
         Point3::new(
             shoulder.x.clamp(b.mins.x, b.maxs.x),
             shoulder.y.clamp(b.mins.y, b.maxs.y),
@@ -190,16 +223,23 @@ impl CellWorld {
     fn inside(&self, a: usize, b: usize) -> bool {
         a != b
             && !self.is_held(a)
-            && self.scene.solids[b].body.cavity_contains(&self.state.poses[b], &self.aabb(a).center())
+            && self.scene.solids[b]
+                .body
+                .cavity_contains(&self.state.poses[b], &self.aabb(a).center())
     }
 
     /// Open: the slab in front of the opening is free of every other solid and of the
     /// solid's own lid or door (things inside it do not count).
     fn open(&self, id: usize) -> bool {
-        let Some(region) = self.scene.solids[id].body.opening_region(&self.state.poses[id]) else {
+        let Some(region) = self.scene.solids[id]
+            .body
+            .opening_region(&self.state.poses[id])
+        else {
             return false;
         };
-        let contents: Vec<usize> = (0..self.scene.solids.len()).filter(|o| self.inside(*o, id)).collect();
+        let contents: Vec<usize> = (0..self.scene.solids.len())
+            .filter(|o| self.inside(*o, id))
+            .collect();
         let mut exclude = contents;
         exclude.push(id);
         !overlaps_any(&region, &self.obstacles(&exclude), &self.counter)
@@ -214,7 +254,11 @@ impl CellWorld {
             ("unlocked", [a]) => !self.state.locked[*a],
             ("upright", [a]) => is_upright(&self.state.poses[*a]),
             ("near robot", [a]) => {
-                self.is_held(*a) || self.scene.robot.reaches(self.state.base, &self.reach_point(*a))
+                self.is_held(*a)
+                    || self
+                        .scene
+                        .robot
+                        .reaches(self.state.base, &self.reach_point(*a))
             }
             ("location known", [a]) => self.state.known[*a],
             ("clean", [a]) => !self.state.dirty[*a],
@@ -284,7 +328,9 @@ impl World for CellWorld {
         if started || !self.state.progress.contains_key(&key) {
             match self.start(action) {
                 Ok(effect) => {
-                    self.state.progress.insert(key.clone(), Progress { done: 0, effect });
+                    self.state
+                        .progress
+                        .insert(key.clone(), Progress { done: 0, effect });
                 }
                 Err(error) => {
                     self.state.progress.remove(&key);
@@ -307,7 +353,9 @@ impl World for CellWorld {
     }
 
     fn halt(&mut self, action: &ActionCall) {
-        self.state.progress.remove(&format!("{} {:?}", action.skill, action.args));
+        self.state
+            .progress
+            .remove(&format!("{} {:?}", action.skill, action.args));
     }
 
     fn fork(&self) -> Box<dyn World> {
@@ -337,9 +385,17 @@ impl World for CellWorld {
                 }
             }
         }
-        for p in ["grasped", "open", "unlocked", "upright", "near robot", "location known", "clean"]
-            .into_iter()
-            .filter(|p| known(p))
+        for p in [
+            "grasped",
+            "open",
+            "unlocked",
+            "upright",
+            "near robot",
+            "location known",
+            "clean",
+        ]
+        .into_iter()
+        .filter(|p| known(p))
         {
             for a in 0..n {
                 if self.holds(p, &[a]) {

@@ -107,7 +107,10 @@ pub(crate) mod tests {
 
     pub(crate) fn yumi() -> Robot {
         Robot {
-            shoulders: vec![Point3::new(0.05, 0.18, 0.28), Point3::new(0.05, -0.18, 0.28)],
+            shoulders: vec![
+                Point3::new(0.05, 0.18, 0.28),
+                Point3::new(0.05, -0.18, 0.28),
+            ],
             reach: 0.559,
             payload: 0.5,
             drive_margin: 0.8,
@@ -140,10 +143,16 @@ pub(crate) mod tests {
         assert!(r.reaches(base, &far));
         assert!(base.y > 0.5 && base.x == 0.0);
         // Too far from the edge to reach by driving along it.
-        assert_eq!(r.base_to_reach(Vector2::zeros(), &Point3::new(1.5, 0.0, 0.02)), None);
+        assert_eq!(
+            r.base_to_reach(Vector2::zeros(), &Point3::new(1.5, 0.0, 0.02)),
+            None
+        );
         // Nothing to do when it is already close.
         let near = Point3::new(0.3, 0.1, 0.02);
-        assert_eq!(r.base_to_reach(Vector2::zeros(), &near), Some(Vector2::zeros()));
+        assert_eq!(
+            r.base_to_reach(Vector2::zeros(), &near),
+            Some(Vector2::zeros())
+        );
     }
 
     #[test]

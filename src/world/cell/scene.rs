@@ -52,7 +52,16 @@ use crate::domain::{Scenario, ScenarioError, SourceFile};
 
 /// The skills the cell can perform, by name.
 pub const SKILLS: &[&str] = &[
-    "grasp", "place", "put_in", "flip", "open", "unlock", "look_for", "move_base", "scoop", "wipe",
+    "grasp",
+    "place",
+    "put_in",
+    "flip",
+    "open",
+    "unlock",
+    "look_for",
+    "move_base",
+    "scoop",
+    "wipe",
 ];
 
 #[derive(Deserialize)]
@@ -218,7 +227,9 @@ fn patch(base: &mut RawSolid, p: RawSolid) {
         base.at = None;
         base.xy = None;
     }
-    take!(shape, size, radius, height, length, wall, bottom, opening, mass, fixed, on, inside, xy, at);
+    take!(
+        shape, size, radius, height, length, wall, bottom, opening, mass, fixed, on, inside, xy, at
+    );
     take!(rotation, upside_down, lid, locked, open, dirty);
 }
 
@@ -243,7 +254,11 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
                 return Err(file.error_in_string(
                     &s.name.span(),
                     0,
-                    format!("the cell world cannot perform a skill named {:?} (it performs: {})", s.name.get_ref(), SKILLS.join(", ")),
+                    format!(
+                        "the cell world cannot perform a skill named {:?} (it performs: {})",
+                        s.name.get_ref(),
+                        SKILLS.join(", ")
+                    ),
                 ));
             }
         }
@@ -284,11 +299,25 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
     }
     if let Some(wanted) = variant {
         let Some((index, v)) = chosen.take() else {
-            return Err(files[last].error_at(0, format!("no world variant {wanted:?} in this scenario (variants: {})", if variant_names.is_empty() { "none".to_string() } else { variant_names.join(", ") })));
+            return Err(files[last].error_at(
+                0,
+                format!(
+                    "no world variant {wanted:?} in this scenario (variants: {})",
+                    if variant_names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        variant_names.join(", ")
+                    }
+                ),
+            ));
         };
         for (name, raw) in v.solids {
             let Some(e) = entries.get_mut(&name) else {
-                return Err(near(&files[index], &format!("\"{name}\""), format!("variant {wanted:?} patches {name:?}, which is not a solid")));
+                return Err(near(
+                    &files[index],
+                    &format!("\"{name}\""),
+                    format!("variant {wanted:?} patches {name:?}, which is not a solid"),
+                ));
             };
             patch(&mut e.raw, raw);
             e.file = index;
@@ -308,7 +337,13 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
 }
 
 fn build_robot(file: &SourceFile, r: RawRobot) -> Result<Robot, ScenarioError> {
-    let missing = |what: &str| near(file, "[world", format!("[world.robot] needs `{what}` (usually in the base cell.toml)"));
+    let missing = |what: &str| {
+        near(
+            file,
+            "[world",
+            format!("[world.robot] needs `{what}` (usually in the base cell.toml)"),
+        )
+    };
     let g = r.gripper.ok_or_else(|| missing("gripper"))?;
     let robot = Robot {
         shoulders: r
@@ -329,47 +364,99 @@ fn build_robot(file: &SourceFile, r: RawRobot) -> Result<Robot, ScenarioError> {
         },
     };
     if robot.shoulders.is_empty() || robot.reach <= 0.0 || robot.payload <= 0.0 {
-        return Err(near(file, "[world", "the robot needs at least one shoulder, and a positive reach and payload"));
+        return Err(near(
+            file,
+            "[world",
+            "the robot needs at least one shoulder, and a positive reach and payload",
+        ));
     }
     Ok(robot)
 }
 
 fn judge(scenario: &Scenario, file: &SourceFile, j: RawJudge) -> Result<Judge, ScenarioError> {
-    let skill = scenario.domain.skills.iter().find(|s| s.name == *j.skill.get_ref());
+    let skill = scenario
+        .domain
+        .skills
+        .iter()
+        .find(|s| s.name == *j.skill.get_ref());
     let Some(skill) = skill else {
-        return Err(file.error_in_string(&j.skill.span(), 0, format!("no skill named {:?} in this scenario", j.skill.get_ref())));
+        return Err(file.error_in_string(
+            &j.skill.span(),
+            0,
+            format!("no skill named {:?} in this scenario", j.skill.get_ref()),
+        ));
     };
     if !skill.values.iter().any(|v| v.name == *j.value.get_ref()) {
-        return Err(file.error_in_string(&j.value.span(), 0, format!("skill {:?} declares no value {:?}", skill.name, j.value.get_ref())));
+        return Err(file.error_in_string(
+            &j.value.span(),
+            0,
+            format!(
+                "skill {:?} declares no value {:?}",
+                skill.name,
+                j.value.get_ref()
+            ),
+        ));
     }
     if let Some(o) = &j.object
         && scenario.domain.vocabulary.object(o.get_ref()).is_none()
     {
-        return Err(file.error_in_string(&o.span(), 0, format!("unknown object {:?}", o.get_ref())));
+        return Err(file.error_in_string(
+            &o.span(),
+            0,
+            format!("unknown object {:?}", o.get_ref()),
+        ));
     }
     let text = |t: Option<String>, key: &str| {
-        t.ok_or_else(|| file.error_in_string(&j.value.span(), 0, format!("a judge with `{key}` also needs its error text")))
+        t.ok_or_else(|| {
+            file.error_in_string(
+                &j.value.span(),
+                0,
+                format!("a judge with `{key}` also needs its error text"),
+            )
+        })
     };
-    let min = j.min.map(|m| text(j.below.clone(), "min").map(|t| (m, t))).transpose()?;
-    let max = j.max.map(|m| text(j.above.clone(), "max").map(|t| (m, t))).transpose()?;
+    let min = j
+        .min
+        .map(|m| text(j.below.clone(), "min").map(|t| (m, t)))
+        .transpose()?;
+    let max = j
+        .max
+        .map(|m| text(j.above.clone(), "max").map(|t| (m, t)))
+        .transpose()?;
     let allowed = match j.allowed {
         Some(a) => Some((a, text(j.otherwise.clone(), "allowed")?)),
         None => None,
     };
     if min.is_none() && max.is_none() && allowed.is_none() {
-        return Err(file.error_in_string(&j.value.span(), 0, "a judge needs `min`, `max` or `allowed`"));
+        return Err(file.error_in_string(
+            &j.value.span(),
+            0,
+            "a judge needs `min`, `max` or `allowed`",
+        ));
     }
-    Ok(Judge { skill: skill.name.clone(), object: j.object.map(|o| o.into_inner()), value: j.value.into_inner(), min, max, allowed })
+    Ok(Judge {
+        skill: skill.name.clone(),
+        object: j.object.map(|o| o.into_inner()),
+        value: j.value.into_inner(),
+        min,
+        max,
+        allowed,
+    })
 }
 
 fn shape_of(file: &SourceFile, name: &str, raw: &RawSolid) -> Result<ShapeSpec, ScenarioError> {
     let err = |m: String| near(file, &format!("\"{name}\""), format!("solid {name:?}: {m}"));
     let Some(shape) = &raw.shape else {
-        return Err(err("needs a `shape` (box, cylinder, ball, capsule, cup, open box)".into()));
+        return Err(err(
+            "needs a `shape` (box, cylinder, ball, capsule, cup, open box)".into(),
+        ));
     };
     let need = |v: Option<f32>, key: &str| match v {
         Some(x) if x > 0.0 => Ok(x),
-        _ => Err(err(format!("a {} needs a positive `{key}`", shape.get_ref()))),
+        _ => Err(err(format!(
+            "a {} needs a positive `{key}`",
+            shape.get_ref()
+        ))),
     };
     let size = || match raw.size {
         Some(s) if s.iter().all(|x| *x > 0.0) => Ok(s),
@@ -377,9 +464,17 @@ fn shape_of(file: &SourceFile, name: &str, raw: &RawSolid) -> Result<ShapeSpec, 
     };
     Ok(match shape.get_ref().as_str() {
         "box" => ShapeSpec::Box { size: size()? },
-        "cylinder" => ShapeSpec::Cylinder { radius: need(raw.radius, "radius")?, height: need(raw.height, "height")? },
-        "ball" => ShapeSpec::Ball { radius: need(raw.radius, "radius")? },
-        "capsule" => ShapeSpec::Capsule { radius: need(raw.radius, "radius")?, length: need(raw.length, "length")? },
+        "cylinder" => ShapeSpec::Cylinder {
+            radius: need(raw.radius, "radius")?,
+            height: need(raw.height, "height")?,
+        },
+        "ball" => ShapeSpec::Ball {
+            radius: need(raw.radius, "radius")?,
+        },
+        "capsule" => ShapeSpec::Capsule {
+            radius: need(raw.radius, "radius")?,
+            length: need(raw.length, "length")?,
+        },
         "cup" => ShapeSpec::Cup {
             radius: need(raw.radius, "radius")?,
             height: need(raw.height, "height")?,
@@ -392,13 +487,25 @@ fn shape_of(file: &SourceFile, name: &str, raw: &RawSolid) -> Result<ShapeSpec, 
                 Some("front") => Opening::Front,
                 Some(other) => {
                     let span = raw.opening.as_ref().map(Spanned::span).unwrap_or_default();
-                    return Err(file.error_in_string(&span, 0, format!("expected \"top\" or \"front\", found {other:?}")));
+                    return Err(file.error_in_string(
+                        &span,
+                        0,
+                        format!("expected \"top\" or \"front\", found {other:?}"),
+                    ));
                 }
             };
-            ShapeSpec::OpenBox { size: size()?, wall: need(raw.wall, "wall")?, opening }
+            ShapeSpec::OpenBox {
+                size: size()?,
+                wall: need(raw.wall, "wall")?,
+                opening,
+            }
         }
         other => {
-            return Err(file.error_in_string(&shape.span(), 0, format!("unknown shape {other:?} (box, cylinder, ball, capsule, cup, open box)")));
+            return Err(file.error_in_string(
+                &shape.span(),
+                0,
+                format!("unknown shape {other:?} (box, cylinder, ball, capsule, cup, open box)"),
+            ));
         }
     })
 }
@@ -414,15 +521,30 @@ fn build(
     for o in &scenario.domain.vocabulary.objects {
         if !entries.contains_key(&o.name) {
             let needle = format!("\"{}\"", o.name);
-            let file = files.iter().rev().find(|f| f.text.contains(&needle)).unwrap_or(&files[files.len() - 1]);
-            return Err(near(file, &needle, format!("object {:?} has no solid: add [world.solids.{:?}]", o.name, o.name)));
+            let file = files
+                .iter()
+                .rev()
+                .find(|f| f.text.contains(&needle))
+                .unwrap_or(&files[files.len() - 1]);
+            return Err(near(
+                file,
+                &needle,
+                format!(
+                    "object {:?} has no solid: add [world.solids.{:?}]",
+                    o.name, o.name
+                ),
+            ));
         }
     }
     let mut solids = Vec::new();
     for (name, e) in &entries {
         let file = &files[e.file];
         if scenario.domain.vocabulary.object(name).is_none() {
-            return Err(near(file, &format!("\"{name}\""), format!("solid {name:?} is not an object of this scenario: add it to [objects]")));
+            return Err(near(
+                file,
+                &format!("\"{name}\""),
+                format!("solid {name:?} is not an object of this scenario: add it to [objects]"),
+            ));
         }
         let lid = e.raw.lid.as_ref().map(|l| Lid {
             body: Body::new(&ShapeSpec::Box { size: l.size }),
@@ -448,13 +570,24 @@ fn build(
     for (file, u) in &unknown {
         match solids.iter().position(|s| s.name == *u.get_ref()) {
             Some(i) => known[i] = false,
-            None => return Err(files[*file].error_in_string(&u.span(), 0, format!("unknown solid {:?}", u.get_ref()))),
+            None => {
+                return Err(files[*file].error_in_string(
+                    &u.span(),
+                    0,
+                    format!("unknown solid {:?}", u.get_ref()),
+                ));
+            }
         }
     }
-    let flag = |f: fn(&RawSolid) -> Option<bool>| raws.iter().map(|e| f(&e.raw).unwrap_or(false)).collect();
+    let flag = |f: fn(&RawSolid) -> Option<bool>| {
+        raws.iter().map(|e| f(&e.raw).unwrap_or(false)).collect()
+    };
     Ok(Scene {
         initial: Initial {
-            poses: poses.into_iter().map(|p| p.unwrap_or_else(Pose::identity)).collect(),
+            poses: poses
+                .into_iter()
+                .map(|p| p.unwrap_or_else(Pose::identity))
+                .collect(),
             lid_open: flag(|r| r.open),
             locked: flag(|r| r.locked),
             dirty: flag(|r| r.dirty),
@@ -482,7 +615,11 @@ fn place(
     let name = &solids[i].name;
     let file = &files[e.file];
     if visiting.contains(&i) {
-        return Err(near(file, &format!("\"{name}\""), format!("solid {name:?} rests on itself through `on`/`in`")));
+        return Err(near(
+            file,
+            &format!("\"{name}\""),
+            format!("solid {name:?} rests on itself through `on`/`in`"),
+        ));
     }
     visiting.push(i);
     let mut rotation = rotation_deg(e.raw.rotation.unwrap_or([0.0; 3]));
@@ -491,9 +628,12 @@ fn place(
     }
     let body = &solids[i].body;
     let support = |s: &Spanned<String>| {
-        solids.iter().position(|x| x.name == *s.get_ref()).ok_or_else(|| {
-            file.error_in_string(&s.span(), 0, format!("no solid named {:?}", s.get_ref()))
-        })
+        solids
+            .iter()
+            .position(|x| x.name == *s.get_ref())
+            .ok_or_else(|| {
+                file.error_in_string(&s.span(), 0, format!("no solid named {:?}", s.get_ref()))
+            })
     };
     let pose = if let Some(at) = e.raw.at {
         Pose::from_parts(at.into(), rotation)
@@ -507,12 +647,20 @@ fn place(
         let j = support(s)?;
         let sp = place(j, raws, solids, files, poses, visiting)?;
         let Some((cavity, half, _)) = solids[j].body.cavity_at(&sp) else {
-            return Err(file.error_in_string(&s.span(), 0, format!("{:?} has no cavity to be in", s.get_ref())));
+            return Err(file.error_in_string(
+                &s.span(),
+                0,
+                format!("{:?} has no cavity to be in", s.get_ref()),
+            ));
         };
         let floor = cavity * nalgebra::Point3::new(0.0, 0.0, -half.z);
         body.resting(rotation, floor.x, floor.y, floor.z)
     } else {
-        return Err(near(file, &format!("\"{name}\""), format!("solid {name:?} needs `at`, `on` (with `xy`) or `in`")));
+        return Err(near(
+            file,
+            &format!("\"{name}\""),
+            format!("solid {name:?} needs `at`, `on` (with `xy`) or `in`"),
+        ));
     };
     visiting.pop();
     poses[i] = Some(pose);

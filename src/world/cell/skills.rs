@@ -41,7 +41,10 @@ impl CellWorld {
             }
             for (name, value) in &action.values {
                 if let Value::Category(c) = value
-                    && skill.values.iter().any(|v| v.name == *name && v.unit.is_none())
+                    && skill
+                        .values
+                        .iter()
+                        .any(|v| v.name == *name && v.unit.is_none())
                     && self.id(c).is_none()
                 {
                     return Err(format!("The {name} {c:?} is not in the cell"));
@@ -73,7 +76,7 @@ impl CellWorld {
                 self.free_hand("scoop", *x)?;
                 self.reachable(*x)?;
                 self.reachable(*c)?;
-                let pose = self.into_cavity(*x, *c)?.0;
+                let pose = self.cavity_rest(*x, *c)?.0;
                 Ok(Effect::Move { id: *x, pose })
             }
             ("wipe", [x]) => {
@@ -81,12 +84,19 @@ impl CellWorld {
                 self.reachable(*x)?;
                 Ok(Effect::Clean(*x))
             }
-            (name, _) => Err(format!("The cell cannot perform {name} on {} object(s)", ids.len())),
+            (name, _) => Err(format!(
+                "The cell cannot perform {name} on {} object(s)",
+                ids.len()
+            )),
         }
     }
 
     fn reachable(&self, id: usize) -> Result<(), String> {
-        if self.scene.robot.reaches(self.state.base, &self.reach_point(id)) {
+        if self
+            .scene
+            .robot
+            .reaches(self.state.base, &self.reach_point(id))
+        {
             Ok(())
         } else {
             Err(OUT_OF_REACH.to_string())
@@ -126,7 +136,10 @@ impl CellWorld {
     fn grasp(&self, x: usize) -> Result<Effect, String> {
         let solid = &self.scene.solids[x];
         if solid.fixed {
-            return Err(format!("{:?} is fixed in place and cannot be grasped", solid.name));
+            return Err(format!(
+                "{:?} is fixed in place and cannot be grasped",
+                solid.name
+            ));
         }
         self.free_hand("grasp", x)?;
         self.reachable(x)?;
@@ -150,7 +163,10 @@ impl CellWorld {
 
     fn flip(&self, x: usize) -> Result<Effect, String> {
         if self.scene.solids[x].fixed {
-            return Err(format!("{:?} is fixed in place and cannot be flipped", self.name(x)));
+            return Err(format!(
+                "{:?} is fixed in place and cannot be flipped",
+                self.name(x)
+            ));
         }
         self.free_hand("flip", x)?;
         self.reachable(x)?;
@@ -161,7 +177,9 @@ impl CellWorld {
         let b = self.aabb(x);
         let c = b.center();
         let turned = super::geometry::flipped(pose.rotation);
-        let pose = self.scene.solids[x].body.resting(turned, c.x, c.y, b.mins.z);
+        let pose = self.scene.solids[x]
+            .body
+            .resting(turned, c.x, c.y, b.mins.z);
         Ok(Effect::Move { id: x, pose })
     }
 
@@ -201,10 +219,22 @@ impl CellWorld {
 
     /// Bring the held object to rest at `pose`, coming in along `direction` (pointing from
     /// the target back out towards where the motion starts) over `travel` metres.
-    fn release_path_clear(&self, held: &Held, pose: &Pose, direction: Vector3<f32>, travel: f32) -> bool {
+    fn release_path_clear(
+        &self,
+        held: &Held,
+        pose: &Pose,
+        direction: Vector3<f32>,
+        travel: f32,
+    ) -> bool {
         let end = Pose::translation(0.0, 0.0, CONTACT_GAP) * pose * held.grip.inverse();
         let start = Pose::from_parts((direction * travel).into(), UnitQuaternion::identity()) * end;
-        !path_collides(&self.carried(held), &start, &end, &self.obstacles(&[held.id]), &self.counter)
+        !path_collides(
+            &self.carried(held),
+            &start,
+            &end,
+            &self.obstacles(&[held.id]),
+            &self.counter,
+        )
     }
 
     fn place_on(&self, x: usize, s: usize) -> Result<Effect, String> {
@@ -216,7 +246,10 @@ impl CellWorld {
         let rotation = (self.state.poses[x]).rotation;
         let top = self.aabb(s);
         let foot = body.aabb(&Pose::from_parts(Default::default(), rotation));
-        let (hx, hy) = ((foot.maxs.x - foot.mins.x) / 2.0, (foot.maxs.y - foot.mins.y) / 2.0);
+        let (hx, hy) = (
+            (foot.maxs.x - foot.mins.x) / 2.0,
+            (foot.maxs.y - foot.mins.y) / 2.0,
+        );
         let spots = self.spots(x, s, hx, hy, &held);
         if spots.is_empty() {
             return Err(OUT_OF_REACH.to_string());
@@ -238,8 +271,12 @@ impl CellWorld {
         let top = self.aabb(s);
         let c = top.center();
         let step = 2.0 * hx.max(hy) + 0.01;
-        let nx = (((top.maxs.x - top.mins.x) / 2.0 - hx) / step).floor().max(0.0) as i32;
-        let ny = (((top.maxs.y - top.mins.y) / 2.0 - hy) / step).floor().max(0.0) as i32;
+        let nx = (((top.maxs.x - top.mins.x) / 2.0 - hx) / step)
+            .floor()
+            .max(0.0) as i32;
+        let ny = (((top.maxs.y - top.mins.y) / 2.0 - hy) / step)
+            .floor()
+            .max(0.0) as i32;
         let others: Vec<_> = (0..self.scene.solids.len())
             .filter(|o| *o != x && *o != s && !self.is_held(*o))
             .map(|o| self.aabb(o))
@@ -272,9 +309,14 @@ impl CellWorld {
 
     /// Where `x` rests on the floor of `c`'s cavity, and the direction and length of the
     /// way in.
-    fn into_cavity(&self, x: usize, c: usize) -> Result<(Pose, Vector3<f32>, f32), String> {
-        let Some((cavity, half, opening)) = self.scene.solids[c].body.cavity_at(&self.state.poses[c]) else {
-            return Err(format!("{:?} has no opening to put things in", self.name(c)));
+    fn cavity_rest(&self, x: usize, c: usize) -> Result<(Pose, Vector3<f32>, f32), String> {
+        let Some((cavity, half, opening)) =
+            self.scene.solids[c].body.cavity_at(&self.state.poses[c])
+        else {
+            return Err(format!(
+                "{:?} has no opening to put things in",
+                self.name(c)
+            ));
         };
         // The lowest point of the cavity in the world, whichever way the container is turned.
         let r = cavity.rotation.to_rotation_matrix();
@@ -282,7 +324,12 @@ impl CellWorld {
         let depth = m[(2, 0)].abs() * half.x + m[(2, 1)].abs() * half.y + m[(2, 2)].abs() * half.z;
         let centre = cavity.translation.vector;
         let floor = Point3::new(centre.x, centre.y, centre.z - depth);
-        let pose = self.scene.solids[x].body.resting(self.state.poses[x].rotation, floor.x, floor.y, floor.z);
+        let pose = self.scene.solids[x].body.resting(
+            self.state.poses[x].rotation,
+            floor.x,
+            floor.y,
+            floor.z,
+        );
         let approach = self.scene.robot.gripper.approach;
         Ok(match opening {
             // Into a top opening the arm comes straight down, whichever way the container
@@ -290,7 +337,9 @@ impl CellWorld {
             Opening::Top => (pose, Vector3::z(), 2.0 * half.z + approach),
             Opening::Front => {
                 let out = cavity.rotation * -Vector3::x();
-                let flat = Vector3::new(out.x, out.y, 0.0).try_normalize(1e-6).unwrap_or(-Vector3::x());
+                let flat = Vector3::new(out.x, out.y, 0.0)
+                    .try_normalize(1e-6)
+                    .unwrap_or(-Vector3::x());
                 (pose, flat, 2.0 * half.x + approach)
             }
         })
@@ -302,7 +351,7 @@ impl CellWorld {
             return Err(format!("{:?} cannot be put in itself", self.name(x)));
         }
         self.reachable(c)?;
-        let (pose, direction, travel) = self.into_cavity(x, c)?;
+        let (pose, direction, travel) = self.cavity_rest(x, c)?;
         if self.release_path_clear(&held, &pose, direction, travel) {
             Ok(Effect::Release { id: x, pose })
         } else {

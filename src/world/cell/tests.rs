@@ -9,7 +9,12 @@ use crate::domain::{ActionCall, Condition, Scenario};
 use crate::world::{Step, World};
 
 fn scenario(rel: &str) -> Scenario {
-    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell").join(rel)).unwrap()
+    Scenario::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/cell")
+            .join(rel),
+    )
+    .unwrap()
 }
 
 fn cell(rel: &str, variant: Option<&str>) -> CellWorld {
@@ -48,10 +53,16 @@ fn on_and_grasped_follow_the_poses() {
     assert!(holds(&w, r#""red cube" on "table""#));
     // Put down clear of the cubes, so grasping the blue cube is free now.
     assert_eq!(act(&mut w, r#"grasp "blue cube""#), Step::Success);
-    assert_eq!(act(&mut w, r#"place "blue cube" "green cube""#), Step::Success);
+    assert_eq!(
+        act(&mut w, r#"place "blue cube" "green cube""#),
+        Step::Success
+    );
     assert!(holds(&w, r#""blue cube" on "green cube""#));
     // It rests on the green cube's top face.
-    let (blue, green) = (w.pose_of("blue cube").unwrap(), w.pose_of("green cube").unwrap());
+    let (blue, green) = (
+        w.pose_of("blue cube").unwrap(),
+        w.pose_of("green cube").unwrap(),
+    );
     assert!((blue.translation.vector.z - green.translation.vector.z - 0.04).abs() < 1e-5);
     assert!(w.broad_checks() > 0);
 }
@@ -59,7 +70,10 @@ fn on_and_grasped_follow_the_poses() {
 #[test]
 fn a_cube_on_top_blocks_the_way_down() {
     let mut w = cell("red_on_blue.toml", None);
-    assert_eq!(act(&mut w, r#"grasp "blue cube""#), Step::Failure(NO_PATH.into()));
+    assert_eq!(
+        act(&mut w, r#"grasp "blue cube""#),
+        Step::Failure(NO_PATH.into())
+    );
     let mut clear = cell("red_on_blue.toml", Some("clear"));
     assert_eq!(act(&mut clear, r#"grasp "blue cube""#), Step::Success);
     // Stacking on a cube that carries another is blocked by where that one is.
@@ -67,7 +81,10 @@ fn a_cube_on_top_blocks_the_way_down() {
     assert_eq!(act(&mut both, r#"grasp "red cube""#), Step::Success);
     assert_eq!(act(&mut both, r#"place "red cube" "table""#), Step::Success);
     assert_eq!(act(&mut both, r#"grasp "blue cube""#), Step::Success);
-    assert_eq!(act(&mut both, r#"place "blue cube" "green cube""#), Step::Failure(NO_PATH.into()));
+    assert_eq!(
+        act(&mut both, r#"place "blue cube" "green cube""#),
+        Step::Failure(NO_PATH.into())
+    );
 }
 
 #[test]
@@ -76,13 +93,19 @@ fn an_upside_down_cup_closes_its_opening() {
     assert!(!holds(&w, r#""red cup" upright"#));
     assert!(!holds(&w, r#""red cup" open"#));
     assert_eq!(act(&mut w, r#"grasp "green cube""#), Step::Success);
-    assert_eq!(act(&mut w, r#"put_in "green cube" "red cup""#), Step::Failure(NO_PATH.into()));
+    assert_eq!(
+        act(&mut w, r#"put_in "green cube" "red cup""#),
+        Step::Failure(NO_PATH.into())
+    );
     let mut w = cell("flip_cup.toml", None);
     assert_eq!(act(&mut w, r#"flip "red cup""#), Step::Success);
     assert!(holds(&w, r#""red cup" upright"#));
     assert!(holds(&w, r#""red cup" open"#));
     assert_eq!(act(&mut w, r#"grasp "green cube""#), Step::Success);
-    assert_eq!(act(&mut w, r#"put_in "green cube" "red cup""#), Step::Success);
+    assert_eq!(
+        act(&mut w, r#"put_in "green cube" "red cup""#),
+        Step::Success
+    );
     assert!(holds(&w, r#""green cube" in "red cup""#));
     assert!(!holds(&w, r#""green cube" on "table""#));
 }
@@ -92,12 +115,18 @@ fn a_closed_lid_blocks_and_an_open_one_does_not() {
     let mut w = cell("centrifuge.toml", None);
     assert!(!holds(&w, r#""centrifuge" open"#));
     assert_eq!(act(&mut w, r#"grasp "test tube""#), Step::Success);
-    assert_eq!(act(&mut w, r#"put_in "test tube" "centrifuge""#), Step::Failure(NO_PATH.into()));
+    assert_eq!(
+        act(&mut w, r#"put_in "test tube" "centrifuge""#),
+        Step::Failure(NO_PATH.into())
+    );
     let mut w = cell("centrifuge.toml", None);
     assert_eq!(act(&mut w, r#"open "centrifuge""#), Step::Success);
     assert!(holds(&w, r#""centrifuge" open"#));
     assert_eq!(act(&mut w, r#"grasp "test tube""#), Step::Success);
-    assert_eq!(act(&mut w, r#"put_in "test tube" "centrifuge""#), Step::Success);
+    assert_eq!(
+        act(&mut w, r#"put_in "test tube" "centrifuge""#),
+        Step::Success
+    );
     assert!(holds(&w, r#""test tube" in "centrifuge""#));
 }
 
@@ -105,10 +134,16 @@ fn a_closed_lid_blocks_and_an_open_one_does_not() {
 fn a_locked_door_does_not_open_and_a_closed_one_blocks() {
     let mut w = cell("cupboard.toml", None);
     assert!(!holds(&w, r#""cupboard" unlocked"#));
-    assert_eq!(act(&mut w, r#"open "cupboard""#), Step::Failure(TORQUE.into()));
+    assert_eq!(
+        act(&mut w, r#"open "cupboard""#),
+        Step::Failure(TORQUE.into())
+    );
     let mut w = cell("cupboard.toml", Some("clear"));
     assert_eq!(act(&mut w, r#"grasp "plate""#), Step::Success);
-    assert_eq!(act(&mut w, r#"put_in "plate" "cupboard""#), Step::Failure(NO_PATH.into()));
+    assert_eq!(
+        act(&mut w, r#"put_in "plate" "cupboard""#),
+        Step::Failure(NO_PATH.into())
+    );
     let mut w = cell("cupboard.toml", Some("clear"));
     assert_eq!(act(&mut w, r#"open "cupboard""#), Step::Success);
     assert!(holds(&w, r#""cupboard" open"#));
@@ -122,7 +157,10 @@ fn reach_and_driving_and_the_robots_map() {
     let mut w = cell("banana_far.toml", None);
     assert!(!holds(&w, r#""banana" near robot"#));
     assert!(holds(&w, r#""tray" near robot"#));
-    assert_eq!(act(&mut w, r#"grasp "banana""#), Step::Failure(OUT_OF_REACH.into()));
+    assert_eq!(
+        act(&mut w, r#"grasp "banana""#),
+        Step::Failure(OUT_OF_REACH.into())
+    );
     assert_eq!(act(&mut w, r#"move_base "banana""#), Step::Success);
     assert!(holds(&w, r#""banana" near robot"#));
     assert_eq!(act(&mut w, r#"grasp "banana""#), Step::Success);
@@ -147,7 +185,10 @@ fn snapshots_restore_and_forks_share_the_check_count() {
     let _ = f.step(&ActionCall::parse(r#"grasp "blue cube""#).unwrap(), true);
     assert!(w.collision_checks() > before);
     let facts: Vec<String> = w.facts().iter().map(ToString::to_string).collect();
-    assert!(facts.contains(&r#""red cube" on "blue cube""#.to_string()), "{facts:?}");
+    assert!(
+        facts.contains(&r#""red cube" on "blue cube""#.to_string()),
+        "{facts:?}"
+    );
 }
 
 fn scratch(name: &str, text: &str) -> PathBuf {
@@ -160,26 +201,52 @@ fn scratch(name: &str, text: &str) -> PathBuf {
     p
 }
 
-const HEAD: &str = "extends = \"cell.toml\"\n[scenario]\nname = \"x\"\n[objects]\nitem = [\"cube\"]\n";
+const HEAD: &str =
+    "extends = \"cell.toml\"\n[scenario]\nname = \"x\"\n[objects]\nitem = [\"cube\"]\n";
 
 #[test]
 fn scene_errors_name_file_line_and_column() {
-    let p = scratch("shape", &format!("{HEAD}[world.solids.\"cube\"]\nshape = \"blob\"\non = \"table\"\n"));
-    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None).err().unwrap();
+    let p = scratch(
+        "shape",
+        &format!("{HEAD}[world.solids.\"cube\"]\nshape = \"blob\"\non = \"table\"\n"),
+    );
+    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+        .err()
+        .unwrap();
     assert_eq!((e.line, e.column), (7, 10), "{e}");
     assert!(e.message.contains("unknown shape \"blob\""), "{e}");
 
-    let p = scratch("support", &format!("{HEAD}[world.solids.\"cube\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\non = \"shelf\"\n"));
-    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None).err().unwrap();
+    let p = scratch(
+        "support",
+        &format!(
+            "{HEAD}[world.solids.\"cube\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\non = \"shelf\"\n"
+        ),
+    );
+    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+        .err()
+        .unwrap();
     assert_eq!((e.line, e.column), (9, 7), "{e}");
 
-    let p = scratch("skill", &format!("{HEAD}[[skills]]\nname = \"juggle\"\nparams = [\"x: item\"]\n[world.solids.\"cube\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\non = \"table\"\n"));
-    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None).err().unwrap();
+    let p = scratch(
+        "skill",
+        &format!(
+            "{HEAD}[[skills]]\nname = \"juggle\"\nparams = [\"x: item\"]\n[world.solids.\"cube\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\non = \"table\"\n"
+        ),
+    );
+    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+        .err()
+        .unwrap();
     assert_eq!(e.line, 7, "{e}");
-    assert!(e.message.contains("cannot perform a skill named \"juggle\""), "{e}");
+    assert!(
+        e.message
+            .contains("cannot perform a skill named \"juggle\""),
+        "{e}"
+    );
 
     let p = scratch("nosolid", HEAD);
-    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None).err().unwrap();
+    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+        .err()
+        .unwrap();
     assert_eq!(e.line, 5, "{e}");
     assert!(e.message.contains("\"cube\" has no solid"), "{e}");
 }

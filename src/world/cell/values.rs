@@ -49,7 +49,8 @@ fn fill(text: &str, value: &Value, judge: &Judge, object: &str) -> String {
         Value::Number { value, unit } => (format!("{value}"), unit.clone()),
         Value::Category(c) => (c.clone(), String::new()),
     };
-    let bound = |b: &Option<(f64, String)>| b.as_ref().map(|(x, _)| format!("{x}")).unwrap_or_default();
+    let bound =
+        |b: &Option<(f64, String)>| b.as_ref().map(|(x, _)| format!("{x}")).unwrap_or_default();
     text.replace("{value}", &v)
         .replace("{unit}", &unit)
         .replace("{min}", &bound(&judge.min))
@@ -70,21 +71,32 @@ pub fn judge(action: &ActionCall, declared: &[ValueParam], judges: &[Judge]) -> 
             (Value::Number { unit, .. }, Some(want)) if unit != want && !unit.is_empty() => {
                 return Some(format!(
                     "{} must be given in {want}, found {value}",
-                    missing_text(param).split(" not defined").next().unwrap_or(&param.name)
+                    missing_text(param)
+                        .split(" not defined")
+                        .next()
+                        .unwrap_or(&param.name)
                 ));
             }
             (Value::Category(_), Some(want)) => {
-                return Some(format!("{} must be a number in {want}, found {value}", param.name));
+                return Some(format!(
+                    "{} must be a number in {want}, found {value}",
+                    param.name
+                ));
             }
             (Value::Number { .. }, None) => {
-                return Some(format!("{} must be one of {}, found {value}", param.name, param.categories.join(", ")));
+                return Some(format!(
+                    "{} must be one of {}, found {value}",
+                    param.name,
+                    param.categories.join(", ")
+                ));
             }
             _ => {}
         }
     }
-    for j in judges.iter().filter(|j| {
-        j.skill == action.skill && j.object.as_deref().is_none_or(|o| o == object)
-    }) {
+    for j in judges
+        .iter()
+        .filter(|j| j.skill == action.skill && j.object.as_deref().is_none_or(|o| o == object))
+    {
         let Some(value) = action.value(&j.value) else {
             continue;
         };
@@ -132,7 +144,11 @@ mod tests {
             object: Some("egg".into()),
             value: "force".into(),
             min: None,
-            max: Some((6.0, "The egg broke: {value} {unit} is more than it can bear ({max} {unit} at most)".into())),
+            max: Some((
+                6.0,
+                "The egg broke: {value} {unit} is more than it can bear ({max} {unit} at most)"
+                    .into(),
+            )),
             allowed: None,
         }
     }
@@ -149,18 +165,46 @@ mod tests {
     #[test]
     fn values_are_judged_per_object() {
         let mut a = ActionCall::new("grasp", ["egg"]);
-        a.set_value("force", Value::Number { value: 50.0, unit: "N".into() });
+        a.set_value(
+            "force",
+            Value::Number {
+                value: 50.0,
+                unit: "N".into(),
+            },
+        );
         assert_eq!(
             judge(&a, &[force()], &[egg_judge()]).unwrap(),
             "The egg broke: 50 N is more than it can bear (6 N at most)"
         );
-        a.set_value("force", Value::Number { value: 5.0, unit: "N".into() });
+        a.set_value(
+            "force",
+            Value::Number {
+                value: 5.0,
+                unit: "N".into(),
+            },
+        );
         assert_eq!(judge(&a, &[force()], &[egg_judge()]), None);
         let mut b = ActionCall::new("grasp", ["hammer"]);
-        b.set_value("force", Value::Number { value: 50.0, unit: "N".into() });
+        b.set_value(
+            "force",
+            Value::Number {
+                value: 50.0,
+                unit: "N".into(),
+            },
+        );
         assert_eq!(judge(&b, &[force()], &[egg_judge()]), None);
-        b.set_value("force", Value::Number { value: 50.0, unit: "lbf".into() });
-        assert!(judge(&b, &[force()], &[]).unwrap().contains("must be given in N"));
+        b.set_value(
+            "force",
+            Value::Number {
+                value: 50.0,
+                unit: "lbf".into(),
+            },
+        );
+        assert!(
+            judge(&b, &[force()], &[])
+                .unwrap()
+                .contains("must be given in N")
+        );
     }
 
     #[test]
@@ -177,7 +221,10 @@ mod tests {
             value: "tool".into(),
             min: None,
             max: None,
-            allowed: Some((vec!["shovel".into()], "A {value} cannot scoop {object}".into())),
+            allowed: Some((
+                vec!["shovel".into()],
+                "A {value} cannot scoop {object}".into(),
+            )),
         };
         let mut a = ActionCall::new("scoop", ["sand", "bucket"]);
         assert_eq!(
@@ -185,6 +232,9 @@ mod tests {
             "Tool not defined. Please define tool (one of: shovel, hammer)"
         );
         a.set_value("tool", Value::Category("hammer".into()));
-        assert_eq!(judge(&a, std::slice::from_ref(&tool), std::slice::from_ref(&j)).unwrap(), "A hammer cannot scoop sand");
+        assert_eq!(
+            judge(&a, std::slice::from_ref(&tool), std::slice::from_ref(&j)).unwrap(),
+            "A hammer cannot scoop sand"
+        );
     }
 }
