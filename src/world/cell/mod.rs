@@ -155,7 +155,7 @@ impl CellWorld {
         self.state.held.as_ref().is_some_and(|h| h.id == id)
     }
 
-    fn aabb(&self, id: usize) -> parry3d::bounding_volume::Aabb {
+    fn aabb(&self, id: usize) -> geometry::Aabb {
         self.scene.solids[id].body.aabb(&self.state.poses[id])
     }
 

@@ -8,10 +8,8 @@
 //! modelled). A mobile base, when a scenario gives the robot one, moves the torso in the
 //! floor plane.
 
+use super::geometry::{Part, cuboid_at};
 use nalgebra::{Point3, Vector2, Vector3};
-use parry3d::shape::SharedShape;
-
-use super::geometry::{Part, Pose};
 
 /// The gripper's solid dimensions (metres).
 #[derive(Debug, Clone, PartialEq)]
@@ -85,18 +83,20 @@ impl Robot {
         let g = &self.gripper;
         let [t, w, len] = g.finger;
         let y = half_width + g.clearance + t / 2.0;
-        let finger = |side: f32| Part {
-            local: Pose::translation(0.0, side * y, len / 2.0),
-            shape: SharedShape::cuboid(w / 2.0, t / 2.0, len / 2.0),
+        let finger = |side: f32| {
+            cuboid_at(
+                Vector3::new(0.0, side * y, len / 2.0),
+                Vector3::new(w / 2.0, t / 2.0, len / 2.0),
+            )
         };
         let [px, ph] = g.palm;
         vec![
             finger(1.0),
             finger(-1.0),
-            Part {
-                local: Pose::translation(0.0, 0.0, len + ph / 2.0),
-                shape: SharedShape::cuboid(px / 2.0, y + t / 2.0, ph / 2.0),
-            },
+            cuboid_at(
+                Vector3::new(0.0, 0.0, len + ph / 2.0),
+                Vector3::new(px / 2.0, y + t / 2.0, ph / 2.0),
+            ),
         ]
     }
 }

@@ -4,16 +4,18 @@
 //! its origin at the centre of its footprint (bottom centre), so "resting on a face" is a
 //! translation to that face's height. Bodies are lists of convex parts (a cup is a ring of
 //! wall slabs plus a bottom disc), which lets a path test run convex-against-convex and
-//! count every test it makes.
+//! count every test it makes. The collision queries themselves are in `collision`.
+
+mod collision;
+
+pub use collision::{Counter, Obstacle, overlaps_any, path_collides};
+pub use parry3d::bounding_volume::Aabb;
 
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use parry3d::bounding_volume::{Aabb, BoundingVolume};
-use parry3d::query::{self, ShapeCastOptions};
+use parry3d::bounding_volume::BoundingVolume;
 use parry3d::shape::SharedShape;
 
 /// A rigid placement in the world (or relative to another frame).
@@ -96,7 +98,8 @@ pub enum ShapeSpec {
 /// Wall slabs around a cup: enough that a cube cannot slip between them.
 const CUP_SEGMENTS: usize = 12;
 
-fn cuboid_at(center: Vector3<f32>, half: Vector3<f32>) -> Part {
+/// A box part centred at `center` with half extents `half` (gripper fingers, walls).
+pub fn cuboid_at(center: Vector3<f32>, half: Vector3<f32>) -> Part {
     Part {
         local: Pose::translation(center.x, center.y, center.z),
         shape: SharedShape::cuboid(half.x, half.y, half.z),
@@ -285,143 +288,6 @@ pub fn aabb_of(parts: &[Part], pose: &Pose) -> Aabb {
     out.unwrap_or_else(|| Aabb::new(Point3::origin(), Point3::origin()))
 }
 
-/// A solid in the world at its current pose: what a moving thing may hit.
-pub struct Obstacle<'a> {
-    pub pose: Pose,
-    pub body: &'a Body,
-}
-
-/// Counts collision tests, shared by every fork of a world (for checks per second):
-/// `narrow` are exact tests of two convex parts (a shape cast or an intersection test),
-/// `broad` are box-against-box tests of whole solids that decide which pairs get one.
-/// `queries` are whole questions (is this path free? is this region empty?) and `nanos`
-/// the time spent answering them.
-#[derive(Debug, Default)]
-pub struct Counter {
-    narrow: AtomicU64,
-    broad: AtomicU64,
-    queries: AtomicU64,
-    nanos: AtomicU64,
-}
-
-impl Counter {
-    pub fn add(&self, narrow: u64, broad: u64, since: Instant) {
-        self.narrow.fetch_add(narrow, Ordering::Relaxed);
-        self.broad.fetch_add(broad, Ordering::Relaxed);
-        self.queries.fetch_add(1, Ordering::Relaxed);
-        let nanos = u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX);
-        self.nanos.fetch_add(nanos, Ordering::Relaxed);
-    }
-
-    /// Questions answered (paths and regions).
-    pub fn queries(&self) -> u64 {
-        self.queries.load(Ordering::Relaxed)
-    }
-
-    /// Seconds spent answering them.
-    pub fn seconds(&self) -> f64 {
-        self.nanos.load(Ordering::Relaxed) as f64 * 1e-9
-    }
-
-    /// Exact tests of part pairs.
-    pub fn get(&self) -> u64 {
-        self.narrow.load(Ordering::Relaxed)
-    }
-
-    /// Box tests of whole solids.
-    pub fn broad(&self) -> u64 {
-        self.broad.load(Ordering::Relaxed)
-    }
-}
-
-/// Whether `moving` parts, carried in a frame that travels in a straight line from
-/// `start` to `end`, touch any obstacle on the way. The swept box of the motion filters
-/// obstacles; each remaining pair of convex parts is tested by casting one against the
-/// other over the whole motion (the exact swept volume of the motion, not samples).
-pub fn path_collides(
-    moving: &[Part],
-    start: &Pose,
-    end: &Pose,
-    obstacles: &[Obstacle],
-    counter: &Counter,
-) -> bool {
-    let since = Instant::now();
-    let swept = aabb_of(moving, start).merged(&aabb_of(moving, end));
-    let travel = end.translation.vector - start.translation.vector;
-    let mut checks = 0;
-    let options = ShapeCastOptions {
-        max_time_of_impact: 1.0,
-        target_distance: 0.0,
-        stop_at_penetration: true,
-        compute_impact_geometry_on_penetration: false,
-    };
-    let mut hit = false;
-    let mut broad = 0;
-    'outer: for o in obstacles {
-        broad += 1;
-        if !o.body.aabb(&o.pose).intersects(&swept) {
-            continue;
-        }
-        for op in o.body.parts.iter() {
-            let op_pose = o.pose * op.local;
-            if !op.shape.compute_aabb(&op_pose).intersects(&swept) {
-                continue;
-            }
-            for mp in moving {
-                checks += 1;
-                let mp_pose = start * mp.local;
-                let cast = query::cast_shapes(
-                    &mp_pose,
-                    &travel,
-                    mp.shape.as_ref(),
-                    &op_pose,
-                    &Vector3::zeros(),
-                    op.shape.as_ref(),
-                    options,
-                );
-                // A query parry cannot answer is treated as a collision: never claim a
-                // path is free without having shown it.
-                if !matches!(cast, Ok(None)) {
-                    hit = true;
-                    break 'outer;
-                }
-            }
-        }
-    }
-    counter.add(checks, broad, since);
-    hit
-}
-
-/// Whether a part (already in world space) overlaps any obstacle.
-pub fn overlaps_any(part: &Part, obstacles: &[Obstacle], counter: &Counter) -> bool {
-    let since = Instant::now();
-    let bound = part.shape.compute_aabb(&part.local);
-    let mut checks = 0;
-    let mut hit = false;
-    let mut broad = 0;
-    'outer: for o in obstacles {
-        broad += 1;
-        if !o.body.aabb(&o.pose).intersects(&bound) {
-            continue;
-        }
-        for op in o.body.parts.iter() {
-            checks += 1;
-            let touching = query::intersection_test(
-                &part.local,
-                part.shape.as_ref(),
-                &(o.pose * op.local),
-                op.shape.as_ref(),
-            );
-            if !matches!(touching, Ok(false)) {
-                hit = true;
-                break 'outer;
-            }
-        }
-    }
-    counter.add(checks, broad, since);
-    hit
-}
-
 /// Whether a body's local +z still points up (within about 8 degrees).
 pub fn is_upright(pose: &Pose) -> bool {
     (pose.rotation * Vector3::z()).z > 0.99
@@ -438,75 +304,4 @@ pub fn rotation_deg(r: [f32; 3]) -> UnitQuaternion<f32> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    pub(crate) fn cube(size: f32) -> Body {
-        Body::new(&ShapeSpec::Box { size: [size; 3] })
-    }
-
-    #[test]
-    fn resting_puts_the_bottom_on_the_face() {
-        let b = cube(0.04);
-        let p = b.resting(UnitQuaternion::identity(), 0.3, 0.1, 0.04);
-        let a = b.aabb(&p);
-        assert!((a.mins.z - 0.04).abs() < 1e-6);
-        assert!((a.center().x - 0.3).abs() < 1e-6);
-        let cup = Body::new(&ShapeSpec::Cup {
-            radius: 0.04,
-            height: 0.09,
-            wall: 0.005,
-            bottom: 0.008,
-        });
-        let down = cup.resting(flipped(UnitQuaternion::identity()), 0.0, 0.0, 0.0);
-        assert!(!is_upright(&down));
-        assert!(cup.aabb(&down).mins.z.abs() < 1e-5);
-    }
-
-    #[test]
-    fn a_falling_cube_hits_a_cube_below_but_not_beside() {
-        let counter = Counter::default();
-        let b = cube(0.04);
-        let below = Obstacle {
-            pose: b.resting(UnitQuaternion::identity(), 0.0, 0.0, 0.0),
-            body: &b,
-        };
-        let start = Pose::translation(0.0, 0.0, 0.3);
-        let end = Pose::translation(0.0, 0.0, 0.01);
-        let parts = b.parts.as_ref().clone();
-        assert!(path_collides(
-            &parts,
-            &start,
-            &end,
-            std::slice::from_ref(&below),
-            &counter
-        ));
-        let aside = Pose::translation(0.1, 0.0, 0.0);
-        assert!(!path_collides(
-            &parts,
-            &(aside * start),
-            &(aside * end),
-            std::slice::from_ref(&below),
-            &counter
-        ));
-        assert!(counter.get() >= 1 && counter.broad() >= 2);
-    }
-
-    #[test]
-    fn cavity_and_opening_follow_the_pose() {
-        let cup = Body::new(&ShapeSpec::Cup {
-            radius: 0.045,
-            height: 0.09,
-            wall: 0.005,
-            bottom: 0.008,
-        });
-        let up = cup.resting(UnitQuaternion::identity(), 0.0, 0.0, 0.0);
-        assert!(cup.cavity_contains(&up, &Point3::new(0.0, 0.0, 0.03)));
-        assert!(!cup.cavity_contains(&up, &Point3::new(0.0, 0.0, 0.12)));
-        let region = cup.opening_region(&up).unwrap();
-        assert!(region.local.translation.vector.z > 0.09);
-        let down = cup.resting(flipped(UnitQuaternion::identity()), 0.0, 0.0, 0.0);
-        let region = cup.opening_region(&down).unwrap();
-        assert!(region.local.translation.vector.z < 0.0);
-    }
-}
+mod tests;
