@@ -4,6 +4,7 @@ mod eval_cmd;
 mod llm_cmds;
 mod model_cmd;
 mod tree_cmds;
+mod values;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -60,14 +61,21 @@ pub enum Command {
         /// Give up after this many ticks.
         #[arg(long, default_value_t = 10_000)]
         max_ticks: u64,
+        /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
+        #[arg(long)]
+        variant: Option<String>,
     },
     /// Plan, run until an action fails, insert conditions as that action's first
     /// preconditions, re-plan and run to success; print and optionally save the tree.
     Repair {
         scenario: PathBuf,
         /// Conditions to insert (a conjunction: 'A & B'); repeat for successive failures.
-        #[arg(long = "add", required = true)]
+        #[arg(long = "add", required_unless_present = "set")]
         add: Vec<String>,
+        /// A value parameter for every action that uses it with the object, e.g.
+        /// "force of egg = 5 N" (repeatable; applied before any --add).
+        #[arg(long = "set")]
+        set: Vec<String>,
         /// Insert the first --add at this action (e.g. 'PickUp "Chips"') instead of the failing one.
         #[arg(long)]
         at: Option<String>,
@@ -77,6 +85,9 @@ pub enum Command {
         /// Write the repaired tree here (atomically).
         #[arg(long)]
         save: Option<PathBuf>,
+        /// Plan and repair in the scenario's `[world.variants.NAME]` world.
+        #[arg(long)]
+        variant: Option<String>,
     },
     /// Ask a language model for the goal an instruction means in the scenario.
     Interpret {
@@ -201,13 +212,23 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             tree,
             trace,
             max_ticks,
-        } => tree_cmds::run(&load(&scenario)?, tree.as_deref(), trace, max_ticks, glyphs),
+            variant,
+        } => tree_cmds::run(
+            &load(&scenario)?,
+            tree.as_deref(),
+            trace,
+            max_ticks,
+            variant.as_deref(),
+            glyphs,
+        ),
         Command::Repair {
             scenario,
             add,
+            set,
             at,
             tree,
             save,
+            variant,
         } => {
             let scenario = load(&scenario)?;
             let additions = add
@@ -221,12 +242,20 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     })
                 })
                 .transpose()?;
+            let settings = set
+                .iter()
+                .map(|s| values::parse_setting(&scenario, s))
+                .collect::<Result<Vec<_>>>()?;
             tree_cmds::repair(
                 &scenario,
-                &additions,
-                at.as_ref(),
-                tree.as_deref(),
-                save.as_deref(),
+                &tree_cmds::RepairRequest {
+                    additions: &additions,
+                    settings: &settings,
+                    at: at.as_ref(),
+                    tree_file: tree.as_deref(),
+                    save: save.as_deref(),
+                    variant: variant.as_deref(),
+                },
                 glyphs,
             )
         }

@@ -11,6 +11,8 @@ use betr::domain::{ActionCall, Condition, Scenario};
 use betr::planner::{self, Outcome, Plan, Planner, RunEnd, path_text, run_tree};
 use betr::world::{self, World};
 
+use super::values::Setting;
+
 const WORLD_FAILED: u8 = 1;
 
 pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<ExitCode> {
@@ -45,9 +47,10 @@ pub fn run(
     tree_file: Option<&Path>,
     trace: bool,
     max_ticks: u64,
+    variant: Option<&str>,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
-    let world = world::load(scenario)?;
+    let world = world::load_variant(scenario, variant)?;
     let tree = match tree_file {
         Some(path) => load_tree(scenario, path)?,
         None => {
@@ -95,20 +98,64 @@ pub fn run(
     }
 }
 
-pub fn repair(
-    scenario: &Scenario,
-    additions: &[Vec<Condition>],
-    at: Option<&ActionCall>,
-    tree_file: Option<&Path>,
-    save: Option<&Path>,
-    glyphs: &Glyphs,
-) -> Result<ExitCode> {
-    let world = world::load(scenario)?;
+/// What `betr repair` was asked to do.
+pub struct RepairRequest<'a> {
+    pub additions: &'a [Vec<Condition>],
+    pub settings: &'a [Setting],
+    pub at: Option<&'a ActionCall>,
+    pub tree_file: Option<&'a Path>,
+    pub save: Option<&'a Path>,
+    pub variant: Option<&'a str>,
+}
+
+pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Result<ExitCode> {
+    let RepairRequest {
+        additions,
+        settings,
+        at,
+        tree_file,
+        save,
+        variant,
+    } = *request;
+    let world = world::load_variant(scenario, variant)?;
     let planner = Planner::new(&scenario.domain);
     let mut plan = match tree_file {
         Some(path) => planner.grow(load_tree(scenario, path)?, world.as_ref()),
         None => planner.plan(&super::goal_of(scenario, None)?.to_dnf(), world.as_ref())?,
     };
+    if !settings.is_empty() {
+        if let Outcome::ActionFailed { action, error, .. } = &plan.outcome {
+            println!("{action}! failed in simulation: {error}");
+        }
+        let mut tree = plan.tree;
+        for setting in settings {
+            let changed = super::values::apply(&mut tree, setting);
+            if changed == 0 {
+                bail!(
+                    "--set {:?}: no action of the tree uses {} with {:?}",
+                    setting.text,
+                    setting
+                        .targets
+                        .iter()
+                        .map(|(s, _)| s.as_str())
+                        .collect::<Vec<_>>()
+                        .join(" or "),
+                    setting.object
+                );
+            }
+            println!(
+                "Setting {} = {} for {:?} on {changed} action(s)",
+                setting
+                    .targets
+                    .first()
+                    .map(|(_, n)| n.as_str())
+                    .unwrap_or_default(),
+                setting.value,
+                setting.object
+            );
+        }
+        plan = planner.grow(tree, world.as_ref());
+    }
     for (i, conditions) in additions.iter().enumerate() {
         let names = conditions
             .iter()

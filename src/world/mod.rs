@@ -5,12 +5,14 @@
 //! planner can try a tree without touching the world it will run in. It knows nothing of
 //! behavior trees or language models.
 
+pub mod cell;
 pub mod symbolic;
 
 use std::any::Any;
 
 use crate::domain::{ActionCall, Condition, Scenario, ScenarioError};
 
+pub use cell::CellWorld;
 pub use symbolic::SymbolicWorld;
 
 /// The result of advancing an action by one tick.
@@ -62,20 +64,34 @@ pub trait World: Send {
 
 /// Build the world a scenario describes.
 pub fn load(scenario: &Scenario) -> Result<Box<dyn World>, ScenarioError> {
-    match scenario.world_kind.as_str() {
-        "symbolic" => Ok(Box::new(SymbolicWorld::from_scenario(scenario)?)),
-        other => {
-            let file = scenario
-                .files
-                .last()
-                .map(|f| f.path.clone())
-                .unwrap_or_default();
-            Err(ScenarioError {
-                file,
-                line: 0,
-                column: 0,
-                message: format!("unknown world kind {other:?} (known: symbolic)"),
-            })
-        }
+    load_variant(scenario, None)
+}
+
+/// Build the world a scenario describes, changed by its `[world.variants.NAME]` table when
+/// `variant` names one (the same scene without an obstacle, say). Only the cell has
+/// variants.
+pub fn load_variant(
+    scenario: &Scenario,
+    variant: Option<&str>,
+) -> Result<Box<dyn World>, ScenarioError> {
+    let error = |message: String| ScenarioError {
+        file: scenario
+            .files
+            .last()
+            .map(|f| f.path.clone())
+            .unwrap_or_default(),
+        line: 0,
+        column: 0,
+        message,
+    };
+    match (scenario.world_kind.as_str(), variant) {
+        ("symbolic", None) => Ok(Box::new(SymbolicWorld::from_scenario(scenario)?)),
+        ("symbolic", Some(v)) => Err(error(format!(
+            "the symbolic world has no variants (asked for {v:?})"
+        ))),
+        ("cell", v) => Ok(Box::new(CellWorld::from_scenario(scenario, v)?)),
+        (other, _) => Err(error(format!(
+            "unknown world kind {other:?} (known: symbolic, cell)"
+        ))),
     }
 }
