@@ -13,4 +13,5 @@ pub mod domain;
 pub mod goal;
 pub mod planner;
 pub mod store;
+pub mod verify;
 pub mod world;
