@@ -214,14 +214,34 @@ impl Model {
             };
             raw_nodes.push((id, node));
         }
-        let grounds = ground_disturbances(domain, disturbances)?;
+        for atom in properties.iter().flat_map(|f| f.atoms()) {
+            conds.id(&Condition::pos(atom));
+        }
+        // A disturbance matters only when it changes an observed atom; its guard is then
+        // observed too, which can make further disturbances matter (a fixpoint).
+        let mut grounds = ground_disturbances(domain, disturbances)?;
+        let mut kept: Vec<Ground> = Vec::new();
+        loop {
+            let before = kept.len();
+            let (relevant, rest): (Vec<Ground>, Vec<Ground>) = grounds
+                .into_iter()
+                .partition(|g| changes_observed(g, &conds.list));
+            grounds = rest;
+            for g in &relevant {
+                for p in &g.pre {
+                    conds.id(p);
+                }
+            }
+            kept.extend(relevant);
+            if kept.len() == before {
+                break;
+            }
+        }
+        let grounds = kept;
         let ground_pre: Vec<Vec<(usize, bool)>> = grounds
             .iter()
             .map(|g| g.pre.iter().map(|p| (conds.id(p), p.negated)).collect())
             .collect();
-        for atom in properties.iter().flat_map(|f| f.atoms()) {
-            conds.id(&Condition::pos(atom));
-        }
 
         // The universe: atoms that can be true and that some condition observes.
         let mut candidates: BTreeSet<Atom> = initial
@@ -487,6 +507,13 @@ enum RawNode {
     Fallback(Vec<usize>),
     Condition(usize, bool),
     Action(usize),
+}
+
+/// Whether a disturbance adds or deletes an atom that one of `observed` can see.
+fn changes_observed(g: &Ground, observed: &[Condition]) -> bool {
+    observed.iter().any(|c| {
+        g.add.iter().any(|a| instance_of(&c.atom, a)) || g.del.iter().any(|d| d.overlaps(&c.atom))
+    })
 }
 
 pub fn bit(state: &State, i: usize) -> bool {
