@@ -75,10 +75,22 @@ impl Checker<'_> {
         match self.tree.kind(n) {
             Ok(NodeKind::Condition(c)) => format!("{c}?"),
             Ok(NodeKind::Action(a)) => format!("{a}!"),
-            Ok(NodeKind::Sequence) => "sequence".into(),
-            Ok(NodeKind::Fallback) => "fallback".into(),
+            Ok(NodeKind::Sequence) => self.composite_text("sequence", n),
+            Ok(NodeKind::Fallback) => self.composite_text("fallback", n),
             Err(_) => n.to_string(),
         }
+    }
+
+    /// A composite named by the condition it leads with (`fallback for Holding_Coffee?`).
+    fn composite_text(&self, kind: &str, n: NodeId) -> String {
+        let mut at = n;
+        while let Some(&first) = self.tree.children(at).ok().and_then(|c| c.first()) {
+            if let Ok(NodeKind::Condition(c)) = self.tree.kind(first) {
+                return format!("the {kind} for {c}?");
+            }
+            at = first;
+        }
+        format!("the {kind} at {}", path_text(&self.path(n)))
     }
 
     fn children(&self, n: NodeId) -> Vec<NodeId> {
@@ -357,7 +369,7 @@ impl Checker<'_> {
             .into_iter()
             .find_map(|(id, g)| needed.iter().find(|c| g.undoes(c)).map(|c| (id, c.clone())))?;
         Some(format!(
-            "{} undoes {undone}, which the earlier sibling {} establishes, and {} in that sibling undoes {needed_undone}, which {} needs: the reactive tree can oscillate between them",
+            "{} undoes {undone}, which the earlier sibling ({}) establishes, and {} in that sibling undoes {needed_undone}, which {} needs: the reactive tree can oscillate between them",
             self.text(undoer),
             self.text(earlier),
             self.text(back),
