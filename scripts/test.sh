@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Every test of betr. (So far the tests need only a Rust toolchain and the goal dataset in
-# ../shared; stages that need system packages install them from here.)
+# Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, and
+# the SPIN model checker (installed here with apt when missing).
 # Usage: bash scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,6 +8,14 @@ cd "$(dirname "$0")/.."
 if [ ! -d ../shared/datasets/llm-obtea ]; then
   echo "error: ../shared/datasets/llm-obtea is missing; the tests read the goal dataset from there" >&2
   exit 2
+fi
+
+# The SPIN model checker cross-checks `betr verify` (tests/verify_scenarios.rs).
+if ! command -v spin >/dev/null 2>&1; then
+  echo "spin is missing: installing the Debian package" >&2
+  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
+  $SUDO apt-get update
+  $SUDO apt-get install -y spin
 fi
 
 cargo test --locked

@@ -17,4 +17,5 @@ pub mod model;
 pub mod planner;
 pub mod session;
 pub mod store;
+pub mod verify;
 pub mod world;

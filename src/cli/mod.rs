@@ -5,6 +5,7 @@ mod llm_cmds;
 mod model_cmd;
 mod tree_cmds;
 mod values;
+mod verify_cmd;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -31,6 +32,32 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Check the planned (or a saved) tree before it runs: structural rules, then every
+    /// reachable state of the abstraction; exit 1 with a counterexample when violated.
+    Verify {
+        scenario: PathBuf,
+        /// A tree in betr's text format to verify instead of planning one.
+        #[arg(long)]
+        tree: Option<PathBuf>,
+        /// A property to check besides the scenario's: 'always F', 'never F', 'eventually F'.
+        #[arg(long = "property")]
+        properties: Vec<String>,
+        /// Write the model for the SPIN model checker: --export promela FILE.
+        #[arg(long, num_args = 2, value_names = ["FORMAT", "FILE"])]
+        export: Option<Vec<String>>,
+        /// Let every action also fail (leaving the state unchanged).
+        #[arg(long)]
+        failures: bool,
+        /// Ignore the disturbances the scenario declares.
+        #[arg(long)]
+        no_disturbances: bool,
+        /// Stop exploring after this many states (the result is then "unknown").
+        #[arg(long, default_value_t = 200_000)]
+        max_states: usize,
+        /// Ticks within which the tree must succeed from every reachable state.
+        #[arg(long, default_value_t = 10_000)]
+        max_ticks: u64,
+    },
     /// Reproduce the paper's experiments.
     Eval {
         #[command(subcommand)]
@@ -259,6 +286,28 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 glyphs,
             )
         }
+        Command::Verify {
+            scenario,
+            tree,
+            properties,
+            export,
+            failures,
+            no_disturbances,
+            max_states,
+            max_ticks,
+        } => verify_cmd::verify(
+            &load(&scenario)?,
+            &verify_cmd::Args {
+                tree,
+                properties,
+                export,
+                failures,
+                no_disturbances,
+                max_states,
+                max_ticks,
+                ascii: cli.ascii,
+            },
+        ),
     }
 }
 

@@ -1,6 +1,7 @@
 //! Scenario files (TOML). A scenario holds what the planner is told (objects, vocabulary,
 //! skills, example instructions, the instruction and its expected goal) and, in its
-//! `[world]` table, what the world really does; the `world` module reads that table.
+//! `[world]` table, what the world really does; the `world` module reads that table (and
+//! the `verify` module its `[verify]` table).
 //!
 //! A scenario may `extends = "other.toml"`: objects and predicates are added to the base's,
 //! a skill name defined in the child replaces every base skill of that name, and the world
@@ -127,6 +128,9 @@ struct RawFile {
     /// Read by the world module.
     #[allow(dead_code)]
     world: Option<toml::Value>,
+    /// Read by the verify module (`verify::VerifyConfig::from_scenario`).
+    #[allow(dead_code)]
+    verify: Option<toml::Value>,
 }
 
 #[derive(Deserialize)]

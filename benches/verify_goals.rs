@@ -1,0 +1,152 @@
+//! Verifies the planned trees of all 100 gold goals of the LLM-OBTEA dataset from the
+//! shared cafe state: structural checks plus model checking, once with nothing but the
+//! tree's own runs and once with action failures and the cafe's declared disturbances.
+//! Prints median and maximum verification time (each the median of several runs) and
+//! the states explored, and how many trees pass.
+//!
+//! Run: `cargo bench --bench verify_goals`
+//! (The 1000-cube tabletop cell joins this benchmark with the `cell` branch.)
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use betr::dataset;
+use betr::domain::Scenario;
+use betr::goal::Formula;
+use betr::planner::Planner;
+use betr::verify::{self, Limits, Report, VerifyConfig, VerifyInput};
+use betr::world;
+
+const REPETITIONS: usize = 5;
+
+struct Row {
+    gold: String,
+    time: Duration,
+    states: usize,
+    transitions: usize,
+    holds: bool,
+    findings: usize,
+    /// The first finding or violated property, for trees that do not verify.
+    why: String,
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scenario = Scenario::load(&root.join("scenarios/cafe/cafe.toml"))?;
+    let config = VerifyConfig::from_scenario(&scenario)?;
+    let world = world::load(&scenario)?;
+    let initial = world.facts();
+    let planner = Planner::new(&scenario.domain);
+    let cases = dataset::load(&root.join("../shared/datasets/llm-obtea"))?;
+    let trees = cases
+        .iter()
+        .map(|c| {
+            let dnf = Formula::parse(&c.gold)?.to_dnf();
+            Ok((c.gold.clone(), planner.plan(&dnf, world.as_ref())?.tree))
+        })
+        .collect::<Result<Vec<_>, Box<dyn std::error::Error>>>()?;
+
+    for (label, disturbed) in [
+        ("the tree's own runs", false),
+        ("with action failures and disturbances", true),
+    ] {
+        let mut rows = Vec::new();
+        for (gold, tree) in &trees {
+            let input = VerifyInput {
+                domain: &scenario.domain,
+                tree,
+                initial: &initial,
+                disturbances: if disturbed { &config.disturbances } else { &[] },
+                properties: &[],
+                limits: Limits {
+                    action_failures: disturbed,
+                    ..Limits::default()
+                },
+            };
+            let mut times = Vec::with_capacity(REPETITIONS);
+            let mut last: Option<Report> = None;
+            for _ in 0..REPETITIONS {
+                let started = Instant::now();
+                let report = verify::verify(&input);
+                times.push(started.elapsed());
+                last = Some(report);
+            }
+            times.sort();
+            let report = last.ok_or("no repetition ran")?;
+            let (states, transitions) = report
+                .model
+                .as_ref()
+                .map_or((0, 0), |m| (m.states, m.transitions));
+            let why = report
+                .findings
+                .first()
+                .map(ToString::to_string)
+                .or_else(|| {
+                    let m = report.model.as_ref().ok()?;
+                    let p = m.properties.iter().find(|p| !p.verdict.holds())?;
+                    Some(match &p.verdict {
+                        verify::Verdict::Violated(cx) => format!("{}: {}", p.name, cx.violation),
+                        other => format!("{}: {other:?}", p.name),
+                    })
+                })
+                .unwrap_or_default();
+            rows.push(Row {
+                why,
+                gold: gold.clone(),
+                time: times[times.len() / 2],
+                states,
+                transitions,
+                holds: report.holds(),
+                findings: report.findings.len(),
+            });
+        }
+        summarize(label, &mut rows);
+    }
+    Ok(())
+}
+
+fn summarize(label: &str, rows: &mut [Row]) {
+    let mut times: Vec<Duration> = rows.iter().map(|r| r.time).collect();
+    times.sort();
+    let mut states: Vec<usize> = rows.iter().map(|r| r.states).collect();
+    states.sort();
+    let median = |v: &[Duration]| v.get(v.len() / 2).copied().unwrap_or_default();
+    println!(
+        "\n{} gold-goal trees, {label} (median of {REPETITIONS} runs each):",
+        rows.len()
+    );
+    println!(
+        "  time   median {:>8.3} ms   max {:>8.3} ms",
+        median(&times).as_secs_f64() * 1e3,
+        times.last().copied().unwrap_or_default().as_secs_f64() * 1e3
+    );
+    println!(
+        "  states median {:>8}      max {:>8}   (transitions max {})",
+        states.get(states.len() / 2).copied().unwrap_or_default(),
+        states.last().copied().unwrap_or_default(),
+        rows.iter().map(|r| r.transitions).max().unwrap_or_default()
+    );
+    println!(
+        "  verified: {} of {}; trees with structural findings: {}",
+        rows.iter().filter(|r| r.holds).count(),
+        rows.len(),
+        rows.iter().filter(|r| r.findings > 0).count()
+    );
+    rows.sort_by_key(|r| std::cmp::Reverse(r.time));
+    println!("  slowest:");
+    for r in rows.iter().take(3) {
+        println!(
+            "    {:>8.3} ms {:>6} states  {}",
+            r.time.as_secs_f64() * 1e3,
+            r.states,
+            r.gold
+        );
+    }
+    let failing: Vec<&Row> = rows.iter().filter(|r| !r.holds).collect();
+    if !failing.is_empty() {
+        println!("  not verified:");
+        for r in failing.iter().take(10) {
+            println!("    {}\n      {}", r.gold, r.why);
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! `betr verify`: structural checks and model checking of the planned (or a saved) tree,
+//! with the shortest counterexample of each violated property, and Promela export.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+
+use betr::bt::{self, Tree};
+use betr::domain::Scenario;
+use betr::planner::{Outcome, Planner};
+use betr::verify::{
+    self, Limits, NamedProperty, Property, Report, Verdict, VerifyConfig, VerifyInput,
+};
+use betr::world;
+
+/// What `betr verify` was asked.
+pub struct Args {
+    pub tree: Option<PathBuf>,
+    pub properties: Vec<String>,
+    pub export: Option<Vec<String>>,
+    pub failures: bool,
+    pub no_disturbances: bool,
+    pub max_states: usize,
+    pub max_ticks: u64,
+    pub ascii: bool,
+}
+
+pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
+    let config = VerifyConfig::from_scenario(scenario)?;
+    let world = world::load(scenario)?;
+    let (tree, origin, note) = match &args.tree {
+        Some(path) => (
+            load_tree(path)?,
+            format!("from {}", path.display()),
+            String::new(),
+        ),
+        None => {
+            let goal = super::goal_of(scenario, None)?;
+            let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
+            let note = match &plan.outcome {
+                Outcome::Success => String::new(),
+                Outcome::ActionFailed { action, error, .. } => format!(
+                    "Note:     planning stopped when {action}! failed in simulation ({error}); repair it and pass --tree\n"
+                ),
+                Outcome::Unreachable { condition, .. } => {
+                    format!("Note:     planning stopped: {condition} cannot be achieved\n")
+                }
+                Outcome::Exhausted { reason } => format!("Note:     planning stopped: {reason}\n"),
+            };
+            (plan.tree, format!("planned for {goal}"), note)
+        }
+    };
+    let mut properties = config.properties.clone();
+    for text in &args.properties {
+        let property = Property::parse_checked(text, &scenario.domain.vocabulary)
+            .map_err(|e| anyhow::anyhow!("--property {text:?}: {e}"))?;
+        properties.push(NamedProperty {
+            text: text.trim().to_string(),
+            property,
+        });
+    }
+    let disturbances = if args.no_disturbances {
+        Vec::new()
+    } else {
+        config.disturbances.clone()
+    };
+    let initial = world.facts();
+    let input = VerifyInput {
+        domain: &scenario.domain,
+        tree: &tree,
+        initial: &initial,
+        disturbances: &disturbances,
+        properties: &properties,
+        limits: Limits {
+            max_states: args.max_states,
+            max_ticks: args.max_ticks,
+            action_failures: args.failures || config.action_failures,
+        },
+    };
+
+    println!("Scenario: {}", scenario.name);
+    println!("Tree:     {origin} ({} nodes)", tree.len());
+    print!("{note}");
+    println!(
+        "Checking: action failures {}, {} disturbance(s){}\n",
+        if input.limits.action_failures {
+            "on"
+        } else {
+            "off"
+        },
+        disturbances.len(),
+        if args.no_disturbances && !config.disturbances.is_empty() {
+            " (--no-disturbances)"
+        } else {
+            ""
+        }
+    );
+
+    if let Some(export) = &args.export {
+        let [format, file] = export.as_slice() else {
+            bail!("--export takes a format and a file: --export promela model.pml");
+        };
+        if format != "promela" {
+            bail!("--export {format:?}: the only format is promela");
+        }
+        let model = verify::export_promela(&input)?;
+        betr::store::write_atomic(Path::new(file), model.text.as_bytes())
+            .with_context(|| format!("writing the Promela model to {file}"))?;
+        let claims: Vec<&str> = model.claims.iter().map(|(n, _)| n.as_str()).collect();
+        println!(
+            "Promela model written to {file} (ltl claims: {})\n",
+            claims.join(", ")
+        );
+    }
+
+    let report = verify::verify(&input);
+    print_report(&report, args.ascii);
+    Ok(if report.holds() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn load_tree(path: &Path) -> Result<Tree> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading tree file {}", path.display()))?;
+    bt::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+fn print_report(report: &Report, ascii: bool) {
+    let (ok, bad, unknown) = if ascii {
+        ("ok ", "FAIL", "??")
+    } else {
+        ("✓", "✕", "?")
+    };
+    println!("Structural checks");
+    if report.findings.is_empty() {
+        println!("  {ok} no findings");
+    }
+    for f in &report.findings {
+        println!("  {bad} {f}");
+        println!("      fix: {}", f.hint);
+    }
+    println!("\nModel checking");
+    match &report.model {
+        Err(e) => println!("  {bad} not possible: {e}"),
+        Ok(m) => {
+            for p in &m.properties {
+                match &p.verdict {
+                    Verdict::Holds if p.detail.is_empty() => println!("  {ok} {}", p.name),
+                    Verdict::Holds => println!("  {ok} {} ({})", p.name, p.detail),
+                    Verdict::Unknown(why) => println!("  {unknown} {}: {why}", p.name),
+                    Verdict::Violated(cx) => {
+                        println!("  {bad} {}", p.name);
+                        println!("    counterexample:");
+                        for line in cx.to_string().lines() {
+                            println!("      {line}");
+                        }
+                    }
+                }
+            }
+            println!(
+                "\n{} states, {} transitions, {} atoms, {:.1} ms{}",
+                m.states,
+                m.transitions,
+                m.atoms,
+                m.elapsed.as_secs_f64() * 1e3,
+                if m.complete {
+                    ""
+                } else {
+                    " (state bound reached)"
+                }
+            );
+        }
+    }
+    println!(
+        "\n{}",
+        if report.holds() {
+            "VERIFIED: every check and property holds"
+        } else {
+            "NOT VERIFIED"
+        }
+    );
+}

@@ -1,0 +1,607 @@
+//! The abstraction the planner reasons in, compiled for fast exploration.
+//!
+//! A state is the set of facts that are true, kept as a bitset over the atoms that matter:
+//! the atoms the tree's conditions, its actions' preconditions, the disturbances' guards
+//! and the properties observe (wildcards included), restricted to those that can ever be
+//! true (initially true, or added by an action of the tree or a disturbance). Every other
+//! atom cannot change anything the tree or a property sees, so it is left out.
+//!
+//! One abstract tick evaluates the tree over a state with the reactive, memoryless
+//! semantics of `bt` (every tick from the root; a Sequence stops at the first child that
+//! does not succeed, a Fallback at the first that does not fail). The first action reached
+//! executes: its declared effects apply and the tick ends (an action takes one abstract
+//! tick). With action failures allowed, an action may instead fail, leaving the state
+//! unchanged; the tick then goes on as the Failure makes it (a Fallback tries its next
+//! child). The root returning Success on a tick where no action was reached is success; it
+//! returning Failure that way is a dead end.
+
+use std::collections::{BTreeSet, HashMap};
+
+use super::config::Disturbance;
+use crate::bt::{NodeId, NodeKind, Tree};
+use crate::domain::skill::Term;
+use crate::domain::{ANY_OBJECT, ActionCall, Atom, AtomPattern, Condition, Domain};
+use crate::goal::Formula;
+
+/// A set of facts as a bitset over `Model::atoms`.
+pub type State = Box<[u64]>;
+
+/// Whether `atom` is an instance of `pattern` (whose `"any object"` arguments match
+/// any object).
+pub fn instance_of(pattern: &Atom, atom: &Atom) -> bool {
+    pattern.predicate == atom.predicate
+        && pattern.args.len() == atom.args.len()
+        && pattern
+            .args
+            .iter()
+            .zip(&atom.args)
+            .all(|(p, a)| p == ANY_OBJECT || p == a)
+}
+
+/// A condition compiled to the bits of the atoms that make its positive form true.
+#[derive(Debug, Clone)]
+pub struct CondBits {
+    pub condition: Condition,
+    bits: Vec<usize>,
+}
+
+impl CondBits {
+    /// The atoms (indices into `Model::atoms`) of which at least one must be true for the
+    /// positive form to hold.
+    pub fn bits(&self) -> &[usize] {
+        &self.bits
+    }
+}
+
+/// A formula compiled over condition ids.
+#[derive(Debug, Clone)]
+pub enum Expr {
+    /// A positive condition (its id into `Model::conditions`).
+    Atom(usize),
+    Not(Box<Expr>),
+    And(Vec<Expr>),
+    Or(Vec<Expr>),
+}
+
+#[derive(Debug, Clone)]
+pub enum CNode {
+    Sequence(Vec<usize>),
+    Fallback(Vec<usize>),
+    Condition(usize),
+    Action(usize),
+}
+
+/// An action node of the tree with its declared preconditions and effects.
+#[derive(Debug, Clone)]
+pub struct CAction {
+    pub node: NodeId,
+    pub path: Vec<usize>,
+    pub call: ActionCall,
+    /// Condition ids of the declared preconditions.
+    pub pre: Vec<usize>,
+    pub add: Vec<usize>,
+    pub del: Vec<usize>,
+}
+
+/// One grounding of a declared disturbance.
+#[derive(Debug, Clone)]
+pub struct CDisturbance {
+    pub description: String,
+    /// The objects its parameters stand for, e.g. `a = "red cube", b = "blue cube"`.
+    pub grounding: String,
+    pub pre: Vec<usize>,
+    pub add: Vec<usize>,
+    pub del: Vec<usize>,
+}
+
+/// What one abstract tick did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TickResult {
+    /// The action that executed (index into `Model::actions`).
+    pub executed: Option<usize>,
+    /// Actions that were reached and failed, in tick order.
+    pub failed: Vec<usize>,
+    /// Actions reached (executed or failed) whose declared precondition (condition id)
+    /// did not hold when they started.
+    pub unmet: Vec<(usize, usize)>,
+    /// What the root returned (`Running` when an action executed).
+    pub root: crate::bt::Outcome,
+}
+
+/// Why a tree cannot be compiled for model checking.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ModelError {
+    #[error(
+        "action {call}! at node {path} names no skill of the scenario, so its effects are unknown"
+    )]
+    UnknownAction { call: String, path: String },
+    #[error("disturbance {0:?} has more than {1} groundings; narrow its parameter types")]
+    TooManyGroundings(String, usize),
+}
+
+/// Groundings of one disturbance beyond this are refused.
+const MAX_GROUNDINGS: usize = 100_000;
+
+/// The compiled tree, actions, disturbances and properties over one atom universe.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub atoms: Vec<Atom>,
+    pub conditions: Vec<CondBits>,
+    pub nodes: Vec<CNode>,
+    pub actions: Vec<CAction>,
+    pub disturbances: Vec<CDisturbance>,
+    pub properties: Vec<Expr>,
+    pub initial: State,
+    words: usize,
+}
+
+/// Collects conditions, deduplicated, before the universe is known.
+#[derive(Default)]
+struct Conds {
+    list: Vec<Condition>,
+    ids: HashMap<Condition, usize>,
+}
+
+impl Conds {
+    fn id(&mut self, c: &Condition) -> usize {
+        let c = Condition::pos(c.atom.clone()); // bits are for the positive form
+        if let Some(&i) = self.ids.get(&c) {
+            return i;
+        }
+        self.list.push(c.clone());
+        self.ids.insert(c, self.list.len() - 1);
+        self.list.len() - 1
+    }
+}
+
+struct Ground {
+    description: String,
+    grounding: String,
+    pre: Vec<Condition>,
+    add: Vec<Atom>,
+    del: Vec<AtomPattern>,
+}
+
+impl Model {
+    /// Compile `tree` over `domain` from `initial` facts, with disturbances (already
+    /// filtered by the caller when they are off) and property formulas.
+    pub fn build(
+        domain: &Domain,
+        tree: &Tree,
+        initial: &[Condition],
+        disturbances: &[Disturbance],
+        properties: &[&Formula],
+    ) -> Result<Model, ModelError> {
+        let mut conds = Conds::default();
+        // Raw per-node data first; atoms become bits once the universe is known.
+        let mut raw_nodes: Vec<(NodeId, RawNode)> = Vec::new();
+        let mut raw_actions = Vec::new();
+        let mut order: HashMap<NodeId, usize> = HashMap::new();
+        for id in tree.preorder() {
+            order.insert(id, order.len());
+        }
+        for id in tree.preorder() {
+            let kind = tree.kind(id).map_err(|_| ModelError::UnknownAction {
+                call: id.to_string(),
+                path: String::new(),
+            })?;
+            let children: Vec<usize> = tree
+                .children(id)
+                .unwrap_or_default()
+                .iter()
+                .filter_map(|c| order.get(c).copied())
+                .collect();
+            let node = match kind {
+                NodeKind::Sequence => RawNode::Sequence(children),
+                NodeKind::Fallback => RawNode::Fallback(children),
+                NodeKind::Condition(c) => RawNode::Condition(conds.id(c), c.negated),
+                NodeKind::Action(call) => {
+                    let path = tree.path(id).unwrap_or_default();
+                    let ground = domain
+                        .resolve(call)
+                        .ok_or_else(|| ModelError::UnknownAction {
+                            call: call.to_string(),
+                            path: crate::planner::path_text(&path),
+                        })?;
+                    let pre: Vec<(usize, bool)> = ground
+                        .pre
+                        .iter()
+                        .map(|p| (conds.id(p), p.negated))
+                        .collect();
+                    raw_actions.push((id, path, call.clone(), pre, ground.add, ground.del));
+                    RawNode::Action(raw_actions.len() - 1)
+                }
+            };
+            raw_nodes.push((id, node));
+        }
+        for atom in properties.iter().flat_map(|f| f.atoms()) {
+            conds.id(&Condition::pos(atom));
+        }
+        // A disturbance matters only when it changes an observed atom; its guard is then
+        // observed too, which can make further disturbances matter (a fixpoint).
+        let mut grounds = ground_disturbances(domain, disturbances)?;
+        let mut kept: Vec<Ground> = Vec::new();
+        loop {
+            let before = kept.len();
+            let (relevant, rest): (Vec<Ground>, Vec<Ground>) = grounds
+                .into_iter()
+                .partition(|g| changes_observed(g, &conds.list));
+            grounds = rest;
+            for g in &relevant {
+                for p in &g.pre {
+                    conds.id(p);
+                }
+            }
+            kept.extend(relevant);
+            if kept.len() == before {
+                break;
+            }
+        }
+        let grounds = kept;
+        let ground_pre: Vec<Vec<(usize, bool)>> = grounds
+            .iter()
+            .map(|g| g.pre.iter().map(|p| (conds.id(p), p.negated)).collect())
+            .collect();
+
+        // The universe: atoms that can be true and that some condition observes.
+        let mut candidates: BTreeSet<Atom> = initial
+            .iter()
+            .filter(|c| !c.negated)
+            .map(|c| c.atom.clone())
+            .collect();
+        for (_, _, _, _, add, _) in &raw_actions {
+            candidates.extend(add.iter().cloned());
+        }
+        for g in &grounds {
+            candidates.extend(g.add.iter().cloned());
+        }
+        let exact: std::collections::HashSet<&Atom> = conds
+            .list
+            .iter()
+            .filter(|c| !c.atom.has_wildcard())
+            .map(|c| &c.atom)
+            .collect();
+        let mut wild: HashMap<&str, Vec<&Atom>> = HashMap::new();
+        for c in conds.list.iter().filter(|c| c.atom.has_wildcard()) {
+            wild.entry(c.atom.predicate.as_str())
+                .or_default()
+                .push(&c.atom);
+        }
+        let observed = |a: &Atom| {
+            exact.contains(a)
+                || wild
+                    .get(a.predicate.as_str())
+                    .is_some_and(|ps| ps.iter().any(|p| instance_of(p, a)))
+        };
+        let atoms: Vec<Atom> = candidates.into_iter().filter(|a| observed(a)).collect();
+        let index: HashMap<&Atom, usize> = atoms.iter().enumerate().map(|(i, a)| (a, i)).collect();
+        let mut by_predicate: HashMap<&str, Vec<usize>> = HashMap::new();
+        for (i, a) in atoms.iter().enumerate() {
+            by_predicate
+                .entry(a.predicate.as_str())
+                .or_default()
+                .push(i);
+        }
+        let matching = |pattern: &Atom| -> Vec<usize> {
+            if !pattern.has_wildcard() {
+                return index.get(pattern).copied().into_iter().collect();
+            }
+            by_predicate
+                .get(pattern.predicate.as_str())
+                .map(|is| {
+                    is.iter()
+                        .copied()
+                        .filter(|&i| instance_of(pattern, &atoms[i]))
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        let deleted = |p: &AtomPattern| -> Vec<usize> {
+            by_predicate
+                .get(p.predicate.as_str())
+                .map(|is| {
+                    is.iter()
+                        .copied()
+                        .filter(|&i| p.matches(&atoms[i]))
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        let added = |adds: &[Atom]| -> Vec<usize> {
+            adds.iter().filter_map(|a| index.get(a).copied()).collect()
+        };
+
+        let conditions: Vec<CondBits> = conds
+            .list
+            .iter()
+            .map(|c| CondBits {
+                condition: c.clone(),
+                bits: matching(&c.atom),
+            })
+            .collect();
+        // Negated conditions are nodes over the positive id plus a sign.
+        let mut nodes = Vec::with_capacity(raw_nodes.len());
+        let mut signs: HashMap<(usize, bool), usize> = HashMap::new();
+        let mut conditions = conditions;
+        let mut signed = |id: usize, negated: bool, conditions: &mut Vec<CondBits>| -> usize {
+            if !negated {
+                return id;
+            }
+            *signs.entry((id, negated)).or_insert_with(|| {
+                let base = &conditions[id];
+                conditions.push(CondBits {
+                    condition: base.condition.negate(),
+                    bits: base.bits.clone(),
+                });
+                conditions.len() - 1
+            })
+        };
+        let mut actions = Vec::with_capacity(raw_actions.len());
+        for (id, path, call, pre, add, del) in &raw_actions {
+            let pre = pre
+                .iter()
+                .map(|&(c, n)| signed(c, n, &mut conditions))
+                .collect();
+            actions.push(CAction {
+                node: *id,
+                path: path.clone(),
+                call: call.clone(),
+                pre,
+                add: added(add),
+                del: del.iter().flat_map(&deleted).collect(),
+            });
+        }
+        for (_, node) in raw_nodes {
+            nodes.push(match node {
+                RawNode::Sequence(c) => CNode::Sequence(c),
+                RawNode::Fallback(c) => CNode::Fallback(c),
+                RawNode::Condition(c, n) => CNode::Condition(signed(c, n, &mut conditions)),
+                RawNode::Action(a) => CNode::Action(a),
+            });
+        }
+        let disturbances = grounds
+            .iter()
+            .zip(&ground_pre)
+            .map(|(g, pre)| CDisturbance {
+                description: g.description.clone(),
+                grounding: g.grounding.clone(),
+                pre: pre
+                    .iter()
+                    .map(|&(c, n)| signed(c, n, &mut conditions))
+                    .collect(),
+                add: added(&g.add),
+                del: g.del.iter().flat_map(&deleted).collect(),
+            })
+            .collect();
+        let properties = properties
+            .iter()
+            .map(|f| compile_formula(f, &conds.ids))
+            .collect();
+        let words = atoms.len().div_ceil(64).max(1);
+        let mut state = vec![0u64; words].into_boxed_slice();
+        for c in initial.iter().filter(|c| !c.negated) {
+            if let Some(&i) = index.get(&c.atom) {
+                state[i / 64] |= 1 << (i % 64);
+            }
+        }
+        drop(index);
+        Ok(Model {
+            atoms,
+            conditions,
+            nodes,
+            actions,
+            disturbances,
+            properties,
+            initial: state,
+            words,
+        })
+    }
+
+    pub fn holds(&self, state: &State, condition: usize) -> bool {
+        let c = &self.conditions[condition];
+        c.bits.iter().any(|&i| bit(state, i)) != c.condition.negated
+    }
+
+    pub fn eval(&self, state: &State, e: &Expr) -> bool {
+        match e {
+            Expr::Atom(c) => self.holds(state, *c),
+            Expr::Not(x) => !self.eval(state, x),
+            Expr::And(v) => v.iter().all(|x| self.eval(state, x)),
+            Expr::Or(v) => v.iter().any(|x| self.eval(state, x)),
+        }
+    }
+
+    /// One abstract tick where the first `fail` actions reached fail.
+    pub fn tick(&self, state: &State, fail: usize) -> TickResult {
+        let mut result = TickResult {
+            executed: None,
+            failed: Vec::new(),
+            unmet: Vec::new(),
+            root: crate::bt::Outcome::Failure,
+        };
+        let mut budget = fail;
+        result.root = self.eval_node(0, state, &mut budget, &mut result);
+        result
+    }
+
+    fn eval_node(
+        &self,
+        n: usize,
+        state: &State,
+        budget: &mut usize,
+        r: &mut TickResult,
+    ) -> crate::bt::Outcome {
+        use crate::bt::Outcome::{Failure, Running, Success};
+        match &self.nodes[n] {
+            CNode::Sequence(children) => {
+                for &c in children {
+                    match self.eval_node(c, state, budget, r) {
+                        Success => {}
+                        other => return other,
+                    }
+                }
+                Success
+            }
+            CNode::Fallback(children) => {
+                for &c in children {
+                    match self.eval_node(c, state, budget, r) {
+                        Failure => {}
+                        other => return other,
+                    }
+                }
+                Failure
+            }
+            CNode::Condition(c) => {
+                if self.holds(state, *c) {
+                    Success
+                } else {
+                    Failure
+                }
+            }
+            CNode::Action(a) => {
+                for &p in &self.actions[*a].pre {
+                    if !self.holds(state, p) {
+                        r.unmet.push((*a, p));
+                    }
+                }
+                if *budget > 0 {
+                    *budget -= 1;
+                    r.failed.push(*a);
+                    Failure
+                } else {
+                    r.executed = Some(*a);
+                    Running
+                }
+            }
+        }
+    }
+
+    /// The state after `del` then `add`.
+    pub fn apply(&self, state: &State, add: &[usize], del: &[usize]) -> State {
+        let mut next = state.clone();
+        for &i in del {
+            next[i / 64] &= !(1 << (i % 64));
+        }
+        for &i in add {
+            next[i / 64] |= 1 << (i % 64);
+        }
+        next
+    }
+
+    /// The atoms true in `state`.
+    pub fn facts(&self, state: &State) -> Vec<&Atom> {
+        (0..self.atoms.len())
+            .filter(|&i| bit(state, i))
+            .map(|i| &self.atoms[i])
+            .collect()
+    }
+
+    /// Words per state (for memory estimates).
+    pub fn words(&self) -> usize {
+        self.words
+    }
+}
+
+enum RawNode {
+    Sequence(Vec<usize>),
+    Fallback(Vec<usize>),
+    Condition(usize, bool),
+    Action(usize),
+}
+
+/// Whether a disturbance adds or deletes an atom that one of `observed` can see.
+fn changes_observed(g: &Ground, observed: &[Condition]) -> bool {
+    observed.iter().any(|c| {
+        g.add.iter().any(|a| instance_of(&c.atom, a)) || g.del.iter().any(|d| d.overlaps(&c.atom))
+    })
+}
+
+pub fn bit(state: &State, i: usize) -> bool {
+    state.get(i / 64).is_some_and(|w| w & (1 << (i % 64)) != 0)
+}
+
+fn compile_formula(f: &Formula, ids: &HashMap<Condition, usize>) -> Expr {
+    match f {
+        Formula::Atom(a) => match ids.get(&Condition::pos(a.clone())) {
+            Some(&i) => Expr::Atom(i),
+            None => Expr::Or(Vec::new()),
+        },
+        Formula::Not(x) => Expr::Not(Box::new(compile_formula(x, ids))),
+        Formula::And(v) => Expr::And(v.iter().map(|x| compile_formula(x, ids)).collect()),
+        Formula::Or(v) => Expr::Or(v.iter().map(|x| compile_formula(x, ids)).collect()),
+    }
+}
+
+/// Every grounding of every disturbance over the objects its parameters admit.
+fn ground_disturbances(
+    domain: &Domain,
+    disturbances: &[Disturbance],
+) -> Result<Vec<Ground>, ModelError> {
+    let vocabulary = &domain.vocabulary;
+    let mut out = Vec::new();
+    for d in disturbances {
+        let mut combos: Vec<Vec<String>> = vec![Vec::new()];
+        for p in &d.params {
+            let objects: Vec<&str> = p.candidates(vocabulary).collect();
+            if combos.len().saturating_mul(objects.len()) > MAX_GROUNDINGS {
+                return Err(ModelError::TooManyGroundings(
+                    d.description.clone(),
+                    MAX_GROUNDINGS,
+                ));
+            }
+            combos = combos
+                .into_iter()
+                .flat_map(|c| {
+                    objects.iter().map(move |o| {
+                        let mut next = c.clone();
+                        next.push((*o).to_string());
+                        next
+                    })
+                })
+                .collect();
+        }
+        for args in combos {
+            let term = |t: &Term| match t {
+                Term::Param(i) => args.get(*i).cloned(),
+                Term::Const(c) => Some(c.clone()),
+                Term::Every => None,
+            };
+            let atom = |t: &crate::domain::skill::AtomTemplate| Atom {
+                predicate: t.predicate.clone(),
+                args: t
+                    .args
+                    .iter()
+                    .map(|a| term(a).unwrap_or_else(|| ANY_OBJECT.to_string()))
+                    .collect(),
+            };
+            out.push(Ground {
+                description: d.description.clone(),
+                grounding: d
+                    .params
+                    .iter()
+                    .zip(&args)
+                    .map(|(p, a)| format!("{} = \"{a}\"", p.name))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                pre: d
+                    .pre
+                    .iter()
+                    .map(|l| Condition {
+                        atom: atom(&l.atom),
+                        negated: l.negated,
+                    })
+                    .collect(),
+                add: d.add.iter().map(atom).collect(),
+                del: d
+                    .del
+                    .iter()
+                    .map(|t| AtomPattern {
+                        predicate: t.predicate.clone(),
+                        args: t.args.iter().map(term).collect(),
+                    })
+                    .collect(),
+            });
+        }
+    }
+    Ok(out)
+}

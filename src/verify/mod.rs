@@ -1,0 +1,369 @@
+//! Verifying a tree before it runs: the step the BETR-XP-LLM paper names as what makes an
+//! LLM-modified policy safe to execute.
+//!
+//! Two layers. Structural checks (`structural.rs`) are fast rules over the tree's shape
+//! and the skills' declarations. Model checking explores every state reachable from the
+//! initial state in the planner's own abstraction (`abstraction.rs`: fact sets, declared
+//! effects, optionally failing actions and declared disturbances, see `config.rs`) and
+//! checks that the tree reaches Success from every reachable state, that every action
+//! starts with its declared preconditions true, and the user's temporal properties
+//! (`temporal.rs`); a violation comes with a shortest counterexample
+//! (`counterexample.rs`). The same model can be exported to Promela (`promela.rs`) so the
+//! SPIN model checker can confirm each verdict independently.
+//!
+//! This module knows nothing of any front end; the CLI and the TUI print its `Report`.
+
+pub mod abstraction;
+pub mod config;
+pub mod counterexample;
+pub mod explore;
+pub mod promela;
+pub mod structural;
+pub mod temporal;
+
+use std::time::{Duration, Instant};
+
+use crate::bt::Tree;
+use crate::domain::{Condition, Domain};
+use crate::planner::path_text;
+
+pub use abstraction::{Model, ModelError};
+pub use config::{Disturbance, NamedProperty, VerifyConfig};
+pub use counterexample::Counterexample;
+pub use explore::Limits;
+pub use temporal::{Property, PropertyError, Temporal};
+
+/// Which structural rule a finding breaks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rule {
+    /// An action's declared precondition is neither checked on its path nor established
+    /// by an earlier sibling.
+    UnguardedPrecondition,
+    /// A node no tick can reach.
+    Unreachable,
+    /// A condition outside the scenario's vocabulary.
+    UnknownAtom,
+    /// An action that names no skill of the scenario.
+    UnknownAction,
+    /// Two Sequence siblings whose actions undo each other's conditions.
+    Oscillation,
+}
+
+impl Rule {
+    pub fn name(self) -> &'static str {
+        match self {
+            Rule::UnguardedPrecondition => "unguarded-precondition",
+            Rule::Unreachable => "unreachable-node",
+            Rule::UnknownAtom => "unknown-atom",
+            Rule::UnknownAction => "unknown-action",
+            Rule::Oscillation => "oscillation",
+        }
+    }
+}
+
+/// One structural problem: where, which rule, what, and how to fix it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    pub path: Vec<usize>,
+    pub rule: Rule,
+    pub message: String,
+    pub hint: String,
+}
+
+impl std::fmt::Display for Finding {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "node {} [{}] {}",
+            path_text(&self.path),
+            self.rule.name(),
+            self.message
+        )
+    }
+}
+
+/// Which property a result is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PropertyKind {
+    /// The tree reaches Success from every reachable state within the tick bound.
+    Success,
+    /// Every action starts with its declared preconditions true.
+    Preconditions,
+    /// The user property with this index (into `VerifyInput::properties`).
+    User(usize),
+}
+
+/// The outcome of checking one property.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Verdict {
+    Holds,
+    Violated(Box<Counterexample>),
+    /// The state bound stopped the exploration before the property could be decided.
+    Unknown(String),
+}
+
+impl Verdict {
+    pub fn holds(&self) -> bool {
+        matches!(self, Verdict::Holds)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct PropertyResult {
+    pub kind: PropertyKind,
+    /// How the property reads (`reaches Success from every reachable state`, `never F`).
+    pub name: String,
+    /// A one-line detail when it holds (e.g. the worst number of ticks).
+    pub detail: String,
+    pub verdict: Verdict,
+}
+
+/// Statistics and results of model checking.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelCheck {
+    pub atoms: usize,
+    pub states: usize,
+    pub transitions: usize,
+    pub complete: bool,
+    pub elapsed: Duration,
+    pub properties: Vec<PropertyResult>,
+}
+
+/// Everything `verify` found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Report {
+    pub findings: Vec<Finding>,
+    /// `Err` when the tree cannot be model checked (an action names no skill).
+    pub model: Result<ModelCheck, ModelError>,
+}
+
+impl Report {
+    /// True when there are no findings and every property holds.
+    pub fn holds(&self) -> bool {
+        self.findings.is_empty()
+            && self
+                .model
+                .as_ref()
+                .is_ok_and(|m| m.properties.iter().all(|p| p.verdict.holds()))
+    }
+
+    /// The result for one property kind, if it was checked.
+    pub fn property(&self, kind: PropertyKind) -> Option<&PropertyResult> {
+        self.model
+            .as_ref()
+            .ok()?
+            .properties
+            .iter()
+            .find(|p| p.kind == kind)
+    }
+}
+
+/// What to verify and how.
+pub struct VerifyInput<'a> {
+    pub domain: &'a Domain,
+    pub tree: &'a Tree,
+    /// The facts true at the start (`World::facts()` of the scenario's world).
+    pub initial: &'a [Condition],
+    /// Disturbances to explore under (empty: none).
+    pub disturbances: &'a [Disturbance],
+    pub properties: &'a [NamedProperty],
+    pub limits: Limits,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_states: 200_000,
+            max_ticks: 10_000,
+            action_failures: false,
+        }
+    }
+}
+
+/// Run the structural checks and model checking.
+pub fn verify(input: &VerifyInput) -> Report {
+    let findings = structural::check(input.domain, input.tree);
+    let model = build_model(input).map(|m| model_check(&m, input));
+    Report { findings, model }
+}
+
+/// Compile the input's tree, disturbances and properties.
+pub fn build_model(input: &VerifyInput) -> Result<Model, ModelError> {
+    let formulas: Vec<&crate::goal::Formula> = input
+        .properties
+        .iter()
+        .map(|p| &p.property.formula)
+        .collect();
+    Model::build(
+        input.domain,
+        input.tree,
+        input.initial,
+        input.disturbances,
+        &formulas,
+    )
+}
+
+/// Export the input as Promela (see `promela.rs`).
+pub fn export_promela(input: &VerifyInput) -> Result<promela::PromelaModel, ModelError> {
+    let model = build_model(input)?;
+    let temporal: Vec<Temporal> = input
+        .properties
+        .iter()
+        .map(|p| p.property.temporal)
+        .collect();
+    Ok(promela::export(
+        &model,
+        &temporal,
+        input.limits.action_failures,
+    ))
+}
+
+fn model_check(model: &Model, input: &VerifyInput) -> ModelCheck {
+    use explore::{Edge, Eventually, Liveness};
+    let started = Instant::now();
+    let limits = &input.limits;
+    let g = explore::explore(model, limits);
+    let unknown = || {
+        Verdict::Unknown(format!(
+            "bound reached: stopped after {} states (raise --max-states)",
+            g.states.len()
+        ))
+    };
+    let cx = |transitions: Vec<(u32, Edge)>, loop_from: Option<usize>, violation: String| {
+        Verdict::Violated(Box::new(Counterexample::build(
+            model,
+            &g.states,
+            &transitions,
+            loop_from,
+            violation,
+        )))
+    };
+    let mut properties = Vec::new();
+
+    // Success from every reachable state.
+    let mut detail = String::new();
+    let verdict = match explore::check_liveness(&g, limits.max_ticks) {
+        Liveness::Holds { worst } => {
+            detail = format!("at most {worst} tick(s) from any reachable state");
+            Verdict::Holds
+        }
+        Liveness::DeadEnd(s) => {
+            let mut path = g.path_to(s);
+            path.push((s, Edge::Tick { fail: 0 }));
+            cx(
+                path,
+                None,
+                "dead end: the root returns Failure and no action can run".into(),
+            )
+        }
+        Liveness::Livelock { entry, cycle } => {
+            let mut path = g.path_to(entry);
+            let from = path.len();
+            let mut at = entry;
+            for next in &cycle {
+                path.push((at, Edge::Tick { fail: 0 }));
+                at = *next;
+            }
+            cx(
+                path,
+                Some(from),
+                format!(
+                    "livelock: the tree keeps acting ({} tick(s) repeat) and never succeeds",
+                    cycle.len()
+                ),
+            )
+        }
+        Liveness::TooSlow { state, ticks } => cx(
+            g.path_to(state),
+            None,
+            format!(
+                "from this state the tree needs {ticks} ticks to succeed, more than the bound of {}",
+                limits.max_ticks
+            ),
+        ),
+        Liveness::Unknown => unknown(),
+    };
+    properties.push(PropertyResult {
+        kind: PropertyKind::Success,
+        name: "reaches Success from every reachable state".into(),
+        detail,
+        verdict,
+    });
+
+    // Declared preconditions at every action start.
+    let verdict = match g.first_unmet {
+        Some((s, fail, action, condition)) => {
+            let mut path = g.path_to(s);
+            path.push((s, Edge::Tick { fail }));
+            cx(
+                path,
+                None,
+                format!(
+                    "{}! starts while its declared precondition {} does not hold",
+                    model.actions[action].call, model.conditions[condition].condition
+                ),
+            )
+        }
+        None if g.complete => Verdict::Holds,
+        None => unknown(),
+    };
+    properties.push(PropertyResult {
+        kind: PropertyKind::Preconditions,
+        name: "every action starts with its declared preconditions true".into(),
+        detail: String::new(),
+        verdict,
+    });
+
+    for (i, (p, e)) in input.properties.iter().zip(&model.properties).enumerate() {
+        let f = &p.property.formula;
+        let verdict = match p.property.temporal {
+            Temporal::Always | Temporal::Never => {
+                let always = p.property.temporal == Temporal::Always;
+                match explore::first_state_where(model, &g, e, !always) {
+                    Some(s) => cx(
+                        g.path_to(s),
+                        None,
+                        if always {
+                            format!("{f} does not hold in this state")
+                        } else {
+                            format!("{f} holds in this state")
+                        },
+                    ),
+                    None if g.complete => Verdict::Holds,
+                    None => unknown(),
+                }
+            }
+            Temporal::Eventually => match explore::check_eventually(model, &g, e) {
+                Eventually::Holds => Verdict::Holds,
+                Eventually::Unknown => unknown(),
+                Eventually::Lasso { mut prefix, cycle } => {
+                    let from = prefix.len();
+                    let len = cycle.len();
+                    prefix.extend(cycle);
+                    cx(
+                        prefix,
+                        Some(from),
+                        format!("{f} never holds: the last {len} step(s) can repeat forever"),
+                    )
+                }
+            },
+        };
+        properties.push(PropertyResult {
+            kind: PropertyKind::User(i),
+            name: p.text.clone(),
+            detail: String::new(),
+            verdict,
+        });
+    }
+    ModelCheck {
+        atoms: model.atoms.len(),
+        states: g.states.len(),
+        transitions: g.transitions,
+        complete: g.complete,
+        elapsed: started.elapsed(),
+        properties,
+    }
+}
+
+#[cfg(test)]
+mod tests;
