@@ -75,6 +75,17 @@ pub struct LlmFlags {
     /// Print each reply's raw text too.
     #[arg(long)]
     pub show_replies: bool,
+    /// Local backend: use this GGUF file instead of the fetched default model
+    /// [env: BETR_MODEL_PATH].
+    #[arg(long, value_name = "FILE")]
+    pub model_path: Option<PathBuf>,
+    /// Local backend: CPU threads (default 1) [env: BETR_THREADS].
+    #[arg(long, value_name = "N")]
+    pub threads: Option<u32>,
+    /// Local backend: let the model write freely instead of following a grammar built
+    /// from the scenario's vocabulary [env: BETR_GRAMMAR=false].
+    #[arg(long)]
+    pub no_grammar: bool,
 }
 
 /// The configured model and its ledger.
@@ -105,6 +116,9 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         max_retries: flags.max_retries,
         cassette: flags.cassette.clone(),
         usage_log: flags.usage_log.clone(),
+        model_path: flags.model_path.clone(),
+        threads: flags.threads,
+        grammar: flags.no_grammar.then_some(false),
         ..Layer::default()
     };
     let settings = Settings::resolve(
@@ -112,6 +126,10 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         Layer::from_env(&var)?,
         flag_layer,
     )?;
+    // The local model is fetched on first use (with a progress bar), then loaded.
+    if settings.backend == Backend::Local && settings.model_path.is_none() {
+        super::model_cmd::ensure(settings.model.as_deref())?;
+    }
     let ledger = Ledger::new(settings.usage_log.clone());
     let model = settings.build(ledger, &var)?;
     let examples = flags.examples.as_deref().map(read_examples).transpose()?;
@@ -123,6 +141,7 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         temperature: settings.temperature,
         max_tokens: settings.max_tokens,
         structured: settings.structured,
+        grammar: settings.grammar,
         templates,
         variant: Variant {
             no_descriptions: flags.no_descriptions,

@@ -97,6 +97,9 @@ impl<M: LanguageModel> LanguageModel for Recorder<M> {
     fn supports_constraint(&self) -> bool {
         self.inner.supports_constraint()
     }
+    fn supports_grammar(&self) -> bool {
+        self.inner.supports_grammar()
+    }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         Box::pin(self.call(request))
     }
@@ -108,6 +111,7 @@ pub struct Replay {
     path: PathBuf,
     model: String,
     structured: bool,
+    grammar: bool,
     entries: HashMap<(String, String), Entry>,
 }
 
@@ -143,10 +147,20 @@ impl Replay {
                 )));
             }
         };
+        // A cassette recorded from a grammar-constrained model replays only requests that
+        // carry the same grammar, so replay asks for grammars exactly when it holds some.
+        let grammar = entries.iter().any(|((m, _), e)| {
+            *m == model
+                && matches!(
+                    e.request.constraint,
+                    Some(super::OutputConstraint::Grammar { .. })
+                )
+        });
         Ok(Replay {
             path: path.to_path_buf(),
             model,
             structured,
+            grammar,
             entries,
         })
     }
@@ -185,6 +199,9 @@ impl LanguageModel for Replay {
     }
     fn supports_constraint(&self) -> bool {
         self.structured
+    }
+    fn supports_grammar(&self) -> bool {
+        self.grammar
     }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         Box::pin(std::future::ready(self.answer(request)))

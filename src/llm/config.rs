@@ -11,6 +11,7 @@ use std::time::Duration;
 use serde::Deserialize;
 
 use super::cassette::{Recorder, Replay};
+use super::local::{EngineOptions, LocalModel};
 use super::openai::{ApiKey, AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
 use super::usage::{Ledger, Metered, PriceTable};
 use super::{LanguageModel, LlmError};
@@ -61,6 +62,14 @@ pub struct Layer {
     pub max_backoff_ms: Option<u64>,
     pub cassette: Option<PathBuf>,
     pub usage_log: Option<PathBuf>,
+    /// Local backend: a GGUF file to use instead of a fetched model.
+    pub model_path: Option<PathBuf>,
+    /// Local backend: CPU threads.
+    pub threads: Option<u32>,
+    /// Local backend: constrain replies with a grammar built from the vocabulary.
+    pub grammar: Option<bool>,
+    /// Local backend: context length in tokens.
+    pub context: Option<u32>,
     /// Refused: keys belong in the environment.
     pub api_key: Option<toml::Value>,
 }
@@ -90,6 +99,10 @@ impl Layer {
             max_backoff_ms,
             cassette,
             usage_log,
+            model_path,
+            threads,
+            grammar,
+            context,
             api_key
         );
     }
@@ -119,6 +132,21 @@ impl Layer {
             structured: bool_var("BETR_STRUCTURED")?,
             cassette: get("BETR_CASSETTE").map(PathBuf::from),
             usage_log: get("BETR_USAGE_LOG").map(PathBuf::from),
+            model_path: get("BETR_MODEL_PATH").map(PathBuf::from),
+            threads: get("BETR_THREADS")
+                .map(|t| {
+                    t.trim()
+                        .parse::<u32>()
+                        .ok()
+                        .filter(|n| *n > 0)
+                        .ok_or_else(|| {
+                            LlmError::Config(format!(
+                                "BETR_THREADS={t:?} is not a positive whole number"
+                            ))
+                        })
+                })
+                .transpose()?,
+            grammar: bool_var("BETR_GRAMMAR")?,
             ..Layer::default()
         })
     }
@@ -193,7 +221,17 @@ pub struct Settings {
     pub prices: PriceTable,
     /// The file the settings came from, if any.
     pub file: Option<PathBuf>,
+    /// Local backend: the GGUF file (`None`: the fetched default model).
+    pub model_path: Option<PathBuf>,
+    pub threads: u32,
+    pub grammar: bool,
+    pub context: u32,
 }
+
+/// Threads for the local model. Measured on the 2-core machine this project runs on: one
+/// thread keeps generating at full speed when another process is busy, where two threads
+/// collapse (both stall waiting for each other); see `betr bench llm`.
+pub const DEFAULT_THREADS: u32 = 1;
 
 impl Settings {
     /// Defaults, then `file`, then `env`, then `flags`.
@@ -223,7 +261,8 @@ impl Settings {
             }
         };
         Ok(Settings {
-            backend: layer.backend.unwrap_or(Backend::Openai),
+            // Offline by default: the embedded model needs no key and no network.
+            backend: layer.backend.unwrap_or(Backend::Local),
             base_url: layer
                 .base_url
                 .unwrap_or_else(|| "https://api.openai.com/v1".into()),
@@ -251,7 +290,34 @@ impl Settings {
             usage_log: layer.usage_log.or_else(super::usage::default_log_path),
             prices,
             file: path,
+            model_path: layer.model_path,
+            threads: layer.threads.unwrap_or(DEFAULT_THREADS).max(1),
+            grammar: layer.grammar.unwrap_or(true),
+            context: layer.context.unwrap_or(4096).max(512),
         })
+    }
+
+    /// The local model's name and file: `--model-path`, else the known model `--model`
+    /// names (the default one without it).
+    pub fn local_model(&self) -> Result<(String, PathBuf), LlmError> {
+        if let Some(path) = &self.model_path {
+            let name = self.model.clone().unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or("local".into(), |s| s.to_string_lossy().into_owned())
+            });
+            return Ok((name, path.clone()));
+        }
+        let spec = match &self.model {
+            None => &crate::model::QWEN_CODER_05B,
+            Some(name) => crate::model::find(name).ok_or_else(|| {
+                let known: Vec<&str> = crate::model::MODELS.iter().map(|m| m.name).collect();
+                LlmError::Config(format!(
+                    "unknown local model {name:?} (known: {}; or pass --model-path FILE.gguf)",
+                    known.join(", ")
+                ))
+            })?,
+        };
+        Ok((spec.name.to_string(), spec.path()))
     }
 
     /// Build the configured model, metered into `ledger`: a live backend records to the
@@ -262,7 +328,21 @@ impl Settings {
         var: &dyn Fn(&str) -> Option<String>,
     ) -> Result<Metered<Box<dyn LanguageModel>>, LlmError> {
         let model: Box<dyn LanguageModel> = match self.backend {
-            Backend::Local => return Err(LlmError::LocalNotBuilt),
+            Backend::Local => {
+                let (name, path) = self.local_model()?;
+                let local = LocalModel::load(
+                    &name,
+                    EngineOptions {
+                        model_path: path,
+                        threads: self.threads,
+                        context: self.context,
+                    },
+                )?;
+                match &self.cassette {
+                    Some(path) => Box::new(Recorder::new(local, path)),
+                    None => Box::new(local),
+                }
+            }
             Backend::Replay => {
                 let Some(cassette) = &self.cassette else {
                     return Err(LlmError::Config(

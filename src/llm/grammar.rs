@@ -97,34 +97,45 @@ pub fn atom_rules(vocabulary: &Vocabulary, wildcard: bool) -> String {
     out
 }
 
-/// `Goal: <formula>` with `&`, `|`, `~` and parentheses over the vocabulary's atoms.
-pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool) -> String {
+/// `Goal: <formula>` with `&`, `|`, `~` and parentheses over the vocabulary's atoms;
+/// with `reasoning`, a free `Reasoning:` line comes first (the chain-of-thought prompt).
+pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) -> String {
     let mut g = String::new();
-    g.push_str("root ::= \"Goal: \" formula\n");
-    g.push_str("formula ::= conjunction ( \" | \" conjunction )*\n");
-    g.push_str("conjunction ::= factor ( \" & \" factor )*\n");
+    if reasoning {
+        g.push_str("root ::= \"Reasoning: \" reasoning \"\\nGoal: \" formula\n");
+        g.push_str(REASONING_RULE);
+    } else {
+        g.push_str("root ::= \"Goal: \" formula\n");
+    }
+    // Bounded repetition: a small model can otherwise loop `& A & A & ...` until the
+    // token limit. Eight conjuncts and four alternatives cover every goal of the dataset.
+    g.push_str("formula ::= conjunction ( \" | \" conjunction ){0,3}\n");
+    g.push_str("conjunction ::= factor ( \" & \" factor ){0,7}\n");
     g.push_str("factor ::= \"~\"? ( atom | \"(\" formula \")\" )\n");
     g.push_str(&atom_rules(vocabulary, wildcard));
     g
 }
 
-/// Free reasoning on one or more lines, then `Conditions: ` and literals joined by ` & `.
+/// One line of free text (the model's reasoning), bounded so it cannot run away.
+const REASONING_RULE: &str = "reasoning ::= [^\\n]{1,600}\n";
+
+/// A `Reasoning:` line, then `Conditions:` and one literal per line.
 pub fn conditions_grammar(vocabulary: &Vocabulary, wildcard: bool) -> String {
     let mut g = String::new();
     g.push_str(
-        "root ::= \"Reasoning: \" reasoning \"\\nConditions: \" literal ( \" & \" literal )*\n",
+        "root ::= \"Reasoning: \" reasoning \"\\nConditions:\\n\" literal ( \"\\n\" literal )?\n",
     );
-    g.push_str("reasoning ::= [^\\n]+\n");
+    g.push_str(REASONING_RULE);
     g.push_str(&atom_rules(vocabulary, wildcard));
     g
 }
 
-/// Free reasoning, then `Parameter value: ` and a number with `unit`, or one of
+/// A `Reasoning:` line, then `Parameter value: ` and a number with `unit`, or one of
 /// `categories`.
 pub fn value_grammar(unit: Option<&str>, categories: &[String]) -> String {
     let mut g = String::new();
     g.push_str("root ::= \"Reasoning: \" reasoning \"\\nParameter value: \" value\n");
-    g.push_str("reasoning ::= [^\\n]+\n");
+    g.push_str(REASONING_RULE);
     if categories.is_empty() {
         let unit = unit
             .map(|u| format!(" {}", lit(&format!(" {u}"))))
@@ -181,8 +192,12 @@ mod tests {
 
     #[test]
     fn answer_grammars_have_their_prefix() {
-        assert!(goal_grammar(&vocab(), false).starts_with("root ::= \"Goal: \" formula"));
-        assert!(conditions_grammar(&vocab(), true).contains("\\nConditions: "));
+        assert!(goal_grammar(&vocab(), false, false).starts_with("root ::= \"Goal: \" formula"));
+        assert!(
+            goal_grammar(&vocab(), false, true)
+                .starts_with("root ::= \"Reasoning: \" reasoning \"\\nGoal: \"")
+        );
+        assert!(conditions_grammar(&vocab(), true).contains("\\nConditions:\\n\" literal"));
         let v = value_grammar(Some("N"), &[]);
         assert!(
             v.contains("value ::= [0-9]{1,4} ( \".\" [0-9]{1,3} )? \" N\""),

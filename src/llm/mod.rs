@@ -10,6 +10,7 @@
 pub mod cassette;
 pub mod config;
 pub mod grammar;
+pub mod local;
 pub mod openai;
 pub mod prompt;
 pub mod reply;
@@ -61,6 +62,8 @@ pub enum OutputConstraint {
         name: String,
         schema: serde_json::Value,
     },
+    /// The reply follows this GBNF grammar (llama.cpp), token by token.
+    Grammar { name: String, gbnf: String },
 }
 
 /// One chat request.
@@ -73,6 +76,9 @@ pub struct ChatRequest {
     pub stop: Vec<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub constraint: Option<OutputConstraint>,
+    /// Sampling seed, for backends that take one (runs of an evaluation differ by it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u32>,
 }
 
 impl ChatRequest {
@@ -83,6 +89,7 @@ impl ChatRequest {
             max_tokens: 800,
             stop: Vec::new(),
             constraint: None,
+            seed: None,
         }
     }
 }
@@ -177,8 +184,8 @@ pub enum LlmError {
     },
     #[error("cassette {path}: {detail}")]
     Cassette { path: String, detail: String },
-    #[error("the local backend is not built yet (issue 5); use --backend openai or replay")]
-    LocalNotBuilt,
+    #[error("local model: {0}")]
+    Local(String),
 }
 
 /// The future a backend returns.
@@ -195,6 +202,10 @@ pub trait LanguageModel: Send + Sync {
     fn supports_constraint(&self) -> bool {
         false
     }
+    /// Whether the backend honours [`OutputConstraint::Grammar`].
+    fn supports_grammar(&self) -> bool {
+        false
+    }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a>;
 }
 
@@ -204,6 +215,9 @@ impl<T: LanguageModel + ?Sized> LanguageModel for Box<T> {
     }
     fn supports_constraint(&self) -> bool {
         (**self).supports_constraint()
+    }
+    fn supports_grammar(&self) -> bool {
+        (**self).supports_grammar()
     }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         (**self).chat(request)
@@ -216,6 +230,9 @@ impl<T: LanguageModel + ?Sized> LanguageModel for std::sync::Arc<T> {
     }
     fn supports_constraint(&self) -> bool {
         (**self).supports_constraint()
+    }
+    fn supports_grammar(&self) -> bool {
+        (**self).supports_grammar()
     }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         (**self).chat(request)

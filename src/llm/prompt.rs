@@ -149,6 +149,22 @@ impl Context<'_> {
             },
         ));
         values.push(("error", error.trim().to_string()));
+        // The facts that name the action's objects: a small model finds the cause among
+        // a handful of lines far more often than in the whole scene.
+        let about: Vec<String> = self
+            .facts
+            .iter()
+            .filter(|f| f.atom.args.iter().any(|a| action.args.contains(a)))
+            .map(|f| format!("- {f}"))
+            .collect();
+        values.push((
+            "action_facts",
+            if about.is_empty() {
+                "(none)".into()
+            } else {
+                about.join("\n")
+            },
+        ));
         values.push((
             "answer_format",
             "Explain the cause first, then list the missing conditions, one per line, exactly like this:\nReasoning: <a few sentences>\nConditions:\n<condition>\n<condition, only if more than one is needed>".into(),
@@ -250,15 +266,15 @@ pub fn fill(
 /// for quoted-form vocabularies, a line on the `"any object"` wildcard.
 pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
     let mut text = predicate_lines(vocabulary, descriptions);
+    // Explained with a placeholder, not a real object: small models copy a concrete
+    // example verbatim as their answer.
     let binary = vocabulary
         .predicates
         .iter()
         .find(|p| crate::domain::condition::is_word_predicate(&p.name) && p.arg_types.len() == 2);
-    if let Some(p) = binary
-        && let Some(object) = vocabulary.objects_fitting(&p.arg_types[1]).next()
-    {
+    if let Some(p) = binary {
         text.push_str(&format!(
-            "\n\"{ANY_OBJECT}\" stands for some object, and negated for none: ~\"{ANY_OBJECT}\" {} \"{object}\" means that no object is {} \"{object}\".",
+            "\n\"{ANY_OBJECT}\" stands for some object, and negated for none: ~\"{ANY_OBJECT}\" {} \"<object>\" means that no object is {} that object.",
             p.name, p.name
         ));
     }

@@ -244,6 +244,9 @@ impl<M: LanguageModel> LanguageModel for Metered<M> {
     fn supports_constraint(&self) -> bool {
         self.inner.supports_constraint()
     }
+    fn supports_grammar(&self) -> bool {
+        self.inner.supports_grammar()
+    }
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         Box::pin(self.call(request))
     }
@@ -274,7 +277,7 @@ mod tests {
                 "gpt-4o"
             }
             fn chat<'a>(&'a self, _: &'a ChatRequest) -> ChatFuture<'a> {
-                Box::pin(std::future::ready(Err(LlmError::LocalNotBuilt)))
+                Box::pin(std::future::ready(Err(LlmError::Local("no model".into()))))
             }
         }
         let dir = std::env::temp_dir().join(format!("betr-usage-{}", std::process::id()));

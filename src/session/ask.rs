@@ -7,7 +7,7 @@ use crate::domain::{ActionCall, Condition, Scenario, ValueParam};
 use crate::goal;
 use crate::llm::prompt::{self, Context};
 use crate::llm::reply::{self, ReplyError, Substitution};
-use crate::llm::{ChatReply, LanguageModel, Message, schema};
+use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 
 use super::types::{Event, Options, Proposal, SessionError};
 
@@ -27,7 +27,10 @@ pub async fn interpret(
         variant: &options.variant,
     };
     let messages = ctx.goal(&options.templates)?;
-    let constraint = schema::goal(&scenario.domain.vocabulary);
+    let vocabulary = &scenario.domain.vocabulary;
+    let constraint = schema::goal(vocabulary);
+    let cot = options.variant.chain_of_thought;
+    let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
     let mut last = None;
     for _ in 0..options.interpret_attempts.max(1) {
         emit(&Event::Asking {
@@ -36,7 +39,7 @@ pub async fn interpret(
         let r = ask(
             model,
             messages.clone(),
-            Some(constraint.clone()),
+            (constraint.clone(), &goal_grammar),
             options,
             emit,
         )
@@ -69,16 +72,23 @@ pub async fn interpret(
     })
 }
 
+/// Ask, constraining the reply the way the backend can: a grammar for the local model
+/// (built only when used), a JSON schema for servers that take one, else plain text.
 async fn ask(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
-    constraint: Option<crate::llm::OutputConstraint>,
+    (schema, grammar): (OutputConstraint, &dyn Fn() -> String),
     options: &Options,
     emit: &mut dyn FnMut(&Event),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
-    if options.structured && model.supports_constraint() {
-        request.constraint = constraint;
+    if options.grammar && model.supports_grammar() {
+        request.constraint = Some(OutputConstraint::Grammar {
+            name: "answer".into(),
+            gbnf: grammar(),
+        });
+    } else if options.structured && model.supports_constraint() {
+        request.constraint = Some(schema);
     }
     let r = model.chat(&request).await?;
     emit(&Event::Replied {
@@ -131,10 +141,11 @@ pub(crate) async fn ask_conditions(
     });
     let messages = ctx.resolve(&options.templates, action, error)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
+    let conditions_grammar = || grammar::conditions_grammar(vocabulary, true);
     let r = ask(
         model,
         messages,
-        Some(schema::conditions(vocabulary)),
+        (schema::conditions(vocabulary), &conditions_grammar),
         options,
         emit,
     )
@@ -173,7 +184,15 @@ pub(crate) async fn ask_value(
         what: format!("a value for {} of {action}!", param.name),
     });
     let messages = ctx.value(&options.templates, action, param, error)?;
-    let r = ask(model, messages, Some(schema::value(param)), options, emit).await?;
+    let value_grammar = || grammar::value_grammar(param.unit.as_deref(), &param.categories);
+    let r = ask(
+        model,
+        messages,
+        (schema::value(param), &value_grammar),
+        options,
+        emit,
+    )
+    .await?;
     Ok(match reply::value(&r.text, param, options.min_similarity) {
         Ok(a) => Some((
             Proposal::Value {

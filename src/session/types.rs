@@ -22,6 +22,8 @@ pub struct Options {
     pub templates: Templates,
     /// Constrain replies with a JSON schema when the model supports it.
     pub structured: bool,
+    /// Constrain replies with a grammar when the model supports it (the local model).
+    pub grammar: bool,
 }
 
 impl Default for Options {
@@ -35,6 +37,7 @@ impl Default for Options {
             variant: Variant::default(),
             templates: Templates::builtin(),
             structured: false,
+            grammar: true,
         }
     }
 }

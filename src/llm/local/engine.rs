@@ -75,7 +75,7 @@ pub enum EngineError {
     WorkerGone,
 }
 
-type Reply = mpsc::Sender<Result<Generated, EngineError>>;
+type Reply = tokio::sync::oneshot::Sender<Result<Generated, EngineError>>;
 
 /// A loaded model, ready for generations.
 pub struct Engine {
@@ -118,22 +118,40 @@ impl Engine {
         self.load_time
     }
 
-    /// Run one generation (blocking; call from a blocking-friendly thread).
-    pub fn generate(&self, generation: Generation) -> Result<Generated, EngineError> {
-        let (tx, rx) = mpsc::channel();
-        self.jobs.send((generation, tx)).map_err(|_| EngineError::WorkerGone)?;
-        rx.recv().map_err(|_| EngineError::WorkerGone)?
+    /// Run one generation; the model thread does the work, so awaiting this never blocks
+    /// an async runtime. Calls queue up and run one at a time.
+    pub async fn generate(&self, generation: Generation) -> Result<Generated, EngineError> {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        self.jobs
+            .send((generation, tx))
+            .map_err(|_| EngineError::WorkerGone)?;
+        rx.await.map_err(|_| EngineError::WorkerGone)?
+    }
+
+    /// The same, for callers outside an async runtime (benchmarks).
+    pub fn generate_blocking(&self, generation: Generation) -> Result<Generated, EngineError> {
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        self.jobs
+            .send((generation, tx))
+            .map_err(|_| EngineError::WorkerGone)?;
+        rx.blocking_recv().map_err(|_| EngineError::WorkerGone)?
     }
 }
 
-fn worker(options: EngineOptions, ready: mpsc::Sender<Result<Duration, EngineError>>, queue: mpsc::Receiver<(Generation, Reply)>) {
+fn worker(
+    options: EngineOptions,
+    ready: mpsc::Sender<Result<Duration, EngineError>>,
+    queue: mpsc::Receiver<(Generation, Reply)>,
+) {
     let started = Instant::now();
     let setup = (|| {
         let backend = backend()?;
-        let model = LlamaModel::load_from_file(backend, &options.model_path, &LlamaModelParams::default()).map_err(|e| EngineError::Load {
-            path: options.model_path.clone(),
-            detail: e.to_string(),
-        })?;
+        let model =
+            LlamaModel::load_from_file(backend, &options.model_path, &LlamaModelParams::default())
+                .map_err(|e| EngineError::Load {
+                    path: options.model_path.clone(),
+                    detail: e.to_string(),
+                })?;
         Ok::<_, EngineError>((backend, model))
     })();
     let (backend, model) = match setup {
@@ -191,9 +209,8 @@ fn worker(options: EngineOptions, ready: mpsc::Sender<Result<Duration, EngineErr
             cached.clear();
             let _ = ctx.clear_kv_cache_seq(None, None, None);
         }
-        if reply.send(result).is_err() {
-            break;
-        }
+        // A caller that went away (a cancelled request) does not stop the worker.
+        let _ = reply.send(result);
     }
 }
 
@@ -214,9 +231,14 @@ fn generate(
     let runtime = |e: &dyn std::fmt::Display| EngineError::Runtime(e.to_string());
     // Reuse the cached prefix; always evaluate at least the last prompt token, whose
     // logits start the reply.
-    let common = cached.iter().zip(tokens).take_while(|(a, b)| a == b).count();
+    let common = cached
+        .iter()
+        .zip(tokens)
+        .take_while(|(a, b)| a == b)
+        .count();
     let keep = common.min(tokens.len().saturating_sub(1));
-    ctx.clear_kv_cache_seq(Some(0), Some(keep as u32), None).map_err(|e| runtime(&e))?;
+    ctx.clear_kv_cache_seq(Some(0), Some(keep as u32), None)
+        .map_err(|e| runtime(&e))?;
     cached.truncate(keep);
 
     let prompt_started = Instant::now();
@@ -238,7 +260,10 @@ fn generate(
 
     let mut samplers = Vec::new();
     if let Some(g) = &job.grammar {
-        samplers.push(LlamaSampler::grammar(model, g, "root").map_err(|e| EngineError::Grammar(e.to_string()))?);
+        samplers.push(
+            LlamaSampler::grammar(model, g, "root")
+                .map_err(|e| EngineError::Grammar(e.to_string()))?,
+        );
     }
     if job.temperature > 0.0 {
         samplers.push(LlamaSampler::temp(job.temperature));
@@ -269,7 +294,9 @@ fn generate(
             break;
         }
         batch.clear();
-        batch.add(token, cached.len() as i32, &[0], true).map_err(|e| runtime(&e))?;
+        batch
+            .add(token, cached.len() as i32, &[0], true)
+            .map_err(|e| runtime(&e))?;
         ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
         cached.push(token);
         logits_at = 0;

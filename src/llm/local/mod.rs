@@ -1,0 +1,91 @@
+//! The embedded backend (`--backend local`): a GGUF model run in-process by llama.cpp,
+//! with grammar-constrained decoding so replies can only use the scenario's vocabulary.
+
+pub mod engine;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+pub use engine::{Engine, EngineError, EngineOptions, Generated, Generation};
+
+use super::{
+    ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, OutputConstraint, ReplySource,
+    Role, TokenUsage,
+};
+
+/// A loaded local model behind the `LanguageModel` trait.
+pub struct LocalModel {
+    engine: Arc<Engine>,
+    name: String,
+}
+
+impl LocalModel {
+    /// Load the model file (takes about a second for the 0.5B default).
+    pub fn load(name: &str, options: EngineOptions) -> Result<LocalModel, LlmError> {
+        let engine = Engine::load(options).map_err(|e| LlmError::Local(e.to_string()))?;
+        Ok(LocalModel {
+            engine: Arc::new(engine),
+            name: name.to_string(),
+        })
+    }
+
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+}
+
+impl LanguageModel for LocalModel {
+    fn model(&self) -> &str {
+        &self.name
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            let grammar = match &request.constraint {
+                Some(OutputConstraint::Grammar { gbnf, .. }) => Some(gbnf.clone()),
+                // JSON schemas are for HTTP backends; the local model is constrained by
+                // grammars only, so it answers in plain text here.
+                Some(OutputConstraint::JsonSchema { .. }) | None => None,
+            };
+            let generation = Generation {
+                messages: request
+                    .messages
+                    .iter()
+                    .map(|m| {
+                        let role = match m.role {
+                            Role::System => "system",
+                            Role::User => "user",
+                            Role::Assistant => "assistant",
+                        };
+                        (role.to_string(), m.content.clone())
+                    })
+                    .collect(),
+                max_tokens: request.max_tokens,
+                temperature: request.temperature,
+                seed: request.seed.unwrap_or(0),
+                stop: request.stop.clone(),
+                grammar,
+            };
+            let started = Instant::now();
+            let out = self
+                .engine
+                .generate(generation)
+                .await
+                .map_err(|e| LlmError::Local(e.to_string()))?;
+            Ok(ChatReply {
+                text: out.text,
+                model: self.name.clone(),
+                usage: TokenUsage {
+                    prompt_tokens: u64::from(out.prompt_tokens),
+                    completion_tokens: u64::from(out.completion_tokens),
+                },
+                latency: started.elapsed(),
+                source: ReplySource::Model,
+            })
+        })
+    }
+}
