@@ -3,6 +3,7 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
 use clap::Args;
@@ -79,7 +80,7 @@ pub struct LlmFlags {
 
 /// The configured model and its ledger.
 struct Llm {
-    model: Metered<Box<dyn LanguageModel>>,
+    model: Arc<Metered<Box<dyn LanguageModel>>>,
     options: Options,
 }
 
@@ -132,7 +133,10 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         },
         ..Options::default()
     };
-    Ok(Llm { model, options })
+    Ok(Llm {
+        model: Arc::new(model),
+        options,
+    })
 }
 
 fn read_examples(path: &Path) -> Result<Vec<Example>> {
@@ -186,7 +190,7 @@ pub fn interpret(
         scenario,
         &world.facts(),
         &instruction,
-        &llm.model,
+        llm.model.as_ref(),
         &llm.options,
         &mut emit,
     ));
@@ -222,7 +226,7 @@ pub fn resolve(
     let result = runtime()?.block_on(session::resolve(
         scenario,
         args.instruction,
-        &llm.model,
+        llm.model.clone(),
         &llm.options,
         &mut approve,
         &mut emit,
@@ -352,6 +356,7 @@ fn print_event_line(event: &Event) {
             action,
             node_path,
             error,
+            ..
         } => {
             println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
         }
@@ -385,10 +390,23 @@ fn print_event_line(event: &Event) {
         }
         Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
         Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        // What a live front end shows; the printed log keeps to the loop's steps.
+        Event::TreeChanged { .. }
+        | Event::Ticked { .. }
+        | Event::WorldChanged { .. }
+        | Event::Usage { .. }
+        | Event::RunState { .. }
+        | Event::Verified { .. }
+        | Event::PolicySaved { .. }
+        | Event::PolicyLoaded { .. }
+        | Event::Notice { .. } => {}
+        Event::Error { message } => println!("error: {message}"),
+        // Returned by the loop as its error, and printed once by `main`.
+        Event::Failed { .. } => {}
     }
 }
 
-fn print_usage(model: &Metered<Box<dyn LanguageModel>>) {
+fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
     let ledger = model.ledger();
     let log = ledger
         .log_path()

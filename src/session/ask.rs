@@ -18,7 +18,7 @@ pub async fn interpret(
     instruction: &str,
     model: &dyn LanguageModel,
     options: &Options,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<reply::GoalAnswer, SessionError> {
     let ctx = Context {
         scenario,
@@ -74,7 +74,7 @@ async fn ask(
     messages: Vec<Message>,
     constraint: Option<crate::llm::OutputConstraint>,
     options: &Options,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
     if options.structured && model.supports_constraint() {
@@ -124,7 +124,7 @@ pub(crate) async fn ask_conditions(
     node: NodeId,
     action: &ActionCall,
     error: &str,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
@@ -167,7 +167,7 @@ pub(crate) async fn ask_value(
     action: &ActionCall,
     param: &ValueParam,
     error: &str,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     emit(&Event::Asking {
         what: format!("a value for {} of {action}!", param.name),
