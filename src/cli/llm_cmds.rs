@@ -85,6 +85,17 @@ struct Llm {
 }
 
 fn setup(flags: &LlmFlags) -> Result<Llm> {
+    let (settings, options) = settings(flags)?;
+    let ledger = Ledger::new(settings.usage_log.clone());
+    let model = settings.build(ledger, &|k: &str| std::env::var(k).ok())?;
+    Ok(Llm {
+        model: Arc::new(model),
+        options,
+    })
+}
+
+/// The resolved settings and the session options the flags ask for (no model built yet).
+pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
     let var = |k: &str| std::env::var(k).ok();
     let file = match FileConfig::locate(flags.config.as_deref(), &var) {
         Some(path) => Some((FileConfig::read(&path)?, path)),
@@ -113,8 +124,6 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         Layer::from_env(&var)?,
         flag_layer,
     )?;
-    let ledger = Ledger::new(settings.usage_log.clone());
-    let model = settings.build(ledger, &var)?;
     let examples = flags.examples.as_deref().map(read_examples).transpose()?;
     let templates = match &flags.prompts {
         Some(dir) => Templates::from_dir(dir)?,
@@ -133,10 +142,7 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         },
         ..Options::default()
     };
-    Ok(Llm {
-        model: Arc::new(model),
-        options,
-    })
+    Ok((settings, options))
 }
 
 fn read_examples(path: &Path) -> Result<Vec<Example>> {
