@@ -206,7 +206,10 @@ impl App {
                 self.tree.set_record(record);
             }
             Event::WorldChanged { facts, reset } => {
-                self.world.facts = facts.iter().map(ToString::to_string).collect();
+                let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
+                // Relations between objects first: they change; "near robot" rarely does.
+                facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
+                self.world.facts = facts;
                 if reset {
                     self.status.ticks = 0;
                     self.status.ending = None;
