@@ -99,7 +99,7 @@ impl Bench {
 
     /// Type the instruction of scenario 1 and step until the grasp fails and the
     /// proposal is shown.
-    async fn to_failure(&mut self) {
+    async fn step_to_failure(&mut self) {
         self.key(KeyCode::Char('i'));
         self.type_text("Put the blue cube on the green cube");
         self.key(KeyCode::Enter);
@@ -139,16 +139,22 @@ fn planned_tree() {
 fn failure_with_a_pending_proposal_then_approval() {
     rt().block_on(async {
         let mut b = Bench::start();
-        b.to_failure().await;
+        b.step_to_failure().await;
         let screen = b.screen(120, 40);
         assert!(screen.contains("◀ failed"), "{screen}");
-        assert!(screen.contains("Proposal for grasp \"blue cube\"!"), "{screen}");
+        assert!(
+            screen.contains("Proposal for grasp \"blue cube\"!"),
+            "{screen}"
+        );
         insta::assert_snapshot!("failure_with_pending_proposal", screen);
 
         b.key(KeyCode::Char('a'));
         b.until(|e| matches!(e, Event::TreeChanged { .. })).await;
         let screen = b.screen(120, 40);
-        assert!(screen.contains("+[-] ~\"any object\" on \"blue cube\"?"), "{screen}");
+        assert!(
+            screen.contains("+[-] ~\"any object\" on \"blue cube\"?"),
+            "{screen}"
+        );
         insta::assert_snapshot!("after_approval", screen);
 
         b.key(KeyCode::Char('r'));
@@ -180,7 +186,7 @@ fn help_overlay_lists_every_binding() {
 fn small_terminal_stays_usable() {
     rt().block_on(async {
         let mut b = Bench::start();
-        b.to_failure().await;
+        b.step_to_failure().await;
         let screen = b.screen(80, 24);
         assert!(screen.contains("Proposal for"), "{screen}");
         assert!(screen.contains("tick"), "{screen}");

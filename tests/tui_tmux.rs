@@ -49,13 +49,21 @@ impl Tmux {
             "40",
             command,
         ]);
-        assert!(out.status.success(), "tmux: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "tmux: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         t
     }
 
     fn screen(&self) -> String {
-        String::from_utf8_lossy(&self.run(&["capture-pane", "-p", "-t", &self.session]).stdout)
-            .into_owned()
+        String::from_utf8_lossy(
+            &self
+                .run(&["capture-pane", "-p", "-t", &self.session])
+                .stdout,
+        )
+        .into_owned()
     }
 
     fn keys(&self, keys: &[&str]) {
@@ -121,7 +129,15 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     let tmux = Tmux::start(&command);
 
     // The workbench opens on scenario 1 with the configured model.
-    tmux.wait_for(&["Behavior tree", "press i to type an instruction", "red_on_blue", "openai fake-model"], 20);
+    tmux.wait_for(
+        &[
+            "Behavior tree",
+            "press i to type an instruction",
+            "red_on_blue",
+            "openai fake-model",
+        ],
+        20,
+    );
 
     // Type the instruction.
     tmux.keys(&["i"]);
@@ -129,7 +145,14 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     tmux.text("Put the blue cube on the green cube");
     tmux.wait_for(&["> Put the blue cube on the green cube"], 10);
     tmux.keys(&["Enter"]);
-    let screen = tmux.wait_for(&["Goal: \"blue cube\" on \"green cube\"", "grasp \"blue cube\"!", "[o] Fallback"], 20);
+    let screen = tmux.wait_for(
+        &[
+            "Goal: \"blue cube\" on \"green cube\"",
+            "grasp \"blue cube\"!",
+            "[o] Fallback",
+        ],
+        20,
+    );
     assert!(screen.contains("1 call(s)"), "{screen}");
 
     // Step until the grasp fails.
@@ -157,7 +180,14 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
 
     // Approve: the tree grows, the new nodes marked.
     tmux.keys(&["a"]);
-    tmux.wait_for(&["repaired:", "+[-] ~\"any object\" on \"blue cube\"?", "place \"red cube\""], 20);
+    tmux.wait_for(
+        &[
+            "repaired:",
+            "+[-] ~\"any object\" on \"blue cube\"?",
+            "place \"red cube\"",
+        ],
+        20,
+    );
 
     // Run to success.
     tmux.keys(&["r"]);
@@ -168,7 +198,10 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     tmux.wait_for(&["saved policy"], 10);
     tmux.keys(&["q"]);
     let screen = tmux.wait_for(&["betr exited with status 0"], 10);
-    assert!(!screen.contains("Behavior tree"), "the alternate screen was left:\n{screen}");
+    assert!(
+        !screen.contains("Behavior tree"),
+        "the alternate screen was left:\n{screen}"
+    );
 
     // The policy parses and says where its fix came from.
     let files: Vec<PathBuf> = std::fs::read_dir(&policies)
@@ -180,15 +213,27 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     let domain = Scenario::load(&scenario).unwrap().domain;
     let policy = betr::session::policy::load(&files[0], &domain).unwrap();
     assert_eq!(policy.fixes.len(), 1);
-    assert!(policy.fixes[0].change.contains("~\"any object\" on \"blue cube\""));
+    assert!(
+        policy.fixes[0]
+            .change
+            .contains("~\"any object\" on \"blue cube\"")
+    );
     assert!(policy.fixes[0].model.contains("hand-written fixture"));
     assert_eq!(policy.goal, "\"blue cube\" on \"green cube\"");
     // The key never reaches a written file.
     for f in support::cli::files_under(&dir) {
         let bytes = std::fs::read(&f).unwrap_or_default();
-        assert!(!String::from_utf8_lossy(&bytes).contains(KEY), "{}", f.display());
+        assert!(
+            !String::from_utf8_lossy(&bytes).contains(KEY),
+            "{}",
+            f.display()
+        );
     }
-    assert!(started.elapsed() < Duration::from_secs(60), "{:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_secs(60),
+        "{:?}",
+        started.elapsed()
+    );
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
 }

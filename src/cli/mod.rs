@@ -37,6 +37,8 @@ pub enum Command {
     /// The workbench: type an instruction, plan, step or run the tree, approve the fixes a
     /// model proposes when an action fails, verify, save the policy.
     Tui(tui_cmd::TuiArgs),
+    #[command(hide = true)]
+    PolicySaveTest(PolicySaveTest),
     /// Check the planned (or a saved) tree before it runs: structural rules, then every
     /// reachable state of the abstraction; exit 1 with a counterexample when violated.
     Verify {
@@ -151,6 +153,16 @@ pub enum Command {
     },
 }
 
+/// Hidden: save a policy of `nodes` nodes to `path` `times` times (tests kill it mid-save).
+#[derive(clap::Args)]
+pub struct PolicySaveTest {
+    pub path: PathBuf,
+    #[arg(long, default_value_t = 20_000)]
+    pub nodes: usize,
+    #[arg(long, default_value_t = 1_000)]
+    pub times: usize,
+}
+
 #[derive(Subcommand)]
 pub enum EvalExperiment {
     /// Goal interpretation on the 100 LLM-OBTEA cafe instructions.
@@ -198,6 +210,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     };
     match command {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
+        Command::PolicySaveTest(args) => policy_save_test(&args),
         Command::Eval {
             experiment:
                 EvalExperiment::Goals {
@@ -318,6 +331,35 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             },
         ),
     }
+}
+
+fn policy_save_test(args: &PolicySaveTest) -> Result<ExitCode> {
+    use betr::bt::{NodeKind, Tree};
+    use betr::session::policy::{Approval, Fix, Policy, PolicyStore, now_rfc3339};
+    let mut tree = Tree::new(NodeKind::Fallback);
+    let condition = Condition::parse("\"blue cube\" on \"green cube\"")?;
+    for _ in 1..args.nodes.max(2) {
+        tree.add_child(tree.root(), NodeKind::Condition(condition.clone()))?;
+    }
+    let store = PolicyStore::new(args.path.parent().unwrap_or(Path::new(".")));
+    for generation in 0..args.times {
+        let policy = Policy {
+            scenario: "policy save test".into(),
+            instruction: None,
+            goal: condition.to_string(),
+            saved_at: now_rfc3339(),
+            fixes: vec![Fix {
+                change: format!("generation {generation}"),
+                nodes: Vec::new(),
+                model: "none".into(),
+                approval: Approval::Edited,
+                at: now_rfc3339(),
+            }],
+            tree: tree.clone(),
+        };
+        store.save(&args.path, &policy)?;
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.
