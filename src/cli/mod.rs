@@ -3,6 +3,7 @@
 mod eval_cmd;
 mod llm_cmds;
 mod model_cmd;
+mod policy_cmd;
 mod tree_cmds;
 pub mod tui_cmd;
 mod values;
@@ -210,7 +211,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     };
     match command {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
-        Command::PolicySaveTest(args) => policy_save_test(&args),
+        Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval {
             experiment:
                 EvalExperiment::Goals {
@@ -331,35 +332,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             },
         ),
     }
-}
-
-fn policy_save_test(args: &PolicySaveTest) -> Result<ExitCode> {
-    use betr::bt::{NodeKind, Tree};
-    use betr::session::policy::{Approval, Fix, Policy, PolicyStore, now_rfc3339};
-    let mut tree = Tree::new(NodeKind::Fallback);
-    let condition = Condition::parse("\"blue cube\" on \"green cube\"")?;
-    for _ in 1..args.nodes.max(2) {
-        tree.add_child(tree.root(), NodeKind::Condition(condition.clone()))?;
-    }
-    let store = PolicyStore::new(args.path.parent().unwrap_or(Path::new(".")));
-    for generation in 0..args.times {
-        let policy = Policy {
-            scenario: "policy save test".into(),
-            instruction: None,
-            goal: condition.to_string(),
-            saved_at: now_rfc3339(),
-            fixes: vec![Fix {
-                change: format!("generation {generation}"),
-                nodes: Vec::new(),
-                model: "none".into(),
-                approval: Approval::Edited,
-                at: now_rfc3339(),
-            }],
-            tree: tree.clone(),
-        };
-        store.save(&args.path, &policy)?;
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.

@@ -20,7 +20,6 @@ pub const OBJECTS: &str = "Objects:";
 pub const LAST_ERROR: &str = "Last error:";
 pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
-pub const PROPOSAL_HINT: &str = "a approve · x reject · e edit";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
 pub const ASKING: &str = "asking the model for";
 pub const REPLY_FROM: &str = "reply from";
@@ -32,7 +31,7 @@ pub const PAUSED: &str = "paused";
 pub const AUTO_APPROVE: &str = "AUTO-APPROVE";
 pub const SUCCESS: &str = "SUCCESS";
 pub const FAILED: &str = "FAILED";
-pub const HELP_HINT: &str = "? help";
+pub const HELP_WORD: &str = "help";
 pub const NEW_MARK: &str = "+";
 pub const FAILED_MARK: &str = "◀ failed";
 

@@ -15,6 +15,7 @@
 
 mod changes;
 mod flow;
+mod policies;
 mod requests;
 
 use std::path::PathBuf;

@@ -77,7 +77,7 @@ impl StatusBar {
         }
         spans.push(sep);
         spans.push(Span::styled(
-            format!("{help_key} {}", &strings::HELP_HINT[2..]),
+            format!("{help_key} {}", strings::HELP_WORD),
             theme.status_bar,
         ));
         frame.render_widget(
