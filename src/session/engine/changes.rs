@@ -126,7 +126,7 @@ impl Engine {
                 let formula = self
                     .scenario
                     .parse_goal(text)
-                    .map_err(|e| format!("{text:?}: {e}"))?;
+                    .map_err(|e| format!("'{text}': {e}"))?;
                 match formula.to_dnf().0.as_slice() {
                     [one] if !one.is_empty() => Ok(Proposal::Conditions {
                         action: action.clone(),
@@ -134,7 +134,7 @@ impl Engine {
                         conditions: one.clone(),
                     }),
                     _ => Err(format!(
-                        "{text:?}: expected one condition or a conjunction ('A & ~B'), found {formula}"
+                        "'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}"
                     )),
                 }
             }
@@ -152,8 +152,8 @@ impl Engine {
                     .find(|s| &s.name == skill)
                     .and_then(|s| s.values.iter().find(|v| &v.name == param))
                     .ok_or_else(|| format!("{skill} declares no value {param}"))?;
-                let value = parse_value(text).map_err(|e| format!("{text:?}: {e}"))?;
-                let value = conform(declared, value).map_err(|e| format!("{text:?}: {e}"))?;
+                let value = parse_value(text).map_err(|e| format!("'{text}': {e}"))?;
+                let value = conform(declared, value).map_err(|e| format!("'{text}': {e}"))?;
                 Ok(Proposal::Value {
                     skill: skill.clone(),
                     object: object.clone(),

@@ -109,11 +109,14 @@ pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
 }
 
 pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme) {
-    let rect = centered(
-        area,
-        area.width.saturating_sub(8).max(20),
-        u16::try_from(lines.len() + 2).unwrap_or(u16::MAX),
-    );
+    let width = area.width.saturating_sub(8).max(20);
+    let inner = usize::from(width.saturating_sub(2)).max(1);
+    // Wrapped lines take more than one row each.
+    let rows: usize = lines
+        .iter()
+        .map(|l| l.chars().count().div_ceil(inner).max(1))
+        .sum();
+    let rect = centered(area, width, u16::try_from(rows + 2).unwrap_or(u16::MAX));
     frame.render_widget(Clear, rect);
     let block = Block::default()
         .borders(Borders::ALL)
