@@ -1,6 +1,6 @@
-//! The LLM pane: the call under way, who answered, the reasoning of the last call, the
-//! pending proposal (which action, what conditions or value, why) with its keys, and a
-//! short log of what happened.
+//! The LLM pane: the call under way, the pending proposal (which action, what conditions
+//! or value) with its keys first, so small terminals show it; then the goal, who
+//! answered, the reasoning of the last call (why), and a short log of what happened.
 
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -89,6 +89,19 @@ impl LlmPane {
                 theme.running,
             )));
         }
+        match &self.proposal {
+            Some(p) => {
+                lines.push(Line::from(Span::styled(
+                    format!("{} {}:", strings::PROPOSAL_FOR, p.target),
+                    theme.proposal,
+                )));
+                for l in &p.lines {
+                    lines.push(Line::from(Span::styled(format!("  {l}"), theme.proposal)));
+                }
+                lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
+            }
+            None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
+        }
         if let Some(goal) = &self.goal {
             lines.push(Line::from(vec![
                 Span::styled(format!("{} ", strings::GOAL), theme.title),
@@ -106,19 +119,6 @@ impl LlmPane {
                 Span::styled(format!("{} ", strings::REASONING), theme.title),
                 Span::raw(r.replace('\n', " ")),
             ]));
-        }
-        match &self.proposal {
-            Some(p) => {
-                lines.push(Line::from(Span::styled(
-                    format!("{} {}:", strings::PROPOSAL_FOR, p.target),
-                    theme.proposal,
-                )));
-                for l in &p.lines {
-                    lines.push(Line::from(Span::styled(format!("  {l}"), theme.proposal)));
-                }
-                lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
-            }
-            None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
         }
         if let Some(e) = &self.error {
             lines.push(Line::from(Span::styled(e.clone(), theme.error)));

@@ -31,11 +31,19 @@ pub struct StatusBar {
 
 impl StatusBar {
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, help_key: &str) {
-        let sep = Span::styled(" │ ", theme.status_bar);
+        // Narrow terminals: the model without its backend, the help key without its word,
+        // tighter separators.
+        let narrow = area.width < 100;
+        let sep = Span::styled(if narrow { "│" } else { " │ " }, theme.status_bar);
+        let who = if narrow {
+            self.model.clone()
+        } else {
+            format!("{} {}", self.backend, self.model)
+        };
         let mut spans = vec![
             Span::styled(format!(" {}", self.scenario), theme.status_bar),
             sep.clone(),
-            Span::styled(format!("{} {}", self.backend, self.model), theme.status_bar),
+            Span::styled(who, theme.status_bar),
             sep.clone(),
             Span::styled(
                 strings::calls(
@@ -76,10 +84,12 @@ impl StatusBar {
             spans.push(Span::styled(strings::AUTO_APPROVE, theme.error));
         }
         spans.push(sep);
-        spans.push(Span::styled(
-            format!("{help_key} {}", strings::HELP_WORD),
-            theme.status_bar,
-        ));
+        let help = if narrow {
+            help_key.to_string()
+        } else {
+            format!("{help_key} {}", strings::HELP_WORD)
+        };
+        spans.push(Span::styled(help, theme.status_bar));
         frame.render_widget(
             Paragraph::new(Line::from(spans)).style(theme.status_bar),
             area,
