@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, and
-# the SPIN model checker (installed here with apt when missing).
+# Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, the
+# SPIN model checker and tmux (both installed here with apt when missing).
 # Usage: bash scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,6 +16,14 @@ if ! command -v spin >/dev/null 2>&1; then
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
   $SUDO apt-get update
   $SUDO apt-get install -y spin
+fi
+
+# tmux runs the real binary as a person would (tests/tui_tmux.rs).
+if ! command -v tmux >/dev/null 2>&1; then
+  echo "tmux is missing: installing the Debian package" >&2
+  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
+  $SUDO apt-get update
+  $SUDO apt-get install -y tmux
 fi
 
 cargo test --locked

@@ -17,5 +17,6 @@ pub mod model;
 pub mod planner;
 pub mod session;
 pub mod store;
+pub mod tui;
 pub mod verify;
 pub mod world;

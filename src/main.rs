@@ -10,13 +10,32 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     let args = cli::Cli::parse();
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_env("BETR_LOG")
-                .unwrap_or_else(|_| "warn".into()),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    let filter =
+        tracing_subscriber::EnvFilter::try_from_env("BETR_LOG").unwrap_or_else(|_| "warn".into());
+    let workbench = matches!(args.command, None | Some(cli::Command::Tui(_)));
+    if workbench {
+        // The terminal belongs to the screen: log to a file (or nowhere).
+        let file = cli::tui_cmd::log_path().and_then(|p| {
+            std::fs::create_dir_all(p.parent()?).ok()?;
+            std::fs::OpenOptions::new()
+                .create(true)
+                .append(true)
+                .open(p)
+                .ok()
+        });
+        let builder = tracing_subscriber::fmt()
+            .with_env_filter(filter)
+            .with_ansi(false);
+        match file {
+            Some(f) => builder.with_writer(std::sync::Mutex::new(f)).init(),
+            None => builder.with_writer(std::io::sink).init(),
+        }
+    } else {
+        tracing_subscriber::fmt()
+            .with_env_filter(filter)
+            .with_writer(std::io::stderr)
+            .init();
+    }
     match cli::run(args) {
         Ok(code) => code,
         Err(e) => {

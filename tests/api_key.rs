@@ -14,7 +14,9 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
     let dir = tmp("key");
     std::fs::write(
         dir.join("betr.toml"),
-        format!("[llm]\nmodel = \"fake-model\"\napi_key_env = \"{KEY_VAR}\"\n"),
+        format!(
+            "[llm]\nbackend = \"openai\"\nmodel = \"fake-model\"\napi_key_env = \"{KEY_VAR}\"\n"
+        ),
     )
     .unwrap();
     let scenario = fixtures::root().join("scenarios/cafe/no_coffee.toml");

@@ -214,7 +214,7 @@ fn structured_output_sends_a_schema_and_reads_json() {
     let r = block(session::resolve(
         &scenario,
         None,
-        &c,
+        std::sync::Arc::new(c),
         &options,
         &mut |_| true,
         &mut |_| {},
@@ -264,7 +264,7 @@ fn resolve_with(
     let r = block(session::resolve(
         &scenario,
         None,
-        &c,
+        std::sync::Arc::new(c),
         &options,
         &mut |_| true,
         &mut |e| events.push(e.clone()),

@@ -5,7 +5,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
 use std::path::Path;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use betr::domain::Scenario;
 use betr::llm::local::{EngineOptions, LocalModel};
@@ -23,21 +23,23 @@ impl Progress for Quiet {
     fn bytes(&mut self, _: u64, _: u64) {}
 }
 
-fn local() -> &'static LocalModel {
-    static MODEL: OnceLock<LocalModel> = OnceLock::new();
+fn local() -> &'static Arc<LocalModel> {
+    static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
     MODEL.get_or_init(|| {
         if !QWEN_CODER_05B.is_present() {
             model::fetch(&QWEN_CODER_05B, &model::cache_dir(), "python3", &mut Quiet).unwrap();
         }
-        LocalModel::load(
-            QWEN_CODER_05B.name,
-            EngineOptions {
-                model_path: QWEN_CODER_05B.path(),
-                threads: betr::llm::config::DEFAULT_THREADS,
-                context: 4096,
-            },
+        Arc::new(
+            LocalModel::load(
+                QWEN_CODER_05B.name,
+                EngineOptions {
+                    model_path: QWEN_CODER_05B.path(),
+                    threads: betr::llm::config::DEFAULT_THREADS,
+                    context: 4096,
+                },
+            )
+            .unwrap(),
         )
-        .unwrap()
     })
 }
 
@@ -70,7 +72,7 @@ async fn resolves_scenario_1_with_a_condition_that_fixes_it_in_simulation() {
     let resolved = session::resolve(
         &s,
         None,
-        local(),
+        local().clone() as Arc<dyn LanguageModel>,
         &Options::default(),
         &mut |p| {
             proposals.push(p.clone());

@@ -154,6 +154,7 @@ fn the_library_loop_applies_the_expected_fixes() {
         max_tokens_field: "max_tokens".into(),
     })
     .unwrap();
+    let client: std::sync::Arc<dyn betr::llm::LanguageModel> = std::sync::Arc::new(client);
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -166,7 +167,7 @@ fn the_library_loop_applies_the_expected_fixes() {
             .block_on(session::resolve(
                 &scenario,
                 None,
-                &client,
+                client.clone(),
                 &Options::default(),
                 &mut |p| {
                     approved.push(p.clone());

@@ -3,6 +3,7 @@
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use anyhow::{Context as _, Result};
 use clap::Args;
@@ -90,11 +91,31 @@ pub struct LlmFlags {
 
 /// The configured model and its ledger.
 struct Llm {
-    model: Metered<Box<dyn LanguageModel>>,
+    model: Arc<Metered<Box<dyn LanguageModel>>>,
     options: Options,
 }
 
 fn setup(flags: &LlmFlags) -> Result<Llm> {
+    let (settings, options) = settings(flags)?;
+    ensure_local_model(&settings)?;
+    let ledger = Ledger::new(settings.usage_log.clone());
+    let model = settings.build(ledger, &|k: &str| std::env::var(k).ok())?;
+    Ok(Llm {
+        model: Arc::new(model),
+        options,
+    })
+}
+
+/// The local model is fetched on first use (with a progress bar) before it is loaded.
+pub fn ensure_local_model(settings: &Settings) -> Result<()> {
+    if settings.backend == Backend::Local && settings.model_path.is_none() {
+        super::model_cmd::ensure(settings.model.as_deref())?;
+    }
+    Ok(())
+}
+
+/// The resolved settings and the session options the flags ask for (no model built yet).
+pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
     let var = |k: &str| std::env::var(k).ok();
     let file = match FileConfig::locate(flags.config.as_deref(), &var) {
         Some(path) => Some((FileConfig::read(&path)?, path)),
@@ -126,12 +147,6 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         Layer::from_env(&var)?,
         flag_layer,
     )?;
-    // The local model is fetched on first use (with a progress bar), then loaded.
-    if settings.backend == Backend::Local && settings.model_path.is_none() {
-        super::model_cmd::ensure(settings.model.as_deref())?;
-    }
-    let ledger = Ledger::new(settings.usage_log.clone());
-    let model = settings.build(ledger, &var)?;
     let examples = flags.examples.as_deref().map(read_examples).transpose()?;
     let templates = match &flags.prompts {
         Some(dir) => Templates::from_dir(dir)?,
@@ -151,7 +166,7 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         },
         ..Options::default()
     };
-    Ok(Llm { model, options })
+    Ok((settings, options))
 }
 
 fn read_examples(path: &Path) -> Result<Vec<Example>> {
@@ -205,7 +220,7 @@ pub fn interpret(
         scenario,
         &world.facts(),
         &instruction,
-        &llm.model,
+        llm.model.as_ref(),
         &llm.options,
         &mut emit,
     ));
@@ -241,7 +256,7 @@ pub fn resolve(
     let result = runtime()?.block_on(session::resolve(
         scenario,
         args.instruction,
-        &llm.model,
+        llm.model.clone(),
         &llm.options,
         &mut approve,
         &mut emit,
@@ -371,6 +386,7 @@ fn print_event_line(event: &Event) {
             action,
             node_path,
             error,
+            ..
         } => {
             println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
         }
@@ -404,10 +420,23 @@ fn print_event_line(event: &Event) {
         }
         Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
         Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        // What a live front end shows; the printed log keeps to the loop's steps.
+        Event::TreeChanged { .. }
+        | Event::Ticked { .. }
+        | Event::WorldChanged { .. }
+        | Event::Usage { .. }
+        | Event::RunState { .. }
+        | Event::Verified { .. }
+        | Event::PolicySaved { .. }
+        | Event::PolicyLoaded { .. }
+        | Event::Notice { .. } => {}
+        Event::Error { message } => println!("error: {message}"),
+        // Returned by the loop as its error, and printed once by `main`.
+        Event::Failed { .. } => {}
     }
 }
 
-fn print_usage(model: &Metered<Box<dyn LanguageModel>>) {
+fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
     let ledger = model.ledger();
     let log = ledger
         .log_path()

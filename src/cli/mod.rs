@@ -3,7 +3,9 @@
 mod eval_cmd;
 mod llm_cmds;
 mod model_cmd;
+mod policy_cmd;
 mod tree_cmds;
+pub mod tui_cmd;
 mod values;
 mod verify_cmd;
 
@@ -23,8 +25,9 @@ use betr::goal::Formula;
     about = "Instruction → goal → behavior tree, repaired when the world disagrees"
 )]
 pub struct Cli {
+    /// What to do (none: the workbench on scenario 1, as `betr tui`).
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
     /// Print trees with ASCII symbols instead of Unicode.
     #[arg(long, global = true)]
     pub ascii: bool,
@@ -32,6 +35,11 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// The workbench: type an instruction, plan, step or run the tree, approve the fixes a
+    /// model proposes when an action fails, verify, save the policy.
+    Tui(tui_cmd::TuiArgs),
+    #[command(hide = true)]
+    PolicySaveTest(PolicySaveTest),
     /// Check the planned (or a saved) tree before it runs: structural rules, then every
     /// reachable state of the abstraction; exit 1 with a counterexample when violated.
     Verify {
@@ -146,6 +154,16 @@ pub enum Command {
     },
 }
 
+/// Hidden: save a policy of `nodes` nodes to `path` `times` times (tests kill it mid-save).
+#[derive(clap::Args)]
+pub struct PolicySaveTest {
+    pub path: PathBuf,
+    #[arg(long, default_value_t = 20_000)]
+    pub nodes: usize,
+    #[arg(long, default_value_t = 1_000)]
+    pub times: usize,
+}
+
 #[derive(Subcommand)]
 pub enum EvalExperiment {
     /// Goal interpretation on the 100 LLM-OBTEA cafe instructions.
@@ -188,7 +206,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     } else {
         &betr::bt::UNICODE
     };
-    match cli.command {
+    let Some(command) = cli.command else {
+        return tui_cmd::tui(&tui_cmd::TuiArgs::default(), cli.ascii);
+    };
+    match command {
+        Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
+        Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval {
             experiment:
                 EvalExperiment::Goals {
@@ -313,6 +336,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.
 fn load(arg: &Path) -> Result<Scenario> {
+    Ok(Scenario::load(&find_scenario(arg)?)?)
+}
+
+/// The file a scenario argument names.
+fn find_scenario(arg: &Path) -> Result<PathBuf> {
     let candidates = [
         arg.to_path_buf(),
         Path::new("scenarios").join(arg),
@@ -329,7 +357,7 @@ fn load(arg: &Path) -> Result<Scenario> {
                 .join(", ")
         );
     };
-    Ok(Scenario::load(path)?)
+    Ok(path.clone())
 }
 
 /// `A & ~B` → the literals, checked against the scenario's vocabulary.

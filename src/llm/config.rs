@@ -441,11 +441,33 @@ mod tests {
             Layer::default(),
             Layer {
                 backend: Some(Backend::Local),
+                model_path: Some("/nonexistent/model.gguf".into()),
                 ..Layer::default()
             },
         )
         .unwrap();
         let e = local.build(Ledger::default(), &|_| None).err().unwrap();
-        assert!(e.to_string().contains("issue 5"));
+        assert!(
+            e.to_string()
+                .contains("/nonexistent/model.gguf does not exist"),
+            "{e}"
+        );
+        let unknown = Settings::resolve(
+            None,
+            Layer::default(),
+            Layer {
+                model: Some("gpt-9".into()),
+                ..Layer::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(unknown.backend, Backend::Local, "offline by default");
+        assert!(
+            unknown
+                .local_model()
+                .unwrap_err()
+                .to_string()
+                .contains("unknown local model \"gpt-9\"")
+        );
     }
 }

@@ -150,7 +150,9 @@ mod tests {
             std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
         let v = Scenario::load(&path).unwrap().domain.vocabulary;
         assert!(ground_literals(&v, MAX_ENUMERATED).is_none());
-        let OutputConstraint::JsonSchema { schema, .. } = conditions(&v);
+        let OutputConstraint::JsonSchema { schema, .. } = conditions(&v) else {
+            panic!("conditions() builds a JSON schema");
+        };
         assert_eq!(
             schema["properties"]["conditions"]["items"]["type"],
             "object"

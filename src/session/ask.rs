@@ -18,7 +18,7 @@ pub async fn interpret(
     instruction: &str,
     model: &dyn LanguageModel,
     options: &Options,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<reply::GoalAnswer, SessionError> {
     let ctx = Context {
         scenario,
@@ -77,9 +77,9 @@ pub async fn interpret(
 async fn ask(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
-    (schema, grammar): (OutputConstraint, &dyn Fn() -> String),
+    (schema, grammar): (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
     if options.grammar && model.supports_grammar() {
@@ -134,7 +134,7 @@ pub(crate) async fn ask_conditions(
     node: NodeId,
     action: &ActionCall,
     error: &str,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
@@ -178,7 +178,7 @@ pub(crate) async fn ask_value(
     action: &ActionCall,
     param: &ValueParam,
     error: &str,
-    emit: &mut dyn FnMut(&Event),
+    emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     emit(&Event::Asking {
         what: format!("a value for {} of {action}!", param.name),

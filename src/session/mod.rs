@@ -1,10 +1,17 @@
-//! Sessions: the loops a person runs, headless. Front ends (CLI, TUI) drive them and show
-//! the events they emit; nothing here prints or reads a terminal.
+//! Sessions, headless: the [`Engine`] (a state machine that owns a task from instruction
+//! to saved policy; commands in, events out), the resolve loop that drives it unattended,
+//! the questions asked of a model, and policies that last. Front ends (CLI, TUI) drive
+//! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
+pub mod engine;
+pub mod policy;
 pub mod resolve;
 pub mod types;
+pub mod values;
 
 pub use ask::{interpret, missing_value};
+pub use engine::{Command, Engine, EngineHandle, Setup};
+pub use policy::{Policy, PolicyStore};
 pub use resolve::resolve;
 pub use types::{Ending, Event, Options, Proposal, Resolved, SessionError};

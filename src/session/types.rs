@@ -1,12 +1,17 @@
 //! The vocabulary of sessions: options, proposals, events, endings and errors.
 
-use crate::bt::{NodeId, Tree};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use crate::bt::{NodeId, TickRecord, Tree};
 use crate::domain::{ActionCall, Condition, ScenarioError, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
 use crate::llm::prompt::{PromptError, Templates, Variant};
 use crate::llm::reply::{self, ReplyError, Substitution};
+use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
+use crate::verify::Report;
 
 /// How the loop asks and how long it keeps trying.
 #[derive(Debug, Clone)]
@@ -85,8 +90,10 @@ impl std::fmt::Display for Proposal {
     }
 }
 
-/// What the loop reports, in order.
-#[derive(Debug, Clone, PartialEq)]
+/// What a session reports, in order: the steps of the resolve loop (asking, replies,
+/// goal, failure, proposal, approval, repair, success) and, for front ends that show a
+/// session live, the tree, the statuses of each tick, the world, usage and errors.
+#[derive(Debug, Clone)]
 pub enum Event {
     /// A question goes to the model (`what`: goal, conditions, or a parameter value).
     Asking {
@@ -115,6 +122,7 @@ pub enum Event {
     /// An action failed in simulation.
     ActionFailed {
         action: ActionCall,
+        node: NodeId,
         node_path: String,
         error: String,
     },
@@ -144,6 +152,54 @@ pub enum Event {
     GaveUp {
         reason: String,
     },
+    /// The tree changed: all of it, the nodes the change added, and why.
+    TreeChanged {
+        tree: Arc<Tree>,
+        new_nodes: Vec<NodeId>,
+        why: String,
+    },
+    /// One tick in the execution world: every node's status.
+    Ticked {
+        record: Arc<TickRecord>,
+    },
+    /// The execution world changed (a tick moved something, or it was reset).
+    WorldChanged {
+        facts: Vec<Condition>,
+        reset: bool,
+    },
+    /// Model calls so far.
+    Usage {
+        totals: UsageTotals,
+    },
+    /// Running (ticking on its own) or paused.
+    RunState {
+        running: bool,
+    },
+    /// `verify` finished.
+    Verified {
+        report: Arc<Report>,
+    },
+    PolicySaved {
+        path: PathBuf,
+        fixes: usize,
+    },
+    /// A saved policy became the tree; `fixes` approved changes came with it.
+    PolicyLoaded {
+        path: PathBuf,
+        fixes: usize,
+    },
+    /// A command could not be carried out; nothing changed.
+    Error {
+        message: String,
+    },
+    /// A step of the pipeline failed (a model call, planning); nothing changed.
+    Failed {
+        error: SessionError,
+    },
+    /// Something worth a line in the log.
+    Notice {
+        message: String,
+    },
 }
 
 /// How the loop ended.
@@ -166,7 +222,7 @@ pub struct Resolved {
     pub repairs: usize,
 }
 
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum SessionError {
     #[error(transparent)]
     Llm(#[from] LlmError),
@@ -180,4 +236,8 @@ pub enum SessionError {
     NoInstruction(String),
     #[error("no usable goal after {attempts} attempt(s); last reply: {last}")]
     NoGoal { attempts: usize, last: ReplyError },
+    #[error("{0}")]
+    Policy(#[from] super::policy::PolicyError),
+    #[error("the session stopped before the loop ended")]
+    Stopped,
 }

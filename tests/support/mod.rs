@@ -2,5 +2,6 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;

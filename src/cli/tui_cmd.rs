@@ -1,0 +1,141 @@
+//! `betr` and `betr tui [SCENARIO]`: the workbench on a scenario (scenario 1 by default)
+//! with the configured model. A model that cannot be built (no model name, the local
+//! backend not built yet) is shown in the LLM pane; the rest of the workbench works.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use betr::llm::LanguageModel;
+use betr::llm::usage::Ledger;
+use betr::session::{PolicyStore, Setup};
+use betr::tui::{Info, KeyBindings, Theme};
+
+use super::llm_cmds::{self, LlmFlags};
+
+/// The scenario the workbench opens when none is given (scenario 1).
+pub const DEFAULT_SCENARIO: &str = "scenarios/cell/red_on_blue.toml";
+
+#[derive(Args, Debug, Clone, Default)]
+pub struct TuiArgs {
+    /// Scenario file (default: scenarios/cell/red_on_blue.toml, the red cube on the blue cube).
+    pub scenario: Option<PathBuf>,
+    /// Apply every proposal of the model without asking (shown in the status bar).
+    #[arg(long)]
+    pub auto_approve: bool,
+    /// Where policies are saved and looked up (default: $XDG_DATA_HOME/betr/policies).
+    #[arg(long, value_name = "DIR")]
+    pub policy_dir: Option<PathBuf>,
+    /// Run in the scenario's `[world.variants.NAME]` world.
+    #[arg(long)]
+    pub variant: Option<String>,
+    /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml).
+    #[arg(long, value_name = "FILE")]
+    pub keys: Option<PathBuf>,
+    /// Milliseconds between ticks when running.
+    #[arg(long, default_value_t = 150, value_name = "MS")]
+    pub tick_ms: u64,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+}
+
+pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
+    let var = |k: &str| std::env::var(k).ok();
+    let arg = args
+        .scenario
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_SCENARIO));
+    let path = super::find_scenario(&arg)?;
+    let scenario = Arc::new(betr::domain::Scenario::load(&path)?);
+    let (settings, mut options) = llm_cmds::settings(&args.llm)?;
+    options.max_rounds = 5;
+    let ledger = Ledger::new(settings.usage_log.clone());
+    // First use fetches the local model with a progress bar, before the screen switches;
+    // a failed fetch leaves the workbench usable without a model and says why.
+    let model = llm_cmds::ensure_local_model(&settings)
+        .map_err(|e| format!("{e:#}"))
+        .and_then(|()| {
+            settings
+                .build(ledger.clone(), &var)
+                .map_err(|e| e.to_string())
+        })
+        .map(|m| {
+            m.set_purpose("workbench");
+            Arc::new(m) as Arc<dyn LanguageModel>
+        });
+    let backend = format!("{:?}", settings.backend).to_lowercase();
+    let model_name = match settings.backend {
+        betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
+        _ => settings.model.clone(),
+    }
+    .unwrap_or_else(|| "(no model)".into());
+    let no_model = model.as_ref().err().cloned();
+    let policy_dir = args
+        .policy_dir
+        .clone()
+        .or_else(|| PolicyStore::default_dir(&var));
+    let keys_path = args.keys.clone().or_else(|| default_keys_path(&var));
+    let (keys, keys_error) = match &keys_path {
+        Some(p) => KeyBindings::load(p),
+        None => (KeyBindings::default(), None),
+    };
+    let info = Info {
+        scenario: path
+            .file_stem()
+            .map_or_else(|| scenario.name.clone(), |s| s.to_string_lossy().into()),
+        backend,
+        model: model_name,
+        auto_approve: args.auto_approve,
+        objects: scenario
+            .domain
+            .vocabulary
+            .objects
+            .iter()
+            .map(|o| o.name.clone())
+            .collect(),
+        no_model,
+        keys_error,
+    };
+    let setup = Setup {
+        variant: args.variant.clone(),
+        ledger: Some(ledger),
+        options,
+        auto_approve: args.auto_approve,
+        policies: policy_dir.map(PolicyStore::new),
+        tick_interval: Duration::from_millis(args.tick_ms),
+        ..Setup::new(scenario, path, model)
+    };
+    let theme = Theme::new(if ascii {
+        &betr::bt::ASCII
+    } else {
+        &betr::bt::UNICODE
+    });
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the async runtime")?;
+    runtime.block_on(betr::tui::run(setup, info, keys, theme))?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn default_keys_path(var: &dyn Fn(&str) -> Option<String>) -> Option<PathBuf> {
+    let config = var("XDG_CONFIG_HOME")
+        .filter(|d| !d.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| var("HOME").map(|h| Path::new(&h).join(".config")))?;
+    Some(config.join("betr").join("keys.toml"))
+}
+
+/// Where the workbench writes its log (the terminal belongs to the screen).
+pub fn log_path() -> Option<PathBuf> {
+    let state = std::env::var_os("XDG_STATE_HOME")
+        .filter(|d| !d.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".local/state")))?;
+    Some(state.join("betr").join("tui.log"))
+}

@@ -1,0 +1,261 @@
+//! Changes to the tree: approving, rejecting and editing proposals, setting values. A
+//! change is kept only when it helps (the failure is gone or has moved on); every kept
+//! change can be undone, and the execution world starts afresh after each attempt so the
+//! changed tree runs from the scenario's first state.
+
+use crate::bt::Tree;
+use crate::domain::action::parse_value;
+use crate::planner::{Outcome, Plan, Planner, RepairError, set_value};
+
+use super::super::ask::missing_value;
+use super::super::policy::{Approval, now_rfc3339};
+use super::super::types::{Event, Proposal};
+use super::super::values::{self, conform};
+use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
+
+impl Engine {
+    pub(super) fn approve(&mut self) {
+        if self.pending.is_none() {
+            return self.error("no proposal to approve");
+        }
+        self.apply_pending(Approval::Person);
+    }
+
+    pub(super) fn reject(&mut self) {
+        if self.pending.take().is_none() {
+            return self.error("no proposal to reject");
+        }
+        self.emit(Event::Rejected);
+    }
+
+    /// Apply the pending proposal; keep it only if it helps.
+    pub(super) fn apply_pending(&mut self, approval: Approval) {
+        let Some(pending) = self.pending.take() else {
+            return;
+        };
+        let Some(tree) = self.tree.clone() else {
+            return self.error("no tree to change");
+        };
+        self.emit(Event::Approved);
+        let planner = Planner::new(&self.scenario.domain);
+        let before = pending.failure.clone().or_else(|| self.failure.clone());
+        let result = apply(&planner, &tree, &pending.proposal, self.planning.as_ref());
+        let (plan, valued_nodes) = match result {
+            Ok(r) => r,
+            Err(e) => {
+                self.emit(Event::DidNotHelp {
+                    reason: e.to_string(),
+                });
+                return self.reset_world(false);
+            }
+        };
+        if let Err(reason) = helped(before.as_ref(), &plan.outcome) {
+            self.emit(Event::DidNotHelp { reason });
+            return self.reset_world(false);
+        }
+        self.emit(Event::Repaired {
+            added_nodes: plan.new_nodes.len(),
+            valued_nodes,
+        });
+        self.undo.push(UndoEntry {
+            tree,
+            fixes: self.fixes.len(),
+        });
+        let change = pending.proposal.to_string();
+        self.fixes.push(AppliedFix {
+            change: change.clone(),
+            nodes: plan.new_nodes.clone(),
+            author: pending.author,
+            approval,
+            at: now_rfc3339(),
+        });
+        self.failure = None;
+        let why = format!("{} ({})", change, approval_text(approval));
+        self.set_tree(plan.tree, plan.new_nodes, why);
+    }
+
+    /// What a person wrote for the pending proposal (or the current failure): validated
+    /// against the vocabulary, then applied. On an error nothing changes.
+    pub(super) fn edit(&mut self, text: &str) {
+        let base = match (&self.pending, &self.failure) {
+            (Some(p), _) => Some((p.proposal.clone(), p.failure.clone())),
+            (None, Some(f)) => self.blank_proposal(f).map(|p| (p, Some(f.clone()))),
+            (None, None) => None,
+        };
+        let Some((base, failure)) = base else {
+            return self.error("nothing to edit: no action has failed and nothing is proposed");
+        };
+        let edited = match self.edited(&base, text) {
+            Ok(p) => p,
+            Err(e) => return self.error(e),
+        };
+        self.emit(Event::Proposal {
+            proposal: edited.clone(),
+            reasoning: Some("written by a person".into()),
+            substitutions: Vec::new(),
+        });
+        self.pending = Some(Pending {
+            proposal: edited,
+            author: "a person".into(),
+            failure,
+        });
+        self.apply_pending(Approval::Edited);
+    }
+
+    /// The kind of proposal a failure calls for, with nothing filled in.
+    fn blank_proposal(&self, f: &Failure) -> Option<Proposal> {
+        Some(match missing_value(&self.scenario, &f.action, &f.error) {
+            Some(param) => Proposal::Value {
+                skill: f.action.skill.clone(),
+                object: f.action.args.first().cloned().unwrap_or_default(),
+                param: param.name.clone(),
+                value: crate::domain::Value::Category(String::new()),
+            },
+            None => Proposal::Conditions {
+                action: f.action.clone(),
+                node: f.node,
+                conditions: Vec::new(),
+            },
+        })
+    }
+
+    fn edited(&self, base: &Proposal, text: &str) -> Result<Proposal, String> {
+        let text = text.trim();
+        match base {
+            Proposal::Conditions { action, node, .. } => {
+                let formula = self
+                    .scenario
+                    .parse_goal(text)
+                    .map_err(|e| format!("'{text}': {e}"))?;
+                match formula.to_dnf().0.as_slice() {
+                    [one] if !one.is_empty() => Ok(Proposal::Conditions {
+                        action: action.clone(),
+                        node: *node,
+                        conditions: one.clone(),
+                    }),
+                    _ => Err(format!(
+                        "'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}"
+                    )),
+                }
+            }
+            Proposal::Value {
+                skill,
+                object,
+                param,
+                ..
+            } => {
+                let declared = self
+                    .scenario
+                    .domain
+                    .skills
+                    .iter()
+                    .find(|s| &s.name == skill)
+                    .and_then(|s| s.values.iter().find(|v| &v.name == param))
+                    .ok_or_else(|| format!("{skill} declares no value {param}"))?;
+                let value = parse_value(text).map_err(|e| format!("'{text}': {e}"))?;
+                let value = conform(declared, value).map_err(|e| format!("'{text}': {e}"))?;
+                Ok(Proposal::Value {
+                    skill: skill.clone(),
+                    object: object.clone(),
+                    param: param.clone(),
+                    value,
+                })
+            }
+        }
+    }
+
+    /// `force of egg = 5 N`: a value on every action that uses it, then re-plan.
+    pub(super) fn set_value(&mut self, text: &str) {
+        let Some(tree) = self.tree.clone() else {
+            return self.error("no tree: plan first");
+        };
+        let setting = match values::parse_setting(&self.scenario, text) {
+            Ok(s) => s,
+            Err(e) => return self.error(e.to_string()),
+        };
+        let mut changed = tree.clone();
+        let valued = values::apply(&mut changed, &setting);
+        if valued == 0 {
+            return self.error(format!(
+                "{text:?}: no action of the tree uses that value with {:?}",
+                setting.object
+            ));
+        }
+        let plan = Planner::new(&self.scenario.domain).grow(changed, self.planning.as_ref());
+        self.emit(Event::Repaired {
+            added_nodes: plan.new_nodes.len(),
+            valued_nodes: valued,
+        });
+        self.undo.push(UndoEntry {
+            tree,
+            fixes: self.fixes.len(),
+        });
+        let change = format!("set {} ({valued} action(s))", setting.text);
+        self.fixes.push(AppliedFix {
+            change: change.clone(),
+            nodes: plan.new_nodes.clone(),
+            author: "a person".into(),
+            approval: Approval::Edited,
+            at: now_rfc3339(),
+        });
+        self.pending = None;
+        self.failure = None;
+        self.set_tree(plan.tree, plan.new_nodes, change);
+    }
+}
+
+fn approval_text(approval: Approval) -> &'static str {
+    match approval {
+        Approval::Person => "approved",
+        Approval::Auto => "auto-approved",
+        Approval::Edited => "written by a person",
+    }
+}
+
+/// The tree with a proposal applied, re-planned; and on how many actions a value was set.
+fn apply(
+    planner: &Planner,
+    tree: &Tree,
+    proposal: &Proposal,
+    world: &dyn crate::world::World,
+) -> Result<(Plan, usize), RepairError> {
+    match proposal {
+        Proposal::Conditions {
+            node, conditions, ..
+        } => Ok((planner.repair(tree.clone(), *node, conditions, world)?, 0)),
+        Proposal::Value {
+            skill,
+            object,
+            param,
+            value,
+        } => {
+            let mut tree = tree.clone();
+            let changed = set_value(&mut tree, skill, object, param, value);
+            Ok((planner.grow(tree, world), changed))
+        }
+    }
+}
+
+/// Whether a change helped: the failure is gone or has moved on.
+fn helped(before: Option<&Failure>, after: &Outcome) -> Result<(), String> {
+    match (before, after) {
+        (_, Outcome::Success) => Ok(()),
+        (Some(f), Outcome::ActionFailed { action, error, .. })
+            if f.action.same_invocation(action) && &f.error == error =>
+        {
+            Err(format!(
+                "{action}! still fails with the same error: {error}"
+            ))
+        }
+        (_, Outcome::ActionFailed { .. }) => Ok(()),
+        (
+            _,
+            Outcome::Unreachable {
+                condition, reason, ..
+            },
+        ) => Err(format!(
+            "after the change, {condition} cannot be achieved: {reason}"
+        )),
+        (_, Outcome::Exhausted { reason }) => Err(format!("after the change, {reason}")),
+    }
+}

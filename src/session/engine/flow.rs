@@ -1,0 +1,302 @@
+//! The engine's own steps: submitting, planning, ticking, running, resetting the world,
+//! undoing and verifying.
+
+use std::sync::Arc;
+
+use crate::bt::{Outcome as TickOutcome, Tree};
+use crate::goal;
+use crate::planner::{Outcome, Plan, Planner, WorldLeaves, path_text};
+use crate::verify::{self, Limits, VerifyConfig, VerifyInput};
+use crate::world;
+
+use super::super::policy;
+use super::super::types::{Event, SessionError};
+use super::requests::Internal;
+use super::{Engine, Failure, Task};
+
+impl Engine {
+    pub(super) fn submit(&mut self, text: &str) {
+        let text = text.trim();
+        if text.is_empty() {
+            return self.error("nothing to submit: type an instruction or a goal");
+        }
+        let not_a_goal = match self.scenario.parse_goal(text) {
+            Ok(goal) => {
+                let matches_expected = self
+                    .scenario
+                    .goal
+                    .as_ref()
+                    .and_then(|expected| goal::equivalent(expected, &goal).ok());
+                self.emit(Event::Goal {
+                    goal: goal.clone(),
+                    reasoning: None,
+                    substitutions: Vec::new(),
+                    matches_expected,
+                });
+                self.task = Some(Task {
+                    goal,
+                    instruction: None,
+                });
+                return self.plan();
+            }
+            Err(e) => e,
+        };
+        if let Some(goal) = self.goal_from_policy(text) {
+            self.task = Some(Task {
+                goal,
+                instruction: Some(text.to_string()),
+            });
+            return self.plan();
+        }
+        match self.model.clone() {
+            Ok(model) => self.ask_goal(model, text),
+            Err(why) => self.error(format!(
+                "{text:?} is not a goal formula ({not_a_goal}), and no language model can read it as an instruction: {why}"
+            )),
+        }
+    }
+
+    /// The goal a saved policy recorded for this instruction (no model call needed).
+    fn goal_from_policy(&self, instruction: &str) -> Option<goal::Formula> {
+        let store = self.policies.as_ref()?;
+        let path = store.find_by_instruction(&self.scenario_path, instruction)?;
+        let saved = policy::load(&path, &self.scenario.domain).ok()?;
+        let goal = self.scenario.parse_goal(&saved.goal).ok()?;
+        self.notice(format!(
+            "instruction known from policy {}: goal {goal}, no LLM call needed",
+            path.display()
+        ));
+        self.emit(Event::Goal {
+            goal: goal.clone(),
+            reasoning: None,
+            substitutions: Vec::new(),
+            matches_expected: None,
+        });
+        Some(goal)
+    }
+
+    /// Plan the task's goal (the scenario's when none was given), or start from its
+    /// saved policy.
+    pub(super) fn plan(&mut self) {
+        let task = match (&self.task, &self.scenario.goal) {
+            (Some(t), _) => t.clone(),
+            (None, Some(goal)) => Task {
+                goal: goal.clone(),
+                instruction: self.scenario.instruction.clone(),
+            },
+            (None, None) => {
+                return self.error("no goal: type an instruction or a goal formula first (i)");
+            }
+        };
+        self.task = Some(task.clone());
+        self.cancel_request();
+        self.set_running(false);
+        self.pending = None;
+        self.failure = None;
+        self.rounds = 0;
+        self.undo.clear();
+        self.fixes.clear();
+        if let Some(store) = &self.policies {
+            let path = store.path_for(&self.scenario_path, &task.goal);
+            if path.is_file() {
+                return self.load_policy(Some(path));
+            }
+        }
+        let planner = Planner::new(&self.scenario.domain);
+        match planner.plan(&task.goal.to_dnf(), self.planning.as_ref()) {
+            Ok(plan) => {
+                let why = format!("planned for {}", task.goal);
+                self.note_outcome(&plan);
+                self.set_tree(plan.tree, Vec::new(), why);
+            }
+            Err(e) => self.emit(Event::Failed {
+                error: SessionError::Plan(e),
+            }),
+        }
+    }
+
+    /// Say what the planner's simulation predicts.
+    fn note_outcome(&self, plan: &Plan) {
+        let what = match &plan.outcome {
+            Outcome::Success => "the simulation reaches success".to_string(),
+            Outcome::ActionFailed { action, error, .. } => {
+                format!("the simulation predicts {action}! fails: {error}")
+            }
+            Outcome::Unreachable {
+                condition, reason, ..
+            } => format!("{condition} cannot be achieved: {reason}"),
+            Outcome::Exhausted { reason } => reason.clone(),
+        };
+        self.notice(format!(
+            "{} node(s), {} expansion(s); {what}",
+            plan.tree.len(),
+            plan.expansions
+        ));
+    }
+
+    /// Make `tree` the tree, tell front ends, and start the execution world afresh.
+    pub(super) fn set_tree(&mut self, tree: Tree, new_nodes: Vec<crate::bt::NodeId>, why: String) {
+        self.emit(Event::TreeChanged {
+            tree: Arc::new(tree.clone()),
+            new_nodes,
+            why,
+        });
+        self.tree = Some(tree);
+        self.reset_world(false);
+    }
+
+    pub(super) fn start_running(&mut self) {
+        if self.tree.is_none() {
+            return self.error("nothing to run: submit an instruction or plan first");
+        }
+        self.run_ticks = 0;
+        self.set_running(true);
+    }
+
+    /// One tick in the execution world.
+    pub(super) fn tick(&mut self) {
+        let Some(tree) = &self.tree else {
+            self.set_running(false);
+            return self.error("nothing to tick: submit an instruction or plan first");
+        };
+        let mut leaves = WorldLeaves {
+            world: self.exec.as_mut(),
+            domain: &self.scenario.domain,
+        };
+        let record = Arc::new(self.ticker.tick(tree, &mut leaves));
+        self.run_ticks += 1;
+        let failed = record.failures.first().and_then(|(node, error)| {
+            let action = tree.kind(*node).ok()?.as_action()?.clone();
+            Some(Failure {
+                node: *node,
+                action,
+                error: error.clone(),
+            })
+        });
+        self.last = Some(record.clone());
+        self.emit(Event::Ticked {
+            record: record.clone(),
+        });
+        let facts = self.exec.facts();
+        if facts != self.facts {
+            self.facts = facts;
+            self.emit(Event::WorldChanged {
+                facts: self.facts.clone(),
+                reset: false,
+            });
+        }
+        match (record.root, failed) {
+            (TickOutcome::Running, _) => {}
+            (TickOutcome::Success, _) if !record.completed.is_empty() => {}
+            (TickOutcome::Success, _) => {
+                self.set_running(false);
+                self.emit(Event::Success {
+                    ticks: self.ticker.tick_count(),
+                });
+            }
+            (TickOutcome::Failure, Some(failure)) => {
+                self.set_running(false);
+                self.on_failure(failure);
+            }
+            (TickOutcome::Failure, None) => {
+                self.set_running(false);
+                self.emit(Event::GaveUp {
+                    reason: "the tree failed without an action failing: a condition it needs is false and nothing achieves it".into(),
+                });
+            }
+        }
+        if self.running && self.run_ticks >= self.max_ticks {
+            self.set_running(false);
+            self.emit(Event::GaveUp {
+                reason: format!("the tree still runs after {} ticks", self.run_ticks),
+            });
+        }
+    }
+
+    fn on_failure(&mut self, failure: Failure) {
+        let node_path = self
+            .tree
+            .as_ref()
+            .and_then(|t| t.path(failure.node).ok())
+            .map(|p| path_text(&p))
+            .unwrap_or_default();
+        self.emit(Event::ActionFailed {
+            action: failure.action.clone(),
+            node: failure.node,
+            node_path,
+            error: failure.error.clone(),
+        });
+        let known = self.failure.as_ref() == Some(&failure)
+            && (self.pending.is_some() || self.request.is_some());
+        self.failure = Some(failure.clone());
+        if !known {
+            self.ask_about(failure);
+        }
+    }
+
+    /// A fresh execution world and ticker (the tree stays).
+    pub(super) fn reset_world(&mut self, announce: bool) {
+        self.set_running(false);
+        match world::load_variant(&self.scenario, self.variant.as_deref()) {
+            Ok(w) => self.exec = w,
+            Err(e) => return self.error(format!("cannot reset the world: {e}")),
+        }
+        self.ticker = crate::bt::Ticker::new();
+        self.last = None;
+        self.run_ticks = 0;
+        self.facts = self.exec.facts();
+        self.emit(Event::WorldChanged {
+            facts: self.facts.clone(),
+            reset: true,
+        });
+        if announce {
+            self.notice("world reset: the tree starts again from the scenario's first state");
+        }
+    }
+
+    pub(super) fn undo(&mut self) {
+        let Some(entry) = self.undo.pop() else {
+            return self.error("nothing to undo: no change has been applied");
+        };
+        self.cancel_request();
+        self.pending = None;
+        self.failure = None;
+        let undone = self.fixes.len().saturating_sub(entry.fixes);
+        self.fixes.truncate(entry.fixes);
+        let why = format!("undid the last change ({undone} fix(es) removed)");
+        self.set_tree(entry.tree, Vec::new(), why);
+    }
+
+    /// Structural checks and model checking, off the engine's thread.
+    pub(super) fn verify(&mut self) {
+        let Some(tree) = self.tree.clone() else {
+            return self.error("nothing to verify: submit an instruction or plan first");
+        };
+        let config = match VerifyConfig::from_scenario(&self.scenario) {
+            Ok(c) => c,
+            Err(e) => return self.error(format!("cannot verify: {e}")),
+        };
+        let scenario = self.scenario.clone();
+        let initial = self.planning.facts();
+        let tx = self.internal_tx.clone();
+        self.verifications += 1;
+        self.notice("verifying the tree …");
+        tokio::task::spawn_blocking(move || {
+            let input = VerifyInput {
+                domain: &scenario.domain,
+                tree: &tree,
+                initial: &initial,
+                disturbances: &config.disturbances,
+                properties: &config.properties,
+                limits: Limits {
+                    action_failures: config.action_failures,
+                    ..Limits::default()
+                },
+            };
+            let report = verify::verify(&input);
+            let _ = tx.send(Internal::Verified {
+                report: Arc::new(report),
+            });
+        });
+    }
+}

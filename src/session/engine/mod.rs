@@ -1,0 +1,378 @@
+//! The session engine: one state machine that owns a task from instruction to saved
+//! policy, headless. Front ends send [`Command`]s and render the [`Event`]s it emits; the
+//! TUI, `betr resolve` and the tests drive the same code.
+//!
+//! The engine owns the scenario, the goal, the tree, a planning world (the planner ticks
+//! the tree in forks of it), an execution world with its `Ticker` (what "tick" and "run"
+//! advance), the language model, the pending proposal, the undo stack (the tree before
+//! each applied change) and the policy store.
+//!
+//! Model calls run as tokio tasks whose results come back as internal messages: the engine
+//! keeps answering commands (ticks included) while a call is under way, and a call whose
+//! answer is no longer wanted (the tree was re-planned, undone or reset) is aborted and
+//! its late answer ignored. Nothing a model proposes changes the tree until it is
+//! approved (by a person, or by `auto_approve`).
+
+mod changes;
+mod flow;
+mod policies;
+mod requests;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+
+use crate::bt::{NodeId, TickRecord, Ticker, Tree};
+use crate::domain::{ActionCall, Condition, Scenario};
+use crate::goal::Formula;
+use crate::llm::LanguageModel;
+use crate::llm::usage::{Ledger, UsageTotals};
+use crate::world::{self, World};
+
+use super::policy::{Approval, PolicyStore};
+use super::types::{Event, Options, Proposal, SessionError};
+
+use requests::Internal;
+
+/// What the engine is given.
+pub struct Setup {
+    pub scenario: Arc<Scenario>,
+    /// The scenario's file (policies are keyed by its stem).
+    pub scenario_path: PathBuf,
+    /// The scenario's `[world.variants.NAME]` to run in.
+    pub variant: Option<String>,
+    /// The model, or why there is none (the session still plans, ticks and takes
+    /// conditions a person types).
+    pub model: Result<Arc<dyn LanguageModel>, String>,
+    /// The ledger the model is metered into, for usage totals (none: counted here).
+    pub ledger: Option<Ledger>,
+    pub options: Options,
+    /// Apply every proposal without asking (shown by front ends).
+    pub auto_approve: bool,
+    /// Where policies are saved and looked up (none: not saved, not loaded).
+    pub policies: Option<PolicyStore>,
+    /// Time between ticks when running (zero: as fast as possible).
+    pub tick_interval: Duration,
+    /// Running stops after this many ticks of one run.
+    pub max_ticks: u64,
+}
+
+impl Setup {
+    /// A setup with default options, no policy store and no pause between ticks.
+    pub fn new(
+        scenario: Arc<Scenario>,
+        scenario_path: impl Into<PathBuf>,
+        model: Result<Arc<dyn LanguageModel>, String>,
+    ) -> Setup {
+        Setup {
+            scenario,
+            scenario_path: scenario_path.into(),
+            variant: None,
+            model,
+            ledger: None,
+            options: Options::default(),
+            auto_approve: false,
+            policies: None,
+            tick_interval: Duration::ZERO,
+            max_ticks: 10_000,
+        }
+    }
+}
+
+/// What a front end asks of the engine.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// An instruction, or a goal formula over the scenario's vocabulary; then plan.
+    Submit(String),
+    /// Plan the current goal (the scenario's when none was submitted).
+    Plan,
+    /// One tick of the tree in the execution world.
+    Tick,
+    /// Tick on their own until success, failure, a pause or the tick limit.
+    Run,
+    Pause,
+    /// Apply the pending proposal.
+    Approve,
+    /// Drop the pending proposal.
+    Reject,
+    /// Conditions (`A & ~B`) or a value (`5 N`) a person wrote for the pending proposal or
+    /// the current failure; validated, then applied.
+    Edit(String),
+    /// A value for every action using a skill with an object: `force of egg = 5 N`.
+    SetValue(String),
+    /// Restore the tree from before the last applied change.
+    Undo,
+    Verify,
+    SavePolicy,
+    /// Load a policy file (none: the saved policy of the current task).
+    LoadPolicy(Option<PathBuf>),
+    /// A fresh execution world and ticker.
+    ResetWorld,
+    /// Stop the engine's loop.
+    Shutdown,
+}
+
+/// An action that failed in the execution world.
+#[derive(Debug, Clone, PartialEq)]
+struct Failure {
+    node: NodeId,
+    action: ActionCall,
+    error: String,
+}
+
+/// The goal being worked on, and the instruction it came from.
+#[derive(Debug, Clone)]
+struct Task {
+    goal: Formula,
+    instruction: Option<String>,
+}
+
+/// A proposal waiting for approval, with who made it.
+#[derive(Debug, Clone)]
+struct Pending {
+    proposal: Proposal,
+    /// Who answered (`model gpt-4o`, a fixture's label, or `a person`).
+    author: String,
+    failure: Option<Failure>,
+}
+
+/// A change that is in the tree, for the policy header.
+#[derive(Debug, Clone)]
+struct AppliedFix {
+    change: String,
+    /// The nodes it added (ids are stable; a later change may remove some).
+    nodes: Vec<NodeId>,
+    author: String,
+    approval: Approval,
+    at: String,
+}
+
+/// The tree before an applied change.
+#[derive(Debug, Clone)]
+struct UndoEntry {
+    tree: Tree,
+    fixes: usize,
+}
+
+/// A model call under way.
+struct Request {
+    id: u64,
+    handle: tokio::task::JoinHandle<()>,
+}
+
+pub struct Engine {
+    scenario: Arc<Scenario>,
+    scenario_path: PathBuf,
+    variant: Option<String>,
+    model: Result<Arc<dyn LanguageModel>, String>,
+    ledger: Option<Ledger>,
+    options: Options,
+    auto_approve: bool,
+    policies: Option<PolicyStore>,
+    tick_interval: Duration,
+    max_ticks: u64,
+
+    planning: Box<dyn World>,
+    exec: Box<dyn World>,
+    ticker: Ticker,
+    /// Ticks since the last Run command (for the limit).
+    run_ticks: u64,
+    facts: Vec<Condition>,
+    task: Option<Task>,
+    tree: Option<Tree>,
+    last: Option<Arc<TickRecord>>,
+    failure: Option<Failure>,
+    pending: Option<Pending>,
+    request: Option<Request>,
+    next_id: u64,
+    undo: Vec<UndoEntry>,
+    fixes: Vec<AppliedFix>,
+    rounds: usize,
+    running: bool,
+    usage: UsageTotals,
+    verifications: usize,
+
+    events: UnboundedSender<Event>,
+    internal_tx: UnboundedSender<Internal>,
+    internal_rx: UnboundedReceiver<Internal>,
+}
+
+/// A front end's end of a running engine.
+#[derive(Clone)]
+pub struct EngineHandle {
+    commands: UnboundedSender<Command>,
+}
+
+impl EngineHandle {
+    /// Send a command; false when the engine has stopped.
+    pub fn send(&self, command: Command) -> bool {
+        self.commands.send(command).is_ok()
+    }
+}
+
+impl Engine {
+    /// An engine for `setup`, and the receiver of its events.
+    pub fn new(setup: Setup) -> Result<(Engine, UnboundedReceiver<Event>), SessionError> {
+        let planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
+        let exec = planning.fork();
+        let facts = exec.facts();
+        let (events, events_rx) = unbounded_channel();
+        let (internal_tx, internal_rx) = unbounded_channel();
+        let engine = Engine {
+            scenario: setup.scenario,
+            scenario_path: setup.scenario_path,
+            variant: setup.variant,
+            model: setup.model,
+            ledger: setup.ledger,
+            options: setup.options,
+            auto_approve: setup.auto_approve,
+            policies: setup.policies,
+            tick_interval: setup.tick_interval,
+            max_ticks: setup.max_ticks,
+            planning,
+            exec,
+            ticker: Ticker::new(),
+            run_ticks: 0,
+            facts,
+            task: None,
+            tree: None,
+            last: None,
+            failure: None,
+            pending: None,
+            request: None,
+            next_id: 0,
+            undo: Vec::new(),
+            fixes: Vec::new(),
+            rounds: 0,
+            running: false,
+            usage: UsageTotals::default(),
+            verifications: 0,
+            events,
+            internal_tx,
+            internal_rx,
+        };
+        engine.emit(Event::WorldChanged {
+            facts: engine.facts.clone(),
+            reset: true,
+        });
+        Ok((engine, events_rx))
+    }
+
+    /// Start the engine as a tokio task; commands go through the handle.
+    pub fn spawn(setup: Setup) -> Result<(EngineHandle, UnboundedReceiver<Event>), SessionError> {
+        let (engine, events) = Engine::new(setup)?;
+        let (tx, rx) = unbounded_channel();
+        tokio::spawn(engine.run(rx));
+        Ok((EngineHandle { commands: tx }, events))
+    }
+
+    /// The engine's loop: commands, answers of model calls, and ticks while running.
+    pub async fn run(mut self, mut commands: UnboundedReceiver<Command>) {
+        loop {
+            let running = self.running;
+            let interval = self.tick_interval;
+            tokio::select! {
+                biased;
+                command = commands.recv() => match command {
+                    None | Some(Command::Shutdown) => break,
+                    Some(c) => self.handle(c),
+                },
+                Some(message) = self.internal_rx.recv() => self.on_internal(message),
+                () = pace(interval), if running => self.tick(),
+            }
+        }
+        if let Some(r) = self.request.take() {
+            r.handle.abort();
+        }
+    }
+
+    /// Carry out one command (model calls it starts run on the current tokio runtime).
+    pub fn handle(&mut self, command: Command) {
+        match command {
+            Command::Submit(text) => self.submit(&text),
+            Command::Plan => self.plan(),
+            Command::Tick => {
+                if self.running {
+                    self.set_running(false);
+                }
+                self.tick();
+            }
+            Command::Run => self.start_running(),
+            Command::Pause => self.set_running(false),
+            Command::Approve => self.approve(),
+            Command::Reject => self.reject(),
+            Command::Edit(text) => self.edit(&text),
+            Command::SetValue(text) => self.set_value(&text),
+            Command::Undo => self.undo(),
+            Command::Verify => self.verify(),
+            Command::SavePolicy => self.save_policy(),
+            Command::LoadPolicy(path) => self.load_policy(path),
+            Command::ResetWorld => self.reset_world(true),
+            Command::Shutdown => self.set_running(false),
+        }
+    }
+
+    /// Wait for the next answer of a model call (or verification) and take it in; false
+    /// when nothing is under way. For drivers that run the engine in their own task.
+    pub async fn next_internal(&mut self) -> bool {
+        if self.request.is_none() && self.verifications == 0 {
+            return false;
+        }
+        match self.internal_rx.recv().await {
+            Some(m) => {
+                self.on_internal(m);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Whether the engine is ticking on its own.
+    pub fn is_running(&self) -> bool {
+        self.running
+    }
+
+    /// Whether a model call is under way.
+    pub fn is_asking(&self) -> bool {
+        self.request.is_some()
+    }
+
+    /// The current tree.
+    pub fn tree(&self) -> Option<&Tree> {
+        self.tree.as_ref()
+    }
+
+    fn emit(&self, event: Event) {
+        // A front end that stopped listening is not an error of the session.
+        let _ = self.events.send(event);
+    }
+
+    fn error(&self, message: impl Into<String>) {
+        self.emit(Event::Error {
+            message: message.into(),
+        });
+    }
+
+    fn notice(&self, message: impl Into<String>) {
+        self.emit(Event::Notice {
+            message: message.into(),
+        });
+    }
+
+    fn set_running(&mut self, running: bool) {
+        if self.running != running {
+            self.running = running;
+            self.emit(Event::RunState { running });
+        }
+    }
+}
+
+async fn pace(interval: Duration) {
+    if interval.is_zero() {
+        tokio::task::yield_now().await;
+    } else {
+        tokio::time::sleep(interval).await;
+    }
+}

@@ -1,0 +1,109 @@
+//! Saving the tree as a policy with its provenance, and loading one back as the tree.
+
+use std::path::PathBuf;
+
+use crate::planner::{Planner, path_text};
+
+use super::super::policy::{self, Fix, Policy};
+use super::super::types::Event;
+use super::{AppliedFix, Engine, Task};
+
+impl Engine {
+    pub(super) fn save_policy(&mut self) {
+        let (Some(tree), Some(task)) = (&self.tree, &self.task) else {
+            return self.error("nothing to save: plan a tree first");
+        };
+        let Some(store) = &self.policies else {
+            return self.error("policies are not kept in this session (no policy directory)");
+        };
+        let path = store.path_for(&self.scenario_path, &task.goal);
+        let fixes: Vec<Fix> = self
+            .fixes
+            .iter()
+            .map(|f| Fix {
+                change: f.change.clone(),
+                nodes: f
+                    .nodes
+                    .iter()
+                    .filter_map(|n| tree.path(*n).ok())
+                    .map(|p| path_text(&p))
+                    .collect(),
+                model: f.author.clone(),
+                approval: f.approval,
+                at: f.at.clone(),
+            })
+            .collect();
+        let saved = Policy {
+            scenario: format!("{} ({})", self.scenario_path.display(), self.scenario.name),
+            instruction: task.instruction.clone(),
+            goal: task.goal.to_string(),
+            saved_at: policy::now_rfc3339(),
+            fixes,
+            tree: tree.clone(),
+        };
+        match store.save(&path, &saved) {
+            Ok(()) => self.emit(Event::PolicySaved {
+                path,
+                fixes: saved.fixes.len(),
+            }),
+            Err(e) => self.emit(Event::Failed { error: e.into() }),
+        }
+    }
+
+    /// Load a policy file (default: the saved policy of the current task) as the tree.
+    pub(super) fn load_policy(&mut self, path: Option<PathBuf>) {
+        let path = match (path, &self.policies, &self.task) {
+            (Some(p), _, _) => p,
+            (None, Some(store), Some(task)) => store.path_for(&self.scenario_path, &task.goal),
+            (None, None, _) => return self.error("no policy directory in this session"),
+            (None, _, None) => return self.error("no task yet: submit an instruction first"),
+        };
+        let saved = match policy::load(&path, &self.scenario.domain) {
+            Ok(p) => p,
+            Err(e) => return self.emit(Event::Failed { error: e.into() }),
+        };
+        if let Ok(goal) = self.scenario.parse_goal(&saved.goal) {
+            let instruction = self.task.as_ref().and_then(|t| t.instruction.clone());
+            self.task = Some(Task {
+                goal,
+                instruction: instruction.or(saved.instruction.clone()),
+            });
+        }
+        self.cancel_request();
+        self.pending = None;
+        self.failure = None;
+        self.rounds = 0;
+        self.undo.clear();
+        self.fixes = saved
+            .fixes
+            .iter()
+            .map(|f| AppliedFix {
+                change: f.change.clone(),
+                nodes: f
+                    .nodes
+                    .iter()
+                    .filter_map(|p| parse_path(p))
+                    .filter_map(|p| saved.tree.node_at_path(&p).ok())
+                    .collect(),
+                author: f.model.clone(),
+                approval: f.approval,
+                at: f.at.clone(),
+            })
+            .collect();
+        // A saved tree may need more expansion in this world (a variant); usually none.
+        let plan = Planner::new(&self.scenario.domain).grow(saved.tree, self.planning.as_ref());
+        self.emit(Event::PolicyLoaded {
+            path: path.clone(),
+            fixes: self.fixes.len(),
+        });
+        let why = format!("loaded policy {}", path.display());
+        self.set_tree(plan.tree, plan.new_nodes, why);
+    }
+}
+
+fn parse_path(text: &str) -> Option<Vec<usize>> {
+    if text == "root" {
+        return Some(Vec::new());
+    }
+    text.split('.').map(|p| p.parse().ok()).collect()
+}

@@ -1,0 +1,202 @@
+//! `--set "force of egg = 5 N"`: a value parameter for every action that uses a skill
+//! declaring that parameter with that object.
+//!
+//! The parameter may be named as the skill declares it (`force`), with its skill
+//! (`grasp force`) or by its description (`grasping force`). The value is checked against
+//! the declaration: a number takes the declared unit (a bare number gets it), a category
+//! must be one of the declared categories.
+
+use crate::bt::Tree;
+use crate::domain::action::parse_value;
+use crate::domain::{Scenario, Value, ValueParam};
+use crate::planner;
+
+/// One parsed `--set`: the value, the object, and every (skill, parameter) it applies to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting {
+    pub text: String,
+    pub object: String,
+    pub value: Value,
+    pub targets: Vec<(String, String)>,
+}
+
+/// Why a setting could not be read; the message names the text and what was expected.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct SettingError(pub String);
+
+macro_rules! bail {
+    ($($t:tt)*) => { return Err(SettingError(format!($($t)*))) };
+}
+
+pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, SettingError> {
+    let usage = "expected `<parameter> of <object> = <value>`, e.g. \"force of egg = 5 N\"";
+    let Some((left, value_text)) = text.split_once('=') else {
+        bail!("--set {text:?}: {usage}");
+    };
+    let Some((param, object)) = left.split_once(" of ") else {
+        bail!("--set {text:?}: {usage}");
+    };
+    let param = param.trim();
+    let object = object.trim().trim_matches('"').to_string();
+    if scenario.domain.vocabulary.object(&object).is_none() {
+        bail!("--set {text:?}: no object {object:?} in this scenario");
+    }
+    let mut targets = Vec::new();
+    let mut declared = None;
+    for skill in &scenario.domain.skills {
+        for v in &skill.values {
+            let names = [
+                v.name.clone(),
+                format!("{} {}", skill.name, v.name),
+                v.description.clone(),
+            ];
+            if names.iter().any(|n| n == param)
+                && !targets.contains(&(skill.name.clone(), v.name.clone()))
+            {
+                targets.push((skill.name.clone(), v.name.clone()));
+                declared = Some(v.clone());
+            }
+        }
+    }
+    let Some(declared) = declared else {
+        let known: Vec<String> = scenario
+            .domain
+            .skills
+            .iter()
+            .flat_map(|s| {
+                s.values
+                    .iter()
+                    .map(move |v| format!("{} {} ({})", s.name, v.name, v.description))
+            })
+            .collect();
+        bail!(
+            "--set {text:?}: no skill declares a value {param:?} (declared: {})",
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        );
+    };
+    let value =
+        parse_value(value_text).map_err(|e| SettingError(format!("--set {text:?}: {e}")))?;
+    let value =
+        conform(&declared, value).map_err(|e| SettingError(format!("--set {text:?}: {e}")))?;
+    Ok(Setting {
+        text: text.to_string(),
+        object,
+        value,
+        targets,
+    })
+}
+
+/// Check `value` against the declaration: a number takes the declared unit (a bare
+/// number gets it), a category must be one of the declared categories.
+pub fn conform(declared: &ValueParam, value: Value) -> Result<Value, String> {
+    match (value, &declared.unit) {
+        (Value::Number { value, unit }, Some(want)) if unit.is_empty() || unit == *want => {
+            Ok(Value::Number {
+                value,
+                unit: want.clone(),
+            })
+        }
+        (Value::Number { unit, .. }, Some(want)) => {
+            Err(format!("{} is given in {want}, not {unit}", declared.name))
+        }
+        (Value::Category(c), None)
+            if declared.categories.is_empty() || declared.categories.contains(&c) =>
+        {
+            Ok(Value::Category(c))
+        }
+        (Value::Category(c), None) => Err(format!(
+            "{c:?} is not one of {}",
+            declared.categories.join(", ")
+        )),
+        (v, Some(want)) => Err(format!(
+            "{} is a number in {want}, found {v}",
+            declared.name
+        )),
+        (v, None) => Err(format!(
+            "{} is one of {}, found {v}",
+            declared.name,
+            declared.categories.join(", ")
+        )),
+    }
+}
+
+/// Apply a setting to every matching action of `tree`; how many actions changed.
+pub fn apply(tree: &mut Tree, setting: &Setting) -> usize {
+    setting
+        .targets
+        .iter()
+        .map(|(skill, name)| planner::set_value(tree, skill, &setting.object, name, &setting.value))
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+
+    fn egg() -> Scenario {
+        Scenario::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/params/egg.toml"),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn settings_name_the_parameter_in_three_ways() {
+        let s = egg();
+        for text in [
+            "force of egg = 5 N",
+            "grasp force of egg = 5",
+            "grasping force of \"egg\" = 5 N",
+        ] {
+            let set = parse_setting(&s, text).unwrap();
+            assert_eq!(set.object, "egg");
+            assert_eq!(
+                set.targets,
+                vec![("grasp".to_string(), "force".to_string())]
+            );
+            assert_eq!(
+                set.value,
+                Value::Number {
+                    value: 5.0,
+                    unit: "N".into()
+                }
+            );
+        }
+    }
+
+    #[test]
+    fn bad_settings_say_why() {
+        let s = egg();
+        assert!(
+            parse_setting(&s, "force of dragon = 5 N")
+                .unwrap_err()
+                .to_string()
+                .contains("no object")
+        );
+        assert!(
+            parse_setting(&s, "speed of egg = 5 N")
+                .unwrap_err()
+                .to_string()
+                .contains("no skill declares")
+        );
+        assert!(
+            parse_setting(&s, "force of egg = 5 lbf")
+                .unwrap_err()
+                .to_string()
+                .contains("not lbf")
+        );
+        assert!(
+            parse_setting(&s, "force egg 5")
+                .unwrap_err()
+                .to_string()
+                .contains("expected")
+        );
+    }
+}

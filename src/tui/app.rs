@@ -1,0 +1,305 @@
+//! The one state of the workbench. Keys become commands for the session (queued, sent
+//! by the event loop); session events update the components. Drawing reads this state
+//! (`ui::draw`); nothing here talks to a terminal.
+
+use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
+
+use crate::session::{Command, Event};
+
+use super::components::help::report_lines;
+use super::components::input::{InputLine, Mode, Submitted};
+use super::components::llm_pane::{LlmPane, ProposalView};
+use super::components::status_bar::{Ending, StatusBar};
+use super::components::tree_pane::TreePane;
+use super::components::world_pane::WorldPane;
+use super::keys::{Action, KeyBindings};
+use super::strings;
+use super::theme::Theme;
+
+/// What the status bar says about the session, fixed at start.
+#[derive(Debug, Clone, Default)]
+pub struct Info {
+    /// The scenario's file stem or name.
+    pub scenario: String,
+    pub backend: String,
+    pub model: String,
+    pub auto_approve: bool,
+    /// The scenario's objects, for the world pane.
+    pub objects: Vec<String>,
+    /// Why there is no model, if there is none.
+    pub no_model: Option<String>,
+    /// Why the key bindings file was not used, if it was not.
+    pub keys_error: Option<String>,
+}
+
+/// What a component asks of the app (the event queue between them).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AppEvent {
+    Command(Command),
+    Quit,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Overlay {
+    Help,
+    Report(Vec<String>),
+}
+
+pub struct App {
+    pub keys: KeyBindings,
+    pub theme: Theme,
+    pub tree: TreePane,
+    pub llm: LlmPane,
+    pub world: WorldPane,
+    pub input: InputLine,
+    pub status: StatusBar,
+    pub overlay: Option<Overlay>,
+    queue: Vec<AppEvent>,
+    quit: bool,
+}
+
+impl App {
+    pub fn new(info: Info, keys: KeyBindings, theme: Theme) -> App {
+        let mut llm = LlmPane::default();
+        if let Some(why) = &info.no_model {
+            llm.error = Some(strings::no_model(why));
+        }
+        if let Some(e) = &info.keys_error {
+            llm.log(strings::keys_file_error(e));
+        }
+        App {
+            keys,
+            theme,
+            tree: TreePane::default(),
+            llm,
+            world: WorldPane {
+                objects: info.objects.clone(),
+                ..WorldPane::default()
+            },
+            input: InputLine::default(),
+            status: StatusBar {
+                scenario: info.scenario,
+                backend: info.backend,
+                model: info.model,
+                auto_approve: info.auto_approve,
+                ..StatusBar::default()
+            },
+            overlay: None,
+            queue: Vec::new(),
+            quit: false,
+        }
+    }
+
+    pub fn should_quit(&self) -> bool {
+        self.quit
+    }
+
+    /// Commands for the session, in order.
+    pub fn take_commands(&mut self) -> Vec<Command> {
+        let mut out = Vec::new();
+        for e in std::mem::take(&mut self.queue) {
+            match e {
+                AppEvent::Command(c) => out.push(c),
+                AppEvent::Quit => self.quit = true,
+            }
+        }
+        out
+    }
+
+    /// Whether something animates (a model call under way).
+    pub fn animating(&self) -> bool {
+        self.llm.asking.is_some()
+    }
+
+    pub fn on_animation(&mut self) {
+        self.llm.animate();
+    }
+
+    pub fn on_key(&mut self, key: KeyEvent) {
+        if key.kind == KeyEventKind::Release {
+            return;
+        }
+        if key.code == KeyCode::Char('c') && key.modifiers.contains(KeyModifiers::CONTROL) {
+            self.queue.push(AppEvent::Quit);
+            return;
+        }
+        if self.input.is_open() {
+            match self.input.event(&key) {
+                Some(Submitted::Instruction(text)) => {
+                    self.llm.error = None;
+                    self.queue.push(AppEvent::Command(Command::Submit(text)));
+                }
+                Some(Submitted::Edit(text)) => {
+                    self.llm.error = None;
+                    self.queue.push(AppEvent::Command(Command::Edit(text)));
+                }
+                None => {}
+            }
+            return;
+        }
+        if self.overlay.take().is_some() {
+            return;
+        }
+        match self.keys.action(&key) {
+            Some(action) => self.on_action(action),
+            None => {
+                self.tree.event(&key);
+            }
+        }
+    }
+
+    fn on_action(&mut self, action: Action) {
+        let command = match action {
+            Action::Step => Command::Tick,
+            Action::Run if self.status.running => Command::Pause,
+            Action::Run => Command::Run,
+            Action::Plan => Command::Plan,
+            Action::Approve => Command::Approve,
+            Action::Reject => Command::Reject,
+            Action::Undo => Command::Undo,
+            Action::Verify => Command::Verify,
+            Action::Save => Command::SavePolicy,
+            Action::Load => Command::LoadPolicy(None),
+            Action::Reset => Command::ResetWorld,
+            Action::Instruction => {
+                return self.input.open(Mode::Instruction, "");
+            }
+            Action::Edit => {
+                let text = self
+                    .llm
+                    .proposal
+                    .as_ref()
+                    .map(|p| p.edit_text.clone())
+                    .unwrap_or_default();
+                return self.input.open(Mode::Edit, &text);
+            }
+            Action::Help => {
+                self.overlay = Some(Overlay::Help);
+                return;
+            }
+            Action::Quit => {
+                self.queue.push(AppEvent::Quit);
+                return;
+            }
+        };
+        self.queue.push(AppEvent::Command(command));
+    }
+
+    pub fn on_session(&mut self, event: Event) {
+        match event {
+            Event::TreeChanged {
+                tree,
+                new_nodes,
+                why,
+            } => {
+                let added = new_nodes.len();
+                self.tree.set_tree(tree, new_nodes);
+                self.status.ending = None;
+                self.llm.log(if added > 0 {
+                    format!("{why}: {added} new node(s)")
+                } else {
+                    why
+                });
+            }
+            Event::Ticked { record } => {
+                self.status.ticks = record.tick;
+                self.tree.set_record(record);
+            }
+            Event::WorldChanged { facts, reset } => {
+                let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
+                // Relations between objects first: they change; "near robot" rarely does.
+                facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
+                self.world.facts = facts;
+                if reset {
+                    self.status.ticks = 0;
+                    self.status.ending = None;
+                    self.tree.clear_statuses();
+                }
+            }
+            Event::ActionFailed {
+                action,
+                node,
+                error,
+                ..
+            } => {
+                let text = strings::failed(&action.to_string(), &error);
+                self.tree.set_failing(node);
+                self.world.last_error = Some(text.clone());
+                self.status.ending = Some(Ending::Failed);
+                self.llm.log(text);
+            }
+            Event::Asking { what } => {
+                self.llm.error = None;
+                self.llm.asking = Some(what);
+            }
+            Event::Replied { attribution, .. } => {
+                self.llm.asking = None;
+                self.llm.replied_by = Some(attribution);
+            }
+            Event::InvalidReply { error } => self.llm.log(format!("unusable reply: {error}")),
+            Event::Goal {
+                goal, reasoning, ..
+            } => {
+                self.llm.goal = Some(goal.to_string());
+                self.llm.reasoning = reasoning;
+            }
+            Event::Proposal {
+                proposal,
+                reasoning,
+                ..
+            } => {
+                self.llm.asking = None;
+                self.llm.reasoning = reasoning;
+                self.llm.proposal = Some(ProposalView::of(&proposal));
+            }
+            Event::Approved => {
+                self.llm.proposal = None;
+                self.llm.log("approved");
+            }
+            Event::Rejected => {
+                self.llm.proposal = None;
+                self.llm
+                    .log("rejected: the tree is unchanged (e to type conditions)");
+            }
+            Event::Repaired {
+                added_nodes,
+                valued_nodes,
+            } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
+            Event::DidNotHelp { reason } => {
+                self.llm
+                    .log(format!("the change did not help and was undone: {reason}"));
+            }
+            Event::Success { ticks } => {
+                self.status.ending = Some(Ending::Success);
+                self.llm.log(strings::success(ticks));
+            }
+            Event::GaveUp { reason } => self.llm.log(reason),
+            Event::Usage { totals } => self.status.usage = totals,
+            Event::RunState { running } => self.status.running = running,
+            Event::Verified { report } => {
+                let holds = report.holds();
+                self.overlay = Some(Overlay::Report(report_lines(&report, &self.theme)));
+                self.llm
+                    .log(if holds { "verified" } else { "NOT verified" });
+            }
+            Event::PolicySaved { path, fixes } => {
+                self.llm
+                    .log(strings::policy_saved(&path.display().to_string(), fixes));
+            }
+            Event::PolicyLoaded { path, fixes } => {
+                self.llm
+                    .log(strings::policy_loaded(&path.display().to_string(), fixes));
+            }
+            Event::Error { message } => {
+                self.llm.error = Some(message.clone());
+                self.llm.log(format!("error: {message}"));
+            }
+            Event::Failed { error } => {
+                self.llm.asking = None;
+                self.llm.error = Some(error.to_string());
+                self.llm.log(format!("error: {error}"));
+            }
+            Event::Notice { message } => self.llm.log(message),
+        }
+    }
+}

@@ -1,0 +1,130 @@
+//! Overlays: the help (generated from the key bindings) and a verification report.
+
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Flex, Layout, Rect};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
+
+use crate::verify::{Report, Verdict};
+
+use super::super::keys::KeyBindings;
+use super::super::strings;
+use super::super::theme::Theme;
+
+/// A box in the middle of `area`, at most `width` × `height`.
+fn centered(area: Rect, width: u16, height: u16) -> Rect {
+    let [v] = Layout::vertical([Constraint::Length(height.min(area.height))])
+        .flex(Flex::Center)
+        .areas(area);
+    let [h] = Layout::horizontal([Constraint::Length(width.min(area.width))])
+        .flex(Flex::Center)
+        .areas(v);
+    h
+}
+
+pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, theme: &Theme) {
+    let entries = keys.help_lines();
+    let key_width = entries
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
+    let mut lines: Vec<Line> = entries
+        .iter()
+        .map(|(k, what)| {
+            Line::from(vec![
+                Span::styled(format!(" {k:>key_width$}  "), theme.key),
+                Span::raw(*what),
+            ])
+        })
+        .collect();
+    lines.push(Line::from(""));
+    lines.push(Line::from(Span::styled(
+        format!(" {}", strings::HELP_FOOTER),
+        theme.dim,
+    )));
+    let width = lines.iter().map(Line::width).max().unwrap_or(20) + 3;
+    let height = lines.len() + 2;
+    let rect = centered(
+        area,
+        u16::try_from(width).unwrap_or(u16::MAX),
+        u16::try_from(height).unwrap_or(u16::MAX),
+    );
+    frame.render_widget(Clear, rect);
+    let block = Block::default()
+        .borders(Borders::ALL)
+        .border_style(theme.key)
+        .title(Span::styled(strings::HELP_TITLE, theme.title));
+    frame.render_widget(Paragraph::new(lines).block(block), rect);
+}
+
+/// The report as lines, in the words of `betr verify`.
+pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
+    let (ok, bad, unknown) = if theme.glyphs.success == "✓" {
+        ("✓", "✕", "?")
+    } else {
+        ("ok", "FAIL", "??")
+    };
+    let mut lines = vec!["Structural checks".to_string()];
+    if report.findings.is_empty() {
+        lines.push(format!("  {ok} no findings"));
+    }
+    for f in &report.findings {
+        lines.push(format!("  {bad} {f}"));
+        lines.push(format!("      fix: {}", f.hint));
+    }
+    lines.push("Model checking".into());
+    match &report.model {
+        Err(e) => lines.push(format!("  {bad} not possible: {e}")),
+        Ok(m) => {
+            for p in &m.properties {
+                match &p.verdict {
+                    Verdict::Holds if p.detail.is_empty() => {
+                        lines.push(format!("  {ok} {}", p.name))
+                    }
+                    Verdict::Holds => lines.push(format!("  {ok} {} ({})", p.name, p.detail)),
+                    Verdict::Unknown(why) => lines.push(format!("  {unknown} {}: {why}", p.name)),
+                    Verdict::Violated(cx) => {
+                        lines.push(format!("  {bad} {}", p.name));
+                        lines.push("    counterexample:".into());
+                        lines.extend(cx.to_string().lines().map(|l| format!("      {l}")));
+                    }
+                }
+            }
+            lines.push(format!(
+                "{} states, {} transitions, {} atoms",
+                m.states, m.transitions, m.atoms
+            ));
+        }
+    }
+    lines.push(
+        if report.holds() {
+            "VERIFIED: every check and property holds"
+        } else {
+            "NOT VERIFIED"
+        }
+        .into(),
+    );
+    lines
+}
+
+pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme) {
+    let width = area.width.saturating_sub(8).max(20);
+    let inner = usize::from(width.saturating_sub(2)).max(1);
+    // Wrapped lines take more than one row each.
+    let rows: usize = lines
+        .iter()
+        .map(|l| l.chars().count().div_ceil(inner).max(1))
+        .sum();
+    let rect = centered(area, width, u16::try_from(rows + 2).unwrap_or(u16::MAX));
+    frame.render_widget(Clear, rect);
+    let block = Block::default()
+        .borders(Borders::ALL)
+        .border_style(theme.key)
+        .title(Span::styled(strings::VERIFY_TITLE, theme.title));
+    let text: Vec<Line> = lines.iter().map(|l| Line::from(l.clone())).collect();
+    frame.render_widget(
+        Paragraph::new(text).wrap(Wrap { trim: false }).block(block),
+        rect,
+    );
+}

@@ -1,0 +1,166 @@
+//! The input line: an instruction (or a goal formula) to submit, or a proposal to edit.
+//! Enter submits, Esc cancels; while it is open it takes every key.
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::Frame;
+use ratatui::layout::{Position, Rect};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph};
+
+use super::super::strings;
+use super::super::theme::Theme;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Instruction,
+    Edit,
+}
+
+/// What the input line produced.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Submitted {
+    Instruction(String),
+    Edit(String),
+}
+
+#[derive(Default)]
+pub struct InputLine {
+    mode: Option<Mode>,
+    text: String,
+    /// Cursor position in characters.
+    cursor: usize,
+}
+
+impl InputLine {
+    pub fn open(&mut self, mode: Mode, text: &str) {
+        self.mode = Some(mode);
+        self.text = text.to_string();
+        self.cursor = self.text.chars().count();
+    }
+
+    pub fn is_open(&self) -> bool {
+        self.mode.is_some()
+    }
+
+    /// Handle a key while open: `Some` when Enter submitted the text.
+    pub fn event(&mut self, key: &KeyEvent) -> Option<Submitted> {
+        let mode = self.mode?;
+        match key.code {
+            KeyCode::Enter => {
+                let text = std::mem::take(&mut self.text);
+                self.mode = None;
+                self.cursor = 0;
+                return Some(match mode {
+                    Mode::Instruction => Submitted::Instruction(text),
+                    Mode::Edit => Submitted::Edit(text),
+                });
+            }
+            KeyCode::Esc => {
+                self.mode = None;
+                self.text.clear();
+                self.cursor = 0;
+            }
+            KeyCode::Char('u') if key.modifiers.contains(KeyModifiers::CONTROL) => {
+                self.text.clear();
+                self.cursor = 0;
+            }
+            KeyCode::Char(c) => {
+                let at = self.byte_at(self.cursor);
+                self.text.insert(at, c);
+                self.cursor += 1;
+            }
+            KeyCode::Backspace if self.cursor > 0 => {
+                self.cursor -= 1;
+                let at = self.byte_at(self.cursor);
+                self.text.remove(at);
+            }
+            KeyCode::Delete if self.cursor < self.text.chars().count() => {
+                let at = self.byte_at(self.cursor);
+                self.text.remove(at);
+            }
+            KeyCode::Left => self.cursor = self.cursor.saturating_sub(1),
+            KeyCode::Right => self.cursor = (self.cursor + 1).min(self.text.chars().count()),
+            KeyCode::Home => self.cursor = 0,
+            KeyCode::End => self.cursor = self.text.chars().count(),
+            _ => {}
+        }
+        None
+    }
+
+    fn byte_at(&self, chars: usize) -> usize {
+        self.text
+            .char_indices()
+            .nth(chars)
+            .map_or(self.text.len(), |(i, _)| i)
+    }
+
+    pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
+        let (title, line) = match self.mode {
+            None => (
+                strings::INPUT_TITLE_IDLE,
+                Line::from(Span::styled(strings::INPUT_HINT, theme.dim)),
+            ),
+            Some(mode) => (
+                match mode {
+                    Mode::Instruction => strings::INPUT_TITLE_INSTRUCTION,
+                    Mode::Edit => strings::INPUT_TITLE_EDIT,
+                },
+                Line::from(vec![
+                    Span::styled("> ", theme.key),
+                    Span::raw(self.text.clone()),
+                ]),
+            ),
+        };
+        let inner_width = usize::from(area.width.saturating_sub(4)).max(1);
+        // Keep the cursor in view on long text.
+        let scroll = self.cursor.saturating_sub(inner_width.saturating_sub(1));
+        let block = Block::default()
+            .borders(Borders::ALL)
+            .border_style(theme.border)
+            .title(Span::styled(title, theme.title));
+        let scroll = u16::try_from(scroll).unwrap_or(u16::MAX);
+        frame.render_widget(Paragraph::new(line).block(block).scroll((0, scroll)), area);
+        if self.mode.is_some() {
+            let x = area.x.saturating_add(3).saturating_add(
+                u16::try_from(self.cursor)
+                    .unwrap_or(0)
+                    .saturating_sub(scroll),
+            );
+            frame.set_cursor_position(Position::new(
+                x.min(area.right().saturating_sub(2)),
+                area.y + 1,
+            ));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(code: KeyCode) -> KeyEvent {
+        KeyEvent::new(code, KeyModifiers::NONE)
+    }
+
+    #[test]
+    fn typing_editing_and_submitting() {
+        let mut input = InputLine::default();
+        assert_eq!(input.event(&key(KeyCode::Char('x'))), None);
+        input.open(Mode::Instruction, "");
+        for c in "gräsp".chars() {
+            input.event(&key(KeyCode::Char(c)));
+        }
+        input.event(&key(KeyCode::Left));
+        input.event(&key(KeyCode::Backspace));
+        input.event(&key(KeyCode::Home));
+        input.event(&key(KeyCode::Char('>')));
+        assert_eq!(
+            input.event(&key(KeyCode::Enter)),
+            Some(Submitted::Instruction(">gräp".into()))
+        );
+        assert!(!input.is_open());
+        input.open(Mode::Edit, "A & B");
+        input.event(&key(KeyCode::Esc));
+        assert!(!input.is_open());
+    }
+}

@@ -1,0 +1,98 @@
+//! The status bar: scenario, backend and model, calls, tokens and cost so far, tick
+//! count, run/pause state, the last outcome, and the auto-approve warning.
+
+use ratatui::Frame;
+use ratatui::layout::Rect;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::Paragraph;
+
+use crate::llm::usage::UsageTotals;
+
+use super::super::strings;
+use super::super::theme::Theme;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ending {
+    Success,
+    Failed,
+}
+
+#[derive(Default)]
+pub struct StatusBar {
+    pub scenario: String,
+    pub backend: String,
+    pub model: String,
+    pub auto_approve: bool,
+    pub usage: UsageTotals,
+    pub ticks: u64,
+    pub running: bool,
+    pub ending: Option<Ending>,
+}
+
+impl StatusBar {
+    pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, help_key: &str) {
+        // Narrow terminals: the model without its backend, the help key without its word,
+        // tighter separators.
+        let narrow = area.width < 100;
+        let sep = Span::styled(if narrow { "│" } else { " │ " }, theme.status_bar);
+        let who = if narrow {
+            self.model.clone()
+        } else {
+            format!("{} {}", self.backend, self.model)
+        };
+        let mut spans = vec![
+            Span::styled(format!(" {}", self.scenario), theme.status_bar),
+            sep.clone(),
+            Span::styled(who, theme.status_bar),
+            sep.clone(),
+            Span::styled(
+                strings::calls(
+                    self.usage.calls,
+                    self.usage.prompt_tokens + self.usage.completion_tokens,
+                    self.usage.price_usd,
+                ),
+                theme.status_bar,
+            ),
+            sep.clone(),
+            Span::styled(strings::tick(self.ticks), theme.status_bar),
+            sep.clone(),
+            Span::styled(
+                if self.running {
+                    strings::RUNNING
+                } else {
+                    strings::PAUSED
+                },
+                theme.status_bar,
+            ),
+        ];
+        match self.ending {
+            Some(Ending::Success) => {
+                spans.push(sep.clone());
+                spans.push(Span::styled(
+                    strings::SUCCESS,
+                    theme.success.patch(theme.title),
+                ));
+            }
+            Some(Ending::Failed) => {
+                spans.push(sep.clone());
+                spans.push(Span::styled(strings::FAILED, theme.error));
+            }
+            None => {}
+        }
+        if self.auto_approve {
+            spans.push(sep.clone());
+            spans.push(Span::styled(strings::AUTO_APPROVE, theme.error));
+        }
+        spans.push(sep);
+        let help = if narrow {
+            help_key.to_string()
+        } else {
+            format!("{help_key} {}", strings::HELP_WORD)
+        };
+        spans.push(Span::styled(help, theme.status_bar));
+        frame.render_widget(
+            Paragraph::new(Line::from(spans)).style(theme.status_bar),
+            area,
+        );
+    }
+}

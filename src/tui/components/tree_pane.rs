@@ -1,0 +1,294 @@
+//! The live behavior tree (tui-tree-widget): each node with its status symbol and
+//! colour, collapsible; nodes added by the last expansion highlighted, the failing action
+//! marked. Items are rebuilt only when the tree or the statuses change, iteratively (no
+//! recursion, so deep trees are fine); the widget draws only the visible rows.
+
+use std::sync::Arc;
+
+use crossterm::event::{KeyCode, KeyEvent};
+use ratatui::Frame;
+use ratatui::layout::Rect;
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
+use tui_tree_widget::{Tree as TreeWidget, TreeItem, TreeState};
+
+use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree};
+
+use super::super::strings;
+use super::super::theme::Theme;
+
+#[derive(Default)]
+pub struct TreePane {
+    tree: Option<Arc<Tree>>,
+    record: Option<Arc<TickRecord>>,
+    new_nodes: Vec<NodeId>,
+    failing: Option<NodeId>,
+    items: Vec<TreeItem<'static, u32>>,
+    state: TreeState<u32>,
+    dirty: bool,
+}
+
+impl TreePane {
+    pub fn set_tree(&mut self, tree: Arc<Tree>, new_nodes: Vec<NodeId>) {
+        self.state = TreeState::default();
+        for path in composite_paths(&tree) {
+            self.state.open(path);
+        }
+        let focus = new_nodes.first().copied();
+        self.tree = Some(tree);
+        self.new_nodes = new_nodes;
+        self.record = None;
+        self.failing = None;
+        self.dirty = true;
+        if let Some(n) = focus {
+            self.select(n);
+        }
+    }
+
+    pub fn set_record(&mut self, record: Arc<TickRecord>) {
+        self.record = Some(record);
+        self.dirty = true;
+    }
+
+    /// Statuses back to "not ticked" (the world was reset).
+    pub fn clear_statuses(&mut self) {
+        self.record = None;
+        self.failing = None;
+        self.dirty = true;
+    }
+
+    pub fn set_failing(&mut self, node: NodeId) {
+        self.failing = Some(node);
+        self.dirty = true;
+        self.select(node);
+    }
+
+    pub fn has_tree(&self) -> bool {
+        self.tree.is_some()
+    }
+
+    fn select(&mut self, node: NodeId) {
+        if let Some(tree) = &self.tree {
+            let mut path: Vec<u32> = Vec::new();
+            let mut at = Some(node);
+            while let Some(n) = at {
+                path.push(n.0);
+                at = tree.parent(n).ok().flatten();
+            }
+            path.reverse();
+            self.state.select(path);
+        }
+    }
+
+    /// Navigation keys; true when consumed.
+    pub fn event(&mut self, key: &KeyEvent) -> bool {
+        match key.code {
+            KeyCode::Up | KeyCode::Char('k') => self.state.key_up(),
+            KeyCode::Down | KeyCode::Char('j') => self.state.key_down(),
+            KeyCode::Left => self.state.key_left(),
+            KeyCode::Right => self.state.key_right(),
+            KeyCode::Enter => self.state.toggle_selected(),
+            KeyCode::Home => self.state.select_first(),
+            KeyCode::End => self.state.select_last(),
+            KeyCode::PageDown => self.state.scroll_down(10),
+            KeyCode::PageUp => self.state.scroll_up(10),
+            _ => return false,
+        };
+        true
+    }
+
+    fn rebuild(&mut self, theme: &Theme) {
+        if !self.dirty {
+            return;
+        }
+        self.dirty = false;
+        self.items = match &self.tree {
+            Some(tree) => vec![build_items(
+                tree,
+                self.record.as_deref(),
+                &self.new_nodes,
+                self.failing,
+                theme,
+            )],
+            None => Vec::new(),
+        };
+    }
+
+    pub fn draw(&mut self, frame: &mut Frame, area: Rect, theme: &Theme) {
+        self.rebuild(theme);
+        let block = Block::default()
+            .borders(Borders::ALL)
+            .border_style(theme.border)
+            .title(Span::styled(strings::TREE_TITLE, theme.title));
+        if self.items.is_empty() {
+            let text = Paragraph::new(strings::TREE_EMPTY)
+                .style(theme.dim)
+                .wrap(Wrap { trim: true })
+                .block(block);
+            frame.render_widget(text, area);
+            return;
+        }
+        match TreeWidget::new(&self.items) {
+            Ok(widget) => {
+                let widget = widget
+                    .block(block)
+                    .highlight_style(theme.selected)
+                    .node_closed_symbol("▸ ")
+                    .node_open_symbol("▾ ")
+                    .node_no_children_symbol("  ");
+                frame.render_stateful_widget(widget, area, &mut self.state);
+            }
+            Err(e) => {
+                tracing::warn!(error = %e, "cannot draw the tree");
+            }
+        }
+    }
+}
+
+/// Identifier paths of every composite, to open them all.
+fn composite_paths(tree: &Tree) -> Vec<Vec<u32>> {
+    let mut out = Vec::new();
+    let mut stack: Vec<(NodeId, Vec<u32>)> = vec![(tree.root(), vec![tree.root().0])];
+    while let Some((node, path)) = stack.pop() {
+        let children = tree.children(node).unwrap_or_default();
+        if children.is_empty() {
+            continue;
+        }
+        for c in children {
+            let mut p = path.clone();
+            p.push(c.0);
+            stack.push((*c, p));
+        }
+        out.push(path);
+    }
+    out
+}
+
+/// The widget's items for `tree`, children before parents (no recursion).
+fn build_items(
+    tree: &Tree,
+    record: Option<&TickRecord>,
+    new_nodes: &[NodeId],
+    failing: Option<NodeId>,
+    theme: &Theme,
+) -> TreeItem<'static, u32> {
+    let mut built: Vec<Option<TreeItem<'static, u32>>> = vec![None; tree.capacity()];
+    let order = tree.preorder();
+    for &node in order.iter().rev() {
+        let status = record.map_or(Status::Idle, |r| r.status(node));
+        let line = node_line(
+            tree,
+            node,
+            status,
+            new_nodes.contains(&node),
+            failing == Some(node),
+            theme,
+        );
+        let children: Vec<TreeItem<'static, u32>> = tree
+            .children(node)
+            .unwrap_or_default()
+            .iter()
+            .filter_map(|c| built.get_mut(c.index()).and_then(Option::take))
+            .collect();
+        let item = if children.is_empty() {
+            TreeItem::new_leaf(node.0, line)
+        } else {
+            match TreeItem::new(node.0, line.clone(), children) {
+                Ok(item) => item,
+                Err(_) => TreeItem::new_leaf(node.0, line),
+            }
+        };
+        if let Some(slot) = built.get_mut(node.index()) {
+            *slot = Some(item);
+        }
+    }
+    built
+        .get_mut(tree.root().index())
+        .and_then(Option::take)
+        .unwrap_or_else(|| TreeItem::new_leaf(tree.root().0, ""))
+}
+
+/// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
+fn node_line(
+    tree: &Tree,
+    node: NodeId,
+    status: Status,
+    new: bool,
+    failing: bool,
+    theme: &Theme,
+) -> Line<'static> {
+    let g = theme.glyphs;
+    let label = match tree.kind(node) {
+        Ok(NodeKind::Sequence) => format!("{} {}", g.sequence, g.sequence_name),
+        Ok(NodeKind::Fallback) => format!("{} {}", g.fallback, g.fallback_name),
+        Ok(NodeKind::Condition(c)) => format!("{c}{}", g.condition_suffix),
+        Ok(NodeKind::Action(a)) => format!("{a}{}", g.action_suffix),
+        Err(_) => String::new(),
+    };
+    let mut spans = vec![
+        Span::styled(if new { strings::NEW_MARK } else { " " }, theme.new_node),
+        Span::styled(format!("[{}] ", g.status(status)), theme.status(status)),
+    ];
+    let style = if failing {
+        theme.failing
+    } else if new {
+        theme.new_node.patch(theme.status(status))
+    } else {
+        theme.status(status)
+    };
+    spans.push(Span::styled(label, style));
+    if failing {
+        spans.push(Span::styled(
+            format!(" {}", strings::FAILED_MARK),
+            theme.error,
+        ));
+    }
+    Line::from(spans)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::{ActionCall, Condition};
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    /// A tree of `n` nodes: a fallback of sequences, each a condition and an action.
+    fn big(n: usize) -> Tree {
+        let mut t = Tree::new(NodeKind::Fallback);
+        let mut count = 1;
+        let mut parent = t.root();
+        while count < n {
+            let seq = t.add_child(parent, NodeKind::Sequence).unwrap();
+            let c = Condition::parse(&format!("Done_{count}")).unwrap();
+            t.add_child(seq, NodeKind::Condition(c)).unwrap();
+            let a = ActionCall::parse(&format!("Do \"thing {count}\"")).unwrap();
+            t.add_child(seq, NodeKind::Action(a)).unwrap();
+            count += 3;
+            if count % 300 == 1 {
+                parent = seq;
+            }
+        }
+        t
+    }
+
+    #[test]
+    fn five_thousand_nodes_render_well_under_a_frame() {
+        let tree = Arc::new(big(5000));
+        assert!(tree.len() >= 5000);
+        let mut pane = TreePane::default();
+        let theme = Theme::default();
+        let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+        let start = std::time::Instant::now();
+        pane.set_tree(tree.clone(), vec![tree.root()]);
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        let first = start.elapsed();
+        // A frame at 60 Hz is 16 ms; debug builds are slow, so allow a generous bound.
+        assert!(first.as_millis() < 400, "first render took {first:?}");
+        let again = std::time::Instant::now();
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        assert!(again.elapsed().as_millis() < 200, "{:?}", again.elapsed());
+        let screen = terminal.backend().to_string();
+        assert!(screen.contains("Fallback"), "{screen}");
+    }
+}

@@ -1,0 +1,89 @@
+//! The event loop: wait on terminal input, session events and an animation ticker;
+//! dispatch; draw once per iteration. A draw error is logged, not fatal.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use crossterm::event::Event as TermEvent;
+use ratatui::Terminal;
+use ratatui::backend::Backend;
+use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+
+use crate::session::{Command, EngineHandle, Event};
+
+use super::app::App;
+use super::ui;
+
+/// Read terminal events on a thread of their own (crossterm's reads block) until `stop`.
+pub fn spawn_input_reader(stop: Arc<AtomicBool>) -> UnboundedReceiver<TermEvent> {
+    let (tx, rx) = unbounded_channel();
+    std::thread::spawn(move || read_input(&tx, &stop));
+    rx
+}
+
+fn read_input(tx: &UnboundedSender<TermEvent>, stop: &AtomicBool) {
+    while !stop.load(Ordering::Relaxed) {
+        match crossterm::event::poll(Duration::from_millis(50)) {
+            Ok(true) => match crossterm::event::read() {
+                Ok(e) => {
+                    if tx.send(e).is_err() {
+                        return;
+                    }
+                }
+                Err(e) => {
+                    tracing::warn!(error = %e, "cannot read the terminal");
+                    return;
+                }
+            },
+            Ok(false) => {}
+            Err(e) => {
+                tracing::warn!(error = %e, "cannot poll the terminal");
+                return;
+            }
+        }
+    }
+}
+
+/// Run until the app quits or the session ends.
+pub async fn run<B: Backend>(
+    terminal: &mut Terminal<B>,
+    app: &mut App,
+    engine: &EngineHandle,
+    events: &mut UnboundedReceiver<Event>,
+    input: &mut UnboundedReceiver<TermEvent>,
+) {
+    let mut animation = tokio::time::interval(Duration::from_millis(150));
+    animation.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    loop {
+        if let Err(e) = terminal.draw(|f| ui::draw(f, app)) {
+            tracing::warn!(error = %e, "cannot draw the screen");
+        }
+        tokio::select! {
+            term = input.recv() => match term {
+                Some(TermEvent::Key(key)) => app.on_key(key),
+                // A resize is drawn at the next iteration.
+                Some(_) => {}
+                None => break,
+            },
+            event = events.recv() => match event {
+                Some(e) => {
+                    app.on_session(e);
+                    // Take in everything already waiting before drawing again.
+                    while let Ok(e) = events.try_recv() {
+                        app.on_session(e);
+                    }
+                }
+                None => break,
+            },
+            _ = animation.tick(), if app.animating() => app.on_animation(),
+        }
+        for command in app.take_commands() {
+            engine.send(command);
+        }
+        if app.should_quit() {
+            engine.send(Command::Shutdown);
+            break;
+        }
+    }
+}

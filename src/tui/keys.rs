@@ -1,0 +1,298 @@
+//! Key bindings: one struct with a field per action and its default key. The help overlay
+//! is generated from the same struct, so it cannot drift; a TOML file of overrides
+//! (`step = "n"`, `quit = "ctrl-q"`) is applied as a patch, and a bad file is reported
+//! while the defaults stay.
+
+use std::fmt;
+use std::path::Path;
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use serde::Deserialize;
+
+/// What a bound key does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Action {
+    Step,
+    Run,
+    Plan,
+    Instruction,
+    Approve,
+    Reject,
+    Edit,
+    Undo,
+    Verify,
+    Save,
+    Load,
+    Reset,
+    Help,
+    Quit,
+}
+
+/// A key with its modifiers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Key {
+    pub code: KeyCode,
+    pub modifiers: KeyModifiers,
+}
+
+impl Key {
+    pub const fn plain(c: char) -> Key {
+        Key {
+            code: KeyCode::Char(c),
+            modifiers: KeyModifiers::NONE,
+        }
+    }
+
+    /// Whether `event` is this key (Shift is ignored for characters: `?` arrives shifted).
+    pub fn matches(&self, event: &KeyEvent) -> bool {
+        let mods = match event.code {
+            KeyCode::Char(_) => event.modifiers - KeyModifiers::SHIFT,
+            _ => event.modifiers,
+        };
+        let want = match self.code {
+            KeyCode::Char(_) => self.modifiers - KeyModifiers::SHIFT,
+            _ => self.modifiers,
+        };
+        event.code == self.code && mods == want
+    }
+
+    /// `space`, `enter`, `esc`, `tab`, `backspace`, `f1`…`f12`, one character, each
+    /// optionally prefixed by `ctrl-` or `alt-`.
+    pub fn parse(text: &str) -> Result<Key, String> {
+        let mut modifiers = KeyModifiers::NONE;
+        let mut rest = text.trim();
+        loop {
+            let lower = rest.to_ascii_lowercase();
+            if lower.starts_with("ctrl-") && rest.len() > 5 {
+                modifiers |= KeyModifiers::CONTROL;
+                rest = &rest[5..];
+            } else if lower.starts_with("alt-") && rest.len() > 4 {
+                modifiers |= KeyModifiers::ALT;
+                rest = &rest[4..];
+            } else {
+                break;
+            }
+        }
+        let code = match rest.to_ascii_lowercase().as_str() {
+            "space" => KeyCode::Char(' '),
+            "enter" => KeyCode::Enter,
+            "esc" => KeyCode::Esc,
+            "tab" => KeyCode::Tab,
+            "backspace" => KeyCode::Backspace,
+            f if f.len() > 1 && f.starts_with('f') => match f[1..].parse::<u8>() {
+                Ok(n @ 1..=12) => KeyCode::F(n),
+                _ => return Err(format!("unknown key {text:?}")),
+            },
+            _ => {
+                let mut chars = rest.chars();
+                match (chars.next(), chars.next()) {
+                    (Some(c), None) => KeyCode::Char(c),
+                    _ => {
+                        return Err(format!(
+                            "unknown key {text:?} (expected one character, space, enter, esc, tab, backspace or f1-f12, optionally with ctrl- or alt-)"
+                        ));
+                    }
+                }
+            }
+        };
+        Ok(Key { code, modifiers })
+    }
+}
+
+impl fmt::Display for Key {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.modifiers.contains(KeyModifiers::CONTROL) {
+            f.write_str("ctrl-")?;
+        }
+        if self.modifiers.contains(KeyModifiers::ALT) {
+            f.write_str("alt-")?;
+        }
+        match self.code {
+            KeyCode::Char(' ') => f.write_str("space"),
+            KeyCode::Char(c) => write!(f, "{c}"),
+            KeyCode::Enter => f.write_str("enter"),
+            KeyCode::Esc => f.write_str("esc"),
+            KeyCode::Tab => f.write_str("tab"),
+            KeyCode::Backspace => f.write_str("backspace"),
+            KeyCode::F(n) => write!(f, "f{n}"),
+            other => write!(f, "{other:?}"),
+        }
+    }
+}
+
+macro_rules! bindings {
+    ($( $field:ident : $action:ident = $default:expr ),* $(,)?) => {
+        /// The key of every action.
+        #[derive(Debug, Clone, PartialEq, Eq)]
+        pub struct KeyBindings {
+            $( pub $field: Key, )*
+        }
+
+        impl Default for KeyBindings {
+            fn default() -> Self {
+                KeyBindings { $( $field: $default, )* }
+            }
+        }
+
+        /// A file of overrides: every field optional.
+        #[derive(Debug, Default, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Patch {
+            $( $field: Option<String>, )*
+        }
+
+        impl KeyBindings {
+            /// Every action with its key, in help order.
+            pub fn entries(&self) -> Vec<(Action, Key)> {
+                vec![ $( (Action::$action, self.$field), )* ]
+            }
+
+            fn apply(&mut self, patch: Patch) -> Result<(), String> {
+                $( if let Some(text) = patch.$field {
+                    self.$field = Key::parse(&text)
+                        .map_err(|e| format!("{}: {e}", stringify!($field)))?;
+                } )*
+                Ok(())
+            }
+        }
+    };
+}
+
+bindings! {
+    step: Step = Key::plain(' '),
+    run: Run = Key::plain('r'),
+    plan: Plan = Key::plain('p'),
+    instruction: Instruction = Key::plain('i'),
+    approve: Approve = Key::plain('a'),
+    reject: Reject = Key::plain('x'),
+    edit: Edit = Key::plain('e'),
+    undo: Undo = Key::plain('u'),
+    verify: Verify = Key::plain('v'),
+    save: Save = Key::plain('s'),
+    load: Load = Key::plain('l'),
+    reset: Reset = Key::plain('w'),
+    help: Help = Key::plain('?'),
+    quit: Quit = Key::plain('q'),
+}
+
+impl KeyBindings {
+    /// The action bound to `event`, if any.
+    pub fn action(&self, event: &KeyEvent) -> Option<Action> {
+        self.entries()
+            .into_iter()
+            .find(|(_, k)| k.matches(event))
+            .map(|(a, _)| a)
+    }
+
+    /// The key of `action`.
+    pub fn key(&self, action: Action) -> Option<Key> {
+        self.entries()
+            .into_iter()
+            .find(|(a, _)| *a == action)
+            .map(|(_, k)| k)
+    }
+
+    /// The defaults patched by a TOML text; two actions may not share a key.
+    pub fn from_toml(text: &str) -> Result<KeyBindings, String> {
+        let patch: Patch = toml::from_str(text).map_err(|e| e.to_string())?;
+        let mut keys = KeyBindings::default();
+        keys.apply(patch)?;
+        let entries = keys.entries();
+        for (i, (a, k)) in entries.iter().enumerate() {
+            if let Some((b, _)) = entries[..i].iter().find(|(_, other)| other == k) {
+                return Err(format!("{k} is bound to both {b:?} and {a:?}"));
+            }
+        }
+        Ok(keys)
+    }
+
+    /// The bindings from `path` when it exists, else the defaults; with the reason a file
+    /// was not used.
+    pub fn load(path: &Path) -> (KeyBindings, Option<String>) {
+        match std::fs::read_to_string(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => (KeyBindings::default(), None),
+            Err(e) => (
+                KeyBindings::default(),
+                Some(format!("{}: {e}", path.display())),
+            ),
+            Ok(text) => match KeyBindings::from_toml(&text) {
+                Ok(k) => (k, None),
+                Err(e) => (
+                    KeyBindings::default(),
+                    Some(format!("{}: {e}", path.display())),
+                ),
+            },
+        }
+    }
+
+    /// The help overlay's lines: every binding, then the fixed navigation keys.
+    pub fn help_lines(&self) -> Vec<(String, &'static str)> {
+        let mut lines: Vec<(String, &'static str)> = self
+            .entries()
+            .into_iter()
+            .map(|(a, k)| (k.to_string(), super::strings::action_help(a)))
+            .collect();
+        lines.extend(
+            super::strings::NAVIGATION
+                .iter()
+                .map(|(k, what)| ((*k).to_string(), *what)),
+        );
+        lines
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn press(c: char, modifiers: KeyModifiers) -> KeyEvent {
+        KeyEvent::new(KeyCode::Char(c), modifiers)
+    }
+
+    #[test]
+    fn defaults_match_the_issue() {
+        let k = KeyBindings::default();
+        let text: Vec<String> = k.entries().iter().map(|(_, k)| k.to_string()).collect();
+        assert_eq!(
+            text,
+            [
+                "space", "r", "p", "i", "a", "x", "e", "u", "v", "s", "l", "w", "?", "q"
+            ]
+        );
+        assert_eq!(
+            k.action(&press('?', KeyModifiers::SHIFT)),
+            Some(Action::Help)
+        );
+        assert_eq!(k.action(&press('q', KeyModifiers::CONTROL)), None);
+    }
+
+    #[test]
+    fn overrides_patch_the_defaults_and_bad_files_are_refused() {
+        let k = KeyBindings::from_toml("step = \"n\"\nquit = \"ctrl-q\"\n").unwrap();
+        assert_eq!(
+            k.action(&press('n', KeyModifiers::NONE)),
+            Some(Action::Step)
+        );
+        assert_eq!(
+            k.action(&press('q', KeyModifiers::CONTROL)),
+            Some(Action::Quit)
+        );
+        assert_eq!(k.run, Key::plain('r'));
+        assert!(KeyBindings::from_toml("jump = \"j\"").is_err());
+        assert!(
+            KeyBindings::from_toml("step = \"banana\"")
+                .unwrap_err()
+                .contains("step")
+        );
+        assert!(
+            KeyBindings::from_toml("step = \"q\"")
+                .unwrap_err()
+                .contains("bound to both")
+        );
+        let help = KeyBindings::default().help_lines();
+        assert!(
+            help.iter()
+                .any(|(k, what)| k == "space" && what.contains("tick"))
+        );
+    }
+}

@@ -1,0 +1,97 @@
+//! The workbench: a ratatui + crossterm front end over a session [`Engine`].
+//!
+//! Laid out like gitui: one app state (`app`), pure drawing of that state (`ui` and the
+//! components' `draw`), components that handle keys and queue app events, key bindings
+//! that also generate the help overlay (`keys`), colours (`theme`) and every user-facing
+//! text (`strings`). The session knows nothing of this module.
+//!
+//! The terminal is restored on every exit path: a guard's `Drop` on normal returns and
+//! errors, and a panic hook (installed before raw mode is entered) on panics.
+
+pub mod app;
+pub mod components;
+pub mod event_loop;
+pub mod keys;
+pub mod strings;
+pub mod theme;
+pub mod ui;
+
+use std::io::{Stdout, stdout};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crossterm::cursor::{Hide, Show};
+use crossterm::execute;
+use crossterm::terminal::{
+    EnterAlternateScreen, LeaveAlternateScreen, disable_raw_mode, enable_raw_mode,
+};
+use ratatui::Terminal;
+use ratatui::backend::CrosstermBackend;
+
+use crate::session::{Engine, SessionError, Setup};
+
+pub use app::{App, Info};
+pub use keys::KeyBindings;
+pub use theme::Theme;
+
+#[derive(Debug, thiserror::Error)]
+pub enum TuiError {
+    #[error("terminal: {0}")]
+    Terminal(#[from] std::io::Error),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+}
+
+/// Puts the terminal back as it was (raw mode off, main screen, cursor shown) when
+/// dropped; safe to run more than once.
+pub struct TerminalGuard;
+
+impl TerminalGuard {
+    /// Raw mode, alternate screen, hidden cursor; and a panic hook that restores them.
+    pub fn enter() -> std::io::Result<(TerminalGuard, Terminal<CrosstermBackend<Stdout>>)> {
+        install_panic_hook();
+        let guard = TerminalGuard;
+        enable_raw_mode()?;
+        execute!(stdout(), EnterAlternateScreen, Hide)?;
+        let terminal = Terminal::new(CrosstermBackend::new(stdout()))?;
+        Ok((guard, terminal))
+    }
+}
+
+impl Drop for TerminalGuard {
+    fn drop(&mut self) {
+        restore();
+    }
+}
+
+/// Leave raw mode and the alternate screen and show the cursor; errors are ignored (this
+/// runs on the way out, where nothing better can be done).
+pub fn restore() {
+    let _ = disable_raw_mode();
+    let _ = execute!(stdout(), LeaveAlternateScreen, Show);
+}
+
+fn install_panic_hook() {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        restore();
+        previous(info);
+    }));
+}
+
+/// Open the workbench on `setup` until the person quits.
+pub async fn run(
+    setup: Setup,
+    info: Info,
+    keys: KeyBindings,
+    theme: Theme,
+) -> Result<(), TuiError> {
+    let (engine, mut events) = Engine::spawn(setup)?;
+    let mut app = App::new(info, keys, theme);
+    let (_guard, mut terminal) = TerminalGuard::enter()?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let mut input = event_loop::spawn_input_reader(stop.clone());
+    event_loop::run(&mut terminal, &mut app, &engine, &mut events, &mut input).await;
+    stop.store(true, Ordering::Relaxed);
+    Ok(())
+}

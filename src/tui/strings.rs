@@ -1,0 +1,118 @@
+//! Every user-facing text of the workbench, in one place.
+
+use crate::bt::Status;
+
+pub const TREE_TITLE: &str = " Behavior tree ";
+pub const TREE_EMPTY: &str = "No tree yet. Press i to type an instruction (or a goal formula), or p to plan the scenario's goal.";
+pub const LLM_TITLE: &str = " LLM ";
+pub const WORLD_TITLE: &str = " World ";
+pub const INPUT_TITLE_IDLE: &str = " Input ";
+pub const INPUT_TITLE_INSTRUCTION: &str = " Instruction or goal (Enter submits, Esc cancels) ";
+pub const INPUT_TITLE_EDIT: &str = " Edit the proposal (Enter applies, Esc cancels) ";
+pub const INPUT_HINT: &str = "press i to type an instruction, ? for help";
+pub const HELP_TITLE: &str = " Keys ";
+pub const HELP_FOOTER: &str = "Press any key to close.";
+pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
+
+pub const NOW_TRUE: &str = "True now:";
+pub const NOTHING_TRUE: &str = "  (nothing)";
+pub const OBJECTS: &str = "Objects:";
+pub const LAST_ERROR: &str = "Last error:";
+pub const REASONING: &str = "Reasoning:";
+pub const PROPOSAL_FOR: &str = "Proposal for";
+pub const NO_PROPOSAL: &str = "No proposal pending.";
+pub const ASKING: &str = "asking the model for";
+pub const REPLY_FROM: &str = "reply from";
+pub const GOAL: &str = "Goal:";
+pub const LOG: &str = "Log";
+
+pub const RUNNING: &str = "running";
+pub const PAUSED: &str = "paused";
+pub const AUTO_APPROVE: &str = "AUTO-APPROVE";
+pub const SUCCESS: &str = "SUCCESS";
+pub const FAILED: &str = "FAILED";
+pub const HELP_WORD: &str = "help";
+pub const NEW_MARK: &str = "+";
+pub const FAILED_MARK: &str = "◀ failed";
+
+/// One line per navigation key (fixed, not rebindable).
+pub const NAVIGATION: &[(&str, &str)] = &[
+    ("↑ ↓ / k j", "move in the tree"),
+    ("← →", "collapse / expand a node"),
+    ("Enter", "toggle a node"),
+    ("PgUp PgDn Home End", "scroll the tree"),
+    ("Ctrl-C", "quit"),
+];
+
+/// What a key-bound action does, for the help overlay.
+pub fn action_help(action: super::keys::Action) -> &'static str {
+    use super::keys::Action::*;
+    match action {
+        Step => "step one tick",
+        Run => "run / pause",
+        Plan => "plan (the typed goal, else the scenario's)",
+        Instruction => "type an instruction or a goal formula",
+        Approve => "approve the proposal",
+        Reject => "reject the proposal",
+        Edit => "edit the proposal (or type conditions yourself)",
+        Undo => "undo the last expansion",
+        Verify => "verify the tree",
+        Save => "save the policy",
+        Load => "load the saved policy",
+        Reset => "reset the world",
+        Help => "show / hide this help",
+        Quit => "quit",
+    }
+}
+
+pub fn status_word(status: Status) -> &'static str {
+    match status {
+        Status::Idle => "not ticked",
+        Status::Running => "running",
+        Status::Success => "success",
+        Status::Failure => "failure",
+        Status::Halted => "halted",
+    }
+}
+
+pub fn calls(n: usize, tokens: u64, price: f64) -> String {
+    format!("{n} call(s), {tokens} tok, ${price:.4}")
+}
+
+pub fn tick(n: u64) -> String {
+    format!("tick {n}")
+}
+
+pub fn failed(action: &str, error: &str) -> String {
+    format!("{action}! failed: {error}")
+}
+
+pub fn policy_loaded(path: &str, fixes: usize) -> String {
+    format!("loaded policy {path}: {fixes} approved fix(es), no LLM call needed")
+}
+
+pub fn policy_saved(path: &str, fixes: usize) -> String {
+    format!("saved policy {path} ({fixes} fix(es))")
+}
+
+pub fn repaired(added: usize, valued: usize) -> String {
+    if valued == 0 {
+        format!("repaired: {added} node(s) added")
+    } else {
+        format!("repaired: value set on {valued} action(s), {added} node(s) added")
+    }
+}
+
+pub fn success(ticks: u64) -> String {
+    format!("SUCCESS after {ticks} tick(s)")
+}
+
+pub fn no_model(why: &str) -> String {
+    format!(
+        "No language model: {why}. You can still type goal formulas, plan, tick, and type conditions with e."
+    )
+}
+
+pub fn keys_file_error(error: &str) -> String {
+    format!("key bindings file ignored (defaults kept): {error}")
+}

@@ -1,0 +1,55 @@
+//! The screen as a function of the app state: tree on the left, LLM and world on the
+//! right, the input line and the status bar below; overlays on top. Narrow terminals
+//! stack the panes.
+
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Layout};
+
+use super::app::{App, Overlay};
+use super::components::help::{draw_help, draw_report};
+use super::keys::Action;
+
+pub fn draw(frame: &mut Frame, app: &mut App) {
+    let area = frame.area();
+    let [main, input, status] = Layout::vertical([
+        Constraint::Min(3),
+        Constraint::Length(3),
+        Constraint::Length(1),
+    ])
+    .areas(area);
+    let (tree_area, llm_area, world_area) = if main.width >= 70 {
+        let [left, right] =
+            Layout::horizontal([Constraint::Percentage(55), Constraint::Percentage(45)])
+                .areas(main);
+        let [llm, world] =
+            Layout::vertical([Constraint::Percentage(60), Constraint::Percentage(40)]).areas(right);
+        (left, llm, world)
+    } else {
+        let [tree, llm, world] = Layout::vertical([
+            Constraint::Percentage(50),
+            Constraint::Percentage(30),
+            Constraint::Percentage(20),
+        ])
+        .areas(main);
+        (tree, llm, world)
+    };
+    let theme = app.theme;
+    let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+    let hint = format!(
+        "{} approve · {} reject · {} edit",
+        key(Action::Approve),
+        key(Action::Reject),
+        key(Action::Edit)
+    );
+    let help_key = key(Action::Help);
+    app.tree.draw(frame, tree_area, &theme);
+    app.llm.draw(frame, llm_area, &theme, &hint);
+    app.world.draw(frame, world_area, &theme);
+    app.input.draw(frame, input, &theme);
+    app.status.draw(frame, status, &theme, &help_key);
+    match &app.overlay {
+        Some(Overlay::Help) => draw_help(frame, area, &app.keys, &theme),
+        Some(Overlay::Report(lines)) => draw_report(frame, area, lines, &theme),
+        None => {}
+    }
+}

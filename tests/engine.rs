@@ -1,0 +1,357 @@
+//! The session engine, headless, on scenario 1 (red cube on the blue cube) with an
+//! in-process model answering from the hand-written fixtures: submit → plan → tick to the
+//! failure → proposal pending (tree untouched) → approve → tree changed with new nodes →
+//! run → success; reject; an invalid edit; undo; a slow model call that does not block
+//! ticks; a saved policy that makes the next session need no model call; no model at all.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+use betr::bt::{self, NodeKind};
+use betr::domain::Scenario;
+use betr::llm::LanguageModel;
+use betr::session::{Command, Engine, EngineHandle, Event, PolicyStore, Setup};
+use support::fake_model::FixtureModel;
+use support::fixtures;
+use tokio::sync::mpsc::UnboundedReceiver;
+
+const INSTRUCTION: &str = "Put the blue cube on the green cube";
+const FIX: &str = "~\"any object\" on \"blue cube\"";
+
+fn scenario_path() -> PathBuf {
+    fixtures::root().join("scenarios/cell/red_on_blue.toml")
+}
+
+fn model(delay: Duration) -> FixtureModel {
+    let mut m = FixtureModel::new(fixtures::every_reply());
+    m.delay = delay;
+    m
+}
+
+fn setup(model: Result<Arc<dyn LanguageModel>, String>, policies: Option<PathBuf>) -> Setup {
+    let path = scenario_path();
+    let scenario = Arc::new(Scenario::load(&path).unwrap());
+    Setup {
+        policies: policies.map(PolicyStore::new),
+        ..Setup::new(scenario, path, model)
+    }
+}
+
+struct Session {
+    engine: EngineHandle,
+    events: UnboundedReceiver<Event>,
+    seen: Vec<Event>,
+}
+
+impl Session {
+    fn start(setup: Setup) -> Session {
+        let (engine, events) = Engine::spawn(setup).unwrap();
+        Session {
+            engine,
+            events,
+            seen: Vec::new(),
+        }
+    }
+
+    fn send(&self, c: Command) {
+        assert!(self.engine.send(c));
+    }
+
+    /// Events up to and including the first that matches; panics after 20 s.
+    async fn until(&mut self, what: &str, pred: impl Fn(&Event) -> bool) -> Vec<Event> {
+        let mut got = Vec::new();
+        let wait = async {
+            loop {
+                let e = self.events.recv().await.expect("the engine stopped");
+                got.push(e.clone());
+                self.seen.push(e.clone());
+                if pred(&e) {
+                    return;
+                }
+            }
+        };
+        if tokio::time::timeout(Duration::from_secs(20), wait)
+            .await
+            .is_err()
+        {
+            panic!("timed out waiting for {what}; got {got:#?}");
+        }
+        got
+    }
+
+    /// Submit the instruction and tick until the grasp fails and a proposal is pending.
+    async fn run_to_proposal(&mut self) -> Vec<Event> {
+        self.send(Command::Submit(INSTRUCTION.into()));
+        self.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        let mut ticks = 0;
+        loop {
+            self.send(Command::Tick);
+            let got = self
+                .until("a tick", |e| matches!(e, Event::Ticked { .. }))
+                .await;
+            ticks += 1;
+            if self
+                .seen
+                .iter()
+                .any(|e| matches!(e, Event::ActionFailed { .. }))
+            {
+                break;
+            }
+            assert!(ticks < 20, "no failure after 20 ticks: {got:#?}");
+        }
+        if !self
+            .seen
+            .iter()
+            .any(|e| matches!(e, Event::Proposal { .. }))
+        {
+            self.until("the proposal", |e| matches!(e, Event::Proposal { .. }))
+                .await;
+        }
+        let failed_at = self
+            .seen
+            .iter()
+            .position(|e| matches!(e, Event::ActionFailed { .. }))
+            .unwrap_or(0);
+        self.seen[failed_at..].to_vec()
+    }
+}
+
+fn rt() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+fn tree_of(events: &[Event]) -> Option<(Arc<bt::Tree>, Vec<bt::NodeId>)> {
+    events.iter().rev().find_map(|e| match e {
+        Event::TreeChanged {
+            tree, new_nodes, ..
+        } => Some((tree.clone(), new_nodes.clone())),
+        _ => None,
+    })
+}
+
+#[test]
+fn submit_plan_fail_propose_approve_run_to_success() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        let got = s.run_to_proposal().await;
+        let failed = s.seen.iter().find_map(|e| match e {
+            Event::ActionFailed { action, error, .. } => Some((action.to_string(), error.clone())),
+            _ => None,
+        });
+        assert_eq!(
+            failed,
+            Some((
+                "grasp \"blue cube\"".to_string(),
+                "No collision free path found".to_string()
+            ))
+        );
+        // Nothing proposed changes the tree before approval.
+        assert!(!got.iter().any(|e| matches!(e, Event::TreeChanged { .. })));
+        let planned = tree_of(&s.seen).unwrap().0;
+        s.send(Command::Approve);
+        let got = s
+            .until("the repaired tree", |e| {
+                matches!(e, Event::TreeChanged { .. })
+            })
+            .await;
+        let (tree, new_nodes) = tree_of(&got).unwrap();
+        assert!(tree.len() > planned.len());
+        assert!(!new_nodes.is_empty());
+        let inserted = new_nodes
+            .iter()
+            .any(|n| matches!(tree.kind(*n), Ok(NodeKind::Condition(c)) if c.to_string() == FIX));
+        assert!(inserted, "{}", bt::to_text(&tree));
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        let usage = s.seen.iter().rev().find_map(|e| match e {
+            Event::Usage { totals } => Some(*totals),
+            _ => None,
+        });
+        assert_eq!(usage.map(|u| u.calls), Some(2), "goal + failure question");
+    });
+}
+
+#[test]
+fn reject_leaves_the_tree_and_an_invalid_edit_is_refused() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        s.send(Command::Reject);
+        s.until("rejected", |e| matches!(e, Event::Rejected)).await;
+        s.send(Command::Edit("\"purple cube\" on \"blue cube\"".into()));
+        let got = s
+            .until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(format!("{got:?}").contains("purple cube"), "{got:?}");
+        s.send(Command::Edit("~\"blue cube\" on \"blue cube\" | ".into()));
+        s.until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        // Neither the rejection nor the bad edits changed the tree.
+        let changes = s
+            .seen
+            .iter()
+            .filter(|e| matches!(e, Event::TreeChanged { .. }))
+            .count();
+        assert_eq!(changes, 1, "only the planned tree");
+        // A valid edit is applied like an approved proposal.
+        s.send(Command::Edit(FIX.into()));
+        let got = s
+            .until("the edited tree", |e| {
+                matches!(e, Event::TreeChanged { .. })
+            })
+            .await;
+        assert!(!tree_of(&got).unwrap().1.is_empty());
+    });
+}
+
+#[test]
+fn undo_restores_the_tree_before_the_last_expansion() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        let planned = bt::to_text(&tree_of(&s.seen).unwrap().0);
+        s.send(Command::Approve);
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Undo);
+        let got = s
+            .until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        assert_eq!(bt::to_text(&tree_of(&got).unwrap().0), planned);
+        s.send(Command::Undo);
+        s.until("nothing to undo", |e| matches!(e, Event::Error { .. }))
+            .await;
+    });
+}
+
+#[test]
+fn a_slow_model_call_does_not_block_ticks() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::from_secs(30)))), None));
+        s.send(Command::Submit(INSTRUCTION.into()));
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        for _ in 0..10 {
+            s.send(Command::Tick);
+            s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
+                .await;
+            if s.seen
+                .iter()
+                .any(|e| matches!(e, Event::Asking { what } if what.contains("preconditions")))
+            {
+                break;
+            }
+        }
+        // The failure question is under way for 30 s; ticks are answered meanwhile.
+        let start = std::time::Instant::now();
+        for _ in 0..5 {
+            s.send(Command::Tick);
+            s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
+                .await;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "{:?}",
+            start.elapsed()
+        );
+        assert!(!s.seen.iter().any(|e| matches!(e, Event::Proposal { .. })));
+        // Re-planning cancels the call.
+        s.send(Command::Plan);
+        s.until("re-planned", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        assert!(
+            s.seen
+                .iter()
+                .any(|e| matches!(e, Event::Notice { message } if message.contains("cancelled")))
+        );
+    });
+}
+
+#[test]
+fn a_saved_policy_needs_no_model_call_next_time() {
+    let dir = std::env::temp_dir().join(format!("betr-engine-policy-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    rt().block_on(async {
+        let mut s = Session::start(setup(
+            Ok(Arc::new(model(Duration::ZERO))),
+            Some(dir.clone()),
+        ));
+        s.run_to_proposal().await;
+        s.send(Command::Approve);
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::SavePolicy);
+        let got = s
+            .until("saved", |e| matches!(e, Event::PolicySaved { .. }))
+            .await;
+        let Some(Event::PolicySaved { path, fixes }) = got.last() else {
+            unreachable!()
+        };
+        assert_eq!(*fixes, 1);
+        let text = std::fs::read_to_string(path).unwrap();
+        assert!(
+            text.contains("# instruction: Put the blue cube on the green cube"),
+            "{text}"
+        );
+        assert!(text.contains(&format!("# fix 1: insert {FIX}")), "{text}");
+        assert!(text.contains("hand-written fixture"), "{text}");
+        assert!(text.contains("approved by a person"), "{text}");
+
+        let fresh = model(Duration::ZERO);
+        let calls = fresh.calls();
+        let mut again = Session::start(setup(Ok(Arc::new(fresh)), Some(dir.clone())));
+        again.send(Command::Submit(INSTRUCTION.into()));
+        let got = again
+            .until("loaded", |e| matches!(e, Event::PolicyLoaded { .. }))
+            .await;
+        assert!(matches!(
+            got.last(),
+            Some(Event::PolicyLoaded { fixes: 1, .. })
+        ));
+        again.send(Command::Run);
+        again
+            .until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
+    });
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn without_a_model_a_person_can_still_resolve() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(
+            Err("the local backend is not built yet".into()),
+            None,
+        ));
+        s.send(Command::Submit(INSTRUCTION.into()));
+        let got = s
+            .until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(format!("{got:?}").contains("not built yet"), "{got:?}");
+        s.send(Command::Submit("\"blue cube\" on \"green cube\"".into()));
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        s.until("the failure", |e| matches!(e, Event::ActionFailed { .. }))
+            .await;
+        s.send(Command::Edit(FIX.into()));
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+    });
+}

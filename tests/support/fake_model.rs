@@ -1,0 +1,77 @@
+//! An in-process language model for engine and screen tests: answers with the first
+//! hand-written fixture whose `when` strings all occur in the prompt, optionally after a
+//! delay, and counts its calls. Its replies are labelled as fixtures, never as a model's.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+
+use betr::llm::{
+    ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, ReplySource, TokenUsage,
+};
+
+use super::fixtures::FixtureReply;
+
+pub struct FixtureModel {
+    replies: Vec<FixtureReply>,
+    /// Delay before answering a failure question (goal questions answer at once).
+    pub delay: Duration,
+    pub calls: Arc<AtomicUsize>,
+}
+
+impl FixtureModel {
+    pub fn new(replies: Vec<FixtureReply>) -> FixtureModel {
+        FixtureModel {
+            replies,
+            delay: Duration::ZERO,
+            calls: Arc::default(),
+        }
+    }
+
+    pub fn calls(&self) -> Arc<AtomicUsize> {
+        self.calls.clone()
+    }
+}
+
+impl LanguageModel for FixtureModel {
+    fn model(&self) -> &str {
+        "fixture-model"
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            self.calls.fetch_add(1, Ordering::SeqCst);
+            let prompt: String = request
+                .messages
+                .iter()
+                .map(|m| m.content.as_str())
+                .collect::<Vec<_>>()
+                .join("\n");
+            if prompt.contains("# Task: failure resolution") && !self.delay.is_zero() {
+                tokio::time::sleep(self.delay).await;
+            }
+            let Some(f) = self
+                .replies
+                .iter()
+                .find(|f| f.when.iter().all(|w| prompt.contains(w.as_str())))
+            else {
+                return Err(LlmError::MalformedReply {
+                    url: "fixture-model".into(),
+                    detail: "no fixture reply for this prompt".into(),
+                });
+            };
+            Ok(ChatReply {
+                text: f.text.clone(),
+                model: "fixture-model".into(),
+                usage: TokenUsage {
+                    prompt_tokens: 100,
+                    completion_tokens: 20,
+                },
+                latency: Duration::ZERO,
+                source: ReplySource::HandWritten {
+                    note: "tests/fixtures/replies".into(),
+                },
+            })
+        })
+    }
+}

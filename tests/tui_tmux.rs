@@ -1,0 +1,239 @@
+//! End to end, as a person would: the real `betr` binary in tmux, the model answered by
+//! the fake OpenAI server from hand-written fixtures. Type the instruction of scenario 1,
+//! step ticks until the grasp fails, see the proposal, approve it, run to success, save
+//! the policy, quit; the screen is checked at each step (polling `capture-pane` with a
+//! timeout), then the restored terminal, the exit status and the saved policy.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+use betr::domain::Scenario;
+use support::cli::{KEY, KEY_VAR, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures;
+
+/// A tmux server of our own (its own socket), killed when dropped.
+struct Tmux {
+    socket: String,
+    session: String,
+}
+
+impl Tmux {
+    fn run(&self, args: &[&str]) -> Output {
+        Command::new("tmux")
+            .arg("-L")
+            .arg(&self.socket)
+            .args(args)
+            .output()
+            .expect("tmux is required for this test (scripts/test.sh installs it)")
+    }
+
+    fn start(command: &str) -> Tmux {
+        let t = Tmux {
+            socket: format!("betr-test-{}", std::process::id()),
+            session: "betr".into(),
+        };
+        let out = t.run(&[
+            "new-session",
+            "-d",
+            "-s",
+            &t.session,
+            "-x",
+            "120",
+            "-y",
+            "40",
+            command,
+        ]);
+        assert!(
+            out.status.success(),
+            "tmux: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        t
+    }
+
+    fn screen(&self) -> String {
+        String::from_utf8_lossy(
+            &self
+                .run(&["capture-pane", "-p", "-t", &self.session])
+                .stdout,
+        )
+        .into_owned()
+    }
+
+    fn keys(&self, keys: &[&str]) {
+        let mut args = vec!["send-keys", "-t", &self.session];
+        args.extend_from_slice(keys);
+        assert!(self.run(&args).status.success());
+    }
+
+    fn text(&self, text: &str) {
+        assert!(
+            self.run(&["send-keys", "-t", &self.session, "-l", text])
+                .status
+                .success()
+        );
+    }
+
+    /// Poll the screen until it contains every one of `wanted`; panic with the screen
+    /// after `secs` seconds.
+    fn wait_for(&self, wanted: &[&str], secs: u64) -> String {
+        let deadline = Instant::now() + Duration::from_secs(secs);
+        loop {
+            let screen = self.screen();
+            if wanted.iter().all(|w| screen.contains(w)) {
+                return screen;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "timed out waiting for {wanted:?}; the screen:\n{screen}"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = self.run(&["kill-server"]);
+    }
+}
+
+fn quote(p: &Path) -> String {
+    format!("'{}'", p.display())
+}
+
+#[test]
+fn a_person_resolves_scenario_1_in_the_workbench() {
+    let started = Instant::now();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux");
+    let policies = dir.join("policies");
+    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    let command = format!(
+        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {bin} tui {scenario} --backend openai \
+         --base-url {url} --model fake-model --api-key-env {KEY_VAR} --policy-dir {policies} \
+         --usage-log usage.jsonl --tick-ms 50; echo \"betr exited with status $?\"; sleep 60",
+        dir = quote(&dir),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+        scenario = quote(&scenario),
+        url = server.base_url(),
+        policies = quote(&policies),
+    );
+    let tmux = Tmux::start(&command);
+
+    // The workbench opens on scenario 1 with the configured model.
+    tmux.wait_for(
+        &[
+            "Behavior tree",
+            "press i to type an instruction",
+            "red_on_blue",
+            "openai fake-model",
+        ],
+        20,
+    );
+
+    // Type the instruction.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("Put the blue cube on the green cube");
+    tmux.wait_for(&["> Put the blue cube on the green cube"], 10);
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for(
+        &[
+            "Goal: \"blue cube\" on \"green cube\"",
+            "grasp \"blue cube\"!",
+            "[o] Fallback",
+        ],
+        20,
+    );
+    assert!(screen.contains("1 call(s)"), "{screen}");
+
+    // Step until the grasp fails.
+    let mut failed = false;
+    for n in 1..=10 {
+        tmux.keys(&["Space"]);
+        let screen = tmux.wait_for(&[&format!("tick {n}")], 10);
+        if screen.contains("◀ failed") {
+            failed = true;
+            break;
+        }
+    }
+    assert!(failed, "the grasp never failed:\n{}", tmux.screen());
+    let screen = tmux.wait_for(
+        &[
+            "grasp \"blue cube\"! ◀ failed",
+            "No collision free path",
+            "Proposal for grasp \"blue cube\"!:",
+            "~\"any object\" on \"blue cube\"",
+            "a approve · x reject · e edit",
+        ],
+        20,
+    );
+    assert!(screen.contains("hand-written fixture"), "{screen}");
+
+    // Approve: the tree grows, the new nodes marked.
+    tmux.keys(&["a"]);
+    tmux.wait_for(
+        &[
+            "repaired:",
+            "+[-] ~\"any object\" on \"blue cube\"?",
+            "place \"red cube\"",
+        ],
+        20,
+    );
+
+    // Run to success.
+    tmux.keys(&["r"]);
+    tmux.wait_for(&["SUCCESS", "\"blue cube\" on \"green cube\""], 30);
+
+    // Save the policy, then quit.
+    tmux.keys(&["s"]);
+    tmux.wait_for(&["saved policy"], 10);
+    tmux.keys(&["q"]);
+    let screen = tmux.wait_for(&["betr exited with status 0"], 10);
+    assert!(
+        !screen.contains("Behavior tree"),
+        "the alternate screen was left:\n{screen}"
+    );
+
+    // The policy parses and says where its fix came from.
+    let files: Vec<PathBuf> = std::fs::read_dir(&policies)
+        .unwrap()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let domain = Scenario::load(&scenario).unwrap().domain;
+    let policy = betr::session::policy::load(&files[0], &domain).unwrap();
+    assert_eq!(policy.fixes.len(), 1);
+    assert!(
+        policy.fixes[0]
+            .change
+            .contains("~\"any object\" on \"blue cube\"")
+    );
+    assert!(policy.fixes[0].model.contains("hand-written fixture"));
+    assert_eq!(policy.goal, "\"blue cube\" on \"green cube\"");
+    // The key never reaches a written file.
+    for f in support::cli::files_under(&dir) {
+        let bytes = std::fs::read(&f).unwrap_or_default();
+        assert!(
+            !String::from_utf8_lossy(&bytes).contains(KEY),
+            "{}",
+            f.display()
+        );
+    }
+    assert!(
+        started.elapsed() < Duration::from_secs(60),
+        "{:?}",
+        started.elapsed()
+    );
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
