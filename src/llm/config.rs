@@ -261,8 +261,13 @@ impl Settings {
             }
         };
         Ok(Settings {
-            // Offline by default: the embedded model needs no key and no network.
-            backend: layer.backend.unwrap_or(Backend::Local),
+            // Offline by default: the embedded model needs no key and no network. A base
+            // URL given without a backend can only mean an HTTP server.
+            backend: layer.backend.unwrap_or(if layer.base_url.is_some() {
+                Backend::Openai
+            } else {
+                Backend::Local
+            }),
             base_url: layer
                 .base_url
                 .unwrap_or_else(|| "https://api.openai.com/v1".into()),

@@ -126,13 +126,27 @@ impl Context<'_> {
     }
 
     /// The failure-resolution request for `action`, which failed with `error`.
+    /// `tried`: proposals for this same failure that did not fix it (reflective feedback,
+    /// so a repeated question does not get the same answer).
     pub fn resolve(
         &self,
         templates: &Templates,
         action: &ActionCall,
         error: &str,
+        tried: &[String],
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
+        values.push((
+            "tried",
+            if tried.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "\nAlready tried, and the action still failed after each; propose something else:\n{}\n",
+                    tried.iter().map(|t| format!("- {t}")).collect::<Vec<_>>().join("\n")
+                )
+            },
+        ));
         let pre: Vec<String> = self
             .scenario
             .domain

@@ -127,19 +127,32 @@ pub fn missing_value<'a>(
 
 pub(crate) type Asked = Option<(Proposal, Option<String>, Vec<Substitution>)>;
 
+/// A failed action as the question about it needs it.
+pub(crate) struct FailedAction<'a> {
+    pub node: NodeId,
+    pub action: &'a ActionCall,
+    pub error: &'a str,
+    /// Changes already tried for this failure that did not fix it.
+    pub tried: &'a [String],
+}
+
 pub(crate) async fn ask_conditions(
     ctx: &Context<'_>,
     model: &dyn LanguageModel,
     options: &Options,
-    node: NodeId,
-    action: &ActionCall,
-    error: &str,
+    failed: &FailedAction<'_>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
+    let FailedAction {
+        node,
+        action,
+        error,
+        tried,
+    } = *failed;
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
-    let messages = ctx.resolve(&options.templates, action, error)?;
+    let messages = ctx.resolve(&options.templates, action, error, tried)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
     let conditions_grammar = || grammar::conditions_grammar(vocabulary, true);
     let r = ask(

@@ -42,16 +42,10 @@ impl Engine {
         let result = apply(&planner, &tree, &pending.proposal, self.planning.as_ref());
         let (plan, valued_nodes) = match result {
             Ok(r) => r,
-            Err(e) => {
-                self.emit(Event::DidNotHelp {
-                    reason: e.to_string(),
-                });
-                return self.reset_world(false);
-            }
+            Err(e) => return self.did_not_help(&pending, &tree, before.as_ref(), e.to_string()),
         };
         if let Err(reason) = helped(before.as_ref(), &plan.outcome) {
-            self.emit(Event::DidNotHelp { reason });
-            return self.reset_world(false);
+            return self.did_not_help(&pending, &tree, before.as_ref(), reason);
         }
         self.emit(Event::Repaired {
             added_nodes: plan.new_nodes.len(),
@@ -72,6 +66,54 @@ impl Engine {
         self.failure = None;
         let why = format!("{} ({})", change, approval_text(approval));
         self.set_tree(plan.tree, plan.new_nodes, why);
+    }
+
+    /// A change that did not fix the failure: remember it for the next question about the
+    /// same failure, and when it named several conditions, look in simulation (no model
+    /// call) for a part of it that does fix the failure and offer that as a new proposal.
+    fn did_not_help(
+        &mut self,
+        pending: &Pending,
+        tree: &Tree,
+        before: Option<&Failure>,
+        reason: String,
+    ) {
+        if let Some(f) = before {
+            self.tried
+                .push((f.clone(), format!("{} ({reason})", pending.proposal)));
+        }
+        self.emit(Event::DidNotHelp { reason });
+        let planner = Planner::new(&self.scenario.domain);
+        match narrowed(
+            &planner,
+            tree,
+            &pending.proposal,
+            before,
+            self.planning.as_ref(),
+        ) {
+            Some((proposal, dropped)) => {
+                let dropped: Vec<String> = dropped.iter().map(ToString::to_string).collect();
+                self.emit(Event::Proposal {
+                    proposal: proposal.clone(),
+                    reasoning: Some(format!(
+                        "In simulation, the proposal works without {}: only the rest fixes the failure.",
+                        dropped.join(" & ")
+                    )),
+                    substitutions: Vec::new(),
+                });
+                self.pending = Some(Pending {
+                    proposal,
+                    author: format!("simulation, narrowed from {}", pending.author),
+                    failure: before.cloned(),
+                });
+                if self.auto_approve {
+                    self.apply_pending(Approval::Auto);
+                } else {
+                    self.reset_world(false);
+                }
+            }
+            None => self.reset_world(false),
+        }
     }
 
     /// What a person wrote for the pending proposal (or the current failure): validated
@@ -258,4 +300,55 @@ fn helped(before: Option<&Failure>, after: &Outcome) -> Result<(), String> {
         )),
         (_, Outcome::Exhausted { reason }) => Err(format!("after the change, {reason}")),
     }
+}
+
+/// The largest part of a multi-condition proposal that fixes the failure in simulation,
+/// and the conditions it leaves out.
+fn narrowed(
+    planner: &Planner,
+    tree: &Tree,
+    proposal: &Proposal,
+    before: Option<&Failure>,
+    world: &dyn crate::world::World,
+) -> Option<(Proposal, Vec<crate::domain::Condition>)> {
+    let Proposal::Conditions {
+        action,
+        node,
+        conditions,
+    } = proposal
+    else {
+        return None;
+    };
+    // Proposals hold a few conditions (the grammar allows two); larger ones are not split.
+    let n = conditions.len();
+    if !(2..=4).contains(&n) {
+        return None;
+    }
+    for size in (1..n).rev() {
+        for mask in 1u32..(1 << n) {
+            if mask.count_ones() as usize != size {
+                continue;
+            }
+            let (kept, dropped): (Vec<_>, Vec<_>) = conditions
+                .iter()
+                .enumerate()
+                .partition(|(i, _)| mask & (1 << i) != 0);
+            let kept: Vec<_> = kept.into_iter().map(|(_, c)| c.clone()).collect();
+            let Ok(plan) = planner.repair(tree.clone(), *node, &kept, world) else {
+                continue;
+            };
+            if helped(before, &plan.outcome).is_ok() {
+                let candidate = Proposal::Conditions {
+                    action: action.clone(),
+                    node: *node,
+                    conditions: kept,
+                };
+                return Some((
+                    candidate,
+                    dropped.into_iter().map(|(_, c)| c.clone()).collect(),
+                ));
+            }
+        }
+    }
+    None
 }

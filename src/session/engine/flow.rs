@@ -94,6 +94,7 @@ impl Engine {
         self.pending = None;
         self.failure = None;
         self.rounds = 0;
+        self.tried.clear();
         self.undo.clear();
         self.fixes.clear();
         if let Some(store) = &self.policies {

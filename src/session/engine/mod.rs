@@ -185,6 +185,9 @@ pub struct Engine {
     last: Option<Arc<TickRecord>>,
     failure: Option<Failure>,
     pending: Option<Pending>,
+    /// Changes tried for a failure that did not fix it, told to the model when it is asked
+    /// about the same failure again.
+    tried: Vec<(Failure, String)>,
     request: Option<Request>,
     next_id: u64,
     undo: Vec<UndoEntry>,
@@ -241,6 +244,7 @@ impl Engine {
             last: None,
             failure: None,
             pending: None,
+            tried: Vec::new(),
             request: None,
             next_id: 0,
             undo: Vec::new(),

@@ -73,6 +73,7 @@ impl Engine {
         self.pending = None;
         self.failure = None;
         self.rounds = 0;
+        self.tried.clear();
         self.undo.clear();
         self.fixes = saved
             .fixes

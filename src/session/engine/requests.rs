@@ -10,7 +10,7 @@ use crate::llm::reply::GoalAnswer;
 use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
-use super::super::ask::{Asked, ask_conditions, ask_value, interpret, missing_value};
+use super::super::ask::{Asked, FailedAction, ask_conditions, ask_value, interpret, missing_value};
 use super::super::policy::Approval;
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Pending, Request, Task};
@@ -147,6 +147,12 @@ impl Engine {
             .and_then(|t| t.instruction.clone())
             .or_else(|| self.task.as_ref().map(|t| t.goal.to_string()))
             .unwrap_or_default();
+        let tried: Vec<String> = self
+            .tried
+            .iter()
+            .filter(|(f, _)| *f == failure)
+            .map(|(_, t)| t.clone())
+            .collect();
         let handle = tokio::spawn(async move {
             let mut replies = Vec::new();
             let result = {
@@ -176,9 +182,12 @@ impl Engine {
                             &ctx,
                             model.as_ref(),
                             &options,
-                            node,
-                            action,
-                            error,
+                            &FailedAction {
+                                node,
+                                action,
+                                error,
+                                tried: &tried,
+                            },
                             &mut emit,
                         )
                         .await
