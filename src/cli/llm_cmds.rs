@@ -77,13 +77,14 @@ pub struct LlmFlags {
     pub show_replies: bool,
 }
 
-/// The configured model and its ledger.
-struct Llm {
-    model: Metered<Box<dyn LanguageModel>>,
-    options: Options,
+/// The configured model and its ledger (also used by `betr eval`).
+pub(super) struct Llm {
+    pub(super) model: Metered<Box<dyn LanguageModel>>,
+    pub(super) options: Options,
+    pub(super) settings: Settings,
 }
 
-fn setup(flags: &LlmFlags) -> Result<Llm> {
+pub(super) fn setup(flags: &LlmFlags) -> Result<Llm> {
     let var = |k: &str| std::env::var(k).ok();
     let file = match FileConfig::locate(flags.config.as_deref(), &var) {
         Some(path) => Some((FileConfig::read(&path)?, path)),
@@ -132,7 +133,11 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
         },
         ..Options::default()
     };
-    Ok(Llm { model, options })
+    Ok(Llm {
+        model,
+        options,
+        settings,
+    })
 }
 
 fn read_examples(path: &Path) -> Result<Vec<Example>> {

@@ -148,21 +148,52 @@ pub enum Command {
 
 #[derive(Subcommand)]
 pub enum EvalExperiment {
-    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions.
+    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions: one model call each
+    /// (or --answers FILE), scored by the dataset's rule.
     Goals {
         /// The dataset directory (easy.txt, medium.txt, hard.txt).
         #[arg(long, default_value = "../shared/datasets/llm-obtea")]
-        dataset: std::path::PathBuf,
+        dataset: PathBuf,
         /// Score these recorded answers (one line per case, easy then medium then hard)
         /// instead of asking a model.
         #[arg(long)]
-        answers: std::path::PathBuf,
-        /// The scenario whose vocabulary answers must use.
+        answers: Option<PathBuf>,
+        /// The scenario whose vocabulary, scene and examples the prompt uses.
         #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
-        scenario: std::path::PathBuf,
-        /// Where to write results.json, results.csv, table.md and accuracy.png.
-        #[arg(long)]
-        out: Option<std::path::PathBuf>,
+        scenario: PathBuf,
+        /// Repetitions; run k sends seed k.
+        #[arg(long, default_value_t = 1)]
+        runs: usize,
+        #[command(flatten)]
+        run: eval_cmd::RunFlags,
+    },
+    /// The ten failure scenarios, each resolved end to end N times in simulation.
+    Resolve {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions about failures per run before giving up.
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/ and cafe/ scenarios.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: eval_cmd::RunFlags,
+    },
+    /// The seven parameter scenarios: values proposed and whether the world accepts them.
+    Params {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions per run before giving up (a rejected value is asked again).
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/params/.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: eval_cmd::RunFlags,
     },
 }
 
@@ -189,15 +220,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         &betr::bt::UNICODE
     };
     match cli.command {
-        Command::Eval {
-            experiment:
-                EvalExperiment::Goals {
-                    dataset,
-                    answers,
-                    scenario,
-                    out,
-                },
-        } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, out.as_deref()),
+        Command::Eval { experiment } => eval(experiment),
         Command::Model {
             action: ModelAction::Fetch { model },
         } => model_cmd::fetch(model.as_deref()),
@@ -308,6 +331,38 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 ascii: cli.ascii,
             },
         ),
+    }
+}
+
+fn eval(experiment: EvalExperiment) -> Result<ExitCode> {
+    use eval_cmd::SessionExperiment as S;
+    match experiment {
+        EvalExperiment::Goals {
+            dataset,
+            answers: Some(answers),
+            scenario,
+            run,
+            ..
+        } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, run.out.as_deref()),
+        EvalExperiment::Goals {
+            dataset,
+            answers: None,
+            scenario,
+            runs,
+            run,
+        } => eval_cmd::goals_with_model(&dataset, &scenario, runs, &run),
+        EvalExperiment::Resolve {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => eval_cmd::session_experiment(S::Resolve, &scenarios, runs, max_rounds, &run),
+        EvalExperiment::Params {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => eval_cmd::session_experiment(S::Params, &scenarios, runs, max_rounds, &run),
     }
 }
 
