@@ -3,164 +3,102 @@
 //! and records every finished case in `cases.jsonl` as it finishes, so an interrupted run
 //! is resumed by running the same command with the same `--out`.
 
-use std::collections::BTreeMap;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use anyhow::{Context, Result};
+use clap::Subcommand;
 
 use betr::dataset;
 use betr::domain::Scenario;
-use betr::eval::run::{Progress, RunConfig};
+use betr::eval::run::RunConfig;
 use betr::eval::{self, chart, chart_runs, goals, goals_run, params, resolve};
-use betr::llm::LanguageModel;
-use betr::llm::config::Backend;
 use betr::store::write_atomic;
 
-use super::llm_cmds::{self, LlmFlags};
+use super::eval_setup::{Bar, RunFlags, prepare};
 
-/// The prompt ablations of the paper's Table III.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum PromptVariant {
-    Full,
-    NoDescriptions,
-    NoObjectRule,
-    OriginalExamples,
-    Cot,
+#[derive(Subcommand)]
+pub enum EvalExperiment {
+    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions: one model call each
+    /// (or --answers FILE), scored by the dataset's rule.
+    Goals {
+        /// The dataset directory (easy.txt, medium.txt, hard.txt).
+        #[arg(long, default_value = "../shared/datasets/llm-obtea")]
+        dataset: PathBuf,
+        /// Score these recorded answers (one line per case, easy then medium then hard)
+        /// instead of asking a model.
+        #[arg(long)]
+        answers: Option<PathBuf>,
+        /// The scenario whose vocabulary, scene and examples the prompt uses.
+        #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
+        scenario: PathBuf,
+        /// Repetitions; run k sends seed k.
+        #[arg(long, default_value_t = 1)]
+        runs: usize,
+        #[command(flatten)]
+        run: RunFlags,
+    },
+    /// The ten failure scenarios, each resolved end to end N times in simulation.
+    Resolve {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions about failures per run before giving up.
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/ and cafe/ scenarios.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: RunFlags,
+    },
+    /// The seven parameter scenarios: values proposed and whether the world accepts them.
+    Params {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions per run before giving up (a rejected value is asked again).
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/params/.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: RunFlags,
+    },
 }
 
-impl PromptVariant {
-    fn name(self) -> &'static str {
-        match self {
-            PromptVariant::Full => "full",
-            PromptVariant::NoDescriptions => "no-descriptions",
-            PromptVariant::NoObjectRule => "no-object-rule",
-            PromptVariant::OriginalExamples => "original-examples",
-            PromptVariant::Cot => "cot",
-        }
+/// Run the chosen experiment.
+pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
+    use SessionExperiment as S;
+    match experiment {
+        EvalExperiment::Goals {
+            dataset,
+            answers: Some(answers),
+            scenario,
+            run,
+            ..
+        } => goals_from_answers(&dataset, &answers, &scenario, run.out.as_deref()),
+        EvalExperiment::Goals {
+            dataset,
+            answers: None,
+            scenario,
+            runs,
+            run,
+        } => goals_with_model(&dataset, &scenario, runs, &run),
+        EvalExperiment::Resolve {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => session_experiment(S::Resolve, &scenarios, runs, max_rounds, &run),
+        EvalExperiment::Params {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => session_experiment(S::Params, &scenarios, runs, max_rounds, &run),
     }
-}
-
-/// Flags every experiment that asks a model shares.
-#[derive(Args, Debug, Clone)]
-pub struct RunFlags {
-    /// Prompt variant (ablations of the paper's Table III); original-examples needs --examples FILE.
-    #[arg(long, value_enum, default_value = "full")]
-    pub prompt: PromptVariant,
-    /// Requests in flight at once (default: 4 for HTTP backends, 1 for the local model).
-    #[arg(long, value_name = "K")]
-    pub concurrency: Option<usize>,
-    /// Where to write the results (default: a new directory under eval-results/). Pointing
-    /// a run at an existing directory resumes it: cases already recorded are not asked again.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// Stop after this many newly finished cases (for testing interruption).
-    #[arg(long, hide = true)]
-    pub limit: Option<usize>,
-    #[command(flatten)]
-    pub llm: LlmFlags,
-}
-
-/// Draws a progress bar on stderr when it is a terminal; otherwise draws nothing.
-struct Bar(ProgressBar);
-
-impl Bar {
-    fn new() -> Bar {
-        let target = if std::io::stderr().is_terminal() {
-            ProgressDrawTarget::stderr()
-        } else {
-            ProgressDrawTarget::hidden()
-        };
-        let bar = ProgressBar::with_draw_target(None, target);
-        if let Ok(style) = ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} [{elapsed_precise}, eta {eta}] {msg}",
-        ) {
-            bar.set_style(style);
-        }
-        Bar(bar)
-    }
-}
-
-impl Progress for Bar {
-    fn begin(&self, total: usize, done: usize) {
-        self.0.set_length(total as u64);
-        self.0.set_position(done as u64);
-        if done > 0 {
-            self.0.println(format!(
-                "resuming: {done} of {total} case(s) already recorded"
-            ));
-        }
-    }
-    fn finished(&self, label: &str) {
-        self.0.inc(1);
-        self.0.set_message(label.to_string());
-    }
-    fn end(&self) {
-        self.0.finish_and_clear();
-    }
-}
-
-/// The model, its options with the prompt variant applied, and the run settings.
-struct Prepared {
-    llm: llm_cmds::Llm,
-    label: String,
-    settings: BTreeMap<String, String>,
-    concurrency: usize,
-}
-
-fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prepared> {
-    let mut llm_flags = flags.llm.clone();
-    match flags.prompt {
-        PromptVariant::Full => {}
-        PromptVariant::NoDescriptions => llm_flags.no_descriptions = true,
-        PromptVariant::NoObjectRule => llm_flags.no_object_rule = true,
-        PromptVariant::Cot => llm_flags.cot = true,
-        PromptVariant::OriginalExamples => {
-            if llm_flags.examples.is_none() {
-                bail!(
-                    "--prompt original-examples: the examples of the original LLM-OBTEA prompt are not shipped with betr; give them with --examples FILE (TOML: [[examples]] with instruction and goal)"
-                );
-            }
-        }
-    }
-    let llm = llm_cmds::setup(&llm_flags)?;
-    let backend = format!("{:?}", llm.settings.backend).to_lowercase();
-    let model = llm.model.model().to_string();
-    let mut settings: BTreeMap<String, String> = BTreeMap::new();
-    settings.insert("backend".into(), backend.clone());
-    settings.insert("model".into(), model.clone());
-    settings.insert("prompt".into(), flags.prompt.name().into());
-    settings.insert("temperature".into(), llm.settings.temperature.to_string());
-    settings.insert("structured".into(), llm.settings.structured.to_string());
-    let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
-    for (k, v) in [
-        ("examples", optional(&llm_flags.examples)),
-        ("prompts", optional(&llm_flags.prompts)),
-    ] {
-        if let Some(v) = v {
-            settings.insert(k.into(), v);
-        }
-    }
-    for (k, v) in extra {
-        settings.insert((*k).into(), v.clone());
-    }
-    let concurrency = flags
-        .concurrency
-        .unwrap_or(if llm.settings.backend == Backend::Local {
-            1
-        } else {
-            4
-        })
-        .max(1);
-    Ok(Prepared {
-        label: format!("{model} ({backend}), prompt {}", flags.prompt.name()),
-        llm,
-        settings,
-        concurrency,
-    })
 }
 
 fn runtime() -> Result<tokio::runtime::Runtime> {

@@ -1,6 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
 mod eval_cmd;
+mod eval_setup;
 mod llm_cmds;
 mod model_cmd;
 mod tree_cmds;
@@ -61,7 +62,7 @@ pub enum Command {
     /// Reproduce the paper's experiments.
     Eval {
         #[command(subcommand)]
-        experiment: EvalExperiment,
+        experiment: eval_cmd::EvalExperiment,
     },
     /// Embedded model files: fetch them into the cache, list them.
     Model {
@@ -147,57 +148,6 @@ pub enum Command {
 }
 
 #[derive(Subcommand)]
-pub enum EvalExperiment {
-    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions: one model call each
-    /// (or --answers FILE), scored by the dataset's rule.
-    Goals {
-        /// The dataset directory (easy.txt, medium.txt, hard.txt).
-        #[arg(long, default_value = "../shared/datasets/llm-obtea")]
-        dataset: PathBuf,
-        /// Score these recorded answers (one line per case, easy then medium then hard)
-        /// instead of asking a model.
-        #[arg(long)]
-        answers: Option<PathBuf>,
-        /// The scenario whose vocabulary, scene and examples the prompt uses.
-        #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
-        scenario: PathBuf,
-        /// Repetitions; run k sends seed k.
-        #[arg(long, default_value_t = 1)]
-        runs: usize,
-        #[command(flatten)]
-        run: eval_cmd::RunFlags,
-    },
-    /// The ten failure scenarios, each resolved end to end N times in simulation.
-    Resolve {
-        /// Runs per scenario; run k sends seed k.
-        #[arg(long, default_value_t = 10)]
-        runs: usize,
-        /// Questions about failures per run before giving up.
-        #[arg(long, default_value_t = 5)]
-        max_rounds: usize,
-        /// The directory holding cell/ and cafe/ scenarios.
-        #[arg(long, default_value = "scenarios")]
-        scenarios: PathBuf,
-        #[command(flatten)]
-        run: eval_cmd::RunFlags,
-    },
-    /// The seven parameter scenarios: values proposed and whether the world accepts them.
-    Params {
-        /// Runs per scenario; run k sends seed k.
-        #[arg(long, default_value_t = 10)]
-        runs: usize,
-        /// Questions per run before giving up (a rejected value is asked again).
-        #[arg(long, default_value_t = 5)]
-        max_rounds: usize,
-        /// The directory holding cell/params/.
-        #[arg(long, default_value = "scenarios")]
-        scenarios: PathBuf,
-        #[command(flatten)]
-        run: eval_cmd::RunFlags,
-    },
-}
-
-#[derive(Subcommand)]
 pub enum ModelAction {
     /// Download, verify and install a model (the default LLM unless --model).
     Fetch {
@@ -220,7 +170,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         &betr::bt::UNICODE
     };
     match cli.command {
-        Command::Eval { experiment } => eval(experiment),
+        Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model {
             action: ModelAction::Fetch { model },
         } => model_cmd::fetch(model.as_deref()),
@@ -331,38 +281,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 ascii: cli.ascii,
             },
         ),
-    }
-}
-
-fn eval(experiment: EvalExperiment) -> Result<ExitCode> {
-    use eval_cmd::SessionExperiment as S;
-    match experiment {
-        EvalExperiment::Goals {
-            dataset,
-            answers: Some(answers),
-            scenario,
-            run,
-            ..
-        } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, run.out.as_deref()),
-        EvalExperiment::Goals {
-            dataset,
-            answers: None,
-            scenario,
-            runs,
-            run,
-        } => eval_cmd::goals_with_model(&dataset, &scenario, runs, &run),
-        EvalExperiment::Resolve {
-            runs,
-            max_rounds,
-            scenarios,
-            run,
-        } => eval_cmd::session_experiment(S::Resolve, &scenarios, runs, max_rounds, &run),
-        EvalExperiment::Params {
-            runs,
-            max_rounds,
-            scenarios,
-            run,
-        } => eval_cmd::session_experiment(S::Params, &scenarios, runs, max_rounds, &run),
     }
 }
 
