@@ -9,6 +9,8 @@ pub mod params;
 pub mod resolve;
 pub mod run;
 mod session_run;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 

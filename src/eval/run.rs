@@ -236,13 +236,16 @@ impl Journal {
     }
 
     /// Every record written so far. A line that does not read (the tail of a write cut
-    /// short) is skipped: that case runs again.
+    /// short) is skipped: that case runs again, on a line of its own.
     pub fn read<T: DeserializeOwned>(&self) -> Result<Vec<T>, EvalError> {
         let text = match std::fs::read_to_string(&self.path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
             Err(e) => return Err(EvalError::io(&self.path, e)),
         };
+        if !text.is_empty() && !text.ends_with('\n') {
+            self.write_line("")?;
+        }
         Ok(text
             .lines()
             .filter(|l| !l.trim().is_empty())
@@ -252,9 +255,13 @@ impl Journal {
 
     /// Append one record as a single write, then sync it to disk.
     pub fn append<T: Serialize>(&self, record: &T) -> Result<(), EvalError> {
-        let mut line = serde_json::to_string(record)
+        let line = serde_json::to_string(record)
             .map_err(|e| EvalError::io(&self.path, std::io::Error::other(e)))?;
-        line.push('\n');
+        self.write_line(&line)
+    }
+
+    fn write_line(&self, line: &str) -> Result<(), EvalError> {
+        let line = format!("{line}\n");
         let _guard = self.lock.lock();
         let write = || -> std::io::Result<()> {
             let mut f = std::fs::OpenOptions::new()
