@@ -1,14 +1,149 @@
-//! `betr eval goals`: score goal interpretations against the LLM-OBTEA dataset.
+//! `betr eval goals | resolve | params`: the paper's experiments. Each prints a table,
+//! writes results.json, results.csv, table.md and a PNG chart into the output directory,
+//! and records every finished case in `cases.jsonl` as it finishes, so an interrupted run
+//! is resumed by running the same command with the same `--out`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
+use clap::Subcommand;
 
 use betr::dataset;
 use betr::domain::Scenario;
-use betr::eval::{self, chart, goals};
+use betr::eval::run::RunConfig;
+use betr::eval::{self, chart, chart_runs, goals, goals_run, params, resolve};
+use betr::llm::LanguageModel;
 use betr::store::write_atomic;
+
+use super::eval_setup::{Bar, RunFlags, prepare};
+
+#[derive(Subcommand)]
+pub enum EvalExperiment {
+    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions: one model call each
+    /// (or --answers FILE), scored by the dataset's rule.
+    Goals {
+        /// The dataset directory (easy.txt, medium.txt, hard.txt).
+        #[arg(long, default_value = "../shared/datasets/llm-obtea")]
+        dataset: PathBuf,
+        /// Score these recorded answers (one line per case, easy then medium then hard)
+        /// instead of asking a model.
+        #[arg(long)]
+        answers: Option<PathBuf>,
+        /// The scenario whose vocabulary, scene and examples the prompt uses.
+        #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
+        scenario: PathBuf,
+        /// Repetitions; run k sends seed k.
+        #[arg(long, default_value_t = 1)]
+        runs: usize,
+        #[command(flatten)]
+        run: RunFlags,
+    },
+    /// The ten failure scenarios, each resolved end to end N times in simulation.
+    Resolve {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions about failures per run before giving up.
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/ and cafe/ scenarios.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: RunFlags,
+    },
+    /// The seven parameter scenarios: values proposed and whether the world accepts them.
+    Params {
+        /// Runs per scenario; run k sends seed k.
+        #[arg(long, default_value_t = 10)]
+        runs: usize,
+        /// Questions per run before giving up (a rejected value is asked again).
+        #[arg(long, default_value_t = 5)]
+        max_rounds: usize,
+        /// The directory holding cell/params/.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        #[command(flatten)]
+        run: RunFlags,
+    },
+}
+
+/// Run the chosen experiment.
+pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
+    use SessionExperiment as S;
+    match experiment {
+        EvalExperiment::Goals {
+            dataset,
+            answers: Some(answers),
+            scenario,
+            run,
+            ..
+        } => goals_from_answers(&dataset, &answers, &scenario, run.out.as_deref()),
+        EvalExperiment::Goals {
+            dataset,
+            answers: None,
+            scenario,
+            runs,
+            run,
+        } => goals_with_model(&dataset, &scenario, runs, &run),
+        EvalExperiment::Resolve {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => session_experiment(S::Resolve, &scenarios, runs, max_rounds, &run),
+        EvalExperiment::Params {
+            runs,
+            max_rounds,
+            scenarios,
+            run,
+        } => session_experiment(S::Params, &scenarios, runs, max_rounds, &run),
+    }
+}
+
+fn runtime() -> Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the async runtime")
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
+    write_atomic(&dir.join(name), bytes).with_context(|| format!("writing {name}"))
+}
+
+/// Write results.json, results.csv and table.md; draw the chart (a missing font only
+/// costs the picture).
+fn write_all<T: serde::Serialize>(
+    dir: &Path,
+    results: &T,
+    csv: &str,
+    table: &str,
+    chart: impl FnOnce() -> Result<(), chart::ChartError>,
+) -> Result<()> {
+    write(
+        dir,
+        "results.json",
+        serde_json::to_string_pretty(results)?.as_bytes(),
+    )?;
+    write(dir, "results.csv", csv.as_bytes())?;
+    write(dir, "table.md", table.as_bytes())?;
+    if let Err(e) = chart() {
+        eprintln!("warning: chart not drawn: {e}");
+    }
+    print!("{table}");
+    println!("\nresults: {}", dir.display());
+    Ok(())
+}
+
+fn stopped(dir: &Path) -> String {
+    format!(
+        "the run stopped; finished cases are kept in {} — run the same command again to resume",
+        dir.join("cases.jsonl").display()
+    )
+}
 
 /// Score a file of recorded answers (one line per case) and write the results.
 pub fn goals_from_answers(
@@ -28,28 +163,175 @@ pub fn goals_from_answers(
     let results = goals::GoalsResults::from_cases(scored);
     let label = format!("answers from {}", answers.display());
     let dir = eval::output_dir(out, "goals").context("creating the output directory")?;
-    write_results(&dir, &label, &results)?;
-    print!("{}", results.table(&label));
-    println!("\nresults: {}", dir.display());
+    let table = results.table(&label);
+    write_all(&dir, &results, &results.csv(), &table, || {
+        goals_chart(&dir, &label, &results)
+    })?;
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_results(dir: &Path, label: &str, results: &goals::GoalsResults) -> Result<()> {
-    let json = serde_json::to_string_pretty(results)?;
-    write_atomic(&dir.join("results.json"), json.as_bytes()).context("writing results.json")?;
-    write_atomic(&dir.join("results.csv"), results.csv().as_bytes())
-        .context("writing results.csv")?;
-    write_atomic(&dir.join("table.md"), results.table(label).as_bytes())
-        .context("writing table.md")?;
-    let png = dir.join("accuracy.png");
-    match chart::accuracy_chart(
-        &png,
+fn goals_chart(
+    dir: &Path,
+    label: &str,
+    results: &goals::GoalsResults,
+) -> Result<(), chart::ChartError> {
+    chart::accuracy_chart(
+        &dir.join("accuracy.png"),
         "Goal interpretation accuracy (LLM-OBTEA cafe set)",
         &eval::goals_series(label, results),
-    ) {
-        Ok(()) => {}
-        // The numbers are written; a missing font only costs the picture.
-        Err(e) => eprintln!("warning: chart not drawn: {e}"),
+    )
+}
+
+/// Ask the model for the goal of each of the 100 instructions, `runs` times.
+pub fn goals_with_model(
+    dataset_dir: &Path,
+    scenario_path: &Path,
+    runs: usize,
+    flags: &RunFlags,
+) -> Result<ExitCode> {
+    let cases = dataset::load(dataset_dir)?;
+    let scenario = Scenario::load(scenario_path)?;
+    let p = prepare(flags, &[("dataset", dataset_dir.display().to_string())])?;
+    let dir =
+        eval::output_dir(flags.out.as_deref(), "goals").context("creating the output directory")?;
+    eval::run::check_settings(&dir, "goals", &p.settings)?;
+    let world = betr::world::load(&scenario)?;
+    let settings = goals_run::PromptSettings {
+        templates: p.llm.options.templates.clone(),
+        variant: p.llm.options.variant.clone(),
+        temperature: p.llm.options.temperature,
+        max_tokens: p.llm.options.max_tokens,
+        structured: p.llm.options.structured,
+        grammar: p.llm.options.grammar,
+    };
+    p.llm.model.set_purpose("eval goals");
+    let model: Arc<dyn LanguageModel> = p.llm.model.clone();
+    let bar = Bar::new();
+    let cfg = RunConfig {
+        runs: runs.max(1),
+        concurrency: p.concurrency,
+        limit: flags.limit,
+        prices: p.llm.settings.prices.clone(),
+        progress: &bar,
+    };
+    let results = runtime()?
+        .block_on(goals_run::run_goals(
+            &model,
+            &scenario,
+            &world.facts(),
+            &cases,
+            &settings,
+            &cfg,
+            &dir,
+        ))
+        .with_context(|| stopped(&dir))?;
+    let table = goals_run::table(
+        &results,
+        &p.label,
+        p.llm.options.temperature,
+        cfg.runs * cases.len(),
+    );
+    write_all(&dir, &results, &results.csv(), &table, || {
+        goals_chart(&dir, &p.label, &results)
+    })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Which experiment `session_experiment` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SessionExperiment {
+    Resolve,
+    Params,
+}
+
+/// `betr eval resolve` and `betr eval params`: each scenario resolved `runs` times.
+pub fn session_experiment(
+    which: SessionExperiment,
+    scenarios_dir: &Path,
+    runs: usize,
+    max_rounds: usize,
+    flags: &RunFlags,
+) -> Result<ExitCode> {
+    let (name, paths): (&str, Vec<&str>) = match which {
+        SessionExperiment::Resolve => ("resolve", resolve::FAILURE_SCENARIOS.to_vec()),
+        SessionExperiment::Params => (
+            "params",
+            params::PARAM_SCENARIOS.iter().map(|(p, _)| *p).collect(),
+        ),
+    };
+    let scenarios = paths
+        .iter()
+        .map(|p| {
+            let path = scenarios_dir.join(p);
+            Scenario::load(&path)
+                .map(|s| ((*p).to_string(), s))
+                .with_context(|| format!("loading {}", path.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let mut p = prepare(flags, &[("max_rounds", max_rounds.to_string())])?;
+    p.llm.options.max_rounds = max_rounds;
+    let dir =
+        eval::output_dir(flags.out.as_deref(), name).context("creating the output directory")?;
+    eval::run::check_settings(&dir, name, &p.settings)?;
+    p.llm.model.set_purpose(&format!("eval {name}"));
+    let model: Arc<dyn LanguageModel> = p.llm.model.clone();
+    let bar = Bar::new();
+    let cfg = RunConfig {
+        runs: runs.max(1),
+        concurrency: p.concurrency,
+        limit: flags.limit,
+        prices: p.llm.settings.prices.clone(),
+        progress: &bar,
+    };
+    let rt = runtime()?;
+    match which {
+        SessionExperiment::Resolve => {
+            let results = rt
+                .block_on(resolve::run_resolve(
+                    &model,
+                    &scenarios,
+                    &p.llm.options,
+                    &cfg,
+                    &dir,
+                ))
+                .with_context(|| stopped(&dir))?;
+            let bars: Vec<(String, f64)> = results
+                .scenarios
+                .iter()
+                .enumerate()
+                .map(|(i, s)| (format!("{} {}", i + 1, s.name), s.success_rate))
+                .collect();
+            let table = results.table(&p.label, cfg.runs);
+            write_all(&dir, &results, &results.csv(), &table, || {
+                chart_runs::success_chart(
+                    &dir.join("resolve.png"),
+                    &format!("Failure resolution: success rate ({})", p.label),
+                    &bars,
+                )
+            })?;
+        }
+        SessionExperiment::Params => {
+            let results = rt
+                .block_on(params::run_params(
+                    &model,
+                    &scenarios,
+                    &p.llm.options,
+                    &cfg,
+                    &dir,
+                ))
+                .with_context(|| stopped(&dir))?;
+            let table = results.table(&p.label, cfg.runs);
+            write_all(&dir, &results, &results.csv(), &table, || {
+                chart_runs::params_chart(
+                    &dir.join("params.png"),
+                    &format!(
+                        "Proposed parameter values, accepted range shaded ({})",
+                        p.label
+                    ),
+                    &chart_runs::params_panels(&results),
+                )
+            })?;
+        }
     }
-    Ok(())
+    Ok(ExitCode::SUCCESS)
 }

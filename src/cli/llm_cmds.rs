@@ -89,13 +89,14 @@ pub struct LlmFlags {
     pub no_grammar: bool,
 }
 
-/// The configured model and its ledger.
-struct Llm {
-    model: Arc<Metered<Box<dyn LanguageModel>>>,
-    options: Options,
+/// The configured model and its ledger (also used by `betr eval`).
+pub(super) struct Llm {
+    pub(super) model: Arc<Metered<Box<dyn LanguageModel>>>,
+    pub(super) options: Options,
+    pub(super) settings: Settings,
 }
 
-fn setup(flags: &LlmFlags) -> Result<Llm> {
+pub(super) fn setup(flags: &LlmFlags) -> Result<Llm> {
     let (settings, options) = settings(flags)?;
     ensure_local_model(&settings)?;
     let ledger = Ledger::new(settings.usage_log.clone());
@@ -103,6 +104,7 @@ fn setup(flags: &LlmFlags) -> Result<Llm> {
     Ok(Llm {
         model: Arc::new(model),
         options,
+        settings,
     })
 }
 

@@ -1,6 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
 mod eval_cmd;
+mod eval_setup;
 mod llm_cmds;
 mod model_cmd;
 mod policy_cmd;
@@ -69,7 +70,7 @@ pub enum Command {
     /// Reproduce the paper's experiments.
     Eval {
         #[command(subcommand)]
-        experiment: EvalExperiment,
+        experiment: eval_cmd::EvalExperiment,
     },
     /// Embedded model files: fetch them into the cache, list them.
     Model {
@@ -165,26 +166,6 @@ pub struct PolicySaveTest {
 }
 
 #[derive(Subcommand)]
-pub enum EvalExperiment {
-    /// Goal interpretation on the 100 LLM-OBTEA cafe instructions.
-    Goals {
-        /// The dataset directory (easy.txt, medium.txt, hard.txt).
-        #[arg(long, default_value = "../shared/datasets/llm-obtea")]
-        dataset: std::path::PathBuf,
-        /// Score these recorded answers (one line per case, easy then medium then hard)
-        /// instead of asking a model.
-        #[arg(long)]
-        answers: std::path::PathBuf,
-        /// The scenario whose vocabulary answers must use.
-        #[arg(long, default_value = "scenarios/cafe/cafe.toml")]
-        scenario: std::path::PathBuf,
-        /// Where to write results.json, results.csv, table.md and accuracy.png.
-        #[arg(long)]
-        out: Option<std::path::PathBuf>,
-    },
-}
-
-#[derive(Subcommand)]
 pub enum ModelAction {
     /// Download, verify and install a model (the default LLM unless --model).
     Fetch {
@@ -212,15 +193,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     match command {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
-        Command::Eval {
-            experiment:
-                EvalExperiment::Goals {
-                    dataset,
-                    answers,
-                    scenario,
-                    out,
-                },
-        } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, out.as_deref()),
+        Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model {
             action: ModelAction::Fetch { model },
         } => model_cmd::fetch(model.as_deref()),

@@ -33,7 +33,7 @@ const FONT_CANDIDATES: [&str; 3] = [
 static FONT: OnceLock<Result<(), String>> = OnceLock::new();
 
 /// Register the label font once per process.
-fn ensure_font() -> Result<(), ChartError> {
+pub(crate) fn ensure_font() -> Result<(), ChartError> {
     FONT.get_or_init(|| {
         let mut tried: Vec<String> = Vec::new();
         let env = std::env::var("BETR_FONT").ok().filter(|f| !f.is_empty());

@@ -11,9 +11,14 @@ use crate::dataset::{Case, Difficulty};
 use crate::domain::Vocabulary;
 use crate::goal::{Formula, same_dnf};
 
+use super::run::{CallRecord, UsageSummary};
+
 /// One scored case, as written to `results.json` and `results.csv`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CaseResult {
+    /// The run (1-based) the answer belongs to.
+    #[serde(default = "first_run")]
+    pub run: usize,
     pub difficulty: String,
     pub index: usize,
     pub instruction: String,
@@ -24,13 +29,16 @@ pub struct CaseResult {
     /// Why a wrong answer is wrong when it is not merely a different goal.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub problem: Option<String>,
-    /// LLM accounting, when the answer came from a model in this run.
+    /// The reply's full text, when the answer came from a model in this run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub prompt_tokens: Option<u64>,
+    pub reply: Option<String>,
+    /// The call's accounting, when the answer came from a model in this run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub completion_tokens: Option<u64>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub latency_ms: Option<f64>,
+    pub call: Option<CallRecord>,
+}
+
+fn first_run() -> usize {
+    1
 }
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -55,7 +63,22 @@ pub struct GoalsResults {
     pub easy: Tally,
     pub medium: Tally,
     pub hard: Tally,
+    /// Per run, when there were several (the tallies above add them up).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub runs: Vec<RunTally>,
+    /// Calls, tokens, cost and latency, when the answers came from a model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub usage: Option<UsageSummary>,
     pub cases: Vec<CaseResult>,
+}
+
+/// The tallies of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunTally {
+    pub run: usize,
+    pub easy: Tally,
+    pub medium: Tally,
+    pub hard: Tally,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -90,6 +113,7 @@ pub fn answer_formula(line: &str) -> &str {
 pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> CaseResult {
     let (correct, problem) = judge(vocabulary, &case.gold, answer);
     CaseResult {
+        run: 1,
         difficulty: case.difficulty.as_str().to_string(),
         index: case.index,
         instruction: case.instruction.clone(),
@@ -97,9 +121,8 @@ pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> Case
         answer: answer.map(str::to_string),
         correct,
         problem,
-        prompt_tokens: None,
-        completion_tokens: None,
-        latency_ms: None,
+        reply: None,
+        call: None,
     }
 }
 
@@ -152,18 +175,39 @@ pub fn read_answers(path: &Path, expected: usize) -> Result<Vec<Option<String>>,
 }
 
 impl GoalsResults {
+    /// Tallies of `cases` (of every run); per-run tallies when there are several runs,
+    /// and the usage of the calls when the answers came from a model.
     pub fn from_cases(cases: Vec<CaseResult>) -> Self {
-        let tally = |d: Difficulty| Tally {
-            correct: cases
-                .iter()
-                .filter(|c| c.difficulty == d.as_str() && c.correct)
-                .count(),
-            total: cases.iter().filter(|c| c.difficulty == d.as_str()).count(),
+        let tally = |run: Option<usize>, d: Difficulty| {
+            let of = |c: &&CaseResult| c.difficulty == d.as_str() && run.is_none_or(|r| c.run == r);
+            Tally {
+                correct: cases.iter().filter(of).filter(|c| c.correct).count(),
+                total: cases.iter().filter(of).count(),
+            }
         };
+        let mut run_ids: Vec<usize> = cases.iter().map(|c| c.run).collect();
+        run_ids.sort_unstable();
+        run_ids.dedup();
+        let runs = if run_ids.len() > 1 {
+            run_ids
+                .iter()
+                .map(|&r| RunTally {
+                    run: r,
+                    easy: tally(Some(r), Difficulty::Easy),
+                    medium: tally(Some(r), Difficulty::Medium),
+                    hard: tally(Some(r), Difficulty::Hard),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let calls: Vec<&CallRecord> = cases.iter().filter_map(|c| c.call.as_ref()).collect();
         GoalsResults {
-            easy: tally(Difficulty::Easy),
-            medium: tally(Difficulty::Medium),
-            hard: tally(Difficulty::Hard),
+            easy: tally(None, Difficulty::Easy),
+            medium: tally(None, Difficulty::Medium),
+            hard: tally(None, Difficulty::Hard),
+            runs,
+            usage: (!calls.is_empty()).then(|| UsageSummary::of(calls)),
             cases,
         }
     }
@@ -193,10 +237,23 @@ impl GoalsResults {
     /// Every case as CSV (RFC 4180 quoting).
     pub fn csv(&self) -> String {
         let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
-        let mut out = String::from("difficulty,index,instruction,gold,answer,correct,problem\n");
+        let mut out = String::from(
+            "run,difficulty,index,instruction,gold,answer,correct,problem,prompt_tokens,completion_tokens,latency_ms\n",
+        );
         for c in &self.cases {
+            let (p, k, l) = c.call.as_ref().map_or_else(
+                || (String::new(), String::new(), String::new()),
+                |x| {
+                    (
+                        x.prompt_tokens.to_string(),
+                        x.completion_tokens.to_string(),
+                        format!("{:.0}", x.latency_ms),
+                    )
+                },
+            );
             out.push_str(&format!(
-                "{},{},{},{},{},{},{}\n",
+                "{},{},{},{},{},{},{},{},{p},{k},{l}\n",
+                c.run,
                 c.difficulty,
                 c.index,
                 q(&c.instruction),

@@ -2,7 +2,15 @@
 //! a table in the paper's layout, JSON and CSV with every case, and a PNG chart.
 
 pub mod chart;
+pub mod chart_runs;
 pub mod goals;
+pub mod goals_run;
+pub mod params;
+pub mod resolve;
+pub mod run;
+mod session_run;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 
@@ -50,4 +58,49 @@ pub fn output_dir(out: Option<&Path>, experiment: &str) -> std::io::Result<PathB
     };
     std::fs::create_dir_all(&dir)?;
     Ok(dir)
+}
+
+/// Why an experiment could not run (a wrong answer is a result, never an error).
+#[derive(Debug, thiserror::Error)]
+pub enum EvalError {
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error(
+        "{dir} holds results made with {what} = {old:?}, not {new:?}; resume with the same settings or choose another --out"
+    )]
+    Mismatch {
+        dir: String,
+        what: String,
+        old: String,
+        new: String,
+    },
+    #[error("{case}: {source}")]
+    Llm {
+        case: String,
+        #[source]
+        source: crate::llm::LlmError,
+    },
+    #[error("{case}: {source}")]
+    Session {
+        case: String,
+        #[source]
+        source: crate::session::SessionError,
+    },
+    #[error(transparent)]
+    Prompt(#[from] crate::llm::prompt::PromptError),
+    #[error(transparent)]
+    Scenario(#[from] crate::domain::ScenarioError),
+}
+
+impl EvalError {
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        EvalError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    }
 }

@@ -76,9 +76,10 @@ pub struct ChatRequest {
     pub stop: Vec<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub constraint: Option<OutputConstraint>,
-    /// Sampling seed, for backends that take one (runs of an evaluation differ by it).
+    /// Sampling seed, for backends that take one (OpenAI `seed`); repeated evaluation runs
+    /// use run k → seed k. `None` leaves the choice to the backend.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub seed: Option<u32>,
+    pub seed: Option<u64>,
 }
 
 impl ChatRequest {

@@ -120,6 +120,9 @@ impl OpenAiClient {
         if !request.stop.is_empty() {
             body["stop"] = json!(request.stop);
         }
+        if let Some(seed) = request.seed {
+            body["seed"] = json!(seed);
+        }
         if self.settings.structured
             && let Some(OutputConstraint::JsonSchema { name, schema }) = &request.constraint
         {

@@ -66,7 +66,8 @@ impl LanguageModel for LocalModel {
                     .collect(),
                 max_tokens: request.max_tokens,
                 temperature: request.temperature,
-                seed: request.seed.unwrap_or(0),
+                // llama.cpp takes a 32-bit seed; evaluation seeds are small run numbers.
+                seed: request.seed.map_or(0, |s| (s % u64::from(u32::MAX)) as u32),
                 stop: request.stop.clone(),
                 grammar,
             };

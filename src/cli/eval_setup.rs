@@ -1,0 +1,158 @@
+//! What the `betr eval` commands share: the prompt variant, the run flags, the model
+//! and its settings (for the resume guard), and a progress bar that draws only on a
+//! terminal.
+
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use betr::eval::run::Progress;
+use betr::llm::LanguageModel;
+use betr::llm::config::Backend;
+
+use super::llm_cmds::{self, LlmFlags};
+
+/// The prompt ablations of the paper's Table III.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PromptVariant {
+    Full,
+    NoDescriptions,
+    NoObjectRule,
+    OriginalExamples,
+    Cot,
+}
+
+impl PromptVariant {
+    fn name(self) -> &'static str {
+        match self {
+            PromptVariant::Full => "full",
+            PromptVariant::NoDescriptions => "no-descriptions",
+            PromptVariant::NoObjectRule => "no-object-rule",
+            PromptVariant::OriginalExamples => "original-examples",
+            PromptVariant::Cot => "cot",
+        }
+    }
+}
+
+/// Flags every experiment that asks a model shares.
+#[derive(Args, Debug, Clone)]
+pub struct RunFlags {
+    /// Prompt variant (ablations of the paper's Table III); original-examples needs --examples FILE.
+    #[arg(long, value_enum, default_value = "full")]
+    pub prompt: PromptVariant,
+    /// Requests in flight at once (default: 4 for HTTP backends, 1 for the local model).
+    #[arg(long, value_name = "K")]
+    pub concurrency: Option<usize>,
+    /// Where to write the results (default: a new directory under eval-results/). Pointing
+    /// a run at an existing directory resumes it: cases already recorded are not asked again.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Stop after this many newly finished cases (for testing interruption).
+    #[arg(long, hide = true)]
+    pub limit: Option<usize>,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+}
+
+/// Draws a progress bar on stderr when it is a terminal; otherwise draws nothing.
+pub(super) struct Bar(ProgressBar);
+
+impl Bar {
+    pub(super) fn new() -> Bar {
+        let target = if std::io::stderr().is_terminal() {
+            ProgressDrawTarget::stderr()
+        } else {
+            ProgressDrawTarget::hidden()
+        };
+        let bar = ProgressBar::with_draw_target(None, target);
+        if let Ok(style) = ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} [{elapsed_precise}, eta {eta}] {msg}",
+        ) {
+            bar.set_style(style);
+        }
+        Bar(bar)
+    }
+}
+
+impl Progress for Bar {
+    fn begin(&self, total: usize, done: usize) {
+        self.0.set_length(total as u64);
+        self.0.set_position(done as u64);
+        if done > 0 {
+            self.0.println(format!(
+                "resuming: {done} of {total} case(s) already recorded"
+            ));
+        }
+    }
+    fn finished(&self, label: &str) {
+        self.0.inc(1);
+        self.0.set_message(label.to_string());
+    }
+    fn end(&self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// The model, its options with the prompt variant applied, and the run settings.
+pub(super) struct Prepared {
+    pub(super) llm: llm_cmds::Llm,
+    pub(super) label: String,
+    pub(super) settings: BTreeMap<String, String>,
+    pub(super) concurrency: usize,
+}
+
+pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prepared> {
+    let mut llm_flags = flags.llm.clone();
+    match flags.prompt {
+        PromptVariant::Full => {}
+        PromptVariant::NoDescriptions => llm_flags.no_descriptions = true,
+        PromptVariant::NoObjectRule => llm_flags.no_object_rule = true,
+        PromptVariant::Cot => llm_flags.cot = true,
+        PromptVariant::OriginalExamples => {
+            if llm_flags.examples.is_none() {
+                bail!(
+                    "--prompt original-examples: the examples of the original LLM-OBTEA prompt are not shipped with betr; give them with --examples FILE (TOML: [[examples]] with instruction and goal)"
+                );
+            }
+        }
+    }
+    let llm = llm_cmds::setup(&llm_flags)?;
+    let backend = format!("{:?}", llm.settings.backend).to_lowercase();
+    let model = llm.model.model().to_string();
+    let mut settings: BTreeMap<String, String> = BTreeMap::new();
+    settings.insert("backend".into(), backend.clone());
+    settings.insert("model".into(), model.clone());
+    settings.insert("prompt".into(), flags.prompt.name().into());
+    settings.insert("temperature".into(), llm.settings.temperature.to_string());
+    settings.insert("structured".into(), llm.settings.structured.to_string());
+    let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+    for (k, v) in [
+        ("examples", optional(&llm_flags.examples)),
+        ("prompts", optional(&llm_flags.prompts)),
+    ] {
+        if let Some(v) = v {
+            settings.insert(k.into(), v);
+        }
+    }
+    for (k, v) in extra {
+        settings.insert((*k).into(), v.clone());
+    }
+    let concurrency = flags
+        .concurrency
+        .unwrap_or(if llm.settings.backend == Backend::Local {
+            1
+        } else {
+            4
+        })
+        .max(1);
+    Ok(Prepared {
+        label: format!("{model} ({backend}), prompt {}", flags.prompt.name()),
+        llm,
+        settings,
+        concurrency,
+    })
+}

@@ -1,0 +1,371 @@
+//! The failure-resolution experiment: each of the ten failure scenarios resolved N times
+//! end to end in simulation (interpret, plan, fail, ask, validate, repair, re-run), every
+//! proposal approved. A proposal counts as correct only if it was kept (it removed the
+//! failure it was asked about) and the final tree, which contains it, succeeds in the
+//! simulated world.
+
+use std::collections::HashSet;
+use std::path::Path;
+use std::time::Instant;
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::domain::Scenario;
+use std::sync::Arc;
+
+use crate::llm::LanguageModel;
+use crate::session::{Event, Options};
+
+use super::EvalError;
+use super::run::{
+    CallRecord, Journal, RunConfig, Tap, UsageSummary, drive, elapsed_ms, mean_sd, percentile,
+};
+use super::session_run::{Trace, resolve_approving};
+
+/// The ten failure scenarios of SCENARIOS.md, in its order (paths under `scenarios/`).
+pub const FAILURE_SCENARIOS: [&str; 10] = [
+    "cell/red_on_blue.toml",
+    "cell/blocked_both.toml",
+    "cell/flip_cup.toml",
+    "cell/centrifuge.toml",
+    "cell/cupboard.toml",
+    "cell/banana_unknown.toml",
+    "cell/banana_far.toml",
+    "cafe/no_coffee.toml",
+    "cafe/find_fries.toml",
+    "cafe/sweep.toml",
+];
+
+/// One proposal of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProposalRecord {
+    pub proposal: String,
+    /// The change removed the failure it was asked about (else it was undone).
+    pub kept: bool,
+    /// Kept, and the final tree succeeded in simulation.
+    pub correct: bool,
+    /// Why it was undone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// One run of one scenario (a line of `cases.jsonl`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResolveCase {
+    pub scenario: String,
+    pub name: String,
+    pub run: usize,
+    pub success: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ticks: Option<u64>,
+    /// Why the run did not succeed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal: Option<String>,
+    /// The interpreted goal equals the scenario's (as formulas).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub goal_as_expected: Option<bool>,
+    pub rounds: usize,
+    pub proposals: Vec<ProposalRecord>,
+    /// Replies that could not be used (no valid answer in them).
+    pub unusable_replies: usize,
+    pub calls: Vec<CallRecord>,
+    pub wall_ms: f64,
+}
+
+/// Per scenario, over its runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ScenarioSummary {
+    pub scenario: String,
+    pub name: String,
+    pub runs: usize,
+    pub successes: usize,
+    pub success_rate: f64,
+    pub proposals: usize,
+    pub wrong_proposals: usize,
+    pub unusable_replies: usize,
+    pub calls_mean: f64,
+    /// Mean ticks of the successful runs.
+    pub ticks_mean: Option<f64>,
+    pub time_median_ms: f64,
+}
+
+/// `results.json` of `betr eval resolve`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ResolveResults {
+    pub scenarios: Vec<ScenarioSummary>,
+    pub usage: UsageSummary,
+    pub cases: Vec<ResolveCase>,
+}
+
+/// Run every (scenario, run) pair the journal in `dir` does not hold yet through the
+/// session with `make`, and return every recorded case of runs 1..=runs, by scenario then run.
+pub(crate) async fn run_sessions<T>(
+    model: &Arc<dyn LanguageModel>,
+    scenarios: &[(String, Scenario)],
+    options: &Options,
+    cfg: &RunConfig<'_>,
+    dir: &Path,
+    key: impl Fn(&T) -> (String, usize),
+    make: impl Fn(&str, &Scenario, usize, Trace, Vec<CallRecord>, f64) -> T,
+) -> Result<Vec<T>, EvalError>
+where
+    T: Serialize + DeserializeOwned,
+{
+    let journal = Journal::new(dir);
+    let have: HashSet<(String, usize)> = journal.read::<T>()?.iter().map(&key).collect();
+    let jobs: Vec<(usize, &(String, Scenario))> = (1..=cfg.runs)
+        .flat_map(|run| scenarios.iter().map(move |s| (run, s)))
+        .filter(|(run, (path, _))| !have.contains(&(path.clone(), *run)))
+        .collect();
+    let done = cfg.runs * scenarios.len() - jobs.len();
+    let label = |t: &T| {
+        let (s, r) = key(t);
+        format!("{s} run {r}")
+    };
+    let make = &make;
+    drive(
+        jobs,
+        done,
+        cfg,
+        &journal,
+        label,
+        |(run, (path, scenario))| async move {
+            let tap = Arc::new(Tap::new(model.clone(), Some(run as u64), &cfg.prices));
+            let start = Instant::now();
+            let trace = resolve_approving(scenario, tap.clone(), options)
+                .await
+                .map_err(|source| EvalError::Session {
+                    case: format!("{path}, run {run}"),
+                    source,
+                })?;
+            Ok(make(
+                path,
+                scenario,
+                run,
+                trace,
+                tap.calls(),
+                elapsed_ms(start),
+            ))
+        },
+    )
+    .await?;
+    let mut all: Vec<T> = Vec::new();
+    let mut seen = HashSet::new();
+    for t in journal.read::<T>()? {
+        let (s, r) = key(&t);
+        if r >= 1 && r <= cfg.runs && scenarios.iter().any(|(p, _)| *p == s) && seen.insert((s, r))
+        {
+            all.push(t);
+        }
+    }
+    let order = |t: &T| {
+        let (s, r) = key(t);
+        (scenarios.iter().position(|(p, _)| *p == s), r)
+    };
+    all.sort_by_key(order);
+    Ok(all)
+}
+
+pub async fn run_resolve(
+    model: &Arc<dyn LanguageModel>,
+    scenarios: &[(String, Scenario)],
+    options: &Options,
+    cfg: &RunConfig<'_>,
+    dir: &Path,
+) -> Result<ResolveResults, EvalError> {
+    let key = |c: &ResolveCase| (c.scenario.clone(), c.run);
+    let cases = run_sessions(model, scenarios, options, cfg, dir, key, record).await?;
+    Ok(summarize(scenarios, cases))
+}
+
+fn record(
+    path: &str,
+    scenario: &Scenario,
+    run: usize,
+    trace: Trace,
+    calls: Vec<CallRecord>,
+    wall_ms: f64,
+) -> ResolveCase {
+    let success = trace.ending.is_ok();
+    let mut proposals: Vec<ProposalRecord> = Vec::new();
+    let mut goal = None;
+    let mut goal_as_expected = None;
+    let mut unusable = 0;
+    for e in &trace.events {
+        match e {
+            Event::Goal {
+                goal: g,
+                matches_expected,
+                ..
+            } => {
+                goal = Some(g.to_string());
+                goal_as_expected = *matches_expected;
+            }
+            Event::InvalidReply { .. } => unusable += 1,
+            Event::Proposal { proposal, .. } => proposals.push(ProposalRecord {
+                proposal: proposal.to_string(),
+                kept: false,
+                correct: false,
+                note: None,
+            }),
+            Event::Repaired { .. } => {
+                if let Some(p) = proposals.last_mut() {
+                    p.kept = true;
+                    p.correct = success;
+                }
+            }
+            Event::DidNotHelp { reason } => {
+                if let Some(p) = proposals.last_mut() {
+                    p.note = Some(reason.clone());
+                }
+            }
+            _ => {}
+        }
+    }
+    ResolveCase {
+        scenario: path.to_string(),
+        name: scenario.name.clone(),
+        run,
+        success,
+        ticks: trace.ending.as_ref().ok().copied(),
+        reason: trace.ending.err(),
+        goal,
+        goal_as_expected,
+        rounds: trace.rounds,
+        proposals,
+        unusable_replies: unusable,
+        calls,
+        wall_ms,
+    }
+}
+
+fn summarize(scenarios: &[(String, Scenario)], cases: Vec<ResolveCase>) -> ResolveResults {
+    let summaries = scenarios
+        .iter()
+        .map(|(path, scenario)| {
+            let runs: Vec<&ResolveCase> = cases.iter().filter(|c| c.scenario == *path).collect();
+            let successes = runs.iter().filter(|c| c.success).count();
+            let proposals: usize = runs.iter().map(|c| c.proposals.len()).sum();
+            let correct: usize = runs
+                .iter()
+                .map(|c| c.proposals.iter().filter(|p| p.correct).count())
+                .sum();
+            let ticks: Vec<f64> = runs
+                .iter()
+                .filter_map(|c| c.ticks)
+                .map(|t| t as f64)
+                .collect();
+            let calls: Vec<f64> = runs.iter().map(|c| c.calls.len() as f64).collect();
+            let times: Vec<f64> = runs.iter().map(|c| c.wall_ms).collect();
+            ScenarioSummary {
+                scenario: path.clone(),
+                name: scenario.name.clone(),
+                runs: runs.len(),
+                successes,
+                success_rate: if runs.is_empty() {
+                    0.0
+                } else {
+                    100.0 * successes as f64 / runs.len() as f64
+                },
+                proposals,
+                wrong_proposals: proposals - correct,
+                unusable_replies: runs.iter().map(|c| c.unusable_replies).sum(),
+                calls_mean: mean_sd(&calls).map_or(0.0, |m| m.0),
+                ticks_mean: mean_sd(&ticks).map(|m| m.0),
+                time_median_ms: percentile(&times, 50.0),
+            }
+        })
+        .collect();
+    let usage = UsageSummary::of(cases.iter().flat_map(|c| &c.calls));
+    ResolveResults {
+        scenarios: summaries,
+        usage,
+        cases,
+    }
+}
+
+impl ResolveResults {
+    /// One row per scenario: success rate, proposals and the wrong ones, unusable
+    /// replies, LLM calls, ticks and time.
+    pub fn table(&self, system: &str, expected_runs: usize) -> String {
+        let mut out = format!(
+            "Failure resolution, {system}\n\n| # | scenario | success | proposals | wrong proposals | unusable replies | LLM calls per run | ticks | time per run |\n|---|---|---|---|---|---|---|---|---|\n"
+        );
+        for (i, s) in self.scenarios.iter().enumerate() {
+            out.push_str(&format!(
+                "| {} | {} | {:.0}% ({}/{}) | {} | {} | {} | {:.1} | {} | {:.2} s |\n",
+                i + 1,
+                s.name,
+                s.success_rate,
+                s.successes,
+                s.runs,
+                s.proposals,
+                s.wrong_proposals,
+                s.unusable_replies,
+                s.calls_mean,
+                s.ticks_mean.map_or("—".into(), |t| format!("{t:.0}")),
+                s.time_median_ms / 1000.0
+            ));
+        }
+        let u = &self.usage;
+        out.push_str(&format!(
+            "\n- {} LLM call(s), {} prompt + {} completion tokens, ${:.4}; latency median {:.2} s, p95 {:.2} s.\n",
+            u.calls,
+            u.prompt_tokens,
+            u.completion_tokens,
+            u.price_usd,
+            u.latency_median_ms / 1000.0,
+            u.latency_p95_ms / 1000.0
+        ));
+        out.push_str("- A proposal is correct only if it was kept and the final tree succeeded in simulation; ticks are of successful runs; time is the median wall time per run.\n");
+        let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
+        let expected = expected_runs * self.scenarios.len();
+        if finished < expected {
+            out.push_str(&format!(
+                "- Partial: {finished} of {expected} runs finished; run the same command again to finish.\n"
+            ));
+        }
+        for n in u.notes() {
+            out.push_str(&format!("- {n}\n"));
+        }
+        out
+    }
+
+    /// Every run as CSV.
+    pub fn csv(&self) -> String {
+        let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
+        let mut out = String::from(
+            "scenario,run,success,rounds,proposals,wrong_proposals,unusable_replies,calls,prompt_tokens,completion_tokens,ticks,wall_ms,goal,proposal_list,reason\n",
+        );
+        for c in &self.cases {
+            let u = UsageSummary::of(&c.calls);
+            let list: Vec<String> = c
+                .proposals
+                .iter()
+                .map(|p| format!("{}{}", p.proposal, if p.correct { "" } else { " [wrong]" }))
+                .collect();
+            out.push_str(&format!(
+                "{},{},{},{},{},{},{},{},{},{},{},{:.0},{},{},{}\n",
+                q(&c.scenario),
+                c.run,
+                c.success,
+                c.rounds,
+                c.proposals.len(),
+                c.proposals.iter().filter(|p| !p.correct).count(),
+                c.unusable_replies,
+                u.calls,
+                u.prompt_tokens,
+                u.completion_tokens,
+                c.ticks.map(|t| t.to_string()).unwrap_or_default(),
+                c.wall_ms,
+                q(c.goal.as_deref().unwrap_or("")),
+                q(&list.join("; ")),
+                q(c.reason.as_deref().unwrap_or(""))
+            ));
+        }
+        out
+    }
+}

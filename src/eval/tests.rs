@@ -1,0 +1,156 @@
+use std::path::Path;
+
+use super::goals_run::answer_of;
+use super::run::{Journal, mean_sd, percentile};
+use crate::domain::Scenario;
+
+fn cafe() -> Scenario {
+    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+        .expect("cafe scenario")
+}
+
+#[test]
+fn the_answer_is_the_goal_line_as_written() {
+    let s = cafe();
+    assert_eq!(
+        answer_of("Goal: Active_AC", &s).as_deref(),
+        Some("Active_AC")
+    );
+    let cot = "Reasoning: they are hot.\nGoal: `Active_AC & Low_ACTemperature`\n";
+    assert_eq!(
+        answer_of(cot, &s).as_deref(),
+        Some("Active_AC & Low_ACTemperature")
+    );
+    // The last goal that parses wins over a broken restatement.
+    let two = "Goal: Active_AC\nFinal goal: Active_AC &";
+    assert_eq!(answer_of(two, &s).as_deref(), Some("Active_AC"));
+    // A name outside the vocabulary is kept as written (and scored wrong), not corrected.
+    assert_eq!(
+        answer_of("{\"goal\": \"Active_Fan\"}", &s).as_deref(),
+        Some("{\"goal\": \"Active_Fan\"}")
+    );
+    assert_eq!(
+        answer_of("{\"goal\": \"Active_AC\"}", &s).as_deref(),
+        Some("Active_AC")
+    );
+    assert_eq!(answer_of("  \n", &s), None);
+    assert_eq!(answer_of("Active_AC", &s).as_deref(), Some("Active_AC"));
+}
+
+#[test]
+fn percentiles_and_spread() {
+    let v: Vec<f64> = (1..=100).map(f64::from).collect();
+    assert_eq!(percentile(&v, 50.0), 50.0);
+    assert_eq!(percentile(&v, 95.0), 95.0);
+    assert_eq!(percentile(&[], 95.0), 0.0);
+    assert_eq!(percentile(&[3.0], 95.0), 3.0);
+    let (m, sd) = mean_sd(&[2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]).expect("values");
+    assert!((m - 5.0).abs() < 1e-12 && (sd - 2.138_089_935).abs() < 1e-6);
+    assert_eq!(mean_sd(&[]), None);
+}
+
+#[test]
+fn a_line_cut_short_is_skipped_and_the_next_record_starts_a_new_line() {
+    let dir = std::env::temp_dir().join(format!("betr-journal-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    std::fs::write(dir.join("cases.jsonl"), "[1]\n[2]\n[3, 4").expect("write");
+    let j = Journal::new(&dir);
+    let read: Vec<Vec<u32>> = j.read().expect("read");
+    assert_eq!(read, vec![vec![1], vec![2]]);
+    j.append(&vec![5u32]).expect("append");
+    let read: Vec<Vec<u32>> = j.read().expect("read");
+    assert_eq!(read, vec![vec![1], vec![2], vec![5]]);
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+/// A model that answers `Goal: Active_AC` after a short wait and counts the calls in flight.
+struct Slow {
+    inflight: std::sync::atomic::AtomicUsize,
+    most: std::sync::atomic::AtomicUsize,
+}
+
+impl crate::llm::LanguageModel for Slow {
+    fn model(&self) -> &str {
+        "slow"
+    }
+    fn chat<'a>(&'a self, request: &'a crate::llm::ChatRequest) -> crate::llm::ChatFuture<'a> {
+        use std::sync::atomic::Ordering::SeqCst;
+        Box::pin(async move {
+            let now = self.inflight.fetch_add(1, SeqCst) + 1;
+            self.most.fetch_max(now, SeqCst);
+            tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+            self.inflight.fetch_sub(1, SeqCst);
+            Ok(crate::llm::ChatReply {
+                text: format!("Goal: Active_AC\n(seed {:?})", request.seed),
+                model: "slow".into(),
+                usage: crate::llm::TokenUsage::default(),
+                latency: std::time::Duration::from_millis(20),
+                source: crate::llm::ReplySource::HandWritten {
+                    note: "unit test".into(),
+                },
+            })
+        })
+    }
+}
+
+#[test]
+fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
+    use super::goals_run::{PromptSettings, run_goals};
+    use super::run::{RunConfig, Silent};
+    use crate::dataset::{Case, Difficulty};
+    let s = cafe();
+    let cases: Vec<Case> = (0..9)
+        .map(|i| Case {
+            difficulty: Difficulty::Easy,
+            index: i,
+            instruction: format!("Please switch the AC on ({i})."),
+            gold: "Active_AC".into(),
+        })
+        .collect();
+    let model = std::sync::Arc::new(Slow {
+        inflight: Default::default(),
+        most: Default::default(),
+    });
+    let dir = std::env::temp_dir().join(format!("betr-concurrency-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let settings = PromptSettings {
+        templates: crate::llm::prompt::Templates::builtin(),
+        variant: Default::default(),
+        temperature: 0.0,
+        max_tokens: 100,
+        structured: false,
+        grammar: true,
+    };
+    let cfg = RunConfig {
+        runs: 2,
+        concurrency: 3,
+        limit: None,
+        prices: Default::default(),
+        progress: &Silent,
+    };
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .expect("runtime");
+    let results = rt
+        .block_on(run_goals(
+            &(model.clone() as std::sync::Arc<dyn crate::llm::LanguageModel>),
+            &s,
+            &[],
+            &cases,
+            &settings,
+            &cfg,
+            &dir,
+        ))
+        .expect("run");
+    assert_eq!(model.most.load(std::sync::atomic::Ordering::SeqCst), 3);
+    assert_eq!(results.easy.correct, 18);
+    assert_eq!(results.runs.len(), 2);
+    for c in &results.cases {
+        let seed = format!("(seed Some({}))", c.run);
+        assert!(c.reply.as_deref().is_some_and(|r| r.contains(&seed)));
+    }
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}

@@ -1,0 +1,168 @@
+//! `betr eval resolve` and `betr eval params` against the fake OpenAI server answering
+//! the hand-written fixture replies of `tests/fixtures/replies/`: tables, JSON and CSV
+//! checked; a rerun asks nothing again; a rejected value followed by a corrected one is
+//! recorded with the world's verdict on each.
+
+#![allow(clippy::unwrap_used)]
+
+mod support;
+
+use std::path::Path;
+
+use serde_json::Value as Json;
+use support::cli::{KEY_VAR, betr, text, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures::{self, FixtureReply};
+
+fn read_json(path: &Path) -> Json {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn session_eval(
+    dir: &Path,
+    server: &FakeServer,
+    experiment: &str,
+    runs: &str,
+) -> std::process::Output {
+    let scenarios = fixtures::root().join("scenarios").display().to_string();
+    let url = server.base_url();
+    betr(
+        dir,
+        &[
+            "eval",
+            experiment,
+            "--runs",
+            runs,
+            "--scenarios",
+            &scenarios,
+            "--out",
+            "out",
+            "--backend",
+            "openai",
+            "--base-url",
+            &url,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            KEY_VAR,
+        ],
+    )
+}
+
+#[test]
+fn resolve_runs_every_failure_scenario_against_fixture_replies() {
+    let dir = tmp("eval-resolve");
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let o = session_eval(&dir, &server, "resolve", "2");
+    assert!(o.status.success(), "{}", text(&o));
+    let r = read_json(&dir.join("out/results.json"));
+    let scenarios = r["scenarios"].as_array().unwrap();
+    assert_eq!(scenarios.len(), 10);
+    assert_eq!(r["cases"].as_array().unwrap().len(), 20);
+    for s in scenarios {
+        assert_eq!(s["successes"], 2, "{s}");
+        assert_eq!(s["wrong_proposals"], 0, "{s}");
+    }
+    // Scenario 2 needs two proposals per run, every other one.
+    let proposals: Vec<u64> = scenarios
+        .iter()
+        .map(|s| s["proposals"].as_u64().unwrap())
+        .collect();
+    assert_eq!(proposals, [2, 4, 2, 2, 2, 2, 2, 2, 2, 2]);
+    let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
+    assert!(table.contains("| 1 | "), "{table}");
+    assert!(
+        table
+            .lines()
+            .filter(|l| l.contains("| 100% (2/2) | "))
+            .count()
+            == 10,
+        "{table}"
+    );
+    assert!(
+        table.contains("| 2 | Cubes on both cubes | 100% (2/2) | 4 | 0 | 0 | 3.0 |"),
+        "{table}"
+    );
+    let calls = server.received().len() as u64;
+    assert_eq!(r["usage"]["calls"].as_u64(), Some(calls));
+    assert!(table.contains(&format!("- {calls} LLM call(s)")), "{table}");
+    assert!(
+        table.contains("replies were hand-written fixtures"),
+        "{table}"
+    );
+    let csv = std::fs::read_to_string(dir.join("out/results.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 21);
+
+    // Rerunning the same command asks nothing again.
+    let o = session_eval(&dir, &server, "resolve", "2");
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(server.received().len() as u64, calls);
+}
+
+#[test]
+fn params_records_values_and_the_worlds_verdicts() {
+    let dir = tmp("eval-params");
+    // For the egg, a first value that breaks it, then a corrected one when the prompt
+    // carries the world's complaint; the other scenarios answer from their fixture files.
+    let note = format!("{}: tests/eval_cmds.rs", fixtures::SOURCE);
+    let mut replies = vec![
+        FixtureReply {
+            when: vec![
+                "# Task: parameter value".into(),
+                "Bring me an egg".into(),
+                "The egg broke".into(),
+            ],
+            text: "Reasoning: gentler.\nParameter value: 5 N".into(),
+            note: note.clone(),
+        },
+        FixtureReply {
+            when: vec!["# Task: parameter value".into(), "Bring me an egg".into()],
+            text: "Reasoning: hold it firmly.\nParameter value: 12 N".into(),
+            note,
+        },
+    ];
+    replies.extend(fixtures::every_reply());
+    let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
+    let o = session_eval(&dir, &server, "params", "2");
+    assert!(o.status.success(), "{}", text(&o));
+    let r = read_json(&dir.join("out/results.json"));
+    let scenarios = r["scenarios"].as_array().unwrap();
+    assert_eq!(scenarios.len(), 7);
+    for s in scenarios {
+        assert_eq!(s["successes"], 2, "{s}");
+    }
+    let egg = &scenarios[0];
+    assert_eq!(egg["first_accepted"], 0);
+    assert_eq!(egg["values_proposed"], 4);
+    assert_eq!(egg["values_accepted"], 2);
+    assert_eq!(egg["limits"]["max"], 6.0);
+    let egg_run = &r["cases"][0];
+    assert_eq!(egg_run["values"][0]["accepted"], false);
+    assert!(
+        egg_run["values"][0]["error"]
+            .as_str()
+            .unwrap()
+            .contains("The egg broke")
+    );
+    assert_eq!(egg_run["values"][1]["accepted"], true);
+    let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
+    assert!(
+        table.contains("| force | 12 N ✗ → 5 N, 12 N ✗ → 5 N | 12.00 ± 0.00 N | 1–6 N | 0/2 | 2/4 | 2/2 | 5.3 N |"),
+        "{table}"
+    );
+    // Every other scenario's fixture value is accepted at once.
+    for s in &scenarios[1..] {
+        assert_eq!(s["first_accepted"], 2, "{s}");
+    }
+    assert!(
+        table.contains(
+            "| tool | shovel, shovel | shovel ×2 | shovel, spoon | 2/2 | 2/2 | 2/2 | shovel |"
+        ),
+        "{table}"
+    );
+    let csv = std::fs::read_to_string(dir.join("out/results.csv")).unwrap();
+    assert!(
+        csv.contains("\"cell/params/egg.toml\",1,1,\"12 N\",12,false,"),
+        "{csv}"
+    );
+}
