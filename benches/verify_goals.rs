@@ -4,8 +4,11 @@
 //! Prints median and maximum verification time (each the median of several runs) and
 //! the states explored, and how many trees pass.
 //!
+//! Then the tabletop cell with 10, 100 and 1000 cubes in towers (built, planned and
+//! repaired as in `cell_towers`): the time to read the initial facts from the geometry,
+//! and verification time, states and transitions, with and without action failures.
+//!
 //! Run: `cargo bench --bench verify_goals`
-//! (The 1000-cube tabletop cell joins this benchmark with the `cell` branch.)
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -15,7 +18,10 @@ use betr::domain::Scenario;
 use betr::goal::Formula;
 use betr::planner::Planner;
 use betr::verify::{self, Limits, Report, VerifyConfig, VerifyInput};
-use betr::world;
+use betr::world::{self, CellWorld, World};
+
+#[path = "support/towers.rs"]
+mod towers;
 
 const REPETITIONS: usize = 5;
 
@@ -102,6 +108,64 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         summarize(label, &mut rows);
     }
+    cell_towers()
+}
+
+/// Verification of the repaired tower-cell trees.
+fn cell_towers() -> Result<(), Box<dyn std::error::Error>> {
+    let dir = std::env::temp_dir().join(format!("betr-verify-towers-{}", std::process::id()));
+    println!("\nTower cells (median of {REPETITIONS} verifications each):");
+    println!(
+        "| cubes | facts | facts (ms) | repairs | tree nodes | failures | verify (ms) | states | transitions | atoms | verified |"
+    );
+    println!(
+        "|------:|------:|-----------:|--------:|-----------:|---------:|------------:|-------:|------------:|------:|---------:|"
+    );
+    for n in [10, 100, 1000] {
+        let scenario = Scenario::load(&towers::write_scenario(&dir, n)?)?;
+        let world = CellWorld::from_scenario(&scenario, None)?;
+        let repaired = towers::plan_and_repair(&scenario, &world)?;
+        let started = Instant::now();
+        let initial = world.facts();
+        let facts_time = started.elapsed();
+        for failures in [false, true] {
+            let input = VerifyInput {
+                domain: &scenario.domain,
+                tree: &repaired.plan.tree,
+                initial: &initial,
+                disturbances: &[],
+                properties: &[],
+                limits: Limits {
+                    action_failures: failures,
+                    ..Limits::default()
+                },
+            };
+            let mut times = Vec::with_capacity(REPETITIONS);
+            let mut last = None;
+            for _ in 0..REPETITIONS {
+                let started = Instant::now();
+                last = Some(verify::verify(&input));
+                times.push(started.elapsed());
+            }
+            times.sort();
+            let report = last.ok_or("no repetition ran")?;
+            let m = report.model.as_ref().map_err(|e| e.to_string())?;
+            println!(
+                "| {n:>5} | {:>5} | {:>10.1} | {:>7} | {:>10} | {:>8} | {:>11.3} | {:>6} | {:>11} | {:>5} | {:>8} |",
+                initial.len(),
+                facts_time.as_secs_f64() * 1e3,
+                repaired.repairs,
+                repaired.plan.tree.len(),
+                if failures { "on" } else { "off" },
+                times[times.len() / 2].as_secs_f64() * 1e3,
+                m.states,
+                m.transitions,
+                m.atoms,
+                if report.holds() { "yes" } else { "NO" },
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }
 

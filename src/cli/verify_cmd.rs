@@ -130,10 +130,10 @@ fn load_tree(path: &Path) -> Result<Tree> {
 }
 
 fn print_report(report: &Report, ascii: bool) {
-    let (ok, bad, unknown) = if ascii {
-        ("ok ", "FAIL", "??")
+    let (ok, bad, unknown, warn) = if ascii {
+        ("ok ", "FAIL", "??", "warn")
     } else {
-        ("✓", "✕", "?")
+        ("✓", "✕", "?", "⚠")
     };
     println!("Structural checks");
     if report.findings.is_empty() {
@@ -142,6 +142,13 @@ fn print_report(report: &Report, ascii: bool) {
     for f in &report.findings {
         println!("  {bad} {f}");
         println!("      fix: {}", f.hint);
+    }
+    for f in &report.notes {
+        println!("  {warn} {f}");
+        println!(
+            "      model checking shows it holds whenever the action starts (guarded by what is reachable, not by the tree's shape); to make the shape guard it: {}",
+            f.hint
+        );
     }
     println!("\nModel checking");
     match &report.model {

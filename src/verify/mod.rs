@@ -133,6 +133,11 @@ pub struct ModelCheck {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Report {
     pub findings: Vec<Finding>,
+    /// Unguarded-precondition findings that model checking refuted: the tree's shape does
+    /// not guard the precondition, but it holds at every start of the action in every
+    /// reachable state (an invariant of the reachable states, e.g. one object in the hand
+    /// at a time). Shown as warnings; they do not fail verification.
+    pub notes: Vec<Finding>,
     /// `Err` when the tree cannot be model checked (an action names no skill).
     pub model: Result<ModelCheck, ModelError>,
 }
@@ -184,7 +189,27 @@ impl Default for Limits {
 pub fn verify(input: &VerifyInput) -> Report {
     let findings = structural::check(input.domain, input.tree);
     let model = build_model(input).map(|m| model_check(&m, input));
-    Report { findings, model }
+    // The structural rule is local and conservative; the exploration is exact over the
+    // abstraction. When it proves every action starts with its preconditions true, an
+    // unguarded precondition is guarded by reachability, not by the tree's shape.
+    let refuted = model.as_ref().is_ok_and(|m| {
+        m.complete
+            && m.properties
+                .iter()
+                .any(|p| p.kind == PropertyKind::Preconditions && p.verdict.holds())
+    });
+    let (notes, findings) = if refuted {
+        findings
+            .into_iter()
+            .partition(|f| f.rule == Rule::UnguardedPrecondition)
+    } else {
+        (Vec::new(), findings)
+    };
+    Report {
+        findings,
+        notes,
+        model,
+    }
 }
 
 /// Compile the input's tree, disturbances and properties.

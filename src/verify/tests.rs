@@ -316,3 +316,21 @@ fn promela_has_one_claim_per_property() {
     assert!(m.text.contains("ltl p0 { <> f"), "{}", m.text);
     assert!(m.text.contains("bool calm = 1;"));
 }
+
+#[test]
+fn an_unguarded_precondition_that_every_reachable_state_meets_is_a_note() {
+    let s = scenario("");
+    // PickUp needs Holding_Nothing; the tree never checks it, but the hand starts empty
+    // and nothing else reachable fills it.
+    let r = run(
+        &s,
+        "fallback\n  Holding_Cup?\n  PickUp \"Cup\"!\n",
+        false,
+        &[],
+    );
+    assert!(r.findings.is_empty(), "{:?}", r.findings);
+    assert_eq!(r.notes.len(), 1, "{:?}", r.notes);
+    assert_eq!(r.notes[0].rule, Rule::UnguardedPrecondition);
+    assert!(r.notes[0].message.contains("Holding_Nothing"));
+    assert!(r.holds(), "{r:#?}");
+}

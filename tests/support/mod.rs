@@ -1,7 +1,9 @@
-//! Test support: a fake OpenAI-compatible server and the hand-written fixture replies.
+//! Test support: a fake OpenAI-compatible server, the hand-written fixture replies, and
+//! the verification helpers.
 #![allow(dead_code)]
 
 pub mod cli;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;
+pub mod verify;
