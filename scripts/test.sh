@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, the
-# SPIN model checker and tmux (both installed here with apt when missing).
+# Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, and
+# a few Debian packages that scripts/setup.sh installs when missing. Tests that run the
+# embedded LLM fetch it into the cache on first use.
 # Usage: bash scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,20 +11,7 @@ if [ ! -d ../shared/datasets/llm-obtea ]; then
   exit 2
 fi
 
-# The SPIN model checker cross-checks `betr verify` (tests/verify_scenarios.rs).
-if ! command -v spin >/dev/null 2>&1; then
-  echo "spin is missing: installing the Debian package" >&2
-  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
-  $SUDO apt-get update
-  $SUDO apt-get install -y spin
-fi
-
-# tmux runs the real binary as a person would (tests/tui_tmux.rs).
-if ! command -v tmux >/dev/null 2>&1; then
-  echo "tmux is missing: installing the Debian package" >&2
-  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
-  $SUDO apt-get update
-  $SUDO apt-get install -y tmux
-fi
+# Build packages, plus spin (cross-checks `betr verify`) and tmux (drives the real binary).
+bash scripts/setup.sh --test
 
 cargo test --locked
