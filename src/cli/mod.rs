@@ -1,5 +1,6 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
+mod bench_cmd;
 mod eval_cmd;
 mod eval_setup;
 mod llm_cmds;
@@ -36,6 +37,11 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
+    /// Benchmarks of the embedded parts.
+    Bench {
+        #[command(subcommand)]
+        what: BenchWhat,
+    },
     /// The workbench: type an instruction, plan, step or run the tree, approve the fixes a
     /// model proposes when an action fails, verify, save the policy.
     Tui(tui_cmd::TuiArgs),
@@ -166,6 +172,24 @@ pub struct PolicySaveTest {
 }
 
 #[derive(Subcommand)]
+pub enum BenchWhat {
+    /// The embedded LLM on the goal prompt: load time, cold and warm latency, tokens/s,
+    /// with and without the grammar.
+    Llm {
+        #[arg(long, default_value = "scenarios/cell/red_on_blue.toml")]
+        scenario: PathBuf,
+        /// A GGUF file instead of the fetched default model.
+        #[arg(long)]
+        model_path: Option<PathBuf>,
+        #[arg(long, default_value_t = betr::llm::config::DEFAULT_THREADS)]
+        threads: u32,
+        /// Warm calls per variant.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+    },
+}
+
+#[derive(Subcommand)]
 pub enum ModelAction {
     /// Download, verify and install a model (the default LLM unless --model).
     Fetch {
@@ -192,6 +216,15 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     };
     match command {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
+        Command::Bench {
+            what:
+                BenchWhat::Llm {
+                    scenario,
+                    model_path,
+                    threads,
+                    repeats,
+                },
+        } => bench_cmd::llm(&scenario, model_path.as_deref(), threads, repeats),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model {
