@@ -207,40 +207,14 @@ impl Skill {
 
     /// Apply the skill to objects. The caller checks `accepts` first.
     pub fn ground(&self, args: &[String]) -> GroundSkill {
-        let term = |t: &Term| match t {
-            Term::Param(i) => args.get(*i).cloned(),
-            Term::Const(c) => Some(c.clone()),
-            Term::Every => None,
-        };
-        let atom = |t: &AtomTemplate| Atom {
-            predicate: t.predicate.clone(),
-            args: t
-                .args
-                .iter()
-                .map(|a| term(a).unwrap_or_else(|| ANY_OBJECT.to_string()))
-                .collect(),
-        };
+        let (pre, add, del) = ground_templates(&self.pre, &self.add, &self.del, args);
         GroundSkill {
             call: ActionCall::new(self.name.clone(), args.iter().cloned()),
             cost: self.cost,
             ticks: self.ticks.max(1),
-            pre: self
-                .pre
-                .iter()
-                .map(|l| Condition {
-                    atom: atom(&l.atom),
-                    negated: l.negated,
-                })
-                .collect(),
-            add: self.add.iter().map(atom).collect(),
-            del: self
-                .del
-                .iter()
-                .map(|t| AtomPattern {
-                    predicate: t.predicate.clone(),
-                    args: t.args.iter().map(term).collect(),
-                })
-                .collect(),
+            pre,
+            add,
+            del,
         }
     }
 
@@ -274,6 +248,45 @@ impl Skill {
         }
         out
     }
+}
+
+/// Templates with their parameters replaced by `args`: the conditions (`{*}` becomes
+/// `"any object"`), the atoms that become true, and the patterns that become false (`{*}`
+/// open). Shared by skills and by anything else written as templates (disturbances).
+pub fn ground_templates(
+    pre: &[LiteralTemplate],
+    add: &[AtomTemplate],
+    del: &[AtomTemplate],
+    args: &[String],
+) -> (Vec<Condition>, Vec<Atom>, Vec<AtomPattern>) {
+    let term = |t: &Term| match t {
+        Term::Param(i) => args.get(*i).cloned(),
+        Term::Const(c) => Some(c.clone()),
+        Term::Every => None,
+    };
+    let atom = |t: &AtomTemplate| Atom {
+        predicate: t.predicate.clone(),
+        args: t
+            .args
+            .iter()
+            .map(|a| term(a).unwrap_or_else(|| ANY_OBJECT.to_string()))
+            .collect(),
+    };
+    (
+        pre.iter()
+            .map(|l| Condition {
+                atom: atom(&l.atom),
+                negated: l.negated,
+            })
+            .collect(),
+        add.iter().map(atom).collect(),
+        del.iter()
+            .map(|t| AtomPattern {
+                predicate: t.predicate.clone(),
+                args: t.args.iter().map(term).collect(),
+            })
+            .collect(),
+    )
 }
 
 impl Domain {

@@ -12,7 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::llm::usage::PriceTable;
-use crate::llm::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, ReplySource};
+use crate::llm::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError};
 
 use super::EvalError;
 
@@ -84,23 +84,8 @@ impl Tap {
     }
 
     fn record(&self, reply: &ChatReply) -> CallRecord {
-        let (source, billed) = match reply.source {
-            ReplySource::Model => ("model", true),
-            ReplySource::Recorded => ("recorded", false),
-            ReplySource::HandWritten { .. } => ("hand-written", false),
-        };
-        let price_usd = if billed {
-            self.prices
-                .price(&reply.model)
-                .or_else(|| self.prices.price(self.inner.model()))
-                .map(|p| {
-                    (reply.usage.prompt_tokens as f64 * p.prompt_per_mtok
-                        + reply.usage.completion_tokens as f64 * p.completion_per_mtok)
-                        / 1e6
-                })
-        } else {
-            Some(0.0)
-        };
+        let (source, price_usd) =
+            crate::llm::usage::billing(&self.prices, reply, self.inner.model());
         CallRecord {
             prompt_tokens: reply.usage.prompt_tokens,
             completion_tokens: reply.usage.completion_tokens,

@@ -201,23 +201,7 @@ impl<M: LanguageModel> Metered<M> {
 
     /// The record a reply makes.
     pub fn record_for(&self, reply: &ChatReply) -> UsageRecord {
-        let (source, billed) = match reply.source {
-            ReplySource::Model => ("model", true),
-            ReplySource::Recorded => ("recorded", false),
-            ReplySource::HandWritten { .. } => ("hand-written", false),
-        };
-        let price_usd = if billed {
-            self.prices
-                .price(&reply.model)
-                .or_else(|| self.prices.price(self.inner.model()))
-                .map(|p| {
-                    (reply.usage.prompt_tokens as f64 * p.prompt_per_mtok
-                        + reply.usage.completion_tokens as f64 * p.completion_per_mtok)
-                        / 1e6
-                })
-        } else {
-            Some(0.0)
-        };
+        let (source, price_usd) = billing(&self.prices, reply, self.inner.model());
         UsageRecord {
             unix_time: unix_now(),
             purpose: self.purpose.lock().map(|p| p.clone()).unwrap_or_default(),
@@ -250,6 +234,34 @@ impl<M: LanguageModel> LanguageModel for Metered<M> {
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         Box::pin(self.call(request))
     }
+}
+
+/// Where a reply came from (`model`, `recorded`, `hand-written`) and what it cost: only a
+/// model's live answer is billed, at the price of the model it names (else the model the
+/// request was for); `None` when the price table does not know it.
+pub fn billing(
+    prices: &PriceTable,
+    reply: &ChatReply,
+    requested: &str,
+) -> (&'static str, Option<f64>) {
+    let (source, billed) = match reply.source {
+        ReplySource::Model => ("model", true),
+        ReplySource::Recorded => ("recorded", false),
+        ReplySource::HandWritten { .. } => ("hand-written", false),
+    };
+    let price = if billed {
+        prices
+            .price(&reply.model)
+            .or_else(|| prices.price(requested))
+            .map(|p| {
+                (reply.usage.prompt_tokens as f64 * p.prompt_per_mtok
+                    + reply.usage.completion_tokens as f64 * p.completion_per_mtok)
+                    / 1e6
+            })
+    } else {
+        Some(0.0)
+    };
+    (source, price)
 }
 
 #[cfg(test)]

@@ -19,7 +19,6 @@ use std::collections::{BTreeSet, HashMap};
 
 use super::config::Disturbance;
 use crate::bt::{NodeId, NodeKind, Tree};
-use crate::domain::skill::Term;
 use crate::domain::{ANY_OBJECT, ActionCall, Atom, AtomPattern, Condition, Domain};
 use crate::goal::Formula;
 
@@ -561,19 +560,8 @@ fn ground_disturbances(
                 .collect();
         }
         for args in combos {
-            let term = |t: &Term| match t {
-                Term::Param(i) => args.get(*i).cloned(),
-                Term::Const(c) => Some(c.clone()),
-                Term::Every => None,
-            };
-            let atom = |t: &crate::domain::skill::AtomTemplate| Atom {
-                predicate: t.predicate.clone(),
-                args: t
-                    .args
-                    .iter()
-                    .map(|a| term(a).unwrap_or_else(|| ANY_OBJECT.to_string()))
-                    .collect(),
-            };
+            let (pre, add, del) =
+                crate::domain::skill::ground_templates(&d.pre, &d.add, &d.del, &args);
             out.push(Ground {
                 description: d.description.clone(),
                 grounding: d
@@ -583,23 +571,9 @@ fn ground_disturbances(
                     .map(|(p, a)| format!("{} = \"{a}\"", p.name))
                     .collect::<Vec<_>>()
                     .join(", "),
-                pre: d
-                    .pre
-                    .iter()
-                    .map(|l| Condition {
-                        atom: atom(&l.atom),
-                        negated: l.negated,
-                    })
-                    .collect(),
-                add: d.add.iter().map(atom).collect(),
-                del: d
-                    .del
-                    .iter()
-                    .map(|t| AtomPattern {
-                        predicate: t.predicate.clone(),
-                        args: t.args.iter().map(term).collect(),
-                    })
-                    .collect(),
+                pre,
+                add,
+                del,
             });
         }
     }
