@@ -18,4 +18,5 @@ pub mod planner;
 pub mod session;
 pub mod store;
 pub mod verify;
+pub mod voice;
 pub mod world;

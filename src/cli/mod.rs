@@ -6,6 +6,7 @@ mod model_cmd;
 mod tree_cmds;
 mod values;
 mod verify_cmd;
+mod voice_cmd;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -120,9 +121,29 @@ pub enum Command {
     Interpret {
         scenario: PathBuf,
         /// The instruction (default: the scenario's).
+        #[arg(conflicts_with = "audio")]
         instruction: Option<String>,
+        /// Dictate the instruction: transcribe this WAV file, print the transcript and use
+        /// it once confirmed (or corrected) on the terminal, or with --yes.
+        #[arg(long, value_name = "FILE.wav")]
+        audio: Option<PathBuf>,
+        /// Use a dictated transcript without asking (it is still printed).
+        #[arg(long, short = 'y')]
+        yes: bool,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
+    },
+    /// Transcribe a WAV file (any rate, channels and bit depth) with the configured
+    /// speech-to-text backend; print the transcript, and timings on stderr.
+    Transcribe {
+        file: PathBuf,
+        /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
     },
     /// Interpret the scenario's instruction, plan, simulate; on each failure ask the model
     /// for the missing preconditions (or parameter value), ask for approval, repair, re-run;
@@ -130,9 +151,13 @@ pub enum Command {
     Resolve {
         scenario: PathBuf,
         /// An instruction instead of the scenario's.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "audio")]
         instruction: Option<String>,
-        /// Approve every proposal without asking.
+        /// Dictate the instruction from a WAV file (printed; confirmed on the terminal or
+        /// by --yes).
+        #[arg(long, value_name = "FILE.wav")]
+        audio: Option<PathBuf>,
+        /// Approve every proposal (and a dictated transcript) without asking.
         #[arg(long, short = 'y')]
         yes: bool,
         /// Questions about failures before giving up.
@@ -143,6 +168,8 @@ pub enum Command {
         save: Option<PathBuf>,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
     },
 }
 
@@ -168,17 +195,24 @@ pub enum EvalExperiment {
 
 #[derive(Subcommand)]
 pub enum ModelAction {
-    /// Download, verify and install a model (the default LLM unless --model).
+    /// Download, verify and install a model (the default LLM unless --model; with --stt
+    /// the default speech-to-text model, whisper-tiny.en).
     Fetch {
         #[arg(long)]
         model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
     },
     /// Known models, their sizes and whether they are in the cache.
     List,
-    /// Check the cached file's SHA-256 against the expected one.
+    /// Check the cached files' SHA-256 against the expected ones.
     Verify {
         #[arg(long)]
         model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
     },
 }
 
@@ -199,38 +233,60 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 },
         } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, out.as_deref()),
         Command::Model {
-            action: ModelAction::Fetch { model },
-        } => model_cmd::fetch(model.as_deref()),
+            action: ModelAction::Fetch { model, stt },
+        } => model_cmd::fetch(model.as_deref(), stt),
         Command::Model {
             action: ModelAction::List,
         } => model_cmd::list(),
         Command::Model {
-            action: ModelAction::Verify { model },
-        } => model_cmd::verify(model.as_deref()),
+            action: ModelAction::Verify { model, stt },
+        } => model_cmd::verify(model.as_deref(), stt),
+        Command::Transcribe { file, config, stt } => {
+            voice_cmd::transcribe(&file, config.as_deref(), &stt)
+        }
         Command::Interpret {
             scenario,
             instruction,
+            audio,
+            yes,
             llm,
-        } => llm_cmds::interpret(&load(&scenario)?, instruction.as_deref(), &llm),
+            stt,
+        } => {
+            let scenario = load(&scenario)?;
+            let instruction = match &audio {
+                Some(audio) => Some(dictate(audio, &llm, &stt, yes)?),
+                None => instruction,
+            };
+            llm_cmds::interpret(&scenario, instruction.as_deref(), &llm)
+        }
         Command::Resolve {
             scenario,
             instruction,
+            audio,
             yes,
             max_rounds,
             save,
             llm,
-        } => llm_cmds::resolve(
-            &load(&scenario)?,
-            &llm_cmds::ResolveArgs {
-                instruction: instruction.as_deref(),
-                yes,
-                max_rounds,
-                save: save.as_deref(),
-                scenario_path: &scenario,
-            },
-            &llm,
-            glyphs,
-        ),
+            stt,
+        } => {
+            let loaded = load(&scenario)?;
+            let instruction = match &audio {
+                Some(audio) => Some(dictate(audio, &llm, &stt, yes)?),
+                None => instruction,
+            };
+            llm_cmds::resolve(
+                &loaded,
+                &llm_cmds::ResolveArgs {
+                    instruction: instruction.as_deref(),
+                    yes,
+                    max_rounds,
+                    save: save.as_deref(),
+                    scenario_path: &scenario,
+                },
+                &llm,
+                glyphs,
+            )
+        }
         Command::Plan { scenario, goal } => {
             tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
         }
@@ -309,6 +365,21 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             },
         ),
     }
+}
+
+/// The instruction dictated in `audio`, as confirmed on the terminal (or by --yes).
+fn dictate(
+    audio: &Path,
+    llm: &llm_cmds::LlmFlags,
+    stt: &voice_cmd::SttFlags,
+    yes: bool,
+) -> Result<String> {
+    voice_cmd::dictated_instruction(&voice_cmd::Dictation {
+        audio,
+        config: llm.config.as_deref(),
+        flags: stt,
+        yes,
+    })
 }
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.

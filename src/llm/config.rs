@@ -132,6 +132,9 @@ pub struct FileConfig {
     pub llm: Layer,
     #[serde(default)]
     pub prices: PriceTable,
+    /// Speech-to-text settings, read by `voice::config`.
+    #[serde(default)]
+    pub stt: crate::voice::SttLayer,
 }
 
 impl FileConfig {
@@ -143,6 +146,12 @@ impl FileConfig {
         if file.llm.api_key.is_some() {
             return Err(LlmError::Config(format!(
                 "{}: `api_key` is not allowed in a file; put the key in an environment variable and name it with `api_key_env`",
+                path.display()
+            )));
+        }
+        if file.stt.api_key.is_some() {
+            return Err(LlmError::Config(format!(
+                "{}: `api_key` is not allowed under [stt]; put the key in an environment variable and name it with `api_key_env`",
                 path.display()
             )));
         }

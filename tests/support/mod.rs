@@ -4,3 +4,4 @@
 pub mod cli;
 pub mod fake_openai;
 pub mod fixtures;
+pub mod multipart;
