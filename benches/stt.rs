@@ -1,7 +1,10 @@
 //! Speech-to-text timing: model load time and the latency of transcribing a 3-second
-//! utterance (spoken by espeak-ng, padded with silence to exactly 3.00 s) with each
-//! embedded Whisper model in the cache (whisper-tiny.en is fetched if missing), greedy
-//! and with beam search. Each latency is the median of several runs after a warm-up.
+//! utterance (spoken by espeak-ng as clear dictation, 140 words per minute with 30 ms
+//! between words, padded with silence to exactly 3.00 s) with each embedded Whisper
+//! model in the cache (whisper-tiny.en is fetched if missing), greedy and with beam
+//! search. Each latency is the median of several runs after a warm-up; the process's CPU
+//! time per run is printed too, as wall-clock times depend on what else the machine runs
+//! (the load average is printed before and after).
 //!
 //! Run: `cargo bench --bench stt` (needs `espeak-ng`; scripts/test.sh installs it)
 
@@ -12,7 +15,7 @@ use std::time::{Duration, Instant};
 use betr::model::{self, Progress, STT_MODELS, WHISPER_TINY_EN};
 use betr::voice::{Audio16k, LocalSettings, LocalWhisper, SAMPLE_RATE, word_error_rate};
 
-const UTTERANCE: &str = "Put the blue cube on the green cube, then open the centrifuge";
+const UTTERANCE: &str = "Put the green cube in the red cup";
 const SECONDS: f64 = 3.0;
 const LOADS: usize = 3;
 const RUNS: usize = 5;
@@ -25,9 +28,9 @@ impl Progress for Log {
     fn bytes(&mut self, _: u64, _: u64) {}
 }
 
-fn speak(text: &str, speed: u32, wav: &Path) -> Result<Audio16k, Box<dyn std::error::Error>> {
+fn speak(text: &str, wav: &Path) -> Result<Audio16k, Box<dyn std::error::Error>> {
     let status = Command::new("espeak-ng")
-        .args(["-s", &speed.to_string(), "-w"])
+        .args(["-g", "3", "-s", "140", "-w"])
         .arg(wav)
         .arg(text)
         .status()?;
@@ -37,15 +40,32 @@ fn speak(text: &str, speed: u32, wav: &Path) -> Result<Audio16k, Box<dyn std::er
     Ok(Audio16k::from_wav(wav)?)
 }
 
-/// The utterance spoken to last just under `SECONDS`, padded with silence to exactly that.
+/// The utterance, padded with silence to (or cut at) exactly `SECONDS`.
 fn utterance(dir: &Path) -> Result<(Audio16k, f64), Box<dyn std::error::Error>> {
     let wav = dir.join("utterance.wav");
-    let natural = speak(UTTERANCE, 175, &wav)?.seconds();
-    let speed = (175.0 * natural / (SECONDS - 0.2)).round() as u32;
-    let mut samples = speak(UTTERANCE, speed, &wav)?.into_samples();
+    let mut samples = speak(UTTERANCE, &wav)?.into_samples();
     let spoken = samples.len() as f64 / f64::from(SAMPLE_RATE);
     samples.resize((SECONDS * f64::from(SAMPLE_RATE)) as usize, 0.0);
     Ok((Audio16k::new(samples), spoken))
+}
+
+/// CPU time of this process so far (user + system, all threads), from /proc (Linux).
+fn cpu_time() -> Duration {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the command name (which is in parentheses): utime is the 12th, stime the 13th.
+    let after = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
+    let fields: Vec<u64> = after
+        .split_whitespace()
+        .map(|f| f.parse().unwrap_or(0))
+        .collect();
+    let ticks = fields.get(11).copied().unwrap_or(0) + fields.get(12).copied().unwrap_or(0);
+    Duration::from_millis(ticks * 10)
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
 }
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -66,12 +86,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (audio, spoken) = utterance(&dir)?;
     let threads = LocalSettings::default().threads;
     println!(
-        "utterance: {UTTERANCE:?}, {spoken:.2} s of speech padded to {:.2} s; {threads} thread(s)",
-        audio.seconds()
+        "utterance: {UTTERANCE:?}, {spoken:.2} s of speech padded to {:.2} s; {threads} thread(s); load average {}",
+        audio.seconds(),
+        load_average()
     );
     println!(
-        "\n{:<16} {:>10} {:>10} {:>6} {:>12} {:>12} {:>12}  transcript",
-        "model", "load 1st", "load med", "beam", "median", "min", "max"
+        "\n{:<16} {:>9} {:>9} {:>5} {:>9} {:>9} {:>9} {:>9}  transcript",
+        "model", "load 1st", "load med", "beam", "median", "min", "max", "CPU/run"
     );
     for spec in STT_MODELS.iter().filter(|m| m.is_present()) {
         let mut loads = Vec::new();
@@ -89,15 +110,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let whisper = LocalWhisper::load(&spec.path(), spec.name, settings)?;
             let warm = whisper.transcribe_blocking(&audio)?;
             let mut times = Vec::new();
+            let cpu_before = cpu_time();
             for _ in 0..RUNS {
                 let started = Instant::now();
                 whisper.transcribe_blocking(&audio)?;
                 times.push(started.elapsed());
             }
+            let cpu = (cpu_time() - cpu_before) / RUNS as u32;
             let min = times.iter().copied().min().unwrap_or_default();
             let max = times.iter().copied().max().unwrap_or_default();
             println!(
-                "{:<16} {:>10} {:>10} {:>6} {:>12} {:>12} {:>12}  {:?} (WER {:.2})",
+                "{:<16} {:>9} {:>9} {:>5} {:>9} {:>9} {:>9} {:>9}  {:?} (WER {:.2})",
                 spec.name,
                 ms(first),
                 ms(load_median),
@@ -105,11 +128,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ms(median(times)),
                 ms(min),
                 ms(max),
+                ms(cpu),
                 warm.text,
                 word_error_rate(UTTERANCE, &warm.text)
             );
         }
     }
+    println!("\nload average after: {}", load_average());
     std::fs::remove_dir_all(&dir)?;
     Ok(())
 }

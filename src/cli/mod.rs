@@ -67,7 +67,7 @@ pub enum Command {
     /// Embedded model files: fetch them into the cache, list them.
     Model {
         #[command(subcommand)]
-        action: ModelAction,
+        action: model_cmd::ModelAction,
     },
     /// Plan a tree for the scenario's goal (or --goal) and print it with its statuses.
     Plan {
@@ -193,29 +193,6 @@ pub enum EvalExperiment {
     },
 }
 
-#[derive(Subcommand)]
-pub enum ModelAction {
-    /// Download, verify and install a model (the default LLM unless --model; with --stt
-    /// the default speech-to-text model, whisper-tiny.en).
-    Fetch {
-        #[arg(long)]
-        model: Option<String>,
-        /// A speech-to-text model.
-        #[arg(long)]
-        stt: bool,
-    },
-    /// Known models, their sizes and whether they are in the cache.
-    List,
-    /// Check the cached files' SHA-256 against the expected ones.
-    Verify {
-        #[arg(long)]
-        model: Option<String>,
-        /// A speech-to-text model.
-        #[arg(long)]
-        stt: bool,
-    },
-}
-
 pub fn run(cli: Cli) -> Result<ExitCode> {
     let glyphs = if cli.ascii {
         &betr::bt::ASCII
@@ -232,15 +209,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     out,
                 },
         } => eval_cmd::goals_from_answers(&dataset, &answers, &scenario, out.as_deref()),
-        Command::Model {
-            action: ModelAction::Fetch { model, stt },
-        } => model_cmd::fetch(model.as_deref(), stt),
-        Command::Model {
-            action: ModelAction::List,
-        } => model_cmd::list(),
-        Command::Model {
-            action: ModelAction::Verify { model, stt },
-        } => model_cmd::verify(model.as_deref(), stt),
+        Command::Model { action } => model_cmd::run(action),
         Command::Transcribe { file, config, stt } => {
             voice_cmd::transcribe(&file, config.as_deref(), &stt)
         }
@@ -254,7 +223,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => {
             let scenario = load(&scenario)?;
             let instruction = match &audio {
-                Some(audio) => Some(dictate(audio, &llm, &stt, yes)?),
+                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
                 None => instruction,
             };
             llm_cmds::interpret(&scenario, instruction.as_deref(), &llm)
@@ -271,7 +240,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => {
             let loaded = load(&scenario)?;
             let instruction = match &audio {
-                Some(audio) => Some(dictate(audio, &llm, &stt, yes)?),
+                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
                 None => instruction,
             };
             llm_cmds::resolve(
@@ -365,21 +334,6 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             },
         ),
     }
-}
-
-/// The instruction dictated in `audio`, as confirmed on the terminal (or by --yes).
-fn dictate(
-    audio: &Path,
-    llm: &llm_cmds::LlmFlags,
-    stt: &voice_cmd::SttFlags,
-    yes: bool,
-) -> Result<String> {
-    voice_cmd::dictated_instruction(&voice_cmd::Dictation {
-        audio,
-        config: llm.config.as_deref(),
-        flags: stt,
-        yes,
-    })
 }
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.

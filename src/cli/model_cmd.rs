@@ -4,9 +4,41 @@
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
+use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use betr::model::{self, DirModelSpec, ModelSpec, Progress};
+
+#[derive(Subcommand)]
+pub enum ModelAction {
+    /// Download, verify and install a model (the default LLM unless --model; with --stt
+    /// the default speech-to-text model, whisper-tiny.en).
+    Fetch {
+        #[arg(long)]
+        model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
+    },
+    /// Known models, their sizes and whether they are in the cache.
+    List,
+    /// Check the cached files' SHA-256 against the expected ones.
+    Verify {
+        #[arg(long)]
+        model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
+    },
+}
+
+pub fn run(action: ModelAction) -> Result<ExitCode> {
+    match action {
+        ModelAction::Fetch { model, stt } => fetch(model.as_deref(), stt),
+        ModelAction::List => list(),
+        ModelAction::Verify { model, stt } => verify(model.as_deref(), stt),
+    }
+}
 
 /// Progress on the terminal: a spinner per step, a byte bar while the file is assembled.
 pub struct TerminalProgress {

@@ -129,23 +129,16 @@ pub fn transcribe(file: &Path, config: Option<&Path>, flags: &SttFlags) -> Resul
     Ok(ExitCode::SUCCESS)
 }
 
-/// Dictation for `interpret` / `resolve`.
-pub struct Dictation<'a> {
-    pub audio: &'a Path,
-    pub config: Option<&'a Path>,
-    pub flags: &'a SttFlags,
-    pub yes: bool,
-}
-
-/// Transcribe the file, print the transcript, and return the instruction the user
-/// confirmed (or corrected).
-pub fn dictated_instruction(d: &Dictation) -> Result<String> {
-    let audio = read(d.audio)?;
-    let loaded = load(&settings(d.config, d.flags)?)?;
+/// For `interpret` / `resolve --audio`: transcribe the file, print the transcript, and
+/// return the instruction the user confirmed or corrected on the terminal (or, with
+/// `yes`, the transcript as printed).
+pub fn dictate(audio: &Path, config: Option<&Path>, flags: &SttFlags, yes: bool) -> Result<String> {
+    let audio = read(audio)?;
+    let loaded = load(&settings(config, flags)?)?;
     let transcript = run_transcription(loaded.stt.as_ref(), &audio)?;
     println!("Dictated:    {}", transcript.text);
     println!("             ({})", timings(&transcript, loaded.load_time));
-    if d.yes {
+    if yes {
         println!("Using the transcript as the instruction (--yes).");
         return Ok(transcript.text);
     }

@@ -351,6 +351,7 @@ mod tests {
         let file = FileConfig::read(&path).unwrap();
         assert_eq!(file.llm.backend, Some(Backend::Openai));
         assert!(file.prices.price("gpt-4o-2024-08-06").is_some());
+        assert_eq!(file.stt.backend, Some(crate::voice::SttBackend::Local));
         let s = Settings::resolve(Some((&path, file)), Layer::default(), Layer::default()).unwrap();
         assert_eq!(s.retry.max_retries, 3);
     }
