@@ -5,12 +5,14 @@
 # Safe to run again: it does nothing when everything is there.
 set -euo pipefail
 
-# Building: llama.cpp (the embedded LLM) is compiled with cmake, and its Rust bindings
-# are generated with libclang. Charts draw their labels with DejaVu Sans.
-packages=(cmake libclang-dev fonts-dejavu-core)
+# Building: llama.cpp (the embedded LLM) and CTranslate2 (speech-to-text) are compiled
+# with cmake and a C++ compiler, llama.cpp's Rust bindings are generated with libclang,
+# cpal links ALSA (pkg-config finds it). Charts draw their labels with DejaVu Sans.
+packages=(cmake g++ pkg-config libclang-dev libasound2-dev fonts-dejavu-core)
 if [ "${1:-}" = "--test" ]; then
-  # spin cross-checks `betr verify`; tmux drives the real binary as a person would.
-  packages+=(spin tmux)
+  # spin cross-checks `betr verify`; tmux drives the real binary as a person would;
+  # espeak-ng speaks the instructions the dictation tests transcribe.
+  packages+=(spin tmux espeak-ng)
 fi
 
 missing=()

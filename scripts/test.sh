@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test of betr. The tests need a Rust toolchain, the goal dataset in ../shared, and
 # a few Debian packages that scripts/setup.sh installs when missing. Tests that run the
-# embedded LLM fetch it into the cache on first use.
+# embedded LLM or speech-to-text fetch their models into the cache on first use.
 # Usage: bash scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +11,7 @@ if [ ! -d ../shared/datasets/llm-obtea ]; then
   exit 2
 fi
 
-# Build packages, plus spin (cross-checks `betr verify`) and tmux (drives the real binary).
+# Build packages, plus spin, tmux and espeak-ng for the tests.
 bash scripts/setup.sh --test
 
 cargo test --locked

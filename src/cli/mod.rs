@@ -10,6 +10,7 @@ mod tree_cmds;
 pub mod tui_cmd;
 mod values;
 mod verify_cmd;
+mod voice_cmd;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -81,7 +82,7 @@ pub enum Command {
     /// Embedded model files: fetch them into the cache, list them.
     Model {
         #[command(subcommand)]
-        action: ModelAction,
+        action: model_cmd::ModelAction,
     },
     /// Plan a tree for the scenario's goal (or --goal) and print it with its statuses.
     Plan {
@@ -135,9 +136,29 @@ pub enum Command {
     Interpret {
         scenario: PathBuf,
         /// The instruction (default: the scenario's).
+        #[arg(conflicts_with = "audio")]
         instruction: Option<String>,
+        /// Dictate the instruction: transcribe this WAV file, print the transcript and use
+        /// it once confirmed (or corrected) on the terminal, or with --yes.
+        #[arg(long, value_name = "FILE.wav")]
+        audio: Option<PathBuf>,
+        /// Use a dictated transcript without asking (it is still printed).
+        #[arg(long, short = 'y')]
+        yes: bool,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
+    },
+    /// Transcribe a WAV file (any rate, channels and bit depth) with the configured
+    /// speech-to-text backend; print the transcript, and timings on stderr.
+    Transcribe {
+        file: PathBuf,
+        /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
     },
     /// Interpret the scenario's instruction, plan, simulate; on each failure ask the model
     /// for the missing preconditions (or parameter value), ask for approval, repair, re-run;
@@ -145,9 +166,13 @@ pub enum Command {
     Resolve {
         scenario: PathBuf,
         /// An instruction instead of the scenario's.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "audio")]
         instruction: Option<String>,
-        /// Approve every proposal without asking.
+        /// Dictate the instruction from a WAV file (printed; confirmed on the terminal or
+        /// by --yes).
+        #[arg(long, value_name = "FILE.wav")]
+        audio: Option<PathBuf>,
+        /// Approve every proposal (and a dictated transcript) without asking.
         #[arg(long, short = 'y')]
         yes: bool,
         /// Questions about failures before giving up.
@@ -158,6 +183,8 @@ pub enum Command {
         save: Option<PathBuf>,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
+        #[command(flatten)]
+        stt: voice_cmd::SttFlags,
     },
 }
 
@@ -189,22 +216,6 @@ pub enum BenchWhat {
     },
 }
 
-#[derive(Subcommand)]
-pub enum ModelAction {
-    /// Download, verify and install a model (the default LLM unless --model).
-    Fetch {
-        #[arg(long)]
-        model: Option<String>,
-    },
-    /// Known models, their sizes and whether they are in the cache.
-    List,
-    /// Check the cached file's SHA-256 against the expected one.
-    Verify {
-        #[arg(long)]
-        model: Option<String>,
-    },
-}
-
 pub fn run(cli: Cli) -> Result<ExitCode> {
     let glyphs = if cli.ascii {
         &betr::bt::ASCII
@@ -227,39 +238,53 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => bench_cmd::llm(&scenario, model_path.as_deref(), threads, repeats),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
-        Command::Model {
-            action: ModelAction::Fetch { model },
-        } => model_cmd::fetch(model.as_deref()),
-        Command::Model {
-            action: ModelAction::List,
-        } => model_cmd::list(),
-        Command::Model {
-            action: ModelAction::Verify { model },
-        } => model_cmd::verify(model.as_deref()),
+        Command::Model { action } => model_cmd::run(action),
+        Command::Transcribe { file, config, stt } => {
+            voice_cmd::transcribe(&file, config.as_deref(), &stt)
+        }
         Command::Interpret {
             scenario,
             instruction,
+            audio,
+            yes,
             llm,
-        } => llm_cmds::interpret(&load(&scenario)?, instruction.as_deref(), &llm),
+            stt,
+        } => {
+            let scenario = load(&scenario)?;
+            let instruction = match &audio {
+                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
+                None => instruction,
+            };
+            llm_cmds::interpret(&scenario, instruction.as_deref(), &llm)
+        }
         Command::Resolve {
             scenario,
             instruction,
+            audio,
             yes,
             max_rounds,
             save,
             llm,
-        } => llm_cmds::resolve(
-            &load(&scenario)?,
-            &llm_cmds::ResolveArgs {
-                instruction: instruction.as_deref(),
-                yes,
-                max_rounds,
-                save: save.as_deref(),
-                scenario_path: &scenario,
-            },
-            &llm,
-            glyphs,
-        ),
+            stt,
+        } => {
+            let loaded = load(&scenario)?;
+            let instruction = match &audio {
+                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
+                None => instruction,
+            };
+            llm_cmds::resolve(
+                &loaded,
+                &llm_cmds::ResolveArgs {
+                    instruction: instruction.as_deref(),
+                    yes,
+                    max_rounds,
+                    save: save.as_deref(),
+                    scenario_path: &scenario,
+                },
+                &llm,
+                glyphs,
+            )
+        }
         Command::Plan { scenario, goal } => {
             tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
         }

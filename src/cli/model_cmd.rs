@@ -1,11 +1,44 @@
-//! `betr model fetch` and `betr model list`.
+//! `betr model fetch`, `list` and `verify`, for the language model and (with `--stt`) the
+//! speech-to-text models.
 
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
+use clap::Subcommand;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use betr::model::{self, ModelSpec, Progress};
+use betr::model::{self, DirModelSpec, ModelSpec, Progress};
+
+#[derive(Subcommand)]
+pub enum ModelAction {
+    /// Download, verify and install a model (the default LLM unless --model; with --stt
+    /// the default speech-to-text model, whisper-tiny.en).
+    Fetch {
+        #[arg(long)]
+        model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
+    },
+    /// Known models, their sizes and whether they are in the cache.
+    List,
+    /// Check the cached files' SHA-256 against the expected ones.
+    Verify {
+        #[arg(long)]
+        model: Option<String>,
+        /// A speech-to-text model.
+        #[arg(long)]
+        stt: bool,
+    },
+}
+
+pub fn run(action: ModelAction) -> Result<ExitCode> {
+    match action {
+        ModelAction::Fetch { model, stt } => fetch(model.as_deref(), stt),
+        ModelAction::List => list(),
+        ModelAction::Verify { model, stt } => verify(model.as_deref(), stt),
+    }
+}
 
 /// Progress on the terminal: a spinner per step, a byte bar while the file is assembled.
 pub struct TerminalProgress {
@@ -70,8 +103,43 @@ pub fn ensure(name: Option<&str>) -> Result<std::path::PathBuf> {
     Ok(path)
 }
 
-pub fn fetch(name: Option<&str>) -> Result<ExitCode> {
-    let path = ensure(name)?;
+fn stt_spec(name: Option<&str>) -> Result<&'static DirModelSpec> {
+    match name {
+        None => Ok(&model::WHISPER_TINY_EN),
+        Some(n) => model::find_stt(n).with_context(|| {
+            let known: Vec<&str> = model::STT_MODELS.iter().map(|m| m.name).collect();
+            format!(
+                "unknown speech-to-text model {n:?} (known: {})",
+                known.join(", ")
+            )
+        }),
+    }
+}
+
+/// Fetch a speech-to-text model unless it is already cached; returns its directory.
+pub fn ensure_stt(name: Option<&str>) -> Result<std::path::PathBuf> {
+    let spec = stt_spec(name)?;
+    if spec.is_present() {
+        return Ok(spec.path());
+    }
+    eprintln!(
+        "Fetching {} ({:.0} MB) into {} — once only",
+        spec.description,
+        spec.size() as f64 / 1e6,
+        model::cache_dir().display()
+    );
+    let mut progress = TerminalProgress::new();
+    let path = model::fetch_dir(spec, &model::cache_dir(), "python3", &mut progress)?;
+    progress.finish(format!("verified and installed {}", path.display()));
+    Ok(path)
+}
+
+pub fn fetch(name: Option<&str>, stt: bool) -> Result<ExitCode> {
+    let path = if stt {
+        ensure_stt(name)?
+    } else {
+        ensure(name)?
+    };
     println!("{}", path.display());
     Ok(ExitCode::SUCCESS)
 }
@@ -87,11 +155,23 @@ pub fn list() -> Result<ExitCode> {
             m.description
         );
     }
+    for m in model::STT_MODELS {
+        println!(
+            "{:<22} {:>6.0} MB  {:<8} {} [--stt]",
+            m.name,
+            m.size() as f64 / 1e6,
+            if m.is_present() { "yes" } else { "no" },
+            m.description
+        );
+    }
     println!("\ncache: {}", model::cache_dir().display());
     Ok(ExitCode::SUCCESS)
 }
 
-pub fn verify(name: Option<&str>) -> Result<ExitCode> {
+pub fn verify(name: Option<&str>, stt: bool) -> Result<ExitCode> {
+    if stt {
+        return verify_stt(stt_spec(name)?);
+    }
     let spec = spec(name)?;
     let path = spec.path();
     if !path.is_file() {
@@ -110,6 +190,46 @@ pub fn verify(name: Option<&str>) -> Result<ExitCode> {
             "{}: SHA-256 is {digest}, expected {}; delete it and run `betr model fetch`",
             path.display(),
             spec.sha256
+        );
+        Ok(ExitCode::from(1))
+    }
+}
+
+fn verify_stt(spec: &DirModelSpec) -> Result<ExitCode> {
+    if !spec.path().is_dir() {
+        anyhow::bail!(
+            "{} is not in the cache ({}); run `betr model fetch --stt --model {}`",
+            spec.name,
+            spec.path().display(),
+            spec.name
+        );
+    }
+    let mut ok = true;
+    for check in spec.verify()? {
+        match &check.found {
+            Some(found) if check.matches() => {
+                println!("{}: SHA-256 matches ({found})", check.path.display());
+            }
+            Some(found) => {
+                ok = false;
+                println!(
+                    "{}: SHA-256 is {found}, expected {}",
+                    check.path.display(),
+                    check.expected
+                );
+            }
+            None => {
+                ok = false;
+                println!("{}: missing", check.path.display());
+            }
+        }
+    }
+    if ok {
+        Ok(ExitCode::SUCCESS)
+    } else {
+        println!(
+            "run `betr model fetch --stt --model {}` to replace it",
+            spec.name
         );
         Ok(ExitCode::from(1))
     }

@@ -160,6 +160,9 @@ pub struct FileConfig {
     pub llm: Layer,
     #[serde(default)]
     pub prices: PriceTable,
+    /// Speech-to-text settings, read by `voice::config`.
+    #[serde(default)]
+    pub stt: crate::voice::SttLayer,
 }
 
 impl FileConfig {
@@ -171,6 +174,12 @@ impl FileConfig {
         if file.llm.api_key.is_some() {
             return Err(LlmError::Config(format!(
                 "{}: `api_key` is not allowed in a file; put the key in an environment variable and name it with `api_key_env`",
+                path.display()
+            )));
+        }
+        if file.stt.api_key.is_some() {
+            return Err(LlmError::Config(format!(
+                "{}: `api_key` is not allowed under [stt]; put the key in an environment variable and name it with `api_key_env`",
                 path.display()
             )));
         }
@@ -427,6 +436,7 @@ mod tests {
         let file = FileConfig::read(&path).unwrap();
         assert_eq!(file.llm.backend, Some(Backend::Openai));
         assert!(file.prices.price("gpt-4o-2024-08-06").is_some());
+        assert_eq!(file.stt.backend, Some(crate::voice::SttBackend::Local));
         let s = Settings::resolve(Some((&path, file)), Layer::default(), Layer::default()).unwrap();
         assert_eq!(s.retry.max_retries, 3);
     }

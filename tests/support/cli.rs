@@ -17,6 +17,11 @@ pub fn tmp(name: &str) -> PathBuf {
 /// Run the binary in `dir` with HOME and XDG dirs inside it, so every file it writes lands
 /// there.
 pub fn betr(dir: &Path, args: &[&str]) -> Output {
+    betr_with(dir, args, &[])
+}
+
+/// [`betr`] with extra environment variables.
+pub fn betr_with(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_betr"))
         .args(args)
         .current_dir(dir)
@@ -30,6 +35,12 @@ pub fn betr(dir: &Path, args: &[&str]) -> Output {
         .env_remove("BETR_BASE_URL")
         .env_remove("BETR_API_KEY_ENV")
         .env_remove("BETR_CASSETTE")
+        .env_remove("BETR_STT")
+        .env_remove("BETR_STT_MODEL")
+        .env_remove("BETR_STT_BASE_URL")
+        .env_remove("BETR_STT_API_KEY_ENV")
+        .env_remove("BETR_STT_LANGUAGE")
+        .envs(env.iter().copied())
         .output()
         .unwrap()
 }

@@ -1,5 +1,6 @@
-//! A small HTTP/1.1 server on 127.0.0.1 that speaks the OpenAI chat-completions wire
-//! format, for tests. Each request takes the next scripted behaviour (then the default):
+//! A small HTTP/1.1 server on 127.0.0.1 that speaks the OpenAI chat-completions and
+//! audio-transcriptions wire formats, for tests (a `Reply` text is a completion's content
+//! or a transcript's text, by path). Each request takes the next scripted behaviour (then the default):
 //! a normal reply, a slow one, 429 with Retry-After, 500, 401, 404, malformed JSON, no
 //! choices, or a hand-written fixture reply chosen by matching the prompt. Replies from
 //! fixtures carry the header `x-betr-fixture`, so they are never shown as a model's.
@@ -14,6 +15,7 @@ use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio::net::{TcpListener, TcpStream};
 
 use super::fixtures::FixtureReply;
+use super::multipart::{self, FormPart};
 
 #[derive(Debug, Clone)]
 pub enum Behavior {
@@ -42,7 +44,10 @@ pub enum Behavior {
 pub struct Received {
     pub path: String,
     pub headers: Vec<(String, String)>,
+    /// The JSON body (`Null` for other bodies).
     pub body: Json,
+    /// The fields of a `multipart/form-data` body.
+    pub form: Vec<FormPart>,
 }
 
 impl Received {
@@ -51,6 +56,11 @@ impl Received {
             .iter()
             .find(|(n, _)| n.eq_ignore_ascii_case(name))
             .map(|(_, v)| v.as_str())
+    }
+
+    /// The form field `name`.
+    pub fn field(&self, name: &str) -> Option<&FormPart> {
+        self.form.iter().find(|p| p.name == name)
     }
 
     /// All message contents, joined.
@@ -151,6 +161,12 @@ async fn serve(mut stream: TcpStream, state: Arc<Mutex<State>>) {
     let Some((path, headers, body)) = read_request(&mut stream).await else {
         return;
     };
+    let form = headers
+        .iter()
+        .find(|(k, _)| k.eq_ignore_ascii_case("content-type"))
+        .and_then(|(_, v)| multipart::boundary(v))
+        .map(|b| multipart::parse(&body, &b))
+        .unwrap_or_default();
     let body: Json = serde_json::from_slice(&body).unwrap_or(Json::Null);
     let behavior = {
         let mut s = state.lock().expect("state");
@@ -158,14 +174,23 @@ async fn serve(mut stream: TcpStream, state: Arc<Mutex<State>>) {
             path: path.clone(),
             headers,
             body: body.clone(),
+            form,
         });
         s.script.pop_front().unwrap_or_else(|| s.default.clone())
     };
     let model = body["model"].as_str().unwrap_or("unknown").to_string();
     let prompt_words = prompt_of(&body).split_whitespace().count();
-    let ok = |text: &str| completion(&model, prompt_words, text);
+    let transcription = path == "/v1/audio/transcriptions";
+    let ok = |text: &str| {
+        if transcription {
+            json!({ "text": text }).to_string()
+        } else {
+            completion(&model, prompt_words, text)
+        }
+    };
     let (status, extra, payload): (u16, Vec<(&str, String)>, String) = if path
         != "/v1/chat/completions"
+        && !transcription
     {
         (
             404,

@@ -6,4 +6,5 @@ pub mod cli;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;
+pub mod multipart;
 pub mod verify;

@@ -1,0 +1,148 @@
+//! WAV files of several formats, levels, and the refusal of empty and silent recordings.
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+use super::*;
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("betr-audio-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn tone(i: usize, rate: u32) -> f64 {
+    0.5 * (2.0 * PI * 440.0 * i as f64 / f64::from(rate)).sin()
+}
+
+/// Write one second of a 440 Hz tone at amplitude 0.5 on every channel.
+fn write_wav(path: &Path, rate: u32, channels: u16, bits: u16, float: bool) {
+    let spec = hound::WavSpec {
+        channels,
+        sample_rate: rate,
+        bits_per_sample: bits,
+        sample_format: if float {
+            hound::SampleFormat::Float
+        } else {
+            hound::SampleFormat::Int
+        },
+    };
+    let mut w = hound::WavWriter::create(path, spec).unwrap();
+    let full = 2f64.powi(i32::from(bits) - 1) - 1.0;
+    for i in 0..rate as usize {
+        for _ in 0..channels {
+            let v = tone(i, rate);
+            match (float, bits) {
+                (true, _) => w.write_sample(v as f32).unwrap(),
+                (false, 8) => w.write_sample((v * full).round() as i8).unwrap(),
+                (false, 16) => w.write_sample((v * full).round() as i16).unwrap(),
+                (false, _) => w.write_sample((v * full).round() as i32).unwrap(),
+            }
+        }
+    }
+    w.finalize().unwrap();
+}
+
+#[test]
+fn wav_files_of_every_format_become_the_same_16k_mono_tone() {
+    let dir = scratch("formats");
+    let cases = [
+        (16_000, 1, 16, false),
+        (44_100, 2, 16, false),
+        (48_000, 1, 24, false),
+        (22_050, 2, 8, false),
+        (8_000, 1, 32, false),
+        (48_000, 2, 32, true),
+    ];
+    for (rate, channels, bits, float) in cases {
+        let path = dir.join(format!("{rate}-{channels}-{bits}-{float}.wav"));
+        write_wav(&path, rate, channels, bits, float);
+        let audio = Audio16k::from_wav(&path).unwrap();
+        let what = path.display();
+        assert_eq!(audio.samples().len(), 16_000, "{what}");
+        // 8-bit samples are quantised to 1/128.
+        let bound = if bits == 8 { 1.5e-2 } else { 3e-3 };
+        let err = audio.samples()[800..15_200]
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| (f64::from(s) - tone(i + 800, SAMPLE_RATE)).abs())
+            .fold(0.0, f64::max);
+        assert!(err < bound, "{what}: error {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn levels_are_in_dbfs() {
+    let audio = Audio16k::new((0..16_000).map(|i| tone(i, SAMPLE_RATE) as f32).collect());
+    let level = audio.level();
+    assert!((level.rms_dbfs - (-9.03)).abs() < 0.05, "{level:?}");
+    assert!((level.peak_dbfs - (-6.02)).abs() < 0.05, "{level:?}");
+    assert!((level.meter() - (60.0 - 9.03) / 60.0).abs() < 0.01);
+    assert_eq!(Level::of(&[]).peak_dbfs, FLOOR_DBFS);
+    assert_eq!(Level::of(&[0.0; 10]).rms_dbfs, FLOOR_DBFS);
+    assert_eq!(Level::of(&[1.0, -1.0]).peak_dbfs, 0.0);
+    assert!(audio.check_speech().is_ok());
+}
+
+#[test]
+fn empty_and_silent_recordings_are_refused_with_a_reason() {
+    let short = Audio16k::new(vec![0.3; 1_600]);
+    let err = short.check_speech().unwrap_err();
+    assert!(matches!(err, VoiceError::EmptyRecording { .. }));
+    assert!(err.to_string().contains("empty (0.10 s)"), "{err}");
+    let err = Audio16k::new(vec![]).check_speech().unwrap_err();
+    assert!(matches!(err, VoiceError::EmptyRecording { .. }));
+    // A dead microphone: digital silence, or a faint hum at -60 dBFS.
+    let err = Audio16k::new(vec![0.0; 32_000]).check_speech().unwrap_err();
+    assert!(err.to_string().contains("silent (peak -120 dBFS)"), "{err}");
+    let hum: Vec<f32> = (0..32_000)
+        .map(|i| tone(i, SAMPLE_RATE) as f32 * 0.002)
+        .collect();
+    assert!(matches!(
+        Audio16k::new(hum).check_speech(),
+        Err(VoiceError::Silent { .. })
+    ));
+}
+
+#[test]
+fn unreadable_files_name_the_file_and_the_problem() {
+    let dir = scratch("bad");
+    let text = dir.join("notes.wav");
+    std::fs::write(&text, "not audio").unwrap();
+    let err = Audio16k::from_wav(&text).unwrap_err().to_string();
+    assert!(
+        err.contains("notes.wav") && err.contains("not a WAV file"),
+        "{err}"
+    );
+    let err = Audio16k::from_wav(&dir.join("missing.wav"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("missing.wav") && err.contains("cannot read"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn wav_bytes_round_trip() {
+    let audio = Audio16k::new((0..8_000).map(|i| tone(i, SAMPLE_RATE) as f32).collect());
+    let bytes = audio.to_wav_bytes();
+    assert_eq!(&bytes[..4], b"RIFF");
+    assert_eq!(bytes.len(), 44 + 2 * 8_000);
+    let dir = scratch("bytes");
+    let path = dir.join("a.wav");
+    std::fs::write(&path, &bytes).unwrap();
+    let back = Audio16k::from_wav(&path).unwrap();
+    assert_eq!(back.samples().len(), 8_000);
+    let err = back
+        .samples()
+        .iter()
+        .zip(audio.samples())
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(err < 1e-4, "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

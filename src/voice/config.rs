@@ -1,0 +1,270 @@
+//! Speech-to-text settings, layered like the language model's: built-in defaults, the
+//! `[stt]` table of `betr.toml`, `BETR_STT*` environment variables, command-line flags.
+//! As there, the API key is never configured: only the name of the variable holding it.
+
+use std::time::Duration;
+
+use serde::Deserialize;
+
+use super::openai_stt::{OpenAiStt, OpenAiSttSettings, SttKey};
+use super::whisper_local::{LocalSettings, LocalWhisper};
+use super::{SpeechToText, VoiceError};
+
+/// The default embedded model.
+pub const DEFAULT_LOCAL_MODEL: &str = "whisper-tiny.en";
+/// The default model name sent to an OpenAI-compatible server.
+pub const DEFAULT_REMOTE_MODEL: &str = "whisper-1";
+
+/// Which backend transcribes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SttBackend {
+    /// Whisper embedded through CTranslate2.
+    Local,
+    /// `POST {base_url}/audio/transcriptions`.
+    Openai,
+}
+
+impl std::str::FromStr for SttBackend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "local" => Ok(SttBackend::Local),
+            "openai" => Ok(SttBackend::Openai),
+            other => Err(format!(
+                "unknown speech-to-text backend {other:?} (expected local or openai)"
+            )),
+        }
+    }
+}
+
+/// One layer: every field optional; later layers win.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SttLayer {
+    pub backend: Option<SttBackend>,
+    /// Local: a model of `betr model list`; openai: the server's model name.
+    pub model: Option<String>,
+    pub base_url: Option<String>,
+    pub api_key_env: Option<String>,
+    /// The language spoken, for multilingual models (`en`, the default).
+    pub language: Option<String>,
+    pub beam_size: Option<usize>,
+    pub threads: Option<usize>,
+    pub timeout_secs: Option<f64>,
+    pub max_retries: Option<u32>,
+    /// Refused: keys belong in the environment.
+    pub api_key: Option<toml::Value>,
+}
+
+macro_rules! merge_fields {
+    ($self:ident, $other:ident, $($f:ident),*) => { $( if $other.$f.is_some() { $self.$f = $other.$f; } )* };
+}
+
+impl SttLayer {
+    pub fn merge(&mut self, other: SttLayer) {
+        merge_fields!(
+            self,
+            other,
+            backend,
+            model,
+            base_url,
+            api_key_env,
+            language,
+            beam_size,
+            threads,
+            timeout_secs,
+            max_retries,
+            api_key
+        );
+    }
+
+    /// `BETR_STT` (backend), `BETR_STT_MODEL`, `BETR_STT_BASE_URL`, `BETR_STT_API_KEY_ENV`,
+    /// `BETR_STT_LANGUAGE`, read through `var`.
+    pub fn from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<SttLayer, VoiceError> {
+        let get = |k: &str| var(k).filter(|v| !v.trim().is_empty());
+        Ok(SttLayer {
+            backend: get("BETR_STT")
+                .map(|b| {
+                    b.parse()
+                        .map_err(|e| VoiceError::Config(format!("BETR_STT: {e}")))
+                })
+                .transpose()?,
+            model: get("BETR_STT_MODEL"),
+            base_url: get("BETR_STT_BASE_URL"),
+            api_key_env: get("BETR_STT_API_KEY_ENV"),
+            language: get("BETR_STT_LANGUAGE"),
+            ..SttLayer::default()
+        })
+    }
+}
+
+/// Resolved settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SttSettings {
+    pub backend: SttBackend,
+    pub model: String,
+    pub base_url: String,
+    pub api_key_env: Option<String>,
+    pub language: Option<String>,
+    pub beam_size: usize,
+    pub threads: usize,
+    pub timeout: Duration,
+    pub max_retries: u32,
+}
+
+impl SttSettings {
+    /// Defaults, then `file`, then `env`, then `flags`.
+    pub fn resolve(
+        file: Option<SttLayer>,
+        env: SttLayer,
+        flags: SttLayer,
+    ) -> Result<SttSettings, VoiceError> {
+        let mut layer = SttLayer::default();
+        if let Some(file) = file {
+            if file.api_key.is_some() {
+                return Err(VoiceError::Config(
+                    "`api_key` is not allowed under [stt]; put the key in an environment variable and name it with `api_key_env`".into(),
+                ));
+            }
+            layer.merge(file);
+        }
+        layer.merge(env);
+        layer.merge(flags);
+        let backend = layer.backend.unwrap_or(SttBackend::Local);
+        let timeout = layer.timeout_secs.unwrap_or(120.0);
+        if !(timeout.is_finite() && timeout > 0.0) {
+            return Err(VoiceError::Config(
+                "timeout_secs must be a positive number of seconds".into(),
+            ));
+        }
+        let defaults = LocalSettings::default();
+        Ok(SttSettings {
+            backend,
+            model: layer.model.unwrap_or_else(|| {
+                match backend {
+                    SttBackend::Local => DEFAULT_LOCAL_MODEL,
+                    SttBackend::Openai => DEFAULT_REMOTE_MODEL,
+                }
+                .to_string()
+            }),
+            base_url: layer
+                .base_url
+                .unwrap_or_else(|| "https://api.openai.com/v1".into()),
+            api_key_env: match layer.api_key_env {
+                Some(v) if v.is_empty() => None,
+                Some(v) => Some(v),
+                None => Some("OPENAI_API_KEY".into()),
+            },
+            language: match layer.language {
+                Some(l) if l.is_empty() => None,
+                Some(l) => Some(l.to_ascii_lowercase()),
+                None => Some("en".into()),
+            },
+            beam_size: layer.beam_size.unwrap_or(defaults.beam_size).max(1),
+            threads: layer.threads.unwrap_or(defaults.threads),
+            timeout: Duration::from_secs_f64(timeout),
+            max_retries: layer.max_retries.unwrap_or(3),
+        })
+    }
+
+    /// The embedded model, loaded from the cache.
+    pub fn load_local(&self) -> Result<LocalWhisper, VoiceError> {
+        LocalWhisper::load_named(
+            &self.model,
+            LocalSettings {
+                language: self.language.clone(),
+                beam_size: self.beam_size,
+                threads: self.threads,
+            },
+        )
+    }
+
+    /// The OpenAI-compatible client, with the key read through `var`.
+    pub fn remote(&self, var: &dyn Fn(&str) -> Option<String>) -> Result<OpenAiStt, VoiceError> {
+        let api_key = self
+            .api_key_env
+            .as_deref()
+            .and_then(var)
+            .filter(|k| !k.is_empty())
+            .map(SttKey::new);
+        let api_key_env = self.api_key_env.as_ref().map(|n| match api_key {
+            Some(_) => n.clone(),
+            None => format!("{n}, which is not set"),
+        });
+        OpenAiStt::new(OpenAiSttSettings {
+            base_url: self.base_url.clone(),
+            model: self.model.clone(),
+            language: self.language.clone(),
+            api_key_env,
+            api_key,
+            timeout: self.timeout,
+            connect_timeout: Duration::from_secs(10),
+            max_retries: self.max_retries,
+            initial_backoff: Duration::from_millis(500),
+            max_backoff: Duration::from_secs(20),
+        })
+    }
+
+    /// The configured backend (the embedded model must be in the cache).
+    pub fn build(
+        &self,
+        var: &dyn Fn(&str) -> Option<String>,
+    ) -> Result<Box<dyn SpeechToText>, VoiceError> {
+        Ok(match self.backend {
+            SttBackend::Local => Box::new(self.load_local()?),
+            SttBackend::Openai => Box::new(self.remote(var)?),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn later_layers_win_and_defaults_follow_the_backend() {
+        let file: SttLayer = toml::from_str("backend = \"openai\"\nlanguage = \"de\"\n").unwrap();
+        let env = SttLayer::from_env(&|k| {
+            (k == "BETR_STT_BASE_URL").then(|| "http://127.0.0.1:9/v1".to_string())
+        })
+        .unwrap();
+        let s = SttSettings::resolve(Some(file), env, SttLayer::default()).unwrap();
+        assert_eq!(s.backend, SttBackend::Openai);
+        assert_eq!(s.model, DEFAULT_REMOTE_MODEL);
+        assert_eq!(s.base_url, "http://127.0.0.1:9/v1");
+        assert_eq!(s.language.as_deref(), Some("de"));
+        let flags = SttLayer {
+            backend: Some(SttBackend::Local),
+            language: Some(String::new()),
+            ..SttLayer::default()
+        };
+        let s = SttSettings::resolve(None, SttLayer::default(), flags).unwrap();
+        assert_eq!(s.model, DEFAULT_LOCAL_MODEL);
+        assert_eq!(s.language, None);
+        assert_eq!(s.api_key_env.as_deref(), Some("OPENAI_API_KEY"));
+    }
+
+    #[test]
+    fn keys_unknown_backends_and_models_are_refused() {
+        let file = SttLayer {
+            api_key: Some(toml::Value::String("sk-x".into())),
+            ..SttLayer::default()
+        };
+        let e = SttSettings::resolve(Some(file), SttLayer::default(), SttLayer::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("api_key_env") && !e.contains("sk-x"), "{e}");
+        assert!(SttLayer::from_env(&|k| (k == "BETR_STT").then(|| "cloud".into())).is_err());
+        let flags = SttLayer {
+            model: Some("whisper-huge".into()),
+            ..SttLayer::default()
+        };
+        let s = SttSettings::resolve(None, SttLayer::default(), flags).unwrap();
+        let e = s.build(&|_| None).err().unwrap().to_string();
+        assert!(
+            e.contains("whisper-huge") && e.contains("whisper-tiny.en"),
+            "{e}"
+        );
+    }
+}
