@@ -19,4 +19,5 @@ pub mod session;
 pub mod store;
 pub mod tui;
 pub mod verify;
+pub mod viz;
 pub mod world;

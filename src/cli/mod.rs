@@ -9,6 +9,7 @@ mod tree_cmds;
 pub mod tui_cmd;
 mod values;
 mod verify_cmd;
+mod viz_flags;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -100,6 +101,8 @@ pub enum Command {
         /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
         #[arg(long)]
         variant: Option<String>,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
     /// Plan, run until an action fails, insert conditions as that action's first
     /// preconditions, re-plan and run to success; print and optionally save the tree.
@@ -124,6 +127,8 @@ pub enum Command {
         /// Plan and repair in the scenario's `[world.variants.NAME]` world.
         #[arg(long)]
         variant: Option<String>,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
     /// Ask a language model for the goal an instruction means in the scenario.
     Interpret {
@@ -152,6 +157,8 @@ pub enum Command {
         save: Option<PathBuf>,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
 }
 
@@ -215,6 +222,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             max_rounds,
             save,
             llm,
+            viz,
         } => llm_cmds::resolve(
             &load(&scenario)?,
             &llm_cmds::ResolveArgs {
@@ -223,6 +231,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 max_rounds,
                 save: save.as_deref(),
                 scenario_path: &scenario,
+                viz: &viz,
             },
             &llm,
             glyphs,
@@ -236,12 +245,14 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             trace,
             max_ticks,
             variant,
+            viz,
         } => tree_cmds::run(
             &load(&scenario)?,
             tree.as_deref(),
             trace,
             max_ticks,
             variant.as_deref(),
+            &viz,
             glyphs,
         ),
         Command::Repair {
@@ -252,6 +263,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             tree,
             save,
             variant,
+            viz,
         } => {
             let scenario = load(&scenario)?;
             let additions = add
@@ -278,6 +290,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     tree_file: tree.as_deref(),
                     save: save.as_deref(),
                     variant: variant.as_deref(),
+                    viz: &viz,
                 },
                 glyphs,
             )
