@@ -45,8 +45,8 @@ fn colour(rgb: [u8; 3], alpha: u8) -> Color {
     Color::from_unmultiplied_rgba(rgb[0], rgb[1], rgb[2], alpha)
 }
 
-/// Log `parts` at `path` (boxes there; cylinders, balls and capsules below it), each
-/// kind cleared when absent so a shape that changed kind leaves nothing behind.
+/// Log `parts` at `path` (boxes there, cleared when there are none; cylinders, balls and
+/// capsules below it).
 fn log_parts(
     rec: &RecordingStream,
     path: &str,
@@ -121,9 +121,8 @@ fn log_parts(
         )?;
     }
     let sub = |kind: &str| format!("{path}/{kind}");
-    if cc.is_empty() {
-        rec.log(sub("cylinders"), &Clear::flat())?;
-    } else {
+    // A solid's parts never change kind, so only kinds it has are logged.
+    if !cc.is_empty() {
         let n = cc.len();
         rec.log(
             sub("cylinders"),
@@ -135,9 +134,7 @@ fn log_parts(
                 .with_labels(labels(n)),
         )?;
     }
-    if ec.is_empty() {
-        rec.log(sub("balls"), &Clear::flat())?;
-    } else {
+    if !ec.is_empty() {
         rec.log(
             sub("balls"),
             &Ellipsoids3D::from_centers_and_radii(ec, er)
@@ -145,9 +142,7 @@ fn log_parts(
                 .with_fill_mode(FillMode::Solid),
         )?;
     }
-    if kt.is_empty() {
-        rec.log(sub("capsules"), &Clear::flat())?;
-    } else {
+    if !kt.is_empty() {
         rec.log(
             sub("capsules"),
             &Capsules3D::from_lengths_and_radii(kl, kr)
