@@ -134,8 +134,9 @@ impl Viz {
                 match rerun::spawn(&opts) {
                     Ok(_) => Some(format!("rerun+http://{}/proxy", opts.connect_addr())),
                     Err(e) => {
-                        tracing::warn!(error = %e, "cannot start the viewer");
-                        notice = Some(format!("{NOT_CONNECTED} (cannot start `rerun`: {e})"));
+                        let e = e.to_string();
+                        let first = e.lines().next().unwrap_or_default().trim();
+                        notice = Some(format!("{NOT_CONNECTED} (cannot start `rerun`: {first})"));
                         None
                     }
                 }
@@ -162,7 +163,9 @@ impl Viz {
 
     /// A viz over a stream made elsewhere (tests use an in-memory one).
     pub fn with_stream(rec: RecordingStream) -> Viz {
-        rec.set_time_sequence(TIMELINE, 0);
+        if rec.is_enabled() {
+            rec.set_time_sequence(TIMELINE, 0);
+        }
         Viz {
             rec,
             tree: None,
@@ -193,6 +196,9 @@ impl Viz {
 
     /// A new tree (shown with no statuses until it is ticked).
     pub fn set_tree(&mut self, tree: Arc<Tree>) {
+        if !self.rec.is_enabled() {
+            return;
+        }
         Self::warn(tree::log_tree(&self.rec, &tree, None, true));
         self.tree = Some(tree);
     }
@@ -201,6 +207,9 @@ impl Viz {
     /// it (when the world is a cell).
     pub fn tick(&mut self, record: &TickRecord, scene: Option<&SceneSnapshot>) {
         self.step += 1;
+        if !self.rec.is_enabled() {
+            return;
+        }
         self.rec.set_time_sequence(TIMELINE, self.step);
         if let Some(tree) = &self.tree {
             Self::warn(tree::log_tree(&self.rec, tree, Some(record), false));
@@ -215,11 +224,17 @@ impl Viz {
 
     /// The scene at the current step.
     pub fn scene(&mut self, scene: &SceneSnapshot) {
+        if !self.rec.is_enabled() {
+            return;
+        }
         Self::warn(scene::log_scene(&self.rec, scene));
     }
 
     /// A line in the event log.
     pub fn log(&mut self, level: &str, text: impl Into<String>) {
+        if !self.rec.is_enabled() {
+            return;
+        }
         Self::warn(
             self.rec
                 .log(EVENTS, &TextLog::new(text.into()).with_level(level)),
@@ -292,6 +307,9 @@ impl Viz {
 
     /// Send what is buffered (before the program exits).
     pub fn flush(&self) {
+        if !self.rec.is_enabled() {
+            return;
+        }
         Self::warn(self.rec.flush_blocking());
     }
 }
