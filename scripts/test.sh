@@ -14,4 +14,13 @@ fi
 # Build packages, plus spin, tmux and espeak-ng for the tests.
 bash scripts/setup.sh --test
 
+# The 3D view's end-to-end test (tests/viz_rrd.rs) checks a recording with the viewer's
+# own CLI, pip-installed once into a virtual environment under target/.
+if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
+  echo "python3-venv is missing: installing the Debian package" >&2
+  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
+  $SUDO apt-get update
+  $SUDO apt-get install -y python3-venv
+fi
+
 cargo test --locked

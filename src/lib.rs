@@ -19,5 +19,6 @@ pub mod session;
 pub mod store;
 pub mod tui;
 pub mod verify;
+pub mod viz;
 pub mod voice;
 pub mod world;

@@ -237,6 +237,7 @@ pub struct ResolveArgs<'a> {
     pub max_rounds: usize,
     pub save: Option<&'a Path>,
     pub scenario_path: &'a Path,
+    pub viz: &'a super::viz_flags::VizFlags,
 }
 
 pub fn resolve(
@@ -248,18 +249,28 @@ pub fn resolve(
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
     llm.model.set_purpose("resolve");
+    let mut viz = args.viz.open(false)?;
     println!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
         println!("Instruction: {i}");
+        if let Some(v) = viz.as_mut() {
+            v.instruction(i);
+        }
     }
-    let mut emit = |e: &Event| print_event(e, flags.show_replies);
+    let mut emit = |e: &Event| {
+        if let Some(v) = viz.as_mut() {
+            v.on_event(e);
+        }
+        print_event(e, flags.show_replies);
+    };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
-    let result = runtime()?.block_on(session::resolve(
+    let result = runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,
         llm.model.clone(),
         &llm.options,
+        args.viz.viewer.is_some() || args.viz.rrd.is_some(),
         &mut approve,
         &mut emit,
     ));
@@ -426,6 +437,7 @@ fn print_event_line(event: &Event) {
         Event::TreeChanged { .. }
         | Event::Ticked { .. }
         | Event::WorldChanged { .. }
+        | Event::Scene { .. }
         | Event::Usage { .. }
         | Event::RunState { .. }
         | Event::Verified { .. }

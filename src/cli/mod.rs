@@ -10,6 +10,7 @@ mod tree_cmds;
 pub mod tui_cmd;
 mod values;
 mod verify_cmd;
+mod viz_flags;
 mod voice_cmd;
 
 use std::path::{Path, PathBuf};
@@ -107,6 +108,8 @@ pub enum Command {
         /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
         #[arg(long)]
         variant: Option<String>,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
     /// Plan, run until an action fails, insert conditions as that action's first
     /// preconditions, re-plan and run to success; print and optionally save the tree.
@@ -131,6 +134,8 @@ pub enum Command {
         /// Plan and repair in the scenario's `[world.variants.NAME]` world.
         #[arg(long)]
         variant: Option<String>,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
     /// Ask a language model for the goal an instruction means in the scenario.
     Interpret {
@@ -185,6 +190,8 @@ pub enum Command {
         llm: llm_cmds::LlmFlags,
         #[command(flatten)]
         stt: voice_cmd::SttFlags,
+        #[command(flatten)]
+        viz: viz_flags::VizFlags,
     },
 }
 
@@ -266,6 +273,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             save,
             llm,
             stt,
+            viz,
         } => {
             let loaded = load(&scenario)?;
             let instruction = match &audio {
@@ -280,6 +288,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     max_rounds,
                     save: save.as_deref(),
                     scenario_path: &scenario,
+                    viz: &viz,
                 },
                 &llm,
                 glyphs,
@@ -294,12 +303,14 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             trace,
             max_ticks,
             variant,
+            viz,
         } => tree_cmds::run(
             &load(&scenario)?,
             tree.as_deref(),
             trace,
             max_ticks,
             variant.as_deref(),
+            &viz,
             glyphs,
         ),
         Command::Repair {
@@ -310,6 +321,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             tree,
             save,
             variant,
+            viz,
         } => {
             let scenario = load(&scenario)?;
             let additions = add
@@ -336,6 +348,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     tree_file: tree.as_deref(),
                     save: save.as_deref(),
                     variant: variant.as_deref(),
+                    viz: &viz,
                 },
                 glyphs,
             )

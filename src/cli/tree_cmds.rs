@@ -10,8 +10,11 @@ use betr::bt::{self, Glyphs, NodeKind, TickRecord, Tree};
 use betr::domain::{ActionCall, Condition, Scenario};
 use betr::planner::{self, Outcome, Plan, Planner, RunEnd, path_text, run_tree};
 use betr::world::{self, World};
+use rerun::TextLogLevel as Level;
 
 use super::values::Setting;
+use super::viz_flags::VizFlags;
+use betr::viz::run_streamed;
 
 const WORLD_FAILED: u8 = 1;
 
@@ -48,25 +51,40 @@ pub fn run(
     trace: bool,
     max_ticks: u64,
     variant: Option<&str>,
+    viz: &VizFlags,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
+    let mut viz = viz.open(false)?;
     let world = world::load_variant(scenario, variant)?;
     let tree = match tree_file {
         Some(path) => load_tree(scenario, path)?,
         None => {
             let goal = super::goal_of(scenario, None)?;
+            if let Some(v) = viz.as_mut() {
+                v.log(Level::INFO, format!("goal: {goal}"));
+            }
             Planner::new(&scenario.domain)
                 .plan(&goal.to_dnf(), world.as_ref())?
                 .tree
         }
     };
     let mut exec = world.fork();
-    let report = run_tree(&tree, exec.as_mut(), &scenario.domain, max_ticks, |r, _| {
-        if trace {
-            print_trace(&tree, r);
-        }
-        true
-    });
+    let report = run_streamed(
+        &tree,
+        exec.as_mut(),
+        &scenario.domain,
+        max_ticks,
+        viz.as_mut(),
+        |r| {
+            if trace {
+                print_trace(&tree, r);
+            }
+            true
+        },
+    );
+    if let Some(v) = viz.as_mut() {
+        v.log(Level::INFO, end_text(&report.end, &tree));
+    }
     print_tree(&tree, report.last.as_ref(), glyphs);
     match report.end {
         RunEnd::Success => {
@@ -106,6 +124,7 @@ pub struct RepairRequest<'a> {
     pub tree_file: Option<&'a Path>,
     pub save: Option<&'a Path>,
     pub variant: Option<&'a str>,
+    pub viz: &'a VizFlags,
 }
 
 pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Result<ExitCode> {
@@ -116,13 +135,30 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
         tree_file,
         save,
         variant,
+        viz,
     } = *request;
+    let mut viz = viz.open(false)?;
     let world = world::load_variant(scenario, variant)?;
     let planner = Planner::new(&scenario.domain);
     let mut plan = match tree_file {
         Some(path) => planner.grow(load_tree(scenario, path)?, world.as_ref()),
         None => planner.plan(&super::goal_of(scenario, None)?.to_dnf(), world.as_ref())?,
     };
+    if viz.is_some() {
+        // The run before the repair, so the recording shows what failed.
+        let mut exec = world.fork();
+        let before = run_streamed(
+            &plan.tree,
+            exec.as_mut(),
+            &scenario.domain,
+            planner.options.max_ticks,
+            viz.as_mut(),
+            |_| true,
+        );
+        if let Some(v) = viz.as_mut() {
+            v.log(Level::INFO, end_text(&before.end, &plan.tree));
+        }
+    }
     if !settings.is_empty() {
         if let Outcome::ActionFailed { action, error, .. } = &plan.outcome {
             println!("{action}! failed in simulation: {error}");
@@ -191,16 +227,29 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
             plan.new_nodes.len(),
             plan.expansions
         );
+        if let Some(v) = viz.as_mut() {
+            v.log(
+                Level::INFO,
+                format!(
+                    "repaired: inserted {names}, {} node(s) added",
+                    plan.new_nodes.len()
+                ),
+            );
+        }
     }
     println!();
     let mut exec = world.fork();
-    let report = run_tree(
+    let report = run_streamed(
         &plan.tree,
         exec.as_mut(),
         &scenario.domain,
         planner.options.max_ticks,
-        |_, _| true,
+        viz.as_mut(),
+        |_| true,
     );
+    if let Some(v) = viz.as_mut() {
+        v.log(Level::INFO, end_text(&report.end, &plan.tree));
+    }
     print_tree(&plan.tree, report.last.as_ref(), glyphs);
     println!("\n{}", bt::to_text(&plan.tree));
     if let Some(path) = save {
@@ -220,6 +269,18 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
             );
             Ok(ExitCode::from(WORLD_FAILED))
         }
+    }
+}
+
+/// How a run ended, as one line of the event log.
+fn end_text(end: &RunEnd, tree: &Tree) -> String {
+    match end {
+        RunEnd::Success => "success".into(),
+        RunEnd::Failure {
+            action: Some((node, error)),
+        } => format!("{} failed: {error}", leaf_text(tree, *node)),
+        RunEnd::Failure { action: None } => "the tree failed".into(),
+        RunEnd::TickLimit => "still running at the tick limit".into(),
     }
 }
 

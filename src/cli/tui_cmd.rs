@@ -41,6 +41,8 @@ pub struct TuiArgs {
     pub tick_ms: u64,
     #[command(flatten)]
     pub llm: LlmFlags,
+    #[command(flatten)]
+    pub viz: super::viz_flags::VizFlags,
 }
 
 pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
@@ -107,8 +109,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         auto_approve: args.auto_approve,
         policies: policy_dir.map(PolicyStore::new),
         tick_interval: Duration::from_millis(args.tick_ms),
+        scenes: args.viz.viewer.is_some() || args.viz.rrd.is_some(),
         ..Setup::new(scenario, path, model)
     };
+    // The status bar says it when a viewer is not there.
+    let mut tap = args.viz.open(true)?.map(super::viz_flags::VizTap);
     let theme = Theme::new(if ascii {
         &betr::bt::ASCII
     } else {
@@ -119,7 +124,13 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    runtime.block_on(betr::tui::run(setup, info, keys, theme))?;
+    runtime.block_on(betr::tui::run(
+        setup,
+        info,
+        keys,
+        theme,
+        tap.as_mut().map(|t| t as &mut dyn betr::tui::Tap),
+    ))?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -13,5 +13,5 @@ pub mod values;
 pub use ask::{interpret, missing_value};
 pub use engine::{Command, Engine, EngineHandle, Setup};
 pub use policy::{Policy, PolicyStore};
-pub use resolve::resolve;
+pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{Ending, Event, Options, Proposal, Resolved, SessionError};

@@ -27,6 +27,20 @@ pub async fn resolve(
     approve: &mut dyn FnMut(&Proposal) -> bool,
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
+    resolve_with_scenes(scenario, instruction, model, options, false, approve, emit).await
+}
+
+/// [`resolve`], and with `scenes` the engine also emits the cell's scene after every tick
+/// (`Event::Scene`, for a 3D view).
+pub async fn resolve_with_scenes(
+    scenario: &Scenario,
+    instruction: Option<&str>,
+    model: Arc<dyn LanguageModel>,
+    options: &Options,
+    scenes: bool,
+    approve: &mut dyn FnMut(&Proposal) -> bool,
+    emit: &mut dyn FnMut(&Event),
+) -> Result<Resolved, SessionError> {
     let instruction = instruction
         .map(str::to_string)
         .or_else(|| scenario.instruction.clone())
@@ -38,6 +52,7 @@ pub async fn resolve(
         .unwrap_or_default();
     let mut setup = Setup::new(Arc::new(scenario.clone()), path, Ok(model));
     setup.options = options.clone();
+    setup.scenes = scenes;
     let (engine, mut events) = Engine::spawn(setup)?;
     engine.send(Command::Submit(instruction));
 

@@ -12,6 +12,7 @@ use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
 use crate::verify::Report;
+use crate::world::cell::snapshot::SceneSnapshot;
 
 /// How the loop asks and how long it keeps trying.
 #[derive(Debug, Clone)]
@@ -161,6 +162,11 @@ pub enum Event {
     /// One tick in the execution world: every node's status.
     Ticked {
         record: Arc<TickRecord>,
+    },
+    /// The execution cell's scene after a tick or a reset, for a 3D view (only with
+    /// `Setup::scenes`, and only for cell worlds).
+    Scene {
+        scene: Arc<SceneSnapshot>,
     },
     /// The execution world changed (a tick moved something, or it was reset).
     WorldChanged {

@@ -300,6 +300,8 @@ impl App {
                 self.llm.log(format!("error: {error}"));
             }
             Event::Notice { message } => self.llm.log(message),
+            // For the 3D view; the world pane shows facts.
+            Event::Scene { .. } => {}
         }
     }
 }

@@ -45,6 +45,15 @@ fn read_input(tx: &UnboundedSender<TermEvent>, stop: &AtomicBool) {
     }
 }
 
+/// Something that follows the session besides the screen (the 3D view): it sees every
+/// session event and every command sent.
+pub trait Tap {
+    fn event(&mut self, event: &Event);
+    fn command(&mut self, command: &Command);
+    /// A line for the status bar (a viewer that is not connected).
+    fn notice(&self) -> Option<String>;
+}
+
 /// Run until the app quits or the session ends.
 pub async fn run<B: Backend>(
     terminal: &mut Terminal<B>,
@@ -52,6 +61,7 @@ pub async fn run<B: Backend>(
     engine: &EngineHandle,
     events: &mut UnboundedReceiver<Event>,
     input: &mut UnboundedReceiver<TermEvent>,
+    tap: &mut Option<&mut dyn Tap>,
 ) {
     let mut animation = tokio::time::interval(Duration::from_millis(150));
     animation.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
@@ -68,9 +78,15 @@ pub async fn run<B: Backend>(
             },
             event = events.recv() => match event {
                 Some(e) => {
+                    if let Some(t) = tap.as_mut() {
+                        t.event(&e);
+                    }
                     app.on_session(e);
                     // Take in everything already waiting before drawing again.
                     while let Ok(e) = events.try_recv() {
+                        if let Some(t) = tap.as_mut() {
+                            t.event(&e);
+                        }
                         app.on_session(e);
                     }
                 }
@@ -79,6 +95,9 @@ pub async fn run<B: Backend>(
             _ = animation.tick(), if app.animating() => app.on_animation(),
         }
         for command in app.take_commands() {
+            if let Some(t) = tap.as_mut() {
+                t.command(&command);
+            }
             engine.send(command);
         }
         if app.should_quit() {

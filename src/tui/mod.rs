@@ -16,6 +16,8 @@ pub mod strings;
 pub mod theme;
 pub mod ui;
 
+pub use event_loop::Tap;
+
 use std::io::{Stdout, stdout};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -85,13 +87,23 @@ pub async fn run(
     info: Info,
     keys: KeyBindings,
     theme: Theme,
+    mut tap: Option<&mut dyn Tap>,
 ) -> Result<(), TuiError> {
     let (engine, mut events) = Engine::spawn(setup)?;
     let mut app = App::new(info, keys, theme);
+    app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     let (_guard, mut terminal) = TerminalGuard::enter()?;
     let stop = Arc::new(AtomicBool::new(false));
     let mut input = event_loop::spawn_input_reader(stop.clone());
-    event_loop::run(&mut terminal, &mut app, &engine, &mut events, &mut input).await;
+    event_loop::run(
+        &mut terminal,
+        &mut app,
+        &engine,
+        &mut events,
+        &mut input,
+        &mut tap,
+    )
+    .await;
     stop.store(true, Ordering::Relaxed);
     Ok(())
 }

@@ -60,6 +60,11 @@ pub trait World: Send {
     fn restore(&mut self, snapshot: &Snapshot) -> Result<(), WorldError>;
     /// The atoms true now, as conditions, in a stable order (for display and prompts).
     fn facts(&self) -> Vec<Condition>;
+    /// The world itself, for front ends that draw one kind of world (the 3D view reads
+    /// the cell's scene through it: `CellWorld::scene_of`). `None` unless a world opts in.
+    fn as_any(&self) -> Option<&dyn Any> {
+        None
+    }
 }
 
 /// Build the world a scenario describes.

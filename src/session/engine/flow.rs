@@ -154,6 +154,18 @@ impl Engine {
         self.set_running(true);
     }
 
+    /// The execution cell's scene, when a front end asked for scenes.
+    pub(super) fn emit_scene(&self) {
+        if !self.scenes {
+            return;
+        }
+        if let Some(scene) = crate::world::CellWorld::scene_of(self.exec.as_ref()) {
+            self.emit(Event::Scene {
+                scene: Arc::new(scene),
+            });
+        }
+    }
+
     /// One tick in the execution world.
     pub(super) fn tick(&mut self) {
         let Some(tree) = &self.tree else {
@@ -178,6 +190,7 @@ impl Engine {
         self.emit(Event::Ticked {
             record: record.clone(),
         });
+        self.emit_scene();
         let facts = self.exec.facts();
         if facts != self.facts {
             self.facts = facts;
@@ -250,6 +263,7 @@ impl Engine {
             facts: self.facts.clone(),
             reset: true,
         });
+        self.emit_scene();
         if announce {
             self.notice("world reset: the tree starts again from the scenario's first state");
         }

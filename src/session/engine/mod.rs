@@ -57,6 +57,8 @@ pub struct Setup {
     pub tick_interval: Duration,
     /// Running stops after this many ticks of one run.
     pub max_ticks: u64,
+    /// Emit `Event::Scene` after every tick and reset of a cell world (for a 3D view).
+    pub scenes: bool,
 }
 
 impl Setup {
@@ -77,6 +79,7 @@ impl Setup {
             policies: None,
             tick_interval: Duration::ZERO,
             max_ticks: 10_000,
+            scenes: false,
         }
     }
 }
@@ -173,6 +176,7 @@ pub struct Engine {
     policies: Option<PolicyStore>,
     tick_interval: Duration,
     max_ticks: u64,
+    scenes: bool,
 
     planning: Box<dyn World>,
     exec: Box<dyn World>,
@@ -234,6 +238,7 @@ impl Engine {
             policies: setup.policies,
             tick_interval: setup.tick_interval,
             max_ticks: setup.max_ticks,
+            scenes: setup.scenes,
             planning,
             exec,
             ticker: Ticker::new(),
@@ -261,6 +266,7 @@ impl Engine {
             facts: engine.facts.clone(),
             reset: true,
         });
+        engine.emit_scene();
         Ok((engine, events_rx))
     }
 

@@ -27,6 +27,8 @@ pub struct StatusBar {
     pub ticks: u64,
     pub running: bool,
     pub ending: Option<Ending>,
+    /// Said once when a 3D viewer was asked for and is not there.
+    pub viewer: Option<String>,
 }
 
 impl StatusBar {
@@ -78,6 +80,10 @@ impl StatusBar {
                 spans.push(Span::styled(strings::FAILED, theme.error));
             }
             None => {}
+        }
+        if let Some(viewer) = &self.viewer {
+            spans.push(sep.clone());
+            spans.push(Span::styled(viewer.clone(), theme.error));
         }
         if self.auto_approve {
             spans.push(sep.clone());

@@ -17,10 +17,13 @@ pub mod geometry;
 pub mod robot;
 pub mod scene;
 mod skills;
+pub mod snapshot;
 #[cfg(test)]
 mod tests;
 pub mod values;
 
+use std::any::Any;
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -87,6 +90,8 @@ pub struct CellWorld {
     index: Arc<HashMap<String, usize>>,
     counter: Arc<Counter>,
     state: State,
+    /// The last approach path a skill swept (for display only: no truth depends on it).
+    approach: RefCell<Option<snapshot::SweptPath>>,
 }
 
 impl CellWorld {
@@ -118,6 +123,7 @@ impl CellWorld {
             domain: Arc::new(scenario.domain.clone()),
             index: Arc::new(index),
             counter: Arc::new(Counter::default()),
+            approach: RefCell::new(None),
         })
     }
 
@@ -370,6 +376,10 @@ impl World for CellWorld {
         let state = snapshot.get::<State>().ok_or(WorldError::ForeignSnapshot)?;
         self.state = state.clone();
         Ok(())
+    }
+
+    fn as_any(&self) -> Option<&dyn Any> {
+        Some(self)
     }
 
     fn facts(&self) -> Vec<Condition> {

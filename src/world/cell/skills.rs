@@ -130,7 +130,9 @@ impl CellWorld {
         let (end, half_width) = self.grip_pose(id);
         let start = Pose::translation(0.0, 0.0, self.scene.robot.gripper.approach) * end;
         let parts = self.scene.robot.gripper_parts(half_width);
-        !path_collides(&parts, &start, &end, &self.obstacles(&[id]), &self.counter)
+        let collided = path_collides(&parts, &start, &end, &self.obstacles(&[id]), &self.counter);
+        self.record_approach(parts, start, end, vec![id], collided);
+        !collided
     }
 
     fn grasp(&self, x: usize) -> Result<Effect, String> {
@@ -228,13 +230,16 @@ impl CellWorld {
     ) -> bool {
         let end = Pose::translation(0.0, 0.0, CONTACT_GAP) * pose * held.grip.inverse();
         let start = Pose::from_parts((direction * travel).into(), UnitQuaternion::identity()) * end;
-        !path_collides(
-            &self.carried(held),
+        let parts = self.carried(held);
+        let collided = path_collides(
+            &parts,
             &start,
             &end,
             &self.obstacles(&[held.id]),
             &self.counter,
-        )
+        );
+        self.record_approach(parts, start, end, vec![held.id], collided);
+        !collided
     }
 
     fn place_on(&self, x: usize, s: usize) -> Result<Effect, String> {

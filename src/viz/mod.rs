@@ -1,0 +1,345 @@
+//! The 3D view: streams the simulated cell, the behavior tree and the session's events to
+//! the rerun viewer (gRPC to a running viewer, a viewer it starts, an `.rrd` file, or
+//! several at once).
+//!
+//! A front-end module: it reads `bt` trees and tick records, the cell's
+//! [`SceneSnapshot`](crate::world::cell::snapshot::SceneSnapshot) and session
+//! [`Event`]s; nothing below the front ends knows it exists. On the `tick` timeline each
+//! tick logs the tree's statuses and the scene after that tick. The timeline counts every
+//! tick logged (a run after a repair continues it), so a recording shows the whole
+//! session in order. Logging never stops a session: a failed log call is traced and
+//! ignored, and a viewer that is not listening is reported once in [`Viz::notice`].
+
+pub mod scene;
+#[cfg(test)]
+mod tests;
+pub mod tree;
+
+use std::net::{TcpStream, ToSocketAddrs};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Duration;
+
+use rerun::sink::{FileSink, GrpcSink, LogSink};
+use rerun::{RecordingStream, RecordingStreamBuilder, TextLog};
+
+use crate::bt::{TickRecord, Tree};
+use crate::domain::Domain;
+use crate::planner::{RunReport, run_tree};
+use crate::session::Event;
+use crate::world::cell::snapshot::SceneSnapshot;
+use crate::world::{CellWorld, World};
+
+/// The application id recordings are made under.
+pub const APP_ID: &str = "betr";
+/// The timeline every tick is logged on.
+pub const TIMELINE: &str = "tick";
+/// Entity path of the event log.
+pub const EVENTS: &str = "events";
+/// What the session says when no viewer listens.
+pub const NOT_CONNECTED: &str = "viewer not connected";
+/// Where a viewer listens by default.
+pub const DEFAULT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
+
+/// A viewer to stream to.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Viewer {
+    /// A running viewer at this URL (none: the default).
+    Connect(Option<String>),
+    /// Start the `rerun` program, then stream to it.
+    Spawn,
+}
+
+impl std::str::FromStr for Viewer {
+    type Err = VizError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.split_once('=') {
+            None if s == "spawn" => Ok(Viewer::Spawn),
+            None if s == "connect" => Ok(Viewer::Connect(None)),
+            Some(("connect", url)) if !url.is_empty() => Ok(Viewer::Connect(Some(url.into()))),
+            _ => Err(VizError::BadViewer(s.to_string())),
+        }
+    }
+}
+
+/// Where a session's recording goes.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Sinks {
+    pub viewer: Option<Viewer>,
+    pub rrd: Option<PathBuf>,
+}
+
+impl Sinks {
+    pub fn is_empty(&self) -> bool {
+        self.viewer.is_none() && self.rrd.is_none()
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum VizError {
+    #[error("--viewer {0:?}: expected `connect`, `connect=URL` or `spawn`")]
+    BadViewer(String),
+    #[error("cannot write the recording {path}: {message}")]
+    Rrd { path: PathBuf, message: String },
+    #[error("cannot start a recording: {0}")]
+    Stream(#[from] rerun::RecordingStreamError),
+}
+
+/// The host and port of a viewer URL (`rerun+http://HOST:PORT/proxy`).
+fn address(url: &str) -> Option<String> {
+    let rest = url.split_once("://").map_or(url, |(_, r)| r);
+    let host = rest.split('/').next()?;
+    (!host.is_empty()).then(|| host.to_string())
+}
+
+/// Whether something listens at the viewer URL (a short TCP probe).
+fn listening(url: &str) -> bool {
+    let Some(addrs) = address(url).and_then(|a| a.to_socket_addrs().ok()) else {
+        return false;
+    };
+    addrs
+        .into_iter()
+        .any(|a| TcpStream::connect_timeout(&a, Duration::from_millis(500)).is_ok())
+}
+
+/// Streams one session.
+pub struct Viz {
+    rec: RecordingStream,
+    tree: Option<Arc<Tree>>,
+    step: i64,
+    notice: Option<String>,
+}
+
+impl Viz {
+    /// Open the sinks; `None` when there are none. A viewer that cannot be reached is
+    /// left out (see [`Viz::notice`]); a file that cannot be created is an error.
+    pub fn open(sinks: &Sinks) -> Result<Option<Viz>, VizError> {
+        if sinks.is_empty() {
+            return Ok(None);
+        }
+        let mut out: Vec<Box<dyn LogSink>> = Vec::new();
+        let mut notice = None;
+        if let Some(path) = &sinks.rrd {
+            let sink = FileSink::new(path).map_err(|e| VizError::Rrd {
+                path: path.clone(),
+                message: e.to_string(),
+            })?;
+            out.push(Box::new(sink));
+        }
+        let url = match &sinks.viewer {
+            Some(Viewer::Connect(url)) => Some(url.clone().unwrap_or_else(|| DEFAULT_URL.into())),
+            Some(Viewer::Spawn) => {
+                let opts = rerun::SpawnOptions::default();
+                match rerun::spawn(&opts) {
+                    Ok(_) => Some(format!("rerun+http://{}/proxy", opts.connect_addr())),
+                    Err(e) => {
+                        let e = e.to_string();
+                        let first = e.lines().next().unwrap_or_default().trim();
+                        notice = Some(format!("{NOT_CONNECTED} (cannot start `rerun`: {first})"));
+                        None
+                    }
+                }
+            }
+            None => None,
+        };
+        if let Some(url) = url {
+            match url.parse() {
+                Ok(uri) if listening(&url) => out.push(Box::new(GrpcSink::new(uri))),
+                Ok(_) => notice = Some(format!("{NOT_CONNECTED} ({url})")),
+                Err(e) => notice = Some(format!("{NOT_CONNECTED} ({url}: {e})")),
+            }
+        }
+        let builder = RecordingStreamBuilder::new(APP_ID);
+        let rec = if out.is_empty() {
+            RecordingStream::disabled()
+        } else {
+            builder.set_sinks(out)?
+        };
+        let mut viz = Viz::with_stream(rec);
+        viz.notice = notice;
+        Ok(Some(viz))
+    }
+
+    /// A viz over a stream made elsewhere (tests use an in-memory one).
+    pub fn with_stream(rec: RecordingStream) -> Viz {
+        if rec.is_enabled() {
+            rec.set_time_sequence(TIMELINE, 0);
+        }
+        Viz {
+            rec,
+            tree: None,
+            step: 0,
+            notice: None,
+        }
+    }
+
+    /// The one line to show when a viewer was asked for and is not there.
+    pub fn notice(&self) -> Option<&str> {
+        self.notice.as_deref()
+    }
+
+    /// Ticks logged so far.
+    pub fn ticks(&self) -> i64 {
+        self.step
+    }
+
+    pub fn stream(&self) -> &RecordingStream {
+        &self.rec
+    }
+
+    fn warn<E: std::fmt::Display>(result: Result<(), E>) {
+        if let Err(e) = result {
+            tracing::warn!(error = %e, "cannot log to the viewer");
+        }
+    }
+
+    /// A new tree (shown with no statuses until it is ticked).
+    pub fn set_tree(&mut self, tree: Arc<Tree>) {
+        if !self.rec.is_enabled() {
+            return;
+        }
+        Self::warn(tree::log_tree(&self.rec, &tree, None, true));
+        self.tree = Some(tree);
+    }
+
+    /// One tick: the next step on the timeline, the tree's statuses, and the scene after
+    /// it (when the world is a cell).
+    pub fn tick(&mut self, record: &TickRecord, scene: Option<&SceneSnapshot>) {
+        self.step += 1;
+        if !self.rec.is_enabled() {
+            return;
+        }
+        self.rec.set_time_sequence(TIMELINE, self.step);
+        if let Some(tree) = &self.tree {
+            Self::warn(tree::log_tree(&self.rec, tree, Some(record), false));
+        }
+        if let Some(scene) = scene {
+            self.scene(scene);
+        }
+        for (_, error) in &record.failures {
+            self.log(rerun::TextLogLevel::ERROR, format!("failed: {error}"));
+        }
+    }
+
+    /// The scene at the current step.
+    pub fn scene(&mut self, scene: &SceneSnapshot) {
+        if !self.rec.is_enabled() {
+            return;
+        }
+        Self::warn(scene::log_scene(&self.rec, scene));
+    }
+
+    /// A line in the event log.
+    pub fn log(&mut self, level: &str, text: impl Into<String>) {
+        if !self.rec.is_enabled() {
+            return;
+        }
+        Self::warn(
+            self.rec
+                .log(EVENTS, &TextLog::new(text.into()).with_level(level)),
+        );
+    }
+
+    pub fn instruction(&mut self, text: &str) {
+        self.log(rerun::TextLogLevel::INFO, format!("instruction: {text}"));
+    }
+
+    /// Follow a session: its tree, ticks, scenes and the steps of the resolve loop.
+    pub fn on_event(&mut self, event: &Event) {
+        use rerun::TextLogLevel as L;
+        match event {
+            Event::TreeChanged { tree, why, .. } => {
+                self.set_tree(tree.clone());
+                self.log(L::INFO, format!("tree: {why}"));
+            }
+            Event::Ticked { record } => self.tick(record, None),
+            Event::Scene { scene } => self.scene(scene),
+            Event::WorldChanged { reset: true, .. } => self.log(L::DEBUG, "world reset"),
+            Event::WorldChanged { .. } => {}
+            Event::Asking { what } => self.log(L::DEBUG, format!("asking the model for {what}")),
+            Event::Replied { attribution, .. } => {
+                self.log(L::DEBUG, format!("reply from {attribution}"));
+            }
+            Event::InvalidReply { error } => self.log(L::WARN, format!("unusable reply: {error}")),
+            Event::Goal {
+                goal, reasoning, ..
+            } => {
+                if let Some(r) = reasoning {
+                    self.log(L::INFO, format!("reasoning: {r}"));
+                }
+                self.log(L::INFO, format!("goal: {goal}"));
+            }
+            // Ticked already logged the failure at its tick.
+            Event::ActionFailed {
+                action, node_path, ..
+            } => self.log(L::WARN, format!("{action}! (node {node_path}) failed")),
+            Event::Proposal {
+                proposal,
+                reasoning,
+                ..
+            } => {
+                if let Some(r) = reasoning {
+                    self.log(L::INFO, format!("reasoning: {r}"));
+                }
+                self.log(L::INFO, format!("proposal: {proposal}"));
+            }
+            Event::Approved => self.log(L::INFO, "approved"),
+            Event::Rejected => self.log(L::WARN, "rejected"),
+            Event::Repaired { added_nodes, .. } => {
+                self.log(L::INFO, format!("repaired: {added_nodes} node(s) added"));
+            }
+            Event::DidNotHelp { reason } => self.log(L::WARN, format!("did not help: {reason}")),
+            Event::Success { ticks } => self.log(L::INFO, format!("success after {ticks} tick(s)")),
+            Event::GaveUp { reason } => self.log(L::ERROR, format!("gave up: {reason}")),
+            Event::Error { message } => self.log(L::ERROR, message.clone()),
+            Event::Failed { error } => self.log(L::ERROR, error.to_string()),
+            Event::Notice { message } => self.log(L::DEBUG, message.clone()),
+            Event::PolicySaved { path, .. } => {
+                self.log(L::INFO, format!("policy saved to {}", path.display()));
+            }
+            Event::PolicyLoaded { path, .. } => {
+                self.log(L::INFO, format!("policy loaded from {}", path.display()));
+            }
+            Event::Usage { .. } | Event::RunState { .. } | Event::Verified { .. } => {}
+        }
+    }
+
+    /// Send what is buffered (before the program exits).
+    pub fn flush(&self) {
+        if !self.rec.is_enabled() {
+            return;
+        }
+        Self::warn(self.rec.flush_blocking());
+    }
+}
+
+/// `planner::run_tree` with the tree, every tick and the cell after it streamed to `viz`
+/// (the scene before the first tick too).
+pub fn run_streamed(
+    tree: &Tree,
+    world: &mut dyn World,
+    domain: &Domain,
+    max_ticks: u64,
+    mut viz: Option<&mut Viz>,
+    mut on_tick: impl FnMut(&TickRecord) -> bool,
+) -> RunReport {
+    if let Some(v) = viz.as_deref_mut() {
+        v.set_tree(Arc::new(tree.clone()));
+        if let Some(scene) = CellWorld::scene_of(world) {
+            v.scene(&scene);
+        }
+    }
+    run_tree(tree, world, domain, max_ticks, |r, w| {
+        if let Some(v) = viz.as_deref_mut() {
+            v.tick(r, CellWorld::scene_of(w).as_ref());
+        }
+        on_tick(r)
+    })
+}
+
+impl Drop for Viz {
+    fn drop(&mut self) {
+        self.flush();
+    }
+}

@@ -1,0 +1,225 @@
+//! Logging the cell's scene: solids by shape, the robot, the approach path, the reach.
+
+use nalgebra::{UnitQuaternion, Vector3};
+use rerun::{
+    Boxes3D, Capsules3D, Clear, Color, Cylinders3D, Ellipsoids3D, FillMode, LineStrips3D, Points3D,
+    Quaternion, RecordingStream, RecordingStreamResult,
+};
+
+use crate::world::cell::snapshot::{PartShape, PartView, SceneSnapshot};
+
+/// Entity paths of the scene (also used by the tests).
+pub const SOLIDS: &str = "world/solids";
+pub const ROBOT_TORSO: &str = "world/robot/torso";
+pub const ROBOT_ARMS: &str = "world/robot/arms";
+pub const ROBOT_JOINTS: &str = "world/robot/joints";
+pub const ROBOT_GRIPPER: &str = "world/robot/gripper";
+pub const APPROACH: &str = "world/approach";
+pub const REACH: &str = "world/reach";
+
+const FREE: [u8; 3] = [40, 200, 80];
+const COLLIDES: [u8; 3] = [230, 40, 40];
+
+/// A name as one entity path part: lower case, words joined by `_`.
+pub fn slug(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c.to_ascii_lowercase());
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_matches('_').to_string()
+}
+
+fn quat(q: &UnitQuaternion<f32>) -> Quaternion {
+    Quaternion::from_xyzw([q.i, q.j, q.k, q.w])
+}
+
+fn xyz(v: &Vector3<f32>) -> [f32; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn colour(rgb: [u8; 3], alpha: u8) -> Color {
+    Color::from_unmultiplied_rgba(rgb[0], rgb[1], rgb[2], alpha)
+}
+
+/// Log `parts` at `path` (boxes there, cleared when there are none; cylinders, balls and
+/// capsules below it).
+fn log_parts(
+    rec: &RecordingStream,
+    path: &str,
+    parts: &[PartView],
+    rgb: [u8; 3],
+    label: Option<&str>,
+) -> RecordingStreamResult<()> {
+    let (mut bc, mut bh, mut bq) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut cc, mut cl, mut cr, mut cq) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut ec, mut er) = (Vec::new(), Vec::new());
+    let (mut kt, mut kl, mut kr, mut kq) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for p in parts {
+        let centre = xyz(&p.pose.translation.vector);
+        match &p.shape {
+            PartShape::Box { half } => {
+                bc.push(centre);
+                bh.push(*half);
+                bq.push(quat(&p.pose.rotation));
+            }
+            PartShape::Cylinder {
+                radius,
+                half_height,
+            } => {
+                // parry's cylinders stand along local y, rerun's along local z.
+                let turn = UnitQuaternion::from_axis_angle(
+                    &Vector3::x_axis(),
+                    -std::f32::consts::FRAC_PI_2,
+                );
+                cc.push(centre);
+                cl.push(2.0 * half_height);
+                cr.push(*radius);
+                cq.push(quat(&(p.pose.rotation * turn)));
+            }
+            PartShape::Ball { radius } => {
+                ec.push(centre);
+                er.push(*radius);
+            }
+            PartShape::Capsule { a, b, radius } => {
+                let d = Vector3::from(*b) - Vector3::from(*a);
+                let turn = UnitQuaternion::rotation_between(&Vector3::z(), &d)
+                    .unwrap_or_else(UnitQuaternion::identity);
+                kt.push(*a);
+                kl.push(d.norm());
+                kr.push(*radius);
+                kq.push(quat(&turn));
+            }
+        }
+    }
+    let c = colour(rgb, 255);
+    let labels = |n: usize| {
+        label
+            .map(|l| {
+                let mut v = vec![String::new(); n];
+                if let Some(first) = v.first_mut() {
+                    *first = l.to_string();
+                }
+                v
+            })
+            .unwrap_or_default()
+    };
+    if bc.is_empty() {
+        rec.log(path, &Clear::flat())?;
+    } else {
+        let n = bc.len();
+        rec.log(
+            path,
+            &Boxes3D::from_centers_and_half_sizes(bc, bh)
+                .with_quaternions(bq)
+                .with_colors([c])
+                .with_fill_mode(FillMode::Solid)
+                .with_labels(labels(n)),
+        )?;
+    }
+    let sub = |kind: &str| format!("{path}/{kind}");
+    // A solid's parts never change kind, so only kinds it has are logged.
+    if !cc.is_empty() {
+        let n = cc.len();
+        rec.log(
+            sub("cylinders"),
+            &Cylinders3D::from_lengths_and_radii(cl, cr)
+                .with_centers(cc)
+                .with_quaternions(cq)
+                .with_colors([c])
+                .with_fill_mode(FillMode::Solid)
+                .with_labels(labels(n)),
+        )?;
+    }
+    if !ec.is_empty() {
+        rec.log(
+            sub("balls"),
+            &Ellipsoids3D::from_centers_and_radii(ec, er)
+                .with_colors([c])
+                .with_fill_mode(FillMode::Solid),
+        )?;
+    }
+    if !kt.is_empty() {
+        rec.log(
+            sub("capsules"),
+            &Capsules3D::from_lengths_and_radii(kl, kr)
+                .with_translations(kt)
+                .with_quaternions(kq)
+                .with_colors([c]),
+        )?;
+    }
+    Ok(())
+}
+
+/// Log the whole scene at the current time.
+pub fn log_scene(rec: &RecordingStream, scene: &SceneSnapshot) -> RecordingStreamResult<()> {
+    for s in &scene.solids {
+        let path = format!("{SOLIDS}/{}", slug(&s.name));
+        log_parts(rec, &path, &s.parts, s.colour, Some(&s.name))?;
+    }
+    let r = &scene.robot;
+    rec.log(
+        ROBOT_TORSO,
+        &Boxes3D::from_centers_and_half_sizes([r.torso_center], [r.torso_half])
+            .with_colors([colour([200, 200, 205], 255)])
+            .with_fill_mode(FillMode::Solid)
+            .with_labels(["YuMi"]),
+    )?;
+    let strips: Vec<Vec<[f32; 3]>> = r
+        .arms
+        .iter()
+        .map(|a| vec![a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_ARMS,
+        &LineStrips3D::new(strips)
+            .with_colors([colour([90, 90, 100], 255)])
+            .with_radii([0.02]),
+    )?;
+    let joints: Vec<[f32; 3]> = r
+        .arms
+        .iter()
+        .flat_map(|a| [a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_JOINTS,
+        &Points3D::new(joints)
+            .with_colors([colour([60, 60, 70], 255)])
+            .with_radii([0.025]),
+    )?;
+    log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
+    match &scene.approach {
+        Some(a) => {
+            let strips: Vec<Vec<[f32; 3]>> =
+                a.points.windows(2).map(<[[f32; 3]]>::to_vec).collect();
+            let colours: Vec<Color> = a
+                .collided
+                .iter()
+                .map(|c| colour(if *c { COLLIDES } else { FREE }, 255))
+                .collect();
+            rec.log(
+                APPROACH,
+                &LineStrips3D::new(strips)
+                    .with_colors(colours)
+                    .with_radii([0.006]),
+            )?;
+        }
+        None => rec.log(APPROACH, &Clear::flat())?,
+    }
+    if scene.out_of_reach.is_empty() {
+        rec.log(REACH, &Clear::flat())?;
+    } else {
+        let centres: Vec<[f32; 3]> = r.arms.iter().map(|a| a.shoulder).collect();
+        let radii = vec![r.reach; centres.len()];
+        rec.log(
+            REACH,
+            &Ellipsoids3D::from_centers_and_radii(centres, radii)
+                .with_colors([colour([120, 160, 255], 60)])
+                .with_fill_mode(FillMode::MajorWireframe),
+        )?;
+    }
+    Ok(())
+}

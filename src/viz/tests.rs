@@ -1,0 +1,240 @@
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+use rerun::RecordingStreamBuilder;
+use rerun::log::{Chunk, LogMsg};
+
+use super::*;
+use crate::domain::Scenario;
+use crate::planner::{Outcome, Planner, RunEnd};
+use crate::world::cell::snapshot::PartShape;
+
+fn scenario1() -> Scenario {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml");
+    Scenario::load(&path).unwrap()
+}
+
+/// Every entity path logged, with its component identifiers and the `tick` values it
+/// was logged at.
+#[derive(Default)]
+struct Logged {
+    components: BTreeMap<String, BTreeSet<String>>,
+    ticks: BTreeMap<String, BTreeSet<i64>>,
+}
+
+fn decode(msgs: Vec<LogMsg>) -> Logged {
+    let mut out = Logged::default();
+    for msg in msgs {
+        let LogMsg::ArrowMsg(_, arrow) = msg else {
+            continue;
+        };
+        let chunk = Chunk::from_arrow_msg(&arrow).unwrap();
+        let path = chunk.entity_path().to_string();
+        let path = path.trim_start_matches('/').to_string();
+        let comps = out.components.entry(path.clone()).or_default();
+        for d in chunk.component_descriptors() {
+            comps.insert(d.component.to_string());
+        }
+        if let Some(column) = chunk.timelines().get(&TIMELINE.into()) {
+            out.ticks
+                .entry(path)
+                .or_default()
+                .extend(column.times_raw().iter().copied());
+        }
+    }
+    out
+}
+
+/// Scenario 1 before and after the repair the paper finds, streamed to memory.
+#[test]
+fn scenario1_before_and_after_repair_streams_scene_tree_and_ticks() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let planner = Planner::new(&scenario.domain);
+    let goal = scenario.goal.clone().unwrap();
+    let plan = planner.plan(&goal.to_dnf(), world.as_ref()).unwrap();
+    let Outcome::ActionFailed { node, .. } = plan.outcome else {
+        panic!("scenario 1 should fail before repair: {:?}", plan.outcome);
+    };
+
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    let mut viz = Viz::with_stream(rec);
+    viz.instruction("Put the blue cube on the green cube");
+    let mut exec = world.fork();
+    let before = run_streamed(
+        &plan.tree,
+        exec.as_mut(),
+        &scenario.domain,
+        100,
+        Some(&mut viz),
+        |_| true,
+    );
+    assert!(matches!(before.end, RunEnd::Failure { action: Some(_) }));
+    assert_eq!(viz.ticks(), before.ticks as i64);
+    // The failing grasp's way down is drawn, red where the red cube is in it.
+    let scene = CellWorld::scene_of(exec.as_ref()).unwrap();
+    let approach = scene.approach.clone().unwrap();
+    assert_eq!(approach.points.len(), snapshot_segments() + 1);
+    assert!(approach.collided.iter().any(|c| *c));
+    assert!(
+        !approach.collided.iter().all(|c| *c),
+        "free above the obstacle"
+    );
+
+    let fix = scenario.parse_goal(&scenario.expected_fix[0]).unwrap();
+    let conditions = fix.to_dnf().0[0].clone();
+    let repaired = planner
+        .repair(plan.tree, node, &conditions, world.as_ref())
+        .unwrap();
+    let mut exec = world.fork();
+    let after = run_streamed(
+        &repaired.tree,
+        exec.as_mut(),
+        &scenario.domain,
+        100,
+        Some(&mut viz),
+        |_| true,
+    );
+    assert_eq!(after.end, RunEnd::Success);
+    assert_eq!(viz.ticks(), (before.ticks + after.ticks) as i64);
+    let scene = CellWorld::scene_of(exec.as_ref()).unwrap();
+    assert!(scene.approach.unwrap().collided.iter().all(|c| !*c));
+    viz.stream().flush_blocking().unwrap();
+
+    let logged = decode(storage.take());
+    let has = |path: &str, component: &str| {
+        logged
+            .components
+            .get(path)
+            .is_some_and(|c| c.contains(component))
+    };
+    for solid in ["table", "blue_cube", "green_cube", "red_cube"] {
+        let path = format!("world/solids/{solid}");
+        assert!(
+            has(&path, "Boxes3D:half_sizes"),
+            "{path}: {:?}",
+            logged.components.get(&path)
+        );
+        assert!(has(&path, "Boxes3D:colors"));
+        assert!(has(&path, "Boxes3D:labels"));
+    }
+    assert!(has(scene::ROBOT_TORSO, "Boxes3D:centers"));
+    assert!(has(scene::ROBOT_ARMS, "LineStrips3D:strips"));
+    assert!(has(scene::ROBOT_GRIPPER, "Boxes3D:half_sizes"));
+    assert!(has(scene::APPROACH, "LineStrips3D:colors"));
+    assert!(has(tree::TREE_GRAPH, "GraphNodes:node_ids"));
+    assert!(has(tree::TREE_GRAPH, "GraphNodes:colors"));
+    assert!(has(tree::TREE_GRAPH, "GraphEdges:edges"));
+    assert!(has(tree::TREE_TEXT, "TextDocument:text"));
+    assert!(has(EVENTS, "TextLog:text"));
+    assert!(has(EVENTS, "TextLog:level"));
+
+    // One step per tick on the timeline, before and after the repair, for the tree's
+    // statuses and for the scene (step 0 holds the scene before the first tick).
+    let steps = |path: &str| {
+        logged
+            .ticks
+            .get(path)
+            .map(|t| t.iter().filter(|t| **t > 0).count())
+            .unwrap_or_default()
+    };
+    let total = (before.ticks + after.ticks) as usize;
+    assert_eq!(steps(tree::TREE_TEXT), total);
+    assert_eq!(steps("world/solids/blue_cube"), total);
+    assert_eq!(steps(scene::ROBOT_ARMS), total);
+    let last = logged.ticks[tree::TREE_TEXT].iter().max().copied();
+    assert_eq!(last, Some(total as i64));
+}
+
+fn snapshot_segments() -> usize {
+    crate::world::cell::snapshot::PATH_SEGMENTS
+}
+
+#[test]
+fn session_events_stream_the_tree_ticks_and_the_log() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let plan = Planner::new(&scenario.domain)
+        .plan(&scenario.goal.clone().unwrap().to_dnf(), world.as_ref())
+        .unwrap();
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    let mut viz = Viz::with_stream(rec);
+    let tree = Arc::new(plan.tree);
+    viz.on_event(&Event::TreeChanged {
+        tree: tree.clone(),
+        new_nodes: Vec::new(),
+        why: "planned".into(),
+    });
+    let mut exec = world.fork();
+    let mut ticker = crate::bt::Ticker::new();
+    let mut leaves = crate::planner::WorldLeaves {
+        world: exec.as_mut(),
+        domain: &scenario.domain,
+    };
+    for _ in 0..3 {
+        let record = Arc::new(ticker.tick(&tree, &mut leaves));
+        viz.on_event(&Event::Ticked { record });
+        let scene = CellWorld::scene_of(&*leaves.world).unwrap();
+        viz.on_event(&Event::Scene {
+            scene: Arc::new(scene),
+        });
+    }
+    viz.on_event(&Event::Approved);
+    viz.stream().flush_blocking().unwrap();
+    assert_eq!(viz.ticks(), 3);
+    let logged = decode(storage.take());
+    assert_eq!(
+        logged.ticks[tree::TREE_TEXT].len(),
+        4,
+        "unticked tree + 3 ticks"
+    );
+    assert!(logged.components.contains_key("world/solids/red_cube"));
+    assert!(logged.components[EVENTS].contains("TextLog:text"));
+}
+
+#[test]
+fn colours_come_from_the_names_and_shapes_from_the_parts() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let scene = CellWorld::scene_of(world.as_ref()).unwrap();
+    let red = scene.solids.iter().find(|s| s.name == "red cube").unwrap();
+    assert_eq!(red.colour, [220, 50, 47]);
+    assert!(matches!(red.parts[0].shape, PartShape::Box { .. }));
+    assert_eq!(scene.robot.arms.len(), 2);
+    assert!(scene.out_of_reach.is_empty());
+    assert!(scene.approach.is_none());
+    assert_eq!(scene::slug("red cube"), "red_cube");
+}
+
+#[test]
+fn viewer_flags_parse() {
+    assert_eq!("spawn".parse::<Viewer>().unwrap(), Viewer::Spawn);
+    assert_eq!("connect".parse::<Viewer>().unwrap(), Viewer::Connect(None));
+    assert_eq!(
+        "connect=rerun+http://127.0.0.1:9999/proxy"
+            .parse::<Viewer>()
+            .unwrap(),
+        Viewer::Connect(Some("rerun+http://127.0.0.1:9999/proxy".into()))
+    );
+    assert!("show".parse::<Viewer>().is_err());
+    assert_eq!(
+        address("rerun+http://127.0.0.1:9999/proxy").as_deref(),
+        Some("127.0.0.1:9999")
+    );
+}
+
+#[test]
+fn a_viewer_that_is_not_there_is_said_once_and_the_session_goes_on() {
+    // Nothing listens on port 9 (discard) here.
+    let viz = Viz::open(&Sinks {
+        viewer: Some(Viewer::Connect(Some(
+            "rerun+http://127.0.0.1:9/proxy".into(),
+        ))),
+        rrd: None,
+    })
+    .unwrap()
+    .unwrap();
+    assert!(viz.notice().unwrap().starts_with(NOT_CONNECTED));
+    let mut viz = viz;
+    viz.log(rerun::TextLogLevel::INFO, "still works");
+}
