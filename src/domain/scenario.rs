@@ -414,6 +414,47 @@ fn split_types(spec: &str) -> Vec<String> {
         .collect()
 }
 
+/// The `add` and `del` lists of a skill or a disturbance, read with `literal`: atoms only
+/// (no `~`), and no `{*}` among the atoms that become true.
+pub(crate) fn effect_templates(
+    file: &SourceFile,
+    add: &[Spanned<String>],
+    del: &[Spanned<String>],
+    literal: impl Fn(&Spanned<String>) -> Result<super::skill::LiteralTemplate, ScenarioError>,
+) -> Result<
+    (
+        Vec<super::skill::AtomTemplate>,
+        Vec<super::skill::AtomTemplate>,
+    ),
+    ScenarioError,
+> {
+    let mut added = Vec::new();
+    for s in add {
+        let t = literal(s)?;
+        if t.negated || t.atom.args.contains(&super::skill::Term::Every) {
+            return Err(file.error_in_string(
+                &s.span(),
+                0,
+                "`add` lists atoms that become true: no `~` and no {*} (put removals in `del`)",
+            ));
+        }
+        added.push(t.atom);
+    }
+    let mut deleted = Vec::new();
+    for s in del {
+        let t = literal(s)?;
+        if t.negated {
+            return Err(file.error_in_string(
+                &s.span(),
+                0,
+                "`del` lists atoms that become false: write them without `~`",
+            ));
+        }
+        deleted.push(t.atom);
+    }
+    Ok((added, deleted))
+}
+
 fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, ScenarioError> {
     let raw = source.raw;
     let file = source.file;
@@ -460,30 +501,7 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
         Ok::<_, ScenarioError>(t)
     };
     let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
-    let mut add = Vec::new();
-    for s in &raw.add {
-        let t = literal(s)?;
-        if t.negated || t.atom.args.contains(&super::skill::Term::Every) {
-            return Err(file.error_in_string(
-                &s.span(),
-                0,
-                "`add` lists atoms that become true: no `~` and no {*} (put removals in `del`)",
-            ));
-        }
-        add.push(t.atom);
-    }
-    let mut del = Vec::new();
-    for s in &raw.del {
-        let t = literal(s)?;
-        if t.negated {
-            return Err(file.error_in_string(
-                &s.span(),
-                0,
-                "`del` lists atoms that become false: write them without `~`",
-            ));
-        }
-        del.push(t.atom);
-    }
+    let (add, del) = effect_templates(file, &raw.add, &raw.del, literal)?;
     if !raw.cost.is_finite() || raw.cost < 0.0 {
         return Err(file.error_in_string(&raw.name.span(), 0, "cost must be a finite number >= 0"));
     }

@@ -137,30 +137,7 @@ fn read_disturbance(
         Ok::<_, ScenarioError>(t)
     };
     let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
-    let mut add = Vec::new();
-    for s in &raw.add {
-        let t = literal(s)?;
-        if t.negated || t.atom.args.contains(&Term::Every) {
-            return Err(file.error_in_string(
-                &s.span(),
-                0,
-                "`add` lists atoms that become true: no `~` and no {*} (put removals in `del`)",
-            ));
-        }
-        add.push(t.atom);
-    }
-    let mut del = Vec::new();
-    for s in &raw.del {
-        let t = literal(s)?;
-        if t.negated {
-            return Err(file.error_in_string(
-                &s.span(),
-                0,
-                "`del` lists atoms that become false: write them without `~`",
-            ));
-        }
-        del.push(t.atom);
-    }
+    let (add, del) = crate::domain::scenario::effect_templates(file, &raw.add, &raw.del, literal)?;
     if add.is_empty() && del.is_empty() {
         return Err(file.error_in_string(
             &raw.description.span(),
