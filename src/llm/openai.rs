@@ -214,8 +214,12 @@ impl OpenAiClient {
             url: self.url.clone(),
             detail,
         };
-        let json: Json = serde_json::from_str(text)
-            .map_err(|e| malformed(format!("{e} in {:?}", excerpt(&self.redact(text)))))?;
+        let json: Json = serde_json::from_str(text).map_err(|e| {
+            malformed(format!(
+                "{e} in {:?}",
+                crate::http_text::excerpt(&self.redact(text))
+            ))
+        })?;
         let choices = json
             .get("choices")
             .and_then(Json::as_array)
@@ -277,24 +281,17 @@ impl OpenAiClient {
         }
     }
 
-    /// The server's error message (OpenAI: `{"error": {"message": ...}}`), shortened and
-    /// without the key.
+    /// The server's error message, shortened and without the key.
     fn detail(&self, body: &str) -> String {
-        let message = serde_json::from_str::<Json>(body).ok().and_then(|j| {
-            j.pointer("/error/message")
-                .or_else(|| j.get("error"))
-                .or_else(|| j.get("message"))
-                .and_then(Json::as_str)
-                .map(str::to_string)
-        });
-        excerpt(&self.redact(&message.unwrap_or_else(|| body.to_string())))
+        crate::http_text::server_message(body, self.key())
     }
 
     fn redact(&self, text: &str) -> String {
-        match &self.settings.api_key {
-            Some(ApiKey(key)) if !key.is_empty() => text.replace(key.as_str(), "<redacted>"),
-            _ => text.to_string(),
-        }
+        crate::http_text::redact(text, self.key())
+    }
+
+    fn key(&self) -> Option<&str> {
+        self.settings.api_key.as_ref().map(|ApiKey(k)| k.as_str())
     }
 }
 
@@ -330,15 +327,6 @@ fn retry_after(headers: &reqwest::header::HeaderMap) -> Option<Duration> {
         .map(|ms| ms / 1000.0)
         .or_else(|| get("retry-after"))?;
     (seconds.is_finite() && seconds >= 0.0).then(|| Duration::from_secs_f64(seconds.min(3600.0)))
-}
-
-fn excerpt(text: &str) -> String {
-    let t = text.trim();
-    match t.char_indices().nth(300) {
-        Some((i, _)) => format!("{}…", &t[..i]),
-        None if t.is_empty() => "(empty body)".into(),
-        None => t.to_string(),
-    }
 }
 
 #[cfg(test)]

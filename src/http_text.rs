@@ -1,0 +1,39 @@
+//! Text from HTTP servers made safe to show: the error message an OpenAI-style server
+//! sends, shortened, with a secret removed. Shared by the chat and the transcription
+//! clients (which otherwise know nothing of each other).
+
+use serde_json::Value as Json;
+
+/// `text` with every occurrence of `secret` replaced (an empty secret changes nothing).
+pub fn redact(text: &str, secret: Option<&str>) -> String {
+    match secret {
+        Some(key) if !key.is_empty() => text.replace(key, "<redacted>"),
+        _ => text.to_string(),
+    }
+}
+
+/// The server's error message (`{"error": {"message": ...}}`, `{"error": "..."}` or
+/// `{"message": ...}`), else the whole body; without `secret`, shortened.
+pub fn server_message(body: &str, secret: Option<&str>) -> String {
+    let message = serde_json::from_str::<Json>(body).ok().and_then(|j| {
+        j.pointer("/error/message")
+            .or_else(|| j.get("error"))
+            .or_else(|| j.get("message"))
+            .and_then(Json::as_str)
+            .map(str::to_string)
+    });
+    excerpt(&redact(
+        &message.unwrap_or_else(|| body.to_string()),
+        secret,
+    ))
+}
+
+/// At most 300 characters of `text`, trimmed; `(empty body)` for nothing.
+pub fn excerpt(text: &str) -> String {
+    let t = text.trim();
+    match t.char_indices().nth(300) {
+        Some((i, _)) => format!("{}…", &t[..i]),
+        None if t.is_empty() => "(empty body)".into(),
+        None => t.to_string(),
+    }
+}
