@@ -326,27 +326,13 @@ impl ParamsResults {
                 s.paper
             ));
         }
-        let u = &self.usage;
-        out.push_str(&format!(
-            "\n- {} LLM call(s), {} prompt + {} completion tokens, ${:.4}; latency median {:.2} s, p95 {:.2} s.\n",
-            u.calls,
-            u.prompt_tokens,
-            u.completion_tokens,
-            u.price_usd,
-            u.latency_median_ms / 1000.0,
-            u.latency_p95_ms / 1000.0
-        ));
-        out.push_str("- mean ± sd over each run's first value; ✗: the world rejected the value (the run then asked again).\n");
         let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
-        let expected = expected_runs * self.scenarios.len();
-        if finished < expected {
-            out.push_str(&format!(
-                "- Partial: {finished} of {expected} runs finished; run the same command again to finish.\n"
-            ));
-        }
-        for n in u.notes() {
-            out.push_str(&format!("- {n}\n"));
-        }
+        out.push_str(&super::run::table_footer(
+            &self.usage,
+            "- mean ± sd over each run's first value; ✗: the world rejected the value (the run then asked again).\n",
+            finished,
+            expected_runs * self.scenarios.len(),
+        ));
         out
     }
 

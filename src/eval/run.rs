@@ -139,6 +139,35 @@ pub struct UsageSummary {
     pub sources: BTreeMap<String, usize>,
 }
 
+/// The lines under a per-scenario table: usage, what the columns mean (`definition`, one
+/// line ending in a newline), a partial-run warning, and the usage notes.
+pub fn table_footer(
+    u: &UsageSummary,
+    definition: &str,
+    finished: usize,
+    expected: usize,
+) -> String {
+    let mut out = format!(
+        "\n- {} LLM call(s), {} prompt + {} completion tokens, ${:.4}; latency median {:.2} s, p95 {:.2} s.\n",
+        u.calls,
+        u.prompt_tokens,
+        u.completion_tokens,
+        u.price_usd,
+        u.latency_median_ms / 1000.0,
+        u.latency_p95_ms / 1000.0
+    );
+    out.push_str(definition);
+    if finished < expected {
+        out.push_str(&format!(
+            "- Partial: {finished} of {expected} runs finished; run the same command again to finish.\n"
+        ));
+    }
+    for n in u.notes() {
+        out.push_str(&format!("- {n}\n"));
+    }
+    out
+}
+
 impl UsageSummary {
     pub fn of<'a>(calls: impl IntoIterator<Item = &'a CallRecord>) -> Self {
         let mut s = UsageSummary::default();
