@@ -145,11 +145,14 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     tmux.text("Put the blue cube on the green cube");
     tmux.wait_for(&["> Put the blue cube on the green cube"], 10);
     tmux.keys(&["Enter"]);
+    // The usage count reaches the status bar in its own event, possibly a frame after the
+    // tree: wait for it too rather than racing it.
     let screen = tmux.wait_for(
         &[
             "Goal: \"blue cube\" on \"green cube\"",
             "grasp \"blue cube\"!",
             "[o] Fallback",
+            "1 call(s)",
         ],
         20,
     );
