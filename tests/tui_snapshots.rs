@@ -15,20 +15,56 @@ use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 
 use betr::domain::Scenario;
-use betr::session::{Engine, EngineHandle, Event, Setup};
+use betr::session::{Command, Engine, EngineHandle, Event, Setup};
+use betr::tui::dictation::{DictationEvent, DictationService, Microphone, SttLoader};
 use betr::tui::{App, Info, KeyBindings, Theme, ui};
+use betr::voice::{Audio16k, SpeechToText, SttFuture, Transcript};
 use support::fake_model::FixtureModel;
 use support::fixtures;
+use support::microphone::{AudioMicrophone, tone};
 use tokio::sync::mpsc::UnboundedReceiver;
 
 struct Bench {
     engine: EngineHandle,
     events: UnboundedReceiver<Event>,
     app: App,
+    dictation: DictationService,
+    heard: UnboundedReceiver<DictationEvent>,
+    /// Commands the app sent, in order.
+    sent: Vec<Command>,
+}
+
+/// Hears the same words in any audio, after 300 ms.
+struct FixedWords(&'static str);
+
+impl SpeechToText for FixedWords {
+    fn describe(&self) -> String {
+        "fixed words (test)".into()
+    }
+    fn transcribe<'a>(&'a self, audio: &'a Audio16k) -> SttFuture<'a> {
+        Box::pin(async move {
+            Ok(Transcript {
+                text: self.0.into(),
+                audio_seconds: audio.seconds(),
+                elapsed: Duration::from_millis(300),
+                source: self.describe(),
+            })
+        })
+    }
+}
+
+fn fixed_words(words: &'static str) -> SttLoader {
+    Arc::new(
+        move |_: &mut dyn FnMut(&str)| Ok(Arc::new(FixedWords(words)) as Arc<dyn SpeechToText>),
+    )
 }
 
 impl Bench {
     fn start() -> Bench {
+        Bench::with_microphone(AudioMicrophone::missing(), fixed_words("unused"))
+    }
+
+    fn with_microphone(microphone: Arc<dyn Microphone>, loader: SttLoader) -> Bench {
         let path = fixtures::root().join("scenarios/cell/red_on_blue.toml");
         let scenario = Arc::new(Scenario::load(&path).unwrap());
         let info = Info {
@@ -49,18 +85,44 @@ impl Bench {
         let model = FixtureModel::new(fixtures::every_reply());
         let setup = Setup::new(scenario, path, Ok(Arc::new(model)));
         let (engine, events) = Engine::spawn(setup).unwrap();
+        let (dictation, heard) = DictationService::new(microphone, Ok(loader));
         Bench {
             engine,
             events,
             app: App::new(info, KeyBindings::default(), Theme::default()),
+            dictation,
+            heard,
+            sent: Vec::new(),
         }
     }
 
+    /// A key, as the event loop handles it (must run inside the runtime).
     fn key(&mut self, code: KeyCode) {
         self.app.on_key(KeyEvent::new(code, KeyModifiers::NONE));
         for c in self.app.take_commands() {
+            self.sent.push(c.clone());
             assert!(self.engine.send(c));
         }
+        for r in self.app.take_dictation_requests() {
+            self.dictation.handle(r);
+        }
+    }
+
+    /// Feed dictation events to the app until one matches.
+    async fn until_heard(&mut self, pred: impl Fn(&DictationEvent) -> bool) {
+        let wait = async {
+            loop {
+                let e = self.heard.recv().await.unwrap();
+                let hit = pred(&e);
+                self.app.on_dictation(e);
+                if hit {
+                    break;
+                }
+            }
+        };
+        tokio::time::timeout(Duration::from_secs(20), wait)
+            .await
+            .expect("timed out");
     }
 
     fn type_text(&mut self, text: &str) {
@@ -195,5 +257,119 @@ fn small_terminal_stays_usable() {
         for (w, h) in [(40, 12), (20, 6), (1, 1)] {
             b.screen(w, h);
         }
+    });
+}
+
+/// Push-to-talk as a person uses it: d records (a level meter, the elapsed time), d again
+/// stops and transcribes, and the words land in the input line, not submitted; Enter
+/// submits them, as typed words would be.
+#[test]
+fn dictation_records_then_puts_the_transcript_in_the_input_line() {
+    rt().block_on(async {
+        let mut b = Bench::with_microphone(
+            AudioMicrophone::playing(tone(2.0)),
+            fixed_words("Put the blue cube on the green cube"),
+        );
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Recording { .. }))
+            .await;
+        // Every level of the 2 s recording (40 windows of 50 ms), then a fixed clock for
+        // the snapshot.
+        for _ in 0..40 {
+            b.until_heard(|e| matches!(e, DictationEvent::Level(_)))
+                .await;
+        }
+        if let betr::tui::components::dictation::Dictation::Recording { elapsed, .. } =
+            &mut b.app.dictation.state
+        {
+            *elapsed = Duration::from_millis(2_040);
+        }
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("● REC 0:02.0"), "{screen}");
+        assert!(screen.contains("test microphone"), "{screen}");
+        assert!(screen.contains("d stops and transcribes"), "{screen}");
+        insta::assert_snapshot!("dictation_recording", screen);
+
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Transcribing { .. }))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("transcribing 2.0 s of audio"), "{screen}");
+        insta::assert_snapshot!("dictation_transcribing", screen);
+
+        b.until_heard(|e| matches!(e, DictationEvent::Heard(_)))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("> Put the blue cube on the green cube"),
+            "{screen}"
+        );
+        assert!(screen.contains("dictated 2.0 s in 0.3 s"), "{screen}");
+        insta::assert_snapshot!("dictation_transcript_in_input_line", screen);
+        assert!(b.sent.is_empty(), "submitted unseen: {:?}", b.sent);
+
+        // The person corrects the transcript, then submits it.
+        for _ in 0.."green cube".len() {
+            b.key(KeyCode::Backspace);
+        }
+        b.type_text("red cube");
+        b.key(KeyCode::Enter);
+        assert_eq!(
+            b.sent,
+            [Command::Submit("Put the blue cube on the red cube".into())]
+        );
+    });
+}
+
+#[test]
+fn dictation_without_a_microphone_says_so_and_the_session_goes_on() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Failed(_)))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("dictation: no microphone"), "{screen}");
+        insta::assert_snapshot!("dictation_no_microphone", screen);
+        // The next key clears the message (the log keeps it) and works as usual.
+        b.key(KeyCode::Char('i'));
+        let screen = b.screen(120, 40);
+        let status_bar = screen.lines().last().unwrap();
+        assert!(!status_bar.contains("no microphone"), "{screen}");
+        assert!(screen.contains("dictation: no microphone"), "{screen}");
+        assert!(screen.contains("Instruction or goal"), "{screen}");
+    });
+}
+
+#[test]
+fn a_recording_can_be_discarded_and_a_silent_one_is_refused() {
+    rt().block_on(async {
+        let mut b = Bench::with_microphone(
+            AudioMicrophone::playing(Audio16k::new(vec![0.0; 32_000])),
+            fixed_words("never heard"),
+        );
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Recording { .. }))
+            .await;
+        b.key(KeyCode::Esc);
+        b.until_heard(|e| matches!(e, DictationEvent::Cancelled))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("recording discarded"), "{screen}");
+        assert!(
+            screen.contains("press i to type an instruction"),
+            "{screen}"
+        );
+
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Recording { .. }))
+            .await;
+        b.key(KeyCode::Char('d'));
+        b.until_heard(|e| matches!(e, DictationEvent::Failed(_)))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("the recording is silent"), "{screen}");
+        assert!(!screen.contains("never heard"), "{screen}");
+        assert!(b.sent.is_empty(), "{:?}", b.sent);
     });
 }

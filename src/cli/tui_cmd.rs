@@ -13,7 +13,8 @@ use clap::Args;
 use betr::llm::LanguageModel;
 use betr::llm::usage::Ledger;
 use betr::session::{PolicyStore, Setup};
-use betr::tui::{Info, KeyBindings, Theme};
+use betr::tui::dictation::{DefaultMicrophone, DictationService};
+use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
 use super::llm_cmds::{self, LlmFlags};
 
@@ -41,6 +42,9 @@ pub struct TuiArgs {
     pub tick_ms: u64,
     #[command(flatten)]
     pub llm: LlmFlags,
+    /// Speech-to-text for push-to-talk (the dictation key).
+    #[command(flatten)]
+    pub stt: super::voice_cmd::SttFlags,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
 }
@@ -124,11 +128,21 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    runtime.block_on(betr::tui::run(
-        setup,
+    // Bad speech settings disable dictation (saying why when the key is pressed), not
+    // the workbench.
+    let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &args.stt)
+        .map(super::voice_cmd::workbench_loader)
+        .map_err(|e| format!("{e:#}"));
+    let workbench = Workbench {
         info,
         keys,
         theme,
+        dictation: DictationService::new(Arc::new(DefaultMicrophone), loader),
+        stderr_to: log_path(),
+    };
+    runtime.block_on(betr::tui::run(
+        setup,
+        workbench,
         tap.as_mut().map(|t| t as &mut dyn betr::tui::Tap),
     ))?;
     Ok(ExitCode::SUCCESS)

@@ -5,12 +5,15 @@
 use std::io::{BufRead, Write};
 use std::path::Path;
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Context as _, Result, bail};
 use clap::Args;
 
 use betr::llm::config::FileConfig;
+use betr::model::Progress;
+use betr::tui::dictation::SttLoader;
 use betr::voice::{self, Audio16k, SpeechToText, SttBackend, SttLayer, SttSettings, Transcript};
 
 /// Speech-to-text flags. Each overrides the matching `BETR_STT*` variable, which overrides
@@ -73,6 +76,59 @@ pub fn settings(config: Option<&Path>, flags: &SttFlags) -> Result<SttSettings> 
 pub struct Loaded {
     pub stt: Box<dyn SpeechToText>,
     pub load_time: Option<Duration>,
+}
+
+/// The workbench's push-to-talk model: built on first use, the embedded model fetched
+/// first when it is not in the cache, with progress reported as short lines (the screen
+/// is up, so nothing is printed).
+pub fn workbench_loader(settings: SttSettings) -> SttLoader {
+    Arc::new(move |report: &mut dyn FnMut(&str)| {
+        if settings.backend == SttBackend::Local
+            && let Some(spec) = betr::model::find_stt(&settings.model)
+            && !spec.is_present()
+        {
+            report(&format!(
+                "fetching {} ({:.0} MB, once only)",
+                spec.name,
+                spec.size() as f64 / 1e6
+            ));
+            let mut progress = ReportedProgress {
+                name: spec.name,
+                report: &mut *report,
+                percent: None,
+            };
+            betr::model::fetch_dir(spec, &betr::model::cache_dir(), "python3", &mut progress)
+                .map_err(|e| e.to_string())?;
+        }
+        if settings.backend == SttBackend::Local {
+            report(&format!("loading {}", settings.model));
+        }
+        settings
+            .build(&|k| std::env::var(k).ok())
+            .map(Arc::from)
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// A fetch's progress as "fetching NAME: 42%" lines, one per percent.
+struct ReportedProgress<'a> {
+    name: &'static str,
+    report: &'a mut dyn FnMut(&str),
+    percent: Option<u64>,
+}
+
+impl Progress for ReportedProgress<'_> {
+    fn stage(&mut self, message: &str) {
+        (self.report)(&format!("{}: {message}", self.name));
+    }
+
+    fn bytes(&mut self, done: u64, total: u64) {
+        let percent = (done * 100).checked_div(total).unwrap_or(0);
+        if self.percent != Some(percent) {
+            self.percent = Some(percent);
+            (self.report)(&format!("fetching {}: {percent}%", self.name));
+        }
+    }
 }
 
 /// Build the backend; the embedded model is fetched first if it is not in the cache.

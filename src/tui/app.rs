@@ -6,12 +6,14 @@ use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
 use crate::session::{Command, Event};
 
+use super::components::dictation::DictationPanel;
 use super::components::help::report_lines;
 use super::components::input::{InputLine, Mode, Submitted};
 use super::components::llm_pane::{LlmPane, ProposalView};
-use super::components::status_bar::{Ending, StatusBar};
+use super::components::status_bar::{Ending, Message, StatusBar};
 use super::components::tree_pane::TreePane;
 use super::components::world_pane::WorldPane;
+use super::dictation::{DictationEvent, DictationRequest};
 use super::keys::{Action, KeyBindings};
 use super::strings;
 use super::theme::Theme;
@@ -36,6 +38,7 @@ pub struct Info {
 #[derive(Debug, Clone, PartialEq)]
 pub enum AppEvent {
     Command(Command),
+    Dictation(DictationRequest),
     Quit,
 }
 
@@ -53,8 +56,11 @@ pub struct App {
     pub world: WorldPane,
     pub input: InputLine,
     pub status: StatusBar,
+    pub dictation: DictationPanel,
     pub overlay: Option<Overlay>,
     queue: Vec<AppEvent>,
+    /// Requests for the push-to-talk service, in order.
+    dictation_requests: Vec<DictationRequest>,
     quit: bool,
 }
 
@@ -84,8 +90,10 @@ impl App {
                 auto_approve: info.auto_approve,
                 ..StatusBar::default()
             },
+            dictation: DictationPanel::default(),
             overlay: None,
             queue: Vec::new(),
+            dictation_requests: Vec::new(),
             quit: false,
         }
     }
@@ -100,19 +108,26 @@ impl App {
         for e in std::mem::take(&mut self.queue) {
             match e {
                 AppEvent::Command(c) => out.push(c),
+                AppEvent::Dictation(r) => self.dictation_requests.push(r),
                 AppEvent::Quit => self.quit = true,
             }
         }
         out
     }
 
-    /// Whether something animates (a model call under way).
+    /// Requests for the push-to-talk service, in order (after `take_commands`).
+    pub fn take_dictation_requests(&mut self) -> Vec<DictationRequest> {
+        std::mem::take(&mut self.dictation_requests)
+    }
+
+    /// Whether something animates (a model call under way, a recording's clock).
     pub fn animating(&self) -> bool {
-        self.llm.asking.is_some()
+        self.llm.asking.is_some() || self.dictation.is_shown()
     }
 
     pub fn on_animation(&mut self) {
         self.llm.animate();
+        self.dictation.animate();
     }
 
     pub fn on_key(&mut self, key: KeyEvent) {
@@ -123,7 +138,15 @@ impl App {
             self.queue.push(AppEvent::Quit);
             return;
         }
+        // While recording, the push-to-talk key stops it wherever the focus is.
+        if self.dictation.is_recording() && self.keys.dictate.matches(&key) {
+            self.status.message = None;
+            return self.on_dictate_key();
+        }
         if self.input.is_open() {
+            if key.code == KeyCode::Enter || key.code == KeyCode::Esc {
+                self.status.message = None;
+            }
             match self.input.event(&key) {
                 Some(Submitted::Instruction(text)) => {
                     self.llm.error = None;
@@ -135,6 +158,13 @@ impl App {
                 }
                 None => {}
             }
+            return;
+        }
+        self.status.message = None;
+        if self.dictation.is_recording() && key.code == KeyCode::Esc {
+            self.queue
+                .push(AppEvent::Dictation(DictationRequest::Cancel));
+            self.dictation.idle();
             return;
         }
         if self.overlay.take().is_some() {
@@ -161,9 +191,14 @@ impl App {
             Action::Save => Command::SavePolicy,
             Action::Load => Command::LoadPolicy(None),
             Action::Reset => Command::ResetWorld,
+            // The recording panel holds the input line's place until the recording ends.
+            Action::Instruction | Action::Edit if self.dictation.is_recording() => {
+                return self.message(strings::STOP_RECORDING_FIRST.to_string(), true);
+            }
             Action::Instruction => {
                 return self.input.open(Mode::Instruction, "");
             }
+            Action::Dictate => return self.on_dictate_key(),
             Action::Edit => {
                 let text = self
                     .llm
@@ -183,6 +218,80 @@ impl App {
             }
         };
         self.queue.push(AppEvent::Command(command));
+    }
+
+    /// Push-to-talk: the same key starts and stops a recording.
+    fn on_dictate_key(&mut self) {
+        use super::components::dictation::Dictation;
+        let request = match self.dictation.state {
+            Dictation::Idle => {
+                self.dictation.state = Dictation::Starting;
+                DictationRequest::Start
+            }
+            Dictation::Recording { .. } => {
+                self.dictation.transcribing(None);
+                DictationRequest::Stop
+            }
+            // The microphone is still opening: the press that stops comes later.
+            Dictation::Starting => return,
+            Dictation::Transcribing { .. } => {
+                return self.message(strings::DICTATION_BUSY.to_string(), true);
+            }
+        };
+        self.queue.push(AppEvent::Dictation(request));
+    }
+
+    fn message(&mut self, text: String, error: bool) {
+        self.status.message = Some(Message { text, error });
+    }
+
+    /// What the push-to-talk service reports.
+    pub fn on_dictation(&mut self, event: DictationEvent) {
+        match event {
+            DictationEvent::Recording { device } => {
+                // A cancel that arrived before the microphone opened wins.
+                if self.dictation.is_recording() {
+                    self.dictation.recording(device);
+                }
+            }
+            DictationEvent::Level(level) => self.dictation.level(level),
+            DictationEvent::Preparing(what) => self.dictation.preparing = Some(what),
+            DictationEvent::Transcribing { seconds } => {
+                self.dictation.preparing = None;
+                self.dictation.transcribing(Some(seconds));
+            }
+            DictationEvent::Heard(transcript) => {
+                self.dictation.idle();
+                self.llm.log(format!("dictated: {}", transcript.text));
+                // Into the input line, for the person to read and correct: never submitted
+                // from here.
+                if !self.input.is_open() {
+                    self.input.open(Mode::Instruction, &transcript.text);
+                } else if !self.input.insert_dictation(&transcript.text) {
+                    let text = strings::transcript_not_placed(&transcript.text);
+                    self.llm.log(text.clone());
+                    return self.message(text, true);
+                }
+                self.message(
+                    strings::dictated(
+                        transcript.audio_seconds,
+                        transcript.elapsed.as_secs_f64(),
+                        &transcript.source,
+                    ),
+                    false,
+                );
+            }
+            DictationEvent::Failed(why) => {
+                self.dictation.idle();
+                let text = strings::dictation_failed(&why);
+                self.llm.log(text.clone());
+                self.message(text, true);
+            }
+            DictationEvent::Cancelled => {
+                self.dictation.idle();
+                self.message(strings::RECORDING_DISCARDED.to_string(), false);
+            }
+        }
     }
 
     pub fn on_session(&mut self, event: Event) {

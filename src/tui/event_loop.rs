@@ -13,6 +13,7 @@ use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 use crate::session::{Command, EngineHandle, Event};
 
 use super::app::App;
+use super::dictation::{DictationEvent, DictationService};
 use super::ui;
 
 /// Read terminal events on a thread of their own (crossterm's reads block) until `stop`.
@@ -54,17 +55,29 @@ pub trait Tap {
     fn notice(&self) -> Option<String>;
 }
 
+/// What the loop waits on besides the animation ticker.
+pub struct Inputs<'a> {
+    pub session: &'a mut UnboundedReceiver<Event>,
+    pub terminal: &'a mut UnboundedReceiver<TermEvent>,
+    pub dictation: &'a mut UnboundedReceiver<DictationEvent>,
+}
+
 /// Run until the app quits or the session ends.
 pub async fn run<B: Backend>(
     terminal: &mut Terminal<B>,
     app: &mut App,
     engine: &EngineHandle,
-    events: &mut UnboundedReceiver<Event>,
-    input: &mut UnboundedReceiver<TermEvent>,
+    inputs: Inputs<'_>,
+    dictation: &mut DictationService,
     tap: &mut Option<&mut dyn Tap>,
 ) {
     let mut animation = tokio::time::interval(Duration::from_millis(150));
     animation.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let Inputs {
+        session: events,
+        terminal: input,
+        dictation: heard,
+    } = inputs;
     loop {
         if let Err(e) = terminal.draw(|f| ui::draw(f, app)) {
             tracing::warn!(error = %e, "cannot draw the screen");
@@ -92,6 +105,13 @@ pub async fn run<B: Backend>(
                 }
                 None => break,
             },
+            // The service holds a sender, so this channel never closes while it lives.
+            Some(event) = heard.recv() => {
+                app.on_dictation(event);
+                while let Ok(e) = heard.try_recv() {
+                    app.on_dictation(e);
+                }
+            },
             _ = animation.tick(), if app.animating() => app.on_animation(),
         }
         for command in app.take_commands() {
@@ -99,6 +119,9 @@ pub async fn run<B: Backend>(
                 t.command(&command);
             }
             engine.send(command);
+        }
+        for request in app.take_dictation_requests() {
+            dictation.handle(request);
         }
         if app.should_quit() {
             engine.send(Command::Shutdown);

@@ -16,6 +16,7 @@ pub enum Action {
     Run,
     Plan,
     Instruction,
+    Dictate,
     Approve,
     Reject,
     Edit,
@@ -163,6 +164,7 @@ bindings! {
     run: Run = Key::plain('r'),
     plan: Plan = Key::plain('p'),
     instruction: Instruction = Key::plain('i'),
+    dictate: Dictate = Key::plain('d'),
     approve: Approve = Key::plain('a'),
     reject: Reject = Key::plain('x'),
     edit: Edit = Key::plain('e'),
@@ -256,7 +258,7 @@ mod tests {
         assert_eq!(
             text,
             [
-                "space", "r", "p", "i", "a", "x", "e", "u", "v", "s", "l", "w", "?", "q"
+                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "w", "?", "q"
             ]
         );
         assert_eq!(

@@ -10,8 +10,10 @@
 
 pub mod app;
 pub mod components;
+pub mod dictation;
 pub mod event_loop;
 pub mod keys;
+pub mod stderr;
 pub mod strings;
 pub mod theme;
 pub mod ui;
@@ -19,6 +21,7 @@ pub mod ui;
 pub use event_loop::Tap;
 
 use std::io::{Stdout, stdout};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -30,7 +33,11 @@ use crossterm::terminal::{
 use ratatui::Terminal;
 use ratatui::backend::CrosstermBackend;
 
+use tokio::sync::mpsc::UnboundedReceiver;
+
 use crate::session::{Engine, SessionError, Setup};
+
+use dictation::{DictationEvent, DictationService};
 
 pub use app::{App, Info};
 pub use keys::KeyBindings;
@@ -49,12 +56,20 @@ pub enum TuiError {
 pub struct TerminalGuard;
 
 impl TerminalGuard {
-    /// Raw mode, alternate screen, hidden cursor; and a panic hook that restores them.
-    pub fn enter() -> std::io::Result<(TerminalGuard, Terminal<CrosstermBackend<Stdout>>)> {
+    /// Raw mode, alternate screen, hidden cursor, standard error to `stderr_to` (when
+    /// given); and a panic hook that restores them.
+    pub fn enter(
+        stderr_to: Option<&Path>,
+    ) -> std::io::Result<(TerminalGuard, Terminal<CrosstermBackend<Stdout>>)> {
         install_panic_hook();
         let guard = TerminalGuard;
         enable_raw_mode()?;
         execute!(stdout(), EnterAlternateScreen, Hide)?;
+        if let Some(file) = stderr_to
+            && let Err(e) = stderr::redirect(file)
+        {
+            tracing::warn!(error = %e, file = %file.display(), "standard error stays on the screen");
+        }
         let terminal = Terminal::new(CrosstermBackend::new(stdout()))?;
         Ok((guard, terminal))
     }
@@ -69,6 +84,7 @@ impl Drop for TerminalGuard {
 /// Leave raw mode and the alternate screen and show the cursor; errors are ignored (this
 /// runs on the way out, where nothing better can be done).
 pub fn restore() {
+    stderr::restore();
     let _ = disable_raw_mode();
     let _ = execute!(stdout(), LeaveAlternateScreen, Show);
 }
@@ -81,29 +97,51 @@ fn install_panic_hook() {
     }));
 }
 
+/// Everything the workbench needs besides the session.
+pub struct Workbench {
+    pub info: Info,
+    pub keys: KeyBindings,
+    pub theme: Theme,
+    /// Push-to-talk: the service and the channel its events arrive on.
+    pub dictation: (DictationService, UnboundedReceiver<DictationEvent>),
+    /// Where standard error goes while the screen is up (the log file).
+    pub stderr_to: Option<PathBuf>,
+}
+
 /// Open the workbench on `setup` until the person quits.
 pub async fn run(
     setup: Setup,
-    info: Info,
-    keys: KeyBindings,
-    theme: Theme,
+    workbench: Workbench,
     mut tap: Option<&mut dyn Tap>,
 ) -> Result<(), TuiError> {
+    let Workbench {
+        info,
+        keys,
+        theme,
+        dictation: (mut dictation, mut heard),
+        stderr_to,
+    } = workbench;
     let (engine, mut events) = Engine::spawn(setup)?;
     let mut app = App::new(info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
-    let (_guard, mut terminal) = TerminalGuard::enter()?;
+    let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let stop = Arc::new(AtomicBool::new(false));
     let mut input = event_loop::spawn_input_reader(stop.clone());
     event_loop::run(
         &mut terminal,
         &mut app,
         &engine,
-        &mut events,
-        &mut input,
+        event_loop::Inputs {
+            session: &mut events,
+            terminal: &mut input,
+            dictation: &mut heard,
+        },
+        &mut dictation,
         &mut tap,
     )
     .await;
     stop.store(true, Ordering::Relaxed);
+    // A recording still open is discarded with the service, before the screen goes.
+    drop(dictation);
     Ok(())
 }

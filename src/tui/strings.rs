@@ -9,7 +9,7 @@ pub const WORLD_TITLE: &str = " World ";
 pub const INPUT_TITLE_IDLE: &str = " Input ";
 pub const INPUT_TITLE_INSTRUCTION: &str = " Instruction or goal (Enter submits, Esc cancels) ";
 pub const INPUT_TITLE_EDIT: &str = " Edit the proposal (Enter applies, Esc cancels) ";
-pub const INPUT_HINT: &str = "press i to type an instruction, ? for help";
+pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, ? for help";
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";
 pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
@@ -52,6 +52,7 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Run => "run / pause",
         Plan => "plan (the typed goal, else the scenario's)",
         Instruction => "type an instruction or a goal formula",
+        Dictate => "dictate an instruction (again: stop; Esc: discard)",
         Approve => "approve the proposal",
         Reject => "reject the proposal",
         Edit => "edit the proposal (or type conditions yourself)",
@@ -115,4 +116,43 @@ pub fn no_model(why: &str) -> String {
 
 pub fn keys_file_error(error: &str) -> String {
     format!("key bindings file ignored (defaults kept): {error}")
+}
+
+pub const REC_MARK: &str = "● REC";
+pub const OPENING_MICROPHONE: &str = "opening the microphone…";
+pub const DICTATION_TITLE_TRANSCRIBING: &str = " Dictation: transcribing ";
+pub const NO_SOUND_YET: &str = "no sound yet: is the microphone muted?";
+pub const DICTATION_BUSY: &str =
+    "still transcribing the last recording; wait for it before recording again";
+pub const STOP_RECORDING_FIRST: &str =
+    "recording: press the dictation key to stop it (Esc discards) before typing";
+pub const RECORDING_DISCARDED: &str = "recording discarded";
+
+pub fn dictation_title_recording(key: &str) -> String {
+    format!(" Dictation: recording ({key} stops and transcribes, Esc discards) ")
+}
+
+pub fn transcribing(seconds: Option<f64>) -> String {
+    match seconds {
+        Some(s) => format!("transcribing {s:.1} s of audio…"),
+        None => "stopping the recording…".to_string(),
+    }
+}
+
+pub fn dictation_unavailable(why: &str) -> String {
+    format!("dictation is not available: {why}")
+}
+
+pub fn dictation_failed(why: &str) -> String {
+    format!("dictation: {why}")
+}
+
+pub fn dictated(audio_seconds: f64, elapsed_seconds: f64, source: &str) -> String {
+    format!(
+        "dictated {audio_seconds:.1} s in {elapsed_seconds:.1} s ({source}): correct it if needed, Enter submits, Esc discards"
+    )
+}
+
+pub fn transcript_not_placed(text: &str) -> String {
+    format!("dictated while the proposal editor was open, so not placed: {text}")
 }

@@ -25,6 +25,8 @@ pub struct Theme {
     pub error: Style,
     pub dim: Style,
     pub key: Style,
+    /// The filled and empty cells of the dictation level meter.
+    pub meter: (&'static str, &'static str),
 }
 
 impl Theme {
@@ -49,6 +51,12 @@ impl Theme {
             error: Style::new().fg(Color::Red).add_modifier(Modifier::BOLD),
             dim: Style::new().fg(Color::DarkGray),
             key: Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD),
+            // Block characters only where the tree glyphs are not plain ASCII either.
+            meter: if glyphs.success.is_ascii() {
+                ("#", "-")
+            } else {
+                ("█", "░")
+            },
         }
     }
 

@@ -45,7 +45,12 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     app.tree.draw(frame, tree_area, &theme);
     app.llm.draw(frame, llm_area, &theme, &hint);
     app.world.draw(frame, world_area, &theme);
-    app.input.draw(frame, input, &theme);
+    if app.dictation.is_shown() && !app.input.is_open() {
+        app.dictation
+            .draw(frame, input, &theme, &key(Action::Dictate));
+    } else {
+        app.input.draw(frame, input, &theme);
+    }
     app.status.draw(frame, status, &theme, &help_key);
     match &app.overlay {
         Some(Overlay::Help) => draw_help(frame, area, &app.keys, &theme),

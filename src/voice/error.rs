@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum VoiceError {
-    #[error("no microphone: {detail} (connect one, or dictate from a file with --audio FILE.wav)")]
+    #[error(
+        "no microphone: connect one, or dictate a WAV file with --audio on interpret/resolve ({detail})"
+    )]
     NoInputDevice { detail: String },
     #[error(
         "the microphone {device:?} is busy ({detail}); close the program using it and try again"

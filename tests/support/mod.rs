@@ -6,5 +6,6 @@ pub mod cli;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;
+pub mod microphone;
 pub mod multipart;
 pub mod verify;

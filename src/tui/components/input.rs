@@ -42,6 +42,28 @@ impl InputLine {
         self.mode.is_some()
     }
 
+    /// Put dictated text at the cursor of an open instruction (spaced from the words
+    /// around it). False when the line is editing a proposal: that text is not touched.
+    pub fn insert_dictation(&mut self, dictated: &str) -> bool {
+        if self.mode != Some(Mode::Instruction) {
+            return false;
+        }
+        let at = self.byte_at(self.cursor);
+        let before = self.text[..at].chars().next_back();
+        let after = self.text[at..].chars().next();
+        let mut piece = String::new();
+        if before.is_some_and(|c| !c.is_whitespace()) {
+            piece.push(' ');
+        }
+        piece.push_str(dictated);
+        if after.is_some_and(|c| !c.is_whitespace()) {
+            piece.push(' ');
+        }
+        self.text.insert_str(at, &piece);
+        self.cursor += piece.chars().count();
+        true
+    }
+
     /// Handle a key while open: `Some` when Enter submitted the text.
     pub fn event(&mut self, key: &KeyEvent) -> Option<Submitted> {
         let mode = self.mode?;
@@ -160,7 +182,27 @@ mod tests {
         );
         assert!(!input.is_open());
         input.open(Mode::Edit, "A & B");
+        assert!(!input.insert_dictation("put the cup"));
         input.event(&key(KeyCode::Esc));
         assert!(!input.is_open());
+    }
+
+    #[test]
+    fn dictation_is_inserted_at_the_cursor_with_spaces() {
+        let mut input = InputLine::default();
+        assert!(!input.insert_dictation("x"));
+        input.open(Mode::Instruction, "Carefully then");
+        input.event(&key(KeyCode::Home));
+        for _ in 0.."Carefully".len() {
+            input.event(&key(KeyCode::Right));
+        }
+        assert!(input.insert_dictation("put the cup on the table"));
+        input.event(&key(KeyCode::Char('!')));
+        assert_eq!(
+            input.event(&key(KeyCode::Enter)),
+            Some(Submitted::Instruction(
+                "Carefully put the cup on the table! then".into()
+            ))
+        );
     }
 }

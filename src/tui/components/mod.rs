@@ -1,6 +1,7 @@
 //! The parts of the screen. Each handles its own keys (`event`) and draws itself
 //! (`draw`) from its state; they talk to the app through its event queue.
 
+pub mod dictation;
 pub mod help;
 pub mod input;
 pub mod llm_pane;

@@ -17,6 +17,13 @@ pub enum Ending {
     Failed,
 }
 
+/// A passing message (dictation's outcome), shown until the next key.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Message {
+    pub text: String,
+    pub error: bool,
+}
+
 #[derive(Default)]
 pub struct StatusBar {
     pub scenario: String,
@@ -29,6 +36,8 @@ pub struct StatusBar {
     pub ending: Option<Ending>,
     /// Said once when a 3D viewer was asked for and is not there.
     pub viewer: Option<String>,
+    /// Takes the bar's middle while it is there.
+    pub message: Option<Message>,
 }
 
 impl StatusBar {
@@ -37,6 +46,35 @@ impl StatusBar {
         // tighter separators.
         let narrow = area.width < 100;
         let sep = Span::styled(if narrow { "│" } else { " │ " }, theme.status_bar);
+        let help = if narrow {
+            help_key.to_string()
+        } else {
+            format!("{help_key} {}", strings::HELP_WORD)
+        };
+        if let Some(message) = &self.message {
+            // The message gets the width; the help key stays at the right edge.
+            let style = if message.error {
+                theme.status_bar.patch(theme.error)
+            } else {
+                theme.status_bar
+            };
+            let scenario = format!(" {}", self.scenario);
+            let fixed =
+                scenario.chars().count() + 2 * sep.content.chars().count() + help.chars().count();
+            let room = usize::from(area.width).saturating_sub(fixed);
+            let spans = vec![
+                Span::styled(scenario, theme.status_bar),
+                sep.clone(),
+                Span::styled(format!("{:<room$}", fit(&message.text, room)), style),
+                sep,
+                Span::styled(help, theme.status_bar),
+            ];
+            frame.render_widget(
+                Paragraph::new(Line::from(spans)).style(theme.status_bar),
+                area,
+            );
+            return;
+        }
         let who = if narrow {
             self.model.clone()
         } else {
@@ -90,15 +128,20 @@ impl StatusBar {
             spans.push(Span::styled(strings::AUTO_APPROVE, theme.error));
         }
         spans.push(sep);
-        let help = if narrow {
-            help_key.to_string()
-        } else {
-            format!("{help_key} {}", strings::HELP_WORD)
-        };
         spans.push(Span::styled(help, theme.status_bar));
         frame.render_widget(
             Paragraph::new(Line::from(spans)).style(theme.status_bar),
             area,
         );
     }
+}
+
+/// `text` cut to `width` characters, with an ellipsis when cut.
+fn fit(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        return text.to_string();
+    }
+    let mut cut: String = text.chars().take(width.saturating_sub(1)).collect();
+    cut.push('…');
+    cut
 }

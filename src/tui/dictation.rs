@@ -1,0 +1,244 @@
+//! Push-to-talk for the workbench: the bridge between the app's key presses and the
+//! `voice` module. The app asks ([`DictationRequest`]); this service owns the recording
+//! and the speech-to-text model and answers with [`DictationEvent`]s on a channel the
+//! event loop reads, so the screen never waits on audio or on a model.
+//!
+//! The microphone is a trait so tests (and machines without a sound card) can stand in a
+//! recording; the model is loaded on first use (fetched first when it is not cached, with
+//! progress), starting while the person is still speaking.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use tokio::sync::OnceCell;
+use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+
+use crate::voice::{self, Audio16k, Level, Recorder, SpeechToText, Transcript, VoiceError};
+
+/// What the app asks of the service.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DictationRequest {
+    /// Start recording from the microphone.
+    Start,
+    /// Stop recording and transcribe what was said.
+    Stop,
+    /// Stop recording and throw it away.
+    Cancel,
+}
+
+/// What the service tells the app.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DictationEvent {
+    /// The microphone is recording.
+    Recording { device: String },
+    /// The level of the last 50 ms of audio.
+    Level(Level),
+    /// Getting the model ready (loading, or fetching it on first use).
+    Preparing(String),
+    /// The recording ended; this many seconds of audio are being transcribed.
+    Transcribing { seconds: f64 },
+    /// What was heard: for the input line, never submitted unseen.
+    Heard(Transcript),
+    /// Why nothing was heard (no microphone, a busy device, silence, no model…).
+    Failed(String),
+    /// The recording was thrown away.
+    Cancelled,
+}
+
+/// A recording in progress.
+pub trait Recording: Send {
+    /// Stop and return the audio at 16 kHz mono (blocking: joins the audio thread).
+    fn stop(self: Box<Self>) -> Result<Audio16k, VoiceError>;
+}
+
+/// Where recordings come from.
+pub trait Microphone: Send + Sync {
+    /// Start recording; `on_level` runs on the audio thread for every 50 ms of audio.
+    /// Returns the device's name with the recording.
+    fn start(
+        &self,
+        on_level: Box<dyn FnMut(Level) + Send>,
+    ) -> Result<(String, Box<dyn Recording>), VoiceError>;
+}
+
+/// The default input device, through cpal.
+pub struct DefaultMicrophone;
+
+impl Recording for Recorder {
+    fn stop(self: Box<Self>) -> Result<Audio16k, VoiceError> {
+        Recorder::stop(*self)
+    }
+}
+
+impl Microphone for DefaultMicrophone {
+    fn start(
+        &self,
+        on_level: Box<dyn FnMut(Level) + Send>,
+    ) -> Result<(String, Box<dyn Recording>), VoiceError> {
+        let recorder = Recorder::start(on_level)?;
+        Ok((recorder.device().to_string(), Box::new(recorder)))
+    }
+}
+
+/// Builds the speech-to-text backend (blocking: it may fetch and load a model), reporting
+/// progress through the callback; the error says what to do.
+pub type SttLoader =
+    Arc<dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, String> + Send + Sync>;
+
+/// Owns the recording in progress and the speech-to-text model.
+pub struct DictationService {
+    microphone: Arc<dyn Microphone>,
+    /// `Err`: why dictation cannot work at all (bad `[stt]` settings).
+    loader: Result<SttLoader, String>,
+    stt: Arc<OnceCell<Arc<dyn SpeechToText>>>,
+    recording: Option<Box<dyn Recording>>,
+    /// A recording is being stopped or transcribed.
+    busy: Arc<AtomicBool>,
+    events: UnboundedSender<DictationEvent>,
+}
+
+impl DictationService {
+    pub fn new(
+        microphone: Arc<dyn Microphone>,
+        loader: Result<SttLoader, String>,
+    ) -> (DictationService, UnboundedReceiver<DictationEvent>) {
+        let (events, rx) = unbounded_channel();
+        let service = DictationService {
+            microphone,
+            loader,
+            stt: Arc::new(OnceCell::new()),
+            recording: None,
+            busy: Arc::new(AtomicBool::new(false)),
+            events,
+        };
+        (service, rx)
+    }
+
+    /// Act on a request. Must run inside a tokio runtime: stopping and transcribing run as
+    /// tasks whose outcome arrives as events.
+    pub fn handle(&mut self, request: DictationRequest) {
+        match request {
+            DictationRequest::Start => self.start(),
+            DictationRequest::Stop => self.stop(),
+            DictationRequest::Cancel => self.cancel(),
+        }
+    }
+
+    fn send(&self, event: DictationEvent) {
+        // The app is gone only when the workbench is closing.
+        let _ = self.events.send(event);
+    }
+
+    fn start(&mut self) {
+        if self.recording.is_some() {
+            return;
+        }
+        if self.busy.load(Ordering::SeqCst) {
+            return self.send(DictationEvent::Failed(
+                super::strings::DICTATION_BUSY.to_string(),
+            ));
+        }
+        let loader = match &self.loader {
+            Ok(l) => l.clone(),
+            Err(why) => {
+                return self.send(DictationEvent::Failed(
+                    super::strings::dictation_unavailable(why),
+                ));
+            }
+        };
+        let levels = self.events.clone();
+        let on_level = Box::new(move |level: Level| {
+            let _ = levels.send(DictationEvent::Level(level));
+        });
+        // Opening the device is quick (the stream starts on its own thread); doing it here
+        // keeps "recording" and the first level in order.
+        match self.microphone.start(on_level) {
+            Ok((device, recording)) => {
+                self.recording = Some(recording);
+                self.send(DictationEvent::Recording { device });
+                // Load the model while the person speaks; a failure here is reported when
+                // the recording is transcribed (the load is tried again then).
+                let (stt, events) = (self.stt.clone(), self.events.clone());
+                tokio::spawn(async move {
+                    if let Err(e) = ready_model(&stt, &loader, &events).await {
+                        tracing::warn!(error = %e, "speech-to-text model not ready");
+                    }
+                });
+            }
+            Err(e) => self.send(DictationEvent::Failed(e.to_string())),
+        }
+    }
+
+    fn stop(&mut self) {
+        let Some(recording) = self.recording.take() else {
+            return;
+        };
+        let Ok(loader) = self.loader.clone() else {
+            return;
+        };
+        self.busy.store(true, Ordering::SeqCst);
+        let (stt, events, busy) = (self.stt.clone(), self.events.clone(), self.busy.clone());
+        tokio::spawn(async move {
+            let outcome = stop_and_transcribe(recording, &stt, &loader, &events).await;
+            busy.store(false, Ordering::SeqCst);
+            let _ = events.send(match outcome {
+                Ok(transcript) => DictationEvent::Heard(transcript),
+                Err(message) => DictationEvent::Failed(message),
+            });
+        });
+    }
+
+    fn cancel(&mut self) {
+        if let Some(recording) = self.recording.take() {
+            // Joining the audio thread blocks briefly: not on the event loop.
+            tokio::task::spawn_blocking(move || drop(recording.stop()));
+            self.send(DictationEvent::Cancelled);
+        }
+    }
+}
+
+async fn stop_and_transcribe(
+    recording: Box<dyn Recording>,
+    stt: &OnceCell<Arc<dyn SpeechToText>>,
+    loader: &SttLoader,
+    events: &UnboundedSender<DictationEvent>,
+) -> Result<Transcript, String> {
+    let audio = tokio::task::spawn_blocking(move || recording.stop())
+        .await
+        .map_err(|e| format!("the recording could not be stopped: {e}"))?
+        .map_err(|e| e.to_string())?;
+    let _ = events.send(DictationEvent::Transcribing {
+        seconds: audio.seconds(),
+    });
+    let model = ready_model(stt, loader, events).await?;
+    voice::transcribe(model.as_ref(), &audio)
+        .await
+        .map_err(|e| e.to_string())
+}
+
+/// The model, loaded once (concurrent callers wait for the same load; a failed load is
+/// tried again by the next caller).
+async fn ready_model(
+    stt: &OnceCell<Arc<dyn SpeechToText>>,
+    loader: &SttLoader,
+    events: &UnboundedSender<DictationEvent>,
+) -> Result<Arc<dyn SpeechToText>, String> {
+    stt.get_or_try_init(|| {
+        let (loader, events) = (loader.clone(), events.clone());
+        async move {
+            tokio::task::spawn_blocking(move || {
+                loader(&mut |message: &str| {
+                    let _ = events.send(DictationEvent::Preparing(message.to_string()));
+                })
+            })
+            .await
+            .map_err(|e| format!("the speech-to-text model could not be loaded: {e}"))?
+        }
+    })
+    .await
+    .cloned()
+}
+
+#[cfg(test)]
+#[path = "dictation_tests.rs"]
+mod tests;
