@@ -8,26 +8,21 @@
 //! is much harder for the tiny model; those word error rates are printed too, not
 //! asserted.
 //!
-//! The interpretation goes through the fake OpenAI server answering with the hand-written
-//! fixture replies (keyed on the instruction's words): it checks that the transcript
-//! carries the instruction's wording into the prompt, not what a model would answer. The
-//! same check with the embedded language model comes with that model.
+//! The interpretation is the embedded language model's (Qwen2.5-Coder-0.5B, the default
+//! backend), asked exactly as `betr interpret` asks it.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 mod support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-use std::sync::OnceLock;
 
 use betr::domain::Scenario;
-use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
-use betr::model::{self, Progress, WHISPER_TINY_EN};
+use betr::model::WHISPER_TINY_EN;
 use betr::session::{self, Event, Options};
 use betr::voice::{self, Audio16k, LocalSettings, LocalWhisper, VoiceError, word_error_rate};
 use support::cli::{betr_with, text, tmp};
-use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
 /// The highest word error rate accepted for a clearly synthesised short instruction.
@@ -39,24 +34,8 @@ const SCENARIOS: [&str; 3] = [
     "scenarios/cell/centrifuge.toml",
 ];
 
-struct Quiet;
-impl Progress for Quiet {
-    fn stage(&mut self, message: &str) {
-        eprintln!("{message}");
-    }
-    fn bytes(&mut self, _: u64, _: u64) {}
-}
-
-/// The model, fetched once if it is not in the cache.
 fn model_dir() -> &'static Path {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        if WHISPER_TINY_EN.is_present() {
-            WHISPER_TINY_EN.path()
-        } else {
-            model::fetch_dir(&WHISPER_TINY_EN, &model::cache_dir(), "python3", &mut Quiet).unwrap()
-        }
-    })
+    support::embedded::whisper_dir()
 }
 
 /// Clear dictation.
@@ -79,29 +58,12 @@ fn speak(text: &str, voice: &[&str], wav: &Path) {
     );
 }
 
-fn llm(base_url: String) -> OpenAiClient {
-    OpenAiClient::new(OpenAiSettings {
-        base_url,
-        model: "fake-model".into(),
-        api_key_env: None,
-        api_key: None,
-        auth_header: AuthHeader::Bearer,
-        timeout: std::time::Duration::from_secs(5),
-        connect_timeout: std::time::Duration::from_secs(1),
-        retry: RetryPolicy::default(),
-        structured: false,
-        max_tokens_field: "max_tokens".into(),
-    })
-    .unwrap()
-}
-
 #[test]
 fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
     let whisper =
         LocalWhisper::load(model_dir(), WHISPER_TINY_EN.name, LocalSettings::default()).unwrap();
     eprintln!("model load: {:.2} s", whisper.load_time().as_secs_f64());
-    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
-    let client = llm(server.base_url());
+    let llm = support::embedded::language_model();
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -143,7 +105,7 @@ fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
                 &scenario,
                 &world.facts(),
                 &transcript.text,
-                &client,
+                llm.as_ref(),
                 &Options::default(),
                 &mut |e| events.push(e.clone()),
             ))
@@ -157,6 +119,7 @@ fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
                 }
             )
         });
+        eprintln!("{rel}: the embedded language model's goal: {}", answer.goal);
         assert!(
             matches,
             "{rel}: goal {} differs from the scenario's",
@@ -206,4 +169,83 @@ fn silence_never_reaches_the_model() {
         ))
         .unwrap_err();
     assert!(matches!(e, VoiceError::Silent { .. }), "{e}");
+}
+
+/// Push-to-talk in the workbench with real speech and the real embedded model: the
+/// microphone plays scenario 1's spoken instruction, the app's key presses go to the
+/// dictation service as the event loop sends them, and the transcript lands in the input
+/// line, unsubmitted, close to what was said.
+#[test]
+fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
+    use betr::tui::dictation::{DictationEvent, DictationService, SttLoader};
+    use betr::tui::{App, Info, KeyBindings, Theme};
+    use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use std::sync::Arc;
+    use support::microphone::AudioMicrophone;
+
+    let dir = tmp("dictation-tui");
+    let wav = dir.join("scenario1.wav");
+    let said = "Put the blue cube on the green cube";
+    speak(said, DICTATION, &wav);
+    let audio = Audio16k::from_wav(&wav).unwrap();
+    let loader: SttLoader = Arc::new(|report: &mut dyn FnMut(&str)| {
+        report("loading whisper-tiny.en");
+        LocalWhisper::load(model_dir(), WHISPER_TINY_EN.name, LocalSettings::default())
+            .map(|w| Arc::new(w) as Arc<dyn voice::SpeechToText>)
+            .map_err(|e| e.to_string())
+    });
+    let (mut service, mut heard) =
+        DictationService::new(AudioMicrophone::playing(audio), Ok(loader));
+    let mut app = App::new(Info::default(), KeyBindings::default(), Theme::default());
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    rt.block_on(async {
+        let mut press = |app: &mut App, c: char| {
+            app.on_key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
+            assert!(app.take_commands().is_empty());
+            for r in app.take_dictation_requests() {
+                service.handle(r);
+            }
+        };
+        press(&mut app, 'd');
+        let mut stopped = false;
+        let transcript = loop {
+            let event = tokio::time::timeout(std::time::Duration::from_secs(60), heard.recv())
+                .await
+                .expect("no word from the dictation service")
+                .unwrap();
+            let recording = matches!(event, DictationEvent::Recording { .. });
+            let outcome = match &event {
+                DictationEvent::Heard(t) => Some(Ok(t.clone())),
+                DictationEvent::Failed(why) => Some(Err(why.clone())),
+                _ => None,
+            };
+            app.on_dictation(event);
+            if recording && !stopped {
+                stopped = true;
+                press(&mut app, 'd');
+            }
+            if let Some(outcome) = outcome {
+                break outcome.unwrap();
+            }
+        };
+        assert!(app.input.is_open(), "the transcript opens the input line");
+        let wer = word_error_rate(said, &transcript.text);
+        eprintln!(
+            "push-to-talk heard {:?} (WER {wer:.3}) in {:.2} s",
+            transcript.text,
+            transcript.elapsed.as_secs_f64()
+        );
+        assert!(wer <= MAX_WER, "{:?}", transcript.text);
+        // Enter submits exactly what the input line shows.
+        app.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+        assert_eq!(
+            app.take_commands(),
+            [betr::session::Command::Submit(transcript.text.clone())]
+        );
+    });
+    std::fs::remove_dir_all(&dir).unwrap();
 }

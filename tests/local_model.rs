@@ -4,43 +4,20 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
+mod support;
+
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use betr::domain::Scenario;
-use betr::llm::local::{EngineOptions, LocalModel};
+use betr::llm::local::LocalModel;
 use betr::llm::prompt::{Context, Templates, Variant};
 use betr::llm::{ChatRequest, LanguageModel, OutputConstraint, grammar, reply};
-use betr::model::{self, Progress, QWEN_CODER_05B};
 use betr::session::{self, Ending, Options, Proposal};
 use betr::world;
 
-struct Quiet;
-impl Progress for Quiet {
-    fn stage(&mut self, message: &str) {
-        eprintln!("{message}");
-    }
-    fn bytes(&mut self, _: u64, _: u64) {}
-}
-
 fn local() -> &'static Arc<LocalModel> {
-    static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
-    MODEL.get_or_init(|| {
-        if !QWEN_CODER_05B.is_present() {
-            model::fetch(&QWEN_CODER_05B, &model::cache_dir(), "python3", &mut Quiet).unwrap();
-        }
-        Arc::new(
-            LocalModel::load(
-                QWEN_CODER_05B.name,
-                EngineOptions {
-                    model_path: QWEN_CODER_05B.path(),
-                    threads: betr::llm::config::DEFAULT_THREADS,
-                    context: 4096,
-                },
-            )
-            .unwrap(),
-        )
-    })
+    support::embedded::language_model()
 }
 
 fn scenario(path: &str) -> Scenario {

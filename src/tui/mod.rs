@@ -3,7 +3,9 @@
 //! Laid out like gitui: one app state (`app`), pure drawing of that state (`ui` and the
 //! components' `draw`), components that handle keys and queue app events, key bindings
 //! that also generate the help overlay (`keys`), colours (`theme`) and every user-facing
-//! text (`strings`). The session knows nothing of this module.
+//! text (`strings`). The session knows nothing of this module. Push-to-talk runs beside the
+//! session: `dictation` owns the microphone and the speech-to-text model and reports on a
+//! channel of its own.
 //!
 //! The terminal is restored on every exit path: a guard's `Drop` on normal returns and
 //! errors, and a panic hook (installed before raw mode is entered) on panics.

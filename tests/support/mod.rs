@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod embedded;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;

@@ -1,0 +1,51 @@
+//! The embedded models, fetched into the cache first when missing (like `betr model
+//! fetch`), each loaded once per test binary.
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+use betr::llm::local::{EngineOptions, LocalModel};
+use betr::model::{self, Progress, QWEN_CODER_05B, WHISPER_TINY_EN};
+
+/// Fetch progress as plain lines on stderr (test output).
+pub struct Lines;
+
+impl Progress for Lines {
+    fn stage(&mut self, message: &str) {
+        eprintln!("{message}");
+    }
+    fn bytes(&mut self, _: u64, _: u64) {}
+}
+
+/// The default language model (Qwen2.5-Coder-0.5B) in llama.cpp.
+pub fn language_model() -> &'static Arc<LocalModel> {
+    static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
+    MODEL.get_or_init(|| {
+        if !QWEN_CODER_05B.is_present() {
+            model::fetch(&QWEN_CODER_05B, &model::cache_dir(), "python3", &mut Lines).unwrap();
+        }
+        Arc::new(
+            LocalModel::load(
+                QWEN_CODER_05B.name,
+                EngineOptions {
+                    model_path: QWEN_CODER_05B.path(),
+                    threads: betr::llm::config::DEFAULT_THREADS,
+                    context: 4096,
+                },
+            )
+            .unwrap(),
+        )
+    })
+}
+
+/// The directory of the default speech-to-text model (Whisper tiny.en).
+pub fn whisper_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        if WHISPER_TINY_EN.is_present() {
+            WHISPER_TINY_EN.path()
+        } else {
+            model::fetch_dir(&WHISPER_TINY_EN, &model::cache_dir(), "python3", &mut Lines).unwrap()
+        }
+    })
+}
