@@ -229,6 +229,68 @@ mod tests {
     }
 
     #[test]
+    fn fetch_progress_is_one_line_per_percent() {
+        let mut lines = Vec::new();
+        let mut report = |l: &str| lines.push(l.to_string());
+        let mut progress = ReportedProgress {
+            name: "whisper-tiny.en",
+            report: &mut report,
+            percent: None,
+        };
+        progress.stage("downloading part 1 of 1");
+        for done in [0, 10, 11, 500, 999, 1000] {
+            progress.bytes(done, 1000);
+        }
+        progress.bytes(5, 0);
+        assert_eq!(
+            lines,
+            [
+                "whisper-tiny.en: downloading part 1 of 1",
+                "fetching whisper-tiny.en: 0%",
+                "fetching whisper-tiny.en: 1%",
+                "fetching whisper-tiny.en: 50%",
+                "fetching whisper-tiny.en: 99%",
+                "fetching whisper-tiny.en: 100%",
+                "fetching whisper-tiny.en: 0%",
+            ]
+        );
+    }
+
+    #[test]
+    fn the_workbench_loader_builds_the_configured_backend() {
+        let settings = SttSettings::resolve(
+            None,
+            SttLayer::default(),
+            SttLayer {
+                backend: Some(SttBackend::Openai),
+                base_url: Some("http://127.0.0.1:9/v1".into()),
+                model: Some("whisper-large".into()),
+                ..SttLayer::default()
+            },
+        )
+        .unwrap();
+        let mut lines = Vec::new();
+        let stt = workbench_loader(settings)(&mut |l: &str| lines.push(l.to_string())).unwrap();
+        assert_eq!(stt.describe(), "whisper-large at http://127.0.0.1:9/v1");
+        assert!(lines.is_empty(), "nothing to fetch or load: {lines:?}");
+        // An unknown embedded model is an error naming the known ones, not a fetch.
+        let settings = SttSettings::resolve(
+            None,
+            SttLayer::default(),
+            SttLayer {
+                model: Some("whisper-huge".into()),
+                ..SttLayer::default()
+            },
+        )
+        .unwrap();
+        let e = workbench_loader(settings)(&mut |_: &str| {}).err().unwrap();
+        assert!(
+            e.contains("whisper-huge") && e.contains("whisper-tiny.en"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn the_user_confirms_corrects_or_cancels() {
         let t = "Put the blue cube on the green cube.";
         assert_eq!(confirm(t, "\n").unwrap(), t);
