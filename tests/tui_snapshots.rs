@@ -273,12 +273,10 @@ fn dictation_records_then_puts_the_transcript_in_the_input_line() {
         b.key(KeyCode::Char('d'));
         b.until_heard(|e| matches!(e, DictationEvent::Recording { .. }))
             .await;
-        // Every level of the 2 s recording (40 windows of 50 ms), then a fixed clock for
+        // A level (every 50 ms window of the tone has the same), then a fixed clock for
         // the snapshot.
-        for _ in 0..40 {
-            b.until_heard(|e| matches!(e, DictationEvent::Level(_)))
-                .await;
-        }
+        b.until_heard(|e| matches!(e, DictationEvent::Level(_)))
+            .await;
         if let betr::tui::components::dictation::Dictation::Recording { elapsed, .. } =
             &mut b.app.dictation.state
         {

@@ -156,8 +156,8 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     // microphone and nothing a native library printed reaches the screen; with one, the
     // recording starts and Esc discards it. Either way the session goes on.
     tmux.keys(&["d"]);
-    let screen = tmux.wait_for_any(&["dictation: no microphone", "Dictation: recording"], 10);
-    if screen.contains("Dictation: recording") {
+    let screen = tmux.wait_for_any(&["dictation: no microphone", "● REC"], 10);
+    if screen.contains("● REC") {
         tmux.keys(&["Escape"]);
         tmux.wait_for(&["recording discarded"], 10);
     }

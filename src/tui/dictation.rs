@@ -146,9 +146,14 @@ impl DictationService {
                 ));
             }
         };
-        let levels = self.events.clone();
+        // Levels are forwarded once `Recording` is sent, so they never arrive before it
+        // (the device may deliver its first 50 ms before `start` returns).
+        let open = Arc::new(AtomicBool::new(false));
+        let (levels, forwarding) = (self.events.clone(), open.clone());
         let on_level = Box::new(move |level: Level| {
-            let _ = levels.send(DictationEvent::Level(level));
+            if forwarding.load(Ordering::Acquire) {
+                let _ = levels.send(DictationEvent::Level(level));
+            }
         });
         // Opening the device is quick (the stream starts on its own thread); doing it here
         // keeps "recording" and the first level in order.
@@ -156,6 +161,7 @@ impl DictationService {
             Ok((device, recording)) => {
                 self.recording = Some(recording);
                 self.send(DictationEvent::Recording { device });
+                open.store(true, Ordering::Release);
                 // Load the model while the person speaks; a failure here is reported when
                 // the recording is transcribed (the load is tried again then).
                 let (stt, events) = (self.stt.clone(), self.events.clone());

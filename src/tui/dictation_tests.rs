@@ -38,7 +38,11 @@ impl Microphone for FakeMicrophone {
         }
         let audio = self.audio.clone();
         let stopped = self.stopped.clone();
+        // The device delivers audio at once; the levels only count once recording is
+        // announced (as the service promises), so wait a little before sending them.
+        on_level(Level::of(&[0.1; 800]));
         std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(20));
             on_level(Level::of(&[0.0; 800]));
             on_level(Level::of(&[0.5, -0.5, 0.5, -0.5]));
         });

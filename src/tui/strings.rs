@@ -120,6 +120,7 @@ pub fn keys_file_error(error: &str) -> String {
 
 pub const REC_MARK: &str = "● REC";
 pub const OPENING_MICROPHONE: &str = "opening the microphone…";
+pub const DICTATION_TITLE_STARTING: &str = " Dictation ";
 pub const DICTATION_TITLE_TRANSCRIBING: &str = " Dictation: transcribing ";
 pub const NO_SOUND_YET: &str = "no sound yet: is the microphone muted?";
 pub const DICTATION_BUSY: &str =

@@ -47,6 +47,8 @@ impl Microphone for AudioMicrophone {
         }
         let samples = self.audio.samples().to_vec();
         std::thread::spawn(move || {
+            // As a device does, a moment after the stream starts.
+            std::thread::sleep(std::time::Duration::from_millis(20));
             for chunk in samples.chunks(800) {
                 on_level(Level::of(chunk));
             }

@@ -120,7 +120,7 @@ impl DictationPanel {
         let (title, line) = match &self.state {
             Dictation::Idle => return,
             Dictation::Starting => (
-                strings::dictation_title_recording(key),
+                strings::DICTATION_TITLE_STARTING.to_string(),
                 Line::from(Span::styled(strings::OPENING_MICROPHONE, theme.dim)),
             ),
             Dictation::Recording {
