@@ -17,6 +17,9 @@ use support::cli::{KEY, KEY_VAR, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
+/// tmux servers started by this process (each test has its own).
+static SERVERS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// A tmux server of our own (its own socket), killed when dropped.
 struct Tmux {
     socket: String,
@@ -35,7 +38,11 @@ impl Tmux {
 
     fn start(command: &str) -> Tmux {
         let t = Tmux {
-            socket: format!("betr-test-{}", std::process::id()),
+            socket: format!(
+                "betr-test-{}-{}",
+                std::process::id(),
+                SERVERS.fetch_add(1, std::sync::atomic::Ordering::SeqCst)
+            ),
             session: "betr".into(),
         };
         let out = t.run(&[
@@ -121,6 +128,24 @@ fn quote(p: &Path) -> String {
     format!("'{}'", p.display())
 }
 
+/// The shell command that opens the workbench on scenario 1 in `dir`, with the model
+/// answered by `server`, then says how it exited.
+fn workbench_command(dir: &Path, server: &FakeServer, env: &str, extra: &str) -> String {
+    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    format!(
+        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {env} {bin} tui {scenario} --backend openai \
+         --base-url {url} --model fake-model --api-key-env {KEY_VAR} --policy-dir {policies} \
+         --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
+         sleep 60",
+        dir = quote(dir),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+        scenario = quote(&scenario),
+        url = server.base_url(),
+        policies = quote(&dir.join("policies")),
+    )
+}
+
 #[test]
 fn a_person_resolves_scenario_1_in_the_workbench() {
     let started = Instant::now();
@@ -128,18 +153,7 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     let dir = tmp("tmux");
     let policies = dir.join("policies");
     let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
-    let command = format!(
-        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
-         XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {bin} tui {scenario} --backend openai \
-         --base-url {url} --model fake-model --api-key-env {KEY_VAR} --policy-dir {policies} \
-         --usage-log usage.jsonl --tick-ms 50; echo \"betr exited with status $?\"; sleep 60",
-        dir = quote(&dir),
-        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
-        scenario = quote(&scenario),
-        url = server.base_url(),
-        policies = quote(&policies),
-    );
-    let tmux = Tmux::start(&command);
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", ""));
 
     // The workbench opens on scenario 1 with the configured model.
     tmux.wait_for(
@@ -264,6 +278,69 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
         "{:?}",
         started.elapsed()
     );
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Push-to-talk with real speech through the real binary: `--audio` plays an espeak-ng
+/// recording of scenario 1's instruction as the microphone, the embedded Whisper model
+/// (fetched into the cache first when missing) transcribes it, the transcript waits in the
+/// input line, and Enter sends it to the model like typed words.
+#[test]
+fn a_person_dictates_the_instruction_in_the_workbench() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-dictation");
+    let wav = dir.join("instruction.wav");
+    let out = Command::new("espeak-ng")
+        .args(["-s", "140", "-g", "3", "-w"])
+        .arg(&wav)
+        .arg("Put the blue cube on the green cube")
+        .output()
+        .expect("espeak-ng is required for this test (scripts/test.sh installs it)");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let models = support::embedded::whisper_dir().parent().unwrap();
+    let tmux = Tmux::start(&workbench_command(
+        &dir,
+        &server,
+        &format!("BETR_MODEL_DIR={}", quote(models)),
+        &format!("--audio {}", quote(&wav)),
+    ));
+    tmux.wait_for(&["press i to type an instruction, d to dictate one"], 20);
+
+    // Press to record: the meter, the clock and the "device" show.
+    tmux.keys(&["d"]);
+    tmux.wait_for(
+        &[
+            "● REC 0:0",
+            "instruction.wav (file)",
+            "d stops and transcribes",
+        ],
+        10,
+    );
+    // Press again: the transcript waits in the input line, not submitted.
+    tmux.keys(&["d"]);
+    let screen = tmux.wait_for(&["> Put the blue cube on the green cube", "dictated "], 60);
+    assert!(
+        screen.contains("No tree yet"),
+        "submitted unseen:\n{screen}"
+    );
+
+    // Enter submits it, as if typed.
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(
+        &[
+            "Goal: \"blue cube\" on \"green cube\"",
+            "grasp \"blue cube\"!",
+            "1 call(s)",
+        ],
+        20,
+    );
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
 }

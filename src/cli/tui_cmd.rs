@@ -13,7 +13,7 @@ use clap::Args;
 use betr::llm::LanguageModel;
 use betr::llm::usage::Ledger;
 use betr::session::{PolicyStore, Setup};
-use betr::tui::dictation::{DefaultMicrophone, DictationService};
+use betr::tui::dictation::{DefaultMicrophone, DictationService, Microphone, WavMicrophone};
 use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
 use super::llm_cmds::{self, LlmFlags};
@@ -42,6 +42,10 @@ pub struct TuiArgs {
     pub tick_ms: u64,
     #[command(flatten)]
     pub llm: LlmFlags,
+    /// Push-to-talk plays this WAV file instead of recording from the microphone (for
+    /// machines without one, demonstrations and tests).
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
     /// Speech-to-text for push-to-talk (the dictation key).
     #[command(flatten)]
     pub stt: super::voice_cmd::SttFlags,
@@ -56,6 +60,14 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_SCENARIO));
     let path = super::find_scenario(&arg)?;
+    let microphone: Arc<dyn Microphone> = match &args.audio {
+        Some(file) => {
+            // A file that cannot be played is said now, not at the first key press.
+            betr::voice::Audio16k::from_wav(file).context("--audio")?;
+            Arc::new(WavMicrophone::new(file.clone()))
+        }
+        None => Arc::new(DefaultMicrophone),
+    };
     let scenario = Arc::new(betr::domain::Scenario::load(&path)?);
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
@@ -137,7 +149,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         info,
         keys,
         theme,
-        dictation: DictationService::new(Arc::new(DefaultMicrophone), loader),
+        dictation: DictationService::new(microphone, loader),
         stderr_to: log_path(),
     };
     runtime.block_on(betr::tui::run(

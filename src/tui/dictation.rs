@@ -7,8 +7,10 @@
 //! recording; the model is loaded on first use (fetched first when it is not cached, with
 //! progress), starting while the person is still speaking.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 use tokio::sync::OnceCell;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
@@ -77,6 +79,67 @@ impl Microphone for DefaultMicrophone {
     ) -> Result<(String, Box<dyn Recording>), VoiceError> {
         let recorder = Recorder::start(on_level)?;
         Ok((recorder.device().to_string(), Box::new(recorder)))
+    }
+}
+
+/// A WAV file played as the microphone (`betr tui --audio FILE.wav`): for machines without
+/// one, demonstrations and end-to-end tests. Its levels arrive in real time, 50 ms at a
+/// time, while "recording"; stopping returns the whole file.
+pub struct WavMicrophone {
+    path: PathBuf,
+}
+
+impl WavMicrophone {
+    pub fn new(path: PathBuf) -> WavMicrophone {
+        WavMicrophone { path }
+    }
+}
+
+/// A file being played: the level thread runs until stopped.
+struct PlayedWav {
+    audio: Audio16k,
+    playing: Arc<AtomicBool>,
+}
+
+impl Recording for PlayedWav {
+    fn stop(self: Box<Self>) -> Result<Audio16k, VoiceError> {
+        self.playing.store(false, Ordering::SeqCst);
+        self.audio.check_speech()?;
+        Ok(self.audio)
+    }
+}
+
+impl Microphone for WavMicrophone {
+    fn start(
+        &self,
+        mut on_level: Box<dyn FnMut(Level) + Send>,
+    ) -> Result<(String, Box<dyn Recording>), VoiceError> {
+        // Read at each press, so a file rewritten between dictations is heard anew.
+        let audio = Audio16k::from_wav(&self.path)?;
+        let playing = Arc::new(AtomicBool::new(true));
+        let (samples, still) = (audio.samples().to_vec(), playing.clone());
+        std::thread::Builder::new()
+            .name("betr-wav-mic".into())
+            .spawn(move || {
+                let window = voice::SAMPLE_RATE as usize / 20;
+                let mut chunks = samples.chunks(window);
+                while still.load(Ordering::SeqCst) {
+                    // After the file's end, the room is silent.
+                    on_level(chunks.next().map_or_else(|| Level::of(&[]), Level::of));
+                    std::thread::sleep(Duration::from_millis(50));
+                }
+            })
+            .map_err(|e| VoiceError::Capture {
+                detail: format!("cannot start the playback thread: {e}"),
+            })?;
+        let name = self.path.file_name().map_or_else(
+            || self.path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        Ok((
+            format!("{name} (file)"),
+            Box::new(PlayedWav { audio, playing }),
+        ))
     }
 }
 

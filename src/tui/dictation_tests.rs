@@ -299,3 +299,40 @@ fn cancel_discards_and_busy_refuses_a_second_recording() {
         );
     });
 }
+
+#[test]
+fn a_wav_file_plays_as_the_microphone() {
+    let dir = std::env::temp_dir().join(format!("betr-wav-mic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let wav = dir.join("said.wav");
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 16_000,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut writer = hound::WavWriter::create(&wav, spec).unwrap();
+    for s in speech(0.5).samples() {
+        writer.write_sample((s * 32_767.0) as i16).unwrap();
+    }
+    writer.finalize().unwrap();
+
+    let (tx, rx) = std::sync::mpsc::channel();
+    let mic = WavMicrophone::new(wav.clone());
+    let (device, recording) = mic
+        .start(Box::new(move |l: Level| {
+            let _ = tx.send(l);
+        }))
+        .unwrap();
+    assert_eq!(device, "said.wav (file)");
+    // The level of the speech first, in real time, then the silence after the file's end.
+    let first = rx.recv_timeout(Duration::from_secs(2)).unwrap();
+    assert!(first.rms_dbfs > -12.0, "{first:?}");
+    let audio = recording.stop().unwrap();
+    assert_eq!(audio.samples().len(), 8_000);
+
+    let missing = WavMicrophone::new(dir.join("missing.wav"));
+    let e = missing.start(Box::new(|_| {})).err().unwrap();
+    assert!(e.to_string().contains("missing.wav"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
