@@ -110,19 +110,7 @@ impl Bench {
 
     /// Feed dictation events to the app until one matches.
     async fn until_heard(&mut self, pred: impl Fn(&DictationEvent) -> bool) {
-        let wait = async {
-            loop {
-                let e = self.heard.recv().await.unwrap();
-                let hit = pred(&e);
-                self.app.on_dictation(e);
-                if hit {
-                    break;
-                }
-            }
-        };
-        tokio::time::timeout(Duration::from_secs(20), wait)
-            .await
-            .expect("timed out");
+        feed_until(&mut self.heard, &mut self.app, App::on_dictation, pred).await;
     }
 
     fn type_text(&mut self, text: &str) {
@@ -133,19 +121,7 @@ impl Bench {
 
     /// Feed events to the app until one matches, then whatever follows within 100 ms.
     async fn until(&mut self, pred: impl Fn(&Event) -> bool) {
-        let wait = async {
-            loop {
-                let e = self.events.recv().await.unwrap();
-                let hit = pred(&e);
-                self.app.on_session(e);
-                if hit {
-                    break;
-                }
-            }
-        };
-        tokio::time::timeout(Duration::from_secs(20), wait)
-            .await
-            .expect("timed out");
+        feed_until(&mut self.events, &mut self.app, App::on_session, pred).await;
         while let Ok(Some(e)) =
             tokio::time::timeout(Duration::from_millis(100), self.events.recv()).await
         {
@@ -175,6 +151,28 @@ impl Bench {
         }
         panic!("no proposal after 10 ticks:\n{}", self.screen(120, 40));
     }
+}
+
+/// Hand what arrives on `rx` to the app until one matches; panics after 20 s.
+async fn feed_until<T>(
+    rx: &mut UnboundedReceiver<T>,
+    app: &mut App,
+    apply: fn(&mut App, T),
+    pred: impl Fn(&T) -> bool,
+) {
+    let wait = async {
+        loop {
+            let e = rx.recv().await.unwrap();
+            let hit = pred(&e);
+            apply(app, e);
+            if hit {
+                break;
+            }
+        }
+    };
+    tokio::time::timeout(Duration::from_secs(20), wait)
+        .await
+        .expect("timed out");
 }
 
 fn rt() -> tokio::runtime::Runtime {
