@@ -138,11 +138,6 @@ impl App {
             self.queue.push(AppEvent::Quit);
             return;
         }
-        // While recording, the push-to-talk key stops it wherever the focus is.
-        if self.dictation.is_recording() && self.keys.dictate.matches(&key) {
-            self.status.message = None;
-            return self.on_dictate_key();
-        }
         if self.input.is_open() {
             if key.code == KeyCode::Enter || key.code == KeyCode::Esc {
                 self.status.message = None;
