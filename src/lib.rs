@@ -12,6 +12,7 @@ pub mod dataset;
 pub mod domain;
 pub mod eval;
 pub mod goal;
+pub mod http_retry;
 pub mod http_text;
 pub mod llm;
 pub mod model;

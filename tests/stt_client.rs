@@ -23,9 +23,11 @@ fn client(base_url: &str, max_retries: u32, timeout: Duration) -> OpenAiStt {
         api_key: Some(SttKey::new(KEY)),
         timeout,
         connect_timeout: Duration::from_secs(2),
-        max_retries,
-        initial_backoff: Duration::from_millis(10),
-        max_backoff: Duration::from_millis(50),
+        retry: betr::http_retry::RetryPolicy {
+            max_retries,
+            initial_backoff: Duration::from_millis(10),
+            max_backoff: Duration::from_millis(50),
+        },
     })
     .unwrap()
 }
@@ -167,9 +169,11 @@ fn client_settings() -> OpenAiSttSettings {
         api_key: None,
         timeout: Duration::from_secs(1),
         connect_timeout: Duration::from_secs(1),
-        max_retries: 0,
-        initial_backoff: Duration::from_millis(1),
-        max_backoff: Duration::from_millis(1),
+        retry: betr::http_retry::RetryPolicy {
+            max_retries: 0,
+            initial_backoff: Duration::from_millis(1),
+            max_backoff: Duration::from_millis(1),
+        },
     }
 }
 

@@ -40,25 +40,7 @@ pub enum AuthHeader {
     ApiKey,
 }
 
-/// Retries of 429 / 5xx replies.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RetryPolicy {
-    /// Retries after the first attempt.
-    pub max_retries: u32,
-    pub initial_backoff: Duration,
-    /// Longest wait between attempts, also for a server's `Retry-After`.
-    pub max_backoff: Duration,
-}
-
-impl Default for RetryPolicy {
-    fn default() -> Self {
-        RetryPolicy {
-            max_retries: 3,
-            initial_backoff: Duration::from_millis(500),
-            max_backoff: Duration::from_secs(20),
-        }
-    }
-}
+pub use crate::http_retry::RetryPolicy;
 
 /// Everything the backend needs.
 #[derive(Debug, Clone)]
@@ -151,7 +133,7 @@ impl OpenAiClient {
             tracing::debug!(url = %self.url, model = %self.settings.model, attempt, "chat request");
             let response = req.send().await.map_err(|e| self.transport_error(&e))?;
             let status = response.status().as_u16();
-            let wait = retry_after(response.headers());
+            let wait = crate::http_retry::retry_after(response.headers());
             let fixture = fixture_note(response.headers());
             let text = response
                 .text()
@@ -184,27 +166,25 @@ impl OpenAiClient {
                         detail: self.detail(&text),
                     });
                 }
-                429 | 500..=599 if attempt <= retry.max_retries => {
-                    let backoff = retry
-                        .initial_backoff
-                        .saturating_mul(2u32.saturating_pow(attempt - 1));
-                    let delay = wait.unwrap_or(backoff).min(retry.max_backoff);
-                    tracing::warn!(
-                        status,
-                        attempt,
-                        delay_ms = delay.as_millis() as u64,
-                        "retrying"
-                    );
-                    tokio::time::sleep(delay).await;
-                }
-                _ => {
-                    return Err(LlmError::Http {
-                        url: self.url.clone(),
-                        status,
-                        attempts: attempt,
-                        detail: self.detail(&text),
-                    });
-                }
+                _ => match retry.delay(status, attempt, wait) {
+                    Some(delay) => {
+                        tracing::warn!(
+                            status,
+                            attempt,
+                            delay_ms = delay.as_millis() as u64,
+                            "retrying"
+                        );
+                        tokio::time::sleep(delay).await;
+                    }
+                    None => {
+                        return Err(LlmError::Http {
+                            url: self.url.clone(),
+                            status,
+                            attempts: attempt,
+                            detail: self.detail(&text),
+                        });
+                    }
+                },
             }
         }
     }
@@ -263,15 +243,9 @@ impl OpenAiClient {
                 seconds: self.settings.timeout.as_secs_f64(),
             }
         } else if e.is_connect() {
-            let mut detail = e.to_string();
-            let mut source = std::error::Error::source(e);
-            while let Some(s) = source {
-                detail = s.to_string();
-                source = s.source();
-            }
             LlmError::Connect {
                 url: self.url.clone(),
-                detail: self.redact(&detail),
+                detail: self.redact(&crate::http_retry::innermost_cause(e)),
             }
         } else {
             LlmError::MalformedReply {
@@ -318,15 +292,6 @@ fn fixture_note(headers: &reqwest::header::HeaderMap) -> Option<String> {
     } else {
         note.to_string()
     })
-}
-
-/// `Retry-After: 2` / `Retry-After: 1.5`, or OpenAI's `retry-after-ms: 1500`.
-fn retry_after(headers: &reqwest::header::HeaderMap) -> Option<Duration> {
-    let get = |name: &str| headers.get(name)?.to_str().ok()?.trim().parse::<f64>().ok();
-    let seconds = get("retry-after-ms")
-        .map(|ms| ms / 1000.0)
-        .or_else(|| get("retry-after"))?;
-    (seconds.is_finite() && seconds >= 0.0).then(|| Duration::from_secs_f64(seconds.min(3600.0)))
 }
 
 #[cfg(test)]

@@ -6,6 +6,8 @@ use std::time::Duration;
 
 use serde::Deserialize;
 
+use crate::http_retry::RetryPolicy;
+
 use super::openai_stt::{OpenAiStt, OpenAiSttSettings, SttKey};
 use super::whisper_local::{LocalSettings, LocalWhisper};
 use super::{SpeechToText, VoiceError};
@@ -200,9 +202,10 @@ impl SttSettings {
             api_key,
             timeout: self.timeout,
             connect_timeout: Duration::from_secs(10),
-            max_retries: self.max_retries,
-            initial_backoff: Duration::from_millis(500),
-            max_backoff: Duration::from_secs(20),
+            retry: RetryPolicy {
+                max_retries: self.max_retries,
+                ..RetryPolicy::default()
+            },
         })
     }
 

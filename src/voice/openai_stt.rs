@@ -12,6 +12,8 @@ use std::time::{Duration, Instant};
 use reqwest::multipart::{Form, Part};
 use serde_json::Value as Json;
 
+use crate::http_retry::RetryPolicy;
+
 use super::{Audio16k, SpeechToText, SttFuture, Transcript, VoiceError};
 
 /// The secret, kept out of `Debug` output.
@@ -42,10 +44,8 @@ pub struct OpenAiSttSettings {
     pub api_key: Option<SttKey>,
     pub timeout: Duration,
     pub connect_timeout: Duration,
-    /// Retries of 429 / 5xx after the first attempt.
-    pub max_retries: u32,
-    pub initial_backoff: Duration,
-    pub max_backoff: Duration,
+    /// Retries of 429 / 5xx.
+    pub retry: RetryPolicy,
 }
 
 pub struct OpenAiStt {
@@ -111,7 +111,7 @@ impl OpenAiStt {
             tracing::debug!(url = %self.url, attempt, bytes = wav.len(), "transcription request");
             let response = request.send().await.map_err(|e| self.transport_error(&e))?;
             let status = response.status().as_u16();
-            let wait = retry_after(response.headers());
+            let wait = crate::http_retry::retry_after(response.headers());
             let body = response
                 .text()
                 .await
@@ -138,28 +138,25 @@ impl OpenAiStt {
                         detail: self.detail(&body),
                     });
                 }
-                429 | 500..=599 if attempt <= self.settings.max_retries => {
-                    let backoff = self
-                        .settings
-                        .initial_backoff
-                        .saturating_mul(2u32.saturating_pow(attempt - 1));
-                    let delay = wait.unwrap_or(backoff).min(self.settings.max_backoff);
-                    tracing::warn!(
-                        status,
-                        attempt,
-                        delay_ms = delay.as_millis() as u64,
-                        "retrying"
-                    );
-                    tokio::time::sleep(delay).await;
-                }
-                _ => {
-                    return Err(VoiceError::Http {
-                        url: self.url.clone(),
-                        status,
-                        attempts: attempt,
-                        detail: self.detail(&body),
-                    });
-                }
+                _ => match self.settings.retry.delay(status, attempt, wait) {
+                    Some(delay) => {
+                        tracing::warn!(
+                            status,
+                            attempt,
+                            delay_ms = delay.as_millis() as u64,
+                            "retrying"
+                        );
+                        tokio::time::sleep(delay).await;
+                    }
+                    None => {
+                        return Err(VoiceError::Http {
+                            url: self.url.clone(),
+                            status,
+                            attempts: attempt,
+                            detail: self.detail(&body),
+                        });
+                    }
+                },
             }
         }
     }
@@ -194,12 +191,7 @@ impl OpenAiStt {
             };
         }
         // The innermost cause says what happened ("Connection refused").
-        let mut detail = e.to_string();
-        let mut source = std::error::Error::source(e);
-        while let Some(s) = source {
-            detail = s.to_string();
-            source = s.source();
-        }
+        let detail = crate::http_retry::innermost_cause(e);
         if e.is_connect() {
             VoiceError::Connect {
                 url: self.url.clone(),
@@ -235,13 +227,4 @@ impl SpeechToText for OpenAiStt {
     fn transcribe<'a>(&'a self, audio: &'a Audio16k) -> SttFuture<'a> {
         Box::pin(self.call(audio))
     }
-}
-
-/// `Retry-After: 2` / `Retry-After: 1.5`, or OpenAI's `retry-after-ms: 1500`.
-fn retry_after(headers: &reqwest::header::HeaderMap) -> Option<Duration> {
-    let get = |name: &str| headers.get(name)?.to_str().ok()?.trim().parse::<f64>().ok();
-    let seconds = get("retry-after-ms")
-        .map(|ms| ms / 1000.0)
-        .or_else(|| get("retry-after"))?;
-    (seconds.is_finite() && seconds >= 0.0).then(|| Duration::from_secs_f64(seconds.min(3600.0)))
 }
