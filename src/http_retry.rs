@@ -45,6 +45,29 @@ impl RetryPolicy {
     }
 }
 
+impl RetryPolicy {
+    /// Sleep before the next attempt when [`RetryPolicy::delay`] allows one (saying so in
+    /// the log); false when the answer is final.
+    pub async fn wait_before_retry(
+        &self,
+        status: u16,
+        attempt: u32,
+        retry_after: Option<Duration>,
+    ) -> bool {
+        let Some(delay) = self.delay(status, attempt, retry_after) else {
+            return false;
+        };
+        tracing::warn!(
+            status,
+            attempt,
+            delay_ms = delay.as_millis() as u64,
+            "retrying"
+        );
+        tokio::time::sleep(delay).await;
+        true
+    }
+}
+
 /// `Retry-After: 2` / `Retry-After: 1.5`, or OpenAI's `retry-after-ms: 1500`.
 pub fn retry_after(headers: &reqwest::header::HeaderMap) -> Option<Duration> {
     let get = |name: &str| headers.get(name)?.to_str().ok()?.trim().parse::<f64>().ok();

@@ -166,17 +166,8 @@ impl OpenAiClient {
                         detail: self.detail(&text),
                     });
                 }
-                _ => match retry.delay(status, attempt, wait) {
-                    Some(delay) => {
-                        tracing::warn!(
-                            status,
-                            attempt,
-                            delay_ms = delay.as_millis() as u64,
-                            "retrying"
-                        );
-                        tokio::time::sleep(delay).await;
-                    }
-                    None => {
+                _ => {
+                    if !retry.wait_before_retry(status, attempt, wait).await {
                         return Err(LlmError::Http {
                             url: self.url.clone(),
                             status,
@@ -184,7 +175,7 @@ impl OpenAiClient {
                             detail: self.detail(&text),
                         });
                     }
-                },
+                }
             }
         }
     }

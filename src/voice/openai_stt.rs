@@ -138,17 +138,13 @@ impl OpenAiStt {
                         detail: self.detail(&body),
                     });
                 }
-                _ => match self.settings.retry.delay(status, attempt, wait) {
-                    Some(delay) => {
-                        tracing::warn!(
-                            status,
-                            attempt,
-                            delay_ms = delay.as_millis() as u64,
-                            "retrying"
-                        );
-                        tokio::time::sleep(delay).await;
-                    }
-                    None => {
+                _ => {
+                    if !self
+                        .settings
+                        .retry
+                        .wait_before_retry(status, attempt, wait)
+                        .await
+                    {
                         return Err(VoiceError::Http {
                             url: self.url.clone(),
                             status,
@@ -156,7 +152,7 @@ impl OpenAiStt {
                             detail: self.detail(&body),
                         });
                     }
-                },
+                }
             }
         }
     }
