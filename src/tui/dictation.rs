@@ -242,8 +242,15 @@ impl DictationService {
         let Some(recording) = self.recording.take() else {
             return;
         };
-        let Ok(loader) = self.loader.clone() else {
-            return;
+        // `start` refuses to record without a loader, so this holds; if it ever did not,
+        // the person hears why rather than nothing.
+        let loader = match self.loader.clone() {
+            Ok(l) => l,
+            Err(why) => {
+                return self.send(DictationEvent::Failed(
+                    super::strings::dictation_unavailable(&why),
+                ));
+            }
         };
         self.busy.store(true, Ordering::SeqCst);
         let (stt, events, busy) = (self.stt.clone(), self.events.clone(), self.busy.clone());
