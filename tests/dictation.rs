@@ -8,7 +8,7 @@
 //! is much harder for the tiny model; those word error rates are printed too, not
 //! asserted.
 //!
-//! The interpretation is the embedded language model's (Qwen2.5-Coder-0.5B, the default
+//! The interpretation is the embedded language model's (the default
 //! backend), asked exactly as `betr interpret` asks it.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
@@ -103,13 +103,14 @@ fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
         let answer = rt
             .block_on(session::interpret(
                 &scenario,
-                &world.facts(),
+                world,
                 &transcript.text,
                 llm.as_ref(),
                 &Options::default(),
                 &mut |e| events.push(e.clone()),
             ))
-            .unwrap_or_else(|e| panic!("{rel}: {e} (transcript {:?})", transcript.text));
+            .unwrap_or_else(|e| panic!("{rel}: {e} (transcript {:?})", transcript.text))
+            .answer;
         let matches = events.iter().any(|e| {
             matches!(
                 e,

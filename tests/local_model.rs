@@ -1,4 +1,4 @@
-//! The embedded model, for real: Qwen2.5-Coder-0.5B in llama.cpp with grammars built from
+//! The embedded model, for real: the default model in llama.cpp with grammars built from
 //! the scenario's vocabulary. The model is fetched into the cache first if it is missing
 //! (about 10 s on this network), then loaded once for all tests here.
 
@@ -27,10 +27,9 @@ fn scenario(path: &str) -> Scenario {
 #[tokio::test]
 async fn interprets_scenario_1_exactly() {
     let s = scenario("scenarios/cell/red_on_blue.toml");
-    let facts = world::load(&s).unwrap().facts();
-    let answer = session::interpret(
+    let reading = session::interpret(
         &s,
-        &facts,
+        world::load(&s).unwrap(),
         s.instruction.as_deref().unwrap(),
         local(),
         &Options::default(),
@@ -38,8 +37,39 @@ async fn interprets_scenario_1_exactly() {
     )
     .await
     .unwrap();
-    assert_eq!(answer.goal.to_string(), "\"blue cube\" on \"green cube\"");
-    assert!(answer.substitutions.is_empty());
+    assert_eq!(
+        reading.answer.goal.to_string(),
+        "\"blue cube\" on \"green cube\""
+    );
+    assert!(reading.answer.substitutions.is_empty());
+    assert!(reading.unchecked.is_none());
+}
+
+#[tokio::test]
+async fn reads_a_cafe_request_with_a_disjunction_and_a_negation() {
+    // Written for this test (not from the evaluation dataset, nor from the example pool).
+    let s = scenario("scenarios/cafe/cafe.toml");
+    let instruction = "I'm at the quiet table number nine: bring me a banana or an orange, and please switch off the hall light.";
+    let reading = session::interpret(
+        &s,
+        world::load(&s).unwrap(),
+        instruction,
+        local(),
+        &Options::default(),
+        &mut |_| {},
+    )
+    .await
+    .unwrap();
+    let expected = s
+        .parse_goal("(On_Banana_QuietTable9 | On_Orange_QuietTable9) & ~Active_HallLight")
+        .unwrap();
+    assert!(
+        betr::goal::equivalent(&expected, &reading.answer.goal).unwrap(),
+        "read as {} (first answer {:?}, {} calls)",
+        reading.answer.goal,
+        reading.first.map(|f| f.to_string()),
+        reading.calls
+    );
 }
 
 #[tokio::test]

@@ -17,14 +17,15 @@ use betr::world;
 /// with and without the grammar, and print one table.
 pub fn llm(
     scenario: &Path,
-    model_path: Option<&Path>,
+    (model_path, model): (Option<&Path>, Option<&str>),
     threads: u32,
     repeats: usize,
 ) -> Result<ExitCode> {
     let path = match model_path {
         Some(p) => p.to_path_buf(),
-        None => super::model_cmd::ensure(None)?,
+        None => super::model_cmd::ensure(model)?,
     };
+    println!("model: {}", path.display());
     let scenario = Scenario::load(scenario)?;
     let facts = world::load(&scenario)?.facts();
     let instruction = scenario

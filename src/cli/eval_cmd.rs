@@ -48,6 +48,10 @@ pub enum EvalExperiment {
         /// Questions about failures per run before giving up.
         #[arg(long, default_value_t = 5)]
         max_rounds: usize,
+        /// Where each run's goal comes from: the model reading the instruction, or the
+        /// scenario's stated goal (so the failure under study is always reached).
+        #[arg(long, value_enum, default_value = "interpret")]
+        goal: GoalSource,
         /// The directory holding cell/ and cafe/ scenarios.
         #[arg(long, default_value = "scenarios")]
         scenarios: PathBuf,
@@ -62,12 +66,25 @@ pub enum EvalExperiment {
         /// Questions per run before giving up (a rejected value is asked again).
         #[arg(long, default_value_t = 5)]
         max_rounds: usize,
+        /// Where each run's goal comes from: the model reading the instruction, or the
+        /// scenario's stated goal (so the failure under study is always reached).
+        #[arg(long, value_enum, default_value = "interpret")]
+        goal: GoalSource,
         /// The directory holding cell/params/.
         #[arg(long, default_value = "scenarios")]
         scenarios: PathBuf,
         #[command(flatten)]
         run: RunFlags,
     },
+}
+
+/// Where a resolve or params run's goal comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum GoalSource {
+    /// The model reads the scenario's instruction (a misread goal is its own column).
+    Interpret,
+    /// The scenario's stated goal; the instruction still reaches the failure questions.
+    Scenario,
 }
 
 /// Run the chosen experiment.
@@ -91,15 +108,17 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
         EvalExperiment::Resolve {
             runs,
             max_rounds,
+            goal,
             scenarios,
             run,
-        } => session_experiment(S::Resolve, &scenarios, runs, max_rounds, &run),
+        } => session_experiment(S::Resolve, &scenarios, runs, (max_rounds, goal), &run),
         EvalExperiment::Params {
             runs,
             max_rounds,
+            goal,
             scenarios,
             run,
-        } => session_experiment(S::Params, &scenarios, runs, max_rounds, &run),
+        } => session_experiment(S::Params, &scenarios, runs, (max_rounds, goal), &run),
     }
 }
 
@@ -196,14 +215,6 @@ pub fn goals_with_model(
         eval::output_dir(flags.out.as_deref(), "goals").context("creating the output directory")?;
     eval::run::check_settings(&dir, "goals", &p.settings)?;
     let world = betr::world::load(&scenario)?;
-    let settings = goals_run::PromptSettings {
-        templates: p.llm.options.templates.clone(),
-        variant: p.llm.options.variant.clone(),
-        temperature: p.llm.options.temperature,
-        max_tokens: p.llm.options.max_tokens,
-        structured: p.llm.options.structured,
-        grammar: p.llm.options.grammar,
-    };
     p.llm.model.set_purpose("eval goals");
     let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let bar = Bar::new();
@@ -218,9 +229,9 @@ pub fn goals_with_model(
         .block_on(goals_run::run_goals(
             &model,
             &scenario,
-            &world.facts(),
+            world.as_ref(),
             &cases,
-            &settings,
+            &p.llm.options,
             &cfg,
             &dir,
         ))
@@ -249,7 +260,7 @@ pub fn session_experiment(
     which: SessionExperiment,
     scenarios_dir: &Path,
     runs: usize,
-    max_rounds: usize,
+    (max_rounds, goal): (usize, GoalSource),
     flags: &RunFlags,
 ) -> Result<ExitCode> {
     let (name, paths): (&str, Vec<&str>) = match which {
@@ -268,8 +279,20 @@ pub fn session_experiment(
                 .with_context(|| format!("loading {}", path.display()))
         })
         .collect::<Result<Vec<_>>>()?;
-    let mut p = prepare(flags, &[("max_rounds", max_rounds.to_string())])?;
+    let goal_source = match goal {
+        GoalSource::Interpret => "interpret",
+        GoalSource::Scenario => "scenario",
+    };
+    let mut p = prepare(
+        flags,
+        &[
+            ("max_rounds", max_rounds.to_string()),
+            ("goal", goal_source.to_string()),
+        ],
+    )?;
     p.llm.options.max_rounds = max_rounds;
+    p.llm.options.use_scenario_goal = goal == GoalSource::Scenario;
+    p.label = format!("{}, goal: {goal_source}", p.label);
     let dir =
         eval::output_dir(flags.out.as_deref(), name).context("creating the output directory")?;
     eval::run::check_settings(&dir, name, &p.settings)?;

@@ -129,6 +129,25 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     settings.insert("prompt".into(), flags.prompt.name().into());
     settings.insert("temperature".into(), llm.settings.temperature.to_string());
     settings.insert("structured".into(), llm.settings.structured.to_string());
+    let options = &llm.options;
+    settings.insert(
+        "examples_shown".into(),
+        options
+            .variant
+            .examples_shown
+            .map_or("all".into(), |k| k.to_string()),
+    );
+    settings.insert(
+        "fixed_examples".into(),
+        options.variant.fixed_examples.to_string(),
+    );
+    settings.insert("checks".into(), options.check_goals.to_string());
+    settings.insert("candidates".into(), options.candidates.to_string());
+    settings.insert(
+        "feedback_rounds".into(),
+        options.goal_feedback_rounds.to_string(),
+    );
+    settings.insert("grammar".into(), llm.settings.grammar.to_string());
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     for (k, v) in [
         ("examples", optional(&llm_flags.examples)),
@@ -150,7 +169,26 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         })
         .max(1);
     Ok(Prepared {
-        label: format!("{model} ({backend}), prompt {}", flags.prompt.name()),
+        label: format!(
+            "{model} ({backend}), prompt {}, {}, {}",
+            flags.prompt.name(),
+            match (
+                llm.options.variant.examples_shown,
+                llm.options.variant.fixed_examples
+            ) {
+                (None, _) => "all examples".to_string(),
+                (Some(k), true) => format!("{k} fixed examples"),
+                (Some(k), false) => format!("{k} retrieved examples"),
+            },
+            if llm.options.check_goals {
+                format!(
+                    "checked ({} candidates, {} feedback rounds)",
+                    llm.options.candidates, llm.options.goal_feedback_rounds
+                )
+            } else {
+                "unchecked".to_string()
+            }
+        ),
         llm,
         settings,
         concurrency,

@@ -12,8 +12,9 @@ use betr::bt::{self, Glyphs};
 use betr::domain::{Example, Scenario};
 use betr::llm::LanguageModel;
 use betr::llm::config::{Backend, FileConfig, Layer, Settings};
-use betr::llm::prompt::{Templates, Variant};
+use betr::llm::prompt::{DEFAULT_EXAMPLES_SHOWN, Templates, Variant};
 use betr::llm::usage::{Ledger, Metered};
+use betr::session::types::DEFAULT_CANDIDATES;
 use betr::session::{self, Ending, Event, Options};
 
 /// Flags shared by every command that asks a language model. Each overrides the
@@ -70,6 +71,25 @@ pub struct LlmFlags {
     /// the scenario's, e.g. the original prompt's examples.
     #[arg(long, value_name = "FILE")]
     pub examples: Option<PathBuf>,
+    /// Worked examples per prompt, chosen from the scenario's pool as the most similar
+    /// to the request (default 6; 0: none).
+    #[arg(long, value_name = "K")]
+    pub examples_shown: Option<usize>,
+    /// Show the pool's first K examples for every request instead of the most similar
+    /// (ablation of retrieval).
+    #[arg(long)]
+    pub fixed_examples: bool,
+    /// Candidates per question: drawn when a goal's first answer fails its checks, and
+    /// for every failure, each tried in simulation before it is offered (default 4).
+    #[arg(long, value_name = "N")]
+    pub candidates: Option<usize>,
+    /// Take the first usable goal as it is: no checks, no vote, no feedback (the paper's
+    /// single call).
+    #[arg(long)]
+    pub no_checks: bool,
+    /// Times the model is told why its goals were refused and asked again (default 2).
+    #[arg(long, value_name = "N")]
+    pub feedback_rounds: Option<usize>,
     /// Read goal.md, resolve.md and value.md from this directory instead of the built-in prompts.
     #[arg(long, value_name = "DIR")]
     pub prompts: Option<PathBuf>,
@@ -164,8 +184,18 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
             no_descriptions: flags.no_descriptions,
             no_object_rule: flags.no_object_rule,
             chain_of_thought: flags.cot,
+            // Examples given in a file (another prompt's) are shown as they are, all of them.
+            examples_shown: match (flags.examples_shown, &examples) {
+                (Some(k), _) => Some(k),
+                (None, Some(_)) => None,
+                (None, None) => Some(DEFAULT_EXAMPLES_SHOWN),
+            },
+            fixed_examples: flags.fixed_examples,
             examples,
         },
+        check_goals: !flags.no_checks,
+        candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
+        goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
         ..Options::default()
     };
     Ok((settings, options))
@@ -220,14 +250,23 @@ pub fn interpret(
     let mut emit = |e: &Event| print_event(e, flags.show_replies);
     let result = runtime()?.block_on(session::interpret(
         scenario,
-        &world.facts(),
+        world,
         &instruction,
         llm.model.as_ref(),
         &llm.options,
         &mut emit,
     ));
     print_usage(&llm.model);
-    result?;
+    let reading = result?;
+    if let Some(why) = &reading.unchecked {
+        println!(
+            "warning: no candidate passed the checks, so this goal is the model's first usable answer and looks wrong: {why}"
+        );
+    }
+    println!(
+        "{} call(s), {} feedback round(s)",
+        reading.calls, reading.feedback_rounds
+    );
     Ok(ExitCode::SUCCESS)
 }
 
@@ -376,6 +415,11 @@ fn print_event_line(event: &Event) {
             *latency_ms as f64 / 1000.0
         ),
         Event::InvalidReply { error } => println!("  unusable reply: {error}"),
+        Event::CandidateRejected {
+            candidate, reason, ..
+        } => {
+            println!("  set aside {candidate}: {reason}");
+        }
         Event::Goal {
             goal,
             reasoning,

@@ -215,6 +215,9 @@ pub enum BenchWhat {
         /// A GGUF file instead of the fetched default model.
         #[arg(long)]
         model_path: Option<PathBuf>,
+        /// A known model by name (`betr model list`), fetched when missing.
+        #[arg(long, conflicts_with = "model_path")]
+        model: Option<String>,
         #[arg(long, default_value_t = betr::llm::config::DEFAULT_THREADS)]
         threads: u32,
         /// Warm calls per variant.
@@ -239,10 +242,16 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 BenchWhat::Llm {
                     scenario,
                     model_path,
+                    model,
                     threads,
                     repeats,
                 },
-        } => bench_cmd::llm(&scenario, model_path.as_deref(), threads, repeats),
+        } => bench_cmd::llm(
+            &scenario,
+            (model_path.as_deref(), model.as_deref()),
+            threads,
+            repeats,
+        ),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model { action } => model_cmd::run(action),

@@ -77,7 +77,7 @@ impl Progress for TerminalProgress {
 
 fn spec(name: Option<&str>) -> Result<&'static ModelSpec> {
     match name {
-        None => Ok(&model::QWEN_CODER_05B),
+        None => Ok(model::DEFAULT_MODEL),
         Some(n) => model::find(n).with_context(|| {
             let known: Vec<&str> = model::MODELS.iter().map(|m| m.name).collect();
             format!("unknown model {n:?} (known: {})", known.join(", "))

@@ -125,6 +125,9 @@ struct RawFile {
     skills: Vec<RawSkill>,
     #[serde(default)]
     examples: Vec<RawExample>,
+    /// A file of `[[examples]]` beside this one: the domain's pool of worked examples,
+    /// from which prompts choose the ones most like each request.
+    example_pool: Option<Spanned<String>>,
     /// Read by the world module.
     #[allow(dead_code)]
     world: Option<toml::Value>,
@@ -187,6 +190,14 @@ struct RawValueParam {
     description: String,
 }
 
+/// An example pool file: nothing but `[[examples]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPool {
+    #[serde(default)]
+    examples: Vec<RawExample>,
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawExample {
@@ -237,7 +248,19 @@ impl Scenario {
                     message: "`extends` forms a cycle or a chain longer than 8 files".into(),
                 });
             }
-            let raw: RawFile = file.parse()?;
+            let mut raw: RawFile = file.parse()?;
+            if let Some(pool) = &raw.example_pool {
+                let pool_path = p.parent().unwrap_or(Path::new(".")).join(pool.get_ref());
+                if !pool_path.exists() {
+                    return Err(file.error_in_string(
+                        &pool.span(),
+                        0,
+                        format!("the example pool {} does not exist", pool_path.display()),
+                    ));
+                }
+                let pooled: RawPool = SourceFile::read(&pool_path)?.parse()?;
+                raw.examples.extend(pooled.examples);
+            }
             if let Some(base) = &raw.extends {
                 let base_path = p.parent().unwrap_or(Path::new(".")).join(base.get_ref());
                 if !base_path.exists() {

@@ -32,9 +32,18 @@ pub struct CaseResult {
     /// The reply's full text, when the answer came from a model in this run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reply: Option<String>,
-    /// The call's accounting, when the answer came from a model in this run.
+    /// Every call's accounting, when the answer came from a model in this run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub calls: Vec<CallRecord>,
+    /// The first call's answer, before any check, vote or feedback (when the answer came
+    /// from a model): what a single call would have scored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub call: Option<CallRecord>,
+    pub first_answer: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_correct: Option<bool>,
+    /// Feedback rounds the answer needed.
+    #[serde(default)]
+    pub feedback_rounds: usize,
 }
 
 fn first_run() -> usize {
@@ -122,8 +131,16 @@ pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> Case
         correct,
         problem,
         reply: None,
-        call: None,
+        calls: Vec::new(),
+        first_answer: None,
+        first_correct: None,
+        feedback_rounds: 0,
     }
+}
+
+/// Whether `answer` is the gold goal of `case` by the dataset's rule.
+pub fn is_correct(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> bool {
+    judge(vocabulary, &case.gold, answer).0
 }
 
 fn judge(vocabulary: &Vocabulary, gold: &str, answer: Option<&str>) -> (bool, Option<String>) {
@@ -201,7 +218,7 @@ impl GoalsResults {
         } else {
             Vec::new()
         };
-        let calls: Vec<&CallRecord> = cases.iter().filter_map(|c| c.call.as_ref()).collect();
+        let calls: Vec<&CallRecord> = cases.iter().flat_map(|c| &c.calls).collect();
         GoalsResults {
             easy: tally(None, Difficulty::Easy),
             medium: tally(None, Difficulty::Medium),
@@ -210,6 +227,24 @@ impl GoalsResults {
             usage: (!calls.is_empty()).then(|| UsageSummary::of(calls)),
             cases,
         }
+    }
+
+    /// The first calls' tallies (easy, medium, hard), when the cases recorded them.
+    pub fn first_call(&self) -> Option<[Tally; 3]> {
+        if self.cases.iter().all(|c| c.first_correct.is_none()) {
+            return None;
+        }
+        Some(Difficulty::ALL.map(|d| {
+            let of: Vec<&CaseResult> = self
+                .cases
+                .iter()
+                .filter(|c| c.difficulty == d.as_str())
+                .collect();
+            Tally {
+                correct: of.iter().filter(|c| c.first_correct == Some(true)).count(),
+                total: of.len(),
+            }
+        }))
     }
 
     pub fn overall(&self) -> Tally {
@@ -238,21 +273,28 @@ impl GoalsResults {
     pub fn csv(&self) -> String {
         let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
         let mut out = String::from(
-            "run,difficulty,index,instruction,gold,answer,correct,problem,prompt_tokens,completion_tokens,latency_ms\n",
+            "run,difficulty,index,instruction,gold,answer,correct,problem,first_answer,first_correct,calls,prompt_tokens,completion_tokens,latency_ms\n",
         );
         for c in &self.cases {
-            let (p, k, l) = c.call.as_ref().map_or_else(
-                || (String::new(), String::new(), String::new()),
-                |x| {
-                    (
-                        x.prompt_tokens.to_string(),
-                        x.completion_tokens.to_string(),
-                        format!("{:.0}", x.latency_ms),
-                    )
-                },
-            );
+            let (p, k, l) = if c.calls.is_empty() {
+                (String::new(), String::new(), String::new())
+            } else {
+                (
+                    c.calls
+                        .iter()
+                        .map(|x| x.prompt_tokens)
+                        .sum::<u64>()
+                        .to_string(),
+                    c.calls
+                        .iter()
+                        .map(|x| x.completion_tokens)
+                        .sum::<u64>()
+                        .to_string(),
+                    format!("{:.0}", c.calls.iter().map(|x| x.latency_ms).sum::<f64>()),
+                )
+            };
             out.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{p},{k},{l}\n",
+                "{},{},{},{},{},{},{},{},{},{},{},{p},{k},{l}\n",
                 c.run,
                 c.difficulty,
                 c.index,
@@ -260,7 +302,10 @@ impl GoalsResults {
                 q(&c.gold),
                 q(c.answer.as_deref().unwrap_or("")),
                 c.correct,
-                q(c.problem.as_deref().unwrap_or(""))
+                q(c.problem.as_deref().unwrap_or("")),
+                q(c.first_answer.as_deref().unwrap_or("")),
+                c.first_correct.map_or(String::new(), |b| b.to_string()),
+                c.calls.len(),
             ));
         }
         out

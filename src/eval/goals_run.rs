@@ -1,73 +1,33 @@
-//! The goal-interpretation experiment with a model: one call per instruction, no
-//! feedback; the reply's goal is scored by the dataset rule exactly as a recorded answer
-//! would be (no name is corrected, so an atom outside the vocabulary stays wrong).
+//! The goal-interpretation experiment with a model: each instruction is read exactly as a
+//! session reads it (examples chosen for the request, candidates checked, a vote, and
+//! feedback when none passes; or one call with the checks off), and scored by the
+//! dataset rule. No name is corrected, so an atom outside the vocabulary stays wrong.
+//! Each case also records the first call's answer, so one run shows both the single-call
+//! accuracy and what checking and feedback added.
 
 use std::path::Path;
-
-use crate::dataset::{Case, Difficulty};
-use crate::domain::{Condition, Scenario};
-use crate::goal::Formula;
-use crate::llm::prompt::{self, Context, Templates, Variant};
-use crate::llm::reply::{self, extract};
 use std::sync::Arc;
 
-use crate::llm::{LanguageModel, OutputConstraint, grammar, schema};
+use crate::dataset::{Case, Difficulty};
+use crate::domain::Scenario;
+use crate::llm::LanguageModel;
+use crate::session::{self, Event, Options};
+use crate::world::World;
 
 use super::EvalError;
-use super::goals::{CaseResult, GoalsResults, Tally, score};
+use super::goals::{CaseResult, GoalsResults, Tally, is_correct, score};
 use super::run::{Journal, RunConfig, Tap, UsageSummary, drive};
-
-/// How the goal prompt is written and sent.
-#[derive(Debug, Clone)]
-pub struct PromptSettings {
-    pub templates: Templates,
-    pub variant: Variant,
-    pub temperature: f32,
-    pub max_tokens: u32,
-    /// Constrain replies with the vocabulary's JSON schema when the model supports it.
-    pub structured: bool,
-    /// Constrain replies with a grammar from the vocabulary when the model supports it.
-    pub grammar: bool,
-}
-
-/// The answer a reply gives: the text after its last `Goal:` label that parses (else the
-/// last one), a JSON reply's goal, or a reply that is a single line. `None`: no answer.
-pub fn answer_of(text: &str, scenario: &Scenario) -> Option<String> {
-    let lines = extract::lines(text);
-    let labelled = extract::labelled(&lines, &["goal", "final goal"]);
-    if let Some((_, last)) = labelled.last() {
-        let parsing = labelled
-            .iter()
-            .rev()
-            .map(|(_, a)| extract::strip_ticks(a).trim())
-            .find(|a| Formula::parse(a).is_ok());
-        return Some(
-            parsing
-                .unwrap_or(extract::strip_ticks(last).trim())
-                .to_string(),
-        );
-    }
-    if text.trim_start().starts_with('{') {
-        // A structured reply: read its goal without correcting any name.
-        return Some(
-            match reply::goal(text, &scenario.domain.vocabulary, f64::INFINITY) {
-                Ok(a) => a.goal.to_string(),
-                Err(_) => text.trim().to_string(),
-            },
-        );
-    }
-    let t = text.trim();
-    (!t.is_empty()).then(|| t.to_string())
-}
 
 /// Ask for every case of every run that `dir`'s journal does not hold yet, score each as
 /// it comes back, and return the results over all recorded cases of runs 1..=runs.
+/// `world`: the scene the instructions are given in (candidates are planned in copies).
+#[allow(clippy::too_many_arguments)]
 pub async fn run_goals(
     model: &Arc<dyn LanguageModel>,
     scenario: &Scenario,
-    facts: &[Condition],
+    world: &dyn World,
     cases: &[Case],
-    settings: &PromptSettings,
+    options: &Options,
     cfg: &RunConfig<'_>,
     dir: &Path,
 ) -> Result<GoalsResults, EvalError> {
@@ -83,13 +43,18 @@ pub async fn run_goals(
         .filter(|(run, c)| !have.contains(&key(*run, c.difficulty.as_str(), c.index)))
         .collect();
     let done = cfg.runs * cases.len() - jobs.len();
+    // Names are never corrected: the dataset rule scores what the model wrote.
+    let options = Options {
+        min_similarity: f64::INFINITY,
+        ..options.clone()
+    };
     drive(
         jobs,
         done,
         cfg,
         &journal,
         |c: &CaseResult| format!("run {} {} #{}", c.run, c.difficulty, c.index + 1),
-        |(run, case)| ask_one(model, scenario, facts, case, run, settings, cfg),
+        |(run, case)| ask_one(model, scenario, world.fork(), case, run, &options, cfg),
     )
     .await?;
     Ok(collect(journal.read()?, cases, cfg.runs))
@@ -98,51 +63,55 @@ pub async fn run_goals(
 async fn ask_one(
     model: &Arc<dyn LanguageModel>,
     scenario: &Scenario,
-    facts: &[Condition],
+    world: Box<dyn World>,
     case: &Case,
     run: usize,
-    settings: &PromptSettings,
+    options: &Options,
     cfg: &RunConfig<'_>,
 ) -> Result<CaseResult, EvalError> {
-    let ctx = Context {
-        scenario,
-        facts,
-        instruction: &case.instruction,
-        variant: &settings.variant,
-    };
-    let mut request = prompt::request(
-        ctx.goal(&settings.templates)?,
-        settings.temperature,
-        settings.max_tokens,
-    );
-    // The same constraint the session would use: a grammar for the local model, a JSON
-    // schema for servers that take one.
-    if settings.grammar && model.supports_grammar() {
-        request.constraint = Some(OutputConstraint::Grammar {
-            name: "goal".into(),
-            gbnf: grammar::goal_grammar(
-                &scenario.domain.vocabulary,
-                true,
-                settings.variant.chain_of_thought,
-            ),
-        });
-    } else if settings.structured && model.supports_constraint() {
-        request.constraint = Some(schema::goal(&scenario.domain.vocabulary));
-    }
     let tap = Tap::new(model.clone(), Some(run as u64), &cfg.prices);
-    let reply = tap.chat(&request).await.map_err(|source| EvalError::Llm {
-        case: format!(
-            "run {run}, {} case {}",
-            case.difficulty.as_str(),
-            case.index + 1
-        ),
-        source,
-    })?;
-    let answer = answer_of(&reply.text, scenario);
-    let mut result = score(&scenario.domain.vocabulary, case, answer.as_deref());
+    let mut replies: Vec<String> = Vec::new();
+    let mut emit = |e: &Event| {
+        if let Event::Replied { text, .. } = e {
+            replies.push(text.clone());
+        }
+    };
+    let reading =
+        session::interpret(scenario, world, &case.instruction, &tap, options, &mut emit).await;
+    let vocabulary = &scenario.domain.vocabulary;
+    let mut result = match reading {
+        Ok(r) => {
+            let mut result = score(vocabulary, case, Some(&r.answer.goal.to_string()));
+            let first = r.first.map(|f| f.to_string());
+            result.first_correct = Some(is_correct(vocabulary, case, first.as_deref()));
+            result.first_answer = first;
+            result.feedback_rounds = r.feedback_rounds;
+            if let Some(why) = r.unchecked {
+                result.problem = Some(format!("no candidate passed the checks: {why}"));
+            }
+            result
+        }
+        // No usable reply at all is a wrong answer, not an error that stops the run.
+        Err(session::SessionError::NoGoal { attempts, last }) => {
+            let mut result = score(vocabulary, case, None);
+            result.problem = Some(format!("no usable reply in {attempts} call(s): {last}"));
+            result.first_correct = Some(false);
+            result
+        }
+        Err(e) => {
+            return Err(EvalError::Session {
+                case: format!(
+                    "run {run}, {} case {}",
+                    case.difficulty.as_str(),
+                    case.index + 1
+                ),
+                source: e,
+            });
+        }
+    };
     result.run = run;
-    result.reply = Some(reply.text);
-    result.call = tap.calls().pop();
+    result.reply = Some(replies.join("\n---\n"));
+    result.calls = tap.calls();
     Ok(result)
 }
 
@@ -186,12 +155,26 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
     let mut out = String::from(
         "| system | easy | medium | hard | overall | calls | prompt tokens | completion tokens | cost | latency median | latency p95 |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
+    if let Some([easy, medium, hard]) = results.first_call() {
+        let overall = Tally {
+            correct: easy.correct + medium.correct + hard.correct,
+            total: easy.total + medium.total + hard.total,
+        };
+        out.push_str(&format!(
+            "| {system}, first call only | {} | {} | {} | {} | {} | | | | | |\n",
+            cell(&easy),
+            cell(&medium),
+            cell(&hard),
+            cell(&overall),
+            results.cases.len(),
+        ));
+    }
     for r in &results.runs {
         let cases: Vec<&super::run::CallRecord> = results
             .cases
             .iter()
             .filter(|c| c.run == r.run)
-            .filter_map(|c| c.call.as_ref())
+            .flat_map(|c| &c.calls)
             .collect();
         let overall = Tally {
             correct: r.easy.correct + r.medium.correct + r.hard.correct,
@@ -232,6 +215,19 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
     } else {
         format!("Temperature {temperature}; run k sends seed k.")
     });
+    if results.first_call().is_some() {
+        let cases = results.cases.len().max(1) as f64;
+        let calls: usize = results.cases.iter().map(|c| c.calls.len()).sum();
+        let fed_back = results
+            .cases
+            .iter()
+            .filter(|c| c.feedback_rounds > 0)
+            .count();
+        notes.push(format!(
+            "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, not true already, plannable), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback.",
+            calls as f64 / cases
+        ));
+    }
     if let Some(u) = &results.usage {
         notes.extend(u.notes());
     }

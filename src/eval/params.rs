@@ -39,6 +39,9 @@ pub struct ValueRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub number: Option<f64>,
     pub accepted: bool,
+    /// Tried in simulation before it was offered, and set aside there.
+    #[serde(default)]
+    pub screened: bool,
     /// What the world reported when it rejected the value.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -53,6 +56,13 @@ pub struct ParamsCase {
     pub success: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// The goal the run worked on was the scenario's.
+    #[serde(default)]
+    pub goal_as_expected: bool,
+    /// The goal was the scenario's, a value was accepted by the world, and the tree
+    /// succeeded.
+    #[serde(default)]
+    pub resolved: bool,
     pub values: Vec<ValueRecord>,
     /// Proposals of conditions instead of a value.
     pub other_proposals: usize,
@@ -104,6 +114,10 @@ pub struct ParamSummary {
     pub values_proposed: usize,
     pub values_accepted: usize,
     pub successes: usize,
+    #[serde(default)]
+    pub resolved: usize,
+    #[serde(default)]
+    pub misread_goals: usize,
     /// The paper's GPT-4 (mean of 10 runs).
     pub paper: String,
 }
@@ -182,9 +196,33 @@ fn record(
     let mut unusable = 0;
     // The (skill, object) of the value being judged, until the next outcome shows.
     let mut pending: Option<(String, String)> = None;
+    let mut goal_as_expected = false;
+    let number = |value: &Value| match value {
+        Value::Number { value, .. } => Some(*value),
+        Value::Category(_) => None,
+    };
+    let written = |value: &Value| match value {
+        Value::Category(c) => c.clone(),
+        v => v.to_string(),
+    };
     for e in &trace.events {
         match e {
+            Event::Goal {
+                matches_expected, ..
+            } => goal_as_expected = *matches_expected == Some(true),
             Event::InvalidReply { .. } => unusable += 1,
+            // A value the model wrote that failed in simulation before it was offered.
+            Event::CandidateRejected {
+                proposal: Some(Proposal::Value { value, .. }),
+                reason,
+                ..
+            } => values.push(ValueRecord {
+                value: written(value),
+                number: number(value),
+                accepted: false,
+                screened: true,
+                error: Some(reason.clone()),
+            }),
             Event::Proposal {
                 proposal:
                     Proposal::Value {
@@ -196,15 +234,10 @@ fn record(
                 ..
             } => {
                 values.push(ValueRecord {
-                    value: match value {
-                        Value::Category(c) => c.clone(),
-                        v => v.to_string(),
-                    },
-                    number: match value {
-                        Value::Number { value, .. } => Some(*value),
-                        Value::Category(_) => None,
-                    },
+                    value: written(value),
+                    number: number(value),
                     accepted: false,
+                    screened: false,
                     error: None,
                 });
                 pending = Some((skill.clone(), object.clone()));
@@ -236,12 +269,15 @@ fn record(
             _ => {}
         }
     }
+    let success = trace.ending.is_ok();
     ParamsCase {
         scenario: path.to_string(),
         name: scenario.name.clone(),
         run,
-        success: trace.ending.is_ok(),
+        success,
         reason: trace.ending.err(),
+        goal_as_expected,
+        resolved: success && goal_as_expected && values.iter().any(|v| v.accepted),
         values,
         other_proposals: other,
         unusable_replies: unusable,
@@ -271,6 +307,8 @@ fn summarize(
         values_proposed: all.clone().count(),
         values_accepted: all.filter(|v| v.accepted).count(),
         successes: runs.iter().filter(|c| c.success).count(),
+        resolved: runs.iter().filter(|c| c.resolved).count(),
+        misread_goals: runs.iter().filter(|c| !c.goal_as_expected).count(),
         paper: PARAM_SCENARIOS
             .iter()
             .find(|(p, _)| *p == path)
@@ -283,7 +321,7 @@ impl ParamsResults {
     /// after →), mean ± sd, the accepted range, how often the world accepted, success.
     pub fn table(&self, system: &str, expected_runs: usize) -> String {
         let mut out = format!(
-            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | all values accepted | success | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|\n"
+            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | all values accepted | resolved | misread goal | tree succeeded | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
         );
         for s in &self.scenarios {
             let each: Vec<String> = self
@@ -311,7 +349,7 @@ impl ParamsResults {
                 _ => category_counts(&s.first_values),
             };
             out.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {}/{} | {}/{} | {}/{} | {} |\n",
+                "| {} | {} | {} | {} | {} | {}/{} | {}/{} | {}/{} | {} | {}/{} | {} |\n",
                 s.name,
                 s.limits.parameter,
                 each.join(", "),
@@ -321,6 +359,9 @@ impl ParamsResults {
                 s.runs,
                 s.values_accepted,
                 s.values_proposed,
+                s.resolved,
+                s.runs,
+                s.misread_goals,
                 s.successes,
                 s.runs,
                 s.paper
@@ -329,7 +370,7 @@ impl ParamsResults {
         let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
         out.push_str(&super::run::table_footer(
             &self.usage,
-            "- mean ± sd over each run's first value; ✗: the world rejected the value (the run then asked again).\n",
+            "- mean ± sd over each run's first value (the model's first answer, before any check in simulation); ✗: the world rejected the value, in the check before it was offered or after it was set. Resolved: the goal was the scenario's, a value was accepted and the tree succeeded; a misread goal is never resolved.\n",
             finished,
             expected_runs * self.scenarios.len(),
         ));

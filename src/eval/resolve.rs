@@ -11,11 +11,11 @@ use std::time::Instant;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::domain::Scenario;
+use crate::domain::{Condition, Scenario};
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;
-use crate::session::{Event, Options};
+use crate::session::{Event, Options, Proposal};
 
 use super::EvalError;
 use super::run::{
@@ -68,7 +68,21 @@ pub struct ResolveCase {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub goal_as_expected: Option<bool>,
     pub rounds: usize,
+    /// An action failed in simulation (the failure under study was reached).
+    #[serde(default)]
+    pub failure_reached: bool,
+    /// Resolved: the goal is the scenario's, a failure was reached, the kept changes hold
+    /// every condition the scenario names as its fix, and the final tree succeeded.
+    #[serde(default)]
+    pub resolved: bool,
+    /// The model's first candidate (before any check in simulation) holds a condition
+    /// the scenario names as its fix.
+    #[serde(default)]
+    pub first_candidate_right: bool,
     pub proposals: Vec<ProposalRecord>,
+    /// Candidates the model wrote that were tried in simulation and set aside.
+    #[serde(default)]
+    pub screened_out: usize,
     /// Replies that could not be used (no valid answer in them).
     pub unusable_replies: usize,
     pub calls: Vec<CallRecord>,
@@ -83,6 +97,13 @@ pub struct ScenarioSummary {
     pub runs: usize,
     pub successes: usize,
     pub success_rate: f64,
+    /// Runs whose goal was not the scenario's (never counted as resolved).
+    #[serde(default)]
+    pub misread_goals: usize,
+    #[serde(default)]
+    pub resolved: usize,
+    #[serde(default)]
+    pub first_candidate_right: usize,
     pub proposals: usize,
     pub wrong_proposals: usize,
     pub unusable_replies: usize,
@@ -194,8 +215,30 @@ fn record(
     let mut goal = None;
     let mut goal_as_expected = None;
     let mut unusable = 0;
+    let mut failure_reached = false;
+    let mut screened_out = 0;
+    let mut first_candidate: Option<Proposal> = None;
+    let mut kept_conditions: Vec<Condition> = Vec::new();
+    let mut pending: Option<Proposal> = None;
+    let fixes: Vec<Condition> = scenario
+        .expected_fix
+        .iter()
+        .filter_map(|f| scenario.parse_goal(f).ok())
+        .flat_map(|f| f.to_dnf().0.into_iter().flatten())
+        .collect();
+    let holds_fix = |p: &Proposal| match p {
+        Proposal::Conditions { conditions, .. } => conditions.iter().any(|c| fixes.contains(c)),
+        Proposal::Value { .. } => false,
+    };
     for e in &trace.events {
         match e {
+            Event::ActionFailed { .. } => failure_reached = true,
+            Event::CandidateRejected {
+                proposal: Some(p), ..
+            } => {
+                screened_out += 1;
+                first_candidate.get_or_insert_with(|| p.clone());
+            }
             Event::Goal {
                 goal: g,
                 matches_expected,
@@ -205,16 +248,23 @@ fn record(
                 goal_as_expected = *matches_expected;
             }
             Event::InvalidReply { .. } => unusable += 1,
-            Event::Proposal { proposal, .. } => proposals.push(ProposalRecord {
-                proposal: proposal.to_string(),
-                kept: false,
-                correct: false,
-                note: None,
-            }),
+            Event::Proposal { proposal, .. } => {
+                first_candidate.get_or_insert_with(|| proposal.clone());
+                pending = Some(proposal.clone());
+                proposals.push(ProposalRecord {
+                    proposal: proposal.to_string(),
+                    kept: false,
+                    correct: false,
+                    note: None,
+                });
+            }
             Event::Repaired { .. } => {
                 if let Some(p) = proposals.last_mut() {
                     p.kept = true;
                     p.correct = success;
+                }
+                if let Some(Proposal::Conditions { conditions, .. }) = pending.take() {
+                    kept_conditions.extend(conditions);
                 }
             }
             Event::DidNotHelp { reason } => {
@@ -225,6 +275,11 @@ fn record(
             _ => {}
         }
     }
+    let resolved = success
+        && goal_as_expected == Some(true)
+        && failure_reached
+        && !fixes.is_empty()
+        && fixes.iter().all(|f| kept_conditions.contains(f));
     ResolveCase {
         scenario: path.to_string(),
         name: scenario.name.clone(),
@@ -235,7 +290,11 @@ fn record(
         goal,
         goal_as_expected,
         rounds: trace.rounds,
+        failure_reached,
+        resolved,
+        first_candidate_right: first_candidate.as_ref().is_some_and(holds_fix),
         proposals,
+        screened_out,
         unusable_replies: unusable,
         calls,
         wall_ms,
@@ -265,6 +324,12 @@ fn summarize(scenarios: &[(String, Scenario)], cases: Vec<ResolveCase>) -> Resol
                 name: scenario.name.clone(),
                 runs: runs.len(),
                 successes,
+                misread_goals: runs
+                    .iter()
+                    .filter(|c| c.goal_as_expected != Some(true))
+                    .count(),
+                resolved: runs.iter().filter(|c| c.resolved).count(),
+                first_candidate_right: runs.iter().filter(|c| c.first_candidate_right).count(),
                 success_rate: if runs.is_empty() {
                     0.0
                 } else {
@@ -292,13 +357,18 @@ impl ResolveResults {
     /// replies, LLM calls, ticks and time.
     pub fn table(&self, system: &str, expected_runs: usize) -> String {
         let mut out = format!(
-            "Failure resolution, {system}\n\n| # | scenario | success | proposals | wrong proposals | unusable replies | LLM calls per run | ticks | time per run |\n|---|---|---|---|---|---|---|---|---|\n"
+            "Failure resolution, {system}\n\n| # | scenario | resolved | first candidate right | misread goal | tree succeeded | proposals | wrong proposals | unusable replies | LLM calls per run | ticks | time per run |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
         );
         for (i, s) in self.scenarios.iter().enumerate() {
             out.push_str(&format!(
-                "| {} | {} | {:.0}% ({}/{}) | {} | {} | {} | {:.1} | {} | {:.2} s |\n",
+                "| {} | {} | {}/{} | {}/{} | {} | {:.0}% ({}/{}) | {} | {} | {} | {:.1} | {} | {:.2} s |\n",
                 i + 1,
                 s.name,
+                s.resolved,
+                s.runs,
+                s.first_candidate_right,
+                s.runs,
+                s.misread_goals,
                 s.success_rate,
                 s.successes,
                 s.runs,
@@ -313,7 +383,7 @@ impl ResolveResults {
         let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
         out.push_str(&super::run::table_footer(
             &self.usage,
-            "- A proposal is correct only if it was kept and the final tree succeeded in simulation; ticks are of successful runs; time is the median wall time per run.\n",
+            "- Resolved: the goal was the scenario's, the failure was reached, the kept changes hold the condition(s) the scenario names as its fix, and the final tree succeeded. A misread goal is never resolved, even when its tree succeeds (\"tree succeeded\"). First candidate right: the model's first answer, before any check in simulation, holds the fix. A proposal is correct only if it was kept and the final tree succeeded; ticks are of successful runs; time is the median wall time per run.\n",
             finished,
             expected_runs * self.scenarios.len(),
         ));

@@ -97,8 +97,13 @@ impl Tap {
 
     async fn call(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
         let mut request = request.clone();
-        if self.seed.is_some() {
-            request.seed = self.seed;
+        // Run k's seed, combined with a draw's own seed so that the sampled candidates of
+        // one question still differ from each other.
+        if let Some(run) = self.seed {
+            request.seed = Some(match request.seed {
+                Some(draw) => run.wrapping_mul(1000).wrapping_add(draw),
+                None => run,
+            });
         }
         let reply = self.inner.chat(&request).await?;
         let record = self.record(&reply);

@@ -1,40 +1,11 @@
 use std::path::Path;
 
-use super::goals_run::answer_of;
 use super::run::{Journal, mean_sd, percentile};
 use crate::domain::Scenario;
 
 fn cafe() -> Scenario {
     Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
         .expect("cafe scenario")
-}
-
-#[test]
-fn the_answer_is_the_goal_line_as_written() {
-    let s = cafe();
-    assert_eq!(
-        answer_of("Goal: Active_AC", &s).as_deref(),
-        Some("Active_AC")
-    );
-    let cot = "Reasoning: they are hot.\nGoal: `Active_AC & Low_ACTemperature`\n";
-    assert_eq!(
-        answer_of(cot, &s).as_deref(),
-        Some("Active_AC & Low_ACTemperature")
-    );
-    // The last goal that parses wins over a broken restatement.
-    let two = "Goal: Active_AC\nFinal goal: Active_AC &";
-    assert_eq!(answer_of(two, &s).as_deref(), Some("Active_AC"));
-    // A name outside the vocabulary is kept as written (and scored wrong), not corrected.
-    assert_eq!(
-        answer_of("{\"goal\": \"Active_Fan\"}", &s).as_deref(),
-        Some("{\"goal\": \"Active_Fan\"}")
-    );
-    assert_eq!(
-        answer_of("{\"goal\": \"Active_AC\"}", &s).as_deref(),
-        Some("Active_AC")
-    );
-    assert_eq!(answer_of("  \n", &s), None);
-    assert_eq!(answer_of("Active_AC", &s).as_deref(), Some("Active_AC"));
 }
 
 #[test]
@@ -96,7 +67,7 @@ impl crate::llm::LanguageModel for Slow {
 
 #[test]
 fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
-    use super::goals_run::{PromptSettings, run_goals};
+    use super::goals_run::run_goals;
     use super::run::{RunConfig, Silent};
     use crate::dataset::{Case, Difficulty};
     let s = cafe();
@@ -115,14 +86,11 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
     let dir = std::env::temp_dir().join(format!("betr-concurrency-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("dir");
-    let settings = PromptSettings {
-        templates: crate::llm::prompt::Templates::builtin(),
-        variant: Default::default(),
-        temperature: 0.0,
+    let options = crate::session::Options {
         max_tokens: 100,
-        structured: false,
-        grammar: true,
+        ..Default::default()
     };
+    let world = crate::world::load(&s).expect("cafe world");
     let cfg = RunConfig {
         runs: 2,
         concurrency: 3,
@@ -138,9 +106,9 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
         .block_on(run_goals(
             &(model.clone() as std::sync::Arc<dyn crate::llm::LanguageModel>),
             &s,
-            &[],
+            world.as_ref(),
             &cases,
-            &settings,
+            &options,
             &cfg,
             &dir,
         ))

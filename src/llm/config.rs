@@ -322,7 +322,7 @@ impl Settings {
             return Ok((name, path.clone()));
         }
         let spec = match &self.model {
-            None => &crate::model::QWEN_CODER_05B,
+            None => crate::model::DEFAULT_MODEL,
             Some(name) => crate::model::find(name).ok_or_else(|| {
                 let known: Vec<&str> = crate::model::MODELS.iter().map(|m| m.name).collect();
                 LlmError::Config(format!(

@@ -107,10 +107,12 @@ pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) ->
     } else {
         g.push_str("root ::= \"Goal: \" formula\n");
     }
+    // One operator per level: `A | B & C` cannot be written, only `A | (B & C)` or
+    // `(A | B) & C`, so the model has to decide how the parts group (small models write
+    // the first meaning the second) and the reader never needs precedence rules.
     // Bounded repetition: a small model can otherwise loop `& A & A & ...` until the
     // token limit. Eight conjuncts and four alternatives cover every goal of the dataset.
-    g.push_str("formula ::= conjunction ( \" | \" conjunction ){0,3}\n");
-    g.push_str("conjunction ::= factor ( \" & \" factor ){0,7}\n");
+    g.push_str("formula ::= factor ( ( \" & \" factor ){1,7} | ( \" | \" factor ){1,3} )?\n");
     g.push_str("factor ::= \"~\"? ( atom | \"(\" formula \")\" )\n");
     g.push_str(&atom_rules(vocabulary, wildcard));
     g
@@ -192,7 +194,13 @@ mod tests {
 
     #[test]
     fn answer_grammars_have_their_prefix() {
-        assert!(goal_grammar(&vocab(), false, false).starts_with("root ::= \"Goal: \" formula"));
+        let g = goal_grammar(&vocab(), false, false);
+        assert!(g.starts_with("root ::= \"Goal: \" formula"));
+        // `&` and `|` never share a level: mixing them needs parentheses.
+        assert!(
+            g.contains("formula ::= factor ( ( \" & \" factor ){1,7} | ( \" | \" factor ){1,3} )?"),
+            "{g}"
+        );
         assert!(
             goal_grammar(&vocab(), false, true)
                 .starts_with("root ::= \"Reasoning: \" reasoning \"\\nGoal: \"")

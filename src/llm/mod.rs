@@ -9,6 +9,7 @@
 
 pub mod cassette;
 pub mod config;
+pub mod examples;
 pub mod grammar;
 pub mod local;
 pub mod openai;

@@ -12,8 +12,11 @@ use std::path::Path;
 use super::{ChatRequest, Message};
 use crate::domain::{ANY_OBJECT, ActionCall, Condition, Example, Scenario, ValueParam, Vocabulary};
 
+/// How many worked examples a prompt shows when it chooses them per request.
+pub const DEFAULT_EXAMPLES_SHOWN: usize = 6;
+
 /// Which ablation of the prompt to write.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
     /// Leave out the one-line descriptions of the conditions.
     pub no_descriptions: bool,
@@ -23,6 +26,36 @@ pub struct Variant {
     pub chain_of_thought: bool,
     /// Examples to use instead of the scenario's (e.g. the original prompt's examples).
     pub examples: Option<Vec<Example>>,
+    /// How many examples to show, chosen from the pool by similarity to the request
+    /// (`None`: every example of the pool, in pool order).
+    pub examples_shown: Option<usize>,
+    /// Show the pool's first `examples_shown` examples for every request instead of the
+    /// most similar ones (the ablation of retrieval).
+    pub fixed_examples: bool,
+}
+
+impl Default for Variant {
+    fn default() -> Self {
+        Variant {
+            no_descriptions: false,
+            no_object_rule: false,
+            chain_of_thought: false,
+            examples: None,
+            examples_shown: Some(DEFAULT_EXAMPLES_SHOWN),
+            fixed_examples: false,
+        }
+    }
+}
+
+impl Variant {
+    /// The examples a prompt about `request` shows, from `pool`.
+    pub fn choose<'a>(&self, pool: &'a [Example], request: &str) -> Vec<&'a Example> {
+        match self.examples_shown {
+            None => pool.iter().collect(),
+            Some(k) if self.fixed_examples => pool.iter().take(k).collect(),
+            Some(k) => super::examples::nearest(pool, request, k),
+        }
+    }
 }
 
 /// The three templates.
@@ -105,7 +138,10 @@ impl Context<'_> {
                     OBJECT_RULE.to_string()
                 },
             ),
-            ("examples", examples_text(examples)),
+            (
+                "examples",
+                examples_text(&self.variant.choose(examples, self.instruction)),
+            ),
             ("scene", scene_text(self.facts)),
             ("instruction", self.instruction.trim().to_string()),
         ]
@@ -136,17 +172,7 @@ impl Context<'_> {
         tried: &[String],
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
-        values.push((
-            "tried",
-            if tried.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    "\nAlready tried, and the action still failed after each; propose something else:\n{}\n",
-                    tried.iter().map(|t| format!("- {t}")).collect::<Vec<_>>().join("\n")
-                )
-            },
-        ));
+        values.push(("tried", tried_text(tried)));
         let pre: Vec<String> = self
             .scenario
             .domain
@@ -187,14 +213,17 @@ impl Context<'_> {
     }
 
     /// The parameter-value request for `param` of `action` (`error`: what it reported).
+    /// `tried`: values already tried for this failure, each with what the world did.
     pub fn value(
         &self,
         templates: &Templates,
         action: &ActionCall,
         param: &ValueParam,
         error: &str,
+        tried: &[String],
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
+        values.push(("tried", tried_text(tried)));
         values.push(("action", action.to_string()));
         values.push((
             "error_line",
@@ -217,6 +246,22 @@ impl Context<'_> {
         values.push(("answer_format", format));
         Ok(messages(fill("value.md", &templates.value, &values)?))
     }
+}
+
+/// Changes already tried for this failure, with what happened after each: the model
+/// learns from the world's verdict instead of repeating itself.
+fn tried_text(tried: &[String]) -> String {
+    if tried.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\nAlready tried in simulation, and the action still failed after each (what happened is in parentheses); learn from it and propose something else:\n{}\n",
+        tried
+            .iter()
+            .map(|t| format!("- {t}"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    )
 }
 
 const OBJECT_RULE: &str = "Use only the objects listed above, spelled exactly as listed. If the person names something that is not listed, use the listed object most similar to it (for example, if they ask for fries and only Chips is listed, use Chips).";
@@ -353,7 +398,7 @@ pub fn objects_text(vocabulary: &Vocabulary) -> String {
         .join("\n")
 }
 
-fn examples_text(examples: &[Example]) -> String {
+fn examples_text(examples: &[&Example]) -> String {
     if examples.is_empty() {
         return "(none)".into();
     }

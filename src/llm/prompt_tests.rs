@@ -36,6 +36,7 @@ fn goal_prompt_has_every_part() {
         no_object_rule: true,
         chain_of_thought: true,
         examples: Some(vec![]),
+        ..Variant::default()
     };
     let ctx = Context {
         variant: &bare,

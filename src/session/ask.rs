@@ -1,87 +1,31 @@
-//! Questions to the model: the goal of an instruction, the missing preconditions of a
-//! failed action, a missing parameter value. Each emits what was asked and who answered;
-//! an unusable reply is reported as an event, not an error.
+//! Questions to the model about a failed action: its missing preconditions, or a missing
+//! parameter value. Several candidates are drawn (the first greedy, the rest sampled) and
+//! each is tried in simulation before it is offered; what did not help is reported, and
+//! told to the model the next time it is asked. Each call emits what was asked and who
+//! answered; an unusable reply is reported as an event, not an error.
 
 use crate::bt::NodeId;
-use crate::domain::{ActionCall, Condition, Scenario, ValueParam};
-use crate::goal;
+use crate::domain::{ActionCall, Scenario, ValueParam};
 use crate::llm::prompt::{self, Context};
 use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 
+use super::screen::Screen;
 use super::types::{Event, Options, Proposal, SessionError};
-
-/// Ask the model for the goal `instruction` means in `scenario`, given the facts true now.
-pub async fn interpret(
-    scenario: &Scenario,
-    facts: &[Condition],
-    instruction: &str,
-    model: &dyn LanguageModel,
-    options: &Options,
-    emit: &mut (dyn FnMut(&Event) + Send),
-) -> Result<reply::GoalAnswer, SessionError> {
-    let ctx = Context {
-        scenario,
-        facts,
-        instruction,
-        variant: &options.variant,
-    };
-    let messages = ctx.goal(&options.templates)?;
-    let vocabulary = &scenario.domain.vocabulary;
-    let constraint = schema::goal(vocabulary);
-    let cot = options.variant.chain_of_thought;
-    let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
-    let mut last = None;
-    for _ in 0..options.interpret_attempts.max(1) {
-        emit(&Event::Asking {
-            what: "the goal of the instruction".into(),
-        });
-        let r = ask(
-            model,
-            messages.clone(),
-            (constraint.clone(), &goal_grammar),
-            options,
-            emit,
-        )
-        .await?;
-        match reply::goal(&r.text, &scenario.domain.vocabulary, options.min_similarity) {
-            Ok(answer) => {
-                let matches_expected = scenario
-                    .goal
-                    .as_ref()
-                    .and_then(|expected| goal::equivalent(expected, &answer.goal).ok());
-                emit(&Event::Goal {
-                    goal: answer.goal.clone(),
-                    reasoning: answer.reasoning.clone(),
-                    substitutions: answer.substitutions.clone(),
-                    matches_expected,
-                });
-                return Ok(answer);
-            }
-            Err(e) => {
-                emit(&Event::InvalidReply {
-                    error: e.to_string(),
-                });
-                last = Some(e);
-            }
-        }
-    }
-    Err(SessionError::NoGoal {
-        attempts: options.interpret_attempts.max(1),
-        last: last.unwrap_or(ReplyError::NoConditions),
-    })
-}
 
 /// Ask, constraining the reply the way the backend can: a grammar for the local model
 /// (built only when used), a JSON schema for servers that take one, else plain text.
-async fn ask(
+/// `seed`: for a sampled draw (a backend's own seed, as an evaluation run's, wins).
+pub(crate) async fn ask(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
     (schema, grammar): (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
+    seed: Option<u64>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
+    request.seed = seed;
     if options.grammar && model.supports_grammar() {
         request.constraint = Some(OutputConstraint::Grammar {
             name: "answer".into(),
@@ -125,15 +69,111 @@ pub fn missing_value<'a>(
         })
 }
 
-pub(crate) type Asked = Option<(Proposal, Option<String>, Vec<Substitution>)>;
+/// What a question about a failure produced.
+pub(crate) struct Asked {
+    /// The first candidate that fixed the failure in simulation, with the model's
+    /// reasoning and the names it corrected; `None` when no candidate did.
+    pub chosen: Option<(Proposal, Option<String>, Vec<Substitution>)>,
+    /// Candidates that did not fix it, each with what happened in simulation.
+    pub rejected: Vec<(Proposal, String)>,
+    /// Replies that could not be read at all.
+    pub unusable: usize,
+}
 
 /// A failed action as the question about it needs it.
 pub(crate) struct FailedAction<'a> {
     pub node: NodeId,
     pub action: &'a ActionCall,
     pub error: &'a str,
-    /// Changes already tried for this failure that did not fix it.
+    /// Changes already tried for this failure that did not fix it, with what happened.
     pub tried: &'a [String],
+}
+
+/// Sampling temperature of the extra candidates for a failure: proposals must differ to
+/// be worth trying.
+const SAMPLE_TEMPERATURE: f32 = 0.8;
+
+/// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
+/// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
+/// first that fixes the failure.
+async fn draw_and_screen(
+    model: &dyn LanguageModel,
+    messages: Vec<Message>,
+    constraint: (OutputConstraint, &(dyn Fn() -> String + Sync)),
+    options: &Options,
+    screen: &mut Screen,
+    read: &(
+         dyn Fn(&str) -> Result<(Proposal, Option<String>, Vec<Substitution>), ReplyError> + Sync
+     ),
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<Asked, SessionError> {
+    let mut asked = Asked {
+        chosen: None,
+        rejected: Vec::new(),
+        unusable: 0,
+    };
+    let draws = options.candidates.max(1);
+    for draw in 0..draws {
+        let mut opts = options.clone();
+        let seed = if draw > 0 {
+            opts.temperature = opts.temperature.max(SAMPLE_TEMPERATURE);
+            Some(draw as u64)
+        } else {
+            None
+        };
+        let r = ask(
+            model,
+            messages.clone(),
+            (constraint.0.clone(), constraint.1),
+            &opts,
+            seed,
+            emit,
+        )
+        .await?;
+        let (proposal, reasoning, substitutions) = match read(&r.text) {
+            Ok(x) => x,
+            Err(e) => {
+                emit(&Event::InvalidReply {
+                    error: e.to_string(),
+                });
+                asked.unusable += 1;
+                continue;
+            }
+        };
+        if asked
+            .rejected
+            .iter()
+            .any(|(p, _)| same_proposal(p, &proposal))
+        {
+            continue;
+        }
+        match screen.check(&proposal) {
+            Ok(()) => {
+                asked.chosen = Some((proposal, reasoning, substitutions));
+                return Ok(asked);
+            }
+            Err(why) => {
+                emit(&Event::CandidateRejected {
+                    candidate: proposal.to_string(),
+                    proposal: Some(proposal.clone()),
+                    reason: format!("tried in simulation: {why}"),
+                });
+                asked.rejected.push((proposal, why));
+            }
+        }
+    }
+    Ok(asked)
+}
+
+/// The same change, whatever the order of its conditions.
+fn same_proposal(a: &Proposal, b: &Proposal) -> bool {
+    match (a, b) {
+        (
+            Proposal::Conditions { conditions: x, .. },
+            Proposal::Conditions { conditions: y, .. },
+        ) => x.len() == y.len() && x.iter().all(|c| y.contains(c)),
+        _ => a == b,
+    }
 }
 
 pub(crate) async fn ask_conditions(
@@ -141,6 +181,7 @@ pub(crate) async fn ask_conditions(
     model: &dyn LanguageModel,
     options: &Options,
     failed: &FailedAction<'_>,
+    screen: &mut Screen,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     let FailedAction {
@@ -155,17 +196,9 @@ pub(crate) async fn ask_conditions(
     let messages = ctx.resolve(&options.templates, action, error, tried)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
     let conditions_grammar = || grammar::conditions_grammar(vocabulary, true);
-    let r = ask(
-        model,
-        messages,
-        (schema::conditions(vocabulary), &conditions_grammar),
-        options,
-        emit,
-    )
-    .await?;
-    Ok(
-        match reply::conditions(&r.text, vocabulary, options.min_similarity) {
-            Ok(a) => Some((
+    let read = |text: &str| {
+        reply::conditions(text, vocabulary, options.min_similarity).map(|a| {
+            (
                 Proposal::Conditions {
                     action: action.clone(),
                     node,
@@ -173,55 +206,63 @@ pub(crate) async fn ask_conditions(
                 },
                 a.reasoning,
                 a.substitutions,
-            )),
-            Err(e) => {
-                emit(&Event::InvalidReply {
-                    error: e.to_string(),
-                });
-                None
-            }
-        },
+            )
+        })
+    };
+    draw_and_screen(
+        model,
+        messages,
+        (schema::conditions(vocabulary), &conditions_grammar),
+        options,
+        screen,
+        &read,
+        emit,
     )
+    .await
 }
 
 pub(crate) async fn ask_value(
     ctx: &Context<'_>,
     model: &dyn LanguageModel,
     options: &Options,
-    action: &ActionCall,
+    failed: &FailedAction<'_>,
     param: &ValueParam,
-    error: &str,
+    screen: &mut Screen,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
+    let FailedAction {
+        action,
+        error,
+        tried,
+        ..
+    } = *failed;
     emit(&Event::Asking {
         what: format!("a value for {} of {action}!", param.name),
     });
-    let messages = ctx.value(&options.templates, action, param, error)?;
+    let messages = ctx.value(&options.templates, action, param, error, tried)?;
     let value_grammar = || grammar::value_grammar(param.unit.as_deref(), &param.categories);
-    let r = ask(
+    let read = |text: &str| {
+        reply::value(text, param, options.min_similarity).map(|a| {
+            (
+                Proposal::Value {
+                    skill: action.skill.clone(),
+                    object: action.args.first().cloned().unwrap_or_default(),
+                    param: param.name.clone(),
+                    value: a.value,
+                },
+                a.reasoning,
+                a.substitutions,
+            )
+        })
+    };
+    draw_and_screen(
         model,
         messages,
         (schema::value(param), &value_grammar),
         options,
+        screen,
+        &read,
         emit,
     )
-    .await?;
-    Ok(match reply::value(&r.text, param, options.min_similarity) {
-        Ok(a) => Some((
-            Proposal::Value {
-                skill: action.skill.clone(),
-                object: action.args.first().cloned().unwrap_or_default(),
-                param: param.name.clone(),
-                value: a.value,
-            },
-            a.reasoning,
-            a.substitutions,
-        )),
-        Err(e) => {
-            emit(&Event::InvalidReply {
-                error: e.to_string(),
-            });
-            None
-        }
-    })
+    .await
 }

@@ -5,13 +5,16 @@
 
 pub mod ask;
 pub mod engine;
+pub mod interpret;
 pub mod policy;
 pub mod resolve;
+pub mod screen;
 pub mod types;
 pub mod values;
 
-pub use ask::{interpret, missing_value};
+pub use ask::missing_value;
 pub use engine::{Command, Engine, EngineHandle, Setup};
+pub use interpret::{Interpretation, check_goal, interpret};
 pub use policy::{Policy, PolicyStore};
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{Ending, Event, Options, Proposal, Resolved, SessionError};

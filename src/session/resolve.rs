@@ -54,7 +54,21 @@ pub async fn resolve_with_scenes(
     setup.options = options.clone();
     setup.scenes = scenes;
     let (engine, mut events) = Engine::spawn(setup)?;
-    engine.send(Command::Submit(instruction));
+    match (&scenario.goal, options.use_scenario_goal) {
+        (Some(goal), true) => {
+            engine.send(Command::SubmitGoal {
+                goal: goal.clone(),
+                instruction,
+            });
+        }
+        (None, true) => {
+            engine.send(Command::Shutdown);
+            return Err(SessionError::NoStatedGoal(scenario.name.clone()));
+        }
+        (_, false) => {
+            engine.send(Command::Submit(instruction));
+        }
+    }
 
     let mut goal = None;
     let mut tree: Option<Arc<Tree>> = None;

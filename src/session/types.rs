@@ -19,8 +19,19 @@ use crate::world::cell::snapshot::SceneSnapshot;
 pub struct Options {
     /// Questions about failures (each reply, valid or not, is one round).
     pub max_rounds: usize,
-    /// Attempts at reading the instruction as a goal.
-    pub interpret_attempts: usize,
+    /// Check every goal read from an instruction (parses, not contradictory, not true
+    /// already, plannable) and draw more candidates when the first fails; off: the
+    /// first usable answer is taken, as the paper's single call.
+    pub check_goals: bool,
+    /// Candidates drawn per question when the first answer fails its checks (goals), or
+    /// always (proposals for a failure, each tried in simulation before it is offered).
+    pub candidates: usize,
+    /// Times the model is told why its candidate goals were refused and asked again.
+    pub goal_feedback_rounds: usize,
+    /// `resolve`: work on the scenario's stated goal instead of reading the instruction
+    /// (so the failure under study is reached whatever a model would read); the
+    /// instruction still reaches the questions about failures.
+    pub use_scenario_goal: bool,
     pub temperature: f32,
     pub max_tokens: u32,
     pub min_similarity: f64,
@@ -32,11 +43,17 @@ pub struct Options {
     pub grammar: bool,
 }
 
+/// Candidates per question: the first answer and three sampled ones.
+pub const DEFAULT_CANDIDATES: usize = 4;
+
 impl Default for Options {
     fn default() -> Self {
         Options {
             max_rounds: 5,
-            interpret_attempts: 2,
+            check_goals: true,
+            candidates: DEFAULT_CANDIDATES,
+            goal_feedback_rounds: 2,
+            use_scenario_goal: false,
             temperature: 0.0,
             max_tokens: 800,
             min_similarity: reply::MIN_SIMILARITY,
@@ -112,6 +129,14 @@ pub enum Event {
     /// A reply that could not be used; the loop asks again while rounds remain.
     InvalidReply {
         error: String,
+    },
+    /// A candidate answer that was checked and set aside, and why (a goal that holds
+    /// already, a proposal that did not fix the failure in simulation, ...).
+    CandidateRejected {
+        candidate: String,
+        /// The candidate, when it was a proposal for a failure.
+        proposal: Option<Proposal>,
+        reason: String,
     },
     /// The instruction read as a goal; `matches_expected` compares with the scenario's goal.
     Goal {
@@ -240,7 +265,9 @@ pub enum SessionError {
     Plan(#[from] RepairError),
     #[error("scenario {0:?} has no instruction; give one")]
     NoInstruction(String),
-    #[error("no usable goal after {attempts} attempt(s); last reply: {last}")]
+    #[error("scenario {0:?} states no goal to work on instead of reading its instruction")]
+    NoStatedGoal(String),
+    #[error("no usable goal after {attempts} call(s); last reply: {last}")]
     NoGoal { attempts: usize, last: ReplyError },
     #[error("{0}")]
     Policy(#[from] super::policy::PolicyError),

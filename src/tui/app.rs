@@ -341,6 +341,11 @@ impl App {
                 self.llm.replied_by = Some(attribution);
             }
             Event::InvalidReply { error } => self.llm.log(format!("unusable reply: {error}")),
+            Event::CandidateRejected {
+                candidate, reason, ..
+            } => {
+                self.llm.log(format!("set aside {candidate}: {reason}"));
+            }
             Event::Goal {
                 goal, reasoning, ..
             } => {

@@ -262,6 +262,11 @@ impl Viz {
                 self.log(L::DEBUG, format!("reply from {attribution}"));
             }
             Event::InvalidReply { error } => self.log(L::WARN, format!("unusable reply: {error}")),
+            Event::CandidateRejected {
+                candidate, reason, ..
+            } => {
+                self.log(L::INFO, format!("set aside {candidate}: {reason}"));
+            }
             Event::Goal {
                 goal, reasoning, ..
             } => {

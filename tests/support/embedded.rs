@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
 use betr::llm::local::{EngineOptions, LocalModel};
-use betr::model::{self, Progress, QWEN_CODER_05B, WHISPER_TINY_EN};
+use betr::model::{self, DEFAULT_MODEL, Progress, WHISPER_TINY_EN};
 
 /// Fetch progress as plain lines on stderr (test output).
 pub struct Lines;
@@ -17,18 +17,18 @@ impl Progress for Lines {
     fn bytes(&mut self, _: u64, _: u64) {}
 }
 
-/// The default language model (Qwen2.5-Coder-0.5B) in llama.cpp.
+/// The default language model in llama.cpp.
 pub fn language_model() -> &'static Arc<LocalModel> {
     static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
     MODEL.get_or_init(|| {
-        if !QWEN_CODER_05B.is_present() {
-            model::fetch(&QWEN_CODER_05B, &model::cache_dir(), "python3", &mut Lines).unwrap();
+        if !DEFAULT_MODEL.is_present() {
+            model::fetch(DEFAULT_MODEL, &model::cache_dir(), "python3", &mut Lines).unwrap();
         }
         Arc::new(
             LocalModel::load(
-                QWEN_CODER_05B.name,
+                DEFAULT_MODEL.name,
                 EngineOptions {
-                    model_path: QWEN_CODER_05B.path(),
+                    model_path: DEFAULT_MODEL.path(),
                     threads: betr::llm::config::DEFAULT_THREADS,
                     context: 4096,
                 },

@@ -5,10 +5,11 @@
 
 use crate::bt::Tree;
 use crate::domain::action::parse_value;
-use crate::planner::{Outcome, Plan, Planner, RepairError, set_value};
+use crate::planner::Planner;
 
 use super::super::ask::missing_value;
 use super::super::policy::{Approval, now_rfc3339};
+use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
 use super::super::values::{self, conform};
 use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
@@ -251,54 +252,6 @@ fn approval_text(approval: Approval) -> &'static str {
         Approval::Person => "approved",
         Approval::Auto => "auto-approved",
         Approval::Edited => "written by a person",
-    }
-}
-
-/// The tree with a proposal applied, re-planned; and on how many actions a value was set.
-fn apply(
-    planner: &Planner,
-    tree: &Tree,
-    proposal: &Proposal,
-    world: &dyn crate::world::World,
-) -> Result<(Plan, usize), RepairError> {
-    match proposal {
-        Proposal::Conditions {
-            node, conditions, ..
-        } => Ok((planner.repair(tree.clone(), *node, conditions, world)?, 0)),
-        Proposal::Value {
-            skill,
-            object,
-            param,
-            value,
-        } => {
-            let mut tree = tree.clone();
-            let changed = set_value(&mut tree, skill, object, param, value);
-            Ok((planner.grow(tree, world), changed))
-        }
-    }
-}
-
-/// Whether a change helped: the failure is gone or has moved on.
-fn helped(before: Option<&Failure>, after: &Outcome) -> Result<(), String> {
-    match (before, after) {
-        (_, Outcome::Success) => Ok(()),
-        (Some(f), Outcome::ActionFailed { action, error, .. })
-            if f.action.same_invocation(action) && &f.error == error =>
-        {
-            Err(format!(
-                "{action}! still fails with the same error: {error}"
-            ))
-        }
-        (_, Outcome::ActionFailed { .. }) => Ok(()),
-        (
-            _,
-            Outcome::Unreachable {
-                condition, reason, ..
-            },
-        ) => Err(format!(
-            "after the change, {condition} cannot be achieved: {reason}"
-        )),
-        (_, Outcome::Exhausted { reason }) => Err(format!("after the change, {reason}")),
     }
 }
 

@@ -15,30 +15,34 @@ use super::requests::Internal;
 use super::{Engine, Failure, Task};
 
 impl Engine {
+    pub(super) fn submit_goal(&mut self, goal: crate::goal::Formula, instruction: String) {
+        self.start_task(goal, Some(instruction));
+    }
+
+    /// Plan `goal`, reporting how it compares with the scenario's goal.
+    fn start_task(&mut self, goal: crate::goal::Formula, instruction: Option<String>) {
+        let matches_expected = self
+            .scenario
+            .goal
+            .as_ref()
+            .and_then(|expected| goal::equivalent(expected, &goal).ok());
+        self.emit(Event::Goal {
+            goal: goal.clone(),
+            reasoning: None,
+            substitutions: Vec::new(),
+            matches_expected,
+        });
+        self.task = Some(Task { goal, instruction });
+        self.plan();
+    }
+
     pub(super) fn submit(&mut self, text: &str) {
         let text = text.trim();
         if text.is_empty() {
             return self.error("nothing to submit: type an instruction or a goal");
         }
         let not_a_goal = match self.scenario.parse_goal(text) {
-            Ok(goal) => {
-                let matches_expected = self
-                    .scenario
-                    .goal
-                    .as_ref()
-                    .and_then(|expected| goal::equivalent(expected, &goal).ok());
-                self.emit(Event::Goal {
-                    goal: goal.clone(),
-                    reasoning: None,
-                    substitutions: Vec::new(),
-                    matches_expected,
-                });
-                self.task = Some(Task {
-                    goal,
-                    instruction: None,
-                });
-                return self.plan();
-            }
+            Ok(goal) => return self.start_task(goal, None),
             Err(e) => e,
         };
         if let Some(goal) = self.goal_from_policy(text) {

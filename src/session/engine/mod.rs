@@ -25,7 +25,7 @@ use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::bt::{NodeId, TickRecord, Ticker, Tree};
-use crate::domain::{ActionCall, Condition, Scenario};
+use crate::domain::{Condition, Scenario};
 use crate::goal::Formula;
 use crate::llm::LanguageModel;
 use crate::llm::usage::{Ledger, UsageTotals};
@@ -89,6 +89,12 @@ impl Setup {
 pub enum Command {
     /// An instruction, or a goal formula over the scenario's vocabulary; then plan.
     Submit(String),
+    /// Work on `goal` for `instruction` as if the instruction had been read as it (no
+    /// model call); the instruction still reaches the questions about failures.
+    SubmitGoal {
+        goal: crate::goal::Formula,
+        instruction: String,
+    },
     /// Plan the current goal (the scenario's when none was submitted).
     Plan,
     /// One tick of the tree in the execution world.
@@ -118,12 +124,7 @@ pub enum Command {
 }
 
 /// An action that failed in the execution world.
-#[derive(Debug, Clone, PartialEq)]
-struct Failure {
-    node: NodeId,
-    action: ActionCall,
-    error: String,
-}
+use super::screen::FailureAt as Failure;
 
 /// The goal being worked on, and the instruction it came from.
 #[derive(Debug, Clone)]
@@ -302,6 +303,7 @@ impl Engine {
     pub fn handle(&mut self, command: Command) {
         match command {
             Command::Submit(text) => self.submit(&text),
+            Command::SubmitGoal { goal, instruction } => self.submit_goal(goal, instruction),
             Command::Plan => self.plan(),
             Command::Tick => {
                 if self.running {

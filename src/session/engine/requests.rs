@@ -10,8 +10,10 @@ use crate::llm::reply::GoalAnswer;
 use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
-use super::super::ask::{Asked, FailedAction, ask_conditions, ask_value, interpret, missing_value};
+use super::super::ask::{Asked, FailedAction, ask_conditions, ask_value, missing_value};
+use super::super::interpret::interpret;
 use super::super::policy::Approval;
+use super::super::screen::Screen;
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Pending, Request, Task};
 
@@ -86,7 +88,8 @@ impl Engine {
     pub(super) fn ask_goal(&mut self, model: Arc<dyn LanguageModel>, instruction: &str) {
         let id = self.next_request_id();
         let scenario = self.scenario.clone();
-        let facts = self.planning.facts();
+        // The candidates are checked by planning in a copy of the planning world.
+        let world = self.planning.fork();
         let options = self.options.clone();
         let events = self.events.clone();
         let tx = self.internal_tx.clone();
@@ -97,13 +100,14 @@ impl Engine {
                 let mut emit = forward(events, &mut replies);
                 interpret(
                     &scenario,
-                    &facts,
+                    world,
                     &instruction,
                     model.as_ref(),
                     &options,
                     &mut emit,
                 )
                 .await
+                .map(|i| i.answer)
             };
             let _ = tx.send(Internal::Goal {
                 id,
@@ -134,6 +138,9 @@ impl Engine {
                 ),
             });
         }
+        let Some(tree) = self.tree.clone() else {
+            return self.error("no tree to change");
+        };
         self.rounds += 1;
         let id = self.next_request_id();
         let scenario = self.scenario.clone();
@@ -153,6 +160,13 @@ impl Engine {
             .filter(|(f, _)| *f == failure)
             .map(|(_, t)| t.clone())
             .collect();
+        // Candidates are tried in a copy of the tree and of the planning world.
+        let mut screen = Screen {
+            scenario: scenario.clone(),
+            tree,
+            world: self.planning.fork(),
+            failure: failure.clone(),
+        };
         let handle = tokio::spawn(async move {
             let mut replies = Vec::new();
             let result = {
@@ -163,16 +177,21 @@ impl Engine {
                     instruction: &instruction,
                     variant: &options.variant,
                 };
-                let (node, action, error) = (failure.node, &failure.action, &failure.error);
-                match missing_value(&scenario, action, error) {
+                let failed = FailedAction {
+                    node: failure.node,
+                    action: &failure.action,
+                    error: &failure.error,
+                    tried: &tried,
+                };
+                match missing_value(&scenario, &failure.action, &failure.error) {
                     Some(param) => {
                         ask_value(
                             &ctx,
                             model.as_ref(),
                             &options,
-                            action,
+                            &failed,
                             param,
-                            error,
+                            &mut screen,
                             &mut emit,
                         )
                         .await
@@ -182,12 +201,8 @@ impl Engine {
                             &ctx,
                             model.as_ref(),
                             &options,
-                            &FailedAction {
-                                node,
-                                action,
-                                error,
-                                tried: &tried,
-                            },
+                            &failed,
+                            &mut screen,
                             &mut emit,
                         )
                         .await
@@ -244,13 +259,27 @@ impl Engine {
                 }
                 self.request = None;
                 match result {
-                    Ok(Some((proposal, reasoning, substitutions))) => {
+                    Ok(asked) => {
+                        // What did not help in simulation is told to the model next time.
+                        for (proposal, why) in asked.rejected {
+                            self.tried
+                                .push((failure.clone(), format!("{proposal} ({why})")));
+                        }
+                        let Some((proposal, reasoning, substitutions)) = asked.chosen else {
+                            // No candidate fixed the failure: ask again while rounds remain.
+                            return self.ask_about(failure);
+                        };
                         let author = replies
                             .last()
                             .map_or_else(|| "unknown".into(), |r| r.attribution.clone());
+                        let checked =
+                            "Tried in simulation before it was offered: it fixes the failure.";
                         self.emit(Event::Proposal {
                             proposal: proposal.clone(),
-                            reasoning,
+                            reasoning: Some(match reasoning {
+                                Some(r) => format!("{r}\n{checked}"),
+                                None => checked.to_string(),
+                            }),
                             substitutions,
                         });
                         self.pending = Some(Pending {
@@ -262,8 +291,6 @@ impl Engine {
                             self.apply_pending(Approval::Auto);
                         }
                     }
-                    // An unusable reply was reported; ask again while rounds remain.
-                    Ok(None) => self.ask_about(failure),
                     Err(error) => self.emit(Event::Failed { error }),
                 }
             }

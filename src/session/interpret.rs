@@ -1,0 +1,364 @@
+//! Reading an instruction as a goal, checked before it is used.
+//!
+//! One call gives the model's first answer. An answer is kept only if it parses over the
+//! vocabulary, is not contradictory, does not hold already (a request asks for a change)
+//! and can be planned with the scenario's skills. When the first answer fails a check,
+//! more candidates are drawn from the same prompt (sampled, so they differ; the prompt is
+//! in the model's cache, so each costs only its own tokens) and the survivors vote: the
+//! largest group of logically equivalent goals wins, the earliest drawn breaking ties.
+//! When none survives, the model is told why, in the same conversation, and asked again
+//! (reflective feedback), for a bounded number of rounds.
+
+use crate::domain::{Condition, Scenario};
+use crate::goal::{self, Formula};
+use crate::llm::prompt::Context;
+use crate::llm::reply::{self, GoalAnswer, ReplyError};
+use crate::llm::{LanguageModel, Message, Role, grammar, schema};
+use crate::planner::{Outcome, Planner};
+use crate::world::World;
+
+use super::ask::ask;
+use super::types::{Event, Options, SessionError};
+
+/// Sampling temperature of the extra candidates: enough to make them differ from the
+/// first answer, low enough to stay on the request.
+const SAMPLE_TEMPERATURE: f32 = 0.7;
+
+/// A goal read from an instruction, with how it was found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Interpretation {
+    pub answer: GoalAnswer,
+    /// The first call's answer as it came (before any check), `None` if unusable.
+    pub first: Option<Formula>,
+    /// Calls made, the first included.
+    pub calls: usize,
+    /// Feedback rounds used (0: the first round's candidates sufficed).
+    pub feedback_rounds: usize,
+    /// Why the chosen goal is not checked, when it is not (every candidate failed a
+    /// check and the rounds ran out: the first usable answer is returned with the reason).
+    pub unchecked: Option<String>,
+}
+
+/// Why a candidate goal cannot be what the person meant.
+pub fn check_goal(scenario: &Scenario, world: &dyn World, goal: &Formula) -> Result<(), String> {
+    let dnf = goal.to_dnf();
+    if dnf.is_false() {
+        return Err("it contradicts itself: no situation makes it true".into());
+    }
+    // The world answers for "any object" as well as for plain atoms.
+    let holds = |atom: &crate::domain::Atom| world.check(&Condition::pos(atom.clone()));
+    if goal.eval(&holds) {
+        return Err("it holds already in the scene now, but the request asks for a change".into());
+    }
+    let planner = Planner::new(&scenario.domain);
+    let plan = planner.plan(&dnf, world).map_err(|e| e.to_string())?;
+    match plan.outcome {
+        // An action that fails in simulation is what failure resolution is for: the goal
+        // itself was plannable.
+        Outcome::Success | Outcome::ActionFailed { .. } => Ok(()),
+        Outcome::Unreachable {
+            condition, reason, ..
+        } => Err(format!("the robot cannot make {condition} true: {reason}")),
+        Outcome::Exhausted { reason } => Err(format!("the robot cannot reach it: {reason}")),
+    }
+}
+
+/// One candidate: the reply's text and what it was read as.
+struct Candidate {
+    text: String,
+    read: Result<GoalAnswer, ReplyError>,
+    problem: Option<String>,
+}
+
+/// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
+/// as the module says (`options.check_goals` off: the first usable answer, as the paper's
+/// single call).
+pub async fn interpret(
+    scenario: &Scenario,
+    world: Box<dyn World>,
+    instruction: &str,
+    model: &dyn LanguageModel,
+    options: &Options,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<Interpretation, SessionError> {
+    let facts = world.facts();
+    let ctx = Context {
+        scenario,
+        facts: &facts,
+        instruction,
+        variant: &options.variant,
+    };
+    let mut messages = ctx.goal(&options.templates)?;
+    let vocabulary = &scenario.domain.vocabulary;
+    let constraint = schema::goal(vocabulary);
+    let cot = options.variant.chain_of_thought;
+    let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
+    let mut calls = 0;
+    let mut first: Option<Option<Formula>> = None;
+    let mut fallback: Option<(GoalAnswer, String)> = None;
+    let rounds = if options.check_goals {
+        options.goal_feedback_rounds + 1
+    } else {
+        1
+    };
+    let mut last_error = ReplyError::NoConditions;
+    for round in 0..rounds {
+        let mut candidates: Vec<Candidate> = Vec::new();
+        let draws = if options.check_goals {
+            options.candidates.max(1)
+        } else {
+            1
+        };
+        for draw in 0..draws {
+            emit(&Event::Asking {
+                what: if draw == 0 {
+                    "the goal of the instruction".into()
+                } else {
+                    format!("another candidate goal ({} of {draws})", draw + 1)
+                },
+            });
+            let mut opts = options.clone();
+            let seed = if draw > 0 {
+                opts.temperature = opts.temperature.max(SAMPLE_TEMPERATURE);
+                Some(draw as u64)
+            } else {
+                None
+            };
+            let r = ask(
+                model,
+                messages.clone(),
+                (constraint.clone(), &goal_grammar),
+                &opts,
+                seed,
+                emit,
+            )
+            .await?;
+            calls += 1;
+            let read = reply::goal(&r.text, vocabulary, options.min_similarity);
+            let problem = match &read {
+                Err(e) => Some(e.to_string()),
+                Ok(_) if !options.check_goals => None,
+                Ok(a) => check_goal(scenario, world.as_ref(), &a.goal).err(),
+            };
+            if first.is_none() {
+                first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
+            }
+            match (&read, &problem) {
+                (Err(e), _) => {
+                    emit(&Event::InvalidReply {
+                        error: e.to_string(),
+                    });
+                    last_error = e.clone();
+                }
+                (Ok(a), Some(p)) => {
+                    emit(&Event::CandidateRejected {
+                        candidate: a.goal.to_string(),
+                        proposal: None,
+                        reason: p.clone(),
+                    });
+                    if fallback.is_none() {
+                        fallback = Some((a.clone(), p.clone()));
+                    }
+                }
+                (Ok(_), None) => {}
+            }
+            candidates.push(Candidate {
+                text: r.text,
+                read,
+                problem,
+            });
+            // A first answer that passes every check is taken as it is: more draws are
+            // only for when it does not.
+            if draw == 0 && candidates[0].problem.is_none() {
+                break;
+            }
+        }
+        if let Some(answer) = vote(&candidates) {
+            emit_goal(scenario, &answer, emit);
+            return Ok(Interpretation {
+                answer,
+                first: first.flatten(),
+                calls,
+                feedback_rounds: round,
+                unchecked: None,
+            });
+        }
+        if round + 1 < rounds {
+            feedback(&mut messages, &candidates);
+        }
+    }
+    match fallback {
+        // Every candidate failed a check: the person sees the first usable answer and
+        // why it looks wrong, and decides (the goal can be edited before it runs).
+        Some((answer, why)) => {
+            emit_goal(scenario, &answer, emit);
+            Ok(Interpretation {
+                answer,
+                first: first.flatten(),
+                calls,
+                feedback_rounds: rounds - 1,
+                unchecked: Some(why),
+            })
+        }
+        None => Err(SessionError::NoGoal {
+            attempts: calls,
+            last: last_error,
+        }),
+    }
+}
+
+fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Event) + Send)) {
+    let matches_expected = scenario
+        .goal
+        .as_ref()
+        .and_then(|expected| goal::equivalent(expected, &answer.goal).ok());
+    emit(&Event::Goal {
+        goal: answer.goal.clone(),
+        reasoning: answer.reasoning.clone(),
+        substitutions: answer.substitutions.clone(),
+        matches_expected,
+    });
+}
+
+/// The answer of the largest group of equivalent candidates that passed the checks; ties
+/// go to the group drawn first (the greedy answer, when it passed).
+fn vote(candidates: &[Candidate]) -> Option<GoalAnswer> {
+    let passed: Vec<&GoalAnswer> = candidates
+        .iter()
+        .filter(|c| c.problem.is_none())
+        .filter_map(|c| c.read.as_ref().ok())
+        .collect();
+    let mut best: Option<(usize, &GoalAnswer)> = None;
+    for (i, a) in passed.iter().enumerate() {
+        // Counted once per group, at its first member.
+        if passed[..i].iter().any(|b| same(a, b)) {
+            continue;
+        }
+        let votes = passed.iter().filter(|b| same(a, b)).count();
+        if best.is_none_or(|(v, _)| votes > v) {
+            best = Some((votes, a));
+        }
+    }
+    best.map(|(_, a)| a.clone())
+}
+
+fn same(a: &GoalAnswer, b: &GoalAnswer) -> bool {
+    a.goal == b.goal || goal::equivalent(&a.goal, &b.goal).unwrap_or(false)
+}
+
+/// Continue the conversation: the first candidate as the model's answer, and what was
+/// wrong with each distinct candidate.
+fn feedback(messages: &mut Vec<Message>, candidates: &[Candidate]) {
+    let Some(first) = candidates.first() else {
+        return;
+    };
+    let mut problems: Vec<String> = Vec::new();
+    for c in candidates {
+        let shown = match &c.read {
+            Ok(a) => a.goal.to_string(),
+            Err(_) => c.text.trim().lines().last().unwrap_or("").to_string(),
+        };
+        let line = format!(
+            "- {shown}: {}",
+            c.problem.as_deref().unwrap_or("(no problem found)")
+        );
+        if !problems.contains(&line) {
+            problems.push(line);
+        }
+    }
+    messages.push(Message {
+        role: Role::Assistant,
+        content: first.text.trim().to_string(),
+    });
+    messages.push(Message::user(format!(
+        "That cannot be the goal the person means:\n{}\nRead the request again and write a goal that fixes this, in the same answer format.",
+        problems.join("\n")
+    )));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn cafe() -> (Scenario, Box<dyn World>) {
+        let s =
+            Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+                .expect("cafe scenario");
+        let w = crate::world::load(&s).expect("cafe world");
+        (s, w)
+    }
+
+    fn check(goal: &str) -> Result<(), String> {
+        let (s, w) = cafe();
+        let f = s.parse_goal(goal).expect("goal parses");
+        check_goal(&s, w.as_ref(), &f)
+    }
+
+    #[test]
+    fn checks_refuse_what_cannot_be_meant() {
+        assert!(check("On_Coffee_Table1").is_ok());
+        assert!(check("Active_AC & ~Active_HallLight").is_ok());
+        let e = check("Active_AC & ~Active_AC").unwrap_err();
+        assert!(e.contains("contradicts"), "{e}");
+        // Already true in the cafe's first state.
+        let e = check("On_Chips_Bar").unwrap_err();
+        assert!(e.contains("already"), "{e}");
+        let e = check("RobotNear_Table1 & RobotNear_Table2").unwrap_err();
+        assert!(e.contains("cannot"), "{e}");
+    }
+
+    fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {
+        Candidate {
+            text: format!("Goal: {}", goal.unwrap_or("?")),
+            read: match goal {
+                Some(g) => Ok(GoalAnswer {
+                    goal: Formula::parse(g).expect("parses"),
+                    reasoning: None,
+                    substitutions: Vec::new(),
+                }),
+                None => Err(ReplyError::NoConditions),
+            },
+            problem: problem.map(str::to_string),
+        }
+    }
+
+    #[test]
+    fn the_largest_group_of_equivalent_survivors_wins() {
+        let cs = vec![
+            candidate(Some("Active_AC"), Some("holds already")),
+            candidate(Some("On_Apple_Bar2"), None),
+            candidate(Some("Active_TubeLight & ~Closed_Curtain"), None),
+            candidate(Some("~Closed_Curtain & Active_TubeLight"), None),
+            candidate(None, Some("unusable")),
+        ];
+        let chosen = vote(&cs).expect("a winner");
+        assert_eq!(
+            chosen.goal.to_string(),
+            "Active_TubeLight & ~Closed_Curtain"
+        );
+        // A tie goes to the earliest.
+        let cs = vec![
+            candidate(Some("On_Apple_Bar2"), None),
+            candidate(Some("On_Apple_Table3"), None),
+        ];
+        assert_eq!(
+            vote(&cs).expect("a winner").goal.to_string(),
+            "On_Apple_Bar2"
+        );
+        assert!(vote(&[candidate(Some("Active_AC"), Some("no"))]).is_none());
+    }
+
+    #[test]
+    fn feedback_tells_each_problem_once() {
+        let mut messages = vec![Message::user("request")];
+        let cs = vec![
+            candidate(Some("On_Chips_Bar"), Some("it holds already")),
+            candidate(Some("On_Chips_Bar"), Some("it holds already")),
+        ];
+        feedback(&mut messages, &cs);
+        assert_eq!(messages.len(), 3);
+        assert_eq!(messages[1].role, Role::Assistant);
+        assert_eq!(messages[2].content.matches("On_Chips_Bar").count(), 1);
+    }
+}

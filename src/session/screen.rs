@@ -1,0 +1,96 @@
+//! Trying a proposed change in simulation: the tree with the change applied is re-planned
+//! in a copy of the planning world (the cell's own motion checks, the symbolic world's
+//! hidden rules), and the change counts as helping only if the failure it was asked about
+//! is gone or has moved on. Proposals are screened this way before anyone is asked to
+//! approve them, and an approved change is checked the same way before it is kept.
+
+use crate::bt::{NodeId, Tree};
+use crate::domain::ActionCall;
+use crate::planner::{Outcome, Plan, Planner, RepairError, set_value};
+use crate::world::World;
+
+use super::types::Proposal;
+
+/// The failure a change is meant to fix.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FailureAt {
+    pub node: NodeId,
+    pub action: ActionCall,
+    pub error: String,
+}
+
+/// The tree with a proposal applied, re-planned; and on how many actions a value was set.
+pub fn apply(
+    planner: &Planner,
+    tree: &Tree,
+    proposal: &Proposal,
+    world: &dyn World,
+) -> Result<(Plan, usize), RepairError> {
+    match proposal {
+        Proposal::Conditions {
+            node, conditions, ..
+        } => Ok((planner.repair(tree.clone(), *node, conditions, world)?, 0)),
+        Proposal::Value {
+            skill,
+            object,
+            param,
+            value,
+        } => {
+            let mut tree = tree.clone();
+            let changed = set_value(&mut tree, skill, object, param, value);
+            Ok((planner.grow(tree, world), changed))
+        }
+    }
+}
+
+/// Whether a change helped: the failure is gone or has moved on.
+pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), String> {
+    match (before, after) {
+        (_, Outcome::Success) => Ok(()),
+        (Some(f), Outcome::ActionFailed { action, error, .. })
+            if f.action.same_invocation(action) && &f.error == error =>
+        {
+            Err(format!(
+                "{action}! still fails with the same error: {error}"
+            ))
+        }
+        (_, Outcome::ActionFailed { .. }) => Ok(()),
+        (
+            _,
+            Outcome::Unreachable {
+                condition, reason, ..
+            },
+        ) => Err(format!(
+            "after the change, {condition} cannot be achieved: {reason}"
+        )),
+        (_, Outcome::Exhausted { reason }) => Err(format!("after the change, {reason}")),
+    }
+}
+
+/// A copy of the tree and the planning world in which proposals are tried before they
+/// are offered. Owned, so a model call can carry it across its awaits.
+pub struct Screen {
+    pub scenario: std::sync::Arc<crate::domain::Scenario>,
+    pub tree: Tree,
+    pub world: Box<dyn World>,
+    pub failure: FailureAt,
+}
+
+impl Screen {
+    /// Ok when `proposal` fixes the failure in simulation; otherwise what happened, in
+    /// words the model can be told. A value passes only when the action that needed it
+    /// no longer fails at all (a different error of the same action, such as "the hammer
+    /// slips" after "no grasp force", means the value is wrong).
+    pub fn check(&self, proposal: &Proposal) -> Result<(), String> {
+        let planner = Planner::new(&self.scenario.domain);
+        let (plan, _) = apply(&planner, &self.tree, proposal, self.world.as_ref())
+            .map_err(|e| e.to_string())?;
+        if let (Proposal::Value { .. }, Outcome::ActionFailed { action, error, .. }) =
+            (proposal, &plan.outcome)
+            && self.failure.action.same_invocation(action)
+        {
+            return Err(format!("{action}! failed: {error}"));
+        }
+        helped(Some(&self.failure), &plan.outcome)
+    }
+}
