@@ -30,16 +30,24 @@ const STOPWORDS: &[&str] = &[
 pub fn terms(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut current = String::new();
-    let mut previous_lower = false;
+    let mut previous: Option<char> = None;
     for c in text.chars() {
-        let boundary = !c.is_alphanumeric() || (c.is_uppercase() && previous_lower);
+        // A word ends at anything else than a letter or digit, at a lower-to-upper case
+        // change (`TubeLight`) and between letters and digits (`Table3`).
+        let boundary = !c.is_alphanumeric()
+            || previous.is_some_and(|p| {
+                (c.is_uppercase() && (p.is_lowercase() || p.is_ascii_digit()))
+                    || (c.is_ascii_digit() != p.is_ascii_digit() && p.is_alphanumeric())
+            });
         if boundary && !current.is_empty() {
             words.push(std::mem::take(&mut current));
         }
         if c.is_alphanumeric() {
             current.extend(c.to_lowercase());
+            previous = Some(c);
+        } else {
+            previous = None;
         }
-        previous_lower = c.is_lowercase() || c.is_ascii_digit();
     }
     if !current.is_empty() {
         words.push(current);
@@ -47,8 +55,29 @@ pub fn terms(text: &str) -> Vec<String> {
     words
         .into_iter()
         .filter(|w| !STOPWORDS.contains(&w.as_str()))
-        .map(|w| stem(&w))
+        .map(|w| number(&w).map_or_else(|| stem(&w), str::to_string))
         .collect()
+}
+
+/// Numbers written as words, cardinal or ordinal, as digits ("table three", "the third
+/// table" and `Table3` share the word 3).
+fn number(word: &str) -> Option<&'static str> {
+    const NUMBERS: [(&str, &str, &str); 10] = [
+        ("one", "first", "1"),
+        ("two", "second", "2"),
+        ("three", "third", "3"),
+        ("four", "fourth", "4"),
+        ("five", "fifth", "5"),
+        ("six", "sixth", "6"),
+        ("seven", "seventh", "7"),
+        ("eight", "eighth", "8"),
+        ("nine", "ninth", "9"),
+        ("ten", "tenth", "10"),
+    ];
+    NUMBERS
+        .iter()
+        .find(|(cardinal, ordinal, _)| word == *cardinal || word == *ordinal)
+        .map(|(_, _, digit)| *digit)
 }
 
 fn stem(word: &str) -> String {
@@ -150,7 +179,9 @@ mod tests {
             terms("\"blue cube\" on \"table\""),
             ["blue", "cube", "table"]
         );
-        assert_eq!(terms("WindowTable4"), ["window", "table4"]);
+        assert_eq!(terms("WindowTable4"), ["window", "table", "4"]);
+        assert_eq!(terms("the third table"), ["3", "table"]);
+        assert_eq!(terms("QuietTable9, table nine"), ["quiet", "table", "9", "table", "9"]);
     }
 
     #[test]

@@ -11,6 +11,7 @@
 
 use crate::domain::{Condition, Scenario};
 use crate::goal::{self, Formula};
+use crate::llm::examples::terms;
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
@@ -63,6 +64,47 @@ pub fn check_goal(scenario: &Scenario, world: &dyn World, goal: &Formula) -> Res
     }
 }
 
+/// A condition of `goal` that one of the `shown` examples' goals holds and that shares no
+/// word with the request: pasted from the example rather than asked for (small models
+/// copy an example's place, or its extra "hand empty", into unrelated answers).
+pub fn copied_from_example(
+    goal: &Formula,
+    shown: &[&crate::domain::Example],
+    request: &str,
+) -> Option<String> {
+    let asked: Vec<String> = terms(request);
+    goal.atoms()
+        .into_iter()
+        .find(|atom| is_copied(atom, shown, &asked))
+        .map(|atom| format!("{atom} comes from an example, and the request says nothing about it"))
+}
+
+fn is_copied(atom: &crate::domain::Atom, shown: &[&crate::domain::Example], asked: &[String]) -> bool {
+    let in_example = shown
+        .iter()
+        .any(|e| Formula::parse(&e.goal).is_ok_and(|f| f.atoms().contains(atom)));
+    in_example && !terms(&atom.to_string()).iter().any(|w| asked.contains(w))
+}
+
+/// A conjunction without its conjuncts pasted from an example, when something is left:
+/// the rest of an answer is often right ("put A on B" read as "A on B & hand empty").
+fn without_copied(
+    goal: &Formula,
+    shown: &[&crate::domain::Example],
+    request: &str,
+) -> Option<Formula> {
+    let Formula::And(items) = goal else {
+        return None;
+    };
+    let asked = terms(request);
+    let kept: Vec<Formula> = items
+        .iter()
+        .filter(|item| !item.atoms().iter().any(|a| is_copied(a, shown, &asked)))
+        .cloned()
+        .collect();
+    (!kept.is_empty() && kept.len() < items.len()).then(|| Formula::and(kept))
+}
+
 /// One candidate: the reply's text and what it was read as.
 struct Candidate {
     text: String,
@@ -89,6 +131,12 @@ pub async fn interpret(
         variant: &options.variant,
     };
     let mut messages = ctx.goal(&options.templates)?;
+    let pool = options
+        .variant
+        .examples
+        .as_deref()
+        .unwrap_or(&scenario.examples);
+    let shown = options.variant.choose(pool, instruction);
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
@@ -138,7 +186,9 @@ pub async fn interpret(
             let problem = match &read {
                 Err(e) => Some(e.to_string()),
                 Ok(_) if !options.check_goals => None,
-                Ok(a) => check_goal(scenario, world.as_ref(), &a.goal).err(),
+                Ok(a) => check_goal(scenario, world.as_ref(), &a.goal)
+                    .err()
+                    .or_else(|| copied_from_example(&a.goal, &shown, instruction)),
             };
             if first.is_none() {
                 first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
@@ -162,14 +212,42 @@ pub async fn interpret(
                 }
                 (Ok(_), None) => {}
             }
+            // The first answer without what it pasted from an example is a candidate
+            // of its own, checked like the others and drawn right after it.
+            let pruned = match (&read, draw) {
+                (Ok(a), 0) if problem.is_some() => without_copied(&a.goal, &shown, instruction),
+                _ => None,
+            };
             candidates.push(Candidate {
                 text: r.text,
                 read,
                 problem,
             });
-            // A first answer that passes every check is taken as it is: more draws are
-            // only for when it does not.
-            if draw == 0 && candidates[0].problem.is_none() {
+            if let Some(goal) = pruned {
+                let problem = check_goal(scenario, world.as_ref(), &goal)
+                    .err()
+                    .or_else(|| copied_from_example(&goal, &shown, instruction));
+                if let Some(p) = &problem {
+                    emit(&Event::CandidateRejected {
+                        candidate: goal.to_string(),
+                        proposal: None,
+                        reason: p.clone(),
+                    });
+                }
+                candidates.push(Candidate {
+                    text: format!("Goal: {goal}"),
+                    read: Ok(GoalAnswer {
+                        goal,
+                        reasoning: None,
+                        substitutions: Vec::new(),
+                    }),
+                    problem,
+                });
+            }
+            // A first answer that passes every check (or passes once what it pasted from
+            // an example is taken out) is taken as it is: more draws are only for when
+            // it does not.
+            if draw == 0 && candidates.iter().any(|c| c.problem.is_none()) {
                 break;
             }
         }
@@ -306,6 +384,26 @@ mod tests {
         assert!(e.contains("already"), "{e}");
         let e = check("RobotNear_Table1 & RobotNear_Table2").unwrap_err();
         assert!(e.contains("cannot"), "{e}");
+    }
+
+    #[test]
+    fn a_condition_pasted_from_an_example_is_found() {
+        let example = crate::domain::Example {
+            instruction: "Put the sponge in the bowl and leave your gripper empty".into(),
+            goal: r#""sponge" in "bowl" & ~"any object" grasped"#.into(),
+        };
+        let shown = [&example];
+        let request = "Put the blue cube on the green cube";
+        let pasted = Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#)
+            .expect("parses");
+        let why = copied_from_example(&pasted, &shown, request).expect("found");
+        assert!(why.contains("grasped"), "{why}");
+        let plain = Formula::parse(r#""blue cube" on "green cube""#).expect("parses");
+        assert!(copied_from_example(&plain, &shown, request).is_none());
+        // Asked for in other words ("hand empty" is not "grasped", but the object is
+        // named): not a copy.
+        let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
+        assert!(copied_from_example(&named, &shown, "take the sponge out").is_none());
     }
 
     fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {
