@@ -1,23 +1,37 @@
 #!/usr/bin/env bash
-# Run the three experiments of `betr eval` with the embedded default model and copy the
-# tables and charts into docs/ (docs/EVAL.md, "Results with the embedded default model").
-# Needs `--backend local` (the embedded model, issue 5) and the model in the cache
-# (`betr model fetch`). Usage: bash scripts/eval_default_model.sh [RUNS]
+# Run the experiments of `betr eval` with the embedded models and copy the tables and
+# charts into docs/ (docs/EVAL.md, "Results with the embedded models"). The models are
+# fetched into the cache on first use. Each command resumes from its directory if
+# interrupted: run this script again.
+# Usage: bash scripts/eval_default_model.sh [RUNS] [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-runs="${1:-10}"
-out="eval-results/default-model"
+runs="${1:-3}"
+threads="${2:-2}"
+out="eval-results/embedded"
 mkdir -p "$out" docs/images
 cargo build --release --locked
 betr=target/release/betr
-# Each command resumes from its directory if interrupted: run this script again.
-"$betr" eval goals --backend local --out "$out/goals"
-"$betr" eval resolve --backend local --runs "$runs" --out "$out/resolve"
-"$betr" eval params --backend local --runs "$runs" --out "$out/params"
-cp "$out/goals/accuracy.png" docs/images/eval-goals-default-model.png
+local=(--backend local --threads "$threads")
+
+# Goals: the default model as the product reads instructions (examples retrieved per
+# request, candidates checked, vote, feedback; the first call is scored too), then each
+# lever taken away, then the fast model.
+"$betr" eval goals "${local[@]}" --out "$out/goals-1.5b"
+"$betr" eval goals "${local[@]}" --fixed-examples --no-checks --out "$out/goals-1.5b-fixed-examples"
+"$betr" eval goals "${local[@]}" --model qwen2.5-coder-0.5b --out "$out/goals-0.5b"
+
+# Failures and values: the goal read from the instruction (a misread goal is its own
+# column), and the scenario's stated goal (the failure is always reached).
+"$betr" eval resolve "${local[@]}" --runs "$runs" --out "$out/resolve"
+"$betr" eval params "${local[@]}" --runs "$runs" --out "$out/params"
+"$betr" eval resolve "${local[@]}" --runs "$runs" --goal scenario --out "$out/resolve-scenario-goal"
+"$betr" eval params "${local[@]}" --runs "$runs" --goal scenario --out "$out/params-scenario-goal"
+
+cp "$out/goals-1.5b/accuracy.png" docs/images/eval-goals-default-model.png
 cp "$out/resolve/resolve.png" docs/images/eval-resolve-default-model.png
 cp "$out/params/params.png" docs/images/eval-params-default-model.png
-for e in goals resolve params; do
+for e in goals-1.5b goals-1.5b-fixed-examples goals-0.5b resolve params resolve-scenario-goal params-scenario-goal; do
   echo "=== $e ($out/$e/table.md)"
   cat "$out/$e/table.md"
 done

@@ -42,7 +42,7 @@ async fn interprets_scenario_1_exactly() {
         "\"blue cube\" on \"green cube\""
     );
     assert!(reading.answer.substitutions.is_empty());
-    assert!(reading.unchecked.is_none());
+    assert!(reading.doubt.is_none());
 }
 
 #[tokio::test]

@@ -258,10 +258,8 @@ pub fn interpret(
     ));
     print_usage(&llm.model);
     let reading = result?;
-    if let Some(why) = &reading.unchecked {
-        println!(
-            "warning: no candidate passed the checks, so this goal is the model's first usable answer and looks wrong: {why}"
-        );
+    if let Some(why) = &reading.doubt {
+        println!("note: kept with a doubt: {why}");
     }
     println!(
         "{} call(s), {} feedback round(s)",

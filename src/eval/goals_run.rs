@@ -86,8 +86,8 @@ async fn ask_one(
             result.first_correct = Some(is_correct(vocabulary, case, first.as_deref()));
             result.first_answer = first;
             result.feedback_rounds = r.feedback_rounds;
-            if let Some(why) = r.unchecked {
-                result.problem = Some(format!("no candidate passed the checks: {why}"));
+            if let Some(why) = r.doubt {
+                result.problem = Some(format!("kept with a doubt: {why}"));
             }
             result
         }

@@ -35,33 +35,66 @@ pub struct Interpretation {
     pub calls: usize,
     /// Feedback rounds used (0: the first round's candidates sufficed).
     pub feedback_rounds: usize,
-    /// Why the chosen goal is not checked, when it is not (every candidate failed a
-    /// check and the rounds ran out: the first usable answer is returned with the reason).
-    pub unchecked: Option<String>,
+    /// A doubt the checks raised about the chosen goal (it holds already, or a condition
+    /// of it comes from an example), for the person to look at before it runs.
+    pub doubt: Option<String>,
 }
 
-/// Why a candidate goal cannot be what the person meant.
-pub fn check_goal(scenario: &Scenario, world: &dyn World, goal: &Formula) -> Result<(), String> {
+/// Why a candidate goal cannot be what the person meant, or may not be.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoalProblem {
+    pub reason: String,
+    /// A doubt rather than a proof: the goal holds already (a person may ask for what is
+    /// true), or a condition of it comes from a shown example (an indirect request may
+    /// mean just that). A doubtful first answer is kept unless the part it pasted can be
+    /// taken out; a wrong one (unreadable, contradictory, unplannable) never is.
+    pub doubt: bool,
+}
+
+/// Check a candidate goal against the skills and the scene: not contradictory,
+/// plannable, and (a doubt) not already true.
+pub fn check_goal(
+    scenario: &Scenario,
+    world: &dyn World,
+    goal: &Formula,
+) -> Result<(), GoalProblem> {
+    let wrong = |reason: String| GoalProblem {
+        reason,
+        doubt: false,
+    };
     let dnf = goal.to_dnf();
     if dnf.is_false() {
-        return Err("it contradicts itself: no situation makes it true".into());
+        return Err(wrong(
+            "it contradicts itself: no situation makes it true".into(),
+        ));
+    }
+    let planner = Planner::new(&scenario.domain);
+    let plan = planner.plan(&dnf, world).map_err(|e| wrong(e.to_string()))?;
+    match plan.outcome {
+        // An action that fails in simulation is what failure resolution is for: the goal
+        // itself was plannable.
+        Outcome::Success | Outcome::ActionFailed { .. } => {}
+        Outcome::Unreachable {
+            condition, reason, ..
+        } => {
+            return Err(wrong(format!(
+                "the robot cannot make {condition} true: {reason}"
+            )));
+        }
+        Outcome::Exhausted { reason } => {
+            return Err(wrong(format!("the robot cannot reach it: {reason}")));
+        }
     }
     // The world answers for "any object" as well as for plain atoms.
     let holds = |atom: &crate::domain::Atom| world.check(&Condition::pos(atom.clone()));
     if goal.eval(&holds) {
-        return Err("it holds already in the scene now, but the request asks for a change".into());
+        return Err(GoalProblem {
+            reason: "it holds already in the scene now, but the request asks for a change"
+                .into(),
+            doubt: true,
+        });
     }
-    let planner = Planner::new(&scenario.domain);
-    let plan = planner.plan(&dnf, world).map_err(|e| e.to_string())?;
-    match plan.outcome {
-        // An action that fails in simulation is what failure resolution is for: the goal
-        // itself was plannable.
-        Outcome::Success | Outcome::ActionFailed { .. } => Ok(()),
-        Outcome::Unreachable {
-            condition, reason, ..
-        } => Err(format!("the robot cannot make {condition} true: {reason}")),
-        Outcome::Exhausted { reason } => Err(format!("the robot cannot reach it: {reason}")),
-    }
+    Ok(())
 }
 
 /// A condition of `goal` that one of the `shown` examples' goals holds and that shares no
@@ -109,7 +142,35 @@ fn without_copied(
 struct Candidate {
     text: String,
     read: Result<GoalAnswer, ReplyError>,
-    problem: Option<String>,
+    problem: Option<GoalProblem>,
+}
+
+impl Candidate {
+    fn clean(&self) -> bool {
+        self.read.is_ok() && self.problem.is_none()
+    }
+    fn doubtful(&self) -> bool {
+        self.read.is_ok() && self.problem.as_ref().is_some_and(|p| p.doubt)
+    }
+}
+
+/// Every check of a readable candidate, the wrong ones first.
+fn assess(
+    scenario: &Scenario,
+    world: &dyn World,
+    goal: &Formula,
+    shown: &[&crate::domain::Example],
+    request: &str,
+) -> Option<GoalProblem> {
+    match check_goal(scenario, world, goal) {
+        Err(p) if !p.doubt => Some(p),
+        checked => copied_from_example(goal, shown, request)
+            .map(|reason| GoalProblem {
+                reason,
+                doubt: true,
+            })
+            .or(checked.err()),
+    }
 }
 
 /// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
@@ -143,7 +204,6 @@ pub async fn interpret(
     let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
     let mut calls = 0;
     let mut first: Option<Option<Formula>> = None;
-    let mut fallback: Option<(GoalAnswer, String)> = None;
     let rounds = if options.check_goals {
         options.goal_feedback_rounds + 1
     } else {
@@ -184,11 +244,12 @@ pub async fn interpret(
             calls += 1;
             let read = reply::goal(&r.text, vocabulary, options.min_similarity);
             let problem = match &read {
-                Err(e) => Some(e.to_string()),
+                Err(e) => Some(GoalProblem {
+                    reason: e.to_string(),
+                    doubt: false,
+                }),
                 Ok(_) if !options.check_goals => None,
-                Ok(a) => check_goal(scenario, world.as_ref(), &a.goal)
-                    .err()
-                    .or_else(|| copied_from_example(&a.goal, &shown, instruction)),
+                Ok(a) => assess(scenario, world.as_ref(), &a.goal, &shown, instruction),
             };
             if first.is_none() {
                 first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
@@ -200,20 +261,15 @@ pub async fn interpret(
                     });
                     last_error = e.clone();
                 }
-                (Ok(a), Some(p)) => {
-                    emit(&Event::CandidateRejected {
-                        candidate: a.goal.to_string(),
-                        proposal: None,
-                        reason: p.clone(),
-                    });
-                    if fallback.is_none() {
-                        fallback = Some((a.clone(), p.clone()));
-                    }
-                }
+                (Ok(a), Some(p)) => emit(&Event::CandidateRejected {
+                    candidate: a.goal.to_string(),
+                    proposal: None,
+                    reason: p.reason.clone(),
+                }),
                 (Ok(_), None) => {}
             }
             // The first answer without what it pasted from an example is a candidate
-            // of its own, checked like the others and drawn right after it.
+            // of its own, checked like the others.
             let pruned = match (&read, draw) {
                 (Ok(a), 0) if problem.is_some() => without_copied(&a.goal, &shown, instruction),
                 _ => None,
@@ -224,14 +280,12 @@ pub async fn interpret(
                 problem,
             });
             if let Some(goal) = pruned {
-                let problem = check_goal(scenario, world.as_ref(), &goal)
-                    .err()
-                    .or_else(|| copied_from_example(&goal, &shown, instruction));
+                let problem = assess(scenario, world.as_ref(), &goal, &shown, instruction);
                 if let Some(p) = &problem {
                     emit(&Event::CandidateRejected {
                         candidate: goal.to_string(),
                         proposal: None,
-                        reason: p.clone(),
+                        reason: p.reason.clone(),
                     });
                 }
                 candidates.push(Candidate {
@@ -244,45 +298,49 @@ pub async fn interpret(
                     problem,
                 });
             }
-            // A first answer that passes every check (or passes once what it pasted from
-            // an example is taken out) is taken as it is: more draws are only for when
-            // it does not.
-            if draw == 0 && candidates.iter().any(|c| c.problem.is_none()) {
+            // More draws only for a first answer that is wrong: one that passes (or
+            // passes once what it pasted is taken out) is taken, and a doubtful one is
+            // kept, since sampled alternatives to the model's best answer are worse more
+            // often than better.
+            if draw == 0 && candidates.iter().any(|c| c.clean() || c.doubtful()) {
                 break;
             }
         }
-        if let Some(answer) = vote(&candidates) {
+        let chosen = vote(&candidates, Candidate::clean)
+            .map(|a| (a, None))
+            .or_else(|| {
+                vote(&candidates, Candidate::doubtful).map(|a| {
+                    let why = candidates
+                        .iter()
+                        .find(|c| c.doubtful())
+                        .and_then(|c| c.problem.as_ref())
+                        .map(|p| p.reason.clone());
+                    (a, why)
+                })
+            });
+        if let Some((answer, doubt)) = chosen {
             emit_goal(scenario, &answer, emit);
+            if let Some(why) = &doubt {
+                emit(&Event::Notice {
+                    message: format!("check the goal before it runs: {why}"),
+                });
+            }
             return Ok(Interpretation {
                 answer,
                 first: first.flatten(),
                 calls,
                 feedback_rounds: round,
-                unchecked: None,
+                doubt,
             });
         }
         if round + 1 < rounds {
             feedback(&mut messages, &candidates);
         }
     }
-    match fallback {
-        // Every candidate failed a check: the person sees the first usable answer and
-        // why it looks wrong, and decides (the goal can be edited before it runs).
-        Some((answer, why)) => {
-            emit_goal(scenario, &answer, emit);
-            Ok(Interpretation {
-                answer,
-                first: first.flatten(),
-                calls,
-                feedback_rounds: rounds - 1,
-                unchecked: Some(why),
-            })
-        }
-        None => Err(SessionError::NoGoal {
-            attempts: calls,
-            last: last_error,
-        }),
-    }
+    Err(SessionError::NoGoal {
+        attempts: calls,
+        last: last_error,
+    })
 }
 
 fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Event) + Send)) {
@@ -300,10 +358,10 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
 
 /// The answer of the largest group of equivalent candidates that passed the checks; ties
 /// go to the group drawn first (the greedy answer, when it passed).
-fn vote(candidates: &[Candidate]) -> Option<GoalAnswer> {
+fn vote(candidates: &[Candidate], eligible: fn(&Candidate) -> bool) -> Option<GoalAnswer> {
     let passed: Vec<&GoalAnswer> = candidates
         .iter()
-        .filter(|c| c.problem.is_none())
+        .filter(|c| eligible(c))
         .filter_map(|c| c.read.as_ref().ok())
         .collect();
     let mut best: Option<(usize, &GoalAnswer)> = None;
@@ -338,7 +396,9 @@ fn feedback(messages: &mut Vec<Message>, candidates: &[Candidate]) {
         };
         let line = format!(
             "- {shown}: {}",
-            c.problem.as_deref().unwrap_or("(no problem found)")
+            c.problem
+                .as_ref()
+                .map_or("(no problem found)", |p| p.reason.as_str())
         );
         if !problems.contains(&line) {
             problems.push(line);
@@ -370,7 +430,7 @@ mod tests {
     fn check(goal: &str) -> Result<(), String> {
         let (s, w) = cafe();
         let f = s.parse_goal(goal).expect("goal parses");
-        check_goal(&s, w.as_ref(), &f)
+        check_goal(&s, w.as_ref(), &f).map_err(|p| p.reason)
     }
 
     #[test]
@@ -417,7 +477,10 @@ mod tests {
                 }),
                 None => Err(ReplyError::NoConditions),
             },
-            problem: problem.map(str::to_string),
+            problem: problem.map(|p| GoalProblem {
+                reason: p.to_string(),
+                doubt: false,
+            }),
         }
     }
 
@@ -430,7 +493,7 @@ mod tests {
             candidate(Some("~Closed_Curtain & Active_TubeLight"), None),
             candidate(None, Some("unusable")),
         ];
-        let chosen = vote(&cs).expect("a winner");
+        let chosen = vote(&cs, Candidate::clean).expect("a winner");
         assert_eq!(
             chosen.goal.to_string(),
             "Active_TubeLight & ~Closed_Curtain"
@@ -441,10 +504,10 @@ mod tests {
             candidate(Some("On_Apple_Table3"), None),
         ];
         assert_eq!(
-            vote(&cs).expect("a winner").goal.to_string(),
+            vote(&cs, Candidate::clean).expect("a winner").goal.to_string(),
             "On_Apple_Bar2"
         );
-        assert!(vote(&[candidate(Some("Active_AC"), Some("no"))]).is_none());
+        assert!(vote(&[candidate(Some("Active_AC"), Some("no"))], Candidate::clean).is_none());
     }
 
     #[test]
