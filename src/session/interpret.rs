@@ -119,8 +119,27 @@ fn is_copied(atom: &crate::domain::Atom, shown: &[&crate::domain::Example], aske
     in_example && !terms(&atom.to_string()).iter().any(|w| asked.contains(w))
 }
 
-/// A conjunction without its conjuncts pasted from an example, when something is left:
-/// the rest of an answer is often right ("put A on B" read as "A on B & hand empty").
+/// Words of a request that ask for no condition by themselves: how a request is phrased,
+/// not what it asks for.
+const PHRASING: &[&str] = &[
+    "put", "place", "bring", "take", "give", "hand", "fetch", "carry", "get", "make", "set",
+    "move", "go", "keep", "need", "have", "now", "then", "also", "too", "right", "away",
+    "thank", "thanks", "kindly", "over",
+];
+
+/// Two words that are one after crude stemming ("close" and "closed" → "clos").
+fn same_word(a: &str, b: &str) -> bool {
+    let shorter = a.len().min(b.len());
+    let k = shorter.min(5);
+    a == b || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+}
+
+/// A conjunction without its conjuncts pasted from an example, when the rest stands
+/// alone: something is left, and every word of the request that asks for something is
+/// covered by what is left ("put the blue cube on the green cube" read as "blue on green
+/// & hand empty": the rest covers blue, green and cube, so the pasted "hand empty" goes).
+/// A request with a word the rest does not cover ("it's hot, close the curtain") may
+/// mean the pasted condition in other words, and keeps it.
 fn without_copied(
     goal: &Formula,
     shown: &[&crate::domain::Example],
@@ -135,7 +154,19 @@ fn without_copied(
         .filter(|item| !item.atoms().iter().any(|a| is_copied(a, shown, &asked)))
         .cloned()
         .collect();
-    (!kept.is_empty() && kept.len() < items.len()).then(|| Formula::and(kept))
+    if kept.is_empty() || kept.len() == items.len() {
+        return None;
+    }
+    let rest = Formula::and(kept);
+    let covered: Vec<String> = rest
+        .atoms()
+        .iter()
+        .flat_map(|a| terms(&a.to_string()))
+        .collect();
+    let unexplained = asked.iter().any(|w| {
+        !PHRASING.contains(&w.as_str()) && !covered.iter().any(|c| same_word(c, w))
+    });
+    (!unexplained).then_some(rest)
 }
 
 /// One candidate: the reply's text and what it was read as.
@@ -464,6 +495,24 @@ mod tests {
         // named): not a copy.
         let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
         assert!(copied_from_example(&named, &shown, "take the sponge out").is_none());
+    }
+
+    #[test]
+    fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
+        let example = crate::domain::Example {
+            instruction: "It's really stuffy in here, and leave your gripper empty".into(),
+            goal: r#"Active_AC & ~"any object" grasped"#.into(),
+        };
+        let shown = [&example];
+        let pasted = Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#)
+            .expect("parses");
+        let rest = without_copied(&pasted, &shown, "Put the blue cube on the green cube")
+            .expect("pruned");
+        assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
+        // "hot" is not covered by the curtain: the AC may be what it asks for.
+        let indirect = Formula::parse("Closed_Curtain & Active_AC").expect("parses");
+        assert!(without_copied(&indirect, &shown, "It's hot here, close the curtain").is_none());
+        assert!(same_word("clos", "close") && same_word("cube", "cube") && !same_word("ac", "at"));
     }
 
     fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {

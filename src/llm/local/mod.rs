@@ -20,7 +20,7 @@ pub struct LocalModel {
 }
 
 impl LocalModel {
-    /// Load the model file (takes about a second for the 0.5B default).
+    /// Load the model file (about a second for the 1.5B default, from the page cache).
     pub fn load(name: &str, options: EngineOptions) -> Result<LocalModel, LlmError> {
         let engine = Engine::load(options).map_err(|e| LlmError::Local(e.to_string()))?;
         Ok(LocalModel {
