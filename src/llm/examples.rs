@@ -181,7 +181,10 @@ mod tests {
         );
         assert_eq!(terms("WindowTable4"), ["window", "table", "4"]);
         assert_eq!(terms("the third table"), ["3", "table"]);
-        assert_eq!(terms("QuietTable9, table nine"), ["quiet", "table", "9", "table", "9"]);
+        assert_eq!(
+            terms("QuietTable9, table nine"),
+            ["quiet", "table", "9", "table", "9"]
+        );
     }
 
     #[test]

@@ -69,7 +69,9 @@ pub fn check_goal(
         ));
     }
     let planner = Planner::new(&scenario.domain);
-    let plan = planner.plan(&dnf, world).map_err(|e| wrong(e.to_string()))?;
+    let plan = planner
+        .plan(&dnf, world)
+        .map_err(|e| wrong(e.to_string()))?;
     match plan.outcome {
         // An action that fails in simulation is what failure resolution is for: the goal
         // itself was plannable.
@@ -89,8 +91,7 @@ pub fn check_goal(
     let holds = |atom: &crate::domain::Atom| world.check(&Condition::pos(atom.clone()));
     if goal.eval(&holds) {
         return Err(GoalProblem {
-            reason: "it holds already in the scene now, but the request asks for a change"
-                .into(),
+            reason: "it holds already in the scene now, but the request asks for a change".into(),
             doubt: true,
         });
     }
@@ -112,7 +113,11 @@ pub fn copied_from_example(
         .map(|atom| format!("{atom} comes from an example, and the request says nothing about it"))
 }
 
-fn is_copied(atom: &crate::domain::Atom, shown: &[&crate::domain::Example], asked: &[String]) -> bool {
+fn is_copied(
+    atom: &crate::domain::Atom,
+    shown: &[&crate::domain::Example],
+    asked: &[String],
+) -> bool {
     let in_example = shown
         .iter()
         .any(|e| Formula::parse(&e.goal).is_ok_and(|f| f.atoms().contains(atom)));
@@ -123,8 +128,8 @@ fn is_copied(atom: &crate::domain::Atom, shown: &[&crate::domain::Example], aske
 /// not what it asks for.
 const PHRASING: &[&str] = &[
     "put", "place", "bring", "take", "give", "hand", "fetch", "carry", "get", "make", "set",
-    "move", "go", "keep", "need", "have", "now", "then", "also", "too", "right", "away",
-    "thank", "thanks", "kindly", "over",
+    "move", "go", "keep", "need", "have", "now", "then", "also", "too", "right", "away", "thank",
+    "thanks", "kindly", "over",
 ];
 
 /// Two words that are one after crude stemming ("close" and "closed" → "clos").
@@ -163,9 +168,9 @@ fn without_copied(
         .iter()
         .flat_map(|a| terms(&a.to_string()))
         .collect();
-    let unexplained = asked.iter().any(|w| {
-        !PHRASING.contains(&w.as_str()) && !covered.iter().any(|c| same_word(c, w))
-    });
+    let unexplained = asked
+        .iter()
+        .any(|w| !PHRASING.contains(&w.as_str()) && !covered.iter().any(|c| same_word(c, w)));
     (!unexplained).then_some(rest)
 }
 
@@ -506,8 +511,8 @@ mod tests {
         let shown = [&example];
         let pasted = Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#)
             .expect("parses");
-        let rest = without_copied(&pasted, &shown, "Put the blue cube on the green cube")
-            .expect("pruned");
+        let rest =
+            without_copied(&pasted, &shown, "Put the blue cube on the green cube").expect("pruned");
         assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
         // "hot" is not covered by the curtain: the AC may be what it asks for.
         let indirect = Formula::parse("Closed_Curtain & Active_AC").expect("parses");
@@ -553,10 +558,19 @@ mod tests {
             candidate(Some("On_Apple_Table3"), None),
         ];
         assert_eq!(
-            vote(&cs, Candidate::clean).expect("a winner").goal.to_string(),
+            vote(&cs, Candidate::clean)
+                .expect("a winner")
+                .goal
+                .to_string(),
             "On_Apple_Bar2"
         );
-        assert!(vote(&[candidate(Some("Active_AC"), Some("no"))], Candidate::clean).is_none());
+        assert!(
+            vote(
+                &[candidate(Some("Active_AC"), Some("no"))],
+                Candidate::clean
+            )
+            .is_none()
+        );
     }
 
     #[test]
