@@ -147,6 +147,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         "feedback_rounds".into(),
         options.goal_feedback_rounds.to_string(),
     );
+    settings.insert("shortlist".into(), options.shortlist.to_string());
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     for (k, v) in [

@@ -24,7 +24,7 @@ pub struct LlmFlags {
     /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
-    /// Which model answers: openai (any OpenAI-compatible server), local (issue 5), replay
+    /// Which model answers: openai (any OpenAI-compatible server), local (the embedded model, the default), replay
     /// [env: BETR_BACKEND].
     #[arg(long, value_name = "openai|local|replay")]
     pub backend: Option<String>,
@@ -90,6 +90,11 @@ pub struct LlmFlags {
     /// Times the model is told why its goals were refused and asked again (default 2).
     #[arg(long, value_name = "N")]
     pub feedback_rounds: Option<usize>,
+    /// Let the model name a failure's missing condition out of the whole vocabulary,
+    /// instead of choosing among the conditions over the action's objects that fix the
+    /// failure when tried in simulation.
+    #[arg(long)]
+    pub no_shortlist: bool,
     /// Read goal.md, resolve.md and value.md from this directory instead of the built-in prompts.
     #[arg(long, value_name = "DIR")]
     pub prompts: Option<PathBuf>,
@@ -196,6 +201,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         check_goals: !flags.no_checks,
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
         goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
+        shortlist: !flags.no_shortlist,
         ..Options::default()
     };
     Ok((settings, options))

@@ -22,7 +22,7 @@ use super::{LanguageModel, LlmError};
 pub enum Backend {
     /// An OpenAI-compatible HTTP server.
     Openai,
-    /// The embedded model (issue 5, not built yet).
+    /// The embedded model (llama.cpp in-process, a GGUF file fetched on first use).
     Local,
     /// Answers from a cassette only.
     Replay,

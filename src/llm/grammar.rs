@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use crate::domain::condition::is_word_predicate;
-use crate::domain::{ANY_OBJECT, Vocabulary};
+use crate::domain::{ANY_OBJECT, Condition, Vocabulary};
 
 /// A GBNF string literal.
 fn lit(text: &str) -> String {
@@ -129,6 +129,19 @@ pub fn conditions_grammar(vocabulary: &Vocabulary, wildcard: bool) -> String {
     );
     g.push_str(REASONING_RULE);
     g.push_str(&atom_rules(vocabulary, wildcard));
+    g
+}
+
+/// As [`conditions_grammar`], with every condition one of `choices` (the conditions found
+/// to fix a failure in simulation).
+pub fn chosen_conditions_grammar(choices: &[Condition]) -> String {
+    let mut g = String::new();
+    g.push_str(
+        "root ::= \"Reasoning: \" reasoning \"\\nConditions:\\n\" literal ( \"\\n\" literal )?\n",
+    );
+    g.push_str(REASONING_RULE);
+    let alternatives: Vec<String> = choices.iter().map(|c| lit(&c.to_string())).collect();
+    let _ = writeln!(g, "literal ::= {}", alternatives.join(" | "));
     g
 }
 

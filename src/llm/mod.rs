@@ -11,6 +11,7 @@ pub mod cassette;
 pub mod config;
 pub mod examples;
 pub mod grammar;
+pub mod lexicon;
 pub mod local;
 pub mod openai;
 pub mod prompt;

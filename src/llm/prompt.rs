@@ -163,16 +163,20 @@ impl Context<'_> {
 
     /// The failure-resolution request for `action`, which failed with `error`.
     /// `tried`: proposals for this same failure that did not fix it (reflective feedback,
-    /// so a repeated question does not get the same answer).
+    /// so a repeated question does not get the same answer). `shortlist`: conditions that
+    /// fixed the failure when tried in simulation, for the model to choose from (empty:
+    /// the model names the condition itself).
     pub fn resolve(
         &self,
         templates: &Templates,
         action: &ActionCall,
         error: &str,
         tried: &[String],
+        shortlist: &[Condition],
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
         values.push(("tried", tried_text(tried)));
+        values.push(("shortlist", shortlist_text(shortlist)));
         let pre: Vec<String> = self
             .scenario
             .domain
@@ -279,6 +283,18 @@ pub fn request(messages: Vec<Message>, temperature: f32, max_tokens: u32) -> Cha
 }
 
 /// Replace each `{{name}}` by its value; a name with no value is an error.
+/// The conditions found to fix a failure in simulation, as the resolve prompt lists them.
+fn shortlist_text(shortlist: &[Condition]) -> String {
+    if shortlist.is_empty() {
+        return String::new();
+    }
+    let lines: Vec<String> = shortlist.iter().map(|c| format!("- {c}")).collect();
+    format!(
+        "\n## Conditions that fix it in simulation\nEach of these, made true before the action starts, stopped the failure when the robot tried it in simulation. Choose the one that names the cause of the error (a condition about \"any object\" covers every object that could be in the way); name two only if both are needed:\n{}\n",
+        lines.join("\n")
+    )
+}
+
 pub fn fill(
     template_name: &str,
     template: &str,

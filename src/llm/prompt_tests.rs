@@ -60,7 +60,7 @@ fn resolve_prompt_names_the_failure() {
     };
     let action = ActionCall::new("MoveTo", ["Coffee"]);
     let text = ctx
-        .resolve(&Templates::builtin(), &action, "Coffee not found", &[])
+        .resolve(&Templates::builtin(), &action, "Coffee not found", &[], &[])
         .unwrap()[1]
         .content
         .clone();

@@ -11,6 +11,7 @@ use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 
 use super::screen::Screen;
+use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
 
 /// Ask, constraining the reply the way the backend can: a grammar for the local model
@@ -176,6 +177,29 @@ fn same_proposal(a: &Proposal, b: &Proposal) -> bool {
     }
 }
 
+/// What the person reads about the conditions tried before the model was asked.
+fn shortlist_notice(list: &Shortlist) -> String {
+    let about = list
+        .objects
+        .iter()
+        .map(|o| format!("\"{o}\""))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if list.fixes.is_empty() {
+        return format!(
+            "tried {} condition(s) about {about} in simulation: none fixes the failure alone; the model names the condition itself",
+            list.tried
+        );
+    }
+    let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
+    format!(
+        "tried {} condition(s) about {about} in simulation; {} fix the failure, the model chooses among: {}",
+        list.tried,
+        list.fixes.len(),
+        fixes.join(", ")
+    )
+}
+
 pub(crate) async fn ask_conditions(
     ctx: &Context<'_>,
     model: &dyn LanguageModel,
@@ -190,19 +214,34 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
+    let choices = if options.shortlist {
+        let list = shortlist(screen);
+        emit(&Event::Notice {
+            message: shortlist_notice(&list),
+        });
+        list.fixes
+    } else {
+        Vec::new()
+    };
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
-    let messages = ctx.resolve(&options.templates, action, error, tried)?;
+    let messages = ctx.resolve(&options.templates, action, error, tried, &choices)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
-    let conditions_grammar = || grammar::conditions_grammar(vocabulary, true);
+    let conditions_grammar = || {
+        if choices.is_empty() {
+            grammar::conditions_grammar(vocabulary, true)
+        } else {
+            grammar::chosen_conditions_grammar(&choices)
+        }
+    };
     let read = |text: &str| {
         reply::conditions(text, vocabulary, options.min_similarity).map(|a| {
             (
                 Proposal::Conditions {
                     action: action.clone(),
                     node,
-                    conditions: a.conditions,
+                    conditions: without_implied(a.conditions),
                 },
                 a.reasoning,
                 a.substitutions,

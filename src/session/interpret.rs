@@ -12,6 +12,7 @@
 use crate::domain::{Condition, Scenario};
 use crate::goal::{self, Formula};
 use crate::llm::examples::terms;
+use crate::llm::lexicon::{Lexicon, same_word};
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
@@ -132,11 +133,48 @@ const PHRASING: &[&str] = &[
     "thanks", "kindly", "over",
 ];
 
-/// Two words that are one after crude stemming ("close" and "closed" → "clos").
-fn same_word(a: &str, b: &str) -> bool {
-    let shorter = a.len().min(b.len());
-    let k = shorter.min(5);
-    a == b || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+/// The conjuncts of `goal` (a conjunction of two or more) that nothing in the request asks
+/// for: every word of the request they answer to is answered by another conjunct too.
+/// Small models append a condition the request never mentions ("robot near table 2"
+/// after "coffee on table 2"); each part of a goal has to answer to a word of its own.
+pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula> {
+    let Formula::And(items) = goal else {
+        return Vec::new();
+    };
+    let asked = terms(request);
+    let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, &asked)).collect();
+    items
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| {
+            covered[*i].iter().all(|w| {
+                covered
+                    .iter()
+                    .enumerate()
+                    .any(|(j, c)| j != *i && c.contains(w))
+            })
+        })
+        .map(|(_, item)| item.clone())
+        .collect()
+}
+
+/// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
+/// first (an appended condition comes last), while more than one is left.
+fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Option<Formula> {
+    let mut current = goal.clone();
+    let mut changed = false;
+    while let Some(extra) = unasked(&current, request, lexicon).pop() {
+        let Formula::And(items) = &current else {
+            break;
+        };
+        let kept: Vec<Formula> = items.iter().filter(|i| **i != extra).cloned().collect();
+        if kept.is_empty() || kept.len() == items.len() {
+            break;
+        }
+        current = Formula::and(kept);
+        changed = true;
+    }
+    changed.then_some(current)
 }
 
 /// A conjunction without its conjuncts pasted from an example, when the rest stands
@@ -195,15 +233,26 @@ fn assess(
     scenario: &Scenario,
     world: &dyn World,
     goal: &Formula,
-    shown: &[&crate::domain::Example],
+    (shown, lexicon): (&[&crate::domain::Example], &Lexicon),
     request: &str,
 ) -> Option<GoalProblem> {
+    let doubt = |reason: String| GoalProblem {
+        reason,
+        doubt: true,
+    };
     match check_goal(scenario, world, goal) {
         Err(p) if !p.doubt => Some(p),
         checked => copied_from_example(goal, shown, request)
-            .map(|reason| GoalProblem {
-                reason,
-                doubt: true,
+            .map(doubt)
+            .or_else(|| {
+                let extra = unasked(goal, request, lexicon);
+                (!extra.is_empty()).then(|| {
+                    let parts: Vec<String> = extra.iter().map(ToString::to_string).collect();
+                    doubt(format!(
+                        "no word of the request asks for {}",
+                        parts.join(" or ")
+                    ))
+                })
             })
             .or(checked.err()),
     }
@@ -234,6 +283,7 @@ pub async fn interpret(
         .as_deref()
         .unwrap_or(&scenario.examples);
     let shown = options.variant.choose(pool, instruction);
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
@@ -285,7 +335,13 @@ pub async fn interpret(
                     doubt: false,
                 }),
                 Ok(_) if !options.check_goals => None,
-                Ok(a) => assess(scenario, world.as_ref(), &a.goal, &shown, instruction),
+                Ok(a) => assess(
+                    scenario,
+                    world.as_ref(),
+                    &a.goal,
+                    (&shown, &lexicon),
+                    instruction,
+                ),
             };
             if first.is_none() {
                 first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
@@ -307,7 +363,8 @@ pub async fn interpret(
             // The first answer without what it pasted from an example is a candidate
             // of its own, checked like the others.
             let pruned = match (&read, draw) {
-                (Ok(a), 0) if problem.is_some() => without_copied(&a.goal, &shown, instruction),
+                (Ok(a), 0) if problem.is_some() => without_copied(&a.goal, &shown, instruction)
+                    .or_else(|| without_unasked(&a.goal, instruction, &lexicon)),
                 _ => None,
             };
             candidates.push(Candidate {
@@ -316,7 +373,13 @@ pub async fn interpret(
                 problem,
             });
             if let Some(goal) = pruned {
-                let problem = assess(scenario, world.as_ref(), &goal, &shown, instruction);
+                let problem = assess(
+                    scenario,
+                    world.as_ref(),
+                    &goal,
+                    (&shown, &lexicon),
+                    instruction,
+                );
                 if let Some(p) = &problem {
                     emit(&Event::CandidateRejected {
                         candidate: goal.to_string(),
@@ -584,5 +647,32 @@ mod tests {
         assert_eq!(messages.len(), 3);
         assert_eq!(messages[1].role, Role::Assistant);
         assert_eq!(messages[2].content.matches("On_Chips_Bar").count(), 1);
+    }
+
+    #[test]
+    fn a_condition_no_word_asks_for_is_taken_out() {
+        let (scenario, _) = cafe();
+        let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        let request = "Please take a sandwich to the second table.";
+        let appended = g("On_Sandwiches_Table2 & RobotNear_Table2");
+        assert_eq!(
+            unasked(&appended, request, &lexicon),
+            vec![g("RobotNear_Table2")]
+        );
+        assert_eq!(
+            without_unasked(&appended, request, &lexicon),
+            Some(g("On_Sandwiches_Table2"))
+        );
+        // Every part answers to words of its own: nothing goes.
+        let request = "Mop the floor, and bring a teacup to table two.";
+        let both = g("IsClean_Floor & On_Teacup_Table2");
+        assert!(unasked(&both, request, &lexicon).is_empty());
+        assert_eq!(without_unasked(&both, request, &lexicon), None);
+        // A single condition is never taken out, however indirect the request.
+        assert_eq!(
+            without_unasked(&g("Active_AC"), "I'm melting.", &lexicon),
+            None
+        );
     }
 }

@@ -9,6 +9,7 @@ pub mod interpret;
 pub mod policy;
 pub mod resolve;
 pub mod screen;
+pub mod shortlist;
 pub mod types;
 pub mod values;
 

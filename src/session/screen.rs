@@ -43,10 +43,23 @@ pub fn apply(
     }
 }
 
+/// How a change that helped helped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// The whole tree succeeds.
+    Succeeds,
+    /// The failure is gone; the tree now stops somewhere else.
+    MovesOn,
+}
+
 /// Whether a change helped: the failure is gone or has moved on.
 pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), String> {
+    verdict(before, after).map(|_| ())
+}
+
+fn verdict(before: Option<&FailureAt>, after: &Outcome) -> Result<Verdict, String> {
     match (before, after) {
-        (_, Outcome::Success) => Ok(()),
+        (_, Outcome::Success) => Ok(Verdict::Succeeds),
         (Some(f), Outcome::ActionFailed { action, error, .. })
             if f.action.same_invocation(action) && &f.error == error =>
         {
@@ -54,7 +67,7 @@ pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), String>
                 "{action}! still fails with the same error: {error}"
             ))
         }
-        (_, Outcome::ActionFailed { .. }) => Ok(()),
+        (_, Outcome::ActionFailed { .. }) => Ok(Verdict::MovesOn),
         (
             _,
             Outcome::Unreachable {
@@ -82,6 +95,11 @@ impl Screen {
     /// no longer fails at all (a different error of the same action, such as "the hammer
     /// slips" after "no grasp force", means the value is wrong).
     pub fn check(&self, proposal: &Proposal) -> Result<(), String> {
+        self.try_change(proposal).map(|_| ())
+    }
+
+    /// As [`Screen::check`], saying whether the whole tree then succeeds.
+    pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, String> {
         let planner = Planner::new(&self.scenario.domain);
         let (plan, _) = apply(&planner, &self.tree, proposal, self.world.as_ref())
             .map_err(|e| e.to_string())?;
@@ -91,6 +109,6 @@ impl Screen {
         {
             return Err(format!("{action}! failed: {error}"));
         }
-        helped(Some(&self.failure), &plan.outcome)
+        verdict(Some(&self.failure), &plan.outcome)
     }
 }

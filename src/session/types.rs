@@ -32,6 +32,10 @@ pub struct Options {
     /// (so the failure under study is reached whatever a model would read); the
     /// instruction still reaches the questions about failures.
     pub use_scenario_goal: bool,
+    /// Before asking about a failure, try the conditions over the failing action's objects
+    /// in simulation and let the model choose among those that fix it; off: the model
+    /// names the condition out of the whole vocabulary.
+    pub shortlist: bool,
     pub temperature: f32,
     pub max_tokens: u32,
     pub min_similarity: f64,
@@ -54,6 +58,7 @@ impl Default for Options {
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,
             use_scenario_goal: false,
+            shortlist: true,
             temperature: 0.0,
             max_tokens: 800,
             min_similarity: reply::MIN_SIMILARITY,

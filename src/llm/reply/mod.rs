@@ -377,7 +377,17 @@ fn reasoning(lines: &[String], answer: usize) -> Option<String> {
         }
         None => lines[..answer.min(lines.len())].join("\n"),
     };
-    let text = text.trim();
+    // A model that writes its answer's label at the end of its reasoning, then the label
+    // again on the next line as the format asks, would show the label twice.
+    let mut text = text.trim();
+    while let Some(label) = all.iter().find(|l| {
+        let l = format!("{l}:");
+        text.len() >= l.len()
+            && text.is_char_boundary(text.len() - l.len())
+            && text[text.len() - l.len()..].eq_ignore_ascii_case(&l)
+    }) {
+        text = text[..text.len() - label.len() - 1].trim_end();
+    }
     (!text.is_empty()).then(|| text.to_string())
 }
 

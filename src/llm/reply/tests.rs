@@ -78,6 +78,13 @@ fn goals_are_found_in_many_shapes() {
 fn reasoning_before_or_after() {
     let v = cafe();
     let a = goal(
+        "Reasoning: the guest wants chips. Goal:\nGoal: On_Chips_Table3",
+        &v,
+        0.5,
+    )
+    .unwrap();
+    assert_eq!(a.reasoning.as_deref(), Some("the guest wants chips."));
+    let a = goal(
         "Reasoning: chips or dessert.\nGoal: On_Chips_Table3 | On_Dessert_Table3",
         &v,
         0.5,

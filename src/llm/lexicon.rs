@@ -1,0 +1,196 @@
+//! Which words of a request each predicate and object of a scene can answer to, so that a
+//! goal can be checked part by part against what was asked.
+//!
+//! A symbol answers to the words of its own name (`WindowTable6` → window, table, 6;
+//! `IsClean` → clean) and to the words the scene's example pool pairs with it: a word of
+//! the pool's instructions that occurs mostly in examples whose goal uses the symbol
+//! ("sweep" with `IsClean`, "deliver" with `On`). Nothing is written by hand per
+//! scene: a new scene's pool teaches its own words.
+
+use std::collections::HashMap;
+
+use crate::domain::{Example, Vocabulary};
+use crate::goal::Formula;
+
+use super::examples::terms;
+
+/// A word of the pool becomes a symbol's word when at least this share of the examples
+/// that use the word use the symbol too.
+const MIN_SHARE: f64 = 0.5;
+
+/// Words that never name a symbol: an instruction's "is" or "robot" asks for nothing.
+const GENERIC: &[&str] = &["is", "robot", "nothing", "object", "any"];
+
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Lexicon {
+    words: HashMap<String, Vec<String>>,
+}
+
+impl Lexicon {
+    /// The words of `vocabulary`'s predicates and objects, and those `pool` teaches.
+    pub fn new(vocabulary: &Vocabulary, pool: &[Example]) -> Self {
+        let mut words: HashMap<String, Vec<String>> = HashMap::new();
+        let names = vocabulary
+            .predicates
+            .iter()
+            .map(|p| p.name.as_str())
+            .chain(vocabulary.objects.iter().map(|o| o.name.as_str()));
+        for name in names {
+            let own: Vec<String> = terms(name)
+                .into_iter()
+                .filter(|t| !GENERIC.contains(&t.as_str()))
+                .collect();
+            words.insert(name.to_string(), own);
+        }
+        // How many examples use each word, and each word together with each symbol.
+        let mut uses: HashMap<String, usize> = HashMap::new();
+        let mut together: HashMap<(String, String), usize> = HashMap::new();
+        for example in pool {
+            let Ok(goal) = Formula::parse(&example.goal) else {
+                continue;
+            };
+            let mut symbols: Vec<String> = Vec::new();
+            for atom in goal.atoms() {
+                for s in std::iter::once(&atom.predicate).chain(&atom.args) {
+                    if !symbols.contains(s) {
+                        symbols.push(s.clone());
+                    }
+                }
+            }
+            let mut said = terms(&example.instruction);
+            said.sort_unstable();
+            said.dedup();
+            for w in said {
+                *uses.entry(w.clone()).or_default() += 1;
+                for s in &symbols {
+                    *together.entry((s.clone(), w.clone())).or_default() += 1;
+                }
+            }
+        }
+        // A word that names a symbol belongs to that symbol alone: "coffee" is Coffee's
+        // word even though most requests for coffee also use On.
+        let named: Vec<String> = words.values().flatten().cloned().collect();
+        let mut learned: Vec<(&(String, String), &usize)> = together.iter().collect();
+        learned.sort();
+        for ((symbol, word), n) in learned {
+            let total = uses.get(word).copied().unwrap_or(0).max(1);
+            let known = words.get(symbol).is_some();
+            let names_other = named.iter().any(|x| same_word(x, word));
+            if known
+                && !names_other
+                && *n as f64 / total as f64 >= MIN_SHARE
+                && !GENERIC.contains(&word.as_str())
+            {
+                let list = words.entry(symbol.clone()).or_default();
+                if !list.contains(word) {
+                    list.push(word.clone());
+                }
+            }
+        }
+        Lexicon { words }
+    }
+
+    /// The words `symbol` answers to (none for a name the scene does not have).
+    pub fn words(&self, symbol: &str) -> &[String] {
+        self.words.get(symbol).map_or(&[], Vec::as_slice)
+    }
+
+    /// The words of `request` (as [`terms`] gives them) that some predicate or object of
+    /// `part` answers to.
+    pub fn covered(&self, part: &Formula, request: &[String]) -> Vec<String> {
+        let mut symbols: Vec<&str> = Vec::new();
+        let atoms = part.atoms();
+        for atom in &atoms {
+            symbols.push(&atom.predicate);
+            symbols.extend(atom.args.iter().map(String::as_str));
+        }
+        request
+            .iter()
+            .filter(|w| {
+                symbols
+                    .iter()
+                    .any(|s| self.words(s).iter().any(|x| same_word(x, w)))
+            })
+            .cloned()
+            .collect()
+    }
+}
+
+/// Two words that are one after crude stemming ("close" and "closed" → "clos").
+pub fn same_word(a: &str, b: &str) -> bool {
+    let shorter = a.len().min(b.len());
+    let k = shorter.min(5);
+    a == b || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::{Object, Predicate};
+
+    fn vocabulary() -> Vocabulary {
+        let object = |n: &str, t: &str| Object {
+            name: n.into(),
+            types: vec![t.into()],
+        };
+        let predicate = |n: &str, args: &[&str]| Predicate {
+            name: n.into(),
+            arg_types: args.iter().map(|a| vec![(*a).to_string()]).collect(),
+            description: String::new(),
+        };
+        Vocabulary {
+            objects: vec![
+                object("Floor", "furniture"),
+                object("Chairs", "furniture"),
+                object("Coffee", "item"),
+                object("WindowTable6", "place"),
+            ],
+            predicates: vec![
+                predicate("IsClean", &["furniture"]),
+                predicate("On", &["item", "place"]),
+                predicate("RobotNear", &["place"]),
+            ],
+        }
+    }
+
+    fn example(instruction: &str, goal: &str) -> Example {
+        Example {
+            instruction: instruction.into(),
+            goal: goal.into(),
+        }
+    }
+
+    #[test]
+    fn names_and_pool_give_words() {
+        let pool = [
+            example("Sweep the floor.", "IsClean_Floor"),
+            example("Sweep up under the chairs.", "IsClean_Chairs"),
+            example(
+                "Deliver a coffee to window table six.",
+                "On_Coffee_WindowTable6",
+            ),
+            example("Wait for me at window table six.", "RobotNear_WindowTable6"),
+        ];
+        let lexicon = Lexicon::new(&vocabulary(), &pool);
+        assert!(lexicon.words("IsClean").contains(&"clean".to_string()));
+        assert!(lexicon.words("IsClean").contains(&"sweep".to_string()));
+        assert!(lexicon.words("WindowTable6").contains(&"6".to_string()));
+        assert!(lexicon.words("On").contains(&"deliver".to_string()));
+        // "window" is used with both On and RobotNear: it names the table, not either.
+        assert!(lexicon.words("RobotNear").contains(&"wait".to_string()));
+        assert!(!lexicon.words("IsClean").contains(&"window".to_string()));
+        assert!(lexicon.words("Unknown").is_empty());
+    }
+
+    #[test]
+    fn a_part_covers_the_words_its_symbols_answer_to() {
+        let lexicon = Lexicon::new(&vocabulary(), &[]);
+        let request = terms("Bring a coffee to the sixth table by the window");
+        let part = Formula::parse("On_Coffee_WindowTable6").expect("parses");
+        let covered = lexicon.covered(&part, &request);
+        assert!(covered.contains(&"coffee".to_string()));
+        assert!(covered.contains(&"6".to_string()));
+        let unrelated = Formula::parse("IsClean_Floor").expect("parses");
+        assert!(lexicon.covered(&unrelated, &request).is_empty());
+    }
+}

@@ -1,0 +1,249 @@
+//! Before the model is asked about a failed action, the conditions that could be its
+//! missing precondition are tried in simulation: every literal over the action's objects
+//! (and the objects its error names) that is false now, in the words of the scene's
+//! vocabulary. Those that make the failure go away are shown to the model, which picks the
+//! one that names the cause; a small model chooses among a handful of working fixes far
+//! more reliably than it names one out of the whole vocabulary. The list is told to the
+//! person as well, so what the model chose from is never hidden.
+
+use super::screen::{Screen, Verdict};
+use super::types::Proposal;
+use crate::domain::{ANY_OBJECT, Atom, Condition};
+
+/// What trying the related conditions found.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Shortlist {
+    /// Conditions that fix the failure alone, best first: those after which the whole
+    /// tree succeeds, then those after which the failure moves on; within each, conditions
+    /// about any object (they keep helping whatever object is in the way next time) first.
+    pub fixes: Vec<Condition>,
+    /// How many conditions were tried.
+    pub tried: usize,
+    /// The objects the conditions were about.
+    pub objects: Vec<String>,
+}
+
+/// Bound on the conditions tried per failure, so a huge scene stays quick to screen.
+const MAX_TRIED: usize = 400;
+
+/// Try every condition related to the failure in `screen`'s copy of the world.
+pub fn shortlist(screen: &Screen) -> Shortlist {
+    let domain = &screen.scenario.domain;
+    let vocabulary = &domain.vocabulary;
+    let failure = &screen.failure;
+    let error = failure.error.to_lowercase();
+    let mut objects: Vec<String> = failure.action.args.clone();
+    for o in &vocabulary.objects {
+        if !objects.contains(&o.name) && names_word(&error, &o.name.to_lowercase()) {
+            objects.push(o.name.clone());
+        }
+    }
+    let ground = domain.resolve(&failure.action);
+    let mut atoms: Vec<Atom> = Vec::new();
+    for atom in vocabulary.ground_atoms() {
+        if !atom.args.iter().any(|a| objects.contains(a)) {
+            continue;
+        }
+        // The same condition with the other objects left open: `"any object" on "x"`.
+        if atom.is_quoted_form() && atom.args.len() > 1 {
+            for (slot, arg) in atom.args.iter().enumerate() {
+                if !objects.contains(arg) {
+                    let mut args = atom.args.clone();
+                    args[slot] = ANY_OBJECT.to_string();
+                    push_new(&mut atoms, Atom::new(atom.predicate.clone(), args));
+                }
+            }
+        }
+        push_new(&mut atoms, atom);
+    }
+    let mut candidates: Vec<Condition> = Vec::new();
+    for atom in atoms {
+        for literal in [Condition::pos(atom.clone()), Condition::neg(atom.clone())] {
+            let excluded = ground.as_ref().is_some_and(|g| {
+                // Already required, contradicting what is required, or what the action
+                // itself is for: none of these can be what is missing.
+                g.pre.contains(&literal)
+                    || g.pre.contains(&literal.negate())
+                    || (!literal.negated && g.add.contains(&literal.atom))
+            });
+            if !excluded && !screen.world.check(&literal) {
+                candidates.push(literal);
+            }
+        }
+    }
+    candidates.truncate(MAX_TRIED);
+    let tried = candidates.len();
+    let mut succeeding = Vec::new();
+    let mut moving_on = Vec::new();
+    for c in candidates {
+        let proposal = Proposal::Conditions {
+            action: failure.action.clone(),
+            node: failure.node,
+            conditions: vec![c.clone()],
+        };
+        match screen.try_change(&proposal) {
+            Ok(Verdict::Succeeds) => succeeding.push(c),
+            Ok(Verdict::MovesOn) => moving_on.push(c),
+            Err(_) => {}
+        }
+    }
+    let general_first = |list: &mut Vec<Condition>| {
+        list.sort_by_key(|c| !c.atom.has_wildcard());
+    };
+    general_first(&mut succeeding);
+    general_first(&mut moving_on);
+    succeeding.extend(moving_on);
+    Shortlist {
+        fixes: succeeding,
+        tried,
+        objects,
+    }
+}
+
+/// `conditions` without those another of them implies (`~"any object" on "x"` implies
+/// `~"red cube" on "x"`; `"red cube" on "x"` implies `"any object" on "x"`) and without
+/// repeats: a precondition the tree would check twice only makes it harder to read.
+pub fn without_implied(conditions: Vec<Condition>) -> Vec<Condition> {
+    let mut kept: Vec<Condition> = Vec::new();
+    for (i, c) in conditions.iter().enumerate() {
+        let redundant = kept.contains(c)
+            || conditions
+                .iter()
+                .enumerate()
+                .any(|(j, other)| j != i && other != c && implies(other, c));
+        if !redundant {
+            kept.push(c.clone());
+        }
+    }
+    kept
+}
+
+/// Whether `a` implies `b` through the wildcard: same predicate and sign, and where they
+/// differ, the negated one names any object in `a`, the positive one in `b`.
+fn implies(a: &Condition, b: &Condition) -> bool {
+    a.negated == b.negated
+        && a.atom.predicate == b.atom.predicate
+        && a.atom.args.len() == b.atom.args.len()
+        && a.atom.args.iter().zip(&b.atom.args).all(|(x, y)| {
+            x == y
+                || if a.negated {
+                    x == ANY_OBJECT
+                } else {
+                    y == ANY_OBJECT
+                }
+        })
+}
+
+fn push_new(atoms: &mut Vec<Atom>, atom: Atom) {
+    if !atoms.contains(&atom) {
+        atoms.push(atom);
+    }
+}
+
+/// Whether `name` (lower case) occurs in `text` (lower case) as a whole word or phrase.
+fn names_word(text: &str, name: &str) -> bool {
+    text.match_indices(name).any(|(at, _)| {
+        let before = text[..at].chars().next_back();
+        let after = text[at + name.len()..].chars().next();
+        !before.is_some_and(char::is_alphanumeric) && !after.is_some_and(char::is_alphanumeric)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::domain::Scenario;
+    use crate::planner::Planner;
+    use crate::session::screen::FailureAt;
+    use crate::world::load;
+
+    fn screen_at_first_failure(path: &str) -> Screen {
+        let scenario = Arc::new(Scenario::load(Path::new(path)).expect("scenario loads"));
+        let world = load(&scenario).expect("world loads");
+        let goal = scenario.goal.clone().expect("a stated goal");
+        let plan = Planner::new(&scenario.domain)
+            .plan(&goal.to_dnf(), world.as_ref())
+            .expect("plans");
+        let crate::planner::Outcome::ActionFailed {
+            action,
+            node,
+            error,
+            ..
+        } = plan.outcome
+        else {
+            panic!("the scenario's plan should fail: {:?}", plan.outcome);
+        };
+        Screen {
+            scenario,
+            tree: plan.tree,
+            world,
+            failure: FailureAt {
+                node,
+                action,
+                error,
+            },
+        }
+    }
+
+    #[test]
+    fn a_blocked_grasp_is_fixed_by_clearing_the_cube_and_only_false_conditions_are_tried() {
+        let screen = screen_at_first_failure("scenarios/cell/red_on_blue.toml");
+        let list = shortlist(&screen);
+        let clear = Condition::parse(r#"~"any object" on "blue cube""#).expect("parses");
+        assert!(list.fixes.contains(&clear), "{:?}", list.fixes);
+        assert_eq!(list.fixes.first(), Some(&clear), "general conditions first");
+        // Something that is true already can never be the missing precondition.
+        let true_now = Condition::parse(r#""red cube" on "blue cube""#).expect("parses");
+        assert!(screen.world.check(&true_now));
+        assert!(!list.fixes.contains(&true_now));
+        assert!(list.tried > list.fixes.len());
+    }
+
+    #[test]
+    fn a_missing_coffee_is_made_first() {
+        let screen = screen_at_first_failure("scenarios/cafe/no_coffee.toml");
+        let list = shortlist(&screen);
+        let made = Condition::parse("Exists_Coffee").expect("parses");
+        assert!(list.fixes.contains(&made), "{:?}", list.fixes);
+    }
+
+    #[test]
+    fn a_condition_implied_by_another_is_left_out() {
+        let c = |t: &str| Condition::parse(t).expect("parses");
+        let kept = without_implied(vec![
+            c(r#"~"any object" on "blue cube""#),
+            c(r#"~"red cube" on "blue cube""#),
+            c(r#""red cup" upright"#),
+            c(r#""red cup" upright"#),
+        ]);
+        assert_eq!(
+            kept,
+            vec![
+                c(r#"~"any object" on "blue cube""#),
+                c(r#""red cup" upright"#)
+            ]
+        );
+        // A positive wildcard is the weaker one: the named object is kept.
+        let kept = without_implied(vec![
+            c(r#""any object" on "tray""#),
+            c(r#""banana" on "tray""#),
+        ]);
+        assert_eq!(kept, vec![c(r#""banana" on "tray""#)]);
+        // Different objects are different conditions.
+        let both = vec![
+            c(r#"~"any object" on "blue cube""#),
+            c(r#"~"any object" on "green cube""#),
+        ];
+        assert_eq!(without_implied(both.clone()), both);
+    }
+
+    #[test]
+    fn whole_words_only() {
+        assert!(names_word("coffee not found", "coffee"));
+        assert!(!names_word("coffeemaker not found", "coffee"));
+        assert!(names_word("\"red cup\" is upside down", "red cup"));
+    }
+}
