@@ -132,13 +132,11 @@ pub fn conditions_grammar(vocabulary: &Vocabulary, wildcard: bool) -> String {
     g
 }
 
-/// As [`conditions_grammar`], with every condition one of `choices` (the conditions found
-/// to fix a failure in simulation).
+/// As [`conditions_grammar`], with one condition, one of `choices` (the conditions found
+/// to fix a failure alone in simulation: a second would only add what is not needed).
 pub fn chosen_conditions_grammar(choices: &[Condition]) -> String {
     let mut g = String::new();
-    g.push_str(
-        "root ::= \"Reasoning: \" reasoning \"\\nConditions:\\n\" literal ( \"\\n\" literal )?\n",
-    );
+    g.push_str("root ::= \"Reasoning: \" reasoning \"\\nConditions:\\n\" literal\n");
     g.push_str(REASONING_RULE);
     let alternatives: Vec<String> = choices.iter().map(|c| lit(&c.to_string())).collect();
     let _ = writeln!(g, "literal ::= {}", alternatives.join(" | "));

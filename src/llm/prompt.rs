@@ -290,7 +290,7 @@ fn shortlist_text(shortlist: &[Condition]) -> String {
     }
     let lines: Vec<String> = shortlist.iter().map(|c| format!("- {c}")).collect();
     format!(
-        "\n## Conditions that fix it in simulation\nEach of these, made true before the action starts, stopped the failure when the robot tried it in simulation. Choose the one that names the cause of the error (a condition about \"any object\" covers every object that could be in the way); name two only if both are needed:\n{}\n",
+        "\n## Conditions that fix it in simulation\nEach of these, made true before the action starts, stopped the failure when the robot tried it in simulation. Choose the one that names the cause of the error (a condition about \"any object\" covers every object that could be in the way) and write only that one:\n{}\n",
         lines.join("\n")
     )
 }

@@ -48,8 +48,10 @@ pub fn apply(
 pub enum Verdict {
     /// The whole tree succeeds.
     Succeeds,
-    /// The failure is gone; the tree now stops somewhere else.
+    /// The failure is gone; the tree now stops at an action it had before the change.
     MovesOn,
+    /// The failure is gone; the tree now stops at an action the change brought in.
+    FailsItself,
 }
 
 /// Whether a change helped: the failure is gone or has moved on.
@@ -109,6 +111,12 @@ impl Screen {
         {
             return Err(format!("{action}! failed: {error}"));
         }
-        verdict(Some(&self.failure), &plan.outcome)
+        let verdict = verdict(Some(&self.failure), &plan.outcome)?;
+        Ok(match &plan.outcome {
+            Outcome::ActionFailed { node, .. } if node.index() >= self.tree.capacity() => {
+                Verdict::FailsItself
+            }
+            _ => verdict,
+        })
     }
 }

@@ -8,14 +8,15 @@
 
 use super::screen::{Screen, Verdict};
 use super::types::Proposal;
-use crate::domain::{ANY_OBJECT, Atom, Condition};
+use crate::domain::{ANY_OBJECT, Atom, Condition, GroundSkill};
 
 /// What trying the related conditions found.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Shortlist {
-    /// Conditions that fix the failure alone, best first: those after which the whole
-    /// tree succeeds, then those after which the failure moves on; within each, conditions
-    /// about any object (they keep helping whatever object is in the way next time) first.
+    /// Conditions that fix the failure alone: those after which the whole tree succeeds,
+    /// or when there are none, those after which it gets further (to an action it had
+    /// before); conditions about any object (they keep helping whatever object is in the
+    /// way next time) first.
     pub fixes: Vec<Condition>,
     /// How many conditions were tried.
     pub tried: usize,
@@ -23,8 +24,8 @@ pub struct Shortlist {
     pub objects: Vec<String>,
 }
 
-/// Bound on the conditions tried per failure, so a huge scene stays quick to screen.
-const MAX_TRIED: usize = 400;
+/// Bound on the conditions tried in each pass, so a huge scene stays quick to screen.
+const MAX_TRIED: usize = 3000;
 
 /// Try every condition related to the failure in `screen`'s copy of the world.
 pub fn shortlist(screen: &Screen) -> Shortlist {
@@ -39,11 +40,42 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
         }
     }
     let ground = domain.resolve(&failure.action);
+    // Conditions over the failure's objects first, then over the rest of the scene (a
+    // sweep that leaves the floor dirty needs a mop the action never names).
+    let mut all = vocabulary.ground_atoms();
+    all.retain(|a| {
+        // An object in two slots of one condition ("the cube on the cube") is never meant.
+        a.args
+            .iter()
+            .enumerate()
+            .all(|(i, x)| !a.args[..i].contains(x))
+    });
+    let (related, rest): (Vec<Atom>, Vec<Atom>) = all
+        .into_iter()
+        .partition(|a| a.args.iter().any(|x| objects.contains(x)));
+    let mut found = screen_all(screen, ground.as_ref(), &objects, related);
+    let mut tried = found.tried;
+    if found.fixes.is_empty() {
+        found = screen_all(screen, ground.as_ref(), &objects, rest);
+        tried += found.tried;
+    }
+    Shortlist {
+        fixes: found.fixes,
+        tried,
+        objects,
+    }
+}
+
+/// Screen the literals over `atoms` that are false now and may be missing.
+fn screen_all(
+    screen: &Screen,
+    ground: Option<&GroundSkill>,
+    objects: &[String],
+    candidates_from: Vec<Atom>,
+) -> Shortlist {
+    let failure = &screen.failure;
     let mut atoms: Vec<Atom> = Vec::new();
-    for atom in vocabulary.ground_atoms() {
-        if !atom.args.iter().any(|a| objects.contains(a)) {
-            continue;
-        }
+    for atom in candidates_from {
         // The same condition with the other objects left open: `"any object" on "x"`.
         if atom.is_quoted_form() && atom.args.len() > 1 {
             for (slot, arg) in atom.args.iter().enumerate() {
@@ -59,7 +91,7 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
     let mut candidates: Vec<Condition> = Vec::new();
     for atom in atoms {
         for literal in [Condition::pos(atom.clone()), Condition::neg(atom.clone())] {
-            let excluded = ground.as_ref().is_some_and(|g| {
+            let excluded = ground.is_some_and(|g| {
                 // Already required, contradicting what is required, or what the action
                 // itself is for: none of these can be what is missing.
                 g.pre.contains(&literal)
@@ -84,7 +116,8 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
         match screen.try_change(&proposal) {
             Ok(Verdict::Succeeds) => succeeding.push(c),
             Ok(Verdict::MovesOn) => moving_on.push(c),
-            Err(_) => {}
+            // A change whose own actions fail only trades one failure for another.
+            Ok(Verdict::FailsItself) | Err(_) => {}
         }
     }
     let general_first = |list: &mut Vec<Condition>| {
@@ -92,11 +125,15 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
     };
     general_first(&mut succeeding);
     general_first(&mut moving_on);
-    succeeding.extend(moving_on);
+    // A change after which the whole task succeeds beats one that only gets further;
+    // the latter are offered when nothing does more.
+    if succeeding.is_empty() {
+        succeeding = moving_on;
+    }
     Shortlist {
         fixes: succeeding,
         tried,
-        objects,
+        objects: objects.to_vec(),
     }
 }
 
@@ -238,6 +275,14 @@ mod tests {
             c(r#"~"any object" on "green cube""#),
         ];
         assert_eq!(without_implied(both.clone()), both);
+    }
+
+    #[test]
+    fn a_tool_the_action_never_names_is_found_in_the_rest_of_the_scene() {
+        let screen = screen_at_first_failure("scenarios/cafe/sweep.toml");
+        let list = shortlist(&screen);
+        let mop = Condition::parse("Holding_Mop").expect("parses");
+        assert!(list.fixes.contains(&mop), "{:?}", list.fixes);
     }
 
     #[test]
