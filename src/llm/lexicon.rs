@@ -24,6 +24,8 @@ const GENERIC: &[&str] = &["is", "robot", "nothing", "object", "any"];
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Lexicon {
     words: HashMap<String, Vec<String>>,
+    /// The words of the objects' own names (table, 6, coffee, station, ...).
+    object_words: Vec<String>,
 }
 
 impl Lexicon {
@@ -42,6 +44,13 @@ impl Lexicon {
                 .collect();
             words.insert(name.to_string(), own);
         }
+        let mut object_words: Vec<String> = vocabulary
+            .objects
+            .iter()
+            .flat_map(|o| words.get(&o.name).cloned().unwrap_or_default())
+            .collect();
+        object_words.sort_unstable();
+        object_words.dedup();
         // How many examples use each word, and each word together with each symbol.
         let mut uses: HashMap<String, usize> = HashMap::new();
         let mut together: HashMap<(String, String), usize> = HashMap::new();
@@ -87,7 +96,15 @@ impl Lexicon {
                 }
             }
         }
-        Lexicon { words }
+        Lexicon {
+            words,
+            object_words,
+        }
+    }
+
+    /// Whether `word` is part of some object's name ("6" of `WindowTable6`).
+    pub fn names_an_object(&self, word: &str) -> bool {
+        self.object_words.iter().any(|w| same_word(w, word))
     }
 
     /// The words `symbol` answers to (none for a name the scene does not have).

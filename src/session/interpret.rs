@@ -7,7 +7,9 @@
 //! in the model's cache, so each costs only its own tokens) and the survivors vote: the
 //! largest group of logically equivalent goals wins, the earliest drawn breaking ties.
 //! When none survives, the model is told why, in the same conversation, and asked again
-//! (reflective feedback), for a bounded number of rounds.
+//! (reflective feedback), for a bounded number of rounds. A first answer that leaves out a
+//! number the request says ("table six" read as table 1) draws more candidates too, and
+//! one that uses the number wins the vote.
 
 use crate::domain::{Condition, Scenario};
 use crate::goal::{self, Formula};
@@ -156,6 +158,23 @@ pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula>
         })
         .map(|(_, item)| item.clone())
         .collect()
+}
+
+/// Words of the request that name an object ("six" of window table 6, "juice") and that
+/// no condition of `goal` answers to: the goal leaves out, or misplaces, something asked.
+pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<String> {
+    let asked = terms(request);
+    let covered = lexicon.covered(goal, &asked);
+    let mut out: Vec<String> = asked
+        .into_iter()
+        .filter(|w| lexicon.names_an_object(w) && !covered.contains(w))
+        .collect();
+    out.dedup();
+    out
+}
+
+fn is_number(word: &str) -> bool {
+    !word.is_empty() && word.chars().all(|c| c.is_ascii_digit())
 }
 
 /// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
@@ -401,11 +420,46 @@ pub async fn interpret(
             // passes once what it pasted is taken out) is taken, and a doubtful one is
             // kept, since sampled alternatives to the model's best answer are worse more
             // often than better.
+            // One exception: a first answer that leaves out a number the request says
+            // ("table six" read as table 1) has misread a place; candidates that use the
+            // number are drawn.
+            let misses = candidates
+                .first()
+                .and_then(|c| c.read.as_ref().ok())
+                .map(|a| {
+                    unanswered_names(&a.goal, instruction, &lexicon)
+                        .into_iter()
+                        .filter(|w| is_number(w))
+                        .collect::<Vec<_>>()
+                });
+            if draw == 0
+                && let Some(missed) = misses.as_ref().filter(|m| !m.is_empty())
+                && let Some(Ok(a)) = candidates.first().map(|c| &c.read)
+                && options.check_goals
+            {
+                emit(&Event::Notice {
+                    message: format!(
+                        "the request says {}, and no condition of {} is about it: drawing more candidates",
+                        missed.join(", "),
+                        a.goal
+                    ),
+                });
+                continue;
+            }
             if draw == 0 && candidates.iter().any(|c| c.clean() || c.doubtful()) {
                 break;
             }
         }
-        let chosen = vote(&candidates, Candidate::clean)
+        let answers_numbers = |c: &Candidate| {
+            c.clean()
+                && c.read.as_ref().is_ok_and(|a| {
+                    !unanswered_names(&a.goal, instruction, &lexicon)
+                        .iter()
+                        .any(|w| is_number(w))
+                })
+        };
+        let chosen = vote(&candidates, answers_numbers)
+            .or_else(|| vote(&candidates, Candidate::clean))
             .map(|a| (a, None))
             .or_else(|| {
                 vote(&candidates, Candidate::doubtful).map(|a| {
@@ -457,7 +511,7 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
 
 /// The answer of the largest group of equivalent candidates that passed the checks; ties
 /// go to the group drawn first (the greedy answer, when it passed).
-fn vote(candidates: &[Candidate], eligible: fn(&Candidate) -> bool) -> Option<GoalAnswer> {
+fn vote(candidates: &[Candidate], eligible: impl Fn(&Candidate) -> bool) -> Option<GoalAnswer> {
     let passed: Vec<&GoalAnswer> = candidates
         .iter()
         .filter(|c| eligible(c))

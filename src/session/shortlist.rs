@@ -15,8 +15,7 @@ use crate::domain::{ANY_OBJECT, Atom, Condition, GroundSkill};
 pub struct Shortlist {
     /// Conditions that fix the failure alone: those after which the whole tree succeeds,
     /// or when there are none, those after which it gets further (to an action it had
-    /// before); conditions about any object (they keep helping whatever object is in the
-    /// way next time) first.
+    /// before); conditions about any object first, then positive ones, then negations.
     pub fixes: Vec<Condition>,
     /// How many conditions were tried.
     pub tried: usize,
@@ -120,8 +119,16 @@ fn screen_all(
             Ok(Verdict::FailsItself) | Err(_) => {}
         }
     }
+    // Conditions about any object first (they keep helping whatever object is in the
+    // way next time), then what must hold (the tool held, the lid open), then the other
+    // things that must not hold: a negation often works only through how the planner
+    // happens to achieve it (the mop is off the entrance because the robot holds it).
     let general_first = |list: &mut Vec<Condition>| {
-        list.sort_by_key(|c| !c.atom.has_wildcard());
+        list.sort_by_key(|c| match (c.atom.has_wildcard(), c.negated) {
+            (true, _) => 0,
+            (false, false) => 1,
+            (false, true) => 2,
+        });
     };
     general_first(&mut succeeding);
     general_first(&mut moving_on);
@@ -283,6 +290,14 @@ mod tests {
         let list = shortlist(&screen);
         let mop = Condition::parse("Holding_Mop").expect("parses");
         assert!(list.fixes.contains(&mop), "{:?}", list.fixes);
+        // Holding the mop comes before what holding it happens to make true.
+        let moved = Condition::parse("~On_Mop_Entrance").expect("parses");
+        let at = |c: &Condition| list.fixes.iter().position(|f| f == c);
+        assert!(
+            at(&moved).is_none_or(|m| at(&mop) < Some(m)),
+            "{:?}",
+            list.fixes
+        );
     }
 
     #[test]
