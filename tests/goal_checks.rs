@@ -1,0 +1,183 @@
+//! How a goal read from an instruction is checked, with a scripted model whose answer
+//! depends on the draw (greedy, or sampled with seed k): a number the request says and the
+//! first answer leaves out draws more candidates; a condition no word of the request asks
+//! for is taken out; a failure is asked about with the conditions that fix it in
+//! simulation as the only choices.
+
+#![allow(clippy::unwrap_used)] // tests may panic on what they check
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use betr::domain::Scenario;
+use betr::goal::{Formula, equivalent};
+use betr::llm::{
+    ChatFuture, ChatReply, ChatRequest, LanguageModel, OutputConstraint, ReplySource, TokenUsage,
+};
+use betr::session::{self, Event, Options, Proposal};
+use betr::world;
+
+/// Answers by draw: `greedy` for the first call, `sampled[k - 1]` for seed k.
+struct ByDraw {
+    greedy: String,
+    sampled: Vec<String>,
+    /// Every request seen, for checking what was asked and how it was constrained.
+    seen: Mutex<Vec<ChatRequest>>,
+}
+
+impl ByDraw {
+    fn new(greedy: &str, sampled: &[&str]) -> ByDraw {
+        ByDraw {
+            greedy: greedy.into(),
+            sampled: sampled.iter().map(|s| (*s).to_string()).collect(),
+            seen: Mutex::default(),
+        }
+    }
+}
+
+impl LanguageModel for ByDraw {
+    fn model(&self) -> &str {
+        "scripted"
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            let text = match request.seed {
+                None => self.greedy.clone(),
+                Some(k) => self
+                    .sampled
+                    .get(usize::try_from(k).unwrap() - 1)
+                    .cloned()
+                    .unwrap_or_else(|| self.greedy.clone()),
+            };
+            Ok(ChatReply {
+                text,
+                model: "scripted".into(),
+                usage: TokenUsage {
+                    prompt_tokens: 10,
+                    completion_tokens: 5,
+                },
+                latency: Duration::ZERO,
+                source: ReplySource::HandWritten {
+                    note: "tests/goal_checks.rs".into(),
+                },
+            })
+        })
+    }
+}
+
+fn scenario(path: &str) -> Scenario {
+    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
+}
+
+async fn read(scenario: &Scenario, model: &ByDraw, instruction: &str) -> (Formula, usize) {
+    let w = world::load(scenario).unwrap();
+    let mut notices = Vec::new();
+    let reading = session::interpret::interpret(
+        scenario,
+        w,
+        instruction,
+        model,
+        &Options::default(),
+        &mut |e| {
+            if let Event::Notice { message } = e {
+                notices.push(message.clone());
+            }
+        },
+    )
+    .await
+    .unwrap();
+    (reading.answer.goal, reading.calls)
+}
+
+#[tokio::test]
+async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let model = ByDraw::new(
+        "Goal: On_Coffee_Table1",
+        &[
+            "Goal: On_Coffee_Table1",
+            "Goal: On_Coffee_WindowTable5",
+            "Goal: On_Coffee_WindowTable5",
+        ],
+    );
+    let (goal, calls) = read(&cafe, &model, "Take a coffee to table five by the window.").await;
+    assert_eq!(goal.to_string(), "On_Coffee_WindowTable5");
+    assert_eq!(calls, 4);
+
+    // No number in the request: the first clean answer is taken, one call.
+    let model = ByDraw::new("Goal: On_Coffee_Table1", &["Goal: On_Coffee_Bar"]);
+    let (goal, calls) = read(&cafe, &model, "Take a coffee to the first table.").await;
+    assert_eq!(goal.to_string(), "On_Coffee_Table1");
+    assert_eq!(calls, 1);
+}
+
+#[tokio::test]
+async fn a_condition_no_word_asks_for_is_taken_out() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let model = ByDraw::new("Goal: On_Chips_Table3 & RobotNear_Table3", &[]);
+    let (goal, calls) = read(&cafe, &model, "Some crisps for table three, please.").await;
+    let expected = Formula::parse("On_Chips_Table3").unwrap();
+    assert!(equivalent(&goal, &expected).unwrap(), "{goal}");
+    assert_eq!(calls, 1);
+}
+
+#[tokio::test]
+async fn a_failure_is_asked_about_with_the_conditions_that_fix_it_as_the_only_choices() {
+    let cell = Arc::new(scenario("scenarios/cell/red_on_blue.toml"));
+    let model = Arc::new(ByDraw::new(
+        "Reasoning: the red cube lies on the blue cube and blocks the gripper.\nConditions:\n~\"any object\" on \"blue cube\"",
+        &[],
+    ));
+    let options = Options {
+        use_scenario_goal: true,
+        ..Options::default()
+    };
+    let mut proposals = Vec::new();
+    let resolved = session::resolve(
+        &cell,
+        None,
+        model.clone() as Arc<dyn LanguageModel>,
+        &options,
+        &mut |p| {
+            proposals.push(p.clone());
+            true
+        },
+        &mut |_| {},
+    )
+    .await
+    .unwrap();
+    assert!(
+        matches!(resolved.ending, session::Ending::Success { .. }),
+        "{:?}",
+        resolved.ending
+    );
+    let Some(Proposal::Conditions { conditions, .. }) = proposals.first() else {
+        panic!("{proposals:?}");
+    };
+    assert_eq!(conditions[0].to_string(), r#"~"any object" on "blue cube""#);
+    // The question listed the conditions found in simulation, and the grammar allowed
+    // only those.
+    let seen = model.seen.lock().unwrap();
+    let question = seen
+        .iter()
+        .find(|r| {
+            r.messages
+                .iter()
+                .any(|m| m.content.contains("# Task: failure resolution"))
+        })
+        .expect("a question about the failure");
+    let prompt: String = question.messages.iter().map(|m| m.content.as_str()).collect();
+    assert!(prompt.contains("## Conditions that fix it in simulation"));
+    assert!(prompt.contains(r#"- ~"any object" on "blue cube""#));
+    let Some(OutputConstraint::Grammar { gbnf, .. }) = &question.constraint else {
+        panic!("no grammar: {:?}", question.constraint);
+    };
+    assert!(gbnf.contains(r#"literal ::= "~\"any object\" on \"blue cube\"""#), "{gbnf}");
+    assert!(!gbnf.contains("atom ::="), "the whole vocabulary is not offered: {gbnf}");
+}
