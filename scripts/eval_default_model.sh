@@ -15,10 +15,11 @@ betr=target/release/betr
 local=(--backend local --threads "$threads")
 
 # Goals: the default model as the product reads instructions (examples retrieved per
-# request, candidates checked, vote, feedback; the first call is scored too), then each
-# lever taken away, then the fast model.
+# request, candidates checked, vote, feedback; the first call alone is scored too, which
+# is the run without checks), then with the pool's first examples instead of retrieved
+# ones, then the fast model.
 "$betr" eval goals "${local[@]}" --out "$out/goals-1.5b"
-"$betr" eval goals "${local[@]}" --fixed-examples --no-checks --out "$out/goals-1.5b-fixed-examples"
+"$betr" eval goals "${local[@]}" --fixed-examples --out "$out/goals-1.5b-fixed-examples"
 "$betr" eval goals "${local[@]}" --model qwen2.5-coder-0.5b --out "$out/goals-0.5b"
 
 # Failures and values: the goal read from the instruction (a misread goal is its own
