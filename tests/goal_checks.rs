@@ -172,12 +172,22 @@ async fn a_failure_is_asked_about_with_the_conditions_that_fix_it_as_the_only_ch
                 .any(|m| m.content.contains("# Task: failure resolution"))
         })
         .expect("a question about the failure");
-    let prompt: String = question.messages.iter().map(|m| m.content.as_str()).collect();
+    let prompt: String = question
+        .messages
+        .iter()
+        .map(|m| m.content.as_str())
+        .collect();
     assert!(prompt.contains("## Conditions that fix it in simulation"));
     assert!(prompt.contains(r#"- ~"any object" on "blue cube""#));
     let Some(OutputConstraint::Grammar { gbnf, .. }) = &question.constraint else {
         panic!("no grammar: {:?}", question.constraint);
     };
-    assert!(gbnf.contains(r#"literal ::= "~\"any object\" on \"blue cube\"""#), "{gbnf}");
-    assert!(!gbnf.contains("atom ::="), "the whole vocabulary is not offered: {gbnf}");
+    assert!(
+        gbnf.contains(r#"literal ::= "~\"any object\" on \"blue cube\"""#),
+        "{gbnf}"
+    );
+    assert!(
+        !gbnf.contains("atom ::="),
+        "the whole vocabulary is not offered: {gbnf}"
+    );
 }
