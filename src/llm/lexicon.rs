@@ -83,7 +83,7 @@ impl Lexicon {
         learned.sort();
         for ((symbol, word), n) in learned {
             let total = uses.get(word).copied().unwrap_or(0).max(1);
-            let known = words.get(symbol).is_some();
+            let known = words.contains_key(symbol);
             let names_other = named.iter().any(|x| same_word(x, word));
             if known
                 && !names_other

@@ -22,8 +22,9 @@ fn goal_prompt_has_every_part() {
     for part in [
         "On_<item>_<place>: the item is at the place",
         "Bar, Bar2, WaterStation",
-        "most similar",
-        "Instruction: Could you put some water",
+        "## Examples",
+        // Retrieval puts the pool's examples that share the most words first.
+        "Instruction: There are no tissues at window table six",
         "- Holding_Nothing",
         "Bring coffee to table six",
         "Goal: <formula>",

@@ -94,6 +94,10 @@ pub(crate) struct FailedAction<'a> {
 /// be worth trying.
 const SAMPLE_TEMPERATURE: f32 = 0.8;
 
+/// Reads one reply into a proposal, the reasoning shown with it and the values it sets.
+type ReadProposal<'a> =
+    dyn Fn(&str) -> Result<(Proposal, Option<String>, Vec<Substitution>), ReplyError> + Sync + 'a;
+
 /// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
 /// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
 /// first that fixes the failure.
@@ -103,9 +107,7 @@ async fn draw_and_screen(
     constraint: (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
     screen: &mut Screen,
-    read: &(
-         dyn Fn(&str) -> Result<(Proposal, Option<String>, Vec<Substitution>), ReplyError> + Sync
-     ),
+    read: &ReadProposal<'_>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
     let mut asked = Asked {

@@ -194,8 +194,11 @@ fn snapshots_restore_and_forks_share_the_check_count() {
 fn scratch(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("betr-cell-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
-    std::fs::copy(base, dir.join("cell.toml")).unwrap();
+    // The base file names its example pool beside it, so both are copied.
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell");
+    for file in ["cell.toml", "examples.toml"] {
+        std::fs::copy(base.join(file), dir.join(file)).unwrap();
+    }
     let p = dir.join("s.toml");
     std::fs::write(&p, text).unwrap();
     p
