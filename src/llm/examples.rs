@@ -25,18 +25,24 @@ const STOPWORDS: &[&str] = &[
 ];
 
 /// The words of `text` a match is made on: lower case, split at anything that is not a
-/// letter or digit and at lower-to-upper case changes, stop words dropped, crude plural
-/// and verb endings removed.
+/// letter or digit, at lower-to-upper case changes and where an acronym ends, stop words
+/// dropped, crude plural and verb endings removed.
 pub fn terms(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut current = String::new();
     let mut previous: Option<char> = None;
-    for c in text.chars() {
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        let next = chars.peek().copied();
         // A word ends at anything else than a letter or digit, at a lower-to-upper case
-        // change (`TubeLight`) and between letters and digits (`Table3`).
+        // change (`TubeLight`), where an acronym gives way to a word (`ACTemperature`,
+        // `NFCJuice`) and between letters and digits (`Table3`).
         let boundary = !c.is_alphanumeric()
             || previous.is_some_and(|p| {
                 (c.is_uppercase() && (p.is_lowercase() || p.is_ascii_digit()))
+                    || (c.is_uppercase()
+                        && p.is_uppercase()
+                        && next.is_some_and(char::is_lowercase))
                     || (c.is_ascii_digit() != p.is_ascii_digit() && p.is_alphanumeric())
             });
         if boundary && !current.is_empty() {
@@ -180,6 +186,8 @@ mod tests {
             ["blue", "cube", "table"]
         );
         assert_eq!(terms("WindowTable4"), ["window", "table", "4"]);
+        assert_eq!(terms("Low_ACTemperature"), ["low", "ac", "temperature"]);
+        assert_eq!(terms("NFCJuice"), ["nfc", "juice"]);
         assert_eq!(terms("the third table"), ["3", "table"]);
         assert_eq!(
             terms("QuietTable9, table nine"),

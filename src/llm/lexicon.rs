@@ -18,6 +18,11 @@ use super::examples::terms;
 /// that use the word use the symbol too.
 const MIN_SHARE: f64 = 0.5;
 
+/// Whether `word` is written in digits (numbers written as words are digits in [`terms`]).
+pub fn is_number(word: &str) -> bool {
+    !word.is_empty() && word.chars().all(|c| c.is_ascii_digit())
+}
+
 /// Words that never name a symbol: an instruction's "is" or "robot" asks for nothing.
 const GENERIC: &[&str] = &["is", "robot", "nothing", "object", "any"];
 
@@ -26,6 +31,8 @@ pub struct Lexicon {
     words: HashMap<String, Vec<String>>,
     /// The words of the objects' own names (table, 6, coffee, station, ...).
     object_words: Vec<String>,
+    /// Each object's own name words, for the objects whose name has a number.
+    numbered: Vec<Vec<String>>,
 }
 
 impl Lexicon {
@@ -51,6 +58,13 @@ impl Lexicon {
             .collect();
         object_words.sort_unstable();
         object_words.dedup();
+        let numbered: Vec<Vec<String>> = vocabulary
+            .objects
+            .iter()
+            .filter_map(|o| words.get(&o.name))
+            .filter(|own| own.iter().any(|w| is_number(w)))
+            .cloned()
+            .collect();
         // How many examples use each word, and each word together with each symbol.
         let mut uses: HashMap<String, usize> = HashMap::new();
         let mut together: HashMap<(String, String), usize> = HashMap::new();
@@ -99,12 +113,37 @@ impl Lexicon {
         Lexicon {
             words,
             object_words,
+            numbered,
         }
     }
 
     /// Whether `word` is part of some object's name ("6" of `WindowTable6`).
     pub fn names_an_object(&self, word: &str) -> bool {
         self.object_words.iter().any(|w| same_word(w, word))
+    }
+
+    /// The numbers of `request` (as [`terms`] gives them) that number a place: a word
+    /// next to the number, or one word further, is in the name of an object with that
+    /// number ("table six", "the third table", "quiet table number eight"), where "one of
+    /// the paper cups" numbers nothing.
+    pub fn place_numbers(&self, request: &[String]) -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for (i, n) in request.iter().enumerate() {
+            if !is_number(n) || out.contains(n) {
+                continue;
+            }
+            let near = &request[i.saturating_sub(2)..(i + 3).min(request.len())];
+            let numbers_a_place = self.numbered.iter().any(|own| {
+                own.contains(n)
+                    && near
+                        .iter()
+                        .any(|w| w != n && own.iter().any(|o| same_word(o, w)))
+            });
+            if numbers_a_place {
+                out.push(n.clone());
+            }
+        }
+        out
     }
 
     /// The words `symbol` answers to (none for a name the scene does not have).
@@ -175,6 +214,17 @@ mod tests {
             instruction: instruction.into(),
             goal: goal.into(),
         }
+    }
+
+    #[test]
+    fn only_a_number_beside_a_numbered_name_numbers_a_place() {
+        let lexicon = Lexicon::new(&vocabulary(), &[]);
+        let numbers = |request: &str| lexicon.place_numbers(&terms(request));
+        assert_eq!(numbers("Bring coffee to table six"), ["6"]);
+        assert_eq!(numbers("I'm at the sixth table by the window"), ["6"]);
+        assert!(numbers("Give me one of the coffees").is_empty());
+        // Six is a number here, but no place of this scene is numbered 2.
+        assert!(numbers("Bring coffee to table two").is_empty());
     }
 
     #[test]

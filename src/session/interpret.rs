@@ -136,27 +136,24 @@ const PHRASING: &[&str] = &[
 ];
 
 /// The conjuncts of `goal` (a conjunction of two or more) that nothing in the request asks
-/// for: every word of the request they answer to is answered by another conjunct too.
-/// Small models append a condition the request never mentions ("robot near table 2"
-/// after "coffee on table 2"); each part of a goal has to answer to a word of its own.
+/// for: every word of the request they answer to is claimed by more conjuncts than the
+/// request says it. Small models append a condition the request never mentions ("robot
+/// near table 2" after "coffee on table 2": "table" and "2" are said once and claimed
+/// twice, and the second conjunct has no word of its own); a request that says "bar" twice
+/// ("not on the bar and bar 2, the milk to the bar") asks for every conjunct about a bar.
 pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula> {
     let Formula::And(items) = goal else {
         return Vec::new();
     };
     let asked = terms(request);
     let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, &asked)).collect();
+    let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
+    let claimed = |w: &String| covered.iter().filter(|c| c.contains(w)).count();
     items
         .iter()
-        .enumerate()
-        .filter(|(i, _)| {
-            covered[*i].iter().all(|w| {
-                covered
-                    .iter()
-                    .enumerate()
-                    .any(|(j, c)| j != *i && c.contains(w))
-            })
-        })
-        .map(|(_, item)| item.clone())
+        .zip(&covered)
+        .filter(|(_, words)| words.iter().all(|w| claimed(w) > said(w)))
+        .map(|(item, _)| item.clone())
         .collect()
 }
 
@@ -171,10 +168,6 @@ pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec
         .collect();
     out.dedup();
     out
-}
-
-fn is_number(word: &str) -> bool {
-    !word.is_empty() && word.chars().all(|c| c.is_ascii_digit())
 }
 
 /// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
@@ -303,6 +296,7 @@ pub async fn interpret(
         .unwrap_or(&scenario.examples);
     let shown = options.variant.choose(pool, instruction);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
+    let place_numbers = lexicon.place_numbers(&terms(instruction));
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
@@ -429,7 +423,7 @@ pub async fn interpret(
                 .map(|a| {
                     unanswered_names(&a.goal, instruction, &lexicon)
                         .into_iter()
-                        .filter(|w| is_number(w))
+                        .filter(|w| place_numbers.contains(w))
                         .collect::<Vec<_>>()
                 });
             if draw == 0
@@ -455,7 +449,7 @@ pub async fn interpret(
                 && c.read.as_ref().is_ok_and(|a| {
                     !unanswered_names(&a.goal, instruction, &lexicon)
                         .iter()
-                        .any(|w| is_number(w))
+                        .any(|w| place_numbers.contains(w))
                 })
         };
         let chosen = vote(&candidates, answers_numbers)

@@ -100,6 +100,16 @@ impl Screen {
         self.try_change(proposal).map(|_| ())
     }
 
+    /// Whether, with `proposal` applied and carried out, the failing action still fails
+    /// with the same error: what the change made true is not what the action lacks.
+    pub fn still_fails(&self, proposal: &Proposal) -> bool {
+        let planner = Planner::new(&self.scenario.domain);
+        apply(&planner, &self.tree, proposal, self.world.as_ref()).is_ok_and(|(plan, _)| {
+            matches!(&plan.outcome, Outcome::ActionFailed { action, error, .. }
+                if self.failure.action.same_invocation(action) && &self.failure.error == error)
+        })
+    }
+
     /// As [`Screen::check`], saying whether the whole tree then succeeds.
     pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, String> {
         let planner = Planner::new(&self.scenario.domain);
