@@ -80,7 +80,8 @@ fn resolve_runs_every_failure_scenario_against_fixture_replies() {
         "{table}"
     );
     assert!(
-        table.contains("| 2 | Cubes on both cubes | 100% (2/2) | 4 | 0 | 0 | 3.0 |"),
+        table
+            .contains("| 2 | Cubes on both cubes | 2/2 | 2/2 | 0 | 100% (2/2) | 4 | 0 | 0 | 3.0 |"),
         "{table}"
     );
     let calls = server.received().len() as u64;
@@ -147,7 +148,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     assert_eq!(egg_run["values"][1]["accepted"], true);
     let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
     assert!(
-        table.contains("| force | 12 N ✗ → 5 N, 12 N ✗ → 5 N | 12.00 ± 0.00 N | 1–6 N | 0/2 | 2/4 | 2/2 | 5.3 N |"),
+        table.contains("| force | 12 N ✗ → 5 N, 12 N ✗ → 5 N | 12.00 ± 0.00 N | 1–6 N | 0/2 | 2/4 | 2/2 | 0 | 2/2 | 5.3 N |"),
         "{table}"
     );
     // Every other scenario's fixture value is accepted at once.
@@ -156,7 +157,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     }
     assert!(
         table.contains(
-            "| tool | shovel, shovel | shovel ×2 | shovel, spoon | 2/2 | 2/2 | 2/2 | shovel |"
+            "| tool | shovel, shovel | shovel ×2 | shovel, spoon | 2/2 | 2/2 | 2/2 | 0 | 2/2 | shovel |"
         ),
         "{table}"
     );

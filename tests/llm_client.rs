@@ -339,7 +339,8 @@ fn unknown_object_is_refused_and_the_tree_unchanged() {
         .iter()
         .filter(|e| matches!(e, Event::InvalidReply { .. }))
         .collect();
-    assert_eq!(invalid.len(), 2, "asked twice (max_rounds = 2)");
+    // Every candidate of both rounds (max_rounds = 2) is unusable.
+    assert_eq!(invalid.len(), 2 * Options::default().candidates);
     assert!(format!("{:?}", invalid[0]).contains("Fries"));
 }
 
@@ -359,14 +360,19 @@ fn a_near_miss_object_is_replaced_and_flagged() {
 }
 
 #[test]
-fn a_proposal_that_does_not_help_is_undone() {
-    // Turning the AC on is achievable but irrelevant: MoveTo "Coffee" fails again with the
-    // same error, so the change is undone and the loop gives up after its rounds.
+fn a_proposal_that_does_not_help_is_never_offered() {
+    // Turning the AC on is achievable but irrelevant: tried in simulation, MoveTo "Coffee"
+    // fails again with the same error, so it is refused before anyone is asked to approve
+    // it, and the loop gives up after its rounds with the tree as it was.
     let (r, events) = resolve_with(Behavior::Reply(
         "Reasoning: hands free.\nConditions: Active_AC".into(),
     ));
     let r = r.unwrap();
     assert!(matches!(r.ending, Ending::GaveUp { .. }), "{:?}", r.ending);
     assert_eq!(bt::to_text(&r.tree), planned_tree(&no_coffee()));
-    assert!(events.iter().any(|e| matches!(e, Event::DidNotHelp { .. })));
+    assert!(events.iter().any(|e| matches!(
+        e,
+        Event::CandidateRejected { reason, .. } if reason.contains("still fails with the same error")
+    )));
+    assert!(!events.iter().any(|e| matches!(e, Event::Proposal { .. })));
 }

@@ -145,6 +145,11 @@ impl Bench {
         for _ in 0..10 {
             self.key(KeyCode::Char(' '));
             self.until(|e| matches!(e, Event::Ticked { .. })).await;
+            // Once the grasp has failed, the conditions are tried and the model asked
+            // before the proposal arrives: wait for it rather than tick again.
+            if self.app.llm.proposal.is_none() && self.screen(120, 40).contains("◀ failed") {
+                self.until(|e| matches!(e, Event::Proposal { .. })).await;
+            }
             if self.app.llm.proposal.is_some() {
                 return;
             }

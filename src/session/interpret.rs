@@ -240,6 +240,30 @@ impl Candidate {
     }
 }
 
+/// An object of a condition of `goal` that holds now and that no word of the request
+/// names: a goal made true already by a place the model chose itself ("bring me a
+/// banana" read as the banana on the table it lies on). A goal that holds through what
+/// the request does say ("check that the hall light is on") stays a doubt.
+fn unsaid_object_holding(
+    goal: &Formula,
+    world: &dyn World,
+    request: &str,
+    lexicon: &Lexicon,
+) -> Option<String> {
+    let asked = terms(request);
+    goal.atoms()
+        .into_iter()
+        .filter(|a| world.check(&Condition::pos(a.clone())))
+        .flat_map(|a| a.args.clone())
+        .filter(|arg| arg != crate::domain::ANY_OBJECT)
+        .find(|arg| {
+            !lexicon
+                .words(arg)
+                .iter()
+                .any(|w| asked.iter().any(|a| same_word(a, w)))
+        })
+}
+
 /// Every check of a readable candidate, the wrong ones first.
 fn assess(
     scenario: &Scenario,
@@ -254,6 +278,15 @@ fn assess(
     };
     match check_goal(scenario, world, goal) {
         Err(p) if !p.doubt => Some(p),
+        Err(_) if let Some(object) = unsaid_object_holding(goal, world, request, lexicon) => {
+            Some(GoalProblem {
+                reason: format!(
+                    "it holds already in the scene now, through {object}, which the request \
+                     never mentions; the request asks for a change"
+                ),
+                doubt: false,
+            })
+        }
         checked => copied_from_example(goal, shown, request)
             .map(doubt)
             .or_else(|| {
@@ -720,6 +753,37 @@ mod tests {
         // A single condition is never taken out, however indirect the request.
         assert_eq!(
             without_unasked(&g("Active_AC"), "I'm melting.", &lexicon),
+            None
+        );
+        // A word said as often as conditions claim it asks for each of them.
+        let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
+        let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
+        assert!(unasked(&bars, request, &lexicon).is_empty());
+    }
+
+    #[test]
+    fn a_goal_true_through_a_place_nobody_named_is_wrong() {
+        let (scenario, world) = cafe();
+        let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        // The chips lie on the bar already; the request says nothing of the bar.
+        assert_eq!(
+            unsaid_object_holding(
+                &g("On_Chips_Bar"),
+                world.as_ref(),
+                "Bring me the chips",
+                &lexicon
+            ),
+            Some("Bar".to_string())
+        );
+        // The hall light is on already, and the request names it: a doubt, not a mistake.
+        assert_eq!(
+            unsaid_object_holding(
+                &g("Active_HallLight"),
+                world.as_ref(),
+                "Could you check that the hall light is on?",
+                &lexicon
+            ),
             None
         );
     }
