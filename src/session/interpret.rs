@@ -240,6 +240,65 @@ impl Candidate {
     }
 }
 
+/// How many alternatives `goal` offers beyond the first where it asks for something:
+/// `A | B | C` offers two; a disjunction under a negation ("neither A nor B") offers none.
+fn alternatives(goal: &Formula, negated: bool) -> usize {
+    match goal {
+        Formula::Atom(_) => 0,
+        Formula::Not(inner) => alternatives(inner, !negated),
+        Formula::And(items) | Formula::Or(items) => {
+            let inner: usize = items.iter().map(|i| alternatives(i, negated)).sum();
+            // `~(A & B)` is `~A | ~B`: a conjunction offers alternatives under a negation.
+            let offers = matches!(goal, Formula::Or(_)) != negated;
+            inner + if offers { items.len() - 1 } else { 0 }
+        }
+    }
+}
+
+/// Words that offer a choice between what comes before and after them.
+const CHOICE_WORDS: &[&str] = &["or", "otherwise", "else", "alternatively", "instead"];
+
+/// How many choices a request offers: each "or" (and "if not", "otherwise", ...), and each
+/// comma of a list that ends in "or" ("coffee, cake, or tea").
+fn choices_offered(request: &str) -> usize {
+    let lower = request.to_lowercase();
+    let mut choices = lower.matches("if not").count();
+    for part in lower.split(['.', ';', ':', '!', '?']) {
+        let words: Vec<&str> = part
+            .split(|c: char| !c.is_alphanumeric() && c != ',')
+            .filter(|w| !w.is_empty())
+            .collect();
+        let mut commas_since_choice = 0;
+        for w in words {
+            let word = w.trim_end_matches(',');
+            if CHOICE_WORDS.contains(&word) {
+                choices += 1 + commas_since_choice;
+                commas_since_choice = 0;
+            }
+            if w.ends_with(',') {
+                commas_since_choice += 1;
+            }
+        }
+    }
+    choices
+}
+
+/// Why `goal` offers more alternatives than `request` does, if it does: "a banana or an
+/// orange, and switch the light off" written `A | B | ~C` makes switching the light off
+/// one of three alternatives, when the request asks for it in any case.
+fn more_alternatives_than_asked(goal: &Formula, request: &str) -> Option<String> {
+    let offered = alternatives(goal, false);
+    let asked = choices_offered(request);
+    (offered > asked).then(|| {
+        format!(
+            "it offers {} alternatives joined by |, where the request gives {} choice(s); \
+             what must hold in any case is joined with &, and a choice in parentheses: (A | B) & C",
+            offered + 1,
+            asked + 1
+        )
+    })
+}
+
 /// An object of a condition of `goal` that holds now and that no word of the request
 /// names: a goal made true already by a place the model chose itself ("bring me a
 /// banana" read as the banana on the table it lies on). A goal that holds through what
@@ -278,6 +337,10 @@ fn assess(
     };
     match check_goal(scenario, world, goal) {
         Err(p) if !p.doubt => Some(p),
+        _ if let Some(reason) = more_alternatives_than_asked(goal, request) => Some(GoalProblem {
+            reason,
+            doubt: false,
+        }),
         Err(_) if let Some(object) = unsaid_object_holding(goal, world, request, lexicon) => {
             Some(GoalProblem {
                 reason: format!(
@@ -759,6 +822,48 @@ mod tests {
         let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
         let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
         assert!(unasked(&bars, request, &lexicon).is_empty());
+    }
+
+    #[test]
+    fn a_goal_may_offer_only_the_choices_the_request_gives() {
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        let request = "Bring me a banana or an orange, and switch off the hall light.";
+        assert!(
+            more_alternatives_than_asked(
+                &g("On_Banana_Bar | On_Orange_Bar | ~Active_HallLight"),
+                request
+            )
+            .is_some()
+        );
+        assert_eq!(
+            more_alternatives_than_asked(
+                &g("(On_Banana_Bar | On_Orange_Bar) & ~Active_HallLight"),
+                request
+            ),
+            None
+        );
+        // A list ending in "or" offers one choice per item.
+        let listed = g("On_Coffee_Bar | On_Cake_Bar | On_Tea_Bar");
+        assert_eq!(
+            more_alternatives_than_asked(&listed, "Coffee, cake, or tea at the bar."),
+            None
+        );
+        // "Neither ... nor" offers no choice: the disjunction is under a negation.
+        let neither = g("~(On_Mop_Entrance | On_Mop_Exit)");
+        assert_eq!(
+            more_alternatives_than_asked(
+                &neither,
+                "Keep the mop away from the entrance and the exit."
+            ),
+            None
+        );
+        assert_eq!(
+            more_alternatives_than_asked(
+                &g("IsClean_Chairs | Exists_Coffee"),
+                "Clean the chairs; if not, make coffee."
+            ),
+            None
+        );
     }
 
     #[test]
