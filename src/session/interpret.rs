@@ -469,10 +469,11 @@ pub async fn interpret(
                 }),
                 (Ok(_), None) => {}
             }
-            // The first answer without what it pasted from an example is a candidate
-            // of its own, checked like the others.
-            let pruned = match (&read, draw) {
-                (Ok(a), 0) if problem.is_some() => without_copied(&a.goal, &shown, instruction)
+            // An answer without what it pasted from an example, or without the parts no
+            // word of the request asks for, is a candidate of its own, checked like the
+            // others.
+            let pruned = match &read {
+                Ok(a) if problem.is_some() => without_copied(&a.goal, &shown, instruction)
                     .or_else(|| without_unasked(&a.goal, instruction, &lexicon)),
                 _ => None,
             };
