@@ -5,6 +5,7 @@
 
 pub mod ask;
 pub mod engine;
+pub mod goal_checks;
 pub mod interpret;
 pub mod policy;
 pub mod resolve;
@@ -15,7 +16,8 @@ pub mod values;
 
 pub use ask::missing_value;
 pub use engine::{Command, Engine, EngineHandle, Setup};
-pub use interpret::{Interpretation, check_goal, interpret};
+pub use goal_checks::check_goal;
+pub use interpret::{Interpretation, interpret};
 pub use policy::{Policy, PolicyStore};
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{Ending, Event, Options, Proposal, Resolved, SessionError};

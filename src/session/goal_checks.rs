@@ -1,0 +1,499 @@
+//! The checks a candidate goal passes before it is used, and the ones that only raise a
+//! doubt. Wrong: it does not parse, contradicts itself, cannot be planned, offers more
+//! alternatives than the request gives, or holds already through an object the request
+//! never names. Doubtful: it holds already, or a part of it is pasted from a shown
+//! example, or no word of the request asks for a part of it (such parts can be taken out,
+//! giving a candidate of its own). Words are matched through the scene's [`Lexicon`].
+
+use crate::domain::{Condition, Scenario};
+use crate::goal::Formula;
+use crate::llm::examples::terms;
+use crate::llm::lexicon::{Lexicon, same_word};
+use crate::planner::{Outcome, Planner};
+use crate::world::World;
+
+/// Why a candidate goal cannot be what the person meant, or may not be.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GoalProblem {
+    pub reason: String,
+    /// A doubt rather than a proof: the goal holds already (a person may ask for what is
+    /// true), or a condition of it comes from a shown example (an indirect request may
+    /// mean just that). A doubtful first answer is kept unless the part it pasted can be
+    /// taken out; a wrong one (unreadable, contradictory, unplannable) never is.
+    pub doubt: bool,
+}
+
+/// Check a candidate goal against the skills and the scene: not contradictory,
+/// plannable, and (a doubt) not already true.
+pub fn check_goal(
+    scenario: &Scenario,
+    world: &dyn World,
+    goal: &Formula,
+) -> Result<(), GoalProblem> {
+    let wrong = |reason: String| GoalProblem {
+        reason,
+        doubt: false,
+    };
+    let dnf = goal.to_dnf();
+    if dnf.is_false() {
+        return Err(wrong(
+            "it contradicts itself: no situation makes it true".into(),
+        ));
+    }
+    let planner = Planner::new(&scenario.domain);
+    let plan = planner
+        .plan(&dnf, world)
+        .map_err(|e| wrong(e.to_string()))?;
+    match plan.outcome {
+        // An action that fails in simulation is what failure resolution is for: the goal
+        // itself was plannable.
+        Outcome::Success | Outcome::ActionFailed { .. } => {}
+        Outcome::Unreachable {
+            condition, reason, ..
+        } => {
+            return Err(wrong(format!(
+                "the robot cannot make {condition} true: {reason}"
+            )));
+        }
+        Outcome::Exhausted { reason } => {
+            return Err(wrong(format!("the robot cannot reach it: {reason}")));
+        }
+    }
+    // The world answers for "any object" as well as for plain atoms.
+    let holds = |atom: &crate::domain::Atom| world.check(&Condition::pos(atom.clone()));
+    if goal.eval(&holds) {
+        return Err(GoalProblem {
+            reason: "it holds already in the scene now, but the request asks for a change".into(),
+            doubt: true,
+        });
+    }
+    Ok(())
+}
+
+/// A condition of `goal` that one of the `shown` examples' goals holds and that shares no
+/// word with the request: pasted from the example rather than asked for (small models
+/// copy an example's place, or its extra "hand empty", into unrelated answers).
+pub fn copied_from_example(
+    goal: &Formula,
+    shown: &[&crate::domain::Example],
+    request: &str,
+) -> Option<String> {
+    let asked: Vec<String> = terms(request);
+    goal.atoms()
+        .into_iter()
+        .find(|atom| is_copied(atom, shown, &asked))
+        .map(|atom| format!("{atom} comes from an example, and the request says nothing about it"))
+}
+
+fn is_copied(
+    atom: &crate::domain::Atom,
+    shown: &[&crate::domain::Example],
+    asked: &[String],
+) -> bool {
+    let in_example = shown
+        .iter()
+        .any(|e| Formula::parse(&e.goal).is_ok_and(|f| f.atoms().contains(atom)));
+    // Pasted when what it is about (its first object) is one the request never names: an
+    // example's saucer at the table the request does name is still the example's saucer,
+    // while the bowl a named sponge is taken out of may come from the scene.
+    in_example
+        && atom.args.first().is_none_or(|arg| {
+            !terms(arg)
+                .iter()
+                .any(|w| asked.iter().any(|a| same_word(a, w)))
+        })
+}
+
+/// Words of a request that ask for no condition by themselves: how a request is phrased,
+/// not what it asks for.
+const PHRASING: &[&str] = &[
+    "put", "place", "bring", "take", "give", "hand", "fetch", "carry", "get", "make", "set",
+    "move", "go", "keep", "need", "have", "now", "then", "also", "too", "right", "away", "thank",
+    "thanks", "kindly", "over",
+];
+
+/// The conjuncts of `goal` (a conjunction of two or more) that nothing in the request asks
+/// for: every word of the request they answer to is claimed by more conjuncts than the
+/// request says it. Small models append a condition the request never mentions ("robot
+/// near table 2" after "coffee on table 2": "table" and "2" are said once and claimed
+/// twice, and the second conjunct has no word of its own); a request that says "bar" twice
+/// ("not on the bar and bar 2, the milk to the bar") asks for every conjunct about a bar.
+pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula> {
+    let Formula::And(items) = goal else {
+        return Vec::new();
+    };
+    let asked = terms(request);
+    let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, &asked)).collect();
+    let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
+    let claimed = |w: &String| covered.iter().filter(|c| c.contains(w)).count();
+    items
+        .iter()
+        .zip(&covered)
+        .filter(|(_, words)| words.iter().all(|w| claimed(w) > said(w)))
+        .map(|(item, _)| item.clone())
+        .collect()
+}
+
+/// Words of the request that name an object ("six" of window table 6, "juice") and that
+/// no condition of `goal` answers to: the goal leaves out, or misplaces, something asked.
+pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<String> {
+    let asked = terms(request);
+    let covered = lexicon.covered(goal, &asked);
+    let mut out: Vec<String> = asked
+        .into_iter()
+        .filter(|w| lexicon.names_an_object(w) && !covered.contains(w))
+        .collect();
+    out.dedup();
+    out
+}
+
+/// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
+/// first (an appended condition comes last), while more than one is left.
+pub(super) fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Option<Formula> {
+    let mut current = goal.clone();
+    let mut changed = false;
+    while let Some(extra) = unasked(&current, request, lexicon).pop() {
+        let Formula::And(items) = &current else {
+            break;
+        };
+        let kept: Vec<Formula> = items.iter().filter(|i| **i != extra).cloned().collect();
+        if kept.is_empty() || kept.len() == items.len() {
+            break;
+        }
+        current = Formula::and(kept);
+        changed = true;
+    }
+    changed.then_some(current)
+}
+
+/// A conjunction without its conjuncts pasted from an example, when the rest stands
+/// alone: something is left, and every word of the request that asks for something is
+/// covered by what is left ("put the blue cube on the green cube" read as "blue on green
+/// & hand empty": the rest covers blue, green and cube, so the pasted "hand empty" goes).
+/// A request with a word the rest does not cover ("it's hot, close the curtain") may
+/// mean the pasted condition in other words, and keeps it.
+pub(super) fn without_copied(
+    goal: &Formula,
+    shown: &[&crate::domain::Example],
+    request: &str,
+) -> Option<Formula> {
+    let Formula::And(items) = goal else {
+        return None;
+    };
+    let asked = terms(request);
+    let kept: Vec<Formula> = items
+        .iter()
+        .filter(|item| !item.atoms().iter().any(|a| is_copied(a, shown, &asked)))
+        .cloned()
+        .collect();
+    if kept.is_empty() || kept.len() == items.len() {
+        return None;
+    }
+    let rest = Formula::and(kept);
+    let covered: Vec<String> = rest
+        .atoms()
+        .iter()
+        .flat_map(|a| terms(&a.to_string()))
+        .collect();
+    let unexplained = asked
+        .iter()
+        .any(|w| !PHRASING.contains(&w.as_str()) && !covered.iter().any(|c| same_word(c, w)));
+    (!unexplained).then_some(rest)
+}
+
+/// How many alternatives `goal` offers beyond the first where it asks for something:
+/// `A | B | C` offers two; a disjunction under a negation ("neither A nor B") offers none.
+fn alternatives(goal: &Formula, negated: bool) -> usize {
+    match goal {
+        Formula::Atom(_) => 0,
+        Formula::Not(inner) => alternatives(inner, !negated),
+        Formula::And(items) | Formula::Or(items) => {
+            let inner: usize = items.iter().map(|i| alternatives(i, negated)).sum();
+            // `~(A & B)` is `~A | ~B`: a conjunction offers alternatives under a negation.
+            let offers = matches!(goal, Formula::Or(_)) != negated;
+            inner + if offers { items.len() - 1 } else { 0 }
+        }
+    }
+}
+
+/// Words that offer a choice between what comes before and after them.
+const CHOICE_WORDS: &[&str] = &["or", "otherwise", "else", "alternatively", "instead"];
+
+/// How many choices a request offers: each "or" (and "if not", "otherwise", ...), and each
+/// comma of a list that ends in "or" ("coffee, cake, or tea").
+fn choices_offered(request: &str) -> usize {
+    let lower = request.to_lowercase();
+    let mut choices = lower.matches("if not").count();
+    for part in lower.split(['.', ';', ':', '!', '?']) {
+        let words: Vec<&str> = part
+            .split(|c: char| !c.is_alphanumeric() && c != ',')
+            .filter(|w| !w.is_empty())
+            .collect();
+        let mut commas_since_choice = 0;
+        for w in words {
+            let word = w.trim_end_matches(',');
+            if CHOICE_WORDS.contains(&word) {
+                choices += 1 + commas_since_choice;
+                commas_since_choice = 0;
+            }
+            if w.ends_with(',') {
+                commas_since_choice += 1;
+            }
+        }
+    }
+    choices
+}
+
+/// Why `goal` offers more alternatives than `request` does, if it does: "a banana or an
+/// orange, and switch the light off" written `A | B | ~C` makes switching the light off
+/// one of three alternatives, when the request asks for it in any case.
+fn more_alternatives_than_asked(goal: &Formula, request: &str) -> Option<String> {
+    let offered = alternatives(goal, false);
+    let asked = choices_offered(request);
+    (offered > asked).then(|| {
+        format!(
+            "it offers {} alternatives joined by |, where the request gives {} choice(s); \
+             what must hold in any case is joined with &, and a choice in parentheses: (A | B) & C",
+            offered + 1,
+            asked + 1
+        )
+    })
+}
+
+/// An object of a condition of `goal` that holds now and that no word of the request
+/// names: a goal made true already by a place the model chose itself ("bring me a
+/// banana" read as the banana on the table it lies on). A goal that holds through what
+/// the request does say ("check that the hall light is on") stays a doubt.
+fn unsaid_object_holding(
+    goal: &Formula,
+    world: &dyn World,
+    request: &str,
+    lexicon: &Lexicon,
+) -> Option<String> {
+    let asked = terms(request);
+    goal.atoms()
+        .into_iter()
+        .filter(|a| world.check(&Condition::pos(a.clone())))
+        .flat_map(|a| a.args.clone())
+        .filter(|arg| arg != crate::domain::ANY_OBJECT)
+        .find(|arg| {
+            !lexicon
+                .words(arg)
+                .iter()
+                .any(|w| asked.iter().any(|a| same_word(a, w)))
+        })
+}
+
+/// Every check of a readable candidate, the wrong ones first.
+pub(super) fn assess(
+    scenario: &Scenario,
+    world: &dyn World,
+    goal: &Formula,
+    (shown, lexicon): (&[&crate::domain::Example], &Lexicon),
+    request: &str,
+) -> Option<GoalProblem> {
+    let doubt = |reason: String| GoalProblem {
+        reason,
+        doubt: true,
+    };
+    match check_goal(scenario, world, goal) {
+        Err(p) if !p.doubt => Some(p),
+        _ if let Some(reason) = more_alternatives_than_asked(goal, request) => Some(GoalProblem {
+            reason,
+            doubt: false,
+        }),
+        Err(_) if let Some(object) = unsaid_object_holding(goal, world, request, lexicon) => {
+            Some(GoalProblem {
+                reason: format!(
+                    "it holds already in the scene now, through {object}, which the request \
+                     never mentions; the request asks for a change"
+                ),
+                doubt: false,
+            })
+        }
+        checked => copied_from_example(goal, shown, request)
+            .map(doubt)
+            .or_else(|| {
+                let extra = unasked(goal, request, lexicon);
+                (!extra.is_empty()).then(|| {
+                    let parts: Vec<String> = extra.iter().map(ToString::to_string).collect();
+                    doubt(format!(
+                        "no word of the request asks for {}",
+                        parts.join(" or ")
+                    ))
+                })
+            })
+            .or(checked.err()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn cafe() -> (Scenario, Box<dyn World>) {
+        let s =
+            Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+                .expect("cafe scenario");
+        let w = crate::world::load(&s).expect("cafe world");
+        (s, w)
+    }
+
+    fn check(goal: &str) -> Result<(), String> {
+        let (s, w) = cafe();
+        let f = s.parse_goal(goal).expect("goal parses");
+        check_goal(&s, w.as_ref(), &f).map_err(|p| p.reason)
+    }
+
+    #[test]
+    fn checks_refuse_what_cannot_be_meant() {
+        assert!(check("On_Coffee_Table1").is_ok());
+        assert!(check("Active_AC & ~Active_HallLight").is_ok());
+        let e = check("Active_AC & ~Active_AC").unwrap_err();
+        assert!(e.contains("contradicts"), "{e}");
+        // Already true in the cafe's first state.
+        let e = check("On_Chips_Bar").unwrap_err();
+        assert!(e.contains("already"), "{e}");
+        let e = check("RobotNear_Table1 & RobotNear_Table2").unwrap_err();
+        assert!(e.contains("cannot"), "{e}");
+    }
+
+    #[test]
+    fn a_condition_pasted_from_an_example_is_found() {
+        let example = crate::domain::Example {
+            instruction: "Put the sponge in the bowl and leave your gripper empty".into(),
+            goal: r#""sponge" in "bowl" & ~"any object" grasped"#.into(),
+        };
+        let shown = [&example];
+        let request = "Put the blue cube on the green cube";
+        let pasted = Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#)
+            .expect("parses");
+        let why = copied_from_example(&pasted, &shown, request).expect("found");
+        assert!(why.contains("grasped"), "{why}");
+        let plain = Formula::parse(r#""blue cube" on "green cube""#).expect("parses");
+        assert!(copied_from_example(&plain, &shown, request).is_none());
+        // Asked for in other words ("hand empty" is not "grasped", but the object is
+        // named): not a copy.
+        let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
+        assert!(copied_from_example(&named, &shown, "take the sponge out").is_none());
+    }
+
+    #[test]
+    fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
+        let example = crate::domain::Example {
+            instruction: "It's really stuffy in here, and leave your gripper empty".into(),
+            goal: r#"Active_AC & ~"any object" grasped"#.into(),
+        };
+        let shown = [&example];
+        let pasted = Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#)
+            .expect("parses");
+        let rest =
+            without_copied(&pasted, &shown, "Put the blue cube on the green cube").expect("pruned");
+        assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
+        // "hot" is not covered by the curtain: the AC may be what it asks for.
+        let indirect = Formula::parse("Closed_Curtain & Active_AC").expect("parses");
+        assert!(without_copied(&indirect, &shown, "It's hot here, close the curtain").is_none());
+        assert!(same_word("clos", "close") && same_word("cube", "cube") && !same_word("ac", "at"));
+    }
+
+    #[test]
+    fn a_condition_no_word_asks_for_is_taken_out() {
+        let (scenario, _) = cafe();
+        let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        let request = "Please take a sandwich to the second table.";
+        let appended = g("On_Sandwiches_Table2 & RobotNear_Table2");
+        assert_eq!(
+            unasked(&appended, request, &lexicon),
+            vec![g("RobotNear_Table2")]
+        );
+        assert_eq!(
+            without_unasked(&appended, request, &lexicon),
+            Some(g("On_Sandwiches_Table2"))
+        );
+        // Every part answers to words of its own: nothing goes.
+        let request = "Mop the floor, and bring a teacup to table two.";
+        let both = g("IsClean_Floor & On_Teacup_Table2");
+        assert!(unasked(&both, request, &lexicon).is_empty());
+        assert_eq!(without_unasked(&both, request, &lexicon), None);
+        // A single condition is never taken out, however indirect the request.
+        assert_eq!(
+            without_unasked(&g("Active_AC"), "I'm melting.", &lexicon),
+            None
+        );
+        // A word said as often as conditions claim it asks for each of them.
+        let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
+        let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
+        assert!(unasked(&bars, request, &lexicon).is_empty());
+    }
+
+    #[test]
+    fn a_goal_may_offer_only_the_choices_the_request_gives() {
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        let request = "Bring me a banana or an orange, and switch off the hall light.";
+        assert!(
+            more_alternatives_than_asked(
+                &g("On_Banana_Bar | On_Orange_Bar | ~Active_HallLight"),
+                request
+            )
+            .is_some()
+        );
+        assert_eq!(
+            more_alternatives_than_asked(
+                &g("(On_Banana_Bar | On_Orange_Bar) & ~Active_HallLight"),
+                request
+            ),
+            None
+        );
+        // A list ending in "or" offers one choice per item.
+        let listed = g("On_Coffee_Bar | On_Cake_Bar | On_Tea_Bar");
+        assert_eq!(
+            more_alternatives_than_asked(&listed, "Coffee, cake, or tea at the bar."),
+            None
+        );
+        // "Neither ... nor" offers no choice: the disjunction is under a negation.
+        let neither = g("~(On_Mop_Entrance | On_Mop_Exit)");
+        assert_eq!(
+            more_alternatives_than_asked(
+                &neither,
+                "Keep the mop away from the entrance and the exit."
+            ),
+            None
+        );
+        assert_eq!(
+            more_alternatives_than_asked(
+                &g("IsClean_Chairs | Exists_Coffee"),
+                "Clean the chairs; if not, make coffee."
+            ),
+            None
+        );
+    }
+
+    #[test]
+    fn a_goal_true_through_a_place_nobody_named_is_wrong() {
+        let (scenario, world) = cafe();
+        let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        // The chips lie on the bar already; the request says nothing of the bar.
+        assert_eq!(
+            unsaid_object_holding(
+                &g("On_Chips_Bar"),
+                world.as_ref(),
+                "Bring me the chips",
+                &lexicon
+            ),
+            Some("Bar".to_string())
+        );
+        // The hall light is on already, and the request names it: a doubt, not a mistake.
+        assert_eq!(
+            unsaid_object_holding(
+                &g("Active_HallLight"),
+                world.as_ref(),
+                "Could you check that the hall light is on?",
+                &lexicon
+            ),
+            None
+        );
+    }
+}
