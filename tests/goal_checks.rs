@@ -98,10 +98,18 @@ async fn read(scenario: &Scenario, model: &ByDraw, instruction: &str) -> (Formul
 #[tokio::test]
 async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
+    // One place in the answer, one place of its kind numbered 5: put right, one call.
+    let model = ByDraw::new("Goal: On_Coffee_Table1", &[]);
+    let (goal, calls) = read(&cafe, &model, "Take a coffee to table five by the window.").await;
+    assert_eq!(goal.to_string(), "On_Coffee_WindowTable5");
+    assert_eq!(calls, 1);
+
+    // Two numbered places in the answer: which one was meant is not known, so more
+    // candidates are drawn and the one that uses the number wins.
     let model = ByDraw::new(
-        "Goal: On_Coffee_Table1",
+        "Goal: On_Coffee_Table1 & RobotNear_Table2",
         &[
-            "Goal: On_Coffee_Table1",
+            "Goal: On_Coffee_Table1 & RobotNear_Table2",
             "Goal: On_Coffee_WindowTable5",
             "Goal: On_Coffee_WindowTable5",
         ],

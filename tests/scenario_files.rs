@@ -49,26 +49,22 @@ fn every_shipped_scenario_loads() {
         }
     }
     assert!(files.len() >= 4);
+    // The files that `key = "name"` lines of the scenario files point at.
+    let named_by = |key: &str| -> Vec<PathBuf> {
+        files
+            .iter()
+            .filter_map(|f| {
+                let text = std::fs::read_to_string(f).unwrap();
+                let line = text.lines().find(|l| l.starts_with(key))?;
+                let name = line.split('"').nth(1)?;
+                Some(f.parent()?.join(name).canonicalize().unwrap())
+            })
+            .collect()
+    };
     // A base file that other files extend need not be a scenario by itself.
-    let extended: Vec<PathBuf> = files
-        .iter()
-        .filter_map(|f| {
-            let text = std::fs::read_to_string(f).unwrap();
-            let line = text.lines().find(|l| l.starts_with("extends"))?;
-            let name = line.split('"').nth(1)?;
-            Some(f.parent()?.join(name).canonicalize().unwrap())
-        })
-        .collect();
+    let extended = named_by("extends");
     // Example pools that scenarios name are lists of examples, loaded with them.
-    let pools: Vec<PathBuf> = files
-        .iter()
-        .filter_map(|f| {
-            let text = std::fs::read_to_string(f).unwrap();
-            let line = text.lines().find(|l| l.starts_with("example_pool"))?;
-            let name = line.split('"').nth(1)?;
-            Some(f.parent()?.join(name).canonicalize().unwrap())
-        })
-        .collect();
+    let pools = named_by("example_pool");
     assert!(!pools.is_empty());
     for f in files {
         if pools.contains(&f.canonicalize().unwrap()) {

@@ -224,7 +224,7 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
             .filter(|c| c.feedback_rounds > 0)
             .count();
         notes.push(format!(
-            "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, not true already, plannable), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback.",
+            "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, plannable, no more alternatives than the request offers, not true already, nothing pasted from an example or asked by no word), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback.",
             calls as f64 / cases
         ));
     }

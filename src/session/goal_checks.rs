@@ -8,7 +8,7 @@
 use crate::domain::{Condition, Scenario};
 use crate::goal::Formula;
 use crate::llm::examples::terms;
-use crate::llm::lexicon::{Lexicon, same_word};
+use crate::llm::lexicon::{Lexicon, is_number, same_word};
 use crate::planner::{Outcome, Planner};
 use crate::world::World;
 
@@ -38,6 +38,11 @@ pub fn check_goal(
     if dnf.is_false() {
         return Err(wrong(
             "it contradicts itself: no situation makes it true".into(),
+        ));
+    }
+    if Formula::Not(Box::new(goal.clone())).to_dnf().is_false() {
+        return Err(wrong(
+            "it is true in every situation (something and its negation as alternatives), so it asks for nothing".into(),
         ));
     }
     let planner = Planner::new(&scenario.domain);
@@ -201,6 +206,62 @@ pub(super) fn without_copied(
     (!unexplained).then_some(rest)
 }
 
+/// `goal` with the one numbered object it names replaced by the one object of the same
+/// kind that has the number the request says and the goal leaves out (`missing`, as
+/// [`terms`] gives numbers): "table six" read as `Table1`, where `WindowTable6` is the only
+/// place numbered 6. `None` when any of it is ambiguous. Returns the goal, and the object
+/// replaced and its replacement.
+pub fn renumbered(
+    goal: &Formula,
+    missing: &[String],
+    vocabulary: &crate::domain::Vocabulary,
+) -> Option<(Formula, String, String)> {
+    let [number] = missing else {
+        return None;
+    };
+    let numbered = |name: &str| terms(name).into_iter().any(|w| is_number(&w));
+    let mut named: Vec<String> = goal
+        .atoms()
+        .iter()
+        .flat_map(|a| a.args.clone())
+        .filter(|arg| numbered(arg))
+        .collect();
+    named.sort();
+    named.dedup();
+    let [from] = named.as_slice() else {
+        return None;
+    };
+    let kinds = &vocabulary.objects.iter().find(|o| &o.name == from)?.types;
+    let mut to = vocabulary
+        .objects
+        .iter()
+        .filter(|o| o.types.iter().any(|t| kinds.contains(t)) && terms(&o.name).contains(number));
+    let (Some(to), None) = (to.next(), to.next()) else {
+        return None;
+    };
+    Some((
+        rename(goal, from, &to.name),
+        from.to_string(),
+        to.name.clone(),
+    ))
+}
+
+/// `goal` with every argument `from` written `to`.
+fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
+    match goal {
+        Formula::Atom(a) => Formula::Atom(crate::domain::Atom::new(
+            a.predicate.clone(),
+            a.args
+                .iter()
+                .map(|x| if x == from { to.to_string() } else { x.clone() })
+                .collect::<Vec<String>>(),
+        )),
+        Formula::Not(inner) => Formula::Not(Box::new(rename(inner, from, to))),
+        Formula::And(items) => Formula::And(items.iter().map(|i| rename(i, from, to)).collect()),
+        Formula::Or(items) => Formula::Or(items.iter().map(|i| rename(i, from, to)).collect()),
+    }
+}
+
 /// How many alternatives `goal` offers beyond the first where it asks for something:
 /// `A | B | C` offers two; a disjunction under a negation ("neither A nor B") offers none.
 fn alternatives(goal: &Formula, negated: bool) -> usize {
@@ -352,6 +413,8 @@ mod tests {
         assert!(check("Active_AC & ~Active_HallLight").is_ok());
         let e = check("Active_AC & ~Active_AC").unwrap_err();
         assert!(e.contains("contradicts"), "{e}");
+        let e = check("RobotNear_Bar | ~RobotNear_Bar").unwrap_err();
+        assert!(e.contains("every situation"), "{e}");
         // Already true in the cafe's first state.
         let e = check("On_Chips_Bar").unwrap_err();
         assert!(e.contains("already"), "{e}");
@@ -426,6 +489,35 @@ mod tests {
         let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
         let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
         assert!(unasked(&bars, request, &lexicon).is_empty());
+    }
+
+    #[test]
+    fn a_place_read_with_the_wrong_number_is_renumbered_when_unambiguous() {
+        let (scenario, _) = cafe();
+        let vocabulary = &scenario.domain.vocabulary;
+        let g = |t: &str| Formula::parse(t).expect("parses");
+        let six = ["6".to_string()];
+        let (goal, from, to) =
+            renumbered(&g("On_Coffee_Table1"), &six, vocabulary).expect("renumbered");
+        assert_eq!(goal, g("On_Coffee_WindowTable6"));
+        assert_eq!((from.as_str(), to.as_str()), ("Table1", "WindowTable6"));
+        // Every occurrence of the place, and nothing else, changes.
+        let (goal, ..) = renumbered(
+            &g("On_Chips_Table2 & (On_Milk_Table2 | RobotNear_Bar)"),
+            &six,
+            vocabulary,
+        )
+        .expect("renumbered");
+        assert_eq!(
+            goal,
+            g("On_Chips_WindowTable6 & (On_Milk_WindowTable6 | RobotNear_Bar)")
+        );
+        // Two numbered places, or two numbers left out: which is which is not known.
+        assert!(renumbered(&g("On_Coffee_Table1 & RobotNear_Table2"), &six, vocabulary).is_none());
+        let two = ["6".to_string(), "2".to_string()];
+        assert!(renumbered(&g("On_Coffee_Table1"), &two, vocabulary).is_none());
+        // No place numbered 12.
+        assert!(renumbered(&g("On_Coffee_Table1"), &["12".to_string()], vocabulary).is_none());
     }
 
     #[test]

@@ -21,7 +21,9 @@ use crate::llm::{LanguageModel, Message, Role, grammar, schema};
 use crate::world::World;
 
 use super::ask::ask;
-use super::goal_checks::{GoalProblem, assess, unanswered_names, without_copied, without_unasked};
+use super::goal_checks::{
+    GoalProblem, assess, renumbered, unanswered_names, without_copied, without_unasked,
+};
 use super::types::{Event, Options, SessionError};
 
 /// Sampling temperature of the extra candidates: enough to make them differ from the
@@ -100,6 +102,14 @@ pub async fn interpret(
         1
     };
     let mut last_error = ReplyError::NoConditions;
+    let answers_numbers = |c: &Candidate| {
+        c.clean()
+            && c.read.as_ref().is_ok_and(|a| {
+                !unanswered_names(&a.goal, instruction, &lexicon)
+                    .iter()
+                    .any(|w| place_numbers.contains(w))
+            })
+    };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
     for round in 0..rounds {
@@ -174,13 +184,32 @@ pub async fn interpret(
                     .or_else(|| without_unasked(&a.goal, instruction, &lexicon)),
                 _ => None,
             };
+            // A place the model chose when the request numbers another ("table six"
+            // read as Table1) is put right when one place of that kind has the number.
+            let renumber = match &read {
+                Ok(a) if options.check_goals => {
+                    let missing: Vec<String> = unanswered_names(&a.goal, instruction, &lexicon)
+                        .into_iter()
+                        .filter(|w| place_numbers.contains(w))
+                        .collect();
+                    renumbered(&a.goal, &missing, vocabulary)
+                }
+                _ => None,
+            };
             candidates.push(Candidate {
                 text: r.text,
                 read,
                 problem,
                 first: round == 0 && draw == 0,
             });
-            if let Some(goal) = pruned {
+            if let Some((goal, from, to)) = &renumber {
+                emit(&Event::Notice {
+                    message: format!(
+                        "the request numbers a place the answer does not: {to} is the only one like {from} with that number, so {goal} is a candidate too"
+                    ),
+                });
+            }
+            for goal in pruned.into_iter().chain(renumber.map(|(g, _, _)| g)) {
                 let problem = assess(
                     scenario,
                     world.as_ref(),
@@ -226,6 +255,7 @@ pub async fn interpret(
                 && let Some(missed) = misses.as_ref().filter(|m| !m.is_empty())
                 && let Some(Ok(a)) = candidates.first().map(|c| &c.read)
                 && options.check_goals
+                && !candidates.iter().any(answers_numbers)
             {
                 emit(&Event::Notice {
                     message: format!(
@@ -240,14 +270,6 @@ pub async fn interpret(
                 break;
             }
         }
-        let answers_numbers = |c: &Candidate| {
-            c.clean()
-                && c.read.as_ref().is_ok_and(|a| {
-                    !unanswered_names(&a.goal, instruction, &lexicon)
-                        .iter()
-                        .any(|w| place_numbers.contains(w))
-                })
-        };
         // A doubtful answer is taken when it is the model's own first answer, or when no
         // round is left: a doubtful sample after a wrong first answer is asked about again
         // (told why), and stays eligible for the last round's vote.
