@@ -16,10 +16,10 @@ local=(--backend local --threads "$threads")
 
 # Goals: the default model as the product reads instructions (examples retrieved per
 # request, candidates checked, vote, feedback; the first call alone is scored too, which
-# is the run without checks), then with the pool's first examples instead of retrieved
-# ones, then the fast model.
+# is the run without checks), then a single call with the pool's first examples instead
+# of retrieved ones (the examples lever alone), then the fast model.
 "$betr" eval goals "${local[@]}" --out "$out/goals-1.5b"
-"$betr" eval goals "${local[@]}" --fixed-examples --out "$out/goals-1.5b-fixed-examples"
+"$betr" eval goals "${local[@]}" --fixed-examples --no-checks --out "$out/goals-1.5b-fixed-examples"
 "$betr" eval goals "${local[@]}" --model qwen2.5-coder-0.5b --out "$out/goals-0.5b"
 
 # Failures and values: the goal read from the instruction (a misread goal is its own
@@ -28,6 +28,13 @@ local=(--backend local --threads "$threads")
 "$betr" eval params "${local[@]}" --runs "$runs" --out "$out/params"
 "$betr" eval resolve "${local[@]}" --runs "$runs" --goal scenario --out "$out/resolve-scenario-goal"
 "$betr" eval params "${local[@]}" --runs "$runs" --goal scenario --out "$out/params-scenario-goal"
+
+# Latency, on an otherwise idle machine: both models, one and two threads.
+for model in qwen2.5-coder-1.5b qwen2.5-coder-0.5b; do
+  for t in 1 2; do
+    "$betr" bench llm --model "$model" --threads "$t"
+  done
+done
 
 cp "$out/goals-1.5b/accuracy.png" docs/images/eval-goals-default-model.png
 cp "$out/resolve/resolve.png" docs/images/eval-resolve-default-model.png
