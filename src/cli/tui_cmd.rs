@@ -1,6 +1,7 @@
 //! `betr` and `betr tui [SCENARIO]`: the workbench on a scenario (scenario 1 by default)
-//! with the configured model. A model that cannot be built (no model name, the local
-//! backend not built yet) is shown in the LLM pane; the rest of the workbench works.
+//! with the configured model. A model that cannot be set up (no model name for a server,
+//! an embedded model file that cannot be fetched or loaded) is shown in the LLM pane; the
+//! rest of the workbench works.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
