@@ -102,13 +102,18 @@ pub async fn interpret(
         1
     };
     let mut last_error = ReplyError::NoConditions;
+    // The place numbers the request says that no condition of `goal` is about.
+    let missing_numbers = |goal: &Formula| -> Vec<String> {
+        unanswered_names(goal, instruction, &lexicon)
+            .into_iter()
+            .filter(|w| place_numbers.contains(w))
+            .collect()
+    };
     let answers_numbers = |c: &Candidate| {
         c.clean()
-            && c.read.as_ref().is_ok_and(|a| {
-                !unanswered_names(&a.goal, instruction, &lexicon)
-                    .iter()
-                    .any(|w| place_numbers.contains(w))
-            })
+            && c.read
+                .as_ref()
+                .is_ok_and(|a| missing_numbers(&a.goal).is_empty())
     };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
@@ -188,11 +193,7 @@ pub async fn interpret(
             // read as Table1) is put right when one place of that kind has the number.
             let renumber = match &read {
                 Ok(a) if options.check_goals => {
-                    let missing: Vec<String> = unanswered_names(&a.goal, instruction, &lexicon)
-                        .into_iter()
-                        .filter(|w| place_numbers.contains(w))
-                        .collect();
-                    renumbered(&a.goal, &missing, vocabulary)
+                    renumbered(&a.goal, &missing_numbers(&a.goal), vocabulary)
                 }
                 _ => None,
             };
@@ -245,12 +246,7 @@ pub async fn interpret(
             let misses = candidates
                 .first()
                 .and_then(|c| c.read.as_ref().ok())
-                .map(|a| {
-                    unanswered_names(&a.goal, instruction, &lexicon)
-                        .into_iter()
-                        .filter(|w| place_numbers.contains(w))
-                        .collect::<Vec<_>>()
-                });
+                .map(|a| missing_numbers(&a.goal));
             if draw == 0
                 && let Some(missed) = misses.as_ref().filter(|m| !m.is_empty())
                 && let Some(Ok(a)) = candidates.first().map(|c| &c.read)

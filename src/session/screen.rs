@@ -19,6 +19,15 @@ pub struct FailureAt {
     pub error: String,
 }
 
+impl FailureAt {
+    /// Whether `outcome` is this failure again: the same action failing with the same
+    /// error.
+    fn recurs_in(&self, outcome: &Outcome) -> bool {
+        matches!(outcome, Outcome::ActionFailed { action, error, .. }
+            if self.action.same_invocation(action) && &self.error == error)
+    }
+}
+
 /// The tree with a proposal applied, re-planned; and on how many actions a value was set.
 pub fn apply(
     planner: &Planner,
@@ -62,13 +71,9 @@ pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), String>
 fn verdict(before: Option<&FailureAt>, after: &Outcome) -> Result<Verdict, String> {
     match (before, after) {
         (_, Outcome::Success) => Ok(Verdict::Succeeds),
-        (Some(f), Outcome::ActionFailed { action, error, .. })
-            if f.action.same_invocation(action) && &f.error == error =>
-        {
-            Err(format!(
-                "{action}! still fails with the same error: {error}"
-            ))
-        }
+        (Some(f), Outcome::ActionFailed { action, error, .. }) if f.recurs_in(after) => Err(
+            format!("{action}! still fails with the same error: {error}"),
+        ),
         (_, Outcome::ActionFailed { .. }) => Ok(Verdict::MovesOn),
         (
             _,
@@ -103,18 +108,19 @@ impl Screen {
     /// Whether, with `proposal` applied and carried out, the failing action still fails
     /// with the same error: what the change made true is not what the action lacks.
     pub fn still_fails(&self, proposal: &Proposal) -> bool {
+        self.replan(proposal)
+            .is_ok_and(|plan| self.failure.recurs_in(&plan.outcome))
+    }
+
+    /// The copy of the tree with `proposal` applied, re-planned in the copy of the world.
+    fn replan(&self, proposal: &Proposal) -> Result<Plan, RepairError> {
         let planner = Planner::new(&self.scenario.domain);
-        apply(&planner, &self.tree, proposal, self.world.as_ref()).is_ok_and(|(plan, _)| {
-            matches!(&plan.outcome, Outcome::ActionFailed { action, error, .. }
-                if self.failure.action.same_invocation(action) && &self.failure.error == error)
-        })
+        apply(&planner, &self.tree, proposal, self.world.as_ref()).map(|(plan, _)| plan)
     }
 
     /// As [`Screen::check`], saying whether the whole tree then succeeds.
     pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, String> {
-        let planner = Planner::new(&self.scenario.domain);
-        let (plan, _) = apply(&planner, &self.tree, proposal, self.world.as_ref())
-            .map_err(|e| e.to_string())?;
+        let plan = self.replan(proposal).map_err(|e| e.to_string())?;
         if let (Proposal::Value { .. }, Outcome::ActionFailed { action, error, .. }) =
             (proposal, &plan.outcome)
             && self.failure.action.same_invocation(action)
