@@ -148,7 +148,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     assert_eq!(egg_run["values"][1]["accepted"], true);
     let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
     assert!(
-        table.contains("| force | 12 N ✗ → 5 N, 12 N ✗ → 5 N | 12.00 ± 0.00 N | 1–6 N | 0/2 | 2/4 | 2/2 | 0 | 2/2 | 5.3 N |"),
+        table.contains("| force | 12 N ✗ → 5 N, 12 N ✗ → 5 N | 12.00 ± 0.00 N | 1–6 N | 0/2 | 2/2 | 2/4 | 2/2 | 0 | 2/2 | 5.3 N |"),
         "{table}"
     );
     // Every other scenario's fixture value is accepted at once.
@@ -157,7 +157,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     }
     assert!(
         table.contains(
-            "| tool | shovel, shovel | shovel ×2 | shovel, spoon | 2/2 | 2/2 | 2/2 | 0 | 2/2 | shovel |"
+            "| tool | shovel, shovel | shovel ×2 | shovel, spoon | 2/2 | 2/2 | 2/2 | 2/2 | 0 | 2/2 | shovel |"
         ),
         "{table}"
     );
@@ -165,5 +165,88 @@ fn params_records_values_and_the_worlds_verdicts() {
     assert!(
         csv.contains("\"cell/params/egg.toml\",1,1,\"12 N\",12,false,"),
         "{csv}"
+    );
+}
+
+#[test]
+fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
+    let dir = tmp("eval-params-bounds");
+    // The hammer: too much force first; told so, a value still above the stated limit
+    // (turned away untried), then one too little; a value midway is then tried by betr.
+    let note = format!("{}: tests/eval_sessions.rs", fixtures::SOURCE);
+    let reply = |when: &[&str], value: &str| FixtureReply {
+        when: when.iter().map(|w| (*w).to_string()).collect(),
+        text: format!("Reasoning: a guess.\nParameter value: {value}"),
+        note: note.clone(),
+    };
+    let task = "# Task: parameter value";
+    let hammer = "Bring me a hammer";
+    let mut replies = vec![
+        reply(&[task, hammer, "not tried: 90 N"], "5 N"),
+        reply(&[task, hammer, "limit exceeded"], "90 N"),
+        reply(&[task, hammer], "100 N"),
+    ];
+    replies.extend(fixtures::every_reply());
+    let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
+    let o = session_eval(&dir, &server, "params", "1");
+    assert!(o.status.success(), "{}", text(&o));
+    let r = read_json(&dir.join("out/results.json"));
+    let case = r["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["scenario"] == "cell/params/hammer.toml")
+        .unwrap();
+    assert_eq!(case["resolved"], true, "{case}");
+    let values: Vec<(&str, bool)> = case["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| {
+            (
+                v["value"].as_str().unwrap(),
+                v["accepted"].as_bool().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        values,
+        [
+            ("100 N", false),
+            ("90 N", false),
+            ("5 N", false),
+            ("50 N", true)
+        ],
+        "{case}"
+    );
+    let error = |i: usize| case["values"][i]["error"].as_str().unwrap().to_string();
+    assert!(error(0).starts_with("tried in simulation"), "{}", error(0));
+    assert!(
+        error(1).starts_with("not tried: 90 N is not at most 80 N"),
+        "{}",
+        error(1)
+    );
+    assert!(error(2).contains("too little"), "{}", error(2));
+    assert_eq!(
+        case["values"][3]["by"],
+        "betr, midway between values the world refused"
+    );
+    // The model was told the bounds in words.
+    let prompts: Vec<String> = server
+        .received()
+        .iter()
+        .map(|r| r.body.to_string())
+        .filter(|p| p.contains(hammer) && p.contains(task))
+        .collect();
+    assert!(
+        prompts
+            .iter()
+            .any(|p| p.contains("leaves only values at most 80 N")),
+        "{prompts:?}"
+    );
+    let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
+    assert!(
+        table.contains("100 N ✗ → 90 N ✗ → 5 N ✗ → 50 N (midway)"),
+        "{table}"
     );
 }

@@ -455,6 +455,7 @@ fn print_event_line(event: &Event) {
             proposal,
             reasoning,
             substitutions,
+            author,
         } => {
             if let Some(r) = reasoning {
                 println!("Reasoning: {r}");
@@ -462,7 +463,7 @@ fn print_event_line(event: &Event) {
             for s in substitutions {
                 println!("  note: {s}");
             }
-            println!("Proposal: {proposal}");
+            println!("Proposal: {proposal} (by {author})");
         }
         Event::Approved => {}
         Event::Rejected => println!("Not approved; stopping."),

@@ -12,6 +12,7 @@ use crate::domain::{Scenario, Value};
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;
+use crate::session::ask::MIDWAY;
 use crate::session::{Event, Options, Proposal};
 
 use super::EvalError;
@@ -45,6 +46,9 @@ pub struct ValueRecord {
     /// What the world reported when it rejected the value.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// Who proposed the value when it was not the model (betr's midway value).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub by: Option<String>,
 }
 
 /// One run of one parameter scenario (a line of `cases.jsonl`).
@@ -111,6 +115,9 @@ pub struct ParamSummary {
     pub mean: Option<f64>,
     pub sd: Option<f64>,
     pub first_accepted: usize,
+    /// Runs in which one of the first three values was accepted.
+    #[serde(default)]
+    pub accepted_within_three: usize,
     pub values_proposed: usize,
     pub values_accepted: usize,
     pub successes: usize,
@@ -215,6 +222,7 @@ fn record(
             Event::CandidateRejected {
                 proposal: Some(Proposal::Value { value, .. }),
                 reason,
+                author,
                 ..
             } => values.push(ValueRecord {
                 value: written(value),
@@ -222,6 +230,7 @@ fn record(
                 accepted: false,
                 screened: true,
                 error: Some(reason.clone()),
+                by: author.clone(),
             }),
             Event::Proposal {
                 proposal:
@@ -231,6 +240,7 @@ fn record(
                         value,
                         ..
                     },
+                author,
                 ..
             } => {
                 values.push(ValueRecord {
@@ -239,6 +249,7 @@ fn record(
                     accepted: false,
                     screened: false,
                     error: None,
+                    by: (author == MIDWAY).then(|| author.clone()),
                 });
                 pending = Some((skill.clone(), object.clone()));
             }
@@ -304,6 +315,10 @@ fn summarize(
         mean: stats.map(|s| s.0),
         sd: stats.map(|s| s.1),
         first_accepted: firsts.iter().filter(|v| v.accepted).count(),
+        accepted_within_three: runs
+            .iter()
+            .filter(|c| c.values.iter().take(3).any(|v| v.accepted))
+            .count(),
         values_proposed: all.clone().count(),
         values_accepted: all.filter(|v| v.accepted).count(),
         successes: runs.iter().filter(|c| c.success).count(),
@@ -321,7 +336,7 @@ impl ParamsResults {
     /// after →), mean ± sd, the accepted range, how often the world accepted, success.
     pub fn table(&self, system: &str, expected_runs: usize) -> String {
         let mut out = format!(
-            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | all values accepted | resolved | misread goal | tree succeeded | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|---|---|\n"
+            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | accepted within 3 values | all values accepted | resolved | misread goal | tree succeeded | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
         );
         for s in &self.scenarios {
             let each: Vec<String> = self
@@ -332,7 +347,14 @@ impl ParamsResults {
                     let v: Vec<String> = c
                         .values
                         .iter()
-                        .map(|v| format!("{}{}", v.value, if v.accepted { "" } else { " ✗" }))
+                        .map(|v| {
+                            format!(
+                                "{}{}{}",
+                                v.value,
+                                if v.by.is_some() { " (midway)" } else { "" },
+                                if v.accepted { "" } else { " ✗" }
+                            )
+                        })
                         .collect();
                     if v.is_empty() {
                         "—".into()
@@ -349,13 +371,15 @@ impl ParamsResults {
                 _ => category_counts(&s.first_values),
             };
             out.push_str(&format!(
-                "| {} | {} | {} | {} | {} | {}/{} | {}/{} | {}/{} | {} | {}/{} | {} |\n",
+                "| {} | {} | {} | {} | {} | {}/{} | {}/{} | {}/{} | {}/{} | {} | {}/{} | {} |\n",
                 s.name,
                 s.limits.parameter,
                 each.join(", "),
                 stat.trim(),
                 s.limits.text().trim(),
                 s.first_accepted,
+                s.runs,
+                s.accepted_within_three,
                 s.runs,
                 s.values_accepted,
                 s.values_proposed,
@@ -370,7 +394,7 @@ impl ParamsResults {
         let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
         out.push_str(&super::run::table_footer(
             &self.usage,
-            "- mean ± sd over each run's first value (the model's first answer, before any check in simulation); ✗: the world rejected the value, in the check before it was offered or after it was set. Resolved: the goal was the scenario's, a value was accepted and the tree succeeded; a misread goal is never resolved.\n",
+            "- mean ± sd over each run's first value (the model's first answer, before any check in simulation); ✗: the world rejected the value, in the check before it was offered or after it was set, or it lay beyond what the world had already refused and was not tried; (midway): betr's value halfway between values refused on either side, after none of the model's helped. Accepted within 3 values: one of a run's first three values was accepted. Resolved: the goal was the scenario's, a value was accepted and the tree succeeded; a misread goal is never resolved.\n",
             finished,
             expected_runs * self.scenarios.len(),
         ));

@@ -217,17 +217,23 @@ impl Context<'_> {
     }
 
     /// The parameter-value request for `param` of `action` (`error`: what it reported).
-    /// `tried`: values already tried for this failure, each with what the world did.
+    /// `tried`: values already tried for this failure, each with what the world did;
+    /// `bounds`: what those answers leave, in one sentence, if they say anything.
     pub fn value(
         &self,
         templates: &Templates,
         action: &ActionCall,
         param: &ValueParam,
         error: &str,
-        tried: &[String],
+        (tried, bounds): (&[String], Option<&str>),
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
-        values.push(("tried", tried_text(tried)));
+        let mut tried = tried_text(tried);
+        if let Some(bounds) = bounds {
+            tried.push_str(bounds);
+            tried.push('\n');
+        }
+        values.push(("tried", tried));
         values.push(("action", action.to_string()));
         values.push((
             "error_line",
@@ -259,7 +265,7 @@ fn tried_text(tried: &[String]) -> String {
         return String::new();
     }
     format!(
-        "\nAlready tried in simulation, and the action still failed after each (what happened is in parentheses); learn from it and propose something else:\n{}\n",
+        "\nAlready proposed and refused (why is in parentheses: the action still failed when it was tried in simulation, or it was not tried because of what the world said before); learn from it and propose something else:\n{}\n",
         tried
             .iter()
             .map(|t| format!("- {t}"))

@@ -13,6 +13,7 @@ use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, s
 use super::screen::Screen;
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
+use super::value_bounds::Bounds;
 
 /// Ask, constraining the reply the way the backend can: a grammar for the local model
 /// (built only when used), a JSON schema for servers that take one, else plain text.
@@ -79,6 +80,24 @@ pub(crate) struct Asked {
     pub rejected: Vec<(Proposal, String)>,
     /// Replies that could not be read at all.
     pub unusable: usize,
+    /// Who wrote the chosen proposal when it was not the model's reply.
+    pub author: Option<String>,
+}
+
+/// Who proposes a value midway between values the world refused on either side.
+pub const MIDWAY: &str = "betr, midway between values the world refused";
+
+/// A change tried for a failure that did not fix it, and what happened.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tried {
+    pub proposal: Proposal,
+    pub why: String,
+}
+
+impl std::fmt::Display for Tried {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({})", self.proposal, self.why)
+    }
 }
 
 /// A failed action as the question about it needs it.
@@ -87,7 +106,7 @@ pub(crate) struct FailedAction<'a> {
     pub action: &'a ActionCall,
     pub error: &'a str,
     /// Changes already tried for this failure that did not fix it, with what happened.
-    pub tried: &'a [String],
+    pub tried: &'a [Tried],
 }
 
 /// Sampling temperature of the extra candidates for a failure: proposals must differ to
@@ -100,13 +119,16 @@ type ReadProposal<'a> =
 
 /// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
 /// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
-/// first that fixes the failure.
+/// first that fixes the failure. A value that `bounds` rules out is turned away without
+/// a try, and what the world says of each value tried tightens `bounds`.
+#[allow(clippy::too_many_arguments)]
 async fn draw_and_screen(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
     constraint: (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
     screen: &mut Screen,
+    bounds: &mut Bounds,
     read: &ReadProposal<'_>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Asked, SessionError> {
@@ -114,6 +136,7 @@ async fn draw_and_screen(
         chosen: None,
         rejected: Vec::new(),
         unusable: 0,
+        author: None,
     };
     let draws = options.candidates.max(1);
     for draw in 0..draws {
@@ -150,22 +173,59 @@ async fn draw_and_screen(
         {
             continue;
         }
-        match screen.check(&proposal) {
+        if let Some(Err(why)) = value_of(&proposal).map(|v| bounds.admits(v)) {
+            let why = format!("not tried: {why}");
+            emit(&Event::CandidateRejected {
+                candidate: proposal.to_string(),
+                proposal: Some(proposal.clone()),
+                reason: why.clone(),
+                author: None,
+            });
+            // Told to the model next time like a value tried; its bound is learned already.
+            asked.rejected.push((proposal, why));
+            continue;
+        }
+        match screen_one(screen, bounds, (&proposal, None), emit) {
             Ok(()) => {
                 asked.chosen = Some((proposal, reasoning, substitutions));
                 return Ok(asked);
             }
-            Err(why) => {
-                emit(&Event::CandidateRejected {
-                    candidate: proposal.to_string(),
-                    proposal: Some(proposal.clone()),
-                    reason: format!("tried in simulation: {why}"),
-                });
-                asked.rejected.push((proposal, why));
-            }
+            Err(why) => asked.rejected.push((proposal, why)),
         }
     }
     Ok(asked)
+}
+
+/// Try `proposal` (by `author`, `None`: the model) in `screen`: Ok when it fixes the
+/// failure, else what happened (reported, and learned into `bounds` for a value).
+fn screen_one(
+    screen: &Screen,
+    bounds: &mut Bounds,
+    (proposal, author): (&Proposal, Option<&str>),
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<(), String> {
+    match screen.check(proposal) {
+        Ok(()) => Ok(()),
+        Err(why) => {
+            emit(&Event::CandidateRejected {
+                candidate: proposal.to_string(),
+                proposal: Some(proposal.clone()),
+                reason: format!("tried in simulation: {why}"),
+                author: author.map(str::to_string),
+            });
+            if let Some(v) = value_of(proposal) {
+                bounds.learn(v, &why);
+            }
+            Err(why)
+        }
+    }
+}
+
+fn value_of(proposal: &Proposal) -> Option<&crate::domain::Value> {
+    match proposal {
+        Proposal::Value { value, .. } => Some(value),
+        Proposal::Conditions { .. } => None,
+    }
 }
 
 /// The same change, whatever the order of its conditions.
@@ -228,7 +288,8 @@ pub(crate) async fn ask_conditions(
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
-    let messages = ctx.resolve(&options.templates, action, error, tried, &choices)?;
+    let tried: Vec<String> = tried.iter().map(ToString::to_string).collect();
+    let messages = ctx.resolve(&options.templates, action, error, &tried, &choices)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
     let conditions_grammar = || {
         if choices.is_empty() {
@@ -256,6 +317,7 @@ pub(crate) async fn ask_conditions(
         (schema::conditions(vocabulary), &conditions_grammar),
         options,
         screen,
+        &mut Bounds::default(),
         &read,
         emit,
     )
@@ -280,30 +342,69 @@ pub(crate) async fn ask_value(
     emit(&Event::Asking {
         what: format!("a value for {} of {action}!", param.name),
     });
-    let messages = ctx.value(&options.templates, action, param, error, tried)?;
+    // What the world said of the values tried so far bounds the next ones.
+    let mut bounds = Bounds::default();
+    for t in tried {
+        if let Some(v) = value_of(&t.proposal) {
+            bounds.learn(v, &t.why);
+        }
+    }
+    let unit = param.unit.as_deref().unwrap_or("");
+    let summary = bounds.summary(unit);
+    let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
+    let messages = ctx.value(
+        &options.templates,
+        action,
+        param,
+        error,
+        (&tried_lines, summary.as_deref()),
+    )?;
     let value_grammar = || grammar::value_grammar(param.unit.as_deref(), &param.categories);
-    let read = |text: &str| {
-        reply::value(text, param, options.min_similarity).map(|a| {
-            (
-                Proposal::Value {
-                    skill: action.skill.clone(),
-                    object: action.args.first().cloned().unwrap_or_default(),
-                    param: param.name.clone(),
-                    value: a.value,
-                },
-                a.reasoning,
-                a.substitutions,
-            )
-        })
+    let proposal = |value| Proposal::Value {
+        skill: action.skill.clone(),
+        object: action.args.first().cloned().unwrap_or_default(),
+        param: param.name.clone(),
+        value,
     };
-    draw_and_screen(
+    let read = |text: &str| {
+        reply::value(text, param, options.min_similarity)
+            .map(|a| (proposal(a.value), a.reasoning, a.substitutions))
+    };
+    let mut asked = draw_and_screen(
         model,
         messages,
         (schema::value(param), &value_grammar),
         options,
         screen,
+        &mut bounds,
         &read,
         emit,
     )
-    .await
+    .await?;
+    // No value of the model's helped, and the world has refused values on both sides:
+    // one midway between them is tried too (in simulation, like any other).
+    if asked.chosen.is_none()
+        && let Some(midway) = bounds.midway()
+    {
+        let value = crate::domain::Value::Number {
+            value: midway,
+            unit: unit.to_string(),
+        };
+        let between = format!(
+            "Midway between the values the world refused on either side: it leaves only values {}.",
+            bounds.describe(unit).unwrap_or_default()
+        );
+        emit(&Event::Notice {
+            message: format!("no value of the model's helped; trying {value}, {between}"),
+        });
+        let midway = proposal(value);
+        match screen_one(screen, &mut bounds, (&midway, Some(MIDWAY)), emit) {
+            Ok(()) => {
+                asked.chosen = Some((midway, Some(between), Vec::new()));
+                asked.author = Some(MIDWAY.to_string());
+            }
+            Err(why) => asked.rejected.push((midway, why)),
+        }
+    }
+    Ok(asked)
 }

@@ -178,6 +178,7 @@ pub async fn interpret(
                     candidate: a.goal.to_string(),
                     proposal: None,
                     reason: p.reason.clone(),
+                    author: None,
                 }),
                 (Ok(_), None) => {}
             }
@@ -223,6 +224,7 @@ pub async fn interpret(
                         candidate: goal.to_string(),
                         proposal: None,
                         reason: p.reason.clone(),
+                        author: Some("betr, from the model's answer".into()),
                     });
                 }
                 candidates.push(Candidate {

@@ -12,6 +12,7 @@ pub mod resolve;
 pub mod screen;
 pub mod shortlist;
 pub mod types;
+pub mod value_bounds;
 pub mod values;
 
 pub use ask::missing_value;

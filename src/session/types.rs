@@ -142,6 +142,8 @@ pub enum Event {
         /// The candidate, when it was a proposal for a failure.
         proposal: Option<Proposal>,
         reason: String,
+        /// Who wrote the candidate when it was not the model.
+        author: Option<String>,
     },
     /// The instruction read as a goal; `matches_expected` compares with the scenario's goal.
     Goal {
@@ -157,11 +159,13 @@ pub enum Event {
         node_path: String,
         error: String,
     },
-    /// The model's proposal, before approval.
+    /// A proposal, before approval, with who wrote it (the model, the simulation that
+    /// narrowed it, a person, betr's midway value).
     Proposal {
         proposal: Proposal,
         reasoning: Option<String>,
         substitutions: Vec<Substitution>,
+        author: String,
     },
     Approved,
     Rejected,

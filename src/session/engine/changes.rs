@@ -7,7 +7,7 @@ use crate::bt::Tree;
 use crate::domain::action::parse_value;
 use crate::planner::Planner;
 
-use super::super::ask::missing_value;
+use super::super::ask::{Tried, missing_value};
 use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
@@ -80,8 +80,13 @@ impl Engine {
         reason: String,
     ) {
         if let Some(f) = before {
-            self.tried
-                .push((f.clone(), format!("{} ({reason})", pending.proposal)));
+            self.tried.push((
+                f.clone(),
+                Tried {
+                    proposal: pending.proposal.clone(),
+                    why: reason.clone(),
+                },
+            ));
         }
         self.emit(Event::DidNotHelp { reason });
         let planner = Planner::new(&self.scenario.domain);
@@ -94,6 +99,7 @@ impl Engine {
         ) {
             Some((proposal, dropped)) => {
                 let dropped: Vec<String> = dropped.iter().map(ToString::to_string).collect();
+                let author = format!("simulation, narrowed from {}", pending.author);
                 self.emit(Event::Proposal {
                     proposal: proposal.clone(),
                     reasoning: Some(format!(
@@ -101,10 +107,11 @@ impl Engine {
                         dropped.join(" & ")
                     )),
                     substitutions: Vec::new(),
+                    author: author.clone(),
                 });
                 self.pending = Some(Pending {
                     proposal,
-                    author: format!("simulation, narrowed from {}", pending.author),
+                    author,
                     failure: before.cloned(),
                 });
                 if self.auto_approve {
@@ -136,6 +143,7 @@ impl Engine {
             proposal: edited.clone(),
             reasoning: Some("written by a person".into()),
             substitutions: Vec::new(),
+            author: "a person".into(),
         });
         self.pending = Some(Pending {
             proposal: edited,

@@ -31,6 +31,7 @@ use crate::llm::LanguageModel;
 use crate::llm::usage::{Ledger, UsageTotals};
 use crate::world::{self, World};
 
+use super::ask::Tried;
 use super::policy::{Approval, PolicyStore};
 use super::types::{Event, Options, Proposal, SessionError};
 
@@ -192,7 +193,7 @@ pub struct Engine {
     pending: Option<Pending>,
     /// Changes tried for a failure that did not fix it, told to the model when it is asked
     /// about the same failure again.
-    tried: Vec<(Failure, String)>,
+    tried: Vec<(Failure, Tried)>,
     request: Option<Request>,
     next_id: u64,
     undo: Vec<UndoEntry>,

@@ -10,7 +10,7 @@ use crate::llm::reply::GoalAnswer;
 use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
-use super::super::ask::{Asked, FailedAction, ask_conditions, ask_value, missing_value};
+use super::super::ask::{Asked, FailedAction, Tried, ask_conditions, ask_value, missing_value};
 use super::super::interpret::interpret;
 use super::super::policy::Approval;
 use super::super::screen::Screen;
@@ -154,7 +154,7 @@ impl Engine {
             .and_then(|t| t.instruction.clone())
             .or_else(|| self.task.as_ref().map(|t| t.goal.to_string()))
             .unwrap_or_default();
-        let tried: Vec<String> = self
+        let tried: Vec<Tried> = self
             .tried
             .iter()
             .filter(|(f, _)| *f == failure)
@@ -262,16 +262,17 @@ impl Engine {
                     Ok(asked) => {
                         // What did not help in simulation is told to the model next time.
                         for (proposal, why) in asked.rejected {
-                            self.tried
-                                .push((failure.clone(), format!("{proposal} ({why})")));
+                            self.tried.push((failure.clone(), Tried { proposal, why }));
                         }
                         let Some((proposal, reasoning, substitutions)) = asked.chosen else {
                             // No candidate fixed the failure: ask again while rounds remain.
                             return self.ask_about(failure);
                         };
-                        let author = replies
-                            .last()
-                            .map_or_else(|| "unknown".into(), |r| r.attribution.clone());
+                        let author = asked.author.unwrap_or_else(|| {
+                            replies
+                                .last()
+                                .map_or_else(|| "unknown".into(), |r| r.attribution.clone())
+                        });
                         let checked =
                             "Tried in simulation before it was offered: it fixes the failure.";
                         self.emit(Event::Proposal {
@@ -281,6 +282,7 @@ impl Engine {
                                 None => checked.to_string(),
                             }),
                             substitutions,
+                            author: author.clone(),
                         });
                         self.pending = Some(Pending {
                             proposal,
