@@ -171,8 +171,9 @@ fn params_records_values_and_the_worlds_verdicts() {
 #[test]
 fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
     let dir = tmp("eval-params-bounds");
-    // The hammer: too much force first; told so, a value still above the stated limit
-    // (turned away untried), then one too little; a value midway is then tried by betr.
+    // The egg: too much force first; told so, a value still above the limit the world
+    // stated (turned away untried), then one too little; a value midway is then tried
+    // by betr. The other scenarios answer from their fixture files.
     let note = format!("{}: tests/eval_sessions.rs", fixtures::SOURCE);
     let reply = |when: &[&str], value: &str| FixtureReply {
         when: when.iter().map(|w| (*w).to_string()).collect(),
@@ -180,23 +181,19 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
         note: note.clone(),
     };
     let task = "# Task: parameter value";
-    let hammer = "Bring me a hammer";
+    let egg = "Bring me an egg";
     let mut replies = vec![
-        reply(&[task, hammer, "not tried: 90 N"], "5 N"),
-        reply(&[task, hammer, "limit exceeded"], "90 N"),
-        reply(&[task, hammer], "100 N"),
+        reply(&[task, egg, "not tried: 8 N"], "0.5 N"),
+        reply(&[task, egg, "The egg broke"], "8 N"),
+        reply(&[task, egg], "10 N"),
     ];
     replies.extend(fixtures::every_reply());
     let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
     let o = session_eval(&dir, &server, "params", "1");
     assert!(o.status.success(), "{}", text(&o));
     let r = read_json(&dir.join("out/results.json"));
-    let case = r["cases"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["scenario"] == "cell/params/hammer.toml")
-        .unwrap();
+    let case = &r["cases"][0];
+    assert_eq!(case["scenario"], "cell/params/egg.toml");
     assert_eq!(case["resolved"], true, "{case}");
     let values: Vec<(&str, bool)> = case["values"]
         .as_array()
@@ -212,41 +209,50 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
     assert_eq!(
         values,
         [
-            ("100 N", false),
-            ("90 N", false),
-            ("5 N", false),
-            ("50 N", true)
+            ("10 N", false),
+            ("8 N", false),
+            ("0.5 N", false),
+            ("3.5 N", true)
         ],
         "{case}"
     );
     let error = |i: usize| case["values"][i]["error"].as_str().unwrap().to_string();
     assert!(error(0).starts_with("tried in simulation"), "{}", error(0));
     assert!(
-        error(1).starts_with("not tried: 90 N is not at most 80 N"),
+        error(1).starts_with("not tried: 8 N is not at most 6 N"),
         "{}",
         error(1)
     );
+    assert_eq!(case["values"][1]["not_tried"], true);
     assert!(error(2).contains("too little"), "{}", error(2));
     assert_eq!(
         case["values"][3]["by"],
         "betr, midway between values the world refused"
     );
-    // The model was told the bounds in words.
+    // The model was told the robot's range, then the bounds in words.
     let prompts: Vec<String> = server
         .received()
         .iter()
         .map(|r| r.body.to_string())
-        .filter(|p| p.contains(hammer) && p.contains(task))
+        .filter(|p| p.contains(egg) && p.contains(task))
         .collect();
+    assert!(
+        prompts[0].contains("the robot can do at most 80 N"),
+        "{}",
+        prompts[0]
+    );
     assert!(
         prompts
             .iter()
-            .any(|p| p.contains("leaves only values at most 80 N")),
+            .any(|p| p.contains("leaves only values at most 6 N")),
         "{prompts:?}"
     );
     let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
+    // Three values tried (the one turned away is not a try): the third was accepted.
     assert!(
-        table.contains("100 N ✗ → 90 N ✗ → 5 N ✗ → 50 N (midway)"),
+        table.contains(
+            "| 10 N ✗ → 8 N ⊘ → 0.5 N ✗ → 3.5 N (midway) | 10.00 ± 0.00 N | 1–6 N | 0/1 | 1/1 |"
+        ),
         "{table}"
     );
 }

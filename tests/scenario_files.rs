@@ -163,3 +163,22 @@ fn unknown_fields_and_missing_bases_are_errors() {
     assert_eq!((e.line, e.column), (1, 12));
     assert!(e.message.contains("does not exist"));
 }
+
+#[test]
+fn a_declared_value_range_must_be_a_range_of_numbers() {
+    let skill = |values: &str| {
+        format!(
+            "{HEAD}\n[[skills]]\nname = \"Grab\"\nparams = [\"i: item\"]\nadd = [\"Holding_{{i}}\"]\nvalues = [{values}]\n"
+        )
+    };
+    let text = skill(r#"{ name = "force", unit = "N", min = 9.0, max = 3.0 }"#);
+    let e = error(&text);
+    assert_eq!(e.line, lines_before(&text, "name = \"Grab\""));
+    assert!(e.message.contains("min 9 is above max 3"), "{e}");
+    let e = error(&skill(
+        r#"{ name = "tool", categories = ["a"], max = 3.0 }"#,
+    ));
+    assert!(e.message.contains("for a number with a unit"), "{e}");
+    let e = error(&skill(r#"{ name = "force", unit = "N", max = nan }"#));
+    assert!(e.message.contains("finite"), "{e}");
+}

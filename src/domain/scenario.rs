@@ -188,6 +188,8 @@ struct RawValueParam {
     categories: Vec<String>,
     #[serde(default)]
     description: String,
+    min: Option<f64>,
+    max: Option<f64>,
 }
 
 /// An example pool file: nothing but `[[examples]]`.
@@ -528,6 +530,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
     if !raw.cost.is_finite() || raw.cost < 0.0 {
         return Err(file.error_in_string(&raw.name.span(), 0, "cost must be a finite number >= 0"));
     }
+    for v in &raw.values {
+        value_range(v).map_err(|m| {
+            file.error_in_string(&raw.name.span(), 0, format!("value {:?}: {m}", v.name))
+        })?;
+    }
     Ok(Skill {
         name: name.to_string(),
         description: raw.description.clone(),
@@ -545,9 +552,27 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
                 unit: v.unit.clone(),
                 categories: v.categories.clone(),
                 description: v.description.clone(),
+                min: v.min,
+                max: v.max,
             })
             .collect(),
     })
+}
+
+/// A declared range is for a number with a unit, finite, and not empty.
+fn value_range(v: &RawValueParam) -> Result<(), String> {
+    if (v.min.is_some() || v.max.is_some()) && v.unit.is_none() {
+        return Err("min and max are for a number with a unit".into());
+    }
+    if v.min.into_iter().chain(v.max).any(|x| !x.is_finite()) {
+        return Err("min and max must be finite numbers".into());
+    }
+    if let (Some(lo), Some(hi)) = (v.min, v.max)
+        && lo > hi
+    {
+        return Err(format!("min {lo} is above max {hi}"));
+    }
+    Ok(())
 }
 
 /// A template's predicate must exist with the right arity, and its constants must fit.

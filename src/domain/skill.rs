@@ -66,6 +66,10 @@ pub struct ValueParam {
     /// The allowed categories of a categorical value (e.g. tool names).
     pub categories: Vec<String>,
     pub description: String,
+    /// What the robot can do at all (its hardware range, such as the gripper's largest
+    /// force), for a numeric value; what an object needs is for the model to judge.
+    pub min: Option<f64>,
+    pub max: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq)]

@@ -12,7 +12,7 @@ use crate::domain::{Scenario, Value};
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;
-use crate::session::ask::MIDWAY;
+use crate::session::ask::{MIDWAY, NOT_TRIED};
 use crate::session::{Event, Options, Proposal};
 
 use super::EvalError;
@@ -49,6 +49,9 @@ pub struct ValueRecord {
     /// Who proposed the value when it was not the model (betr's midway value).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub by: Option<String>,
+    /// Turned away without a try: beyond what the world had refused, or refused before.
+    #[serde(default)]
+    pub not_tried: bool,
 }
 
 /// One run of one parameter scenario (a line of `cases.jsonl`).
@@ -115,7 +118,8 @@ pub struct ParamSummary {
     pub mean: Option<f64>,
     pub sd: Option<f64>,
     pub first_accepted: usize,
-    /// Runs in which one of the first three values was accepted.
+    /// Runs in which one of the first three values tried (in simulation or in the world)
+    /// was accepted.
     #[serde(default)]
     pub accepted_within_three: usize,
     pub values_proposed: usize,
@@ -231,6 +235,7 @@ fn record(
                 screened: true,
                 error: Some(reason.clone()),
                 by: author.clone(),
+                not_tried: reason.starts_with(NOT_TRIED),
             }),
             Event::Proposal {
                 proposal:
@@ -250,6 +255,7 @@ fn record(
                     screened: false,
                     error: None,
                     by: (author == MIDWAY).then(|| author.clone()),
+                    not_tried: false,
                 });
                 pending = Some((skill.clone(), object.clone()));
             }
@@ -317,7 +323,13 @@ fn summarize(
         first_accepted: firsts.iter().filter(|v| v.accepted).count(),
         accepted_within_three: runs
             .iter()
-            .filter(|c| c.values.iter().take(3).any(|v| v.accepted))
+            .filter(|c| {
+                c.values
+                    .iter()
+                    .filter(|v| !v.not_tried)
+                    .take(3)
+                    .any(|v| v.accepted)
+            })
             .count(),
         values_proposed: all.clone().count(),
         values_accepted: all.filter(|v| v.accepted).count(),
@@ -336,7 +348,7 @@ impl ParamsResults {
     /// after →), mean ± sd, the accepted range, how often the world accepted, success.
     pub fn table(&self, system: &str, expected_runs: usize) -> String {
         let mut out = format!(
-            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | accepted within 3 values | all values accepted | resolved | misread goal | tree succeeded | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+            "Missing parameters, {system}\n\n| scenario | parameter | proposed (each run) | mean ± sd | world accepts | first value accepted | accepted within 3 values tried | all values accepted | resolved | misread goal | tree succeeded | paper (GPT-4) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n"
         );
         for s in &self.scenarios {
             let each: Vec<String> = self
@@ -352,7 +364,11 @@ impl ParamsResults {
                                 "{}{}{}",
                                 v.value,
                                 if v.by.is_some() { " (midway)" } else { "" },
-                                if v.accepted { "" } else { " ✗" }
+                                match (v.accepted, v.not_tried) {
+                                    (true, _) => "",
+                                    (false, false) => " ✗",
+                                    (false, true) => " ⊘",
+                                }
                             )
                         })
                         .collect();
@@ -394,7 +410,7 @@ impl ParamsResults {
         let finished: usize = self.scenarios.iter().map(|s| s.runs).sum();
         out.push_str(&super::run::table_footer(
             &self.usage,
-            "- mean ± sd over each run's first value (the model's first answer, before any check in simulation); ✗: the world rejected the value, in the check before it was offered or after it was set, or it lay beyond what the world had already refused and was not tried; (midway): betr's value halfway between values refused on either side, after none of the model's helped. Accepted within 3 values: one of a run's first three values was accepted. Resolved: the goal was the scenario's, a value was accepted and the tree succeeded; a misread goal is never resolved.\n",
+            "- mean ± sd over each run's first value (the model's first answer, before any check in simulation); ✗: the world rejected the value, in the check before it was offered or after it was set; ⊘: not tried, as it lay beyond what the world had already refused or the robot can do, or was refused before (it still counts among the values proposed); (midway): betr's value halfway between values refused on either side, after none of the model's helped. Accepted within 3 values tried: one of a run's first three values tried in simulation or the world was accepted. Resolved: the goal was the scenario's, a value was accepted and the tree succeeded; a misread goal is never resolved.\n",
             finished,
             expected_runs * self.scenarios.len(),
         ));

@@ -446,7 +446,13 @@ pub fn scene_text(facts: &[Condition]) -> String {
 fn parameter_text(param: &ValueParam) -> String {
     let mut s = format!("\"{}\"", param.name);
     if let Some(unit) = &param.unit {
-        s.push_str(&format!(" (a number in {unit})"));
+        let range = match (param.min, param.max) {
+            (Some(lo), Some(hi)) => format!("; the robot can do {lo} to {hi} {unit}"),
+            (None, Some(hi)) => format!("; the robot can do at most {hi} {unit}"),
+            (Some(lo), None) => format!("; the robot can do no less than {lo} {unit}"),
+            (None, None) => String::new(),
+        };
+        s.push_str(&format!(" (a number in {unit}{range})"));
     } else if !param.categories.is_empty() {
         s.push_str(&format!(" (one of: {})", param.categories.join(", ")));
     }

@@ -87,6 +87,9 @@ pub(crate) struct Asked {
 /// Who proposes a value midway between values the world refused on either side.
 pub const MIDWAY: &str = "betr, midway between values the world refused";
 
+/// How the reason of a value turned away untried begins.
+pub const NOT_TRIED: &str = "not tried: ";
+
 /// A change tried for a failure that did not fix it, and what happened.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tried {
@@ -174,7 +177,7 @@ async fn draw_and_screen(
             continue;
         }
         if let Some(Err(why)) = value_of(&proposal).map(|v| bounds.admits(v)) {
-            let why = format!("not tried: {why}");
+            let why = format!("{NOT_TRIED}{why}");
             emit(&Event::CandidateRejected {
                 candidate: proposal.to_string(),
                 proposal: Some(proposal.clone()),
@@ -343,7 +346,7 @@ pub(crate) async fn ask_value(
         what: format!("a value for {} of {action}!", param.name),
     });
     // What the world said of the values tried so far bounds the next ones.
-    let mut bounds = Bounds::default();
+    let mut bounds = Bounds::declared(param);
     for t in tried {
         if let Some(v) = value_of(&t.proposal) {
             bounds.learn(v, &t.why);

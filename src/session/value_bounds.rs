@@ -6,9 +6,10 @@
 //! A refused value on a known side bounds every later value; when the refusal states the
 //! limit itself ("6 N at most"), the bound is that limit. Values outside the bounds are
 //! turned away before they are tried, the bounds are told to the model in words, and when
-//! both sides are known a value midway between them can be tried.
+//! both sides are known a value midway between them can be tried. What the skill declares
+//! the robot can do (its hardware range) bounds values from the start.
 
-use crate::domain::Value;
+use crate::domain::{Value, ValueParam};
 
 /// Which way a refused value missed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,15 +103,16 @@ pub fn stated_limit(error: &str, unit: &str, side: Side) -> Option<f64> {
         .find_map(|i| quantity_before(i).or_else(|| quantity_after(i + 2)))
 }
 
-/// One side's bound: the refused value, or the limit the refusal stated.
+/// One side's bound: the refused value, the limit the refusal stated, or what the skill
+/// declares the robot can do.
 #[derive(Debug, Clone, PartialEq)]
 struct Limit {
     value: f64,
     /// The limit itself is allowed (a stated "at most"), not only what lies beyond it.
     allowed: bool,
-    /// The refused value and what the world said of it.
-    refused: String,
-    because: String,
+    /// Where the bound comes from, in words: the refused value and what the world said
+    /// of it, or the skill's declaration.
+    source: String,
 }
 
 impl Limit {
@@ -146,6 +148,24 @@ pub struct Bounds {
 }
 
 impl Bounds {
+    /// The bounds before anything was refused: the range the skill declares the robot
+    /// can do, if it declares one.
+    pub fn declared(param: &ValueParam) -> Bounds {
+        let limit = |value: f64| Limit {
+            value,
+            allowed: true,
+            source: format!(
+                "the robot's range for {} is declared by its skill",
+                param.name
+            ),
+        };
+        Bounds {
+            high: param.max.map(limit),
+            low: param.min.map(limit),
+            refused: Vec::new(),
+        }
+    }
+
     /// Take in that the world refused `value` with `error`.
     pub fn learn(&mut self, value: &Value, error: &str) {
         self.refused.push((value.clone(), error.to_string()));
@@ -162,8 +182,7 @@ impl Bounds {
         let limit = Limit {
             value: stated.unwrap_or(*v),
             allowed: stated.is_some(),
-            refused: value.to_string(),
-            because: error.to_string(),
+            source: format!("the world refused {value} ({error})"),
         };
         let slot = match side {
             Side::TooHigh => &mut self.high,
@@ -185,7 +204,7 @@ impl Bounds {
     /// words the person and the model can be told.
     pub fn admits(&self, value: &Value) -> Result<(), String> {
         if let Some((_, why)) = self.refused.iter().find(|(r, _)| same_value(r, value)) {
-            return Err(format!("the world already refused {value} ({why})"));
+            return Err(format!("{value} was refused before ({why})"));
         }
         let Value::Number { value: v, unit } = value else {
             return Ok(());
@@ -195,10 +214,9 @@ impl Bounds {
                 && l.excludes(*v, side)
             {
                 return Err(format!(
-                    "{value} is not {}: the world refused {} ({})",
+                    "{value} is not {}: {}",
                     l.words(side, unit),
-                    l.refused,
-                    l.because
+                    l.source
                 ));
             }
         }
@@ -312,7 +330,7 @@ mod tests {
         assert!(
             b.admits(&n(10.0, "N"))
                 .unwrap_err()
-                .contains("already refused")
+                .contains("refused before")
         );
         assert_eq!(b.midway(), None);
 
@@ -323,6 +341,28 @@ mod tests {
         assert_eq!(b.midway(), Some(3.5));
         let summary = b.summary("N").unwrap();
         assert!(summary.contains("at most 6 N and above 1 N"), "{summary}");
+    }
+
+    #[test]
+    fn the_declared_range_bounds_values_from_the_start() {
+        let speed = ValueParam {
+            name: "speed".into(),
+            unit: Some("m/s".into()),
+            categories: vec![],
+            description: "movement speed".into(),
+            min: None,
+            max: Some(1.5),
+        };
+        let mut b = Bounds::declared(&speed);
+        assert!(b.admits(&n(1.5, "m/s")).is_ok());
+        let why = b.admits(&n(10.0, "m/s")).unwrap_err();
+        assert!(why.contains("not at most 1.5 m/s"), "{why}");
+        assert!(why.contains("declared by its skill"), "{why}");
+        // A refusal below the declared limit tightens it; one above it does not widen it.
+        b.learn(&n(1.0, "m/s"), "1 m/s is faster than is safe near a person");
+        assert_eq!(b.describe("m/s").unwrap(), "below 1 m/s");
+        b.learn(&n(0.1, "m/s"), "Too slow: 0.1 m/s keeps the person waiting");
+        assert_eq!(b.midway(), Some(0.55));
     }
 
     #[test]

@@ -96,6 +96,18 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
 pub fn conform(declared: &ValueParam, value: Value) -> Result<Value, String> {
     match (value, &declared.unit) {
         (Value::Number { value, unit }, Some(want)) if unit.is_empty() || unit == *want => {
+            if let Some(max) = declared.max.filter(|m| value > *m) {
+                return Err(format!(
+                    "{value} {want} is more than the robot can do ({} at most {max} {want})",
+                    declared.name
+                ));
+            }
+            if let Some(min) = declared.min.filter(|m| value < *m) {
+                return Err(format!(
+                    "{value} {want} is less than the robot can do ({} at least {min} {want})",
+                    declared.name
+                ));
+            }
             Ok(Value::Number {
                 value,
                 unit: want.clone(),
@@ -169,6 +181,17 @@ mod tests {
                 }
             );
         }
+    }
+
+    #[test]
+    fn a_value_beyond_what_the_robot_can_do_is_refused() {
+        let s = Scenario::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/params/hammer.toml"),
+        )
+        .unwrap();
+        assert!(parse_setting(&s, "force of hammer = 80 N").is_ok());
+        let e = parse_setting(&s, "force of hammer = 120 N").unwrap_err();
+        assert!(e.to_string().contains("more than the robot can do"), "{e}");
     }
 
     #[test]

@@ -42,6 +42,8 @@ fn force() -> ValueParam {
         unit: Some("N".into()),
         categories: vec![],
         description: String::new(),
+        min: None,
+        max: None,
     }
 }
 
@@ -51,6 +53,8 @@ fn tool() -> ValueParam {
         unit: None,
         categories: vec!["shovel".into(), "sponge".into(), "brush".into()],
         description: String::new(),
+        min: None,
+        max: None,
     }
 }
 

@@ -135,6 +135,8 @@ mod tests {
             unit: Some("N".into()),
             categories: vec![],
             description: "grasping force".into(),
+            min: None,
+            max: None,
         }
     }
 
@@ -214,6 +216,8 @@ mod tests {
             unit: None,
             categories: vec!["shovel".into(), "hammer".into()],
             description: "tool".into(),
+            min: None,
+            max: None,
         };
         let j = Judge {
             skill: "scoop".into(),
