@@ -31,6 +31,15 @@ pub struct Example {
     pub goal: String,
 }
 
+/// What a request means in a domain beyond its vocabulary ("what is brought to the
+/// person goes on the tray"), written by whoever sets the domain up.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Convention {
+    pub text: String,
+    /// The objects it speaks of: it applies to a scene that has all of them.
+    pub objects: Vec<String>,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
     pub name: String,
@@ -42,6 +51,8 @@ pub struct Scenario {
     /// Conditions that fix the scenario's failure (for evaluation, never used to resolve).
     pub expected_fix: Vec<String>,
     pub examples: Vec<Example>,
+    /// The domain's conventions, base file first.
+    pub conventions: Vec<Convention>,
     pub domain: Domain,
     /// Which simulator runs this scenario (`symbolic`, `cell`).
     pub world_kind: String,
@@ -128,6 +139,10 @@ struct RawFile {
     /// A file of `[[examples]]` beside this one: the domain's pool of worked examples,
     /// from which prompts choose the ones most like each request.
     example_pool: Option<Spanned<String>>,
+    /// What requests mean here beyond the vocabulary, told to the model with each goal
+    /// question in a scene that has the objects a convention names.
+    #[serde(default)]
+    conventions: Vec<RawConvention>,
     /// Read by the world module.
     #[allow(dead_code)]
     world: Option<toml::Value>,
@@ -198,6 +213,14 @@ struct RawValueParam {
 struct RawPool {
     #[serde(default)]
     examples: Vec<RawExample>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConvention {
+    text: String,
+    #[serde(default)]
+    objects: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -397,6 +420,14 @@ impl Scenario {
                 .map(|f| f.get_ref().clone())
                 .collect(),
             examples,
+            conventions: raws
+                .iter()
+                .flat_map(|r| &r.conventions)
+                .map(|c| Convention {
+                    text: c.text.trim().to_string(),
+                    objects: c.objects.clone(),
+                })
+                .collect(),
             domain: Domain { vocabulary, skills },
             world_kind,
             files,

@@ -150,6 +150,7 @@ impl Context<'_> {
     /// The goal-interpretation request.
     pub fn goal(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
+        values.push(("conventions", self.conventions_text()));
         values.push((
             "answer_format",
             if self.variant.chain_of_thought {
@@ -255,6 +256,25 @@ impl Context<'_> {
         };
         values.push(("answer_format", format));
         Ok(messages(fill("value.md", &templates.value, &values)?))
+    }
+}
+
+impl Context<'_> {
+    /// The domain's conventions that apply to this scene (it has every object one names),
+    /// as a section of the goal prompt; empty when none does.
+    fn conventions_text(&self) -> String {
+        let vocabulary = &self.scenario.domain.vocabulary;
+        let lines: Vec<String> = self
+            .scenario
+            .conventions
+            .iter()
+            .filter(|c| c.objects.iter().all(|o| vocabulary.object(o).is_some()))
+            .map(|c| format!("- {}", c.text))
+            .collect();
+        if lines.is_empty() {
+            return String::new();
+        }
+        format!("\n## What requests mean here\n{}\n", lines.join("\n"))
     }
 }
 

@@ -80,3 +80,32 @@ fn fill_reports_unknown_placeholders() {
         "a 1\n"
     );
 }
+
+#[test]
+fn a_convention_is_told_only_in_a_scene_with_its_objects() {
+    let goal_prompt = |file: &str| {
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(file);
+        let s = Scenario::load(&path).unwrap();
+        let variant = Variant::default();
+        let ctx = Context {
+            scenario: &s,
+            facts: &[],
+            instruction: "Bring me an egg",
+            variant: &variant,
+        };
+        ctx.goal(&Templates::builtin()).unwrap()[1].content.clone()
+    };
+    let with_tray = goal_prompt("scenarios/cell/params/egg.toml");
+    assert!(
+        with_tray.contains("## What requests mean here\n- What the person asks to be brought"),
+        "{with_tray}"
+    );
+    let without = goal_prompt("scenarios/cell/red_on_blue.toml");
+    assert!(!without.contains("What requests mean here"), "{without}");
+    // A scene without conventions reads as before: the object rule, then the next part.
+    let cafe = goal_prompt("scenarios/cafe/no_coffee.toml");
+    assert!(
+        cafe.contains("use Chips).\n\n## How to write a goal"),
+        "{cafe}"
+    );
+}
