@@ -6,6 +6,7 @@ pub mod condition;
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};
 pub mod scenario;
+mod scenario_file;
 pub mod skill;
 pub mod vocabulary;
 

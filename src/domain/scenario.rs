@@ -9,10 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
-use indexmap::IndexMap;
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::scenario_file::{RawFile, RawPool, RawSkill, value_range};
 use super::skill::{Domain, Param, Skill, ValueParam, parse_template};
 use super::vocabulary::{Object, Predicate, Vocabulary};
 use crate::goal::Formula;
@@ -121,121 +121,6 @@ impl SourceFile {
             self.error_at(at, e.message().trim().to_string())
         })
     }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawFile {
-    extends: Option<Spanned<String>>,
-    scenario: Option<RawMeta>,
-    #[serde(default)]
-    objects: IndexMap<String, Vec<Spanned<String>>>,
-    #[serde(default)]
-    predicates: Vec<RawPredicate>,
-    #[serde(default)]
-    skills: Vec<RawSkill>,
-    #[serde(default)]
-    examples: Vec<RawExample>,
-    /// A file of `[[examples]]` beside this one: the domain's pool of worked examples,
-    /// from which prompts choose the ones most like each request.
-    example_pool: Option<Spanned<String>>,
-    /// What requests mean here beyond the vocabulary, told to the model with each goal
-    /// question in a scene that has the objects a convention names.
-    #[serde(default)]
-    conventions: Vec<RawConvention>,
-    /// Read by the world module.
-    #[allow(dead_code)]
-    world: Option<toml::Value>,
-    /// Read by the verify module (`verify::VerifyConfig::from_scenario`).
-    #[allow(dead_code)]
-    verify: Option<toml::Value>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawMeta {
-    name: String,
-    #[serde(default)]
-    description: String,
-    instruction: Option<String>,
-    goal: Option<Spanned<String>>,
-    #[serde(default)]
-    expected_fix: Vec<Spanned<String>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawPredicate {
-    name: Spanned<String>,
-    #[serde(default)]
-    args: Vec<Spanned<String>>,
-    description: String,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawSkill {
-    name: Spanned<String>,
-    #[serde(default)]
-    description: String,
-    #[serde(default)]
-    params: Vec<Spanned<String>>,
-    #[serde(default)]
-    pre: Vec<Spanned<String>>,
-    #[serde(default)]
-    add: Vec<Spanned<String>>,
-    #[serde(default)]
-    del: Vec<Spanned<String>>,
-    #[serde(default = "default_cost")]
-    cost: f64,
-    #[serde(default = "default_ticks")]
-    ticks: u32,
-    #[serde(default)]
-    values: Vec<RawValueParam>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawValueParam {
-    name: String,
-    unit: Option<String>,
-    #[serde(default)]
-    categories: Vec<String>,
-    #[serde(default)]
-    description: String,
-    min: Option<f64>,
-    max: Option<f64>,
-}
-
-/// An example pool file: nothing but `[[examples]]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawPool {
-    #[serde(default)]
-    examples: Vec<RawExample>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawConvention {
-    text: String,
-    #[serde(default)]
-    objects: Vec<String>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawExample {
-    instruction: String,
-    goal: String,
-}
-
-fn default_cost() -> f64 {
-    1.0
-}
-
-fn default_ticks() -> u32 {
-    1
 }
 
 /// Where a skill came from, so its errors can point into the right file.
@@ -588,22 +473,6 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
             })
             .collect(),
     })
-}
-
-/// A declared range is for a number with a unit, finite, and not empty.
-fn value_range(v: &RawValueParam) -> Result<(), String> {
-    if (v.min.is_some() || v.max.is_some()) && v.unit.is_none() {
-        return Err("min and max are for a number with a unit".into());
-    }
-    if v.min.into_iter().chain(v.max).any(|x| !x.is_finite()) {
-        return Err("min and max must be finite numbers".into());
-    }
-    if let (Some(lo), Some(hi)) = (v.min, v.max)
-        && lo > hi
-    {
-        return Err(format!("min {lo} is above max {hi}"));
-    }
-    Ok(())
 }
 
 /// A template's predicate must exist with the right arity, and its constants must fit.

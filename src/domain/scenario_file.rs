@@ -1,0 +1,137 @@
+//! The scenario file as TOML gives it, before it is checked: what `Scenario::load` reads
+//! from each file of an `extends` chain and from an example pool.
+
+use indexmap::IndexMap;
+use serde::Deserialize;
+use toml::Spanned;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawFile {
+    pub(super) extends: Option<Spanned<String>>,
+    pub(super) scenario: Option<RawMeta>,
+    #[serde(default)]
+    pub(super) objects: IndexMap<String, Vec<Spanned<String>>>,
+    #[serde(default)]
+    pub(super) predicates: Vec<RawPredicate>,
+    #[serde(default)]
+    pub(super) skills: Vec<RawSkill>,
+    #[serde(default)]
+    pub(super) examples: Vec<RawExample>,
+    /// A file of `[[examples]]` beside this one: the domain's pool of worked examples,
+    /// from which prompts choose the ones most like each request.
+    pub(super) example_pool: Option<Spanned<String>>,
+    /// What requests mean here beyond the vocabulary, told to the model with each goal
+    /// question in a scene that has the objects a convention names.
+    #[serde(default)]
+    pub(super) conventions: Vec<RawConvention>,
+    /// Read by the world module.
+    #[allow(dead_code)]
+    pub(super) world: Option<toml::Value>,
+    /// Read by the verify module (`verify::VerifyConfig::from_scenario`).
+    #[allow(dead_code)]
+    pub(super) verify: Option<toml::Value>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMeta {
+    pub(super) name: String,
+    #[serde(default)]
+    pub(super) description: String,
+    pub(super) instruction: Option<String>,
+    pub(super) goal: Option<Spanned<String>>,
+    #[serde(default)]
+    pub(super) expected_fix: Vec<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPredicate {
+    pub(super) name: Spanned<String>,
+    #[serde(default)]
+    pub(super) args: Vec<Spanned<String>>,
+    pub(super) description: String,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSkill {
+    pub(super) name: Spanned<String>,
+    #[serde(default)]
+    pub(super) description: String,
+    #[serde(default)]
+    pub(super) params: Vec<Spanned<String>>,
+    #[serde(default)]
+    pub(super) pre: Vec<Spanned<String>>,
+    #[serde(default)]
+    pub(super) add: Vec<Spanned<String>>,
+    #[serde(default)]
+    pub(super) del: Vec<Spanned<String>>,
+    #[serde(default = "default_cost")]
+    pub(super) cost: f64,
+    #[serde(default = "default_ticks")]
+    pub(super) ticks: u32,
+    #[serde(default)]
+    pub(super) values: Vec<RawValueParam>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawValueParam {
+    pub(super) name: String,
+    pub(super) unit: Option<String>,
+    #[serde(default)]
+    pub(super) categories: Vec<String>,
+    #[serde(default)]
+    pub(super) description: String,
+    pub(super) min: Option<f64>,
+    pub(super) max: Option<f64>,
+}
+
+/// An example pool file: nothing but `[[examples]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPool {
+    #[serde(default)]
+    pub(super) examples: Vec<RawExample>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawConvention {
+    pub(super) text: String,
+    #[serde(default)]
+    pub(super) objects: Vec<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawExample {
+    pub(super) instruction: String,
+    pub(super) goal: String,
+}
+
+pub(super) fn default_cost() -> f64 {
+    1.0
+}
+
+pub(super) fn default_ticks() -> u32 {
+    1
+}
+
+/// A declared range is for a number with a unit, finite, and not empty.
+pub(super) fn value_range(v: &RawValueParam) -> Result<(), String> {
+    if (v.min.is_some() || v.max.is_some()) && v.unit.is_none() {
+        return Err("min and max are for a number with a unit".into());
+    }
+    if v.min.into_iter().chain(v.max).any(|x| !x.is_finite()) {
+        return Err("min and max must be finite numbers".into());
+    }
+    if let (Some(lo), Some(hi)) = (v.min, v.max)
+        && lo > hi
+    {
+        return Err(format!("min {lo} is above max {hi}"));
+    }
+    Ok(())
+}
