@@ -97,10 +97,11 @@ impl Session {
                 .until("a tick", |e| matches!(e, Event::Ticked { .. }))
                 .await;
             ticks += 1;
-            if self
-                .seen
+            // The tick's own record says whether an action failed (the failure event
+            // follows it).
+            if got
                 .iter()
-                .any(|e| matches!(e, Event::ActionFailed { .. }))
+                .any(|e| matches!(e, Event::Ticked { record } if !record.failures.is_empty()))
             {
                 break;
             }
@@ -217,6 +218,30 @@ fn reject_leaves_the_tree_and_an_invalid_edit_is_refused() {
 }
 
 #[test]
+fn a_pending_proposal_is_not_ticked_past() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        s.send(Command::Tick);
+        s.send(Command::Run);
+        for _ in 0..2 {
+            s.until("the answer", |e| {
+                matches!(e, Event::Notice { message }
+                    if message.contains("not ticked: the failure waits for approval"))
+            })
+            .await;
+        }
+        // After approval the repaired tree ticks again.
+        s.send(Command::Approve);
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Tick);
+        s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
+            .await;
+    });
+}
+
+#[test]
 fn undo_restores_the_tree_before_the_last_expansion() {
     rt().block_on(async {
         let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
@@ -245,22 +270,38 @@ fn a_slow_model_call_does_not_block_ticks() {
             .await;
         for _ in 0..10 {
             s.send(Command::Tick);
-            s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
+            let got = s
+                .until("a tick", |e| matches!(e, Event::Ticked { .. }))
                 .await;
-            if s.seen
+            if got
                 .iter()
-                .any(|e| matches!(e, Event::Asking { what } if what.contains("preconditions")))
+                .any(|e| matches!(e, Event::Ticked { record } if !record.failures.is_empty()))
             {
                 break;
             }
         }
-        // The failure question is under way for 30 s; ticks are answered meanwhile.
+        s.until(
+            "the question",
+            |e| matches!(e, Event::Asking { what } if what.contains("preconditions")),
+        )
+        .await;
+        // The failure question is under way for 30 s; a tick is answered at once, and
+        // the failed tree is not ticked again while the proposal is awaited.
         let start = std::time::Instant::now();
         for _ in 0..5 {
             s.send(Command::Tick);
-            s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
-                .await;
+            s.until(
+                "the answer to a tick",
+                |e| matches!(e, Event::Notice { message } if message.contains("not ticked")),
+            )
+            .await;
         }
+        let failures = s
+            .seen
+            .iter()
+            .filter(|e| matches!(e, Event::ActionFailed { .. }))
+            .count();
+        assert_eq!(failures, 1, "the failed tree was ticked again");
         assert!(
             start.elapsed() < Duration::from_secs(5),
             "{:?}",

@@ -207,6 +207,8 @@ impl App {
                 self.overlay = Some(Overlay::Help);
                 return;
             }
+            Action::LogUp => return self.llm.scroll_log_up(),
+            Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
                 self.queue.push(AppEvent::Quit);
                 return;
@@ -317,6 +319,7 @@ impl App {
                 if reset {
                     self.status.ticks = 0;
                     self.status.ending = None;
+                    self.world.last_error = None;
                     self.tree.clear_statuses();
                 }
             }
@@ -329,10 +332,12 @@ impl App {
                 let text = strings::failed(&action.to_string(), &error);
                 self.tree.set_failing(node);
                 self.world.last_error = Some(text.clone());
+                self.world.error_resolved = false;
                 self.status.ending = Some(Ending::Failed);
                 self.llm.log(text);
             }
             Event::Asking { what } => {
+                self.status.awaiting = Some(&strings::AWAITING_MODEL);
                 self.llm.error = None;
                 self.llm.asking = Some(what);
             }
@@ -349,6 +354,7 @@ impl App {
             Event::Goal {
                 goal, reasoning, ..
             } => {
+                self.status.awaiting = None;
                 self.llm.goal = Some(goal.to_string());
                 self.llm.reasoning = reasoning;
             }
@@ -360,12 +366,15 @@ impl App {
                 self.llm.asking = None;
                 self.llm.reasoning = reasoning;
                 self.llm.proposal = Some(ProposalView::of(&proposal));
+                self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
             }
             Event::Approved => {
+                self.status.awaiting = None;
                 self.llm.proposal = None;
                 self.llm.log("approved");
             }
             Event::Rejected => {
+                self.status.awaiting = None;
                 self.llm.proposal = None;
                 self.llm
                     .log("rejected: the tree is unchanged (e to type conditions)");
@@ -375,14 +384,19 @@ impl App {
                 valued_nodes,
             } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
             Event::DidNotHelp { reason } => {
+                self.status.awaiting = None;
                 self.llm
                     .log(format!("the change did not help and was undone: {reason}"));
             }
             Event::Success { ticks } => {
                 self.status.ending = Some(Ending::Success);
+                self.world.error_resolved = true;
                 self.llm.log(strings::success(ticks));
             }
-            Event::GaveUp { reason } => self.llm.log(reason),
+            Event::GaveUp { reason } => {
+                self.status.awaiting = None;
+                self.llm.log(reason);
+            }
             Event::Usage { totals } => self.status.usage = totals,
             Event::RunState { running } => self.status.running = running,
             Event::Verified { report } => {
@@ -404,6 +418,7 @@ impl App {
                 self.llm.log(format!("error: {message}"));
             }
             Event::Failed { error } => {
+                self.status.awaiting = None;
                 self.llm.asking = None;
                 self.llm.error = Some(error.to_string());
                 self.llm.log(format!("error: {error}"));

@@ -25,6 +25,8 @@ pub enum Action {
     Save,
     Load,
     Reset,
+    LogUp,
+    LogDown,
     Help,
     Quit,
 }
@@ -173,6 +175,8 @@ bindings! {
     save: Save = Key::plain('s'),
     load: Load = Key::plain('l'),
     reset: Reset = Key::plain('w'),
+    log_up: LogUp = Key::plain('['),
+    log_down: LogDown = Key::plain(']'),
     help: Help = Key::plain('?'),
     quit: Quit = Key::plain('q'),
 }
@@ -252,13 +256,14 @@ mod tests {
     }
 
     #[test]
-    fn defaults_match_the_issue() {
+    fn defaults_are_the_documented_keys() {
         let k = KeyBindings::default();
         let text: Vec<String> = k.entries().iter().map(|(_, k)| k.to_string()).collect();
         assert_eq!(
             text,
             [
-                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "w", "?", "q"
+                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "w", "[", "]", "?",
+                "q"
             ]
         );
         assert_eq!(

@@ -18,6 +18,21 @@ pub const NOW_TRUE: &str = "True now:";
 pub const NOTHING_TRUE: &str = "  (nothing)";
 pub const OBJECTS: &str = "Objects:";
 pub const LAST_ERROR: &str = "Last error:";
+pub const LAST_ERROR_RESOLVED: &str = "Last error (resolved: the tree has succeeded since):";
+/// What a failure waits for, in the status bar: in full, and for narrow terminals.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Awaiting {
+    pub long: &'static str,
+    pub short: &'static str,
+}
+pub const AWAITING_MODEL: Awaiting = Awaiting {
+    long: "asking the model",
+    short: "asking",
+};
+pub const AWAITING_APPROVAL: Awaiting = Awaiting {
+    long: "awaiting approval",
+    short: "approve?",
+};
 pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
@@ -25,6 +40,16 @@ pub const ASKING: &str = "asking the model for";
 pub const REPLY_FROM: &str = "reply from";
 pub const GOAL: &str = "Goal:";
 pub const LOG: &str = "Log";
+
+/// The marker under a log scrolled up: how many rows are below.
+pub fn log_below(rows: usize) -> String {
+    format!("↓ {rows} more row(s) below ([ ] scroll, newest at the bottom)")
+}
+
+/// A log line said `count` times in a row.
+pub fn repeated(line: &str, count: usize) -> String {
+    format!("{line} (×{count})")
+}
 
 pub const RUNNING: &str = "running";
 pub const PAUSED: &str = "paused";
@@ -61,6 +86,8 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Save => "save the policy",
         Load => "load the saved policy",
         Reset => "reset the world",
+        LogUp => "scroll the log to older lines",
+        LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",
         Quit => "quit",
     }

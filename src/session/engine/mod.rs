@@ -306,6 +306,14 @@ impl Engine {
             Command::Submit(text) => self.submit(&text),
             Command::SubmitGoal { goal, instruction } => self.submit_goal(goal, instruction),
             Command::Plan => self.plan(),
+            Command::Tick | Command::Run if self.awaiting().is_some() => {
+                let what = self.awaiting().unwrap_or_default();
+                self.emit(Event::Notice {
+                    message: format!(
+                        "not ticked: the failure waits for {what}; the failed tree would only fail again"
+                    ),
+                });
+            }
             Command::Tick => {
                 if self.running {
                     self.set_running(false);
@@ -339,6 +347,19 @@ impl Engine {
                 true
             }
             None => false,
+        }
+    }
+
+    /// What a failure waits for before the tree can change: a person's approval of the
+    /// pending proposal, or the model's proposal. Ticking the failed tree meanwhile would
+    /// only fail again.
+    fn awaiting(&self) -> Option<&'static str> {
+        if self.pending.is_some() {
+            Some("approval of the proposal")
+        } else if self.request.is_some() && self.failure.is_some() {
+            Some("the model's proposal")
+        } else {
+            None
         }
     }
 

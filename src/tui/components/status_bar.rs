@@ -34,6 +34,8 @@ pub struct StatusBar {
     pub ticks: u64,
     pub running: bool,
     pub ending: Option<Ending>,
+    /// What a failure waits for (the model's proposal, a person's approval).
+    pub awaiting: Option<&'static strings::Awaiting>,
     /// Said once when a 3D viewer was asked for and is not there.
     pub viewer: Option<String>,
     /// Takes the bar's middle while it is there.
@@ -96,14 +98,16 @@ impl StatusBar {
             sep.clone(),
             Span::styled(strings::tick(self.ticks), theme.status_bar),
             sep.clone(),
-            Span::styled(
-                if self.running {
-                    strings::RUNNING
-                } else {
-                    strings::PAUSED
-                },
-                theme.status_bar,
-            ),
+            // A failure that waits (for the model, for approval) says so where the run
+            // state stands: the tree does not tick meanwhile.
+            match (self.running, self.awaiting) {
+                (true, _) => Span::styled(strings::RUNNING, theme.status_bar),
+                (false, Some(what)) => Span::styled(
+                    if narrow { what.short } else { what.long },
+                    theme.status_bar.patch(theme.running),
+                ),
+                (false, None) => Span::styled(strings::PAUSED, theme.status_bar),
+            },
         ];
         match self.ending {
             Some(Ending::Success) => {

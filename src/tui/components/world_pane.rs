@@ -14,14 +14,24 @@ pub struct WorldPane {
     pub facts: Vec<String>,
     pub objects: Vec<String>,
     pub last_error: Option<String>,
+    /// The tree has succeeded since the last error.
+    pub error_resolved: bool,
 }
 
 impl WorldPane {
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
         let mut lines: Vec<Line> = Vec::new();
         if let Some(e) = &self.last_error {
-            lines.push(Line::from(Span::styled(strings::LAST_ERROR, theme.title)));
-            lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
+            if self.error_resolved {
+                lines.push(Line::from(Span::styled(
+                    strings::LAST_ERROR_RESOLVED,
+                    theme.dim,
+                )));
+                lines.push(Line::from(Span::styled(format!("  {e}"), theme.dim)));
+            } else {
+                lines.push(Line::from(Span::styled(strings::LAST_ERROR, theme.title)));
+                lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
+            }
         }
         lines.push(Line::from(Span::styled(
             format!("{} {}", strings::OBJECTS, self.objects.join(", ")),
