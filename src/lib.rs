@@ -11,6 +11,7 @@ pub mod bt;
 pub mod dataset;
 pub mod domain;
 pub mod eval;
+pub mod excerpt;
 pub mod goal;
 pub mod http_retry;
 pub mod http_text;

@@ -166,6 +166,16 @@ fn bad_input_exits_2_with_the_reason() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown object \"Fries\""));
 
+    // A goal nested too deep is refused, and the message quotes only the stretch around
+    // the column it is about.
+    let deep = format!("{}Holding_Nothing{}", "(".repeat(5000), ")".repeat(5000));
+    let out = betr(&["plan", "scenarios/cafe/cafe.toml", "--goal", &deep]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("column 257") && err.contains("nested"), "{err}");
+    assert!(err.contains("(10015 characters)"), "{err}");
+    assert!(err.len() < 300, "{} bytes: {err}", err.len());
+
     let dir = temp_dir("bad-tree");
     let tree = dir.join("bad.bt");
     std::fs::write(

@@ -20,6 +20,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
 use betr::domain::{Condition, Scenario};
+use betr::excerpt::excerpt;
 use betr::goal::Formula;
 
 #[derive(Parser)]
@@ -415,24 +416,30 @@ fn find_scenario(arg: &Path) -> Result<PathBuf> {
 
 /// `A & ~B` → the literals, checked against the scenario's vocabulary.
 fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>> {
-    let formula = scenario
-        .parse_goal(text)
-        .map_err(|e| anyhow::anyhow!("--add {text:?}: {e}"))?;
+    let formula = parse_formula(scenario, "--add", text)?;
     let dnf = formula.to_dnf();
     match dnf.0.as_slice() {
         [one] if !one.is_empty() => Ok(one.clone()),
         _ => bail!(
-            "--add {text:?}: expected one condition or a conjunction ('A & ~B'), found {formula}"
+            "--add {}: expected one condition or a conjunction ('A & ~B'), found {formula}",
+            excerpt(text, None)
         ),
     }
+}
+
+/// A goal formula for `flag`, its text echoed in an error as an excerpt around the
+/// column the error is about.
+fn parse_formula(scenario: &Scenario, flag: &str, text: &str) -> Result<Formula> {
+    let at = Formula::parse(text).err().map(|e| e.at);
+    scenario
+        .parse_goal(text)
+        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", excerpt(text, at)))
 }
 
 /// The goal to plan: `--goal`, else the scenario's.
 fn goal_of(scenario: &Scenario, goal: Option<&str>) -> Result<Formula> {
     match goal {
-        Some(text) => scenario
-            .parse_goal(text)
-            .map_err(|e| anyhow::anyhow!("--goal {text:?}: {e}")),
+        Some(text) => parse_formula(scenario, "--goal", text),
         None => scenario
             .goal
             .clone()

@@ -50,7 +50,8 @@ impl GoalError {
             at,
             column: column_of(text, at),
             expected: expected.into(),
-            found: found.into(),
+            // What was found is echoed, so a long run of it is cut.
+            found: crate::excerpt::shortened(&found.into(), 40),
         }
     }
 }

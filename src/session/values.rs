@@ -30,17 +30,18 @@ macro_rules! bail {
 }
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, SettingError> {
+    let shown = crate::excerpt::excerpt(text, None);
     let usage = "expected `<parameter> of <object> = <value>`, e.g. \"force of egg = 5 N\"";
     let Some((left, value_text)) = text.split_once('=') else {
-        bail!("--set {text:?}: {usage}");
+        bail!("--set {shown}: {usage}");
     };
     let Some((param, object)) = left.split_once(" of ") else {
-        bail!("--set {text:?}: {usage}");
+        bail!("--set {shown}: {usage}");
     };
     let param = param.trim();
     let object = object.trim().trim_matches('"').to_string();
     if scenario.domain.vocabulary.object(&object).is_none() {
-        bail!("--set {text:?}: no object {object:?} in this scenario");
+        bail!("--set {shown}: no object {object:?} in this scenario");
     }
     let mut targets = Vec::new();
     let mut declared = None;
@@ -71,7 +72,7 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
             })
             .collect();
         bail!(
-            "--set {text:?}: no skill declares a value {param:?} (declared: {})",
+            "--set {shown}: no skill declares a value {param:?} (declared: {})",
             if known.is_empty() {
                 "none".to_string()
             } else {
@@ -79,10 +80,9 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
             }
         );
     };
+    let value = parse_value(value_text).map_err(|e| SettingError(format!("--set {shown}: {e}")))?;
     let value =
-        parse_value(value_text).map_err(|e| SettingError(format!("--set {text:?}: {e}")))?;
-    let value =
-        conform(&declared, value).map_err(|e| SettingError(format!("--set {text:?}: {e}")))?;
+        conform(&declared, value).map_err(|e| SettingError(format!("--set {shown}: {e}")))?;
     Ok(Setting {
         text: text.to_string(),
         object,

@@ -55,7 +55,8 @@ impl Engine {
         match self.model.clone() {
             Ok(model) => self.ask_goal(model, text),
             Err(why) => self.error(format!(
-                "{text:?} is not a goal formula ({not_a_goal}), and no language model can read it as an instruction: {why}"
+                "{} is not a goal formula ({not_a_goal}), and no language model can read it as an instruction: {why}",
+                crate::excerpt::excerpt(text, None)
             )),
         }
     }

@@ -67,7 +67,10 @@ impl StatusBar {
             let spans = vec![
                 Span::styled(scenario, theme.status_bar),
                 sep.clone(),
-                Span::styled(format!("{:<room$}", fit(&message.text, room)), style),
+                Span::styled(
+                    format!("{:<room$}", crate::excerpt::shortened(&message.text, room)),
+                    style,
+                ),
                 sep,
                 Span::styled(help, theme.status_bar),
             ];
@@ -138,14 +141,4 @@ impl StatusBar {
             area,
         );
     }
-}
-
-/// `text` cut to `width` characters, with an ellipsis when cut.
-fn fit(text: &str, width: usize) -> String {
-    if text.chars().count() <= width {
-        return text.to_string();
-    }
-    let mut cut: String = text.chars().take(width.saturating_sub(1)).collect();
-    cut.push('…');
-    cut
 }
