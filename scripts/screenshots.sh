@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Screenshots of the workbench for the README: the real `betr tui` in a real terminal
+# (tmux, 140×45), driven with keys as a person would on scenario 1 with the embedded
+# default model, captured with its colours at three moments and drawn as SVG images into
+# docs/images/: the planned tree, the failure with the proposal awaiting approval, and
+# success after the repair. Run it again whenever the screens change.
+# Usage: bash scripts/screenshots.sh   (needs tmux and python3; fetches the model once)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+command -v tmux >/dev/null || { echo "error: tmux is needed (apt install tmux)" >&2; exit 2; }
+cargo build --release --locked
+betr="$PWD/target/release/betr"
+out="docs/images"
+mkdir -p "$out"
+betr_dir="$(mktemp -d)"
+socket="betr-screenshots-$$"
+trap 'tmux -L "$socket" kill-server 2>/dev/null || true; rm -rf "$betr_dir"' EXIT
+
+# The model is fetched before the terminal opens (with its progress bar here), so the
+# screens show the workbench and not a download.
+"$betr" model fetch
+
+tmux -L "$socket" new-session -d -s betr -x 140 -y 45 \
+  "cd '$betr_dir' && XDG_STATE_HOME='$betr_dir/state' XDG_DATA_HOME='$betr_dir/data' '$betr' tui '$PWD/scenarios/cell/red_on_blue.toml' --policy-dir '$betr_dir/policies'; sleep 60"
+
+screen() { tmux -L "$socket" capture-pane -p -t betr; }
+# Wait until the screen shows every argument; give up after 300 s (the model is slow on
+# two cores).
+wait_for() {
+  local deadline=$((SECONDS + 300))
+  while :; do
+    local s
+    s="$(screen)"
+    local all=1
+    for want in "$@"; do
+      [[ "$s" == *"$want"* ]] || all=0
+    done
+    [ "$all" = 1 ] && return 0
+    if [ "$SECONDS" -ge "$deadline" ]; then
+      echo "error: timed out waiting for: $*" >&2
+      echo "$s" >&2
+      exit 1
+    fi
+    sleep 0.2
+  done
+}
+shot() {
+  tmux -L "$socket" capture-pane -e -p -t betr | python3 scripts/ansi_to_svg.py > "$out/$1"
+  echo "wrote $out/$1"
+}
+keys() { tmux -L "$socket" send-keys -t betr "$@"; }
+
+wait_for "Behavior tree" "press i to type an instruction"
+keys i
+wait_for "Instruction or goal"
+keys -l "Put the blue cube on the green cube"
+keys Enter
+wait_for 'Goal: "blue cube" on "green cube"' '[o] Fallback'
+sleep 0.5
+shot workbench-planned.svg
+
+for _ in $(seq 1 10); do
+  keys Space
+  sleep 0.3
+  [[ "$(screen)" == *"◀ failed"* ]] && break
+done
+wait_for "◀ failed" "Proposal for grasp" "awaiting approval"
+sleep 0.5
+shot workbench-proposal.svg
+
+keys a
+wait_for "repaired:"
+keys r
+wait_for "SUCCESS"
+sleep 0.5
+shot workbench-success.svg
+keys q
