@@ -172,7 +172,10 @@ fn bad_input_exits_2_with_the_reason() {
     let out = betr(&["plan", "scenarios/cafe/cafe.toml", "--goal", &deep]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("column 257") && err.contains("nested"), "{err}");
+    assert!(
+        err.contains("column 257") && err.contains("nested"),
+        "{err}"
+    );
     assert!(err.contains("(10015 characters)"), "{err}");
     assert!(err.len() < 300, "{} bytes: {err}", err.len());
 

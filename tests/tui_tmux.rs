@@ -2,7 +2,9 @@
 //! the fake OpenAI server from hand-written fixtures. Type the instruction of scenario 1,
 //! step ticks until the grasp fails, see the proposal, approve it, run to success, save
 //! the policy, quit; the screen is checked at each step (polling `capture-pane` with a
-//! timeout), then the restored terminal, the exit status and the saved policy.
+//! timeout), then the restored terminal, the exit status and the saved policy. A second
+//! session rejects, edits, undoes, verifies and saves, and a fresh workbench reuses the
+//! saved policy without asking the model.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -280,6 +282,108 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     );
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The rest of the loop: reject the proposal, type the condition instead (edit), undo
+/// it, let the model propose again and approve, verify, run to success, save; then a
+/// fresh workbench reads the same instruction from the saved policy with no model call.
+#[test]
+fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-loop");
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", ""));
+    tmux.wait_for(&["press i to type an instruction"], 20);
+    let instruct = |tmux: &Tmux| {
+        tmux.keys(&["i"]);
+        tmux.wait_for(&["Instruction or goal"], 10);
+        tmux.text("Put the blue cube on the green cube");
+        tmux.keys(&["Enter"]);
+        tmux.wait_for(
+            &[
+                "Goal: \"blue cube\" on \"green cube\"",
+                "grasp \"blue cube\"!",
+            ],
+            20,
+        );
+    };
+    let step_to_proposal = |tmux: &Tmux| {
+        for _ in 0..10 {
+            tmux.keys(&["Space"]);
+            std::thread::sleep(Duration::from_millis(200));
+            if tmux.screen().contains("◀ failed") {
+                break;
+            }
+        }
+        tmux.wait_for(
+            &["Proposal for grasp \"blue cube\"!:", "awaiting approval"],
+            20,
+        )
+    };
+    instruct(&tmux);
+    step_to_proposal(&tmux);
+
+    // Reject: the tree stays as planned.
+    tmux.keys(&["x"]);
+    let screen = tmux.wait_for(&["rejected: the tree is unchanged"], 10);
+    assert!(!screen.contains("+[-]"), "{screen}");
+
+    // Edit: the person types the condition; it is applied like an approved proposal.
+    tmux.keys(&["e"]);
+    tmux.wait_for(&[strings_edit_title()], 10);
+    tmux.text("~\"any object\" on \"blue cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
+
+    // Undo: the planned tree is back.
+    tmux.keys(&["u"]);
+    let screen = tmux.wait_for(&["undid the last change (1 fix(es) removed)"], 10);
+    assert!(!screen.contains("+[-]"), "{screen}");
+
+    // The failure again: the model proposes, the person approves.
+    step_to_proposal(&tmux);
+    tmux.keys(&["a"]);
+    tmux.wait_for(&["repaired:", "+[-] ~\"any object\" on \"blue cube\"?"], 20);
+
+    // Verify: the report opens over the screen; any key closes it.
+    tmux.keys(&["v"]);
+    tmux.wait_for(&["Verification (any key closes)"], 30);
+    tmux.keys(&["Escape"]);
+    tmux.wait_for(&["verified"], 10);
+
+    tmux.keys(&["r"]);
+    tmux.wait_for(&["SUCCESS"], 30);
+    tmux.keys(&["s"]);
+    tmux.wait_for(&["saved policy"], 10);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
+    let calls = server.received().len();
+
+    // A fresh workbench: the same instruction is known from the saved policy.
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", ""));
+    tmux.wait_for(&["press i to type an instruction"], 20);
+    instruct(&tmux);
+    tmux.wait_for(
+        &[
+            "no LLM call needed",
+            "[-] ~\"any object\" on \"blue cube\"?",
+        ],
+        20,
+    );
+    tmux.keys(&["r"]);
+    let screen = tmux.wait_for(&["SUCCESS"], 30);
+    assert!(screen.contains("0 call(s)"), "{screen}");
+    assert!(!screen.contains("◀ failed"), "{screen}");
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    assert_eq!(server.received().len(), calls, "the model was asked again");
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The title of the input line while a proposal is edited.
+fn strings_edit_title() -> &'static str {
+    betr::tui::strings::INPUT_TITLE_EDIT.trim()
 }
 
 /// Push-to-talk with real speech through the real binary: `--audio` plays an espeak-ng
