@@ -273,22 +273,19 @@ mod tests {
     }
 
     #[test]
-    fn five_thousand_nodes_render_well_under_a_frame() {
+    fn five_thousand_nodes_render() {
+        // How fast is measured by `cargo bench --bench tree_render`; here only that a large tree draws,
+        // and draws the same again.
         let tree = Arc::new(big(5000));
         assert!(tree.len() >= 5000);
         let mut pane = TreePane::default();
         let theme = Theme::default();
         let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
-        let start = std::time::Instant::now();
         pane.set_tree(tree.clone(), vec![tree.root()]);
         terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
-        let first = start.elapsed();
-        // A frame at 60 Hz is 16 ms; debug builds are slow, so allow a generous bound.
-        assert!(first.as_millis() < 400, "first render took {first:?}");
-        let again = std::time::Instant::now();
+        let first = terminal.backend().to_string();
+        assert!(first.contains("Fallback"), "{first}");
         terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
-        assert!(again.elapsed().as_millis() < 200, "{:?}", again.elapsed());
-        let screen = terminal.backend().to_string();
-        assert!(screen.contains("Fallback"), "{screen}");
+        assert_eq!(terminal.backend().to_string(), first);
     }
 }
