@@ -15,6 +15,7 @@ pub mod excerpt;
 pub mod goal;
 pub mod http_retry;
 pub mod http_text;
+pub mod interop;
 pub mod llm;
 pub mod model;
 pub mod planner;

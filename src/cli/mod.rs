@@ -3,6 +3,7 @@
 mod bench_cmd;
 mod eval_cmd;
 mod eval_setup;
+mod export_cmd;
 mod llm_cmds;
 mod model_cmd;
 mod policy_cmd;
@@ -54,7 +55,8 @@ pub enum Command {
     /// reachable state of the abstraction; exit 1 with a counterexample when violated.
     Verify {
         scenario: PathBuf,
-        /// A tree in betr's text format to verify instead of planning one.
+        /// A tree file to verify instead of planning one (betr text, a saved policy, or
+        /// BehaviorTree.CPP v4 XML).
         #[arg(long)]
         tree: Option<PathBuf>,
         /// A property to check besides the scenario's: 'always F', 'never F', 'eventually F'.
@@ -75,6 +77,21 @@ pub enum Command {
         /// Ticks within which the tree must succeed from every reachable state.
         #[arg(long, default_value_t = 10_000)]
         max_ticks: u64,
+    },
+    /// Write a tree as BehaviorTree.CPP v4 XML (for BT.CPP and Groot2) or Graphviz DOT
+    /// (statuses of the last tick of a run as colours, the last fix's nodes marked).
+    Export {
+        /// A scenario file (its planned tree) or a tree file (betr text, a saved policy,
+        /// or BT.CPP XML).
+        source: PathBuf,
+        #[arg(long, value_enum)]
+        format: export_cmd::Format,
+        /// The scenario of a tree file that does not name one in a policy header.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Write here (atomically) instead of to standard output.
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Reproduce the paper's experiments.
     Eval {
@@ -97,7 +114,8 @@ pub enum Command {
     /// Tick the planned tree (or a saved one) in a fresh world until success or failure.
     Run {
         scenario: PathBuf,
-        /// A tree in betr's text format to run instead of planning one.
+        /// A tree file to run instead of planning one (betr text, a saved policy, or
+        /// BehaviorTree.CPP v4 XML).
         #[arg(long)]
         tree: Option<PathBuf>,
         /// Print the running action and failures at every tick.
@@ -126,7 +144,8 @@ pub enum Command {
         /// Insert the first --add at this action (e.g. 'PickUp "Chips"') instead of the failing one.
         #[arg(long)]
         at: Option<String>,
-        /// Start from this saved tree instead of planning.
+        /// Start from this tree file instead of planning (betr text, a saved policy, or
+        /// BehaviorTree.CPP v4 XML).
         #[arg(long)]
         tree: Option<PathBuf>,
         /// Write the repaired tree here (atomically).
@@ -304,6 +323,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                 glyphs,
             )
         }
+        Command::Export {
+            source,
+            format,
+            scenario,
+            out,
+        } => export_cmd::export(&source, scenario.as_deref(), format, out.as_deref()),
         Command::Plan { scenario, goal } => {
             tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
         }
@@ -333,7 +358,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             variant,
             viz,
         } => {
-            let scenario = load(&scenario)?;
+            let scenario_path = find_scenario(&scenario)?;
+            let scenario = Scenario::load(&scenario_path)?;
             let additions = add
                 .iter()
                 .map(|a| parse_conditions(&scenario, a))
@@ -352,6 +378,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             tree_cmds::repair(
                 &scenario,
                 &tree_cmds::RepairRequest {
+                    scenario_path: &scenario_path,
                     additions: &additions,
                     settings: &settings,
                     at: at.as_ref(),

@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 
-use betr::bt::{self, Glyphs, NodeKind, TickRecord, Tree};
+use betr::bt::{self, Glyphs, NodeId, NodeKind, TickRecord, Tree};
 use betr::domain::{ActionCall, Condition, Scenario};
-use betr::planner::{self, Outcome, Plan, Planner, RunEnd, path_text, run_tree};
+use betr::planner::{Outcome, Plan, Planner, RunEnd, path_text, run_tree};
+use betr::session::policy::{self, Approval, Fix, Policy};
 use betr::world::{self, World};
 use rerun::TextLogLevel as Level;
 
@@ -57,7 +58,7 @@ pub fn run(
     let mut viz = viz.open(false)?;
     let world = world::load_variant(scenario, variant)?;
     let tree = match tree_file {
-        Some(path) => load_tree(scenario, path)?,
+        Some(path) => super::export_cmd::load_tree(scenario, path)?.0,
         None => {
             let goal = super::goal_of(scenario, None)?;
             if let Some(v) = viz.as_mut() {
@@ -118,6 +119,7 @@ pub fn run(
 
 /// What `betr repair` was asked to do.
 pub struct RepairRequest<'a> {
+    pub scenario_path: &'a Path,
     pub additions: &'a [Vec<Condition>],
     pub settings: &'a [Setting],
     pub at: Option<&'a ActionCall>,
@@ -129,6 +131,7 @@ pub struct RepairRequest<'a> {
 
 pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Result<ExitCode> {
     let RepairRequest {
+        scenario_path,
         additions,
         settings,
         at,
@@ -141,7 +144,10 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
     let world = world::load_variant(scenario, variant)?;
     let planner = Planner::new(&scenario.domain);
     let mut plan = match tree_file {
-        Some(path) => planner.grow(load_tree(scenario, path)?, world.as_ref()),
+        Some(path) => planner.grow(
+            super::export_cmd::load_tree(scenario, path)?.0,
+            world.as_ref(),
+        ),
         None => planner.plan(&super::goal_of(scenario, None)?.to_dnf(), world.as_ref())?,
     };
     if viz.is_some() {
@@ -192,6 +198,11 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
         }
         plan = planner.grow(tree, world.as_ref());
     }
+    // What each change was and the nodes it added, for the saved policy's header.
+    let mut changes: Vec<(String, Vec<NodeId>)> = settings
+        .iter()
+        .map(|s| (format!("set {}", s.text), Vec::new()))
+        .collect();
     for (i, conditions) in additions.iter().enumerate() {
         let names = conditions
             .iter()
@@ -199,6 +210,13 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
             .collect::<Vec<_>>()
             .join(" & ");
         let at_action = if i == 0 { at } else { None };
+        let change = match (&plan.outcome, at_action) {
+            (_, Some(action)) => format!("insert {names} before {action}!"),
+            (Outcome::ActionFailed { action, .. }, None) => {
+                format!("insert {names} as the first precondition(s) of {action}!")
+            }
+            _ => format!("insert {names}"),
+        };
         plan = match (&plan.outcome, at_action) {
             (_, Some(action)) => {
                 println!("Inserting {names} before {action}!");
@@ -227,6 +245,7 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
             plan.new_nodes.len(),
             plan.expansions
         );
+        changes.push((change, plan.new_nodes.clone()));
         if let Some(v) = viz.as_mut() {
             v.log(
                 Level::INFO,
@@ -253,7 +272,8 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
     print_tree(&plan.tree, report.last.as_ref(), glyphs);
     println!("\n{}", bt::to_text(&plan.tree));
     if let Some(path) = save {
-        betr::store::write_atomic(path, bt::to_text(&plan.tree).as_bytes())
+        let saved = repaired_policy(scenario, scenario_path, &plan.tree, &changes)?;
+        betr::store::write_atomic(path, policy::render(&saved).as_bytes())
             .with_context(|| format!("saving the repaired tree to {}", path.display()))?;
         println!("Saved to {}", path.display());
     }
@@ -284,17 +304,44 @@ fn end_text(end: &RunEnd, tree: &Tree) -> String {
     }
 }
 
-fn load_tree(scenario: &Scenario, path: &Path) -> Result<Tree> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading tree file {}", path.display()))?;
-    let tree = bt::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    planner::check_tree(&scenario.domain, &tree)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    Ok(tree)
+/// The repaired tree as a policy: the scenario, its goal, and per change the nodes it
+/// added (so `betr export` can mark them), written by a person on the command line.
+fn repaired_policy(
+    scenario: &Scenario,
+    scenario_path: &Path,
+    tree: &Tree,
+    changes: &[(String, Vec<NodeId>)],
+) -> Result<Policy> {
+    let at = policy::now_rfc3339();
+    Ok(Policy {
+        scenario: format!("{} ({})", scenario_path.display(), scenario.name),
+        instruction: scenario.instruction.clone(),
+        goal: super::goal_of(scenario, None)?.to_string(),
+        saved_at: at.clone(),
+        fixes: changes
+            .iter()
+            .map(|(change, nodes)| Fix {
+                change: change.clone(),
+                nodes: nodes
+                    .iter()
+                    .filter_map(|n| tree.path(*n).ok())
+                    .map(|p| path_text(&p))
+                    .collect(),
+                model: "a person (betr repair)".into(),
+                approval: Approval::Edited,
+                at: at.clone(),
+            })
+            .collect(),
+        tree: tree.clone(),
+    })
 }
 
 /// The statuses of a full run of `tree` in a fresh copy of the scenario's world.
-fn final_record(scenario: &Scenario, tree: &Tree, world: &dyn World) -> Option<TickRecord> {
+pub(super) fn final_record(
+    scenario: &Scenario,
+    tree: &Tree,
+    world: &dyn World,
+) -> Option<TickRecord> {
     let mut sim = world.fork();
     run_tree(
         tree,

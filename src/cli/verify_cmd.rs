@@ -6,7 +6,6 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 
-use betr::bt::{self, Tree};
 use betr::domain::Scenario;
 use betr::planner::{Outcome, Planner};
 use betr::verify::{
@@ -30,11 +29,14 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     let config = VerifyConfig::from_scenario(scenario)?;
     let world = world::load(scenario)?;
     let (tree, origin, note) = match &args.tree {
-        Some(path) => (
-            load_tree(path)?,
-            format!("from {}", path.display()),
-            String::new(),
-        ),
+        Some(path) => {
+            let (tree, format) = super::export_cmd::load_tree(scenario, path)?;
+            (
+                tree,
+                format!("loaded from {} ({})", path.display(), format.name()),
+                String::new(),
+            )
+        }
         None => {
             let goal = super::goal_of(scenario, None)?;
             let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
@@ -121,12 +123,6 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     } else {
         ExitCode::from(1)
     })
-}
-
-fn load_tree(path: &Path) -> Result<Tree> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading tree file {}", path.display()))?;
-    bt::parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 fn print_report(report: &Report, ascii: bool) {

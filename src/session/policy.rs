@@ -206,6 +206,24 @@ pub fn load(path: &Path, domain: &Domain) -> Result<Policy, PolicyError> {
     })
 }
 
+/// The scenario file a policy's header names (`# scenario: PATH (name)`), if it has one.
+pub fn scenario_of(text: &str) -> Option<PathBuf> {
+    let value = header_value(text, "scenario")?;
+    let path = match value.split_once(" (") {
+        Some((path, name)) if name.ends_with(')') => path,
+        _ => value,
+    };
+    (!path.is_empty()).then(|| PathBuf::from(path))
+}
+
+/// A node path as the header writes it (`0.1.2`, `root`).
+pub fn parse_node_path(text: &str) -> Option<Vec<usize>> {
+    if text == "root" {
+        return Some(Vec::new());
+    }
+    text.split('.').map(|p| p.parse().ok()).collect()
+}
+
 /// Read a policy's text.
 pub fn parse(text: &str, domain: &Domain) -> Result<Policy, String> {
     let tree = bt::parse(text).map_err(|e| e.to_string())?;
@@ -290,6 +308,22 @@ mod tests {
             &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml"),
         )
         .unwrap()
+    }
+
+    #[test]
+    fn the_scenario_is_read_from_the_header() {
+        let named =
+            "# betr policy\n# scenario: scenarios/cell/red_on_blue.toml (Red cube (1))\nsequence\n";
+        assert_eq!(
+            scenario_of(named),
+            Some(PathBuf::from("scenarios/cell/red_on_blue.toml"))
+        );
+        let bare = "# scenario: cafe/no_coffee.toml\n";
+        assert_eq!(
+            scenario_of(bare),
+            Some(PathBuf::from("cafe/no_coffee.toml"))
+        );
+        assert_eq!(scenario_of("sequence\n  A?\n"), None);
     }
 
     #[test]

@@ -280,6 +280,14 @@ pub enum SessionError {
     NoGoal { attempts: usize, last: ReplyError },
     #[error("{0}")]
     Policy(#[from] super::policy::PolicyError),
+    #[error(transparent)]
+    TreeFile(Box<crate::interop::TreeFileError>),
     #[error("the session stopped before the loop ended")]
     Stopped,
+}
+
+impl From<crate::interop::TreeFileError> for SessionError {
+    fn from(e: crate::interop::TreeFileError) -> Self {
+        SessionError::TreeFile(Box::new(e))
+    }
 }

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::interop::{self, TreeFormat};
 use crate::planner::{Planner, path_text};
 
 use super::super::policy::{self, Fix, Policy};
@@ -58,15 +59,41 @@ impl Engine {
             (None, None, _) => return self.error("no policy directory in this session"),
             (None, _, None) => return self.error("no task yet: submit an instruction first"),
         };
-        let saved = match policy::load(&path, &self.scenario.domain) {
-            Ok(p) => p,
+        // Any tree file: a policy (its header kept), betr text, or BT.CPP XML.
+        let loaded = match interop::load_tree_file(&path, &self.scenario.domain) {
+            Ok(l) => l,
             Err(e) => return self.emit(Event::Failed { error: e.into() }),
         };
+        let saved = match loaded.format {
+            TreeFormat::Text => match policy::load(&path, &self.scenario.domain) {
+                Ok(p) => p,
+                Err(e) => return self.emit(Event::Failed { error: e.into() }),
+            },
+            TreeFormat::BtCpp => Policy {
+                scenario: String::new(),
+                instruction: None,
+                goal: String::new(),
+                saved_at: String::new(),
+                fixes: Vec::new(),
+                tree: loaded.tree,
+            },
+        };
+        for note in loaded.notes {
+            self.emit(Event::Notice {
+                message: format!("{}: {note}", path.display()),
+            });
+        }
         if let Ok(goal) = self.scenario.parse_goal(&saved.goal) {
             let instruction = self.task.as_ref().and_then(|t| t.instruction.clone());
             self.task = Some(Task {
                 goal,
                 instruction: instruction.or(saved.instruction.clone()),
+            });
+        } else if let (None, Some(goal)) = (&self.task, &self.scenario.goal) {
+            // A tree that does not say its goal (BT.CPP XML) works on the scenario's task.
+            self.task = Some(Task {
+                goal: goal.clone(),
+                instruction: self.scenario.instruction.clone(),
             });
         }
         self.cancel_request();
@@ -83,7 +110,7 @@ impl Engine {
                 nodes: f
                     .nodes
                     .iter()
-                    .filter_map(|p| parse_path(p))
+                    .filter_map(|p| policy::parse_node_path(p))
                     .filter_map(|p| saved.tree.node_at_path(&p).ok())
                     .collect(),
                 author: f.model.clone(),
@@ -100,11 +127,4 @@ impl Engine {
         let why = format!("loaded policy {}", path.display());
         self.set_tree(plan.tree, plan.new_nodes, why);
     }
-}
-
-fn parse_path(text: &str) -> Option<Vec<usize>> {
-    if text == "root" {
-        return Some(Vec::new());
-    }
-    text.split('.').map(|p| p.parse().ok()).collect()
 }

@@ -1,0 +1,111 @@
+//! `betr export`: a planned or saved tree as BehaviorTree.CPP v4 XML or Graphviz DOT, and
+//! the one reader of tree files the commands share.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+
+use betr::bt::{NodeId, Tree};
+use betr::domain::Scenario;
+use betr::interop::{self, TreeFormat};
+use betr::planner::Planner;
+use betr::session::policy;
+use betr::world;
+
+/// What `betr export` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// BehaviorTree.CPP v4 XML (opens in Groot2).
+    Btcpp,
+    /// Graphviz DOT, coloured by the statuses of the last tick of a run.
+    Dot,
+}
+
+/// Read a tree file (betr text, a policy, or BT.CPP XML) checked against the scenario;
+/// what was read differently from how it was written is said on stderr.
+pub fn load_tree(scenario: &Scenario, path: &Path) -> Result<(Tree, TreeFormat)> {
+    let loaded = interop::load_tree_file(path, &scenario.domain)?;
+    for note in &loaded.notes {
+        eprintln!("note: {}: {note}", path.display());
+    }
+    Ok((loaded.tree, loaded.format))
+}
+
+pub fn export(
+    source: &Path,
+    scenario_arg: Option<&Path>,
+    format: Format,
+    out: Option<&Path>,
+) -> Result<ExitCode> {
+    let is_scenario = source
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let (scenario_path, tree, new_nodes) = if is_scenario {
+        let path = super::find_scenario(source)?;
+        let scenario = Scenario::load(&path)?;
+        let goal = super::goal_of(&scenario, None)?;
+        let world = world::load(&scenario)?;
+        let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
+        (path, plan.tree, Vec::new())
+    } else {
+        let text = std::fs::read_to_string(source)
+            .with_context(|| format!("reading tree file {}", source.display()))?;
+        let scenario_path = match (scenario_arg, policy::scenario_of(&text)) {
+            (Some(s), _) => super::find_scenario(s)?,
+            (None, Some(named)) => super::find_scenario(&named).with_context(|| {
+                format!(
+                    "the scenario {} named in {}",
+                    named.display(),
+                    source.display()
+                )
+            })?,
+            (None, None) => bail!(
+                "{} does not say which scenario it belongs to: pass --scenario FILE",
+                source.display()
+            ),
+        };
+        let scenario = Scenario::load(&scenario_path)?;
+        let (tree, format) = load_tree(&scenario, source)?;
+        let new_nodes = match format {
+            TreeFormat::Text => last_fix_nodes(&text, &scenario, &tree),
+            TreeFormat::BtCpp => Vec::new(),
+        };
+        (scenario_path, tree, new_nodes)
+    };
+    let scenario = Scenario::load(&scenario_path)?;
+    let name = scenario_path
+        .file_stem()
+        .map_or_else(|| "tree".to_string(), |s| s.to_string_lossy().into_owned());
+    let text = match format {
+        Format::Btcpp => interop::to_btcpp(&tree, &scenario.domain, &name)?,
+        Format::Dot => {
+            let world = world::load(&scenario)?;
+            let record = super::tree_cmds::final_record(&scenario, &tree, world.as_ref());
+            interop::to_dot(&tree, record.as_ref(), &new_nodes, &name)
+        }
+    };
+    match out {
+        Some(path) => {
+            betr::store::write_atomic(path, text.as_bytes())
+                .with_context(|| format!("writing {}", path.display()))?;
+            eprintln!("Wrote {}", path.display());
+        }
+        None => print!("{text}"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The nodes the policy's last fix added, by the paths its header records.
+fn last_fix_nodes(text: &str, scenario: &Scenario, tree: &Tree) -> Vec<NodeId> {
+    let Ok(saved) = policy::parse(text, &scenario.domain) else {
+        return Vec::new();
+    };
+    saved.fixes.last().map_or_else(Vec::new, |fix| {
+        fix.nodes
+            .iter()
+            .filter_map(|p| policy::parse_node_path(p))
+            .filter_map(|p| tree.node_at_path(&p).ok())
+            .collect()
+    })
+}

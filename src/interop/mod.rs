@@ -1,0 +1,59 @@
+//! Trees in other tools' formats: BehaviorTree.CPP v4 XML (written and read, so a tree
+//! planned in betr runs in BT.CPP and opens in Groot2, and a BT.CPP tree can be checked
+//! and stepped here) and Graphviz DOT (written, with the statuses of a tick).
+//!
+//! How betr's nodes meet BT.CPP's:
+//!
+//! | betr | BT.CPP v4 |
+//! |---|---|
+//! | `sequence` | `<ReactiveSequence>` (a memory `<Sequence>` is read when memory changes nothing) |
+//! | `fallback` | `<ReactiveFallback>` (likewise `<Fallback>`) |
+//! | `"blue cube" on "green cube"?` | `<Condition ID="on" arg1="blue cube" arg2="green cube"/>` |
+//! | `~On_Coffee_Table1?` | `<Inverter><Condition ID="On" arg1="Coffee" arg2="Table1"/></Inverter>` |
+//! | `grasp "egg" {force = 5 N}!` | `<Action ID="grasp" x="egg" force="5 N"/>` |
+//!
+//! A condition's ID is its predicate with `_` for spaces (`near robot` → `near_robot`) and
+//! its ports are its arguments by position; an action's ID is its skill and its ports are
+//! the skill's parameter names, then its value parameters.
+
+mod btcpp_read;
+mod btcpp_write;
+mod dot;
+mod tree_file;
+
+pub use btcpp_read::{Imported, XmlError, from_btcpp};
+pub use btcpp_write::{ExportError, to_btcpp};
+pub use dot::to_dot;
+pub use tree_file::{LoadedTree, TreeFileError, TreeFormat, load_tree_file, read_tree};
+
+use crate::domain::vocabulary::Predicate;
+use crate::domain::{Domain, Skill};
+
+/// The BT.CPP node ID of a predicate: its name with `_` for each space.
+pub fn condition_id(predicate: &str) -> String {
+    predicate.replace(' ', "_")
+}
+
+/// The port holding argument `index` (0-based) of a condition.
+pub fn condition_port(index: usize) -> String {
+    format!("arg{}", index + 1)
+}
+
+/// The predicate a condition ID names in `domain`.
+fn predicate_for_id<'d>(domain: &'d Domain, id: &str) -> Option<&'d Predicate> {
+    domain
+        .vocabulary
+        .predicates
+        .iter()
+        .find(|p| condition_id(&p.name) == id)
+}
+
+/// The skills (one name may have several signatures) an action ID names in `domain`.
+fn skills_for_id<'d>(domain: &'d Domain, id: &str) -> Vec<&'d Skill> {
+    domain.skills.iter().filter(|s| s.name == id).collect()
+}
+
+/// Type names of a slot as words: `item`, `place or item`.
+fn slot_types(types: &[String]) -> String {
+    types.join(" or ")
+}
