@@ -11,8 +11,9 @@ set -euo pipefail
 packages=(cmake g++ pkg-config libclang-dev libasound2-dev fonts-dejavu-core)
 if [ "${1:-}" = "--test" ]; then
   # spin cross-checks `betr verify`; tmux drives the real binary as a person would;
-  # espeak-ng speaks the instructions the dictation tests transcribe.
-  packages+=(spin tmux espeak-ng)
+  # espeak-ng speaks the instructions the dictation tests transcribe; graphviz renders
+  # the DOT export.
+  packages+=(spin tmux espeak-ng graphviz)
 fi
 
 missing=()

@@ -11,7 +11,7 @@ if [ ! -d ../shared/datasets/llm-obtea ]; then
   exit 2
 fi
 
-# Build packages, plus spin, tmux and espeak-ng for the tests.
+# Build packages, plus spin, tmux, espeak-ng and graphviz for the tests.
 bash scripts/setup.sh --test
 
 # The 3D view's end-to-end test (tests/viz_rrd.rs) checks a recording with the viewer's

@@ -369,7 +369,7 @@ impl<'a, 'i> Reader<'a, 'i> {
             .vocabulary
             .predicates
             .iter()
-            .map(|p| condition_id(&p.name))
+            .map(|p| condition_id(self.domain, &p.name))
             .collect();
         let mut actions: Vec<&str> = self.domain.skills.iter().map(|s| s.name.as_str()).collect();
         actions.dedup();

@@ -15,11 +15,11 @@ pub enum ExportError {
     #[error("{action}! names no skill of the scenario that accepts its objects")]
     UnknownSkill { action: String },
     #[error(
-        "the predicate {predicate:?} and the skill {skill:?} would both be the node ID {id:?}; BT.CPP needs one ID per node type"
+        "the predicates {first:?} and {second:?} would both be the node ID {id:?}; BT.CPP needs one ID per node type"
     )]
     IdClash {
-        predicate: String,
-        skill: String,
+        first: String,
+        second: String,
         id: String,
     },
     #[error("writing XML: {0}")]
@@ -38,15 +38,17 @@ struct Element {
 
 /// `tree` as a BT.CPP v4 XML document whose one `<BehaviorTree>` is `tree_id`.
 pub fn to_btcpp(tree: &Tree, domain: &Domain, tree_id: &str) -> Result<String, ExportError> {
+    let mut seen: Vec<(String, &str)> = Vec::new();
     for p in &domain.vocabulary.predicates {
-        let id = condition_id(&p.name);
-        if let Some(s) = domain.skills.iter().find(|s| s.name == id) {
+        let id = condition_id(domain, &p.name);
+        if let Some((_, other)) = seen.iter().find(|(i, _)| *i == id) {
             return Err(ExportError::IdClash {
-                predicate: p.name.clone(),
-                skill: s.name.clone(),
+                first: (*other).to_string(),
+                second: p.name.clone(),
                 id,
             });
         }
+        seen.push((id, &p.name));
     }
     let top = element(tree, domain, tree.root())?;
     let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
@@ -106,7 +108,7 @@ fn element(tree: &Tree, domain: &Domain, id: NodeId) -> Result<Element, ExportEr
                 .enumerate()
                 .map(|(i, a)| (condition_port(i), a.clone()))
                 .collect();
-            let condition = leaf("Condition", &condition_id(&c.atom.predicate), ports);
+            let condition = leaf("Condition", &condition_id(domain, &c.atom.predicate), ports);
             if c.negated {
                 Element {
                     tag: "Inverter",
@@ -178,7 +180,7 @@ fn write_model(w: &mut Out, domain: &Domain) -> std::io::Result<()> {
                 )
             })
             .collect();
-        model_entry(w, "Condition", &condition_id(&p.name), &ports)?;
+        model_entry(w, "Condition", &condition_id(domain, &p.name), &ports)?;
     }
     let mut seen = std::collections::HashSet::new();
     let names = domain.skills.iter().map(|s| s.name.as_str());

@@ -12,8 +12,9 @@
 //! | `~On_Coffee_Table1?` | `<Inverter><Condition ID="On" arg1="Coffee" arg2="Table1"/></Inverter>` |
 //! | `grasp "egg" {force = 5 N}!` | `<Action ID="grasp" x="egg" force="5 N"/>` |
 //!
-//! A condition's ID is its predicate with `_` for spaces (`near robot` → `near_robot`) and
-//! its ports are its arguments by position; an action's ID is its skill and its ports are
+//! A condition's ID is its predicate with `_` for spaces (`near robot` → `near_robot`),
+//! prefixed with `is_` when a skill has the same name (`open` → `is_open`), and its ports
+//! are its arguments by position; an action's ID is its skill and its ports are
 //! the skill's parameter names, then its value parameters.
 
 mod btcpp_read;
@@ -26,12 +27,25 @@ pub use btcpp_write::{ExportError, to_btcpp};
 pub use dot::to_dot;
 pub use tree_file::{LoadedTree, TreeFileError, TreeFormat, load_tree_file, read_tree};
 
+use crate::domain::condition::is_word_predicate;
 use crate::domain::vocabulary::Predicate;
 use crate::domain::{Domain, Skill};
 
-/// The BT.CPP node ID of a predicate: its name with `_` for each space.
-pub fn condition_id(predicate: &str) -> String {
-    predicate.replace(' ', "_")
+/// The BT.CPP node ID of a predicate: its name with `_` for each space, prefixed with
+/// `is_` (`Is` for identifier-form predicates) while a skill has the same name, since
+/// conditions and actions share one namespace in BT.CPP (`open` → `is_open` when `open`
+/// is also a skill).
+pub fn condition_id(domain: &Domain, predicate: &str) -> String {
+    let prefix = if is_word_predicate(predicate) {
+        "is_"
+    } else {
+        "Is"
+    };
+    let mut id = predicate.replace(' ', "_");
+    while domain.skills.iter().any(|s| s.name == id) {
+        id = format!("{prefix}{id}");
+    }
+    id
 }
 
 /// The port holding argument `index` (0-based) of a condition.
@@ -45,7 +59,7 @@ fn predicate_for_id<'d>(domain: &'d Domain, id: &str) -> Option<&'d Predicate> {
         .vocabulary
         .predicates
         .iter()
-        .find(|p| condition_id(&p.name) == id)
+        .find(|p| condition_id(domain, &p.name) == id)
 }
 
 /// The skills (one name may have several signatures) an action ID names in `domain`.
@@ -57,3 +71,6 @@ fn skills_for_id<'d>(domain: &'d Domain, id: &str) -> Vec<&'d Skill> {
 fn slot_types(types: &[String]) -> String {
     types.join(" or ")
 }
+
+#[cfg(test)]
+mod tests;
