@@ -371,6 +371,57 @@ fn a_saved_policy_needs_no_model_call_next_time() {
 }
 
 #[test]
+fn the_repaired_tree_is_exported_and_a_fresh_engine_runs_the_btcpp_file() {
+    let dir = std::env::temp_dir().join(format!("betr-engine-export-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    rt().block_on(async {
+        let mut s = Session::start(setup(
+            Ok(Arc::new(model(Duration::ZERO))),
+            Some(dir.clone()),
+        ));
+        s.run_to_proposal().await;
+        s.send(Command::Approve);
+        let got = s
+            .until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        let (repaired, _) = tree_of(&got).unwrap();
+        s.send(Command::Export);
+        let got = s
+            .until("exported", |e| matches!(e, Event::Exported { .. }))
+            .await;
+        let Some(Event::Exported { paths }) = got.last() else {
+            unreachable!()
+        };
+        let names: Vec<String> = paths
+            .iter()
+            .map(|p| p.extension().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["xml", "dot"]);
+        let dot = std::fs::read_to_string(&paths[1]).unwrap();
+        assert!(
+            dot.contains("penwidth=3"),
+            "the fix's nodes are marked:\n{dot}"
+        );
+
+        let fresh = model(Duration::ZERO);
+        let calls = fresh.calls();
+        let mut again = Session::start(setup(Ok(Arc::new(fresh)), None));
+        again.send(Command::LoadPolicy(Some(paths[0].clone())));
+        let got = again
+            .until("loaded", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        let (loaded, _) = tree_of(&got).unwrap();
+        assert_eq!(bt::to_text(&loaded), bt::to_text(&repaired));
+        again.send(Command::Run);
+        again
+            .until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
+    });
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn without_a_model_a_person_can_still_resolve() {
     rt().block_on(async {
         let mut s = Session::start(setup(

@@ -491,6 +491,7 @@ fn print_event_line(event: &Event) {
         | Event::RunState { .. }
         | Event::Verified { .. }
         | Event::PolicySaved { .. }
+        | Event::Exported { .. }
         | Event::PolicyLoaded { .. }
         | Event::Notice { .. } => {}
         Event::Error { message } => println!("error: {message}"),

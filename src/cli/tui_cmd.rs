@@ -32,6 +32,10 @@ pub struct TuiArgs {
     /// Where policies are saved and looked up (default: $XDG_DATA_HOME/betr/policies).
     #[arg(long, value_name = "DIR")]
     pub policy_dir: Option<PathBuf>,
+    /// Open this tree file instead of planning one (betr text, a saved policy, or
+    /// BehaviorTree.CPP v4 XML).
+    #[arg(long, value_name = "FILE")]
+    pub tree: Option<PathBuf>,
     /// Run in the scenario's `[world.variants.NAME]` world.
     #[arg(long)]
     pub variant: Option<String>,
@@ -70,6 +74,10 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         None => Arc::new(DefaultMicrophone),
     };
     let scenario = Arc::new(betr::domain::Scenario::load(&path)?);
+    // A tree that cannot be read is said before the screen opens (exit 2).
+    if let Some(tree) = &args.tree {
+        super::export_cmd::load_tree(&scenario, tree)?;
+    }
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
@@ -152,6 +160,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         theme,
         dictation: DictationService::new(microphone, loader),
         stderr_to: log_path(),
+        tree: args.tree.clone(),
     };
     runtime.block_on(betr::tui::run(
         setup,

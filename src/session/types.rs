@@ -223,6 +223,10 @@ pub enum Event {
         path: PathBuf,
         fixes: usize,
     },
+    /// The tree was written in other tools' formats (BT.CPP XML, Graphviz DOT).
+    Exported {
+        paths: Vec<PathBuf>,
+    },
     /// A saved policy became the tree; `fixes` approved changes came with it.
     PolicyLoaded {
         path: PathBuf,

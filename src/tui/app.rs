@@ -185,6 +185,7 @@ impl App {
             Action::Verify => Command::Verify,
             Action::Save => Command::SavePolicy,
             Action::Load => Command::LoadPolicy(None),
+            Action::Export => Command::Export,
             Action::Reset => Command::ResetWorld,
             // The recording panel holds the input line's place until the recording ends.
             Action::Instruction | Action::Edit if self.dictation.is_recording() => {
@@ -408,6 +409,10 @@ impl App {
             Event::PolicySaved { path, fixes } => {
                 self.llm
                     .log(strings::policy_saved(&path.display().to_string(), fixes));
+            }
+            Event::Exported { paths } => {
+                let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+                self.llm.log(strings::exported(&names));
             }
             Event::PolicyLoaded { path, fixes } => {
                 self.llm

@@ -108,6 +108,8 @@ pub struct Workbench {
     pub dictation: (DictationService, UnboundedReceiver<DictationEvent>),
     /// Where standard error goes while the screen is up (the log file).
     pub stderr_to: Option<PathBuf>,
+    /// A tree file to open instead of planning (betr text, a policy, BT.CPP XML).
+    pub tree: Option<PathBuf>,
 }
 
 /// Open the workbench on `setup` until the person quits.
@@ -122,8 +124,12 @@ pub async fn run(
         theme,
         dictation: (mut dictation, mut heard),
         stderr_to,
+        tree,
     } = workbench;
     let (engine, mut events) = Engine::spawn(setup)?;
+    if let Some(path) = tree {
+        engine.send(crate::session::Command::LoadPolicy(Some(path)));
+    }
     let mut app = App::new(info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;

@@ -85,6 +85,7 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Verify => "verify the tree",
         Save => "save the policy",
         Load => "load the saved policy",
+        Export => "write the tree out as BT.CPP XML and Graphviz DOT",
         Reset => "reset the world",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
@@ -121,6 +122,10 @@ pub fn policy_loaded(path: &str, fixes: usize) -> String {
 
 pub fn policy_saved(path: &str, fixes: usize) -> String {
     format!("saved policy {path} ({fixes} fix(es))")
+}
+
+pub fn exported(paths: &[String]) -> String {
+    format!("tree written to {}", paths.join(" and "))
 }
 
 pub fn repaired(added: usize, valued: usize) -> String {

@@ -303,6 +303,11 @@ impl Viz {
             Event::PolicySaved { path, .. } => {
                 self.log(L::INFO, format!("policy saved to {}", path.display()));
             }
+            Event::Exported { paths } => {
+                for path in paths {
+                    self.log(L::INFO, format!("tree exported to {}", path.display()));
+                }
+            }
             Event::PolicyLoaded { path, .. } => {
                 self.log(L::INFO, format!("policy loaded from {}", path.display()));
             }

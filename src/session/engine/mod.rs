@@ -116,6 +116,8 @@ pub enum Command {
     Undo,
     Verify,
     SavePolicy,
+    /// Write the tree beside its policy as BT.CPP XML and Graphviz DOT.
+    Export,
     /// Load a policy file (none: the saved policy of the current task).
     LoadPolicy(Option<PathBuf>),
     /// A fresh execution world and ticker.
@@ -329,6 +331,7 @@ impl Engine {
             Command::Undo => self.undo(),
             Command::Verify => self.verify(),
             Command::SavePolicy => self.save_policy(),
+            Command::Export => self.export(),
             Command::LoadPolicy(path) => self.load_policy(path),
             Command::ResetWorld => self.reset_world(true),
             Command::Shutdown => self.set_running(false),

@@ -51,6 +51,43 @@ impl Engine {
         }
     }
 
+    /// Write the tree beside its policy file as BT.CPP XML (`.xml`) and Graphviz DOT
+    /// (`.dot`, coloured by the last tick, the last change's nodes marked).
+    pub(super) fn export(&mut self) {
+        let (Some(tree), Some(task)) = (&self.tree, &self.task) else {
+            return self.error("nothing to export: plan a tree first");
+        };
+        let Some(store) = &self.policies else {
+            return self.error(
+                "trees are exported beside the policies, and this session keeps none (no policy directory)",
+            );
+        };
+        let base = store.path_for(&self.scenario_path, &task.goal);
+        let name = self
+            .scenario_path
+            .file_stem()
+            .map_or_else(|| "tree".to_string(), |s| s.to_string_lossy().into_owned());
+        let xml = match interop::to_btcpp(tree, &self.scenario.domain, &name) {
+            Ok(xml) => xml,
+            Err(e) => return self.error(format!("cannot export as BT.CPP XML: {e}")),
+        };
+        let added = self
+            .fixes
+            .last()
+            .map(|f| f.nodes.clone())
+            .unwrap_or_default();
+        let dot = interop::to_dot(tree, self.last.as_deref(), &added, &name);
+        let mut paths = Vec::new();
+        for (extension, text) in [("xml", xml), ("dot", dot)] {
+            let path = base.with_extension(extension);
+            if let Err(e) = crate::store::write_atomic(&path, text.as_bytes()) {
+                return self.error(format!("cannot write {}: {e}", path.display()));
+            }
+            paths.push(path);
+        }
+        self.emit(Event::Exported { paths });
+    }
+
     /// Load a policy file (default: the saved policy of the current task) as the tree.
     pub(super) fn load_policy(&mut self, path: Option<PathBuf>) {
         let path = match (path, &self.policies, &self.task) {
