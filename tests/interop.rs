@@ -363,3 +363,22 @@ fn a_dot_export_renders_to_png_with_graphviz() {
         bytes.len()
     );
 }
+
+#[test]
+fn the_readme_shows_the_xml_betr_writes_for_scenario_ones_repaired_tree() {
+    let s = Scenario::load(&root().join("scenarios/cell/red_on_blue.toml")).unwrap();
+    let xml = interop::to_btcpp(&repaired(&s), &s.domain, "red_on_blue").unwrap();
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let start = readme.find("```xml\n").expect("an xml block in the README") + "```xml\n".len();
+    let end = start + readme[start..].find("```").unwrap();
+    assert_eq!(
+        &readme[start..end],
+        xml,
+        "regenerate the README's XML with betr export"
+    );
+    assert!(
+        root()
+            .join("docs/images/red_on_blue-repaired.png")
+            .is_file()
+    );
+}
