@@ -59,6 +59,29 @@ impl Session {
         }
     }
 
+    /// A session keeping policies in `dir`, past scenario 1's first proposal, approved;
+    /// with the events up to the repaired tree.
+    async fn repaired(dir: &std::path::Path) -> (Session, Vec<Event>) {
+        let mut s = Session::start(setup(
+            Ok(Arc::new(model(Duration::ZERO))),
+            Some(dir.to_path_buf()),
+        ));
+        s.run_to_proposal().await;
+        s.send(Command::Approve);
+        let got = s
+            .until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        (s, got)
+    }
+
+    /// Run to success, having asked the model nothing (`calls` counts its calls).
+    async fn runs_to_success_without_a_call(&mut self, calls: &std::sync::atomic::AtomicUsize) {
+        self.send(Command::Run);
+        self.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
+    }
+
     fn send(&self, c: Command) {
         assert!(self.engine.send(c));
     }
@@ -325,14 +348,7 @@ fn a_saved_policy_needs_no_model_call_next_time() {
     let dir = std::env::temp_dir().join(format!("betr-engine-policy-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     rt().block_on(async {
-        let mut s = Session::start(setup(
-            Ok(Arc::new(model(Duration::ZERO))),
-            Some(dir.clone()),
-        ));
-        s.run_to_proposal().await;
-        s.send(Command::Approve);
-        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
+        let (mut s, _) = Session::repaired(&dir).await;
         s.send(Command::SavePolicy);
         let got = s
             .until("saved", |e| matches!(e, Event::PolicySaved { .. }))
@@ -361,11 +377,7 @@ fn a_saved_policy_needs_no_model_call_next_time() {
             got.last(),
             Some(Event::PolicyLoaded { fixes: 1, .. })
         ));
-        again.send(Command::Run);
-        again
-            .until("success", |e| matches!(e, Event::Success { .. }))
-            .await;
-        assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
+        again.runs_to_success_without_a_call(&calls).await;
     });
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -375,15 +387,7 @@ fn the_repaired_tree_is_exported_and_a_fresh_engine_runs_the_btcpp_file() {
     let dir = std::env::temp_dir().join(format!("betr-engine-export-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     rt().block_on(async {
-        let mut s = Session::start(setup(
-            Ok(Arc::new(model(Duration::ZERO))),
-            Some(dir.clone()),
-        ));
-        s.run_to_proposal().await;
-        s.send(Command::Approve);
-        let got = s
-            .until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
+        let (mut s, got) = Session::repaired(&dir).await;
         let (repaired, _) = tree_of(&got).unwrap();
         s.send(Command::Export);
         let got = s
@@ -412,11 +416,7 @@ fn the_repaired_tree_is_exported_and_a_fresh_engine_runs_the_btcpp_file() {
             .await;
         let (loaded, _) = tree_of(&got).unwrap();
         assert_eq!(bt::to_text(&loaded), bt::to_text(&repaired));
-        again.send(Command::Run);
-        again
-            .until("success", |e| matches!(e, Event::Success { .. }))
-            .await;
-        assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
+        again.runs_to_success_without_a_call(&calls).await;
     });
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -158,6 +158,31 @@ fn a_btcpp_file_written_by_hand_imports_as_scenario_ones_repaired_tree() {
     );
 }
 
+/// Scenario 1 repaired on the command line, saved as the policy `repaired.bt` in `dir`,
+/// and exported in `format` (`btcpp`, `dot`) to `repaired.EXTENSION`; the exported text.
+fn repair_and_export(dir: &Path, format: &str, extension: &str) -> String {
+    let scenario = root().join("scenarios/cell/red_on_blue.toml");
+    let add = betr(
+        dir,
+        &[
+            "repair",
+            scenario.to_str().unwrap(),
+            "--add",
+            "~\"any object\" on \"blue cube\"",
+            "--save",
+            "repaired.bt",
+        ],
+    );
+    assert!(add.status.success(), "{}", text(&add));
+    let out = format!("repaired.{extension}");
+    let export = betr(
+        dir,
+        &["export", "repaired.bt", "--format", format, "--out", &out],
+    );
+    assert!(export.status.success(), "{}", text(&export));
+    std::fs::read_to_string(dir.join(out)).unwrap()
+}
+
 #[test]
 fn the_binary_runs_verifies_and_exports_a_btcpp_tree() {
     let dir = tmp("btcpp-run");
@@ -194,31 +219,7 @@ fn the_binary_runs_verifies_and_exports_a_btcpp_tree() {
     );
 
     // Repaired on the command line, saved as a policy, exported as XML, read back.
-    let add = betr(
-        &dir,
-        &[
-            "repair",
-            scenario,
-            "--add",
-            "~\"any object\" on \"blue cube\"",
-            "--save",
-            "repaired.bt",
-        ],
-    );
-    assert!(add.status.success(), "{}", text(&add));
-    let export = betr(
-        &dir,
-        &[
-            "export",
-            "repaired.bt",
-            "--format",
-            "btcpp",
-            "--out",
-            "repaired.xml",
-        ],
-    );
-    assert!(export.status.success(), "{}", text(&export));
-    let written = std::fs::read_to_string(dir.join("repaired.xml")).unwrap();
+    let written = repair_and_export(&dir, "btcpp", "xml");
     assert!(written.contains("<root BTCPP_format=\"4\" main_tree_to_execute=\"red_on_blue\">"));
     assert!(written.contains("<TreeNodesModel>") && written.contains("<Action ID=\"grasp\">"));
     let back = betr(&dir, &["run", scenario, "--tree", "repaired.xml"]);
@@ -312,32 +313,7 @@ fn graphviz() -> Option<&'static str> {
 #[test]
 fn a_dot_export_renders_to_png_with_graphviz() {
     let dir = tmp("dot-png");
-    let scenario = root().join("scenarios/cell/red_on_blue.toml");
-    let add = betr(
-        &dir,
-        &[
-            "repair",
-            scenario.to_str().unwrap(),
-            "--add",
-            "~\"any object\" on \"blue cube\"",
-            "--save",
-            "repaired.bt",
-        ],
-    );
-    assert!(add.status.success(), "{}", text(&add));
-    let export = betr(
-        &dir,
-        &[
-            "export",
-            "repaired.bt",
-            "--format",
-            "dot",
-            "--out",
-            "repaired.dot",
-        ],
-    );
-    assert!(export.status.success(), "{}", text(&export));
-    let dot = std::fs::read_to_string(dir.join("repaired.dot")).unwrap();
+    let dot = repair_and_export(&dir, "dot", "dot");
     // The fix's nodes are marked; the last tick of the run succeeded at the root.
     assert!(
         dot.contains("+ ~\\\"any object\\\" on \\\"blue cube\\\""),

@@ -82,19 +82,10 @@ pub fn to_dot(
     out
 }
 
-/// A DOT string literal.
+/// A DOT string literal. Rust's debug quoting escapes exactly what DOT needs here (`"`,
+/// `\`, newlines) and keeps other characters (`→`, `~`) as they are.
 fn quoted(text: &str) -> String {
-    let mut out = String::from("\"");
-    for c in text.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
+    format!("{text:?}")
 }
 
 #[cfg(test)]
