@@ -7,9 +7,12 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 
 use betr::domain::Scenario;
-use betr::planner::{Outcome, Planner};
+use betr::interop::TreeFormat;
+use betr::planner::Outcome;
+use betr::session::policy;
 use betr::verify::{
-    self, Limits, NamedProperty, Property, Report, Verdict, VerifyConfig, VerifyInput,
+    self, Limits, NamedProperty, Property, Report, Rule, Verdict, VerifyConfig, VerifyInput,
+    plan_in_model,
 };
 use betr::world;
 
@@ -28,31 +31,6 @@ pub struct Args {
 pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     let config = VerifyConfig::from_scenario(scenario)?;
     let world = world::load(scenario)?;
-    let (tree, origin, note) = match &args.tree {
-        Some(path) => {
-            let (tree, format) = super::export_cmd::load_tree(scenario, path)?;
-            (
-                tree,
-                format!("loaded from {} ({})", path.display(), format.name()),
-                String::new(),
-            )
-        }
-        None => {
-            let goal = super::goal_of(scenario, None)?;
-            let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
-            let note = match &plan.outcome {
-                Outcome::Success => String::new(),
-                Outcome::ActionFailed { action, error, .. } => format!(
-                    "Note:     planning stopped when {action}! failed in simulation ({error}); repair it and pass --tree\n"
-                ),
-                Outcome::Unreachable { condition, .. } => {
-                    format!("Note:     planning stopped: {condition} cannot be achieved\n")
-                }
-                Outcome::Exhausted { reason } => format!("Note:     planning stopped: {reason}\n"),
-            };
-            (plan.tree, format!("planned for {goal}"), note)
-        }
-    };
     let mut properties = config.properties.clone();
     for text in &args.properties {
         let property = Property::parse_checked(text, &scenario.domain.vocabulary)
@@ -68,6 +46,48 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
         config.disturbances.clone()
     };
     let initial = world.facts();
+    let (tree, origin, note) = match &args.tree {
+        Some(path) => {
+            let (tree, format) = super::export_cmd::load_tree(scenario, path)?;
+            (tree, origin_of_file(path, format, scenario), String::new())
+        }
+        None => {
+            let goal = super::goal_of(scenario, None)?;
+            let planned = plan_in_model(
+                &scenario.domain,
+                &initial,
+                &goal.to_dnf(),
+                &properties,
+                &disturbances,
+            )?;
+            let mut note = String::new();
+            for c in &planned.constraints {
+                note.push_str(&format!(
+                    "Added:    {}? before {}! (property: {})\n",
+                    c.condition, c.action, c.property
+                ));
+            }
+            match &planned.plan.outcome {
+                Outcome::Success => {}
+                Outcome::Unreachable { condition, .. } => {
+                    note.push_str(&format!("Note:     {condition} cannot be achieved\n"));
+                }
+                Outcome::ActionFailed { action, error, .. } => {
+                    note.push_str(&format!(
+                        "Note:     {action}! failed in the model ({error})\n"
+                    ));
+                }
+                Outcome::Exhausted { reason } => {
+                    note.push_str(&format!("Note:     planning stopped: {reason}\n"));
+                }
+            }
+            (
+                planned.plan.tree,
+                format!("planned in the planner's model for {goal} (no simulation)"),
+                note,
+            )
+        }
+    };
     let input = VerifyInput {
         domain: &scenario.domain,
         tree: &tree,
@@ -125,6 +145,24 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     })
 }
 
+/// How a tree file came to be, for the report: a policy with its fixes is a repaired
+/// tree; anything else was loaded as written.
+fn origin_of_file(path: &Path, format: TreeFormat, scenario: &Scenario) -> String {
+    let fixes = std::fs::read_to_string(path)
+        .ok()
+        .filter(|_| format == TreeFormat::Text)
+        .and_then(|text| policy::parse(&text, &scenario.domain).ok())
+        .map_or(0, |p| p.fixes.len());
+    if fixes > 0 {
+        format!(
+            "repaired: loaded from the policy {} with {fixes} fix(es)",
+            path.display()
+        )
+    } else {
+        format!("loaded from {} ({})", path.display(), format.name())
+    }
+}
+
 fn print_report(report: &Report, ascii: bool) {
     let (ok, bad, unknown, warn) = if ascii {
         ("ok ", "FAIL", "??", "warn")
@@ -141,10 +179,15 @@ fn print_report(report: &Report, ascii: bool) {
     }
     for f in &report.notes {
         println!("  {warn} {f}");
-        println!(
-            "      model checking shows it holds whenever the action starts (guarded by what is reachable, not by the tree's shape); to make the shape guard it: {}",
-            f.hint
-        );
+        let shown = match f.rule {
+            Rule::Oscillation => {
+                "model checking shows the tree reaches success from every reachable state, so the oscillation cannot start from a state it reaches"
+            }
+            _ => {
+                "model checking shows it holds whenever the action starts (guarded by what is reachable, not by the tree's shape)"
+            }
+        };
+        println!("      {shown}; to make the shape guard it: {}", f.hint);
     }
     println!("\nModel checking");
     match &report.model {

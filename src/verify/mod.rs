@@ -17,6 +17,7 @@ pub mod abstraction;
 pub mod config;
 pub mod counterexample;
 pub mod explore;
+pub mod model_plan;
 pub mod promela;
 pub mod structural;
 pub mod temporal;
@@ -31,6 +32,7 @@ pub use abstraction::{Model, ModelError};
 pub use config::{Disturbance, NamedProperty, VerifyConfig};
 pub use counterexample::Counterexample;
 pub use explore::Limits;
+pub use model_plan::{Constraint, ModelPlan, model_world, plan_in_model};
 pub use temporal::{Property, PropertyError, Temporal};
 
 /// Which structural rule a finding breaks.
@@ -189,22 +191,25 @@ impl Default for Limits {
 pub fn verify(input: &VerifyInput) -> Report {
     let findings = structural::check(input.domain, input.tree);
     let model = build_model(input).map(|m| model_check(&m, input));
-    // The structural rule is local and conservative; the exploration is exact over the
+    // The structural rules are local and conservative; the exploration is exact over the
     // abstraction. When it proves every action starts with its preconditions true, an
-    // unguarded precondition is guarded by reachability, not by the tree's shape.
-    let refuted = model.as_ref().is_ok_and(|m| {
-        m.complete
-            && m.properties
-                .iter()
-                .any(|p| p.kind == PropertyKind::Preconditions && p.verdict.holds())
-    });
-    let (notes, findings) = if refuted {
-        findings
-            .into_iter()
-            .partition(|f| f.rule == Rule::UnguardedPrecondition)
-    } else {
-        (Vec::new(), findings)
+    // unguarded precondition is guarded by reachability, not by the tree's shape; when
+    // it proves the tree reaches success from every reachable state, siblings that could
+    // undo each other never do so in a state the tree can reach.
+    let proves = |kind: PropertyKind| {
+        model.as_ref().is_ok_and(|m| {
+            m.complete
+                && m.properties
+                    .iter()
+                    .any(|p| p.kind == kind && p.verdict.holds())
+        })
     };
+    let refuted = |rule: Rule| match rule {
+        Rule::UnguardedPrecondition => proves(PropertyKind::Preconditions),
+        Rule::Oscillation => proves(PropertyKind::Success),
+        _ => false,
+    };
+    let (notes, findings) = findings.into_iter().partition(|f| refuted(f.rule));
     Report {
         findings,
         notes,
