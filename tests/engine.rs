@@ -254,10 +254,14 @@ fn a_pending_proposal_is_not_ticked_past() {
             })
             .await;
         }
-        // After approval the repaired tree ticks again.
+        // After approval the repaired tree is verified in the model, then ticks again.
         s.send(Command::Approve);
         s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
             .await;
+        s.until("the check", |e| {
+            matches!(e, Event::Notice { message } if message.contains("verifies in the model"))
+        })
+        .await;
         s.send(Command::Tick);
         s.until("a tick", |e| matches!(e, Event::Ticked { .. }))
             .await;

@@ -343,13 +343,16 @@ pub fn resolve(
         None if success => Some(default_policy_path(args.scenario_path)),
         None => None,
     };
+    // A tree whose last change failed verification is not kept.
+    let violated = matches!(resolved.ending, Ending::Violated { .. });
     match save {
-        Some(path) if success || resolved.repairs > 0 => {
+        Some(path) if (success || resolved.repairs > 0) && !violated => {
             betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
                 .with_context(|| format!("saving the tree to {}", path.display()))?;
             let note = if success { "" } else { " (it still fails)" };
             println!("\nSaved the tree to {}{note}", path.display());
         }
+        _ if violated => println!("\nNothing saved: the last change fails verification."),
         _ => println!("\nNothing saved: no change was kept."),
     }
     println!(
@@ -482,6 +485,15 @@ fn print_event_line(event: &Event) {
         }
         Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
         Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        Event::ChangeViolates { report } => {
+            println!(
+                "\n✕ The approved change fails verification in the model; the changed tree was not run (counterexample on stderr)"
+            );
+            let mut err = std::io::stderr();
+            if let Err(e) = super::verify_cmd::write_report(&mut err, report, false) {
+                tracing::warn!("cannot write the report to stderr: {e}");
+            }
+        }
         // What a live front end shows; the printed log keeps to the loop's steps.
         Event::TreeChanged { .. }
         | Event::Ticked { .. }

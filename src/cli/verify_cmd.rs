@@ -137,7 +137,7 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     }
 
     let report = verify::verify(&input);
-    print_report(&report, args.ascii);
+    write_report(&mut std::io::stdout(), &report, args.ascii)?;
     Ok(if report.holds() {
         ExitCode::SUCCESS
     } else {
@@ -163,22 +163,28 @@ fn origin_of_file(path: &Path, format: TreeFormat, scenario: &Scenario) -> Strin
     }
 }
 
-fn print_report(report: &Report, ascii: bool) {
+/// The report as `betr verify` prints it, to any writer (`betr resolve` writes a failed
+/// change's report to stderr).
+pub(super) fn write_report(
+    out: &mut dyn std::io::Write,
+    report: &Report,
+    ascii: bool,
+) -> std::io::Result<()> {
     let (ok, bad, unknown, warn) = if ascii {
         ("ok ", "FAIL", "??", "warn")
     } else {
         ("✓", "✕", "?", "⚠")
     };
-    println!("Structural checks");
+    writeln!(out, "Structural checks")?;
     if report.findings.is_empty() {
-        println!("  {ok} no findings");
+        writeln!(out, "  {ok} no findings")?;
     }
     for f in &report.findings {
-        println!("  {bad} {f}");
-        println!("      fix: {}", f.hint);
+        writeln!(out, "  {bad} {f}")?;
+        writeln!(out, "      fix: {}", f.hint)?;
     }
     for f in &report.notes {
-        println!("  {warn} {f}");
+        writeln!(out, "  {warn} {f}")?;
         let shown = match f.rule {
             Rule::Oscillation => {
                 "model checking shows the tree reaches success from every reachable state, so the oscillation cannot start from a state it reaches"
@@ -187,27 +193,27 @@ fn print_report(report: &Report, ascii: bool) {
                 "model checking shows it holds whenever the action starts (guarded by what is reachable, not by the tree's shape)"
             }
         };
-        println!("      {shown}; to make the shape guard it: {}", f.hint);
+        writeln!(out, "      {shown}; to make the shape guard it: {}", f.hint)?;
     }
-    println!("\nModel checking");
+    writeln!(out, "\nModel checking")?;
     match &report.model {
-        Err(e) => println!("  {bad} not possible: {e}"),
+        Err(e) => writeln!(out, "  {bad} not possible: {e}")?,
         Ok(m) => {
             for p in &m.properties {
                 match &p.verdict {
-                    Verdict::Holds if p.detail.is_empty() => println!("  {ok} {}", p.name),
-                    Verdict::Holds => println!("  {ok} {} ({})", p.name, p.detail),
-                    Verdict::Unknown(why) => println!("  {unknown} {}: {why}", p.name),
+                    Verdict::Holds if p.detail.is_empty() => writeln!(out, "  {ok} {}", p.name)?,
+                    Verdict::Holds => writeln!(out, "  {ok} {} ({})", p.name, p.detail)?,
+                    Verdict::Unknown(why) => writeln!(out, "  {unknown} {}: {why}", p.name)?,
                     Verdict::Violated(cx) => {
-                        println!("  {bad} {}", p.name);
-                        println!("    counterexample:");
+                        writeln!(out, "  {bad} {}", p.name)?;
+                        writeln!(out, "    counterexample:")?;
                         for line in cx.to_string().lines() {
-                            println!("      {line}");
+                            writeln!(out, "      {line}")?;
                         }
                     }
                 }
             }
-            println!(
+            writeln!(out, 
                 "\n{} states, {} transitions, {} atoms, {:.1} ms{}",
                 m.states,
                 m.transitions,
@@ -218,15 +224,16 @@ fn print_report(report: &Report, ascii: bool) {
                 } else {
                     " (state bound reached)"
                 }
-            );
+            )?;
         }
     }
-    println!(
+    writeln!(out, 
         "\n{}",
         if report.holds() {
             "VERIFIED: every check and property holds"
         } else {
             "NOT VERIFIED"
         }
-    );
+    )?;
+    Ok(())
 }

@@ -99,6 +99,8 @@ pub async fn resolve_with_scenes(
             }
             Event::Repaired { .. } => repairs += 1,
             Event::Rejected => break Ending::Rejected,
+            // Never approved past a failed check, not even under --yes.
+            Event::ChangeViolates { report } => break Ending::Violated { report },
             Event::Success { ticks } => break Ending::Success { ticks },
             Event::GaveUp { reason } => break Ending::GaveUp { reason },
             Event::Failed { error } => {

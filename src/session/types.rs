@@ -215,8 +215,15 @@ pub enum Event {
     RunState {
         running: bool,
     },
-    /// `verify` finished.
+    /// `verify` finished; `origin` says where the verified tree came from.
     Verified {
+        report: Arc<Report>,
+        origin: String,
+    },
+    /// An applied change made the tree fail verification in the model: it does not run
+    /// until a person approves the change again with the counterexample in view, or
+    /// undoes it.
+    ChangeViolates {
         report: Arc<Report>,
     },
     PolicySaved {
@@ -252,6 +259,8 @@ pub enum Ending {
     Success { ticks: u64 },
     Rejected,
     GaveUp { reason: String },
+    /// An approved change failed verification in the model; the changed tree did not run.
+    Violated { report: Arc<Report> },
 }
 
 /// The loop's result: the final tree (with every change that helped) and how it ended.

@@ -400,11 +400,20 @@ impl App {
             }
             Event::Usage { totals } => self.status.usage = totals,
             Event::RunState { running } => self.status.running = running,
-            Event::Verified { report } => {
+            Event::Verified { report, origin } => {
                 let holds = report.holds();
-                self.overlay = Some(Overlay::Report(report_lines(&report, &self.theme)));
+                let mut lines = vec![strings::verified_tree(&origin)];
+                lines.extend(report_lines(&report, &self.theme));
+                self.overlay = Some(Overlay::Report(lines));
                 self.llm
                     .log(if holds { "verified" } else { "NOT verified" });
+            }
+            Event::ChangeViolates { report } => {
+                self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
+                let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
+                lines.extend(report_lines(&report, &self.theme));
+                self.overlay = Some(Overlay::Report(lines));
+                self.llm.log(strings::CHANGE_VIOLATES);
             }
             Event::PolicySaved { path, fixes } => {
                 self.llm

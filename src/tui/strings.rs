@@ -33,6 +33,11 @@ pub const AWAITING_APPROVAL: Awaiting = Awaiting {
     long: "awaiting approval",
     short: "approve?",
 };
+pub const AWAITING_VIOLATION: Awaiting = Awaiting {
+    long: "fails verification: approve again or undo",
+    short: "violates",
+};
+pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, or undo it (u).";
 pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
@@ -122,6 +127,10 @@ pub fn policy_loaded(path: &str, fixes: usize) -> String {
 
 pub fn policy_saved(path: &str, fixes: usize) -> String {
     format!("saved policy {path} ({fixes} fix(es))")
+}
+
+pub fn verified_tree(origin: &str) -> String {
+    format!("Tree: {origin}")
 }
 
 pub fn exported(paths: &[String]) -> String {

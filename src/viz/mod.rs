@@ -303,6 +303,9 @@ impl Viz {
             Event::PolicySaved { path, .. } => {
                 self.log(L::INFO, format!("policy saved to {}", path.display()));
             }
+            Event::ChangeViolates { .. } => {
+                self.log(L::WARN, "the changed tree fails verification in the model");
+            }
             Event::Exported { paths } => {
                 for path in paths {
                     self.log(L::INFO, format!("tree exported to {}", path.display()));

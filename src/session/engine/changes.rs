@@ -16,6 +16,9 @@ use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
 
 impl Engine {
     pub(super) fn approve(&mut self) {
+        if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
+            return self.approve_violation();
+        }
         if self.pending.is_none() {
             return self.error("no proposal to approve");
         }
@@ -67,6 +70,7 @@ impl Engine {
         self.failure = None;
         let why = format!("{} ({})", change, approval_text(approval));
         self.set_tree(plan.tree, plan.new_nodes, why);
+        self.check_change();
     }
 
     /// A change that did not fix the failure: remember it for the next question about the
@@ -252,6 +256,7 @@ impl Engine {
         self.pending = None;
         self.failure = None;
         self.set_tree(plan.tree, plan.new_nodes, change);
+        self.check_change();
     }
 }
 

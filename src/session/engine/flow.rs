@@ -6,12 +6,10 @@ use std::sync::Arc;
 use crate::bt::{Outcome as TickOutcome, Tree};
 use crate::goal;
 use crate::planner::{Outcome, Plan, Planner, WorldLeaves, path_text};
-use crate::verify::{self, Limits, VerifyConfig, VerifyInput};
 use crate::world;
 
 use super::super::policy;
 use super::super::types::{Event, SessionError};
-use super::requests::Internal;
 use super::{Engine, Failure, Task};
 
 impl Engine {
@@ -94,6 +92,7 @@ impl Engine {
             }
         };
         self.task = Some(task.clone());
+        self.loaded_from = None;
         self.cancel_request();
         self.set_running(false);
         self.pending = None;
@@ -148,6 +147,7 @@ impl Engine {
             why,
         });
         self.tree = Some(tree);
+        self.gate = None;
         self.reset_world(false);
     }
 
@@ -285,38 +285,5 @@ impl Engine {
         self.fixes.truncate(entry.fixes);
         let why = format!("undid the last change ({undone} fix(es) removed)");
         self.set_tree(entry.tree, Vec::new(), why);
-    }
-
-    /// Structural checks and model checking, off the engine's thread.
-    pub(super) fn verify(&mut self) {
-        let Some(tree) = self.tree.clone() else {
-            return self.error("nothing to verify: submit an instruction or plan first");
-        };
-        let config = match VerifyConfig::from_scenario(&self.scenario) {
-            Ok(c) => c,
-            Err(e) => return self.error(format!("cannot verify: {e}")),
-        };
-        let scenario = self.scenario.clone();
-        let initial = self.planning.facts();
-        let tx = self.internal_tx.clone();
-        self.verifications += 1;
-        self.notice("verifying the tree …");
-        tokio::task::spawn_blocking(move || {
-            let input = VerifyInput {
-                domain: &scenario.domain,
-                tree: &tree,
-                initial: &initial,
-                disturbances: &config.disturbances,
-                properties: &config.properties,
-                limits: Limits {
-                    action_failures: config.action_failures,
-                    ..Limits::default()
-                },
-            };
-            let report = verify::verify(&input);
-            let _ = tx.send(Internal::Verified {
-                report: Arc::new(report),
-            });
-        });
     }
 }

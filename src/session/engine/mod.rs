@@ -14,6 +14,7 @@
 //! approved (by a person, or by `auto_approve`).
 
 mod changes;
+mod checks;
 mod flow;
 mod policies;
 mod requests;
@@ -204,6 +205,10 @@ pub struct Engine {
     running: bool,
     usage: UsageTotals,
     verifications: usize,
+    /// The check of the last applied change, while it is under way or failed.
+    gate: Option<checks::Gate>,
+    /// The file the tree was loaded from, until the next plan.
+    loaded_from: Option<PathBuf>,
 
     events: UnboundedSender<Event>,
     internal_tx: UnboundedSender<Internal>,
@@ -262,6 +267,8 @@ impl Engine {
             running: false,
             usage: UsageTotals::default(),
             verifications: 0,
+            gate: None,
+            loaded_from: None,
             events,
             internal_tx,
             internal_rx,
@@ -308,13 +315,22 @@ impl Engine {
             Command::Submit(text) => self.submit(&text),
             Command::SubmitGoal { goal, instruction } => self.submit_goal(goal, instruction),
             Command::Plan => self.plan(),
+            Command::Run if matches!(self.gate, Some(checks::Gate::Checking { .. })) => {
+                if let Some(checks::Gate::Checking { run_after, .. }) = &mut self.gate {
+                    *run_after = true;
+                }
+                self.notice("the changed tree is being verified; it runs when the check passes");
+            }
             Command::Tick | Command::Run if self.awaiting().is_some() => {
                 let what = self.awaiting().unwrap_or_default();
-                self.emit(Event::Notice {
-                    message: format!(
+                let message = if self.gate.is_some() {
+                    format!("not ticked: the changed tree waits for {what}")
+                } else {
+                    format!(
                         "not ticked: the failure waits for {what}; the failed tree would only fail again"
-                    ),
-                });
+                    )
+                };
+                self.emit(Event::Notice { message });
             }
             Command::Tick => {
                 if self.running {
@@ -357,6 +373,14 @@ impl Engine {
     /// pending proposal, or the model's proposal. Ticking the failed tree meanwhile would
     /// only fail again.
     fn awaiting(&self) -> Option<&'static str> {
+        if let Some(gate) = self.gate {
+            return Some(match gate {
+                checks::Gate::Checking { .. } => "the verification of the change",
+                checks::Gate::Violated => {
+                    "approval of the change that fails verification (approve again, or undo)"
+                }
+            });
+        }
         if self.pending.is_some() {
             Some("approval of the proposal")
         } else if self.request.is_some() && self.failure.is_some() {

@@ -161,6 +161,7 @@ impl Engine {
             path: path.clone(),
             fixes: self.fixes.len(),
         });
+        self.loaded_from = Some(path.clone());
         let why = format!("loaded policy {}", path.display());
         self.set_tree(plan.tree, plan.new_nodes, why);
     }

@@ -33,6 +33,9 @@ pub(crate) enum Internal {
     },
     Verified {
         report: Arc<Report>,
+        origin: String,
+        /// The check of an applied change this answers, if it is one.
+        gate: Option<u64>,
     },
 }
 
@@ -221,10 +224,11 @@ impl Engine {
 
     pub(super) fn on_internal(&mut self, message: Internal) {
         match message {
-            Internal::Verified { report } => {
-                self.verifications = self.verifications.saturating_sub(1);
-                self.emit(Event::Verified { report });
-            }
+            Internal::Verified {
+                report,
+                origin,
+                gate,
+            } => self.on_verified(report, origin, gate),
             Internal::Goal {
                 id,
                 instruction,

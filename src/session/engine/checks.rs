@@ -1,0 +1,164 @@
+//! Verification in the engine. `Verify` checks the tree as it is, except before the first
+//! tick of a freshly planned tree, when the whole tree is planned in the planner's model
+//! (no simulation, the scenario's safety properties as constraints) and that tree is
+//! shown and checked. Every applied change is checked the same way before it can run:
+//! while the check is under way the tree is not ticked (a `Run` waits for it), and when
+//! the changed tree fails, it does not run until a person approves the change again with
+//! the counterexample in view, or undoes it. Automatic approval never approves a change
+//! past a failed check.
+
+use std::sync::Arc;
+
+use crate::bt::{Tree, to_text};
+use crate::verify::{self, Limits, Report, VerifyConfig, VerifyInput, plan_in_model};
+
+use super::super::types::Event;
+use super::Engine;
+use super::requests::Internal;
+
+/// The check of the last applied change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Gate {
+    /// Under way; `run_after`: a `Run` came meanwhile and starts when the check passes.
+    Checking { id: u64, run_after: bool },
+    /// The changed tree fails verification.
+    Violated,
+}
+
+impl Engine {
+    /// Where the current tree came from, for the verification report.
+    fn origin(&self) -> String {
+        let fixes = self.fixes.len();
+        match (&self.loaded_from, fixes) {
+            (Some(path), 0) => format!("loaded from {}", path.display()),
+            (Some(path), n) => format!("loaded from {} with {n} fix(es)", path.display()),
+            (None, 0) => "planned in simulation".to_string(),
+            (None, n) => format!("repaired: planned, then changed by {n} approved fix(es)"),
+        }
+    }
+
+    /// Structural checks and model checking, off the engine's thread.
+    pub(super) fn verify(&mut self) {
+        let Some(tree) = self.tree.clone() else {
+            return self.error("nothing to verify: submit an instruction or plan first");
+        };
+        let config = match VerifyConfig::from_scenario(&self.scenario) {
+            Ok(c) => c,
+            Err(e) => return self.error(format!("cannot verify: {e}")),
+        };
+        let fresh = self.last.is_none() && self.fixes.is_empty() && self.loaded_from.is_none();
+        let current = tree;
+        let (tree, origin) = match (&self.task, fresh) {
+            (Some(task), true) => {
+                let initial = self.planning.facts();
+                let planned = match plan_in_model(
+                    &self.scenario.domain,
+                    &initial,
+                    &task.goal.to_dnf(),
+                    &config.properties,
+                    &config.disturbances,
+                ) {
+                    Ok(p) => p,
+                    Err(e) => return self.error(format!("cannot plan in the model: {e}")),
+                };
+                let added: Vec<String> = planned
+                    .constraints
+                    .iter()
+                    .map(|c| format!("{}? before {}! ({})", c.condition, c.action, c.property))
+                    .collect();
+                let mut origin = "planned in the planner's model (no simulation)".to_string();
+                if !added.is_empty() {
+                    origin.push_str(&format!("; the properties added {}", added.join(", ")));
+                }
+                let tree = planned.plan.tree;
+                if to_text(&tree) != to_text(&current) {
+                    self.set_tree(tree.clone(), planned.plan.new_nodes, origin.clone());
+                }
+                (tree, origin)
+            }
+            _ => (current, self.origin()),
+        };
+        self.verifications += 1;
+        self.notice("verifying the tree …");
+        self.spawn_check(tree, config, None, origin);
+    }
+
+    /// Check the tree an applied change produced before it may run.
+    pub(super) fn check_change(&mut self) {
+        let Some(tree) = self.tree.clone() else {
+            return;
+        };
+        let config = match VerifyConfig::from_scenario(&self.scenario) {
+            Ok(c) => c,
+            Err(e) => return self.error(format!("cannot verify the change: {e}")),
+        };
+        self.next_id += 1;
+        let id = self.next_id;
+        self.gate = Some(Gate::Checking {
+            id,
+            run_after: false,
+        });
+        self.notice("verifying the changed tree in the model before it runs …");
+        let origin = self.origin();
+        self.spawn_check(tree, config, Some(id), origin);
+    }
+
+    fn spawn_check(&self, tree: Tree, config: VerifyConfig, gate: Option<u64>, origin: String) {
+        let scenario = self.scenario.clone();
+        let initial = self.planning.facts();
+        let tx = self.internal_tx.clone();
+        tokio::task::spawn_blocking(move || {
+            let input = VerifyInput {
+                domain: &scenario.domain,
+                tree: &tree,
+                initial: &initial,
+                disturbances: &config.disturbances,
+                properties: &config.properties,
+                limits: Limits {
+                    action_failures: config.action_failures,
+                    ..Limits::default()
+                },
+            };
+            let report = Arc::new(verify::verify(&input));
+            let _ = tx.send(Internal::Verified {
+                report,
+                origin,
+                gate,
+            });
+        });
+    }
+
+    /// A verification finished: a report for the person, or the verdict on a change.
+    pub(super) fn on_verified(&mut self, report: Arc<Report>, origin: String, gate: Option<u64>) {
+        let Some(id) = gate else {
+            self.verifications = self.verifications.saturating_sub(1);
+            return self.emit(Event::Verified { report, origin });
+        };
+        let Some(Gate::Checking { id: current, run_after }) = self.gate else {
+            return;
+        };
+        if id != current {
+            return;
+        }
+        if report.holds() {
+            self.gate = None;
+            self.notice("the changed tree verifies in the model");
+            if run_after {
+                self.start_running();
+            }
+        } else {
+            self.gate = Some(Gate::Violated);
+            self.set_running(false);
+            self.emit(Event::ChangeViolates { report });
+            self.notice(
+                "the changed tree fails verification: it does not run until the change is approved again with the counterexample in view, or undone",
+            );
+        }
+    }
+
+    /// A person approves a change that failed verification, having seen why.
+    pub(super) fn approve_violation(&mut self) {
+        self.gate = None;
+        self.notice("the change was approved again with the counterexample in view: the tree may run");
+    }
+}
