@@ -213,7 +213,8 @@ pub(super) fn write_report(
                     }
                 }
             }
-            writeln!(out, 
+            writeln!(
+                out,
                 "\n{} states, {} transitions, {} atoms, {:.1} ms{}",
                 m.states,
                 m.transitions,
@@ -227,7 +228,8 @@ pub(super) fn write_report(
             )?;
         }
     }
-    writeln!(out, 
+    writeln!(
+        out,
         "\n{}",
         if report.holds() {
             "VERIFIED: every check and property holds"

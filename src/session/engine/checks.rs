@@ -32,6 +32,7 @@ impl Engine {
         match (&self.loaded_from, fixes) {
             (Some(path), 0) => format!("loaded from {}", path.display()),
             (Some(path), n) => format!("loaded from {} with {n} fix(es)", path.display()),
+            (None, 0) if self.planned_in_model => "planned in the planner's model".to_string(),
             (None, 0) => "planned in simulation".to_string(),
             (None, n) => format!("repaired: planned, then changed by {n} approved fix(es)"),
         }
@@ -74,6 +75,7 @@ impl Engine {
                 if to_text(&tree) != to_text(&current) {
                     self.set_tree(tree.clone(), planned.plan.new_nodes, origin.clone());
                 }
+                self.planned_in_model = true;
                 (tree, origin)
             }
             _ => (current, self.origin()),
@@ -134,7 +136,11 @@ impl Engine {
             self.verifications = self.verifications.saturating_sub(1);
             return self.emit(Event::Verified { report, origin });
         };
-        let Some(Gate::Checking { id: current, run_after }) = self.gate else {
+        let Some(Gate::Checking {
+            id: current,
+            run_after,
+        }) = self.gate
+        else {
             return;
         };
         if id != current {
@@ -159,6 +165,8 @@ impl Engine {
     /// A person approves a change that failed verification, having seen why.
     pub(super) fn approve_violation(&mut self) {
         self.gate = None;
-        self.notice("the change was approved again with the counterexample in view: the tree may run");
+        self.notice(
+            "the change was approved again with the counterexample in view: the tree may run",
+        );
     }
 }

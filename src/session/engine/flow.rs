@@ -93,6 +93,7 @@ impl Engine {
         };
         self.task = Some(task.clone());
         self.loaded_from = None;
+        self.planned_in_model = false;
         self.cancel_request();
         self.set_running(false);
         self.pending = None;

@@ -209,6 +209,9 @@ pub struct Engine {
     gate: Option<checks::Gate>,
     /// The file the tree was loaded from, until the next plan.
     loaded_from: Option<PathBuf>,
+    /// Whether the tree was planned in the planner's model (by `Verify` before the first
+    /// tick) rather than in simulation.
+    planned_in_model: bool,
 
     events: UnboundedSender<Event>,
     internal_tx: UnboundedSender<Internal>,
@@ -269,6 +272,7 @@ impl Engine {
             verifications: 0,
             gate: None,
             loaded_from: None,
+            planned_in_model: false,
             events,
             internal_tx,
             internal_rx,

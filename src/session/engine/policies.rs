@@ -162,6 +162,7 @@ impl Engine {
             fixes: self.fixes.len(),
         });
         self.loaded_from = Some(path.clone());
+        self.planned_in_model = false;
         let why = format!("loaded policy {}", path.display());
         self.set_tree(plan.tree, plan.new_nodes, why);
     }
