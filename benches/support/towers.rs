@@ -16,17 +16,18 @@ use betr::world::CellWorld;
 
 pub const TOWER: usize = 3;
 
-/// A scenario with `n` cubes (A, B and the rest), written next to a copy of cell.toml.
+/// A scenario with `n` cubes (A, B and the rest), extending the cell's cell.toml.
 pub fn write_scenario(dir: &Path, n: usize) -> Result<PathBuf> {
     std::fs::create_dir_all(dir)?;
+    // Extends the cell in place, so its example pool and conventions come with it.
     let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
-    std::fs::copy(base, dir.join("cell.toml"))?;
     let mut names = vec!["cube A".to_string(), "cube B".to_string()];
     names.extend((1..n.saturating_sub(1)).map(|i| format!("cube {i}")));
     let mut t = String::new();
     writeln!(
         t,
-        "extends = \"cell.toml\"\n[scenario]\nname = \"{n} cubes in towers\""
+        "extends = '{}'\n[scenario]\nname = \"{n} cubes in towers\"",
+        base.display()
     )?;
     writeln!(t, "goal = '\"cube A\" on \"cube B\"'\n[objects]")?;
     let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
