@@ -264,8 +264,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "w", "[", "]", "?",
-                "q"
+                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "w", "[", "]",
+                "?", "q"
             ]
         );
         assert_eq!(
