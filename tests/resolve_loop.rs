@@ -44,6 +44,23 @@ fn is_param(p: &Path) -> bool {
     p.components().any(|c| c.as_os_str() == "params")
 }
 
+/// `betr resolve SCENARIO --yes` against the fake OpenAI-compatible server at `base`.
+fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
+    vec![
+        "resolve",
+        scenario,
+        "--yes",
+        "--backend",
+        "openai",
+        "--base-url",
+        base,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+    ]
+}
+
 fn relative(p: &Path) -> String {
     p.strip_prefix(fixtures::root())
         .unwrap_or(p)
@@ -73,28 +90,16 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
         let path_s = path.to_string_lossy().to_string();
         let save_s = save.to_string_lossy().to_string();
         let base = server.base_url();
-        let out = betr(
-            &dir,
-            &[
-                "resolve",
-                &path_s,
-                "--yes",
-                "--backend",
-                "openai",
-                "--base-url",
-                &base,
-                "--model",
-                "fake-model",
-                "--api-key-env",
-                KEY_VAR,
-                "--save",
-                &save_s,
-                "--cassette",
-                "cassette.jsonl",
-                "--usage-log",
-                "usage.jsonl",
-            ],
-        );
+        let mut args = resolve_yes(&path_s, &base);
+        args.extend([
+            "--save",
+            &save_s,
+            "--cassette",
+            "cassette.jsonl",
+            "--usage-log",
+            "usage.jsonl",
+        ]);
+        let out = betr(&dir, &args);
         let log = text(&out);
         calls += log.matches("\n→ asking for ").count();
         // Shown with `cargo test --test resolve_loop -- --nocapture`.
@@ -291,4 +296,31 @@ fn a_recorded_cassette_replays_without_a_server_and_misses_loudly() {
         text(&out)
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn resolve_yes_stops_at_a_change_that_fails_verification() {
+    // Scenario 1 with the red cube fragile: the fix the model proposes grasps it.
+    let path = fixtures::root().join("tests/fixtures/scenarios/fragile_red.toml");
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("cli-violation");
+    let base = server.base_url();
+    let out = betr(&dir, &resolve_yes(path.to_str().unwrap(), &base));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out));
+    assert!(
+        stdout.contains("fails verification in the model"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("Nothing saved: the last change fails verification."),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("SUCCESS in simulation"), "{stdout}");
+    // The counterexample is on stderr: the red cube grasped.
+    assert!(stderr.contains("✕ never \"red cube\" grasped"), "{stderr}");
+    assert!(stderr.contains("counterexample:"), "{stderr}");
+    assert!(stderr.contains("grasp \"red cube\"!"), "{stderr}");
+    assert!(!dir.join("policies").exists(), "nothing may be saved");
 }

@@ -9,8 +9,8 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use betr::dataset;
-use betr::domain::Scenario;
-use betr::goal::Formula;
+use betr::domain::{Condition, Scenario};
+use betr::goal::{Dnf, Formula};
 use betr::planner::Outcome;
 use betr::verify::{self, Limits, VerifyConfig, VerifyInput, plan_in_model};
 use betr::world;
@@ -37,19 +37,24 @@ fn scenario_files() -> Vec<PathBuf> {
     out
 }
 
-fn model_tree(s: &Scenario) -> betr::bt::Tree {
+/// `goal` planned in the model from `initial`, under the scenario's `[verify]` table;
+/// it must succeed there.
+fn model_tree(s: &Scenario, initial: &[Condition], goal: &Dnf) -> betr::bt::Tree {
     let config = VerifyConfig::from_scenario(s).unwrap();
-    let initial = world::load(s).unwrap().facts();
-    let goal = s.goal.clone().unwrap().to_dnf();
     let planned = plan_in_model(
         &s.domain,
-        &initial,
-        &goal,
+        initial,
+        goal,
         &config.properties,
         &config.disturbances,
     )
     .unwrap();
-    assert_eq!(planned.plan.outcome, Outcome::Success, "{}", s.name);
+    assert_eq!(
+        planned.plan.outcome,
+        Outcome::Success,
+        "{}: {goal:?}",
+        s.name
+    );
     planned.plan.tree
 }
 
@@ -80,18 +85,10 @@ fn the_trees_of_the_hundred_cafe_gold_goals_verify_in_the_model() {
     let mut failed = Vec::new();
     for case in cases {
         let goal = Formula::parse(&case.gold).unwrap().to_dnf();
-        let planned = plan_in_model(
-            &s.domain,
-            &initial,
-            &goal,
-            &config.properties,
-            &config.disturbances,
-        )
-        .unwrap();
-        assert_eq!(planned.plan.outcome, Outcome::Success, "{}", case.gold);
+        let tree = model_tree(&s, &initial, &goal);
         let input = VerifyInput {
             domain: &s.domain,
-            tree: &planned.plan.tree,
+            tree: &tree,
             initial: &initial,
             disturbances: &config.disturbances,
             properties: &config.properties,
@@ -130,7 +127,8 @@ fn the_trees_of_the_hundred_cafe_gold_goals_verify_in_the_model() {
 fn spin_agrees_on_every_scenario_model_planned_in_the_model() {
     for file in scenario_files() {
         let s = Scenario::load(&file).unwrap();
-        let tree = model_tree(&s);
+        let initial = world::load(&s).unwrap().facts();
+        let tree = model_tree(&s, &initial, &s.goal.clone().unwrap().to_dnf());
         let (report, model) = check(&s, &tree, false);
         assert!(report.holds(), "{}:\n{report:#?}", file.display());
         let name = format!("model-{}", s.name.replace([' ', ':', '/'], "_"));

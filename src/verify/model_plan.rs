@@ -220,6 +220,20 @@ mod tests {
         (s, config)
     }
 
+    /// The scenario's goal planned in the model from its world's first facts.
+    fn planned(s: &Scenario, config: &VerifyConfig) -> ModelPlan {
+        let world = crate::world::load(s).expect("world");
+        let goal = s.goal.clone().expect("goal").to_dnf();
+        plan_in_model(
+            &s.domain,
+            &world.facts(),
+            &goal,
+            &config.properties,
+            &config.disturbances,
+        )
+        .expect("plan")
+    }
+
     #[test]
     fn a_never_property_becomes_the_precondition_it_implies() {
         let (s, config) = load("scenarios/cell/red_on_blue.toml");
@@ -241,16 +255,7 @@ mod tests {
     #[test]
     fn the_model_plan_carries_the_constraint_and_no_world_is_asked() {
         let (s, config) = load("scenarios/cell/red_on_blue.toml");
-        let world = crate::world::load(&s).expect("world");
-        let goal = s.goal.clone().expect("goal").to_dnf();
-        let planned = plan_in_model(
-            &s.domain,
-            &world.facts(),
-            &goal,
-            &config.properties,
-            &config.disturbances,
-        )
-        .expect("plan");
+        let planned = planned(&s, &config);
         assert_eq!(planned.constraints.len(), 1, "{:?}", planned.constraints);
         assert_eq!(
             planned.constraints[0].action.to_string(),
@@ -268,16 +273,7 @@ mod tests {
     #[test]
     fn sweeping_needs_the_mop_and_an_always_property_reads_as_never_its_negation() {
         let (s, config) = load("scenarios/cafe/sweep.toml");
-        let world = crate::world::load(&s).expect("world");
-        let goal = s.goal.clone().expect("goal").to_dnf();
-        let planned = plan_in_model(
-            &s.domain,
-            &world.facts(),
-            &goal,
-            &config.properties,
-            &config.disturbances,
-        )
-        .expect("plan");
+        let planned = planned(&s, &config);
         let found: Vec<String> = planned
             .constraints
             .iter()
