@@ -18,9 +18,10 @@ use betr::world;
 pub fn llm(
     scenario: &Path,
     (model_path, model): (Option<&Path>, Option<&str>),
-    threads: u32,
+    threads: Option<u32>,
     repeats: usize,
 ) -> Result<ExitCode> {
+    let threads = threads.map_or_else(betr::llm::local::threads::idle_threads, |t| t.max(1));
     let path = match model_path {
         Some(p) => p.to_path_buf(),
         None => super::model_cmd::ensure(model)?,

@@ -105,7 +105,8 @@ pub struct LlmFlags {
     /// [env: BETR_MODEL_PATH].
     #[arg(long, value_name = "FILE")]
     pub model_path: Option<PathBuf>,
-    /// Local backend: CPU threads (default 1) [env: BETR_THREADS].
+    /// Local backend: CPU threads (default: the cores idle when the model loads)
+    /// [env: BETR_THREADS].
     #[arg(long, value_name = "N")]
     pub threads: Option<u32>,
     /// Local backend: let the model write freely instead of following a grammar built

@@ -238,8 +238,9 @@ pub enum BenchWhat {
         /// A known model by name (`betr model list`), fetched when missing.
         #[arg(long, conflicts_with = "model_path")]
         model: Option<String>,
-        #[arg(long, default_value_t = betr::llm::config::DEFAULT_THREADS)]
-        threads: u32,
+        /// CPU threads (default: the cores idle when the model loads).
+        #[arg(long)]
+        threads: Option<u32>,
         /// Warm calls per variant.
         #[arg(long, default_value_t = 3)]
         repeats: usize,

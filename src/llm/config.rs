@@ -232,14 +232,16 @@ pub struct Settings {
     pub file: Option<PathBuf>,
     /// Local backend: the GGUF file (`None`: the fetched default model).
     pub model_path: Option<PathBuf>,
-    pub threads: u32,
+    /// Local backend: CPU threads (`None`: the cores idle when the model loads).
+    pub threads: Option<u32>,
     pub grammar: bool,
     pub context: u32,
 }
 
-/// Threads for the local model. Measured on the 2-core machine this project runs on: one
-/// thread keeps generating at full speed when another process is busy, where two threads
-/// collapse (both stall waiting for each other); see `betr bench llm`.
+/// Threads for the local model when the load cannot decide (tests, which share the
+/// machine with other tests, use it too): one thread keeps generating at full speed when
+/// another process is busy, where two threads stall waiting for each other; see
+/// `betr bench llm` and `local::threads`.
 pub const DEFAULT_THREADS: u32 = 1;
 
 impl Settings {
@@ -305,7 +307,7 @@ impl Settings {
             prices,
             file: path,
             model_path: layer.model_path,
-            threads: layer.threads.unwrap_or(DEFAULT_THREADS).max(1),
+            threads: layer.threads.map(|t| t.max(1)),
             grammar: layer.grammar.unwrap_or(true),
             context: layer.context.unwrap_or(4096).max(512),
         })
@@ -348,7 +350,9 @@ impl Settings {
                     &name,
                     EngineOptions {
                         model_path: path,
-                        threads: self.threads,
+                        threads: self
+                            .threads
+                            .unwrap_or_else(super::local::threads::idle_threads),
                         context: self.context,
                     },
                 )?;
