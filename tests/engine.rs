@@ -537,7 +537,7 @@ fn a_change_approved_again_with_the_counterexample_in_view_runs() {
 }
 
 #[test]
-fn an_unattended_loop_never_approves_past_a_failed_check() {
+fn an_unattended_loop_rejects_a_change_that_fails_its_check_and_asks_again() {
     rt().block_on(async {
         let setup = fragile_setup();
         let scenario = (*setup.scenario).clone();
@@ -553,12 +553,22 @@ fn an_unattended_loop_never_approves_past_a_failed_check() {
         )
         .await
         .unwrap();
+        // The fixture model proposes the same fix every time; each is refused by the check,
+        // undone, and told to the next question, until the rounds run out.
         assert!(
-            matches!(resolved.ending, betr::session::Ending::Violated { .. }),
+            matches!(resolved.ending, betr::session::Ending::GaveUp { .. }),
             "{:?}",
             resolved.ending
         );
+        assert_eq!(resolved.repairs, 0);
         assert!(!events.iter().any(|e| matches!(e, Event::Success { .. })));
+        let refused = events
+            .iter()
+            .filter(|e| matches!(e, Event::ChangeViolates { .. }))
+            .count();
+        assert!(refused >= 2, "asked again after the first refusal: {refused}");
+        assert!(events.iter().any(|e| matches!(e, Event::DidNotHelp { reason }
+            if reason.contains("fails verification in the model: never \"red cube\" grasped is violated"))));
     });
 }
 
@@ -602,5 +612,28 @@ fn verify_before_the_first_tick_plans_the_whole_tree_in_the_model() {
             unreachable!()
         };
         assert_eq!(origin, "planned in the planner's model");
+    });
+}
+
+#[test]
+fn a_rejected_change_that_failed_its_check_is_undone_and_told_to_the_model() {
+    rt().block_on(async {
+        let mut s = Session::start(fragile_setup());
+        s.run_to_proposal().await;
+        let planned = bt::to_text(&tree_of(&s.seen).unwrap().0);
+        s.send(Command::Approve);
+        s.until("the verdict", |e| matches!(e, Event::ChangeViolates { .. }))
+            .await;
+        s.send(Command::Reject);
+        let got = s
+            .until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        assert!(got.iter().any(|e| matches!(e, Event::DidNotHelp { reason }
+            if reason.contains("fails verification in the model"))));
+        assert_eq!(bt::to_text(&tree_of(&got).unwrap().0), planned);
+        // The failure is met again and the next question lists the refused change.
+        s.send(Command::Run);
+        s.until("the question", |e| matches!(e, Event::Asking { .. }))
+            .await;
     });
 }

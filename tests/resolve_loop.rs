@@ -299,7 +299,7 @@ fn a_recorded_cassette_replays_without_a_server_and_misses_loudly() {
 }
 
 #[test]
-fn resolve_yes_stops_at_a_change_that_fails_verification() {
+fn resolve_yes_never_keeps_a_change_that_fails_verification() {
     // Scenario 1 with the red cube fragile: the fix the model proposes grasps it.
     let path = fixtures::root().join("tests/fixtures/scenarios/fragile_red.toml");
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
@@ -314,7 +314,12 @@ fn resolve_yes_stops_at_a_change_that_fails_verification() {
         "{stdout}"
     );
     assert!(
-        stdout.contains("Nothing saved: the last change fails verification."),
+        stdout.contains("Nothing saved: no change was kept."),
+        "{stdout}"
+    );
+    // Each refused change is told to the next question.
+    assert!(
+        stdout.contains("The change did not help and was undone: it fixes the failure in simulation, but the changed tree fails verification"),
         "{stdout}"
     );
     assert!(!stdout.contains("SUCCESS in simulation"), "{stdout}");

@@ -344,16 +344,13 @@ pub fn resolve(
         None if success => Some(default_policy_path(args.scenario_path)),
         None => None,
     };
-    // A tree whose last change failed verification is not kept.
-    let violated = matches!(resolved.ending, Ending::Violated { .. });
     match save {
-        Some(path) if (success || resolved.repairs > 0) && !violated => {
+        Some(path) if success || resolved.repairs > 0 => {
             betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
                 .with_context(|| format!("saving the tree to {}", path.display()))?;
             let note = if success { "" } else { " (it still fails)" };
             println!("\nSaved the tree to {}{note}", path.display());
         }
-        _ if violated => println!("\nNothing saved: the last change fails verification."),
         _ => println!("\nNothing saved: no change was kept."),
     }
     println!(
@@ -488,7 +485,7 @@ fn print_event_line(event: &Event) {
         Event::GaveUp { reason } => println!("\nGave up: {reason}"),
         Event::ChangeViolates { report } => {
             println!(
-                "\n✕ The approved change fails verification in the model; the changed tree was not run (counterexample on stderr)"
+                "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
             );
             let mut err = std::io::stderr();
             if let Err(e) = super::verify_cmd::write_report(&mut err, report, false) {

@@ -34,9 +34,6 @@ pub async fn resolve_approving(
                 Ending::Success { ticks } => Ok(ticks),
                 Ending::GaveUp { reason } => Err(reason),
                 Ending::Rejected => Err("a proposal was rejected".into()),
-                Ending::Violated { .. } => {
-                    Err("an approved change failed verification in the model".into())
-                }
             },
             r.rounds,
         ),

@@ -177,7 +177,10 @@ impl Context<'_> {
     ) -> Result<Vec<Message>, PromptError> {
         let mut values = self.common();
         values.push(("tried", tried_text(tried)));
-        values.push(("shortlist", shortlist_text(shortlist)));
+        values.push((
+            "shortlist",
+            shortlist_text(shortlist, &self.scenario.domain.vocabulary),
+        ));
         let pre: Vec<String> = self
             .scenario
             .domain
@@ -309,12 +312,27 @@ pub fn request(messages: Vec<Message>, temperature: f32, max_tokens: u32) -> Cha
 }
 
 /// Replace each `{{name}}` by its value; a name with no value is an error.
-/// The conditions found to fix a failure in simulation, as the resolve prompt lists them.
-fn shortlist_text(shortlist: &[Condition]) -> String {
+/// The conditions found to fix a failure in simulation, as the resolve prompt lists them,
+/// each with what its predicate means (negated: "not: …"), so the choice is made on the
+/// meaning beside it rather than on a name alone.
+fn shortlist_text(shortlist: &[Condition], vocabulary: &Vocabulary) -> String {
     if shortlist.is_empty() {
         return String::new();
     }
-    let lines: Vec<String> = shortlist.iter().map(|c| format!("- {c}")).collect();
+    let lines: Vec<String> = shortlist
+        .iter()
+        .map(|c| {
+            let meaning = vocabulary
+                .predicate(&c.atom.predicate)
+                .map(|p| p.description.trim())
+                .filter(|d| !d.is_empty());
+            match (meaning, c.negated) {
+                (Some(m), false) => format!("- {c} ({m})"),
+                (Some(m), true) => format!("- {c} (not: {m})"),
+                (None, _) => format!("- {c}"),
+            }
+        })
+        .collect();
     format!(
         "\n## Conditions that fix it in simulation\nEach of these, made true before the action starts, stopped the failure when the robot tried it in simulation. Choose the one that names the cause of the error (a condition about \"any object\" covers every object that could be in the way) and write only that one:\n{}\n",
         lines.join("\n")

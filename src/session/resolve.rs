@@ -73,7 +73,7 @@ pub async fn resolve_with_scenes(
     let mut goal = None;
     let mut tree: Option<Arc<Tree>> = None;
     let mut rounds = 0;
-    let mut repairs = 0;
+    let mut repairs: usize = 0;
     let ending = loop {
         let Some(event) = events.recv().await else {
             return Err(SessionError::Stopped);
@@ -99,8 +99,12 @@ pub async fn resolve_with_scenes(
             }
             Event::Repaired { .. } => repairs += 1,
             Event::Rejected => break Ending::Rejected,
-            // Never approved past a failed check, not even under --yes.
-            Event::ChangeViolates { report } => break Ending::Violated { report },
+            // Never approved past a failed check, not even under --yes: the change is
+            // rejected, undone, and the model is asked again knowing why.
+            Event::ChangeViolates { .. } => {
+                repairs = repairs.saturating_sub(1);
+                engine.send(Command::Reject);
+            }
             Event::Success { ticks } => break Ending::Success { ticks },
             Event::GaveUp { reason } => break Ending::GaveUp { reason },
             Event::Failed { error } => {

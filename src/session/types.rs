@@ -256,17 +256,9 @@ pub enum Event {
 /// How the loop ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Ending {
-    Success {
-        ticks: u64,
-    },
+    Success { ticks: u64 },
     Rejected,
-    GaveUp {
-        reason: String,
-    },
-    /// An approved change failed verification in the model; the changed tree did not run.
-    Violated {
-        report: Arc<Report>,
-    },
+    GaveUp { reason: String },
 }
 
 /// The loop's result: the final tree (with every change that helped) and how it ended.

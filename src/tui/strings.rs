@@ -34,10 +34,10 @@ pub const AWAITING_APPROVAL: Awaiting = Awaiting {
     short: "approve?",
 };
 pub const AWAITING_VIOLATION: Awaiting = Awaiting {
-    long: "fails verification: approve again or undo",
+    long: "fails verification: approve again, reject or undo",
     short: "violates",
 };
-pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, or undo it (u).";
+pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, reject it (x: undone, and the model is asked again knowing why), or undo it (u).";
 pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";

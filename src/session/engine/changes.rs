@@ -26,6 +26,9 @@ impl Engine {
     }
 
     pub(super) fn reject(&mut self) {
+        if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
+            return self.reject_violation();
+        }
         if self.pending.take().is_none() {
             return self.error("no proposal to reject");
         }
@@ -60,6 +63,7 @@ impl Engine {
             fixes: self.fixes.len(),
         });
         let change = pending.proposal.to_string();
+        self.last_change = Some((before.clone(), pending.proposal.clone()));
         self.fixes.push(AppliedFix {
             change: change.clone(),
             nodes: plan.new_nodes.clone(),

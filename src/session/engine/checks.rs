@@ -25,6 +25,30 @@ pub(super) enum Gate {
     Violated,
 }
 
+/// What failed in a report, in one line: the first finding or violated property, with the
+/// counterexample's last words.
+fn violation_summary(report: &Report) -> String {
+    if let Some(f) = report.findings.first() {
+        return f.to_string();
+    }
+    let Ok(model) = &report.model else {
+        return "it could not be checked".to_string();
+    };
+    model
+        .properties
+        .iter()
+        .find(|p| !p.verdict.holds())
+        .map_or_else(
+            || "it could not be checked".to_string(),
+            |p| match &p.verdict {
+                verify::Verdict::Violated(cx) => {
+                    format!("{} is violated ({})", p.name, cx.violation)
+                }
+                other => format!("{}: {other:?}", p.name),
+            },
+        )
+}
+
 impl Engine {
     /// Where the current tree came from, for the verification report.
     fn origin(&self) -> String {
@@ -154,12 +178,33 @@ impl Engine {
             }
         } else {
             self.gate = Some(Gate::Violated);
+            self.violation = Some(violation_summary(&report));
             self.set_running(false);
             self.emit(Event::ChangeViolates { report });
             self.notice(
-                "the changed tree fails verification: it does not run until the change is approved again with the counterexample in view, or undone",
+                "the changed tree fails verification: it does not run until the change is approved again with the counterexample in view, rejected (the model is told why), or undone",
             );
         }
+    }
+
+    /// A change that failed verification is rejected: undone, and remembered as tried for
+    /// its failure with what verification found, so the next question tells the model.
+    pub(super) fn reject_violation(&mut self) {
+        let why = format!(
+            "it fixes the failure in simulation, but the changed tree fails verification in the model: {}",
+            self.violation.take().unwrap_or_default()
+        );
+        if let Some((Some(failure), proposal)) = self.last_change.take() {
+            self.tried.push((
+                failure,
+                super::super::ask::Tried {
+                    proposal,
+                    why: why.clone(),
+                },
+            ));
+        }
+        self.emit(Event::DidNotHelp { reason: why });
+        self.undo();
     }
 
     /// A person approves a change that failed verification, having seen why.

@@ -207,6 +207,11 @@ pub struct Engine {
     verifications: usize,
     /// The check of the last applied change, while it is under way or failed.
     gate: Option<checks::Gate>,
+    /// The last proposal applied and the failure it was for, so a change that fails
+    /// verification and is rejected is told to the model as tried.
+    last_change: Option<(Option<Failure>, Proposal)>,
+    /// What the last failed check found, in one line.
+    violation: Option<String>,
     /// The file the tree was loaded from, until the next plan.
     loaded_from: Option<PathBuf>,
     /// Whether the tree was planned in the planner's model (by `Verify` before the first
@@ -272,6 +277,8 @@ impl Engine {
             verifications: 0,
             gate: None,
             loaded_from: None,
+            last_change: None,
+            violation: None,
             planned_in_model: false,
             events,
             internal_tx,
@@ -381,7 +388,7 @@ impl Engine {
             return Some(match gate {
                 checks::Gate::Checking { .. } => "the verification of the change",
                 checks::Gate::Violated => {
-                    "approval of the change that fails verification (approve again, or undo)"
+                    "approval of the change that fails verification (approve again, reject, or undo)"
                 }
             });
         }
