@@ -5,7 +5,7 @@
 //! answered; an unusable reply is reported as an event, not an error.
 
 use crate::bt::NodeId;
-use crate::domain::{ActionCall, Scenario, ValueParam};
+use crate::domain::{ActionCall, Condition, Scenario, ValueParam};
 use crate::llm::prompt::{self, Context};
 use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
@@ -242,23 +242,36 @@ fn same_proposal(a: &Proposal, b: &Proposal) -> bool {
     }
 }
 
+/// Whether `condition` alone was proposed for this failure before and refused.
+fn refused_alone(tried: &[Tried], condition: &Condition) -> bool {
+    tried.iter().any(|t| {
+        matches!(&t.proposal, Proposal::Conditions { conditions, .. }
+            if conditions.as_slice() == std::slice::from_ref(condition))
+    })
+}
+
 /// What the person reads about the conditions tried before the model was asked.
-fn shortlist_notice(list: &Shortlist) -> String {
+fn shortlist_notice(list: &Shortlist, refused: usize) -> String {
     let about = list
         .objects
         .iter()
         .map(|o| format!("\"{o}\""))
         .collect::<Vec<_>>()
         .join(", ");
+    let left_out = if refused > 0 {
+        format!(" ({refused} refused before, left out)")
+    } else {
+        String::new()
+    };
     if list.fixes.is_empty() {
         return format!(
-            "tried {} condition(s) about {about} in simulation: none fixes the failure alone; the model names the condition itself",
+            "tried {} condition(s) about {about} in simulation: none fixes the failure alone{left_out}; the model names the condition itself",
             list.tried
         );
     }
     let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
     format!(
-        "tried {} condition(s) about {about} in simulation; {} fix the failure, the model chooses among: {}",
+        "tried {} condition(s) about {about} in simulation; {} fix the failure{left_out}, the model chooses among: {}",
         list.tried,
         list.fixes.len(),
         fixes.join(", ")
@@ -280,9 +293,14 @@ pub(crate) async fn ask_conditions(
         tried,
     } = *failed;
     let choices = if options.shortlist {
-        let list = shortlist(screen);
+        let mut list = shortlist(screen);
+        // A fix already proposed for this failure and refused (by the simulation, by
+        // verification or by a person) is not offered again: the model chooses under a
+        // grammar that allows only the shortlist, so it would choose it again.
+        let before = list.fixes.len();
+        list.fixes.retain(|c| !refused_alone(tried, c));
         emit(&Event::Notice {
-            message: shortlist_notice(&list),
+            message: shortlist_notice(&list, before - list.fixes.len()),
         });
         list.fixes
     } else {
