@@ -4,9 +4,9 @@
 //! is gone or has moved on. Proposals are screened this way before anyone is asked to
 //! approve them, and an approved change is checked the same way before it is kept.
 
-use crate::bt::{NodeId, Tree};
+use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::ActionCall;
-use crate::planner::{Outcome, Plan, Planner, RepairError, set_value};
+use crate::planner::{Outcome, Plan, Planner, RepairError, run_tree, set_value};
 use crate::world::World;
 
 use super::types::Proposal;
@@ -118,6 +118,26 @@ impl Screen {
         apply(&planner, &self.tree, proposal, self.world.as_ref()).map(|(plan, _)| plan)
     }
 
+    /// Whether running `tree` in a copy of the world completes the failed action.
+    fn completes_failed_action(&self, tree: &Tree) -> bool {
+        let mut sim = self.world.fork();
+        let mut completed = false;
+        let planner = Planner::new(&self.scenario.domain);
+        run_tree(
+            tree,
+            sim.as_mut(),
+            &self.scenario.domain,
+            planner.options.max_ticks,
+            |record, _| {
+                completed |= record.completed.iter().any(|n| {
+                    matches!(tree.kind(*n), Ok(NodeKind::Action(a)) if a.same_invocation(&self.failure.action))
+                });
+                !completed
+            },
+        );
+        completed
+    }
+
     /// As [`Screen::check`], saying whether the whole tree then succeeds.
     pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, String> {
         let plan = self.replan(proposal).map_err(|e| e.to_string())?;
@@ -128,6 +148,19 @@ impl Screen {
             return Err(format!("{action}! failed: {error}"));
         }
         let verdict = verdict(Some(&self.failure), &plan.outcome)?;
+        // A missing precondition lets the action succeed. A condition after which the
+        // tree succeeds without the action ever completing only closes its branch, so a
+        // goal with alternatives takes another way ("the chips somewhere else" makes the
+        // robot bring the dessert): that goes around the failure, it does not fix it.
+        if matches!(proposal, Proposal::Conditions { .. })
+            && verdict == Verdict::Succeeds
+            && !self.completes_failed_action(&plan.tree)
+        {
+            return Err(format!(
+                "the tree then succeeds without {}! ever completing: the change closes the action's branch instead of giving it what it lacks",
+                self.failure.action
+            ));
+        }
         Ok(match &plan.outcome {
             Outcome::ActionFailed { node, .. } if node.index() >= self.tree.capacity() => {
                 Verdict::FailsItself

@@ -27,7 +27,7 @@ pub struct Shortlist {
 const MAX_TRIED: usize = 3000;
 
 /// Bound on the fixes compared pairwise for working only through another.
-const MAX_PAIRED: usize = 12;
+const MAX_PAIRED: usize = 32;
 
 /// Try every condition related to the failure in `screen`'s copy of the world.
 pub fn shortlist(screen: &Screen) -> Shortlist {
