@@ -27,7 +27,7 @@ pub struct Shortlist {
 const MAX_TRIED: usize = 3000;
 
 /// Bound on the fixes compared pairwise for working only through another.
-const MAX_PAIRED: usize = 32;
+const MAX_PAIRED: usize = 64;
 
 /// Try every condition related to the failure in `screen`'s copy of the world.
 pub fn shortlist(screen: &Screen) -> Shortlist {
@@ -328,6 +328,34 @@ mod tests {
         // The mop off the entrance fixes sweeping only because picking it up holds it.
         let moved = Condition::parse("~On_Mop_Entrance").expect("parses");
         assert!(!list.fixes.contains(&moved), "{:?}", list.fixes);
+    }
+
+    #[test]
+    fn a_condition_that_only_closes_the_actions_branch_is_no_fix() {
+        // "Fries or a dessert": putting the chips anywhere but the bar makes the chips
+        // branch impossible, so the robot brings the dessert instead; the pick-up of the
+        // chips never completes.
+        let screen = screen_at_first_failure("scenarios/cafe/find_fries.toml");
+        let list = shortlist(&screen);
+        let near = Condition::parse("RobotNear_Bar").expect("parses");
+        assert!(list.fixes.contains(&near), "{:?}", list.fixes);
+        assert!(
+            !list
+                .fixes
+                .iter()
+                .any(|c| c.atom.predicate == "On" && !c.negated),
+            "{:?}",
+            list.fixes
+        );
+        let around = Proposal::Conditions {
+            action: screen.failure.action.clone(),
+            node: screen.failure.node,
+            conditions: vec![Condition::parse("On_Chips_Table1").expect("parses")],
+        };
+        let why = screen
+            .try_change(&around)
+            .expect_err("goes around the failure");
+        assert!(why.contains("closes the action's branch"), "{why}");
     }
 
     #[test]
