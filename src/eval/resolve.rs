@@ -219,6 +219,9 @@ fn record(
     let mut screened_out = 0;
     let mut first_candidate: Option<Proposal> = None;
     let mut kept_conditions: Vec<Condition> = Vec::new();
+    // How many kept conditions there were before the last kept change, so a change that
+    // fails verification afterwards (and is rejected) is taken out again.
+    let mut kept_before_last = 0;
     let mut pending: Option<Proposal> = None;
     let fixes: Vec<Condition> = scenario
         .expected_fix
@@ -263,9 +266,17 @@ fn record(
                     p.kept = true;
                     p.correct = success;
                 }
+                kept_before_last = kept_conditions.len();
                 if let Some(Proposal::Conditions { conditions, .. }) = pending.take() {
                     kept_conditions.extend(conditions);
                 }
+            }
+            Event::ChangeViolates { .. } => {
+                if let Some(p) = proposals.last_mut() {
+                    p.kept = false;
+                    p.correct = false;
+                }
+                kept_conditions.truncate(kept_before_last);
             }
             Event::DidNotHelp { reason } => {
                 if let Some(p) = proposals.last_mut() {
