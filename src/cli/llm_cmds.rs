@@ -282,6 +282,9 @@ pub struct ResolveArgs<'a> {
     pub save: Option<&'a Path>,
     pub scenario_path: &'a Path,
     pub viz: &'a super::viz_flags::VizFlags,
+    pub stated_goal: bool,
+    /// Offer the kept fixes as rules, kept in this directory's knowledge file.
+    pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
 }
 
 pub fn resolve(
@@ -292,6 +295,7 @@ pub fn resolve(
 ) -> Result<ExitCode> {
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
+    llm.options.use_scenario_goal = args.stated_goal;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
     println!("Scenario:    {}", scenario.name);
@@ -357,6 +361,10 @@ pub fn resolve(
         "{} question(s) about failures, {} change(s) kept",
         resolved.rounds, resolved.repairs
     );
+    if let Some(dir) = args.learn.filter(|_| success) {
+        println!();
+        super::knowledge_cmd::offer(scenario, args.scenario_path, &resolved.kept, dir, args.yes)?;
+    }
     print_usage(&llm.model);
     Ok(if success {
         ExitCode::SUCCESS

@@ -4,6 +4,7 @@ mod bench_cmd;
 mod eval_cmd;
 mod eval_setup;
 mod export_cmd;
+mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
 mod policy_cmd;
@@ -77,6 +78,8 @@ pub enum Command {
         /// Ticks within which the tree must succeed from every reachable state.
         #[arg(long, default_value_t = 10_000)]
         max_ticks: u64,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Write a tree as BehaviorTree.CPP v4 XML (for BT.CPP and Groot2) or Graphviz DOT
     /// (statuses of the last tick of a run as colours, the last fix's nodes marked).
@@ -98,6 +101,12 @@ pub enum Command {
         #[command(subcommand)]
         experiment: eval_cmd::EvalExperiment,
     },
+    /// Rules learned from approved fixes (kept with `betr resolve --learn` or in the
+    /// workbench): list them, show one with where it came from, revoke one.
+    Knowledge {
+        #[command(subcommand)]
+        action: knowledge_cmd::KnowledgeAction,
+    },
     /// Embedded model files: fetch them into the cache, list them.
     Model {
         #[command(subcommand)]
@@ -110,6 +119,8 @@ pub enum Command {
         /// A goal formula instead of the scenario's goal, e.g. 'On_Coffee_Table1 & Active_AC'.
         #[arg(long)]
         goal: Option<String>,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Tick the planned tree (or a saved one) in a fresh world until success or failure.
     Run {
@@ -129,6 +140,8 @@ pub enum Command {
         variant: Option<String>,
         #[command(flatten)]
         viz: viz_flags::VizFlags,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Plan, run until an action fails, insert conditions as that action's first
     /// preconditions, re-plan and run to success; print and optionally save the tree.
@@ -156,6 +169,8 @@ pub enum Command {
         variant: Option<String>,
         #[command(flatten)]
         viz: viz_flags::VizFlags,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Ask a language model for the goal an instruction means in the scenario.
     Interpret {
@@ -206,6 +221,17 @@ pub enum Command {
         /// Where to save the final tree (default: policies/<scenario>.bt on success).
         #[arg(long)]
         save: Option<PathBuf>,
+        /// Work on the scenario's stated goal instead of reading its instruction (no model
+        /// call for the goal).
+        #[arg(long)]
+        stated_goal: bool,
+        /// After success, offer each approved fix as a rule of its skill for later tasks
+        /// (asked on the terminal; with --yes kept without asking), checked before it is
+        /// kept in the knowledge file beside the policies.
+        #[arg(long)]
+        learn: bool,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
         #[command(flatten)]
         llm: llm_cmds::LlmFlags,
         #[command(flatten)]
@@ -276,6 +302,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model { action } => model_cmd::run(action),
+        Command::Knowledge { action } => knowledge_cmd::run(action),
         Command::Transcribe { file, config, stt } => {
             voice_cmd::transcribe(&file, config.as_deref(), &stt)
         }
@@ -301,11 +328,15 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             yes,
             max_rounds,
             save,
+            stated_goal,
+            learn,
+            knowledge,
             llm,
             stt,
             viz,
         } => {
-            let loaded = load(&scenario)?;
+            let mut loaded = load(&scenario)?;
+            knowledge.apply(&mut loaded)?;
             let instruction = match &audio {
                 Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
                 None => instruction,
@@ -319,6 +350,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
                     save: save.as_deref(),
                     scenario_path: &scenario,
                     viz: &viz,
+                    stated_goal,
+                    learn: learn.then_some(&knowledge.dir),
                 },
                 &llm,
                 glyphs,
@@ -330,8 +363,14 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             scenario,
             out,
         } => export_cmd::export(&source, scenario.as_deref(), format, out.as_deref()),
-        Command::Plan { scenario, goal } => {
-            tree_cmds::plan(&load(&scenario)?, goal.as_deref(), glyphs)
+        Command::Plan {
+            scenario,
+            goal,
+            knowledge,
+        } => {
+            let mut scenario = load(&scenario)?;
+            knowledge.apply(&mut scenario)?;
+            tree_cmds::plan(&scenario, goal.as_deref(), glyphs)
         }
         Command::Run {
             scenario,
@@ -340,8 +379,13 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             max_ticks,
             variant,
             viz,
+            knowledge,
         } => tree_cmds::run(
-            &load(&scenario)?,
+            &{
+                let mut s = load(&scenario)?;
+                knowledge.apply(&mut s)?;
+                s
+            },
             tree.as_deref(),
             trace,
             max_ticks,
@@ -358,9 +402,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             save,
             variant,
             viz,
+            knowledge,
         } => {
             let scenario_path = find_scenario(&scenario)?;
-            let scenario = Scenario::load(&scenario_path)?;
+            let mut scenario = Scenario::load(&scenario_path)?;
+            knowledge.apply(&mut scenario)?;
             let additions = add
                 .iter()
                 .map(|a| parse_conditions(&scenario, a))
@@ -400,8 +446,13 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             no_disturbances,
             max_states,
             max_ticks,
+            knowledge,
         } => verify_cmd::verify(
-            &load(&scenario)?,
+            &{
+                let mut s = load(&scenario)?;
+                knowledge.apply(&mut s)?;
+                s
+            },
             &verify_cmd::Args {
                 tree,
                 properties,

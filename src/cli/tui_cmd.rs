@@ -32,6 +32,10 @@ pub struct TuiArgs {
     /// Where policies are saved and looked up (default: $XDG_DATA_HOME/betr/policies).
     #[arg(long, value_name = "DIR")]
     pub policy_dir: Option<PathBuf>,
+    /// Plan without the rules learned from approved fixes (knowledge.toml in the policy
+    /// directory).
+    #[arg(long)]
+    pub no_knowledge: bool,
     /// Open this tree file instead of planning one (betr text, a saved policy, or
     /// BehaviorTree.CPP v4 XML).
     #[arg(long, value_name = "FILE")]
@@ -73,7 +77,15 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         }
         None => Arc::new(DefaultMicrophone),
     };
-    let scenario = Arc::new(betr::domain::Scenario::load(&path)?);
+    let mut scenario = betr::domain::Scenario::load(&path)?;
+    super::knowledge_cmd::KnowledgeFlags {
+        dir: super::knowledge_cmd::PolicyDir {
+            policy_dir: args.policy_dir.clone(),
+        },
+        no_knowledge: args.no_knowledge,
+    }
+    .apply(&mut scenario)?;
+    let scenario = Arc::new(scenario);
     // A tree that cannot be read is said before the screen opens (exit 2).
     if let Some(tree) = &args.tree {
         super::export_cmd::load_tree(&scenario, tree)?;

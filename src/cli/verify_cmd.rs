@@ -104,6 +104,14 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     println!("Scenario: {}", scenario.name);
     println!("Tree:     {origin} ({} nodes)", tree.len());
     print!("{note}");
+    for learned in betr::session::knowledge::learned_in_tree(&scenario.domain, &tree) {
+        println!(
+            "Learned:  {}? before {}! (rule {})",
+            learned.condition,
+            learned.action,
+            learned.rules.join(", ")
+        );
+    }
     println!(
         "Checking: action failures {}, {} disturbance(s){}\n",
         if input.limits.action_failures {

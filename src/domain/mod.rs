@@ -2,6 +2,7 @@
 
 pub mod action;
 pub mod condition;
+pub mod learned;
 
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};
@@ -10,6 +11,7 @@ mod scenario_file;
 pub mod skill;
 pub mod vocabulary;
 
+pub use learned::{LearnError, LearnedRule};
 pub use scenario::{Example, Scenario, ScenarioError, SourceFile};
 pub use skill::{AtomPattern, Domain, GroundSkill, Param, Skill, ValueParam};
 pub use vocabulary::{Object, Predicate, Vocabulary, VocabularyError};

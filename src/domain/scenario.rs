@@ -472,6 +472,7 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
                 max: v.max,
             })
             .collect(),
+        learned: Vec::new(),
     })
 }
 

@@ -6,6 +6,7 @@
 
 use super::action::ActionCall;
 use super::condition::{ANY_OBJECT, Atom, Condition};
+use super::learned::LearnedPrecondition;
 use super::vocabulary::Vocabulary;
 
 /// One argument of a condition template.
@@ -84,6 +85,9 @@ pub struct Skill {
     /// How many ticks the action runs before it completes (at least 1).
     pub ticks: u32,
     pub values: Vec<ValueParam>,
+    /// Preconditions kept from approved fixes (`betr knowledge`), checked before the
+    /// declared ones.
+    pub learned: Vec<LearnedPrecondition>,
 }
 
 /// An atom with some positions open (`None` = any object): what a deletion removes.
@@ -211,7 +215,20 @@ impl Skill {
 
     /// Apply the skill to objects. The caller checks `accepts` first.
     pub fn ground(&self, args: &[String]) -> GroundSkill {
-        let (pre, add, del) = ground_templates(&self.pre, &self.add, &self.del, args);
+        let (mut pre, add, del) = ground_templates(&self.pre, &self.add, &self.del, args);
+        let learned: Vec<LiteralTemplate> = self
+            .learned
+            .iter()
+            .filter(|l| l.applies(args))
+            .map(|l| l.condition.clone())
+            .collect();
+        if !learned.is_empty() {
+            let (mut first, _, _) = ground_templates(&learned, &[], &[], args);
+            first.retain(|c| !pre.contains(c));
+            first.dedup();
+            first.append(&mut pre);
+            pre = first;
+        }
         GroundSkill {
             call: ActionCall::new(self.name.clone(), args.iter().cloned()),
             cost: self.cost,
@@ -409,6 +426,7 @@ mod tests {
             cost: 2.0,
             ticks: 1,
             values: vec![],
+            learned: vec![],
         }
     }
 

@@ -83,7 +83,7 @@ pub fn rank(
         let unmet: Vec<&Condition> = ground.pre.iter().filter(|p| !world.check(p)).collect();
         if unmet
             .iter()
-            .any(|p| forbidden.contains(p) || !achievable_without(domain, p, &forbidden))
+            .any(|p| forbidden.contains(p) || !achievable_now(domain, world, p, &forbidden))
         {
             continue;
         }
@@ -99,6 +99,24 @@ pub fn rank(
     // Stable sort: equal scores keep declaration order.
     out.sort_by(|a, b| a.score.total_cmp(&b.score));
     out
+}
+
+/// Whether `condition` can be achieved without any of `forbidden`; a wildcard condition
+/// (`~"any object" on X`) through each object that falsifies it now, as expansion does.
+fn achievable_now(
+    domain: &Domain,
+    world: &dyn World,
+    condition: &Condition,
+    forbidden: &[&Condition],
+) -> bool {
+    if !condition.atom.has_wildcard() {
+        return achievable_without(domain, condition, forbidden);
+    }
+    let witnesses = wildcard_witnesses(domain, world, condition);
+    !witnesses.is_empty()
+        && witnesses
+            .iter()
+            .all(|w| !forbidden.contains(&w) && achievable_without(domain, w, forbidden))
 }
 
 /// Whether some skill achieves `condition` without needing any of `forbidden`.

@@ -74,6 +74,8 @@ pub async fn resolve_with_scenes(
     let mut tree: Option<Arc<Tree>> = None;
     let mut rounds = 0;
     let mut repairs: usize = 0;
+    let mut offered: Option<(Proposal, String)> = None;
+    let mut kept: Vec<(Proposal, String)> = Vec::new();
     let ending = loop {
         let Some(event) = events.recv().await else {
             return Err(SessionError::Stopped);
@@ -89,20 +91,27 @@ pub async fn resolve_with_scenes(
             Event::DidNotHelp { .. } => {
                 engine.send(Command::Run);
             }
-            Event::Proposal { proposal, .. } => {
+            Event::Proposal {
+                proposal, author, ..
+            } => {
                 let yes = approve(&proposal);
+                offered = Some((proposal.clone(), author.clone()));
                 engine.send(if yes {
                     Command::Approve
                 } else {
                     Command::Reject
                 });
             }
-            Event::Repaired { .. } => repairs += 1,
+            Event::Repaired { .. } => {
+                repairs += 1;
+                kept.extend(offered.take());
+            }
             Event::Rejected => break Ending::Rejected,
             // Never approved past a failed check, not even under --yes: the change is
             // rejected, undone, and the model is asked again knowing why.
             Event::ChangeViolates { .. } => {
                 repairs = repairs.saturating_sub(1);
+                kept.pop();
                 engine.send(Command::Reject);
             }
             Event::Success { ticks } => break Ending::Success { ticks },
@@ -125,5 +134,6 @@ pub async fn resolve_with_scenes(
         ending,
         rounds,
         repairs,
+        kept,
     })
 }

@@ -271,6 +271,8 @@ pub struct Resolved {
     pub rounds: usize,
     /// Approved changes kept in the tree.
     pub repairs: usize,
+    /// The approved proposals kept in the tree, in order, with who wrote each.
+    pub kept: Vec<(Proposal, String)>,
 }
 
 #[derive(Debug, Clone, thiserror::Error)]

@@ -1,0 +1,268 @@
+//! Learned knowledge on the command line: the flags every planning command shares, the
+//! offer to keep an approved fix as a rule (`betr resolve --learn`), and
+//! `betr knowledge list|show|revoke`.
+
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand};
+
+use betr::domain::Scenario;
+use betr::session::knowledge::{self, KeptRule, Knowledge, check_rule, offered_rule};
+use betr::session::policy::now_rfc3339;
+use betr::session::{PolicyStore, Proposal};
+
+#[derive(Args, Debug, Clone, Default)]
+pub struct PolicyDir {
+    /// Where policies and the learned knowledge (knowledge.toml) live (default:
+    /// $XDG_DATA_HOME/betr/policies).
+    #[arg(long, value_name = "DIR")]
+    pub policy_dir: Option<PathBuf>,
+}
+
+impl PolicyDir {
+    /// The knowledge file, when a directory is given or a default one exists.
+    pub fn knowledge_path(&self) -> Option<PathBuf> {
+        self.policy_dir
+            .clone()
+            .or_else(|| PolicyStore::default_dir(&|k| std::env::var(k).ok()))
+            .map(|d| Knowledge::path_in(&d))
+    }
+
+    fn open(&self) -> Result<Knowledge> {
+        let path = self.knowledge_path().context(
+            "no policy directory: pass --policy-dir (neither XDG_DATA_HOME nor HOME is set)",
+        )?;
+        Ok(Knowledge::open(&path)?)
+    }
+}
+
+#[derive(Args, Debug, Clone, Default)]
+pub struct KnowledgeFlags {
+    #[command(flatten)]
+    pub dir: PolicyDir,
+    /// Plan without the learned rules.
+    #[arg(long)]
+    pub no_knowledge: bool,
+}
+
+impl KnowledgeFlags {
+    /// Add the learned rules of the scenario's domain to its skills and say so on stderr
+    /// (nothing is said when there are none).
+    pub fn apply(&self, scenario: &mut Scenario) -> Result<Vec<String>> {
+        if self.no_knowledge {
+            return Ok(Vec::new());
+        }
+        let Some(path) = self.dir.knowledge_path() else {
+            return Ok(Vec::new());
+        };
+        let knowledge = Knowledge::open(&path)?;
+        let (applied, notes) = knowledge.apply(scenario);
+        for note in &notes {
+            eprintln!("Knowledge: {note}");
+        }
+        if !applied.is_empty() {
+            eprintln!(
+                "Knowledge: {} learned rule(s) from {} ({}); --no-knowledge plans without them",
+                applied.len(),
+                path.display(),
+                applied.join(", ")
+            );
+        }
+        Ok(applied)
+    }
+}
+
+#[derive(Subcommand, Debug)]
+pub enum KnowledgeAction {
+    /// The kept rules, one per line: id, domain, the rule in words.
+    List {
+        #[command(flatten)]
+        dir: PolicyDir,
+    },
+    /// One rule with where it came from.
+    Show {
+        id: String,
+        #[command(flatten)]
+        dir: PolicyDir,
+    },
+    /// Take a rule out: planning no longer adds it.
+    Revoke {
+        id: String,
+        #[command(flatten)]
+        dir: PolicyDir,
+    },
+}
+
+pub fn run(action: KnowledgeAction) -> Result<ExitCode> {
+    match action {
+        KnowledgeAction::List { dir } => {
+            let knowledge = dir.open()?;
+            if knowledge.rules.is_empty() {
+                println!("No learned rules in {}", knowledge.path.display());
+            }
+            for r in &knowledge.rules {
+                println!("{:<4} {:<6} {}", r.id, r.domain, words(r));
+            }
+        }
+        KnowledgeAction::Show { id, dir } => {
+            let knowledge = dir.open()?;
+            let r = knowledge.get(&id)?;
+            println!("Rule:        {} ({})", r.id, words(r));
+            println!("Domain:      {}", r.domain);
+            println!("Skill:       {}", r.skill);
+            println!("Requires:    {}", r.requires);
+            if let Some(only) = &r.only {
+                println!("Only for:    {}", quoted(only));
+            }
+            println!("From:        {} in {}", r.scenario, r.kept_at);
+            println!("Fix:         {} before {}!", r.condition, r.action);
+            println!("Proposed by: {}", r.proposed_by);
+            println!("Kept by:     {}", r.kept_by);
+        }
+        KnowledgeAction::Revoke { id, dir } => {
+            let mut knowledge = dir.open()?;
+            let r = knowledge.revoke(&id)?;
+            println!(
+                "Revoked {} ({}) from {}",
+                r.id,
+                words(&r),
+                knowledge.path.display()
+            );
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn quoted(objects: &[String]) -> String {
+    objects
+        .iter()
+        .map(|o| format!("\"{o}\""))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// A kept rule in words, with positional objects shown as `{1}` or the objects it is for.
+fn words(r: &KeptRule) -> String {
+    let mut requires = r.requires.clone();
+    let subject = match &r.only {
+        Some(only) => {
+            for (i, o) in only.iter().enumerate().rev() {
+                requires = requires.replace(&format!("{{{}}}", i + 1), o);
+            }
+            format!("{} {}", r.skill, quoted(only))
+        }
+        None => {
+            let n = (1..=9)
+                .filter(|i| r.requires.contains(&format!("{{{i}}}")))
+                .max()
+                .unwrap_or(0);
+            let objects: Vec<String> = (1..=n).map(|i| format!("{{{i}}}")).collect();
+            format!("{} {}", r.skill, objects.join(" "))
+        }
+    };
+    format!("{} needs {requires}", subject.trim_end())
+}
+
+/// After a resolved session: offer each kept fix as a rule (asking unless `yes`), check
+/// it, and keep it in the knowledge file. Returns how many were kept.
+pub fn offer(
+    scenario: &Scenario,
+    scenario_path: &std::path::Path,
+    kept: &[(Proposal, String)],
+    dir: &PolicyDir,
+    yes: bool,
+) -> Result<usize> {
+    let mut knowledge = dir.open()?;
+    let mut count = 0;
+    for (proposal, author) in kept {
+        let Proposal::Conditions {
+            action, conditions, ..
+        } = proposal
+        else {
+            continue;
+        };
+        for condition in conditions {
+            let lifted = offered_rule(action, condition, false);
+            let only = offered_rule(action, condition, true);
+            let rule = if yes {
+                println!(
+                    "Keep as a rule: {}? yes (--yes --learn)",
+                    lifted.describe(&scenario.domain)
+                );
+                Some(lifted)
+            } else {
+                ask(&lifted, &only, scenario)
+            };
+            let Some(rule) = rule else {
+                println!("Not kept.");
+                continue;
+            };
+            if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
+                println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
+                continue;
+            }
+            let kept = knowledge.keep(KeptRule {
+                id: String::new(),
+                domain: knowledge::domain_of(scenario),
+                skill: rule.skill.clone(),
+                requires: rule.requires.clone(),
+                only: rule.only.clone(),
+                kept_at: now_rfc3339(),
+                scenario: scenario_path.display().to_string(),
+                action: action.to_string(),
+                condition: condition.to_string(),
+                proposed_by: author.clone(),
+                kept_by: if yes {
+                    "--yes --learn".into()
+                } else {
+                    "a person".into()
+                },
+            })?;
+            println!(
+                "Kept rule {}: {} (in {})",
+                kept.id,
+                rule.describe(&scenario.domain),
+                knowledge.path.display()
+            );
+            count += 1;
+        }
+    }
+    Ok(count)
+}
+
+fn ask(
+    lifted: &betr::domain::LearnedRule,
+    only: &betr::domain::LearnedRule,
+    scenario: &Scenario,
+) -> Option<betr::domain::LearnedRule> {
+    let general = lifted.only.is_none();
+    if general {
+        print!(
+            "Keep as a rule: {}? [y]es / [o]nly {} / [N]o ",
+            lifted.describe(&scenario.domain),
+            only.describe(&scenario.domain)
+        );
+    } else {
+        print!(
+            "Keep as a rule: {}? [y/N] ",
+            only.describe(&scenario.domain)
+        );
+    }
+    let _ = std::io::stdout().flush();
+    let mut line = String::new();
+    match std::io::stdin().lock().read_line(&mut line) {
+        Ok(0) | Err(_) => None,
+        Ok(_) => match line.trim().to_ascii_lowercase().as_str() {
+            "y" | "yes" => Some(if general {
+                lifted.clone()
+            } else {
+                only.clone()
+            }),
+            "o" | "only" if general => Some(only.clone()),
+            _ => None,
+        },
+    }
+}
