@@ -27,6 +27,7 @@ pub fn betr_with(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
         .current_dir(dir)
         .env("HOME", dir)
         .env("XDG_STATE_HOME", dir.join("state"))
+        .env("XDG_DATA_HOME", dir.join("data"))
         .env("XDG_CONFIG_HOME", dir.join("config"))
         .env(KEY_VAR, KEY)
         .env_remove("BETR_CONFIG")

@@ -1,0 +1,267 @@
+//! Fixes that carry over: a fix approved and kept as a rule in one task plans the next
+//! task of the same kind right from the start (the real binary, a model server that
+//! counts its calls), rules are checked before they are kept, and the knowledge file can
+//! be listed, shown and revoked.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use std::path::Path;
+
+use betr::domain::{ActionCall, Condition, LearnedRule, Scenario};
+use betr::session::knowledge::{Knowledge, Refusal, check_rule, learned_in_tree, offered_rule};
+use support::cli::{KEY_VAR, betr, text, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures;
+
+fn scenario_path(rel: &str) -> String {
+    fixtures::root().join(rel).to_string_lossy().into_owned()
+}
+
+/// `betr resolve SCENARIO --yes` against the fake server, with the policy directory `dir`.
+fn resolve<'a>(scenario: &'a str, base: &'a str, policies: &'a str) -> Vec<&'a str> {
+    vec![
+        "resolve",
+        scenario,
+        "--yes",
+        "--backend",
+        "openai",
+        "--base-url",
+        base,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+        "--policy-dir",
+        policies,
+    ]
+}
+
+#[test]
+fn a_kept_fix_plans_the_next_task_with_no_model_call_and_no_failure() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("knowledge-carry");
+    let policies = dir.join("policies").to_string_lossy().into_owned();
+    let base = server.base_url();
+
+    // Scenario 1, resolved once, its fix kept as a rule.
+    let first = scenario_path("scenarios/cell/red_on_blue.toml");
+    let mut args = resolve(&first, &base, &policies);
+    args.push("--learn");
+    let out = betr(&dir, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        log.contains("Kept rule r1: grasp {x} needs ~\"any object\" on \"{x}\""),
+        "{log}"
+    );
+    let calls_after_first = server.received().len();
+    assert!(calls_after_first >= 2, "goal and fix: {calls_after_first}");
+    let knowledge = Knowledge::open(&Path::new(&policies).join("knowledge.toml")).unwrap();
+    assert_eq!(knowledge.rules.len(), 1);
+    assert_eq!(knowledge.rules[0].requires, "~\"any object\" on \"{1}\"");
+    assert!(
+        knowledge.rules[0]
+            .proposed_by
+            .contains("hand-written fixture")
+    );
+
+    // A new task with other cubes in the same kind of stack: no call, no failure.
+    let next = scenario_path("scenarios/cell/tasks/yellow_on_red.toml");
+    let mut args = resolve(&next, &base, &policies);
+    args.push("--stated-goal");
+    let out = betr(&dir, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(log.contains("SUCCESS in simulation"), "{log}");
+    assert!(log.contains("0 question(s) about failures"), "{log}");
+    assert!(!log.contains("failed"), "no failure in the world:\n{log}");
+    assert!(log.contains("1 learned rule(s)"), "{log}");
+    assert_eq!(server.received().len(), calls_after_first, "no model call");
+
+    // Without the knowledge the same task fails in the world and asks the model.
+    let mut args = resolve(&next, &base, &policies);
+    args.extend(["--stated-goal", "--no-knowledge"]);
+    let out = betr(&dir, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(log.contains("No collision free path found"), "{log}");
+    assert!(server.received().len() > calls_after_first);
+
+    // `betr verify` names the rule the tree depends on.
+    let out = betr(&dir, &["verify", &next, "--policy-dir", &policies]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        log.contains(
+            "Learned:  ~\"any object\" on \"yellow cube\"? before grasp \"yellow cube\"! (rule r1)"
+        ),
+        "{log}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn knowledge_is_listed_shown_and_revoked() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("knowledge-cli");
+    let policies = dir.join("p").to_string_lossy().into_owned();
+    let base = server.base_url();
+    let first = scenario_path("scenarios/cell/red_on_blue.toml");
+    let mut args = resolve(&first, &base, &policies);
+    args.push("--learn");
+    assert_eq!(betr(&dir, &args).status.code(), Some(0));
+
+    let out = betr(&dir, &["knowledge", "list", "--policy-dir", &policies]);
+    let log = text(&out);
+    assert!(
+        log.contains("r1   cell   grasp {1} needs ~\"any object\" on \"{1}\""),
+        "{log}"
+    );
+    let out = betr(
+        &dir,
+        &["knowledge", "show", "r1", "--policy-dir", &policies],
+    );
+    let log = text(&out);
+    assert!(
+        log.contains("Fix:         ~\"any object\" on \"blue cube\" before grasp \"blue cube\"!"),
+        "{log}"
+    );
+    assert!(log.contains("Kept by:     --yes --learn"), "{log}");
+    assert!(log.contains("red_on_blue.toml"), "{log}");
+
+    // The same task again: the rule plans it, nothing fails, nothing new is kept.
+    let out = betr(&dir, &args);
+    assert!(text(&out).contains("0 change(s) kept"), "{}", text(&out));
+    let knowledge = Knowledge::open(&Path::new(&policies).join("knowledge.toml")).unwrap();
+    assert_eq!(knowledge.rules.len(), 1);
+    // Offered again, a kept rule is refused as known.
+    let again = knowledge.rules[0].rule();
+    let e = check_rule(
+        &again,
+        &scenario("scenarios/cell/red_on_blue.toml"),
+        &knowledge,
+    );
+    assert_eq!(e, Err(Refusal::Known("r1".into())));
+
+    let out = betr(
+        &dir,
+        &["knowledge", "revoke", "r7", "--policy-dir", &policies],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("no rule \"r7\""), "{}", text(&out));
+    assert!(text(&out).contains("rules: r1"), "{}", text(&out));
+    let out = betr(
+        &dir,
+        &["knowledge", "revoke", "r1", "--policy-dir", &policies],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let out = betr(&dir, &["knowledge", "list", "--policy-dir", &policies]);
+    assert!(text(&out).contains("No learned rules"), "{}", text(&out));
+
+    // A knowledge file that cannot be read is refused with where it is wrong.
+    std::fs::write(
+        Path::new(&policies).join("knowledge.toml"),
+        "version = 1\n[[rules]]\nid = 3\n",
+    )
+    .unwrap();
+    let next = scenario_path("scenarios/cell/tasks/yellow_on_red.toml");
+    let out = betr(&dir, &["plan", &next, "--policy-dir", &policies]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(
+        text(&out).contains("knowledge.toml: line 3"),
+        "{}",
+        text(&out)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn scenario(rel: &str) -> Scenario {
+    Scenario::load(&fixtures::root().join(rel)).unwrap()
+}
+
+fn empty_knowledge() -> Knowledge {
+    Knowledge {
+        path: "unused.toml".into(),
+        rules: Vec::new(),
+    }
+}
+
+fn rule(skill: &str, requires: &str) -> LearnedRule {
+    LearnedRule {
+        id: String::new(),
+        skill: skill.into(),
+        requires: requires.into(),
+        only: None,
+    }
+}
+
+#[test]
+fn rules_that_contradict_the_skills_or_break_a_goal_are_refused() {
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let k = empty_knowledge();
+    // grasp declares ~"any object" grasped: its negation could never hold with it.
+    let e = check_rule(&rule("grasp", "\"any object\" grasped"), &s, &k).unwrap_err();
+    assert!(matches!(e, Refusal::ContradictsPrecondition { .. }), "{e}");
+    // grasp makes its object grasped: asking for that first makes it pointless.
+    let e = check_rule(&rule("grasp", "\"{1}\" grasped"), &s, &k).unwrap_err();
+    assert!(matches!(e, Refusal::ContradictsEffect { .. }), "{e}");
+    // Nothing may lie on the table before anything is grasped: every cell task that
+    // grasps something on the table becomes unplannable.
+    let e = check_rule(&rule("grasp", "~\"any object\" on \"table\""), &s, &k).unwrap_err();
+    assert!(matches!(e, Refusal::GoalUnplannable { .. }), "{e}");
+    assert!(e.to_string().contains("can no longer be planned"), "{e}");
+    // A rule naming a skill the domain does not have.
+    let e = check_rule(&rule("fly", "\"{1}\" open"), &s, &k).unwrap_err();
+    assert!(matches!(e, Refusal::DoesNotFit(_)), "{e}");
+    // Scenario 1's fix is fine.
+    check_rule(&rule("grasp", "~\"any object\" on \"{1}\""), &s, &k).unwrap();
+}
+
+#[test]
+fn a_fix_naming_none_of_the_actions_objects_is_kept_only_for_them() {
+    // The fries' fix: the robot near the bar. Nothing ties the bar to the chips in the
+    // vocabulary, so the rule cannot be lifted to every item.
+    let action = ActionCall::parse("PickUp \"Chips\"").unwrap();
+    let fix = Condition::parse("RobotNear_Bar").unwrap();
+    let r = offered_rule(&action, &fix, false);
+    assert_eq!(r.only, Some(vec!["Chips".to_string()]));
+    let s = scenario("scenarios/cafe/find_fries.toml");
+    assert_eq!(
+        r.describe(&s.domain),
+        "PickUp \"Chips\" needs RobotNear_Bar (only for these objects)"
+    );
+    check_rule(&r, &s, &empty_knowledge()).unwrap();
+}
+
+#[test]
+fn the_tree_marks_the_conditions_a_rule_put_there() {
+    let mut s = scenario("scenarios/cell/tasks/yellow_on_red.toml");
+    let mut r = rule("grasp", "~\"any object\" on \"{1}\"");
+    r.id = "r4".into();
+    s.domain.learn(&r).unwrap();
+    let world = betr::world::load(&s).unwrap();
+    let plan = betr::planner::Planner::new(&s.domain)
+        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
+        .unwrap();
+    assert_eq!(plan.outcome, betr::planner::Outcome::Success);
+    let marked = learned_in_tree(&s.domain, &plan.tree);
+    let text: Vec<String> = marked
+        .iter()
+        .map(|m| {
+            format!(
+                "{} before {} ({})",
+                m.condition,
+                m.action,
+                m.rules.join(",")
+            )
+        })
+        .collect();
+    assert!(
+        text.contains(
+            &"~\"any object\" on \"yellow cube\" before grasp \"yellow cube\" (r4)".to_string()
+        ),
+        "{text:?}"
+    );
+}
