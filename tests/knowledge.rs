@@ -217,6 +217,30 @@ fn rules_that_contradict_the_skills_or_break_a_goal_are_refused() {
     assert!(matches!(e, Refusal::DoesNotFit(_)), "{e}");
     // Scenario 1's fix is fine.
     check_rule(&rule("grasp", "~\"any object\" on \"{1}\""), &s, &k).unwrap();
+
+    // A fix of the fries lifted too far: every item would have to lie on the bar before
+    // it is picked up, and the cafe's worked examples that fetch things from elsewhere no
+    // longer plan (to put an item on the bar the robot must pick it up first).
+    let cafe = scenario("scenarios/cafe/no_coffee.toml");
+    let e = check_rule(&rule("PickUp", "On_{1}_Bar"), &cafe, &k).unwrap_err();
+    assert!(matches!(e, Refusal::GoalUnplannable { .. }), "{e}");
+    assert!(e.to_string().contains("worked example"), "{e}");
+    // The no-coffee fix lifted: a makable item must have been made before it is picked
+    // up. The predicate takes only makables, so the rule says nothing of other items, and
+    // every example still plans.
+    check_rule(&rule("PickUp", "Exists_{1}"), &cafe, &k).unwrap();
+    let mut d = cafe.domain.clone();
+    d.learn(&rule("PickUp", "Exists_{1}")).unwrap();
+    let pick = |item: &str| {
+        d.resolve(&ActionCall::parse(&format!("PickUp \"{item}\"")).unwrap())
+            .unwrap()
+            .pre
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(pick("Coffee")[0], "Exists_Coffee");
+    assert!(!pick("Chips").iter().any(|c| c.starts_with("Exists")));
 }
 
 #[test]
@@ -264,4 +288,86 @@ fn the_tree_marks_the_conditions_a_rule_put_there() {
         ),
         "{text:?}"
     );
+}
+
+#[test]
+fn the_sequence_eval_reports_calls_and_failures_with_and_without_kept_knowledge() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("knowledge-sequence");
+    let scenarios = fixtures::root().join("scenarios").display().to_string();
+    let base = server.base_url();
+    let args = [
+        "eval",
+        "resolve",
+        "--sequence",
+        "--goal",
+        "scenario",
+        "--scenarios",
+        &scenarios,
+        "--out",
+        "out",
+        "--backend",
+        "openai",
+        "--base-url",
+        &base,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+    ];
+    let out = betr(&dir, &args);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/results.json")).unwrap())
+            .unwrap();
+    let steps = results["steps"].as_array().unwrap();
+    let tasks = std::fs::read_dir(fixtures::root().join("scenarios/cell/tasks"))
+        .unwrap()
+        .count();
+    assert_eq!(steps.len(), 2 * (10 + tasks));
+    let step = |scenario: &str, with: bool| {
+        steps
+            .iter()
+            .find(|s| s["scenario"] == scenario && s["with_knowledge"] == with)
+            .unwrap_or_else(|| panic!("no step {scenario} {with}"))
+    };
+    for s in steps {
+        assert_eq!(s["success"], true, "{s}");
+    }
+    // Scenario 1 keeps the grasp rule; the new cube task then needs nothing.
+    let first = step("cell/red_on_blue.toml", true);
+    assert!(
+        first["rules_kept"][0]
+            .as_str()
+            .unwrap()
+            .starts_with("r1 grasp {x} needs"),
+        "{first}"
+    );
+    let cubes = step("cell/tasks/yellow_on_red.toml", true);
+    assert_eq!(cubes["calls"], 0, "{cubes}");
+    assert_eq!(cubes["world_failures"], 0, "{cubes}");
+    let without = step("cell/tasks/yellow_on_red.toml", false);
+    assert_eq!(without["world_failures"], 1, "{without}");
+    assert_eq!(without["calls"], 1, "{without}");
+    // Over the new tasks, kept knowledge never costs calls or failures.
+    let total = |with: bool, key: &str| -> u64 {
+        steps
+            .iter()
+            .filter(|s| s["with_knowledge"] == with)
+            .filter(|s| s["scenario"].as_str().unwrap().starts_with("cell/tasks/"))
+            .map(|s| s[key].as_u64().unwrap())
+            .sum()
+    };
+    assert!(total(true, "calls") < total(false, "calls"));
+    assert!(total(true, "world_failures") < total(false, "world_failures"));
+    let table = std::fs::read_to_string(dir.join("out/table.md")).unwrap();
+    assert!(table.contains("the new tasks:"), "{table}");
+    assert!(table.contains("Rules kept along the way:"), "{table}");
+
+    // Run again: every step is in the journal, nothing is asked.
+    let calls = server.received().len();
+    let out = betr(&dir, &args);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert_eq!(server.received().len(), calls);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

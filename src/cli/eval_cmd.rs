@@ -55,6 +55,13 @@ pub enum EvalExperiment {
         /// The directory holding cell/ and cafe/ scenarios.
         #[arg(long, default_value = "scenarios")]
         scenarios: PathBuf,
+        /// Run the ten failure scenarios one after the other and then the new tasks of
+        /// cell/tasks/ (the same kinds of failure with other objects), once keeping every
+        /// approved fix as a rule for the next (as `betr resolve --yes --learn`) and once
+        /// without: model calls, failures in the world and ticks side by side (--runs is
+        /// not used).
+        #[arg(long)]
+        sequence: bool,
         #[command(flatten)]
         run: RunFlags,
     },
@@ -110,8 +117,17 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
             max_rounds,
             goal,
             scenarios,
+            sequence: false,
             run,
         } => session_experiment(S::Resolve, &scenarios, runs, (max_rounds, goal), &run),
+        EvalExperiment::Resolve {
+            max_rounds,
+            goal,
+            scenarios,
+            sequence: true,
+            run,
+            ..
+        } => sequence_experiment(&scenarios, (max_rounds, goal), &run),
         EvalExperiment::Params {
             runs,
             max_rounds,
@@ -245,6 +261,90 @@ pub fn goals_with_model(
     write_all(&dir, &results, &results.csv(), &table, || {
         goals_chart(&dir, &p.label, &results)
     })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `betr eval resolve --sequence`: the failure scenarios, then the new tasks, without and
+/// with the fixes kept as rules between them.
+fn sequence_experiment(
+    scenarios_dir: &Path,
+    (max_rounds, goal): (usize, GoalSource),
+    flags: &RunFlags,
+) -> Result<ExitCode> {
+    let mut paths: Vec<String> = resolve::FAILURE_SCENARIOS
+        .iter()
+        .map(|p| (*p).to_string())
+        .collect();
+    let failure_steps = paths.len();
+    let tasks_dir = scenarios_dir.join("cell/tasks");
+    let mut tasks: Vec<String> = std::fs::read_dir(&tasks_dir)
+        .with_context(|| format!("reading {}", tasks_dir.display()))?
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter_map(|p| {
+            p.file_name()
+                .map(|n| format!("cell/tasks/{}", n.to_string_lossy()))
+        })
+        .collect();
+    tasks.sort();
+    paths.extend(tasks);
+    let scenarios = paths
+        .iter()
+        .map(|p| {
+            let path = scenarios_dir.join(p);
+            Scenario::load(&path)
+                .map(|s| (p.clone(), s))
+                .with_context(|| format!("loading {}", path.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let goal_source = match goal {
+        GoalSource::Interpret => "interpret",
+        GoalSource::Scenario => "scenario",
+    };
+    let mut p = prepare(
+        flags,
+        &[
+            ("max_rounds", max_rounds.to_string()),
+            ("goal", goal_source.to_string()),
+            ("sequence", paths.join(" ")),
+        ],
+    )?;
+    p.llm.options.max_rounds = max_rounds;
+    p.llm.options.use_scenario_goal = goal == GoalSource::Scenario;
+    p.label = format!("{}, goal: {goal_source}", p.label);
+    let dir = eval::output_dir(flags.out.as_deref(), "resolve-sequence")
+        .context("creating the output directory")?;
+    eval::run::check_settings(&dir, "resolve-sequence", &p.settings)?;
+    p.llm.model.set_purpose("eval resolve --sequence");
+    let model: Arc<dyn LanguageModel> = p.llm.model.clone();
+    let bar = Bar::new();
+    let cfg = RunConfig {
+        runs: 1,
+        concurrency: 1,
+        limit: flags.limit,
+        prices: p.llm.settings.prices.clone(),
+        progress: &bar,
+    };
+    let results = runtime()?
+        .block_on(eval::sequence::run_sequence(
+            &model,
+            &scenarios,
+            failure_steps,
+            &p.llm.options,
+            &cfg,
+            &dir,
+        ))
+        .with_context(|| stopped(&dir))?;
+    let table = results.table(&p.label);
+    write(
+        &dir,
+        "results.json",
+        serde_json::to_string_pretty(&results)?.as_bytes(),
+    )?;
+    write(&dir, "table.md", table.as_bytes())?;
+    print!("{table}");
+    println!("\nresults: {}", dir.display());
     Ok(ExitCode::SUCCESS)
 }
 

@@ -10,7 +10,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 
 use betr::domain::Scenario;
-use betr::session::knowledge::{self, KeptRule, Knowledge, check_rule, offered_rule};
+use betr::session::knowledge::{self, KeptRule, Knowledge, check_rule, offered_rule, rule_for_fix};
 use betr::session::policy::now_rfc3339;
 use betr::session::{PolicyStore, Proposal};
 
@@ -185,25 +185,35 @@ pub fn offer(
             continue;
         };
         for condition in conditions {
-            let lifted = offered_rule(action, condition, false);
-            let only = offered_rule(action, condition, true);
             let rule = if yes {
-                println!(
-                    "Keep as a rule: {}? yes (--yes --learn)",
-                    lifted.describe(&scenario.domain)
-                );
-                Some(lifted)
+                match rule_for_fix(action, condition, scenario, &knowledge) {
+                    Ok(rule) => {
+                        println!(
+                            "Keep as a rule: {}? yes (--yes --learn)",
+                            rule.describe(&scenario.domain)
+                        );
+                        rule
+                    }
+                    Err(refused) => {
+                        for (rule, why) in refused {
+                            println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
+                        }
+                        continue;
+                    }
+                }
             } else {
-                ask(&lifted, &only, scenario)
+                let lifted = offered_rule(action, condition, false);
+                let only = offered_rule(action, condition, true);
+                let Some(rule) = ask(&lifted, &only, scenario) else {
+                    println!("Not kept.");
+                    continue;
+                };
+                if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
+                    println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
+                    continue;
+                }
+                rule
             };
-            let Some(rule) = rule else {
-                println!("Not kept.");
-                continue;
-            };
-            if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
-                println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
-                continue;
-            }
             let kept = knowledge.keep(KeptRule {
                 id: String::new(),
                 domain: knowledge::domain_of(scenario),

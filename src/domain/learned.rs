@@ -33,12 +33,19 @@ pub struct LearnedPrecondition {
     pub rule: String,
     pub condition: LiteralTemplate,
     pub only: Option<Vec<String>>,
+    /// Per skill parameter the condition names, the objects its predicate can take there:
+    /// a rule learned for a cup says nothing of a centrifuge that is not an item.
+    pub fitting: Vec<(usize, Vec<String>)>,
 }
 
 impl LearnedPrecondition {
     /// Whether the rule holds for an action on `args`.
     pub fn applies(&self, args: &[String]) -> bool {
         self.only.as_ref().is_none_or(|only| only == args)
+            && self
+                .fitting
+                .iter()
+                .all(|(i, objects)| args.get(*i).is_some_and(|a| objects.contains(a)))
     }
 }
 
@@ -173,6 +180,34 @@ impl LearnedRule {
     }
 }
 
+/// For each parameter of `skill` that `condition` names, the objects the parameter admits
+/// that the predicate takes at that position.
+fn fitting(
+    vocabulary: &super::Vocabulary,
+    skill: &Skill,
+    condition: &LiteralTemplate,
+) -> Vec<(usize, Vec<String>)> {
+    let Some(predicate) = vocabulary.predicate(&condition.atom.predicate) else {
+        return Vec::new();
+    };
+    let mut out: Vec<(usize, Vec<String>)> = Vec::new();
+    for (term, types) in condition.atom.args.iter().zip(&predicate.arg_types) {
+        let Term::Param(i) = term else { continue };
+        let Some(param) = skill.params.get(*i) else {
+            continue;
+        };
+        let objects: Vec<String> = param
+            .candidates(vocabulary)
+            .filter(|o| vocabulary.fits(o, types))
+            .map(str::to_string)
+            .filter(|o| out.iter().all(|(j, os)| j != i || os.contains(o)))
+            .collect();
+        out.retain(|(j, _)| j != i);
+        out.push((*i, objects));
+    }
+    out
+}
+
 impl Domain {
     /// Add `rule` to every skill it names, as a first precondition (before the declared
     /// ones); a rule the skill already declares changes nothing.
@@ -181,6 +216,19 @@ impl Domain {
         for skill in self.skills.iter_mut().filter(|s| s.name == rule.skill) {
             found = true;
             let condition = rule.template(skill)?;
+            let fitting = fitting(&self.vocabulary, skill, &condition);
+            if let Some((i, _)) = fitting.iter().find(|(_, objects)| objects.is_empty()) {
+                return Err(LearnError::Condition {
+                    rule: rule.id.clone(),
+                    requires: rule.requires.clone(),
+                    reason: format!(
+                        "no object {} takes as {{{}}} fits {}",
+                        skill.name,
+                        skill.params.get(*i).map_or("?", |p| p.name.as_str()),
+                        condition.atom.predicate
+                    ),
+                });
+            }
             if skill.pre.contains(&condition)
                 || skill
                     .learned
@@ -193,6 +241,7 @@ impl Domain {
                 rule: rule.id.clone(),
                 condition,
                 only: rule.only.clone(),
+                fitting,
             });
         }
         if found {

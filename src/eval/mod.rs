@@ -8,6 +8,7 @@ pub mod goals_run;
 pub mod params;
 pub mod resolve;
 pub mod run;
+pub mod sequence;
 mod session_run;
 #[cfg(test)]
 mod tests;

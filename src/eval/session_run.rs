@@ -14,6 +14,8 @@ pub struct Trace {
     /// stopped without success.
     pub ending: Result<u64, String>,
     pub rounds: usize,
+    /// The approved proposals kept in the final tree, with who wrote each.
+    pub kept: Vec<(session::Proposal, String)>,
 }
 
 /// Resolve `scenario`'s instruction end to end, approving every proposal. A reply that
@@ -28,7 +30,7 @@ pub async fn resolve_approving(
     let mut approve = |_: &session::Proposal| true;
     let mut emit = |e: &Event| events.push(e.clone());
     let result = session::resolve(scenario, None, model, options, &mut approve, &mut emit).await;
-    let (ending, rounds) = match result {
+    let (ending, rounds, kept) = match result {
         Ok(r) => (
             match r.ending {
                 Ending::Success { ticks } => Ok(ticks),
@@ -36,13 +38,15 @@ pub async fn resolve_approving(
                 Ending::Rejected => Err("a proposal was rejected".into()),
             },
             r.rounds,
+            r.kept,
         ),
-        Err(e @ SessionError::NoGoal { .. }) => (Err(e.to_string()), 0),
+        Err(e @ SessionError::NoGoal { .. }) => (Err(e.to_string()), 0, Vec::new()),
         Err(e) => return Err(e),
     };
     Ok(Trace {
         events,
         ending,
         rounds,
+        kept,
     })
 }

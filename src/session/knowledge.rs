@@ -336,23 +336,52 @@ pub fn check_rule(
             });
         }
     }
+    let with_rule = |s: &Scenario| {
+        let mut s = s.clone();
+        knowledge.apply(&mut s);
+        s.domain.learn(rule).ok().map(|()| s)
+    };
+    // The domain's worked examples are goals a person may ask for in this scene.
+    let facts = facts_of(scenario).map_err(|why| Refusal::GoalUnplannable {
+        scenario: scenario.name.clone(),
+        goal: String::new(),
+        why,
+    })?;
+    if let Some(learned) = with_rule(scenario) {
+        for example in &scenario.examples {
+            let Ok(goal) = scenario.parse_goal(&example.goal) else {
+                continue;
+            };
+            if plans(scenario, &facts, &goal).is_err() {
+                continue;
+            }
+            if let Err(why) = plans(&learned, &facts, &goal) {
+                return Err(Refusal::GoalUnplannable {
+                    scenario: format!("the worked example {:?}", example.instruction),
+                    goal: goal.to_string(),
+                    why,
+                });
+            }
+        }
+    }
     for path in domain_scenarios(scenario) {
-        let Ok(mut other) = Scenario::load(&path) else {
+        let Ok(other) = Scenario::load(&path) else {
             continue;
         };
         let Some(goal) = other.goal.clone() else {
             continue;
         };
-        let before = plans(&other, &goal);
-        if before.is_err() {
-            // Unplannable without the rule too: not the rule's doing.
+        let Ok(facts) = facts_of(&other) else {
+            continue;
+        };
+        // Unplannable without the rule too: not the rule's doing.
+        if plans(&other, &facts, &goal).is_err() {
             continue;
         }
-        knowledge.apply(&mut other);
-        if other.domain.learn(rule).is_err() {
+        let Some(learned) = with_rule(&other) else {
             continue;
-        }
-        if let Err(why) = plans(&other, &goal) {
+        };
+        if let Err(why) = plans(&learned, &facts, &goal) {
             return Err(Refusal::GoalUnplannable {
                 scenario: path.display().to_string(),
                 goal: goal.to_string(),
@@ -363,10 +392,20 @@ pub fn check_rule(
     Ok(())
 }
 
-/// Whether the scenario's goal plans to success in the model from its world's first facts.
-fn plans(scenario: &Scenario, goal: &crate::goal::Formula) -> Result<(), String> {
-    let world = crate::world::load(scenario).map_err(|e| e.to_string())?;
-    let planned = plan_in_model(&scenario.domain, &world.facts(), &goal.to_dnf(), &[], &[])
+/// The facts true in the scenario's world at the start.
+fn facts_of(scenario: &Scenario) -> Result<Vec<Condition>, String> {
+    Ok(crate::world::load(scenario)
+        .map_err(|e| e.to_string())?
+        .facts())
+}
+
+/// Whether `goal` plans to success in the model from `facts`.
+fn plans(
+    scenario: &Scenario,
+    facts: &[Condition],
+    goal: &crate::goal::Formula,
+) -> Result<(), String> {
+    let planned = plan_in_model(&scenario.domain, facts, &goal.to_dnf(), &[], &[])
         .map_err(|e| e.to_string())?;
     match planned.plan.outcome {
         Outcome::Success => Ok(()),
@@ -489,4 +528,30 @@ pub fn learned_in_tree(domain: &crate::domain::Domain, tree: &crate::bt::Tree) -
         }
     }
     out
+}
+
+/// The rule to keep for a fix when nobody is asked (`--yes --learn`): the lifted rule, or,
+/// when that is refused, the rule for the fix's objects alone. `Err` holds each refusal.
+pub fn rule_for_fix(
+    action: &ActionCall,
+    condition: &Condition,
+    scenario: &Scenario,
+    knowledge: &Knowledge,
+) -> Result<LearnedRule, Vec<(LearnedRule, Refusal)>> {
+    let lifted = offered_rule(action, condition, false);
+    let only = offered_rule(action, condition, true);
+    let mut refused = Vec::new();
+    for rule in [lifted, only] {
+        if refused
+            .iter()
+            .any(|(r, _): &(LearnedRule, Refusal)| *r == rule)
+        {
+            continue;
+        }
+        match check_rule(&rule, scenario, knowledge) {
+            Ok(()) => return Ok(rule),
+            Err(e) => refused.push((rule, e)),
+        }
+    }
+    Err(refused)
 }
