@@ -43,7 +43,7 @@ fn main() -> Result<()> {
     let mut pane = TreePane::default();
     let mut terminal = Terminal::new(TestBackend::new(120, 40))?;
     let start = Instant::now();
-    pane.set_tree(tree.clone(), vec![tree.root()]);
+    pane.set_tree(tree.clone(), vec![tree.root()], Vec::new());
     terminal.draw(|f| pane.draw(f, f.area(), &theme))?;
     let first = start.elapsed().as_secs_f64() * 1e3;
     let mut frames: Vec<f64> = (0..50)

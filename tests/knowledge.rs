@@ -371,3 +371,104 @@ fn the_sequence_eval_reports_calls_and_failures_with_and_without_kept_knowledge(
     assert_eq!(server.received().len(), calls);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+mod engine {
+    use std::sync::Arc;
+    use std::time::Duration;
+
+    use betr::domain::Scenario;
+    use betr::session::{Command, Engine, Event, Knowledge, Setup};
+    use tokio::sync::mpsc::UnboundedReceiver;
+
+    use super::support::fake_model::FixtureModel;
+    use super::support::fixtures;
+
+    async fn until(events: &mut UnboundedReceiver<Event>, pred: impl Fn(&Event) -> bool) -> Event {
+        let wait = async {
+            loop {
+                let e = events.recv().await.expect("the engine stopped");
+                if pred(&e) {
+                    return e;
+                }
+            }
+        };
+        tokio::time::timeout(Duration::from_secs(20), wait)
+            .await
+            .expect("timed out")
+    }
+
+    #[test]
+    fn an_approved_fix_is_offered_kept_and_marked_in_the_tree() {
+        let dir = super::tmp("knowledge-engine");
+        let file = dir.join("knowledge.toml");
+        let rt = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(2)
+            .enable_all()
+            .build()
+            .unwrap();
+        rt.block_on(async {
+            let path = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+            let scenario = Scenario::load(&path).unwrap();
+            let model = FixtureModel::new(fixtures::every_reply());
+            let setup = Setup {
+                knowledge: Some(Knowledge::open(&file).unwrap()),
+                ..Setup::new(Arc::new(scenario.clone()), path, Ok(Arc::new(model)))
+            };
+            let (engine, mut events) = Engine::spawn(setup).unwrap();
+            engine.send(Command::SubmitGoal {
+                goal: scenario.goal.clone().unwrap(),
+                instruction: scenario.instruction.clone().unwrap(),
+            });
+            until(&mut events, |e| matches!(e, Event::TreeChanged { .. })).await;
+            engine.send(Command::Run);
+            until(&mut events, |e| matches!(e, Event::Proposal { .. })).await;
+            engine.send(Command::Approve);
+            let offer = until(&mut events, |e| matches!(e, Event::RuleOffered { .. })).await;
+            let Event::RuleOffered { rule, only, .. } = offer else {
+                unreachable!()
+            };
+            assert_eq!(rule, "grasp {x} needs ~\"any object\" on \"{x}\"");
+            assert_eq!(
+                only.as_deref(),
+                Some("grasp \"blue cube\" needs ~\"any object\" on \"blue cube\" (only for these objects)")
+            );
+            // Nothing is kept before a person says so.
+            assert!(Knowledge::open(&file).unwrap().rules.is_empty());
+            engine.send(Command::KeepRule { only: false });
+            let kept = until(&mut events, |e| matches!(e, Event::RuleKept { .. })).await;
+            let Event::RuleKept { id, .. } = kept else {
+                unreachable!()
+            };
+            assert_eq!(id, "r1");
+            // The tree now shows which of its conditions the rule explains.
+            let marked = until(&mut events, |e| {
+                matches!(e, Event::TreeChanged { learned, .. } if !learned.is_empty())
+            })
+            .await;
+            let Event::TreeChanged { tree, learned, .. } = marked else {
+                unreachable!()
+            };
+            let (node, rules) = &learned[0];
+            assert_eq!(rules, &vec!["r1".to_string()]);
+            assert_eq!(
+                tree.kind(*node).unwrap().as_condition().unwrap().to_string(),
+                "~\"any object\" on \"blue cube\""
+            );
+            let k = Knowledge::open(&file).unwrap();
+            assert_eq!(k.rules.len(), 1);
+            assert_eq!(k.rules[0].kept_by, "a person (workbench)");
+            // Nothing more is offered; the view lists the rule.
+            engine.send(Command::DeclineRule);
+            until(&mut events, |e| matches!(e, Event::Error { .. })).await;
+            engine.send(Command::ShowKnowledge);
+            let view = until(&mut events, |e| matches!(e, Event::Knowledge { .. })).await;
+            let Event::Knowledge { rules, .. } = view else {
+                unreachable!()
+            };
+            assert_eq!(rules.len(), 1);
+            assert!(rules[0].starts_with("r1: grasp {x} needs"), "{rules:?}");
+            engine.send(Command::Shutdown);
+        });
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

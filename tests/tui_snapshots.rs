@@ -65,6 +65,15 @@ impl Bench {
     }
 
     fn with_microphone(microphone: Arc<dyn Microphone>, loader: SttLoader) -> Bench {
+        Bench::with_knowledge(microphone, loader, None)
+    }
+
+    /// A bench whose engine offers approved fixes as rules, kept in `knowledge`.
+    fn with_knowledge(
+        microphone: Arc<dyn Microphone>,
+        loader: SttLoader,
+        knowledge: Option<betr::session::Knowledge>,
+    ) -> Bench {
         let path = fixtures::root().join("scenarios/cell/red_on_blue.toml");
         let scenario = Arc::new(Scenario::load(&path).unwrap());
         let info = Info {
@@ -83,7 +92,10 @@ impl Bench {
             keys_error: None,
         };
         let model = FixtureModel::new(fixtures::every_reply());
-        let setup = Setup::new(scenario, path, Ok(Arc::new(model)));
+        let setup = Setup {
+            knowledge,
+            ..Setup::new(scenario, path, Ok(Arc::new(model)))
+        };
         let (engine, events) = Engine::spawn(setup).unwrap();
         let (dictation, heard) = DictationService::new(microphone, Ok(loader));
         Bench {
@@ -228,6 +240,49 @@ fn failure_with_a_pending_proposal_then_approval() {
         assert!(screen.contains("SUCCESS"), "{screen}");
         insta::assert_snapshot!("after_run_to_success", screen);
     });
+}
+
+#[test]
+fn an_approved_fix_kept_as_a_rule_is_marked_in_the_tree() {
+    let dir = std::env::temp_dir().join(format!("betr-tui-knowledge-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("knowledge.toml");
+    rt().block_on(async {
+        let knowledge = betr::session::Knowledge::open(&file).unwrap();
+        let mut b = Bench::with_knowledge(
+            AudioMicrophone::missing(),
+            fixed_words("unused"),
+            Some(knowledge),
+        );
+        b.step_to_failure().await;
+        b.key(KeyCode::Char('a'));
+        b.until(|e| matches!(e, Event::RuleOffered { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("Keep as a rule for later tasks: grasp {x} needs"),
+            "{screen}"
+        );
+        b.key(KeyCode::Char('m'));
+        b.until(|e| matches!(e, Event::TreeChanged { learned, .. } if !learned.is_empty()))
+            .await;
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("~\"any object\" on \"blue cube\"? ◆ learned r1"),
+            "{screen}"
+        );
+        // (No snapshot: the screen shows the knowledge file's temporary path.)
+        assert!(screen.contains("kept as rule r1"), "{screen}");
+        b.key(KeyCode::Char('g'));
+        b.until(|e| matches!(e, Event::Knowledge { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("Rules learned from approved fixes (1"),
+            "{screen}"
+        );
+        assert!(screen.contains("r1: grasp {x} needs"), "{screen}");
+    });
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -511,6 +511,10 @@ fn print_event_line(event: &Event) {
         | Event::PolicySaved { .. }
         | Event::Exported { .. }
         | Event::PolicyLoaded { .. }
+        | Event::RuleOffered { .. }
+        | Event::RuleKept { .. }
+        | Event::RuleRefused { .. }
+        | Event::Knowledge { .. }
         | Event::Notice { .. } => {}
         Event::Error { message } => println!("error: {message}"),
         // Returned by the loop as its error, and printed once by `main`.

@@ -78,13 +78,18 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         None => Arc::new(DefaultMicrophone),
     };
     let mut scenario = betr::domain::Scenario::load(&path)?;
-    super::knowledge_cmd::KnowledgeFlags {
+    let knowledge_flags = super::knowledge_cmd::KnowledgeFlags {
         dir: super::knowledge_cmd::PolicyDir {
             policy_dir: args.policy_dir.clone(),
         },
         no_knowledge: args.no_knowledge,
-    }
-    .apply(&mut scenario)?;
+    };
+    knowledge_flags.apply(&mut scenario)?;
+    // Fixes approved in the workbench may be kept as rules in the same file.
+    let knowledge = match knowledge_flags.dir.knowledge_path() {
+        Some(p) if !args.no_knowledge => Some(betr::session::Knowledge::open(&p)?),
+        _ => None,
+    };
     let scenario = Arc::new(scenario);
     // A tree that cannot be read is said before the screen opens (exit 2).
     if let Some(tree) = &args.tree {
@@ -147,6 +152,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         policies: policy_dir.map(PolicyStore::new),
         tick_interval: Duration::from_millis(args.tick_ms),
         scenes: args.viz.viewer.is_some() || args.viz.rrd.is_some(),
+        knowledge,
         ..Setup::new(scenario, path, model)
     };
     // The status bar says it when a viewer is not there.

@@ -187,11 +187,37 @@ pub enum Event {
     GaveUp {
         reason: String,
     },
-    /// The tree changed: all of it, the nodes the change added, and why.
+    /// The tree changed: all of it, the nodes the change added, the conditions learned
+    /// rules put there (with the rules' ids), and why.
     TreeChanged {
         tree: Arc<Tree>,
         new_nodes: Vec<NodeId>,
+        learned: Vec<(NodeId, Vec<String>)>,
         why: String,
+    },
+    /// An applied fix may be kept as a rule for later tasks: the rule in words, the
+    /// narrower choice (only for the fix's objects) when the rule generalises, and how
+    /// many fixes are offered with this one.
+    RuleOffered {
+        rule: String,
+        only: Option<String>,
+        remaining: usize,
+    },
+    /// A rule was kept in the knowledge file.
+    RuleKept {
+        id: String,
+        rule: String,
+        path: PathBuf,
+    },
+    /// A rule was not kept, and why.
+    RuleRefused {
+        rule: String,
+        reason: String,
+    },
+    /// The kept rules of the scenario's domain, one line each.
+    Knowledge {
+        path: PathBuf,
+        rules: Vec<String>,
     },
     /// One tick in the execution world: every node's status.
     Ticked {

@@ -186,6 +186,10 @@ impl App {
             Action::Save => Command::SavePolicy,
             Action::Load => Command::LoadPolicy(None),
             Action::Export => Command::Export,
+            Action::KeepRule => Command::KeepRule { only: false },
+            Action::KeepRuleOnly => Command::KeepRule { only: true },
+            Action::DeclineRule => Command::DeclineRule,
+            Action::Knowledge => Command::ShowKnowledge,
             Action::Reset => Command::ResetWorld,
             // The recording panel holds the input line's place until the recording ends.
             Action::Instruction | Action::Edit if self.dictation.is_recording() => {
@@ -297,10 +301,11 @@ impl App {
             Event::TreeChanged {
                 tree,
                 new_nodes,
+                learned,
                 why,
             } => {
                 let added = new_nodes.len();
-                self.tree.set_tree(tree, new_nodes);
+                self.tree.set_tree(tree, new_nodes, learned);
                 self.status.ending = None;
                 self.llm.log(if added > 0 {
                     format!("{why}: {added} new node(s)")
@@ -438,6 +443,41 @@ impl App {
                 self.llm.log(format!("error: {error}"));
             }
             Event::Notice { message } => self.llm.log(message),
+            Event::RuleOffered { rule, only, .. } => {
+                let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+                let text = strings::rule_offer(
+                    &rule,
+                    only.as_deref(),
+                    (
+                        &key(Action::KeepRule),
+                        &key(Action::KeepRuleOnly),
+                        &key(Action::DeclineRule),
+                    ),
+                );
+                self.llm.log(text.clone());
+                self.message(text, false);
+            }
+            Event::RuleKept { id, rule, path } => {
+                let text = strings::rule_kept(&id, &rule, &path.display().to_string());
+                self.llm.log(text.clone());
+                self.message(text, false);
+            }
+            Event::RuleRefused { rule, reason } => {
+                let text = strings::rule_refused(&rule, &reason);
+                self.llm.log(text.clone());
+                self.message(text, true);
+            }
+            Event::Knowledge { path, rules } => {
+                let mut lines = vec![strings::knowledge_title(
+                    &path.display().to_string(),
+                    rules.len(),
+                )];
+                if rules.is_empty() {
+                    lines.push(strings::NO_RULES.to_string());
+                }
+                lines.extend(rules);
+                self.overlay = Some(Overlay::Report(lines));
+            }
             // For the 3D view; the world pane shows facts.
             Event::Scene { .. } => {}
         }

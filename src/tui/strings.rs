@@ -91,6 +91,10 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Save => "save the policy",
         Load => "load the saved policy",
         Export => "write the tree out as BT.CPP XML and Graphviz DOT",
+        KeepRule => "keep the approved fix as a rule for later tasks",
+        KeepRuleOnly => "keep the approved fix as a rule for its objects only",
+        DeclineRule => "do not keep the approved fix as a rule",
+        Knowledge => "show the rules learned from approved fixes",
         Reset => "reset the world",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
@@ -197,4 +201,39 @@ pub fn dictated(audio_seconds: f64, elapsed_seconds: f64, source: &str) -> Strin
 
 pub fn transcript_not_placed(text: &str) -> String {
     format!("dictated while the proposal editor was open, so not placed: {text}")
+}
+
+/// The offer to keep an approved fix as a rule, with the keys that answer it.
+pub fn rule_offer(rule: &str, only: Option<&str>, keys: (&str, &str, &str)) -> String {
+    let (keep, keep_only, decline) = keys;
+    match only {
+        Some(only) => format!(
+            "Keep as a rule for later tasks: {rule}? {keep} keeps it · {keep_only} only: {only} · {decline} keeps nothing"
+        ),
+        None => format!(
+            "Keep as a rule for later tasks: {rule}? {keep} keeps it · {decline} keeps nothing"
+        ),
+    }
+}
+
+pub fn rule_kept(id: &str, rule: &str, path: &str) -> String {
+    format!("kept as rule {id}: {rule} (in {path}); later tasks plan with it")
+}
+
+pub fn rule_refused(rule: &str, reason: &str) -> String {
+    format!("not kept as a rule: {rule}: {reason}")
+}
+
+pub fn knowledge_title(path: &str, count: usize) -> String {
+    format!(
+        "Rules learned from approved fixes ({count}, in {path}; betr knowledge revoke ID takes one out)"
+    )
+}
+
+pub const NO_RULES: &str =
+    "No rules kept yet for this domain: approve a fix, then keep it as a rule.";
+
+/// The mark after a condition a learned rule put in the tree.
+pub fn learned_mark(rules: &[String]) -> String {
+    format!(" ◆ learned {}", rules.join(", "))
 }

@@ -314,7 +314,17 @@ impl Viz {
             Event::PolicyLoaded { path, .. } => {
                 self.log(L::INFO, format!("policy loaded from {}", path.display()));
             }
-            Event::Usage { .. } | Event::RunState { .. } | Event::Verified { .. } => {}
+            Event::RuleKept { id, rule, .. } => {
+                self.log(L::INFO, format!("kept as rule {id}: {rule}"));
+            }
+            Event::RuleRefused { rule, reason } => {
+                self.log(L::WARN, format!("not kept as a rule: {rule}: {reason}"));
+            }
+            Event::Usage { .. }
+            | Event::RunState { .. }
+            | Event::Verified { .. }
+            | Event::RuleOffered { .. }
+            | Event::Knowledge { .. } => {}
         }
     }
 

@@ -163,6 +163,7 @@ fn session_events_stream_the_tree_ticks_and_the_log() {
     viz.on_event(&Event::TreeChanged {
         tree: tree.clone(),
         new_nodes: Vec::new(),
+        learned: Vec::new(),
         why: "planned".into(),
     });
     let mut exec = world.fork();

@@ -67,7 +67,7 @@ impl Engine {
         self.fixes.push(AppliedFix {
             change: change.clone(),
             nodes: plan.new_nodes.clone(),
-            author: pending.author,
+            author: pending.author.clone(),
             approval,
             at: now_rfc3339(),
         });
@@ -75,6 +75,7 @@ impl Engine {
         let why = format!("{} ({})", change, approval_text(approval));
         self.set_tree(plan.tree, plan.new_nodes, why);
         self.check_change();
+        self.offer_rules(&pending.proposal, &pending.author);
     }
 
     /// A change that did not fix the failure: remember it for the next question about the

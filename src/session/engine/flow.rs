@@ -142,9 +142,14 @@ impl Engine {
 
     /// Make `tree` the tree, tell front ends, and start the execution world afresh.
     pub(super) fn set_tree(&mut self, tree: Tree, new_nodes: Vec<crate::bt::NodeId>, why: String) {
+        let learned = crate::session::knowledge::learned_in_tree(&self.scenario.domain, &tree)
+            .into_iter()
+            .map(|l| (l.node, l.rules))
+            .collect();
         self.emit(Event::TreeChanged {
             tree: Arc::new(tree.clone()),
             new_nodes,
+            learned,
             why,
         });
         self.tree = Some(tree);
@@ -282,6 +287,7 @@ impl Engine {
         self.cancel_request();
         self.pending = None;
         self.failure = None;
+        self.drop_offers();
         let undone = self.fixes.len().saturating_sub(entry.fixes);
         self.fixes.truncate(entry.fixes);
         let why = format!("undid the last change ({undone} fix(es) removed)");

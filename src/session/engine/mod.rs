@@ -16,6 +16,7 @@
 mod changes;
 mod checks;
 mod flow;
+mod learning;
 mod policies;
 mod requests;
 
@@ -61,6 +62,9 @@ pub struct Setup {
     pub max_ticks: u64,
     /// Emit `Event::Scene` after every tick and reset of a cell world (for a 3D view).
     pub scenes: bool,
+    /// The learned knowledge: approved fixes of conditions are offered as rules and kept
+    /// here (none: nothing is offered).
+    pub knowledge: Option<super::knowledge::Knowledge>,
 }
 
 impl Setup {
@@ -82,6 +86,7 @@ impl Setup {
             tick_interval: Duration::ZERO,
             max_ticks: 10_000,
             scenes: false,
+            knowledge: None,
         }
     }
 }
@@ -123,6 +128,14 @@ pub enum Command {
     LoadPolicy(Option<PathBuf>),
     /// A fresh execution world and ticker.
     ResetWorld,
+    /// Keep the offered fix as a rule of its skill (`only`: for the fix's objects alone).
+    KeepRule {
+        only: bool,
+    },
+    /// Keep nothing of the offered fix.
+    DeclineRule,
+    /// The kept rules of the scenario's domain (`Event::Knowledge`).
+    ShowKnowledge,
     /// Stop the engine's loop.
     Shutdown,
 }
@@ -182,6 +195,9 @@ pub struct Engine {
     tick_interval: Duration,
     max_ticks: u64,
     scenes: bool,
+    knowledge: Option<super::knowledge::Knowledge>,
+    /// Fixes of the last applied change that may still be kept as rules.
+    offers: Vec<learning::RuleOffer>,
 
     planning: Box<dyn World>,
     exec: Box<dyn World>,
@@ -256,6 +272,8 @@ impl Engine {
             tick_interval: setup.tick_interval,
             max_ticks: setup.max_ticks,
             scenes: setup.scenes,
+            knowledge: setup.knowledge,
+            offers: Vec::new(),
             planning,
             exec,
             ticker: Ticker::new(),
@@ -361,6 +379,9 @@ impl Engine {
             Command::Export => self.export(),
             Command::LoadPolicy(path) => self.load_policy(path),
             Command::ResetWorld => self.reset_world(true),
+            Command::KeepRule { only } => self.keep_rule(only),
+            Command::DeclineRule => self.decline_rule(),
+            Command::ShowKnowledge => self.show_knowledge(),
             Command::Shutdown => self.set_running(false),
         }
     }

@@ -22,6 +22,8 @@ pub struct TreePane {
     tree: Option<Arc<Tree>>,
     record: Option<Arc<TickRecord>>,
     new_nodes: Vec<NodeId>,
+    /// Conditions learned rules put there, with the rules' ids.
+    learned: Vec<(NodeId, Vec<String>)>,
     failing: Option<NodeId>,
     items: Vec<TreeItem<'static, u32>>,
     state: TreeState<u32>,
@@ -29,7 +31,12 @@ pub struct TreePane {
 }
 
 impl TreePane {
-    pub fn set_tree(&mut self, tree: Arc<Tree>, new_nodes: Vec<NodeId>) {
+    pub fn set_tree(
+        &mut self,
+        tree: Arc<Tree>,
+        new_nodes: Vec<NodeId>,
+        learned: Vec<(NodeId, Vec<String>)>,
+    ) {
         self.state = TreeState::default();
         for path in composite_paths(&tree) {
             self.state.open(path);
@@ -37,6 +44,7 @@ impl TreePane {
         let focus = new_nodes.first().copied();
         self.tree = Some(tree);
         self.new_nodes = new_nodes;
+        self.learned = learned;
         self.record = None;
         self.failing = None;
         self.dirty = true;
@@ -107,6 +115,7 @@ impl TreePane {
                 tree,
                 self.record.as_deref(),
                 &self.new_nodes,
+                &self.learned,
                 self.failing,
                 theme,
             )],
@@ -169,6 +178,7 @@ fn build_items(
     tree: &Tree,
     record: Option<&TickRecord>,
     new_nodes: &[NodeId],
+    learned: &[(NodeId, Vec<String>)],
     failing: Option<NodeId>,
     theme: &Theme,
 ) -> TreeItem<'static, u32> {
@@ -176,7 +186,7 @@ fn build_items(
     let order = tree.preorder();
     for &node in order.iter().rev() {
         let status = record.map_or(Status::Idle, |r| r.status(node));
-        let line = node_line(
+        let mut line = node_line(
             tree,
             node,
             status,
@@ -184,6 +194,10 @@ fn build_items(
             failing == Some(node),
             theme,
         );
+        if let Some((_, rules)) = learned.iter().find(|(n, _)| *n == node) {
+            line.spans
+                .push(Span::styled(strings::learned_mark(rules), theme.dim));
+        }
         let children: Vec<TreeItem<'static, u32>> = tree
             .children(node)
             .unwrap_or_default()
@@ -281,7 +295,7 @@ mod tests {
         let mut pane = TreePane::default();
         let theme = Theme::default();
         let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
-        pane.set_tree(tree.clone(), vec![tree.root()]);
+        pane.set_tree(tree.clone(), vec![tree.root()], Vec::new());
         terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
         let first = terminal.backend().to_string();
         assert!(first.contains("Fallback"), "{first}");

@@ -1,0 +1,167 @@
+//! Keeping approved fixes as rules in the engine: after a change of conditions is applied
+//! (and its verification passed), each condition is offered as a rule of the failing
+//! action's skill, lifted to its objects where the vocabulary allows and, as the other
+//! choice, only for the fix's objects. A rule a person keeps is checked
+//! (`knowledge::check_rule`), written to the knowledge file and added to the engine's own
+//! domain at once, so the rest of the session plans with it too. Nothing is kept unasked.
+
+use std::sync::Arc;
+
+use crate::domain::{ActionCall, Condition, LearnedRule};
+use crate::session::knowledge::{self, KeptRule, learned_in_tree, offered_rule};
+use crate::session::policy::now_rfc3339;
+use crate::session::types::{Event, Proposal};
+
+use super::Engine;
+
+/// A fix that may be kept as a rule.
+#[derive(Debug, Clone)]
+pub(super) struct RuleOffer {
+    action: ActionCall,
+    condition: Condition,
+    author: String,
+    lifted: LearnedRule,
+    only: LearnedRule,
+}
+
+impl Engine {
+    /// Queue the conditions of an applied change as rule offers (only when the engine has
+    /// a knowledge file), and show the first.
+    pub(super) fn offer_rules(&mut self, proposal: &Proposal, author: &str) {
+        if self.knowledge.is_none() {
+            return;
+        }
+        let Proposal::Conditions {
+            action, conditions, ..
+        } = proposal
+        else {
+            return;
+        };
+        self.offers = conditions
+            .iter()
+            .map(|c| RuleOffer {
+                action: action.clone(),
+                condition: c.clone(),
+                author: author.to_string(),
+                lifted: offered_rule(action, c, false),
+                only: offered_rule(action, c, true),
+            })
+            .collect();
+        self.show_offer();
+    }
+
+    /// Offers of a change that was undone are gone with it.
+    pub(super) fn drop_offers(&mut self) {
+        self.offers.clear();
+    }
+
+    fn show_offer(&self) {
+        let Some(offer) = self.offers.first() else {
+            return;
+        };
+        let domain = &self.scenario.domain;
+        let general = offer.lifted != offer.only;
+        self.emit(Event::RuleOffered {
+            rule: if general {
+                offer.lifted.describe(domain)
+            } else {
+                offer.only.describe(domain)
+            },
+            only: general.then(|| offer.only.describe(domain)),
+            remaining: self.offers.len(),
+        });
+    }
+
+    /// Keep the first offer as a rule (`only`: for the fix's objects alone).
+    pub(super) fn keep_rule(&mut self, only: bool) {
+        if self.offers.is_empty() {
+            return self.error("no fix to keep as a rule: approve a fix of conditions first");
+        }
+        let offer = self.offers.remove(0);
+        let rule = if only { offer.only } else { offer.lifted };
+        let words = rule.describe(&self.scenario.domain);
+        let Some(store) = self.knowledge.as_mut() else {
+            return;
+        };
+        if let Err(refusal) = knowledge::check_rule(&rule, &self.scenario, store) {
+            self.emit(Event::RuleRefused {
+                rule: words,
+                reason: refusal.to_string(),
+            });
+            return self.show_offer();
+        }
+        let kept = store.keep(KeptRule {
+            id: String::new(),
+            domain: knowledge::domain_of(&self.scenario),
+            skill: rule.skill.clone(),
+            requires: rule.requires.clone(),
+            only: rule.only.clone(),
+            kept_at: now_rfc3339(),
+            scenario: self.scenario_path.display().to_string(),
+            action: offer.action.to_string(),
+            condition: offer.condition.to_string(),
+            proposed_by: offer.author,
+            kept_by: "a person (workbench)".into(),
+        });
+        match kept {
+            Ok(kept) => {
+                let mut learned = rule.clone();
+                learned.id = kept.id.clone();
+                // Checked above: the rule fits this domain.
+                let _ = Arc::make_mut(&mut self.scenario).domain.learn(&learned);
+                let path = store.path.clone();
+                self.emit(Event::RuleKept {
+                    id: kept.id,
+                    rule: words,
+                    path,
+                });
+                if let Some(tree) = self.tree.clone() {
+                    // The tree is unchanged; its conditions from rules are marked now.
+                    self.emit(Event::TreeChanged {
+                        learned: learned_in_tree(&self.scenario.domain, &tree)
+                            .into_iter()
+                            .map(|l| (l.node, l.rules))
+                            .collect(),
+                        tree: Arc::new(tree),
+                        new_nodes: Vec::new(),
+                        why: "a fix was kept as a rule".into(),
+                    });
+                }
+            }
+            Err(e) => self.error(format!("the rule was not kept: {e}")),
+        }
+        self.show_offer();
+    }
+
+    /// Keep nothing of the first offer.
+    pub(super) fn decline_rule(&mut self) {
+        if self.offers.is_empty() {
+            return self.error("no fix is offered as a rule");
+        }
+        self.offers.remove(0);
+        self.notice("not kept as a rule");
+        self.show_offer();
+    }
+
+    /// The kept rules of this scenario's domain, in words, for a view.
+    pub(super) fn show_knowledge(&self) {
+        let Some(store) = &self.knowledge else {
+            return self.error("no knowledge file: the workbench has no policy directory");
+        };
+        let domain = knowledge::domain_of(&self.scenario);
+        let rules = store
+            .rules_of(&domain)
+            .map(|r| {
+                let words = r.rule().describe(&self.scenario.domain);
+                format!(
+                    "{}: {words}. From {} ({} before {}!), proposed by {}, kept by {} at {}",
+                    r.id, r.scenario, r.condition, r.action, r.proposed_by, r.kept_by, r.kept_at
+                )
+            })
+            .collect();
+        self.emit(Event::Knowledge {
+            path: store.path.clone(),
+            rules,
+        });
+    }
+}
