@@ -472,3 +472,44 @@ mod engine {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+#[test]
+fn learn_without_yes_asks_and_can_keep_the_rule_for_the_fixs_objects_only() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("knowledge-ask");
+    let policies = dir.join("p").to_string_lossy().into_owned();
+    let base = server.base_url();
+    let first = scenario_path("scenarios/cell/red_on_blue.toml");
+    let mut args = resolve(&first, &base, &policies);
+    args.retain(|a| *a != "--yes");
+    args.push("--learn");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_betr"))
+        .args(&args)
+        .current_dir(&dir)
+        .env("HOME", &dir)
+        .env("XDG_STATE_HOME", dir.join("state"))
+        .env("XDG_DATA_HOME", dir.join("data"))
+        .env(KEY_VAR, support::cli::KEY)
+        .env_remove("BETR_CONFIG")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Approve the fix, then keep it only for the blue cube.
+    child.stdin.take().unwrap().write_all(b"y\no\n").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        log.contains("Keep as a rule: grasp {x} needs ~\"any object\" on \"{x}\"? [y]es / [o]nly grasp \"blue cube\" needs"),
+        "{log}"
+    );
+    let knowledge = Knowledge::open(&Path::new(&policies).join("knowledge.toml")).unwrap();
+    assert_eq!(knowledge.rules.len(), 1);
+    assert_eq!(knowledge.rules[0].only, Some(vec!["blue cube".to_string()]));
+    assert_eq!(knowledge.rules[0].kept_by, "a person");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
