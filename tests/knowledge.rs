@@ -11,7 +11,7 @@ use std::path::Path;
 
 use betr::domain::{ActionCall, Condition, LearnedRule, Scenario};
 use betr::session::knowledge::{Knowledge, Refusal, check_rule, learned_in_tree, offered_rule};
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -19,23 +19,11 @@ fn scenario_path(rel: &str) -> String {
     fixtures::root().join(rel).to_string_lossy().into_owned()
 }
 
-/// `betr resolve SCENARIO --yes` against the fake server, with the policy directory `dir`.
+/// `betr resolve SCENARIO --yes` against the fake server, keeping policies in `policies`.
 fn resolve<'a>(scenario: &'a str, base: &'a str, policies: &'a str) -> Vec<&'a str> {
-    vec![
-        "resolve",
-        scenario,
-        "--yes",
-        "--backend",
-        "openai",
-        "--base-url",
-        base,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-        "--policy-dir",
-        policies,
-    ]
+    let mut args = resolve_yes(scenario, base);
+    args.extend(["--policy-dir", policies]);
+    args
 }
 
 #[test]

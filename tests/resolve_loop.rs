@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use betr::domain::Scenario;
 use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
 use betr::session::{self, Ending, Event, Options, Proposal};
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -42,23 +42,6 @@ fn resolvable_scenarios() -> Vec<PathBuf> {
 
 fn is_param(p: &Path) -> bool {
     p.components().any(|c| c.as_os_str() == "params")
-}
-
-/// `betr resolve SCENARIO --yes` against the fake OpenAI-compatible server at `base`.
-fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
-    vec![
-        "resolve",
-        scenario,
-        "--yes",
-        "--backend",
-        "openai",
-        "--base-url",
-        base,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-    ]
 }
 
 fn relative(p: &Path) -> String {

@@ -289,15 +289,7 @@ fn sequence_experiment(
         .collect();
     tasks.sort();
     paths.extend(tasks);
-    let scenarios = paths
-        .iter()
-        .map(|p| {
-            let path = scenarios_dir.join(p);
-            Scenario::load(&path)
-                .map(|s| (p.clone(), s))
-                .with_context(|| format!("loading {}", path.display()))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let scenarios = load_scenarios(scenarios_dir, &paths)?;
     let goal_source = match goal {
         GoalSource::Interpret => "interpret",
         GoalSource::Scenario => "scenario",
@@ -348,6 +340,19 @@ fn sequence_experiment(
     Ok(ExitCode::SUCCESS)
 }
 
+/// The scenarios at `paths` under `dir`, each with its path as given.
+fn load_scenarios(dir: &Path, paths: &[impl AsRef<str>]) -> Result<Vec<(String, Scenario)>> {
+    paths
+        .iter()
+        .map(|p| {
+            let path = dir.join(p.as_ref());
+            Scenario::load(&path)
+                .map(|s| (p.as_ref().to_string(), s))
+                .with_context(|| format!("loading {}", path.display()))
+        })
+        .collect()
+}
+
 /// Which experiment `session_experiment` runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SessionExperiment {
@@ -370,15 +375,7 @@ pub fn session_experiment(
             params::PARAM_SCENARIOS.iter().map(|(p, _)| *p).collect(),
         ),
     };
-    let scenarios = paths
-        .iter()
-        .map(|p| {
-            let path = scenarios_dir.join(p);
-            Scenario::load(&path)
-                .map(|s| ((*p).to_string(), s))
-                .with_context(|| format!("loading {}", path.display()))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let scenarios = load_scenarios(scenarios_dir, &paths)?;
     let goal_source = match goal {
         GoalSource::Interpret => "interpret",
         GoalSource::Scenario => "scenario",

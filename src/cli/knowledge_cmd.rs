@@ -10,8 +10,9 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 
 use betr::domain::Scenario;
-use betr::session::knowledge::{self, KeptRule, Knowledge, check_rule, offered_rule, rule_for_fix};
-use betr::session::policy::now_rfc3339;
+use betr::session::knowledge::{
+    KeptRule, Knowledge, Provenance, check_rule, offered_rule, rule_for_fix,
+};
 use betr::session::{PolicyStore, Proposal};
 
 #[derive(Args, Debug, Clone, Default)]
@@ -214,23 +215,17 @@ pub fn offer(
                 }
                 rule
             };
-            let kept = knowledge.keep(KeptRule {
-                id: String::new(),
-                domain: knowledge::domain_of(scenario),
-                skill: rule.skill.clone(),
-                requires: rule.requires.clone(),
-                only: rule.only.clone(),
-                kept_at: now_rfc3339(),
-                scenario: scenario_path.display().to_string(),
-                action: action.to_string(),
-                condition: condition.to_string(),
-                proposed_by: author.clone(),
-                kept_by: if yes {
-                    "--yes --learn".into()
-                } else {
-                    "a person".into()
+            let kept = knowledge.keep(KeptRule::new(
+                &rule,
+                scenario,
+                Provenance {
+                    scenario_file: scenario_path.display().to_string(),
+                    action,
+                    condition,
+                    proposed_by: author.clone(),
+                    kept_by: if yes { "--yes --learn" } else { "a person" }.into(),
                 },
-            })?;
+            ))?;
             println!(
                 "Kept rule {}: {} (in {})",
                 kept.id,

@@ -15,8 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::domain::Scenario;
 use crate::llm::LanguageModel;
-use crate::session::knowledge::{self, KeptRule, Knowledge, rule_for_fix};
-use crate::session::policy::now_rfc3339;
+use crate::session::knowledge::{KeptRule, Knowledge, Provenance, rule_for_fix};
 use crate::session::{Event, Options, Proposal};
 
 use super::EvalError;
@@ -166,19 +165,17 @@ async fn run_step(
                     }
                 };
                 let kept = knowledge
-                    .keep(KeptRule {
-                        id: String::new(),
-                        domain: knowledge::domain_of(scenario),
-                        skill: rule.skill.clone(),
-                        requires: rule.requires.clone(),
-                        only: rule.only.clone(),
-                        kept_at: now_rfc3339(),
-                        scenario: path.to_string(),
-                        action: action.to_string(),
-                        condition: condition.to_string(),
-                        proposed_by: author.clone(),
-                        kept_by: "betr eval resolve --sequence (every fix kept)".into(),
-                    })
+                    .keep(KeptRule::new(
+                        &rule,
+                        scenario,
+                        Provenance {
+                            scenario_file: path.to_string(),
+                            action,
+                            condition,
+                            proposed_by: author.clone(),
+                            kept_by: "betr eval resolve --sequence (every fix kept)".into(),
+                        },
+                    ))
                     .map_err(|e| {
                         EvalError::io(&knowledge.path, std::io::Error::other(e.to_string()))
                     })?;

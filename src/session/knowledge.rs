@@ -46,7 +46,35 @@ pub struct KeptRule {
     pub kept_by: String,
 }
 
+/// Where a kept rule came from: the fix, in which scenario, who proposed and who kept it.
+#[derive(Debug, Clone)]
+pub struct Provenance<'a> {
+    pub scenario_file: String,
+    pub action: &'a ActionCall,
+    pub condition: &'a Condition,
+    pub proposed_by: String,
+    pub kept_by: String,
+}
+
 impl KeptRule {
+    /// `rule` of `scenario`'s domain with its provenance, kept now (the id is given when
+    /// it is kept).
+    pub fn new(rule: &LearnedRule, scenario: &Scenario, from: Provenance) -> KeptRule {
+        KeptRule {
+            id: String::new(),
+            domain: domain_of(scenario),
+            skill: rule.skill.clone(),
+            requires: rule.requires.clone(),
+            only: rule.only.clone(),
+            kept_at: crate::session::policy::now_rfc3339(),
+            scenario: from.scenario_file,
+            action: from.action.to_string(),
+            condition: from.condition.to_string(),
+            proposed_by: from.proposed_by,
+            kept_by: from.kept_by,
+        }
+    }
+
     pub fn rule(&self) -> LearnedRule {
         LearnedRule {
             id: self.id.clone(),

@@ -78,3 +78,21 @@ pub fn relative_to(p: &Path, base: &Path) -> String {
         .to_string_lossy()
         .replace('\\', "/")
 }
+
+/// `betr resolve SCENARIO --yes` against an OpenAI-compatible server at `base` (the fake
+/// server of the tests), with the key in [`KEY_VAR`].
+pub fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
+    vec![
+        "resolve",
+        scenario,
+        "--yes",
+        "--backend",
+        "openai",
+        "--base-url",
+        base,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+    ]
+}

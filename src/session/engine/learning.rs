@@ -8,8 +8,7 @@
 use std::sync::Arc;
 
 use crate::domain::{ActionCall, Condition, LearnedRule};
-use crate::session::knowledge::{self, KeptRule, learned_in_tree, offered_rule};
-use crate::session::policy::now_rfc3339;
+use crate::session::knowledge::{self, KeptRule, Provenance, learned_in_tree, offered_rule};
 use crate::session::types::{Event, Proposal};
 
 use super::Engine;
@@ -90,19 +89,17 @@ impl Engine {
             });
             return self.show_offer();
         }
-        let kept = store.keep(KeptRule {
-            id: String::new(),
-            domain: knowledge::domain_of(&self.scenario),
-            skill: rule.skill.clone(),
-            requires: rule.requires.clone(),
-            only: rule.only.clone(),
-            kept_at: now_rfc3339(),
-            scenario: self.scenario_path.display().to_string(),
-            action: offer.action.to_string(),
-            condition: offer.condition.to_string(),
-            proposed_by: offer.author,
-            kept_by: "a person (workbench)".into(),
-        });
+        let kept = store.keep(KeptRule::new(
+            &rule,
+            &self.scenario,
+            Provenance {
+                scenario_file: self.scenario_path.display().to_string(),
+                action: &offer.action,
+                condition: &offer.condition,
+                proposed_by: offer.author.clone(),
+                kept_by: "a person (workbench)".into(),
+            },
+        ));
         match kept {
             Ok(kept) => {
                 let mut learned = rule.clone();
