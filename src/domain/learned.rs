@@ -51,23 +51,23 @@ impl LearnedPrecondition {
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LearnError {
-    #[error("rule {rule}: no skill named {skill:?} in this domain")]
+    #[error("{rule}: no skill named {skill:?} in this domain")]
     UnknownSkill { rule: String, skill: String },
-    #[error("rule {rule}: {skill} takes {arity} object(s), the rule names object {{{position}}}")]
+    #[error("{rule}: {skill} takes {arity} object(s), the rule names object {{{position}}}")]
     NoSuchObject {
         rule: String,
         skill: String,
         arity: usize,
         position: usize,
     },
-    #[error("rule {rule}: {skill} takes {arity} object(s), the rule is kept only for {only}")]
+    #[error("{rule}: {skill} takes {arity} object(s), the rule is kept only for {only}")]
     OnlyArity {
         rule: String,
         skill: String,
         arity: usize,
         only: usize,
     },
-    #[error("rule {rule}: {requires:?} is not a condition of this domain: {reason}")]
+    #[error("{rule}: {requires:?} is not a condition of this domain: {reason}")]
     Condition {
         rule: String,
         requires: String,
@@ -90,6 +90,15 @@ impl LearnedRule {
             skill: action.skill.clone(),
             requires: lifted.to_string(),
             only: for_these_only.then(|| action.args.clone()),
+        }
+    }
+
+    /// How errors name the rule: by its id once kept.
+    fn label(&self) -> String {
+        if self.id.is_empty() {
+            "the rule".into()
+        } else {
+            format!("rule {}", self.id)
         }
     }
 
@@ -122,7 +131,7 @@ impl LearnedRule {
         if let Some(position) = (arity + 1..=arity + 9).find(|i| text.contains(&format!("{{{i}}}")))
         {
             return Err(LearnError::NoSuchObject {
-                rule: self.id.clone(),
+                rule: self.label(),
                 skill: skill.name.clone(),
                 arity,
                 position,
@@ -132,7 +141,7 @@ impl LearnedRule {
             && only.len() != arity
         {
             return Err(LearnError::OnlyArity {
-                rule: self.id.clone(),
+                rule: self.label(),
                 skill: skill.name.clone(),
                 arity,
                 only: only.len(),
@@ -140,13 +149,13 @@ impl LearnedRule {
         }
         let template =
             parse_template(&text, &skill.params).map_err(|reason| LearnError::Condition {
-                rule: self.id.clone(),
+                rule: self.label(),
                 requires: self.requires.clone(),
                 reason,
             })?;
         if template.atom.args.contains(&Term::Every) {
             return Err(LearnError::Condition {
-                rule: self.id.clone(),
+                rule: self.label(),
                 requires: self.requires.clone(),
                 reason: "{*} stands only in a deletion".into(),
             });
@@ -208,27 +217,58 @@ fn fitting(
     out
 }
 
+/// The rule's condition as a template of `skill`, with the objects each parameter it names
+/// may be, when the rule fits the skill (its objects, when kept only for them, too).
+fn fit(
+    vocabulary: &super::Vocabulary,
+    skill: &Skill,
+    rule: &LearnedRule,
+) -> Result<(LiteralTemplate, Vec<(usize, Vec<String>)>), LearnError> {
+    let condition = rule.template(skill)?;
+    let fitting = fitting(vocabulary, skill, &condition);
+    if let Some((i, _)) = fitting.iter().find(|(_, objects)| objects.is_empty()) {
+        return Err(LearnError::Condition {
+            rule: rule.label(),
+            requires: rule.requires.clone(),
+            reason: format!(
+                "no object {} takes as {{{}}} fits {}",
+                skill.name,
+                skill.params.get(*i).map_or("?", |p| p.name.as_str()),
+                condition.atom.predicate
+            ),
+        });
+    }
+    if let Some(only) = &rule.only
+        && !skill.accepts(vocabulary, only)
+    {
+        return Err(LearnError::Condition {
+            rule: rule.label(),
+            requires: rule.requires.clone(),
+            reason: format!("{} does not take {}", skill.name, only.join(", ")),
+        });
+    }
+    Ok((condition, fitting))
+}
+
 impl Domain {
     /// Add `rule` to every skill it names, as a first precondition (before the declared
     /// ones); a rule the skill already declares changes nothing.
     pub fn learn(&mut self, rule: &LearnedRule) -> Result<(), LearnError> {
-        let mut found = false;
+        // A skill name may have several declarations (MoveTo a place, MoveTo a made
+        // item): the rule goes to those it fits; it is an error only when it fits none.
+        let mut first_error = None;
+        let mut fitted = false;
+        let vocabulary = self.vocabulary.clone();
         for skill in self.skills.iter_mut().filter(|s| s.name == rule.skill) {
-            found = true;
-            let condition = rule.template(skill)?;
-            let fitting = fitting(&self.vocabulary, skill, &condition);
-            if let Some((i, _)) = fitting.iter().find(|(_, objects)| objects.is_empty()) {
-                return Err(LearnError::Condition {
-                    rule: rule.id.clone(),
-                    requires: rule.requires.clone(),
-                    reason: format!(
-                        "no object {} takes as {{{}}} fits {}",
-                        skill.name,
-                        skill.params.get(*i).map_or("?", |p| p.name.as_str()),
-                        condition.atom.predicate
-                    ),
-                });
-            }
+            let condition = match fit(&vocabulary, skill, rule) {
+                Ok(c) => c,
+                Err(e) => {
+                    first_error.get_or_insert(e);
+                    continue;
+                }
+            };
+            fitted = true;
+            let (condition, fitting) = condition;
             if skill.pre.contains(&condition)
                 || skill
                     .learned
@@ -244,13 +284,13 @@ impl Domain {
                 fitting,
             });
         }
-        if found {
-            Ok(())
-        } else {
-            Err(LearnError::UnknownSkill {
-                rule: rule.id.clone(),
+        match (fitted, first_error) {
+            (true, _) => Ok(()),
+            (false, Some(e)) => Err(e),
+            (false, None) => Err(LearnError::UnknownSkill {
+                rule: rule.label(),
                 skill: rule.skill.clone(),
-            })
+            }),
         }
     }
 
@@ -302,8 +342,18 @@ mod tests {
     }
 
     fn domain() -> Domain {
+        let objects = ["blue cube", "red cube", "green cube"]
+            .into_iter()
+            .map(|name| crate::domain::Object {
+                name: name.into(),
+                types: vec!["item".into()],
+            })
+            .collect();
         Domain {
-            vocabulary: Vocabulary::default(),
+            vocabulary: Vocabulary {
+                objects,
+                ..Vocabulary::default()
+            },
             skills: vec![grasp()],
         }
     }

@@ -364,26 +364,35 @@ pub fn check_rule(
             });
         }
     }
-    let with_rule = |s: &Scenario| {
+    // Judged against the rules kept so far, so that only this rule's effect counts.
+    let known = |s: &Scenario| {
         let mut s = s.clone();
         knowledge.apply(&mut s);
+        s
+    };
+    let with_rule = |s: &Scenario| {
+        let mut s = known(s);
         s.domain.learn(rule).ok().map(|()| s)
     };
-    // The domain's worked examples are goals a person may ask for in this scene.
-    let facts = facts_of(scenario).map_err(|why| Refusal::GoalUnplannable {
-        scenario: scenario.name.clone(),
-        goal: String::new(),
-        why,
-    })?;
-    if let Some(learned) = with_rule(scenario) {
+    // The domain's worked examples are goals a person may ask for: in this scenario and
+    // in the domain's base file (a scenario may declare its skills differently).
+    let base = scenario
+        .files
+        .first()
+        .and_then(|f| Scenario::load(&f.path).ok());
+    for scene in std::iter::once(scenario).chain(base.as_ref()) {
+        let (Some(after), Ok(facts)) = (with_rule(scene), facts_of(scene)) else {
+            continue;
+        };
+        let before = known(scene);
         for example in &scenario.examples {
-            let Ok(goal) = scenario.parse_goal(&example.goal) else {
+            let Ok(goal) = scene.parse_goal(&example.goal) else {
                 continue;
             };
-            if plans(scenario, &facts, &goal).is_err() {
+            if plans(&before, &facts, &goal).is_err() {
                 continue;
             }
-            if let Err(why) = plans(&learned, &facts, &goal) {
+            if let Err(why) = plans(&after, &facts, &goal) {
                 return Err(Refusal::GoalUnplannable {
                     scenario: format!("the worked example {:?}", example.instruction),
                     goal: goal.to_string(),
@@ -403,13 +412,13 @@ pub fn check_rule(
             continue;
         };
         // Unplannable without the rule too: not the rule's doing.
-        if plans(&other, &facts, &goal).is_err() {
+        if plans(&known(&other), &facts, &goal).is_err() {
             continue;
         }
-        let Some(learned) = with_rule(&other) else {
+        let Some(after) = with_rule(&other) else {
             continue;
         };
-        if let Err(why) = plans(&learned, &facts, &goal) {
+        if let Err(why) = plans(&after, &facts, &goal) {
             return Err(Refusal::GoalUnplannable {
                 scenario: path.display().to_string(),
                 goal: goal.to_string(),
