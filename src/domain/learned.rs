@@ -35,7 +35,7 @@ pub struct LearnedPrecondition {
     pub only: Option<Vec<String>>,
     /// Per skill parameter the condition names, the objects its predicate can take there:
     /// a rule learned for a cup says nothing of a centrifuge that is not an item.
-    pub fitting: Vec<(usize, Vec<String>)>,
+    pub fitting: Fitting,
 }
 
 impl LearnedPrecondition {
@@ -195,7 +195,7 @@ fn fitting(
     vocabulary: &super::Vocabulary,
     skill: &Skill,
     condition: &LiteralTemplate,
-) -> Vec<(usize, Vec<String>)> {
+) -> Fitting {
     let Some(predicate) = vocabulary.predicate(&condition.atom.predicate) else {
         return Vec::new();
     };
@@ -217,13 +217,16 @@ fn fitting(
     out
 }
 
+/// Per skill parameter a condition names, the objects it may be there.
+type Fitting = Vec<(usize, Vec<String>)>;
+
 /// The rule's condition as a template of `skill`, with the objects each parameter it names
 /// may be, when the rule fits the skill (its objects, when kept only for them, too).
 fn fit(
     vocabulary: &super::Vocabulary,
     skill: &Skill,
     rule: &LearnedRule,
-) -> Result<(LiteralTemplate, Vec<(usize, Vec<String>)>), LearnError> {
+) -> Result<(LiteralTemplate, Fitting), LearnError> {
     let condition = rule.template(skill)?;
     let fitting = fitting(vocabulary, skill, &condition);
     if let Some((i, _)) = fitting.iter().find(|(_, objects)| objects.is_empty()) {
