@@ -187,21 +187,18 @@ pub fn offer(
         };
         for condition in conditions {
             let rule = if yes {
-                match rule_for_fix(action, condition, scenario, &knowledge) {
-                    Ok(rule) => {
-                        println!(
-                            "Keep as a rule: {}? yes (--yes --learn)",
-                            rule.describe(&scenario.domain)
-                        );
-                        rule
-                    }
-                    Err(refused) => {
-                        for (rule, why) in refused {
-                            println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
-                        }
-                        continue;
-                    }
+                let (rule, refused) = rule_for_fix(action, condition, scenario, &knowledge);
+                for (rule, why) in refused {
+                    println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
                 }
+                let Some(rule) = rule else {
+                    continue;
+                };
+                println!(
+                    "Keep as a rule: {}? yes (--yes --learn)",
+                    rule.describe(&scenario.domain)
+                );
+                rule
             } else {
                 let lifted = offered_rule(action, condition, false);
                 let only = offered_rule(action, condition, true);

@@ -191,11 +191,7 @@ impl LearnedRule {
 
 /// For each parameter of `skill` that `condition` names, the objects the parameter admits
 /// that the predicate takes at that position.
-fn fitting(
-    vocabulary: &super::Vocabulary,
-    skill: &Skill,
-    condition: &LiteralTemplate,
-) -> Fitting {
+fn fitting(vocabulary: &super::Vocabulary, skill: &Skill, condition: &LiteralTemplate) -> Fitting {
     let Some(predicate) = vocabulary.predicate(&condition.atom.predicate) else {
         return Vec::new();
     };

@@ -154,15 +154,12 @@ async fn run_step(
                 continue;
             };
             for condition in conditions {
-                let rule = match rule_for_fix(action, condition, scenario, knowledge) {
-                    Ok(rule) => rule,
-                    Err(refused) => {
-                        for (rule, why) in refused {
-                            rules_refused
-                                .push(format!("{}: {why}", rule.describe(&scenario.domain)));
-                        }
-                        continue;
-                    }
+                let (rule, refused) = rule_for_fix(action, condition, scenario, knowledge);
+                for (rule, why) in refused {
+                    rules_refused.push(format!("{}: {why}", rule.describe(&scenario.domain)));
+                }
+                let Some(rule) = rule else {
+                    continue;
                 };
                 let kept = knowledge
                     .keep(KeptRule::new(

@@ -568,27 +568,25 @@ pub fn learned_in_tree(domain: &crate::domain::Domain, tree: &crate::bt::Tree) -
 }
 
 /// The rule to keep for a fix when nobody is asked (`--yes --learn`): the lifted rule, or,
-/// when that is refused, the rule for the fix's objects alone. `Err` holds each refusal.
+/// when that is refused, the rule for the fix's objects alone; with every refusal on the
+/// way (a narrower rule kept after the lifted one was refused says why).
 pub fn rule_for_fix(
     action: &ActionCall,
     condition: &Condition,
     scenario: &Scenario,
     knowledge: &Knowledge,
-) -> Result<LearnedRule, Vec<(LearnedRule, Refusal)>> {
+) -> (Option<LearnedRule>, Vec<(LearnedRule, Refusal)>) {
     let lifted = offered_rule(action, condition, false);
     let only = offered_rule(action, condition, true);
-    let mut refused = Vec::new();
+    let mut refused: Vec<(LearnedRule, Refusal)> = Vec::new();
     for rule in [lifted, only] {
-        if refused
-            .iter()
-            .any(|(r, _): &(LearnedRule, Refusal)| *r == rule)
-        {
+        if refused.iter().any(|(r, _)| *r == rule) {
             continue;
         }
         match check_rule(&rule, scenario, knowledge) {
-            Ok(()) => return Ok(rule),
+            Ok(()) => return (Some(rule), refused),
             Err(e) => refused.push((rule, e)),
         }
     }
-    Err(refused)
+    (None, refused)
 }
