@@ -37,13 +37,19 @@ pub fn export(
     scenario_arg: Option<&Path>,
     format: Format,
     out: Option<&Path>,
+    knowledge: &super::knowledge_cmd::KnowledgeFlags,
 ) -> Result<ExitCode> {
+    let load = |path: &Path| -> Result<Scenario> {
+        let mut scenario = Scenario::load(path)?;
+        knowledge.apply(&mut scenario)?;
+        Ok(scenario)
+    };
     let is_scenario = source
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let (scenario_path, tree, new_nodes) = if is_scenario {
         let path = super::find_scenario(source)?;
-        let scenario = Scenario::load(&path)?;
+        let scenario = load(&path)?;
         let goal = super::goal_of(&scenario, None)?;
         let world = world::load(&scenario)?;
         let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
@@ -65,7 +71,7 @@ pub fn export(
                 source.display()
             ),
         };
-        let scenario = Scenario::load(&scenario_path)?;
+        let scenario = load(&scenario_path)?;
         let (tree, format) = load_tree(&scenario, source)?;
         let new_nodes = match format {
             TreeFormat::Text => last_fix_nodes(&text, &scenario, &tree),
@@ -73,7 +79,7 @@ pub fn export(
         };
         (scenario_path, tree, new_nodes)
     };
-    let scenario = Scenario::load(&scenario_path)?;
+    let scenario = load(&scenario_path)?;
     let name = scenario_path
         .file_stem()
         .map_or_else(|| "tree".to_string(), |s| s.to_string_lossy().into_owned());

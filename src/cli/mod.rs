@@ -95,6 +95,8 @@ pub enum Command {
         /// Write here (atomically) instead of to standard output.
         #[arg(long)]
         out: Option<PathBuf>,
+        #[command(flatten)]
+        knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Reproduce the paper's experiments.
     Eval {
@@ -362,7 +364,14 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             format,
             scenario,
             out,
-        } => export_cmd::export(&source, scenario.as_deref(), format, out.as_deref()),
+            knowledge,
+        } => export_cmd::export(
+            &source,
+            scenario.as_deref(),
+            format,
+            out.as_deref(),
+            &knowledge,
+        ),
         Command::Plan {
             scenario,
             goal,
