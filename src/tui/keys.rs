@@ -1,6 +1,6 @@
 //! Key bindings: one struct with a field per action and its default key. The help overlay
 //! is generated from the same struct, so it cannot drift; a TOML file of overrides
-//! (`step = "n"`, `quit = "ctrl-q"`) is applied as a patch, and a bad file is reported
+//! (`step = "t"`, `quit = "ctrl-q"`) is applied as a patch, and a bad file is reported
 //! while the defaults stay.
 
 use std::fmt;
@@ -272,8 +272,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "w", "[", "]",
-                "?", "q"
+                "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
+                "g", "w", "[", "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -285,9 +285,9 @@ mod tests {
 
     #[test]
     fn overrides_patch_the_defaults_and_bad_files_are_refused() {
-        let k = KeyBindings::from_toml("step = \"n\"\nquit = \"ctrl-q\"\n").unwrap();
+        let k = KeyBindings::from_toml("step = \"t\"\nquit = \"ctrl-q\"\n").unwrap();
         assert_eq!(
-            k.action(&press('n', KeyModifiers::NONE)),
+            k.action(&press('t', KeyModifiers::NONE)),
             Some(Action::Step)
         );
         assert_eq!(
