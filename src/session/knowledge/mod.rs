@@ -3,10 +3,8 @@
 //! came from. Every planning command adds the rules of its scenario's domain to the
 //! skills, so a new task plans them from the start (no failure, no model call).
 //!
-//! A rule is checked before it is kept: it must fit the skill, must not contradict what
-//! the skill declares (the negation of a declared precondition, or the skill's own
-//! effect), and every scenario of the domain (the files beside the domain's base file)
-//! must still plan its goal in the planner's model with it.
+//! A rule is checked before it is kept (`check.rs`): it must fit the skill, must not
+//! contradict what the skill declares, and every goal of the domain must still plan.
 //!
 //! The file is written atomically (`store::write_atomic`): a crash never leaves half of it.
 
@@ -15,8 +13,10 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::domain::{ActionCall, Condition, LearnError, LearnedRule, Scenario};
-use crate::planner::Outcome;
-use crate::verify::plan_in_model;
+
+mod check;
+
+pub use check::{Refusal, check_rule, domain_scenarios, offered_rule, rule_for_fix};
 
 /// The file's name inside the policy directory.
 pub const FILE_NAME: &str = "knowledge.toml";
@@ -114,29 +114,6 @@ pub enum KnowledgeError {
     },
     #[error(transparent)]
     Learn(#[from] LearnError),
-}
-
-/// Why a rule was not kept.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum Refusal {
-    #[error("{0}")]
-    DoesNotFit(LearnError),
-    #[error(
-        "it contradicts {skill}'s declared precondition {declared}: the action could never run"
-    )]
-    ContradictsPrecondition { skill: String, declared: String },
-    #[error(
-        "it asks for {skill}'s own effect {effect} before the action, which is there to make it true"
-    )]
-    ContradictsEffect { skill: String, effect: String },
-    #[error("with it, {scenario}'s goal {goal} can no longer be planned ({why})")]
-    GoalUnplannable {
-        scenario: String,
-        goal: String,
-        why: String,
-    },
-    #[error("it is kept already as {0}")]
-    Known(String),
 }
 
 /// The rules kept so far, and where they live.
@@ -307,218 +284,6 @@ fn located(text: &str, e: &toml::de::Error) -> String {
     }
 }
 
-/// The rule a fix teaches, as it would be kept: lifted to the action's parameters where
-/// the condition names the action's objects, else (nothing to generalise) only for them.
-pub fn offered_rule(action: &ActionCall, condition: &Condition, only: bool) -> LearnedRule {
-    let lifted = LearnedRule::from_fix(action, condition, false);
-    if only || !lifted.generalises() {
-        LearnedRule::from_fix(action, condition, true)
-    } else {
-        lifted
-    }
-}
-
-/// Whether `rule` may be kept for `scenario`'s domain, given the rules kept already:
-/// it fits, contradicts no declaration, and every scenario of the domain still plans.
-pub fn check_rule(
-    rule: &LearnedRule,
-    scenario: &Scenario,
-    knowledge: &Knowledge,
-) -> Result<(), Refusal> {
-    let domain = domain_of(scenario);
-    if let Some(same) = knowledge
-        .rules_of(&domain)
-        .find(|k| k.skill == rule.skill && k.requires == rule.requires && k.only == rule.only)
-    {
-        return Err(Refusal::Known(same.id.clone()));
-    }
-    let mut probe = scenario.domain.clone();
-    probe.learn(rule).map_err(Refusal::DoesNotFit)?;
-    for skill in scenario
-        .domain
-        .skills
-        .iter()
-        .filter(|s| s.name == rule.skill)
-    {
-        let t = rule.template(skill).map_err(Refusal::DoesNotFit)?;
-        if let Some(declared) = skill
-            .pre
-            .iter()
-            .find(|p| p.atom == t.atom && p.negated != t.negated)
-        {
-            return Err(Refusal::ContradictsPrecondition {
-                skill: skill.name.clone(),
-                declared: template_text(skill, declared),
-            });
-        }
-        if !t.negated && skill.add.contains(&t.atom) {
-            return Err(Refusal::ContradictsEffect {
-                skill: skill.name.clone(),
-                effect: template_text(
-                    skill,
-                    &crate::domain::skill::LiteralTemplate {
-                        atom: t.atom.clone(),
-                        negated: false,
-                    },
-                ),
-            });
-        }
-    }
-    // Judged against the rules kept so far, so that only this rule's effect counts.
-    let known = |s: &Scenario| {
-        let mut s = s.clone();
-        knowledge.apply(&mut s);
-        s
-    };
-    let with_rule = |s: &Scenario| {
-        let mut s = known(s);
-        s.domain.learn(rule).ok().map(|()| s)
-    };
-    // The domain's worked examples are goals a person may ask for: in this scenario and
-    // in the domain's base file (a scenario may declare its skills differently).
-    let base = scenario
-        .files
-        .first()
-        .and_then(|f| Scenario::load(&f.path).ok());
-    for scene in std::iter::once(scenario).chain(base.as_ref()) {
-        let (Some(after), Ok(facts)) = (with_rule(scene), facts_of(scene)) else {
-            continue;
-        };
-        let before = known(scene);
-        for example in &scenario.examples {
-            let Ok(goal) = scene.parse_goal(&example.goal) else {
-                continue;
-            };
-            if plans(&before, &facts, &goal).is_err() {
-                continue;
-            }
-            if let Err(why) = plans(&after, &facts, &goal) {
-                return Err(Refusal::GoalUnplannable {
-                    scenario: format!("the worked example {:?}", example.instruction),
-                    goal: goal.to_string(),
-                    why,
-                });
-            }
-        }
-    }
-    for path in domain_scenarios(scenario) {
-        let Ok(other) = Scenario::load(&path) else {
-            continue;
-        };
-        let Some(goal) = other.goal.clone() else {
-            continue;
-        };
-        let Ok(facts) = facts_of(&other) else {
-            continue;
-        };
-        // Unplannable without the rule too: not the rule's doing.
-        if plans(&known(&other), &facts, &goal).is_err() {
-            continue;
-        }
-        let Some(after) = with_rule(&other) else {
-            continue;
-        };
-        if let Err(why) = plans(&after, &facts, &goal) {
-            return Err(Refusal::GoalUnplannable {
-                scenario: path.display().to_string(),
-                goal: goal.to_string(),
-                why,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// The facts true in the scenario's world at the start.
-fn facts_of(scenario: &Scenario) -> Result<Vec<Condition>, String> {
-    Ok(crate::world::load(scenario)
-        .map_err(|e| e.to_string())?
-        .facts())
-}
-
-/// Whether `goal` plans to success in the model from `facts`.
-fn plans(
-    scenario: &Scenario,
-    facts: &[Condition],
-    goal: &crate::goal::Formula,
-) -> Result<(), String> {
-    let planned = plan_in_model(&scenario.domain, facts, &goal.to_dnf(), &[], &[])
-        .map_err(|e| e.to_string())?;
-    match planned.plan.outcome {
-        Outcome::Success => Ok(()),
-        Outcome::Unreachable { condition, .. } => Err(format!("{condition} cannot be achieved")),
-        Outcome::ActionFailed { action, error, .. } => Err(format!("{action}! fails: {error}")),
-        Outcome::Exhausted { reason } => Err(reason),
-    }
-}
-
-/// The scenario files of the same domain: every `.toml` under the directory of the
-/// domain's base file whose chain starts at the same base file.
-pub fn domain_scenarios(scenario: &Scenario) -> Vec<PathBuf> {
-    let Some(base) = scenario.files.first().map(|f| f.path.clone()) else {
-        return Vec::new();
-    };
-    let base_canon = std::fs::canonicalize(&base).unwrap_or_else(|_| base.clone());
-    let Some(dir) = base.parent() else {
-        return Vec::new();
-    };
-    let mut files = Vec::new();
-    collect_toml(dir, &mut files, 3);
-    files.sort();
-    files
-        .into_iter()
-        .filter(|p| {
-            Scenario::load(p).is_ok_and(|s| {
-                s.files.first().is_some_and(|f| {
-                    std::fs::canonicalize(&f.path).unwrap_or_else(|_| f.path.clone()) == base_canon
-                })
-            })
-        })
-        .collect()
-}
-
-fn collect_toml(dir: &Path, out: &mut Vec<PathBuf>, depth: usize) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    for entry in entries.filter_map(Result::ok) {
-        let path = entry.path();
-        if path.is_dir() && depth > 0 {
-            collect_toml(&path, out, depth - 1);
-        } else if path.extension().is_some_and(|e| e == "toml") {
-            out.push(path);
-        }
-    }
-}
-
-fn template_text(
-    skill: &crate::domain::Skill,
-    t: &crate::domain::skill::LiteralTemplate,
-) -> String {
-    use crate::domain::skill::Term;
-    let atom = crate::domain::Atom {
-        predicate: t.atom.predicate.clone(),
-        args: t
-            .atom
-            .args
-            .iter()
-            .map(|a| match a {
-                Term::Param(i) => skill
-                    .params
-                    .get(*i)
-                    .map_or_else(|| "?".into(), |p| format!("{{{}}}", p.name)),
-                Term::Const(c) => c.clone(),
-                Term::Every => "{*}".into(),
-            })
-            .collect(),
-    };
-    Condition {
-        atom,
-        negated: t.negated,
-    }
-    .to_string()
-}
-
 /// A condition of a tree that a learned rule put there.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LearnedNode {
@@ -565,28 +330,4 @@ pub fn learned_in_tree(domain: &crate::domain::Domain, tree: &crate::bt::Tree) -
         }
     }
     out
-}
-
-/// The rule to keep for a fix when nobody is asked (`--yes --learn`): the lifted rule, or,
-/// when that is refused, the rule for the fix's objects alone; with every refusal on the
-/// way (a narrower rule kept after the lifted one was refused says why).
-pub fn rule_for_fix(
-    action: &ActionCall,
-    condition: &Condition,
-    scenario: &Scenario,
-    knowledge: &Knowledge,
-) -> (Option<LearnedRule>, Vec<(LearnedRule, Refusal)>) {
-    let lifted = offered_rule(action, condition, false);
-    let only = offered_rule(action, condition, true);
-    let mut refused: Vec<(LearnedRule, Refusal)> = Vec::new();
-    for rule in [lifted, only] {
-        if refused.iter().any(|(r, _)| *r == rule) {
-            continue;
-        }
-        match check_rule(&rule, scenario, knowledge) {
-            Ok(()) => return (Some(rule), refused),
-            Err(e) => refused.push((rule, e)),
-        }
-    }
-    (None, refused)
 }
