@@ -94,6 +94,16 @@ pub enum GoalSource {
     Scenario,
 }
 
+impl GoalSource {
+    /// As run.json records it.
+    fn name(self) -> &'static str {
+        match self {
+            GoalSource::Interpret => "interpret",
+            GoalSource::Scenario => "scenario",
+        }
+    }
+}
+
 /// Run the chosen experiment.
 pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
     use SessionExperiment as S;
@@ -290,10 +300,7 @@ fn sequence_experiment(
     tasks.sort();
     paths.extend(tasks);
     let scenarios = load_scenarios(scenarios_dir, &paths)?;
-    let goal_source = match goal {
-        GoalSource::Interpret => "interpret",
-        GoalSource::Scenario => "scenario",
-    };
+    let goal_source = goal.name();
     let mut p = prepare(
         flags,
         &[
@@ -376,10 +383,7 @@ pub fn session_experiment(
         ),
     };
     let scenarios = load_scenarios(scenarios_dir, &paths)?;
-    let goal_source = match goal {
-        GoalSource::Interpret => "interpret",
-        GoalSource::Scenario => "scenario",
-    };
+    let goal_source = goal.name();
     let mut p = prepare(
         flags,
         &[
