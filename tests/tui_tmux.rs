@@ -224,13 +224,22 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     );
     assert!(screen.contains("hand-written fixture"), "{screen}");
 
-    // Approve: the tree grows, the new nodes marked.
+    // Approve: the tree grows, the new nodes marked; the fix is offered as a rule.
     tmux.keys(&["a"]);
     tmux.wait_for(
         &[
-            "repaired:",
             "+[-] ~\"any object\" on \"blue cube\"?",
             "place \"red cube\"",
+            "Keep as a rule for later tasks: grasp {x} needs",
+        ],
+        20,
+    );
+    // Keep it: the condition is marked as learned.
+    tmux.keys(&["m"]);
+    tmux.wait_for(
+        &[
+            "kept as rule r1",
+            "~\"any object\" on \"blue cube\"? ◆ learned r1",
         ],
         20,
     );
@@ -249,13 +258,17 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
         "the alternate screen was left:\n{screen}"
     );
 
-    // The policy parses and says where its fix came from.
+    // The policy parses and says where its fix came from; the rule kept beside it too.
     let files: Vec<PathBuf> = std::fs::read_dir(&policies)
         .unwrap()
         .filter_map(Result::ok)
         .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "bt"))
         .collect();
     assert_eq!(files.len(), 1, "{files:?}");
+    let knowledge = betr::session::Knowledge::open(&policies.join("knowledge.toml")).unwrap();
+    assert_eq!(knowledge.rules.len(), 1);
+    assert_eq!(knowledge.rules[0].kept_by, "a person (workbench)");
     let domain = Scenario::load(&scenario).unwrap().domain;
     let policy = betr::session::policy::load(&files[0], &domain).unwrap();
     assert_eq!(policy.fixes.len(), 1);
@@ -342,7 +355,16 @@ fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
     // The failure again: the model proposes, the person approves.
     step_to_proposal(&tmux);
     tmux.keys(&["a"]);
-    tmux.wait_for(&["repaired:", "+[-] ~\"any object\" on \"blue cube\"?"], 20);
+    tmux.wait_for(
+        &[
+            "+[-] ~\"any object\" on \"blue cube\"?",
+            "Keep as a rule for later tasks",
+        ],
+        20,
+    );
+    // Not kept as a rule: the offer goes, the repair's steps are in the log.
+    tmux.keys(&["n"]);
+    tmux.wait_for(&["not kept as a rule", "repaired:"], 10);
 
     // Verify: the report opens over the screen; any key closes it.
     tmux.keys(&["v"]);

@@ -181,14 +181,20 @@ impl App {
             Action::Plan => Command::Plan,
             Action::Approve => Command::Approve,
             Action::Reject => Command::Reject,
-            Action::Undo => Command::Undo,
+            Action::Undo => {
+                self.llm.offer = None;
+                Command::Undo
+            }
             Action::Verify => Command::Verify,
             Action::Save => Command::SavePolicy,
             Action::Load => Command::LoadPolicy(None),
             Action::Export => Command::Export,
             Action::KeepRule => Command::KeepRule { only: false },
             Action::KeepRuleOnly => Command::KeepRule { only: true },
-            Action::DeclineRule => Command::DeclineRule,
+            Action::DeclineRule => {
+                self.llm.offer = None;
+                Command::DeclineRule
+            }
             Action::Knowledge => Command::ShowKnowledge,
             Action::Reset => Command::ResetWorld,
             // The recording panel holds the input line's place until the recording ends.
@@ -454,15 +460,18 @@ impl App {
                         &key(Action::DeclineRule),
                     ),
                 );
-                self.llm.log(text.clone());
-                self.message(text, false);
+                // Shown where a proposal would be, until it is answered: the log keeps the
+                // steps of the repair in view.
+                self.llm.offer = Some(text);
             }
             Event::RuleKept { id, rule, path } => {
+                self.llm.offer = None;
                 let text = strings::rule_kept(&id, &rule, &path.display().to_string());
                 self.llm.log(text.clone());
                 self.message(text, false);
             }
             Event::RuleRefused { rule, reason } => {
+                self.llm.offer = None;
                 let text = strings::rule_refused(&rule, &reason);
                 self.llm.log(text.clone());
                 self.message(text, true);

@@ -64,6 +64,8 @@ pub struct LlmPane {
     pub goal: Option<String>,
     pub reasoning: Option<String>,
     pub proposal: Option<ProposalView>,
+    /// An approved fix offered as a rule, with the keys that answer it.
+    pub offer: Option<String>,
     pub error: Option<String>,
     /// Each line with how many times in a row it was said.
     log: Vec<(String, usize)>,
@@ -141,7 +143,10 @@ impl LlmPane {
                 }
                 lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
             }
-            None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
+            None => match &self.offer {
+                Some(offer) => lines.push(Line::from(Span::styled(offer.clone(), theme.proposal))),
+                None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
+            },
         }
         if let Some(goal) = &self.goal {
             lines.push(Line::from(vec![
