@@ -11,7 +11,7 @@ use clap::{Args, Subcommand};
 
 use betr::domain::Scenario;
 use betr::session::knowledge::{
-    KeptRule, Knowledge, Provenance, check_rule, offered_rule, rule_for_fix,
+    KeptRule, Knowledge, Provenance, check_rule, kept_conditions, offered_rule, rule_for_fix,
 };
 use betr::session::{PolicyStore, Proposal};
 
@@ -50,16 +50,21 @@ pub struct KnowledgeFlags {
 }
 
 impl KnowledgeFlags {
-    /// Add the learned rules of the scenario's domain to its skills and say so on stderr
-    /// (nothing is said when there are none).
-    pub fn apply(&self, scenario: &mut Scenario) -> Result<Vec<String>> {
-        if self.no_knowledge {
-            return Ok(Vec::new());
+    /// The knowledge file, unless `--no-knowledge` or there is no policy directory.
+    pub fn load(&self) -> Result<Option<Knowledge>> {
+        match self.dir.knowledge_path() {
+            Some(path) if !self.no_knowledge => Ok(Some(Knowledge::open(&path)?)),
+            _ => Ok(None),
         }
-        let Some(path) = self.dir.knowledge_path() else {
-            return Ok(Vec::new());
+    }
+
+    /// Add the learned rules of the scenario's domain to its skills and say so on stderr
+    /// (nothing is said when there are none); the knowledge read, for a session that may
+    /// keep more.
+    pub fn apply(&self, scenario: &mut Scenario) -> Result<Option<Knowledge>> {
+        let Some(knowledge) = self.load()? else {
+            return Ok(None);
         };
-        let knowledge = Knowledge::open(&path)?;
         let (applied, notes) = knowledge.apply(scenario);
         for note in &notes {
             eprintln!("Knowledge: {note}");
@@ -68,11 +73,11 @@ impl KnowledgeFlags {
             eprintln!(
                 "Knowledge: {} learned rule(s) from {} ({}); --no-knowledge plans without them",
                 applied.len(),
-                path.display(),
+                knowledge.path.display(),
                 applied.join(", ")
             );
         }
-        Ok(applied)
+        Ok(Some(knowledge))
     }
 }
 
@@ -178,59 +183,51 @@ pub fn offer(
 ) -> Result<usize> {
     let mut knowledge = dir.open()?;
     let mut count = 0;
-    for (proposal, author) in kept {
-        let Proposal::Conditions {
-            action, conditions, ..
-        } = proposal
-        else {
-            continue;
-        };
-        for condition in conditions {
-            let rule = if yes {
-                let (rule, refused) = rule_for_fix(action, condition, scenario, &knowledge);
-                for (rule, why) in refused {
-                    println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
-                }
-                let Some(rule) = rule else {
-                    continue;
-                };
-                println!(
-                    "Keep as a rule: {}? yes (--yes --learn)",
-                    rule.describe(&scenario.domain)
-                );
-                rule
-            } else {
-                let lifted = offered_rule(action, condition, false);
-                let only = offered_rule(action, condition, true);
-                let Some(rule) = ask(&lifted, &only, scenario) else {
-                    println!("Not kept.");
-                    continue;
-                };
-                if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
-                    println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
-                    continue;
-                }
-                rule
+    for (action, condition, author) in kept_conditions(kept) {
+        let rule = if yes {
+            let (rule, refused) = rule_for_fix(action, condition, scenario, &knowledge);
+            for (rule, why) in refused {
+                println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
+            }
+            let Some(rule) = rule else {
+                continue;
             };
-            let kept = knowledge.keep(KeptRule::new(
-                &rule,
-                scenario,
-                Provenance {
-                    scenario_file: scenario_path.display().to_string(),
-                    action,
-                    condition,
-                    proposed_by: author.clone(),
-                    kept_by: if yes { "--yes --learn" } else { "a person" }.into(),
-                },
-            ))?;
             println!(
-                "Kept rule {}: {} (in {})",
-                kept.id,
-                rule.describe(&scenario.domain),
-                knowledge.path.display()
+                "Keep as a rule: {}? yes (--yes --learn)",
+                rule.describe(&scenario.domain)
             );
-            count += 1;
-        }
+            rule
+        } else {
+            let lifted = offered_rule(action, condition, false);
+            let only = offered_rule(action, condition, true);
+            let Some(rule) = ask(&lifted, &only, scenario) else {
+                println!("Not kept.");
+                continue;
+            };
+            if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
+                println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
+                continue;
+            }
+            rule
+        };
+        let kept = knowledge.keep(KeptRule::new(
+            &rule,
+            scenario,
+            Provenance {
+                scenario_file: scenario_path.display().to_string(),
+                action,
+                condition,
+                proposed_by: author.to_string(),
+                kept_by: if yes { "--yes --learn" } else { "a person" }.into(),
+            },
+        ))?;
+        println!(
+            "Kept rule {}: {} (in {})",
+            kept.id,
+            rule.describe(&scenario.domain),
+            knowledge.path.display()
+        );
+        count += 1;
     }
     Ok(count)
 }

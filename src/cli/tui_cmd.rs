@@ -84,12 +84,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         },
         no_knowledge: args.no_knowledge,
     };
-    knowledge_flags.apply(&mut scenario)?;
     // Fixes approved in the workbench may be kept as rules in the same file.
-    let knowledge = match knowledge_flags.dir.knowledge_path() {
-        Some(p) if !args.no_knowledge => Some(betr::session::Knowledge::open(&p)?),
-        _ => None,
-    };
+    let knowledge = knowledge_flags.apply(&mut scenario)?;
     let scenario = Arc::new(scenario);
     // A tree that cannot be read is said before the screen opens (exit 2).
     if let Some(tree) = &args.tree {

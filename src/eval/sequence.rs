@@ -15,8 +15,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::domain::Scenario;
 use crate::llm::LanguageModel;
-use crate::session::knowledge::{KeptRule, Knowledge, Provenance, rule_for_fix};
-use crate::session::{Event, Options, Proposal};
+use crate::session::knowledge::{KeptRule, Knowledge, Provenance, kept_conditions, rule_for_fix};
+use crate::session::{Event, Options};
 
 use super::EvalError;
 use super::run::{Journal, RunConfig, Tap, elapsed_ms};
@@ -146,38 +146,30 @@ async fn run_step(
     let mut rules_kept = Vec::new();
     let mut rules_refused = Vec::new();
     if with_knowledge && trace.ending.is_ok() {
-        for (proposal, author) in &trace.kept {
-            let Proposal::Conditions {
-                action, conditions, ..
-            } = proposal
-            else {
+        for (action, condition, author) in kept_conditions(&trace.kept) {
+            let (rule, refused) = rule_for_fix(action, condition, scenario, knowledge);
+            for (rule, why) in refused {
+                rules_refused.push(format!("{}: {why}", rule.describe(&scenario.domain)));
+            }
+            let Some(rule) = rule else {
                 continue;
             };
-            for condition in conditions {
-                let (rule, refused) = rule_for_fix(action, condition, scenario, knowledge);
-                for (rule, why) in refused {
-                    rules_refused.push(format!("{}: {why}", rule.describe(&scenario.domain)));
-                }
-                let Some(rule) = rule else {
-                    continue;
-                };
-                let kept = knowledge
-                    .keep(KeptRule::new(
-                        &rule,
-                        scenario,
-                        Provenance {
-                            scenario_file: path.to_string(),
-                            action,
-                            condition,
-                            proposed_by: author.clone(),
-                            kept_by: "betr eval resolve --sequence (every fix kept)".into(),
-                        },
-                    ))
-                    .map_err(|e| {
-                        EvalError::io(&knowledge.path, std::io::Error::other(e.to_string()))
-                    })?;
-                rules_kept.push(format!("{} {}", kept.id, rule.describe(&scenario.domain)));
-            }
+            let kept = knowledge
+                .keep(KeptRule::new(
+                    &rule,
+                    scenario,
+                    Provenance {
+                        scenario_file: path.to_string(),
+                        action,
+                        condition,
+                        proposed_by: author.to_string(),
+                        kept_by: "betr eval resolve --sequence (every fix kept)".into(),
+                    },
+                ))
+                .map_err(|e| {
+                    EvalError::io(&knowledge.path, std::io::Error::other(e.to_string()))
+                })?;
+            rules_kept.push(format!("{} {}", kept.id, rule.describe(&scenario.domain)));
         }
     }
     Ok(SequenceStep {

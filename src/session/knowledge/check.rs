@@ -128,10 +128,7 @@ pub fn check_rule(
             }
         }
     }
-    for path in domain_scenarios(scenario) {
-        let Ok(other) = Scenario::load(&path) else {
-            continue;
-        };
+    for (path, other) in domain_scenarios(scenario) {
         let Some(goal) = other.goal.clone() else {
             continue;
         };
@@ -181,11 +178,12 @@ fn plans(
 
 /// The scenario files of the same domain: every `.toml` under the directory of the
 /// domain's base file whose chain starts at the same base file.
-pub fn domain_scenarios(scenario: &Scenario) -> Vec<PathBuf> {
+pub fn domain_scenarios(scenario: &Scenario) -> Vec<(PathBuf, Scenario)> {
     let Some(base) = scenario.files.first().map(|f| f.path.clone()) else {
         return Vec::new();
     };
-    let base_canon = std::fs::canonicalize(&base).unwrap_or_else(|_| base.clone());
+    let canonical = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    let base_canon = canonical(&base);
     let Some(dir) = base.parent() else {
         return Vec::new();
     };
@@ -194,12 +192,11 @@ pub fn domain_scenarios(scenario: &Scenario) -> Vec<PathBuf> {
     files.sort();
     files
         .into_iter()
-        .filter(|p| {
-            Scenario::load(p).is_ok_and(|s| {
-                s.files.first().is_some_and(|f| {
-                    std::fs::canonicalize(&f.path).unwrap_or_else(|_| f.path.clone()) == base_canon
-                })
-            })
+        .filter_map(|p| Scenario::load(&p).ok().map(|s| (p, s)))
+        .filter(|(_, s)| {
+            s.files
+                .first()
+                .is_some_and(|f| canonical(&f.path) == base_canon)
         })
         .collect()
 }

@@ -18,6 +18,22 @@ mod check;
 
 pub use check::{Refusal, check_rule, domain_scenarios, offered_rule, rule_for_fix};
 
+/// Each condition of the approved changes `kept` in a tree, with the action it was
+/// inserted before and who proposed it: the fixes that may become rules.
+pub fn kept_conditions(
+    kept: &[(crate::session::Proposal, String)],
+) -> impl Iterator<Item = (&ActionCall, &Condition, &str)> {
+    kept.iter().flat_map(|(proposal, author)| match proposal {
+        crate::session::Proposal::Conditions {
+            action, conditions, ..
+        } => conditions
+            .iter()
+            .map(|c| (action, c, author.as_str()))
+            .collect::<Vec<_>>(),
+        crate::session::Proposal::Value { .. } => Vec::new(),
+    })
+}
+
 /// The file's name inside the policy directory.
 pub const FILE_NAME: &str = "knowledge.toml";
 
