@@ -27,7 +27,16 @@ fn main() -> Result<()> {
     println!(
         "|------:|----------:|------------:|--------:|--------:|----------:|------------:|---------------:|--------:|"
     );
-    for n in [10, 100, 1000] {
+    let sizes: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let sizes = if sizes.is_empty() {
+        vec![10, 100, 1000]
+    } else {
+        sizes
+    };
+    for n in sizes {
         let scenario = Scenario::load(&write_scenario(&dir, n)?)?;
         let world = CellWorld::from_scenario(&scenario, None)?;
         let Repaired {

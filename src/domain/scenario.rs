@@ -7,6 +7,7 @@
 //! a skill name defined in the child replaces every base skill of that name, and the world
 //! table is merged by the world module. Every error names the file, line and column.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -197,6 +198,8 @@ impl Scenario {
         };
 
         let mut vocabulary = Vocabulary::default();
+        // Where each object stands in the vocabulary, so a large scene loads in linear time.
+        let mut index: HashMap<String, usize> = HashMap::new();
         for (raw, file) in raws.iter().zip(&files) {
             for (ty, names) in &raw.objects {
                 for name in names {
@@ -208,13 +211,16 @@ impl Scenario {
                             "an object name must be non-empty and contain no quote",
                         ));
                     }
-                    match vocabulary.objects.iter_mut().find(|o| o.name == n) {
+                    match index.get(n).and_then(|&i| vocabulary.objects.get_mut(i)) {
                         Some(o) if !o.types.contains(ty) => o.types.push(ty.clone()),
                         Some(_) => {}
-                        None => vocabulary.objects.push(Object {
-                            name: n.to_string(),
-                            types: vec![ty.clone()],
-                        }),
+                        None => {
+                            index.insert(n.to_string(), vocabulary.objects.len());
+                            vocabulary.objects.push(Object {
+                                name: n.to_string(),
+                                types: vec![ty.clone()],
+                            });
+                        }
                     }
                 }
             }

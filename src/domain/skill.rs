@@ -52,9 +52,7 @@ impl Param {
         &'a self,
         vocabulary: &'a Vocabulary,
     ) -> impl Iterator<Item = &'a str> + 'a {
-        vocabulary
-            .objects_fitting(&self.types)
-            .filter(move |o| !vocabulary.fits(o, &self.except))
+        vocabulary.objects_fitting_except(&self.types, &self.except)
     }
 }
 

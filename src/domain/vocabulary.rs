@@ -11,6 +11,14 @@ pub struct Object {
     pub types: Vec<String>,
 }
 
+impl Object {
+    /// Whether this object fits a slot that accepts `types` (type names, or object names
+    /// standing for themselves).
+    pub fn fits(&self, types: &[String]) -> bool {
+        types.iter().any(|t| *t == self.name) || self.types.iter().any(|ot| types.contains(ot))
+    }
+}
+
 /// A predicate with the types each argument slot accepts (a union: `place|item`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Predicate {
@@ -80,10 +88,7 @@ impl Vocabulary {
     /// Whether `object` fits a slot that accepts `types` (type names, or object names
     /// standing for themselves).
     pub fn fits(&self, object: &str, types: &[String]) -> bool {
-        types.iter().any(|t| t == object)
-            || self
-                .object(object)
-                .is_some_and(|o| o.types.iter().any(|ot| types.contains(ot)))
+        types.iter().any(|t| t == object) || self.object(object).is_some_and(|o| o.fits(types))
     }
 
     /// The objects that fit a slot, in declaration order.
@@ -91,9 +96,20 @@ impl Vocabulary {
         &'a self,
         types: &'a [String],
     ) -> impl Iterator<Item = &'a str> + 'a {
+        self.objects_fitting_except(types, &[])
+    }
+
+    /// The objects that fit `types` and not `except`, in declaration order. Each object's
+    /// types are read where it stands (looking it up by name again, as `fits` does, makes
+    /// listing a large scene quadratic).
+    pub fn objects_fitting_except<'a>(
+        &'a self,
+        types: &'a [String],
+        except: &'a [String],
+    ) -> impl Iterator<Item = &'a str> + 'a {
         self.objects
             .iter()
-            .filter(move |o| self.fits(&o.name, types))
+            .filter(move |o| o.fits(types) && !o.fits(except))
             .map(|o| o.name.as_str())
     }
 

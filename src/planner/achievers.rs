@@ -6,6 +6,8 @@
 //! (a robot that is at the bar puts things down at the bar), and heavily against undoing
 //! a condition the tree has already achieved. Ties keep the scenario's declaration order.
 
+use std::collections::HashSet;
+
 use crate::domain::{ANY_OBJECT, Atom, Condition, Domain, GroundSkill};
 use crate::world::World;
 
@@ -76,8 +78,12 @@ pub fn rank(
     let mut forbidden: Vec<&Condition> = above.iter().collect();
     forbidden.push(condition);
     let mut out: Vec<Candidate> = Vec::new();
+    // Grounded skills carry no values yet: a call is its skill and objects.
+    let mut seen: HashSet<(String, Vec<String>)> = HashSet::new();
     for ground in groundings(domain, condition) {
-        if ground.pre.contains(condition) || out.iter().any(|c| c.skill.call == ground.call) {
+        if ground.pre.contains(condition)
+            || seen.contains(&(ground.call.skill.clone(), ground.call.args.clone()))
+        {
             continue;
         }
         let unmet: Vec<&Condition> = ground.pre.iter().filter(|p| !world.check(p)).collect();
@@ -91,6 +97,7 @@ pub fn rank(
         let score = ground.cost
             + UNMET_PRECONDITION_COST * unmet.len() as f64
             + UNDO_PROTECTED_COST * undone;
+        seen.insert((ground.call.skill.clone(), ground.call.args.clone()));
         out.push(Candidate {
             skill: ground,
             score,
@@ -142,8 +149,19 @@ fn groundings(domain: &Domain, condition: &Condition) -> Vec<GroundSkill> {
                     None => p.candidates(&domain.vocabulary).collect(),
                 })
                 .collect();
+            // Free parameters were chosen among the objects they admit; only the ones
+            // the condition fixed need checking (checking all would look every object
+            // up again for every grounding, quadratic in the scene's size).
+            let fixed_fit = skill
+                .params
+                .iter()
+                .zip(&binding)
+                .all(|(p, b)| b.as_deref().is_none_or(|o| p.admits(&domain.vocabulary, o)));
+            if !fixed_fit {
+                continue;
+            }
             for args in cartesian(&choices, MAX_GROUNDINGS_PER_SKILL) {
-                if skill.accepts(&domain.vocabulary, &args) {
+                {
                     let ground = skill.ground(&args);
                     if ground.achieves(condition) {
                         out.push(ground);

@@ -12,7 +12,7 @@
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
-use super::geometry::{CONTACT_GAP, Opening, Part, Pose, path_collides};
+use super::geometry::{CONTACT_GAP, Footprints, Opening, Part, Pose, path_collides};
 use super::values::judge;
 use super::{CellWorld, Effect, Held};
 use crate::domain::{ActionCall, Value};
@@ -282,11 +282,14 @@ impl CellWorld {
         let ny = (((top.maxs.y - top.mins.y) / 2.0 - hy) / step)
             .floor()
             .max(0.0) as i32;
-        let others: Vec<_> = (0..self.scene.solids.len())
-            .filter(|o| *o != x && *o != s && !self.is_held(*o))
-            .map(|o| self.aabb(o))
-            .filter(|b| b.maxs.z > top.maxs.z + CONTACT_GAP)
-            .collect();
+        let others = Footprints::new(
+            (0..self.scene.solids.len())
+                .filter(|o| *o != x && *o != s && !self.is_held(*o))
+                .map(|o| self.aabb(o))
+                .filter(|b| b.maxs.z > top.maxs.z + CONTACT_GAP)
+                .collect(),
+            ENOUGH_CLEARANCE,
+        );
         let mut scored = Vec::new();
         for i in -nx..=nx {
             for j in -ny..=ny {
@@ -295,15 +298,7 @@ impl CellWorld {
                 if !self.scene.robot.reaches(self.state.base, &point) {
                     continue;
                 }
-                let gap = others
-                    .iter()
-                    .map(|b| {
-                        let dx = (b.mins.x - (px + hx)).max(px - hx - b.maxs.x).max(0.0);
-                        let dy = (b.mins.y - (py + hy)).max(py - hy - b.maxs.y).max(0.0);
-                        dx.hypot(dy)
-                    })
-                    .fold(f32::INFINITY, f32::min)
-                    .min(ENOUGH_CLEARANCE);
+                let gap = others.gap((px, py), (hx, hy), ENOUGH_CLEARANCE);
                 let from = (px - held.from.x).hypot(py - held.from.y);
                 scored.push((-gap, from, px, py));
             }

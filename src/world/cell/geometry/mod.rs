@@ -7,8 +7,10 @@
 //! count every test it makes. The collision queries themselves are in `collision`.
 
 mod collision;
+mod footprints;
 
 pub use collision::{Counter, Obstacle, overlaps_any, path_collides};
+pub use footprints::Footprints;
 pub use parry3d::bounding_volume::Aabb;
 
 use std::f32::consts::{FRAC_PI_2, PI};

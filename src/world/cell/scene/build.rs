@@ -1,6 +1,8 @@
 //! Turning the merged scene entries into solids and initial poses: shapes are checked,
 //! and a solid `on` another rests on that one's top face (supports are placed first).
 
+use std::collections::HashSet;
+
 use indexmap::IndexMap;
 use toml::Spanned;
 
@@ -102,10 +104,17 @@ pub(super) fn build(
             ));
         }
     }
+    let objects: HashSet<&str> = scenario
+        .domain
+        .vocabulary
+        .objects
+        .iter()
+        .map(|o| o.name.as_str())
+        .collect();
     let mut solids = Vec::new();
     for (name, e) in &entries {
         let file = &files[e.file];
-        if scenario.domain.vocabulary.object(name).is_none() {
+        if !objects.contains(name.as_str()) {
             return Err(near(
                 file,
                 &format!("\"{name}\""),
@@ -130,11 +139,18 @@ pub(super) fn build(
     let raws: Vec<&Entry> = entries.values().collect();
     let mut poses: Vec<Option<Pose>> = vec![None; raws.len()];
     for i in 0..raws.len() {
-        place(i, &raws, &solids, files, &mut poses, &mut Vec::new())?;
+        place(
+            i,
+            &raws,
+            (&solids, &entries),
+            files,
+            &mut poses,
+            &mut Vec::new(),
+        )?;
     }
     let mut known = vec![true; solids.len()];
     for (file, u) in &unknown {
-        match solids.iter().position(|s| s.name == *u.get_ref()) {
+        match entries.get_index_of(u.get_ref()) {
             Some(i) => known[i] = false,
             None => {
                 return Err(files[*file].error_in_string(
@@ -166,10 +182,12 @@ pub(super) fn build(
     })
 }
 
+/// The pose of solid `i`, placing its supports first. `entries` index the solids by name
+/// (same order).
 fn place(
     i: usize,
     raws: &[&Entry],
-    solids: &[Solid],
+    (solids, entries): (&[Solid], &IndexMap<String, Entry>),
     files: &[SourceFile],
     poses: &mut Vec<Option<Pose>>,
     visiting: &mut Vec<usize>,
@@ -194,24 +212,21 @@ fn place(
     }
     let body = &solids[i].body;
     let support = |s: &Spanned<String>| {
-        solids
-            .iter()
-            .position(|x| x.name == *s.get_ref())
-            .ok_or_else(|| {
-                file.error_in_string(&s.span(), 0, format!("no solid named {:?}", s.get_ref()))
-            })
+        entries.get_index_of(s.get_ref()).ok_or_else(|| {
+            file.error_in_string(&s.span(), 0, format!("no solid named {:?}", s.get_ref()))
+        })
     };
     let pose = if let Some(at) = e.raw.at {
         Pose::from_parts(at.into(), rotation)
     } else if let Some(s) = &e.raw.on {
         let j = support(s)?;
-        let sp = place(j, raws, solids, files, poses, visiting)?;
+        let sp = place(j, raws, (solids, entries), files, poses, visiting)?;
         let top = solids[j].body.aabb(&sp);
         let [x, y] = e.raw.xy.unwrap_or([top.center().x, top.center().y]);
         body.resting(rotation, x, y, top.maxs.z)
     } else if let Some(s) = &e.raw.inside {
         let j = support(s)?;
-        let sp = place(j, raws, solids, files, poses, visiting)?;
+        let sp = place(j, raws, (solids, entries), files, poses, visiting)?;
         let Some((cavity, half, _)) = solids[j].body.cavity_at(&sp) else {
             return Err(file.error_in_string(
                 &s.span(),
