@@ -15,7 +15,7 @@ impl Object {
     /// Whether this object fits a slot that accepts `types` (type names, or object names
     /// standing for themselves).
     pub fn fits(&self, types: &[String]) -> bool {
-        types.iter().any(|t| *t == self.name) || self.types.iter().any(|ot| types.contains(ot))
+        types.contains(&self.name) || self.types.iter().any(|ot| types.contains(ot))
     }
 }
 
