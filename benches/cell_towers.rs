@@ -15,11 +15,10 @@ use anyhow::Result;
 use betr::domain::Scenario;
 use betr::world::CellWorld;
 
-#[path = "support/towers.rs"]
-mod towers;
-use towers::{Repaired, plan_and_repair, write_scenario};
+use betr::bench::towers::{Repaired, plan_and_repair, write_scenario};
 
 fn main() -> Result<()> {
+    let base = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
     let dir = std::env::temp_dir().join(format!("betr-cell-towers-{}", std::process::id()));
     println!(
         "| cubes | plan (ms) | repair (ms) | repairs | queries | box tests | exact tests | collision (ms) | tests/s |"
@@ -37,7 +36,7 @@ fn main() -> Result<()> {
         sizes
     };
     for n in sizes {
-        let scenario = Scenario::load(&write_scenario(&dir, n)?)?;
+        let scenario = Scenario::load(&write_scenario(&dir, n, &base)?)?;
         let world = CellWorld::from_scenario(&scenario, None)?;
         let Repaired {
             plan_time,

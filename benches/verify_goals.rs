@@ -20,8 +20,7 @@ use betr::goal::Formula;
 use betr::verify::{self, Limits, Report, VerifyConfig, VerifyInput};
 use betr::world::{self, CellWorld, World};
 
-#[path = "support/towers.rs"]
-mod towers;
+use betr::bench::towers;
 
 const REPETITIONS: usize = 5;
 
@@ -120,6 +119,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// Verification of the repaired tower-cell trees.
 fn cell_towers() -> Result<(), Box<dyn std::error::Error>> {
+    let base = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
     let dir = std::env::temp_dir().join(format!("betr-verify-towers-{}", std::process::id()));
     println!("\nTower cells (median of {REPETITIONS} verifications each):");
     println!(
@@ -129,7 +129,7 @@ fn cell_towers() -> Result<(), Box<dyn std::error::Error>> {
         "|------:|------:|-----------:|--------:|-----------:|---------:|------------:|-------:|------------:|------:|---------:|"
     );
     for n in [10, 100, 1000] {
-        let scenario = Scenario::load(&towers::write_scenario(&dir, n)?)?;
+        let scenario = Scenario::load(&towers::write_scenario(&dir, n, &base)?)?;
         let world = CellWorld::from_scenario(&scenario, None)?;
         let repaired = towers::plan_and_repair(&scenario, &world)?;
         let started = Instant::now();

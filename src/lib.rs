@@ -7,6 +7,7 @@
 //! by these modules.
 #![forbid(unsafe_code)]
 
+pub mod bench;
 pub mod bt;
 pub mod dataset;
 pub mod domain;

@@ -1,11 +1,14 @@
-//! `betr bench llm`: how fast the embedded model answers the goal prompt of scenario 1.
+//! `betr bench`: betr against its anchors, one table (and JSON); `betr bench llm` times
+//! each call of the goal prompt in detail.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, Result};
+use clap::{Args, ValueEnum};
 
+use betr::bench::{self, Report, cold, model, scale, ticks};
 use betr::domain::Scenario;
 use betr::llm::grammar;
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
@@ -13,9 +16,243 @@ use betr::llm::prompt::{Context, Templates, Variant};
 use betr::llm::{Message, Role};
 use betr::world;
 
+/// A part of `betr bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Part {
+    /// The tick loop against py_trees 2.6.0 on the same ~1000-node tree.
+    Ticks,
+    /// Scenario 1 end to end, and repair in cells of 10 to 10,000 cubes.
+    Scale,
+    /// Prompt and generation tokens/s against llama-bench (same libraries, file, threads).
+    Model,
+    /// The first answer of a one-shot command against a warm one, for both embedded models.
+    Cold,
+    /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
+    /// not part of the default set.
+    Llm,
+}
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// The parts to run (default: ticks, scale, model, cold).
+    #[arg(value_enum)]
+    parts: Vec<Part>,
+    /// Tiny sizes and short runs: checks that every part runs, measures little.
+    #[arg(long)]
+    quick: bool,
+    /// Where the report is written as JSON.
+    #[arg(long, default_value = "eval-results/bench.json")]
+    json: PathBuf,
+    #[arg(long, default_value = "scenarios/cell/red_on_blue.toml")]
+    scenario: PathBuf,
+    /// The py_trees anchor script.
+    #[arg(long, default_value = "../shared/anchors/bench_pytrees.py")]
+    pytrees: PathBuf,
+    /// Seconds each tick loop runs.
+    #[arg(long, default_value_t = 3.0)]
+    seconds: f64,
+    /// A GGUF file instead of the default model (the model and llm parts).
+    #[arg(long)]
+    model_path: Option<PathBuf>,
+    /// A known model by name (`betr model list`), fetched when missing.
+    #[arg(long, conflicts_with = "model_path")]
+    model: Option<String>,
+    /// CPU threads for the model (default: the model part tries 1 to the number of cores,
+    /// the cold part uses every core, the llm part the cores idle when the model loads).
+    #[arg(long)]
+    threads: Option<u32>,
+    /// Runs per model measure (llama-bench's -r), warm calls in the cold and llm parts.
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+}
+
+/// Run the chosen parts, print the table and write the JSON.
+pub fn run(args: &BenchArgs) -> Result<ExitCode> {
+    if args.parts == [Part::Llm] {
+        return llm(
+            &args.scenario,
+            (args.model_path.as_deref(), args.model.as_deref()),
+            args.threads,
+            args.repeats,
+        );
+    }
+    let parts: Vec<Part> = if args.parts.is_empty() {
+        vec![Part::Ticks, Part::Scale, Part::Model, Part::Cold]
+    } else {
+        args.parts.clone()
+    };
+    let mut report = Report::new();
+    for part in &parts {
+        eprintln!("bench: {}", format!("{part:?}").to_lowercase());
+        let rows = match part {
+            Part::Ticks => ticks_part(args)?,
+            Part::Scale => scale_part(args)?,
+            Part::Model => model_part(args)?,
+            Part::Cold => cold_part(args)?,
+            Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
+        };
+        for row in &rows {
+            eprintln!(
+                "  {} {}: {}",
+                row.part,
+                row.measure,
+                bench::number(row.betr)
+            );
+        }
+        report.rows.extend(rows);
+    }
+    report.machine.load_after = bench::load_average();
+    println!("{}", report.markdown());
+    report
+        .write_json(&args.json)
+        .with_context(|| format!("cannot write {}", args.json.display()))?;
+    eprintln!("bench: written to {}", args.json.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn ticks_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
+    let time = Duration::from_secs_f64(if args.quick {
+        0.2
+    } else {
+        args.seconds.max(0.1)
+    });
+    let nodes = 1000;
+    let python = ticks::pytrees_python(Path::new("target/bench-venv"))?;
+    // Back to back: the anchor, then betr, on the same shape.
+    let anchor = ticks::pytrees_ticks(&python, &args.pytrees, nodes, time)?;
+    let tree = ticks::pytrees_shape(nodes)?;
+    let betr = ticks::betr_ticks(&tree, time);
+    if (betr.nodes, betr.visited_per_tick) != (anchor.nodes, anchor.visited_per_tick) {
+        anyhow::bail!(
+            "the trees differ: betr {} nodes, {} visited per tick; py_trees {} and {}",
+            betr.nodes,
+            betr.visited_per_tick,
+            anchor.nodes,
+            anchor.visited_per_tick
+        );
+    }
+    Ok(vec![bench::Row {
+        part: "ticks".into(),
+        measure: format!("ticks of a {}-node planned-BT-shaped tree", betr.nodes),
+        unit: "ticks/s".into(),
+        better: bench::Better::Higher,
+        betr: betr.ticks_per_s,
+        anchor: Some((ticks::PY_TREES.replace("==", " "), anchor.ticks_per_s)),
+        target: Some(bench::Target::RatioAtLeast(50.0)),
+        note: format!(
+            "{} nodes visited per tick; {:.1} s each; betr records every node's status per tick",
+            betr.visited_per_tick,
+            time.as_secs_f64()
+        ),
+    }])
+}
+
+fn scale_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
+    let time = Duration::from_secs_f64(if args.quick { 0.05 } else { 1.0 });
+    let mut rows = vec![scale::scenario_one(&args.scenario, time)?];
+    let sizes: &[usize] = if args.quick {
+        &[10, 100]
+    } else {
+        &[10, 100, 1000, 10_000]
+    };
+    // The towers extend the cell's base file, beside scenario 1's.
+    let base = args
+        .scenario
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join("cell.toml");
+    rows.extend(scale::towers(sizes, &base)?);
+    Ok(rows)
+}
+
+fn model_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
+    let path = model_file(args, None)?;
+    let name = model_name(&path);
+    let sizes = if args.quick {
+        model::ModelSizes {
+            prompt: 64,
+            generate: 8,
+            repeats: 1,
+        }
+    } else {
+        model::ModelSizes {
+            prompt: 512,
+            generate: 64,
+            repeats: u32::try_from(args.repeats.max(1)).unwrap_or(3),
+        }
+    };
+    // The llama.cpp this very binary was built with: the profile directory it lies in.
+    let exe = std::env::current_exe().context("cannot tell where betr runs from")?;
+    let profile = exe
+        .ancestors()
+        .skip(1)
+        .find(|d| d.join("build").is_dir())
+        .context("betr does not run from a cargo target directory, where llama-bench is built against its llama.cpp")?;
+    let binary = model::llama_bench_binary(Path::new("scripts/llama-bench.sh"), profile)?;
+    let cores =
+        u32::try_from(std::thread::available_parallelism().map_or(1, usize::from)).unwrap_or(1);
+    let threads: Vec<u32> = match args.threads {
+        Some(t) => vec![t.max(1)],
+        None if args.quick => vec![cores],
+        None => (1..=cores).collect(),
+    };
+    let mut rows = Vec::new();
+    for t in threads {
+        // Back to back: llama-bench, then betr, with the same file and threads.
+        let anchor = model::llama_bench(&binary, &path, t, sizes)?;
+        let betr = model::betr_speeds(&path, t, sizes)?;
+        rows.extend(model::rows(&name, t, betr, anchor, sizes));
+    }
+    Ok(rows)
+}
+
+fn cold_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
+    // Every core, unless told: the idle-core count the product uses would depend on what
+    // the part before left running.
+    let threads = args.threads.map_or_else(
+        || u32::try_from(std::thread::available_parallelism().map_or(1, usize::from)).unwrap_or(1),
+        |t| t.max(1),
+    );
+    // Both embedded models, unless one was chosen.
+    let models: Vec<PathBuf> = if args.model_path.is_some() || args.model.is_some() {
+        vec![model_file(args, None)?]
+    } else {
+        betr::model::MODELS
+            .iter()
+            .map(|m| model_file(args, Some(m.name)))
+            .collect::<Result<_>>()?
+    };
+    let states =
+        std::env::temp_dir().join(format!("betr-bench-prompt-state-{}", std::process::id()));
+    let warm = if args.quick { 1 } else { args.repeats.max(1) };
+    let mut rows = Vec::new();
+    for path in models {
+        let l = cold::latencies(&path, &args.scenario, threads, &states, warm);
+        let _ = std::fs::remove_dir_all(&states);
+        rows.extend(cold::rows(&model_name(&path), threads, &l?));
+    }
+    Ok(rows)
+}
+
+/// The model file: `--model-path`, else the named (or `--model`, or default) model,
+/// fetched when missing.
+fn model_file(args: &BenchArgs, name: Option<&str>) -> Result<PathBuf> {
+    match (&args.model_path, name) {
+        (Some(p), _) => Ok(p.clone()),
+        (None, Some(n)) => super::model_cmd::ensure(Some(n)),
+        (None, None) => super::model_cmd::ensure(args.model.as_deref()),
+    }
+}
+
+fn model_name(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
 /// Load the model, then time a cold call, warm calls that share the cached prompt prefix,
 /// with and without the grammar, and print one table.
-pub fn llm(
+fn llm(
     scenario: &Path,
     (model_path, model): (Option<&Path>, Option<&str>),
     threads: Option<u32>,
@@ -62,6 +299,7 @@ pub fn llm(
         model_path: path,
         threads,
         context: 4096,
+        prompt_states: None,
     })?;
     let load = started.elapsed();
     println!(

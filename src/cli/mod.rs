@@ -42,11 +42,10 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Benchmarks of the embedded parts.
-    Bench {
-        #[command(subcommand)]
-        what: BenchWhat,
-    },
+    /// betr against the tools it replaces, measured back to back on this machine: ticks
+    /// against py_trees, planning and repair at scale, the embedded model against
+    /// llama-bench, and the first answer of a one-shot command; one table, also as JSON.
+    Bench(bench_cmd::BenchArgs),
     /// The workbench: type an instruction, plan, step or run the tree, approve the fixes a
     /// model proposes when an action fails, verify, save the policy.
     Tui(tui_cmd::TuiArgs),
@@ -253,28 +252,6 @@ pub struct PolicySaveTest {
     pub times: usize,
 }
 
-#[derive(Subcommand)]
-pub enum BenchWhat {
-    /// The embedded LLM on the goal prompt: load time, cold and warm latency, tokens/s,
-    /// with and without the grammar.
-    Llm {
-        #[arg(long, default_value = "scenarios/cell/red_on_blue.toml")]
-        scenario: PathBuf,
-        /// A GGUF file instead of the fetched default model.
-        #[arg(long)]
-        model_path: Option<PathBuf>,
-        /// A known model by name (`betr model list`), fetched when missing.
-        #[arg(long, conflicts_with = "model_path")]
-        model: Option<String>,
-        /// CPU threads (default: the cores idle when the model loads).
-        #[arg(long)]
-        threads: Option<u32>,
-        /// Warm calls per variant.
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-    },
-}
-
 pub fn run(cli: Cli) -> Result<ExitCode> {
     let glyphs = if cli.ascii {
         &betr::bt::ASCII
@@ -286,21 +263,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     };
     match command {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
-        Command::Bench {
-            what:
-                BenchWhat::Llm {
-                    scenario,
-                    model_path,
-                    model,
-                    threads,
-                    repeats,
-                },
-        } => bench_cmd::llm(
-            &scenario,
-            (model_path.as_deref(), model.as_deref()),
-            threads,
-            repeats,
-        ),
+        Command::Bench(args) => bench_cmd::run(&args),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model { action } => model_cmd::run(action),

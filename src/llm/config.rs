@@ -354,6 +354,7 @@ impl Settings {
                             .threads
                             .unwrap_or_else(super::local::threads::idle_threads),
                         context: self.context,
+                        prompt_states: Some(crate::model::cache_dir().join("prompt-state")),
                     },
                 )?;
                 match &self.cassette {

@@ -31,6 +31,7 @@ pub fn language_model() -> &'static Arc<LocalModel> {
                     model_path: DEFAULT_MODEL.path(),
                     threads: betr::llm::config::DEFAULT_THREADS,
                     context: 4096,
+                    prompt_states: None,
                 },
             )
             .unwrap(),

@@ -20,6 +20,8 @@ use llama_cpp_2::model::{LlamaChatMessage, LlamaModel};
 use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
 
+use super::prompt_state::{self, PromptStates};
+
 /// How the engine runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EngineOptions {
@@ -28,6 +30,8 @@ pub struct EngineOptions {
     pub threads: u32,
     /// Context length in tokens.
     pub context: u32,
+    /// Where the state after a prompt is kept between processes (`None`: not kept).
+    pub prompt_states: Option<PathBuf>,
 }
 
 /// One generation request, already in chat form.
@@ -187,9 +191,17 @@ fn worker(
     if ready.send(Ok(started.elapsed())).is_err() {
         return;
     }
+    let states = options
+        .prompt_states
+        .as_deref()
+        .map(|dir| PromptStates::new(dir, &options.model_path));
     // Tokens whose keys and values are in the cache, in order.
     let mut cached: Vec<LlamaToken> = Vec::new();
     while let Ok((job, reply)) = queue.recv() {
+        // From an empty cache (the first call, or after a failure) a saved state of the
+        // prompt's fixed part spares evaluating it again; a state is saved after the call.
+        let cold = cached.is_empty();
+        let mut loaded = false;
         let result = (|| {
             let chat = job
                 .messages
@@ -202,15 +214,37 @@ fn worker(
                 .map_err(|e| EngineError::Template(e.to_string()))?;
             // The template already wrote the special tokens; parse them as such.
             let tokens = model.vocab().tokenize(prompt.as_bytes(), false, true);
+            if cold && let Some(saved) = states.as_ref().and_then(|s| s.load(&mut ctx, &tokens)) {
+                tracing::debug!(file = %saved.file.display(), tokens = saved.tokens.len(), "prompt state loaded");
+                cached = saved.tokens;
+                loaded = true;
+            }
             generate(&model, &mut ctx, &mut cached, &tokens, &job)
         })();
-        if result.is_err() {
-            // After a failure the cache contents are unknown: start clean next time.
-            cached.clear();
-            let _ = ctx.clear_kv_cache_seq(None, None, None);
-        }
+        let save = match &result {
+            Ok(g) => {
+                cold && (!loaded
+                    || !prompt_state::still_fits(
+                        g.cached_tokens as usize,
+                        g.prompt_tokens as usize,
+                    ))
+            }
+            Err(_) => {
+                // After a failure the cache contents are unknown: start clean next time.
+                cached.clear();
+                let _ = ctx.clear_kv_cache_seq(None, None, None);
+                false
+            }
+        };
         // A caller that went away (a cancelled request) does not stop the worker.
         let _ = reply.send(result);
+        // Saved after answering, so the caller does not wait for the write.
+        if save
+            && let Some(states) = &states
+            && let Err(e) = states.save(&ctx, &cached)
+        {
+            tracing::warn!("{e}");
+        }
     }
 }
 

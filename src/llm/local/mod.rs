@@ -2,6 +2,7 @@
 //! with grammar-constrained decoding so replies can only use the scenario's vocabulary.
 
 pub mod engine;
+pub mod prompt_state;
 pub mod threads;
 
 use std::sync::Arc;

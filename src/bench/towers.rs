@@ -1,26 +1,26 @@
-//! The tower cells shared by the benchmarks (`cell_towers`, `verify_goals`): `n` cubes
-//! stacked in towers of three, cube A at the bottom of one tower near the robot, the task
-//! "put cube A on cube B"; and the repair that inserts `~"any object" on "X"` at each
-//! grasp that fails until the tree succeeds.
-#![allow(dead_code)] // each benchmark uses a part of it
+//! Tower cells for planning at scale (`betr bench scale`, and the `cell_towers` and
+//! `verify_goals` benchmarks): `n` cubes stacked in towers of three, cube A at the bottom
+//! of one tower near the robot, the task "put cube A on cube B"; and the repair that
+//! inserts `~"any object" on "X"` at each grasp that fails until the tree succeeds (the fix
+//! a person approves in scenario 1, without the model).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result, bail};
-
-use betr::domain::{Condition, Scenario};
-use betr::planner::{Outcome, Plan, Planner};
-use betr::world::CellWorld;
+use super::BenchError;
+use crate::domain::{Condition, Scenario};
+use crate::planner::{Outcome, Plan, Planner};
+use crate::world::World;
 
 pub const TOWER: usize = 3;
 
-/// A scenario with `n` cubes (A, B and the rest), extending the cell's cell.toml.
-pub fn write_scenario(dir: &Path, n: usize) -> Result<PathBuf> {
+/// A scenario with `n` cubes (A, B and the rest) in `dir`, extending the cell's `base`
+/// file (`scenarios/cell/cell.toml`) in place, so its example pool and conventions come
+/// with it.
+pub fn write_scenario(dir: &Path, n: usize, base: &Path) -> Result<PathBuf, BenchError> {
     std::fs::create_dir_all(dir)?;
-    // Extends the cell in place, so its example pool and conventions come with it.
-    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
+    let base = std::path::absolute(base)?;
     let mut names = vec!["cube A".to_string(), "cube B".to_string()];
     names.extend((1..n.saturating_sub(1)).map(|i| format!("cube {i}")));
     let mut t = String::new();
@@ -37,7 +37,11 @@ pub fn write_scenario(dir: &Path, n: usize) -> Result<PathBuf> {
         t,
         "[world.solids.\"table\"]\nsize = [2.4, 3.2, 0.05]\nat = [1.2, 0.0, -0.05]"
     )?;
-    let cube = |t: &mut String, name: &str, support: &str, xy: Option<(f32, f32)>| -> Result<()> {
+    let cube = |t: &mut String,
+                name: &str,
+                support: &str,
+                xy: Option<(f32, f32)>|
+     -> Result<(), BenchError> {
         writeln!(
             t,
             "[world.solids.\"{name}\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\nmass = 0.05\non = \"{support}\""
@@ -83,17 +87,21 @@ pub struct Repaired {
     pub repairs: usize,
 }
 
-/// Plan the scenario's goal in `world`, then repair each failing grasp.
-pub fn plan_and_repair(scenario: &Scenario, world: &CellWorld) -> Result<Repaired> {
+/// Plan the scenario's goal in `world`, then repair each grasp that fails by clearing what
+/// lies on the grasped object, until the tree succeeds (at most `TOWER + 1` repairs).
+pub fn plan_and_repair(scenario: &Scenario, world: &dyn World) -> Result<Repaired, BenchError> {
+    let failed = |what: String| BenchError::Setup(format!("{}: {what}", scenario.name));
     let goal = scenario
         .goal
         .clone()
-        .context("the scenario has a goal")?
+        .ok_or_else(|| failed("the scenario has no goal".into()))?
         .to_dnf();
     let planner = Planner::new(&scenario.domain);
 
     let started = Instant::now();
-    let mut plan = planner.plan(&goal, world)?;
+    let mut plan = planner
+        .plan(&goal, world)
+        .map_err(|e| failed(e.to_string()))?;
     let plan_time = started.elapsed();
 
     let started = Instant::now();
@@ -104,20 +112,27 @@ pub fn plan_and_repair(scenario: &Scenario, world: &CellWorld) -> Result<Repaire
         error,
     } = &plan.outcome
     {
-        if action.skill != "grasp" || repairs > TOWER {
-            bail!("{}: unexpected failure of {action}: {error}", scenario.name);
+        let Some(object) = action.args.first().filter(|_| action.skill == "grasp") else {
+            return Err(failed(format!("unexpected failure of {action}: {error}")));
+        };
+        if repairs > TOWER {
+            return Err(failed(format!(
+                "{action} still fails after {repairs} repairs"
+            )));
         }
-        let fix = Condition::parse(&format!("~\"any object\" on \"{}\"", action.args[0]))?;
-        plan = planner.repair(plan.tree.clone(), *node, &[fix], world)?;
+        let fix = Condition::parse(&format!("~\"any object\" on \"{object}\""))
+            .map_err(|e| failed(e.to_string()))?;
+        plan = planner
+            .repair(plan.tree.clone(), *node, &[fix], world)
+            .map_err(|e| failed(e.to_string()))?;
         repairs += 1;
     }
     let repair_time = started.elapsed();
     if plan.outcome != Outcome::Success {
-        bail!(
-            "{}: the repaired tree does not succeed: {:?}",
-            scenario.name,
+        return Err(failed(format!(
+            "the repaired tree does not succeed: {:?}",
             plan.outcome
-        );
+        )));
     }
     Ok(Repaired {
         plan,

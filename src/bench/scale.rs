@@ -1,0 +1,107 @@
+//! Planning and repair at scale: scenario 1 end to end (plan, fail, repair, re-plan, run to
+//! success; the model's part left out: the fix is the one a person approves) and tower
+//! cells of up to 10,000 cubes.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use super::towers::{self, Repaired};
+use super::{BenchError, Better, Row, Target};
+use crate::domain::Scenario;
+use crate::planner::{RunEnd, run_tree};
+use crate::world::{self, World};
+
+/// The reference Python planner's time for scenario 1 on this machine kind, from the
+/// issue tracker's measurement (its path planner is ABB-internal, so it cannot run here).
+pub const PAPER_PLANNER_MS: (f64, f64) = (2.3, 4.4);
+/// Ticks allowed when running the repaired tree to success.
+const RUN_TICKS: u64 = 10_000;
+
+/// Scenario 1 end to end, repeated for at least `time`; the mean per run.
+pub fn scenario_one(path: &Path, time: Duration) -> Result<Row, BenchError> {
+    let scenario = Scenario::load(path).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let world = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let mut runs = 0u32;
+    let started = Instant::now();
+    let mut repairs = 0;
+    while runs == 0 || started.elapsed() < time {
+        repairs = end_to_end(&scenario, world.as_ref())?;
+        runs += 1;
+    }
+    let ms = started.elapsed().as_secs_f64() * 1e3 / f64::from(runs);
+    let (low, high) = PAPER_PLANNER_MS;
+    Ok(Row {
+        part: "scale".into(),
+        measure: "scenario 1: plan, fail, repair, re-plan, run to success".into(),
+        unit: "ms".into(),
+        better: Better::Lower,
+        betr: ms,
+        anchor: None,
+        target: Some(Target::AtMost(0.25)),
+        note: format!(
+            "mean of {runs} runs, {repairs} repair(s); the paper's Python planner needs {low}–{high} ms for the same work on this machine kind (not run here: its path planner is ABB-internal)"
+        ),
+    })
+}
+
+/// One run: plan, repair each failing grasp, then tick the repaired tree in a fresh copy
+/// of the world until it succeeds. The number of repairs.
+fn end_to_end(scenario: &Scenario, world: &dyn World) -> Result<usize, BenchError> {
+    let Repaired { plan, repairs, .. } = towers::plan_and_repair(scenario, world)?;
+    let mut run = world.fork();
+    let report = run_tree(
+        &plan.tree,
+        run.as_mut(),
+        &scenario.domain,
+        RUN_TICKS,
+        |_, _| true,
+    );
+    if report.end != RunEnd::Success {
+        return Err(BenchError::Setup(format!(
+            "{}: the repaired tree ended {:?} after {} ticks",
+            scenario.name, report.end, report.ticks
+        )));
+    }
+    Ok(repairs)
+}
+
+/// The tower cells of each size, extending `base` (the cell's cell.toml): plan and repair
+/// times, against the targets for 1000 and 10,000 cubes. The scenarios are written to a
+/// directory of their own and removed afterwards.
+pub fn towers(sizes: &[usize], base: &Path) -> Result<Vec<Row>, BenchError> {
+    let dir = std::env::temp_dir().join(format!("betr-bench-towers-{}", std::process::id()));
+    let rows = tower_rows(sizes, base, &dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    rows
+}
+
+fn tower_rows(sizes: &[usize], base: &Path, dir: &Path) -> Result<Vec<Row>, BenchError> {
+    let mut rows = Vec::new();
+    for &n in sizes {
+        let path = towers::write_scenario(dir, n, base)?;
+        let scenario = Scenario::load(&path).map_err(|e| BenchError::Setup(e.to_string()))?;
+        let world = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+        let r = towers::plan_and_repair(&scenario, world.as_ref())?;
+        let target = match n {
+            1000 => Some(Target::AtMost(20.0)),
+            10_000 => Some(Target::AtMost(200.0)),
+            _ => None,
+        };
+        rows.push(Row {
+            part: "scale".into(),
+            measure: format!("repair, {n} cubes in towers"),
+            unit: "ms".into(),
+            better: Better::Lower,
+            betr: r.repair_time.as_secs_f64() * 1e3,
+            anchor: None,
+            target,
+            note: format!(
+                "{} repairs, {} nodes; planning before it {:.2} ms",
+                r.repairs,
+                r.plan.tree.len(),
+                r.plan_time.as_secs_f64() * 1e3
+            ),
+        });
+    }
+    Ok(rows)
+}
