@@ -17,18 +17,24 @@ impl Progress for Lines {
     fn bytes(&mut self, _: u64, _: u64) {}
 }
 
+/// The default language model's file, fetched when missing.
+pub fn default_model_file() -> PathBuf {
+    if !DEFAULT_MODEL.is_present() {
+        model::fetch(DEFAULT_MODEL, &model::cache_dir(), "python3", &mut Lines).unwrap();
+    }
+    DEFAULT_MODEL.path()
+}
+
 /// The default language model in llama.cpp.
 pub fn language_model() -> &'static Arc<LocalModel> {
     static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
     MODEL.get_or_init(|| {
-        if !DEFAULT_MODEL.is_present() {
-            model::fetch(DEFAULT_MODEL, &model::cache_dir(), "python3", &mut Lines).unwrap();
-        }
+        let path = default_model_file();
         Arc::new(
             LocalModel::load(
                 DEFAULT_MODEL.name,
                 EngineOptions {
-                    model_path: DEFAULT_MODEL.path(),
+                    model_path: path,
                     threads: betr::llm::config::DEFAULT_THREADS,
                     context: 4096,
                     prompt_states: None,

@@ -83,8 +83,22 @@ type Reply = tokio::sync::oneshot::Sender<Result<Generated, EngineError>>;
 
 /// A loaded model, ready for generations.
 pub struct Engine {
-    jobs: mpsc::Sender<(Generation, Reply)>,
+    /// `None` only while dropping.
+    jobs: Option<mpsc::Sender<(Generation, Reply)>>,
+    worker: Option<std::thread::JoinHandle<()>>,
     load_time: Duration,
+}
+
+impl Drop for Engine {
+    /// Close the queue and wait for the worker, which may still be saving the prompt state
+    /// of its last call (a one-shot command that exits right after its answer would leave
+    /// it unsaved).
+    fn drop(&mut self) {
+        self.jobs.take();
+        if let Some(worker) = self.worker.take() {
+            let _ = worker.join();
+        }
+    }
 }
 
 /// llama.cpp's backend may be initialised once per process.
@@ -110,12 +124,16 @@ impl Engine {
         }
         let (jobs, queue) = mpsc::channel::<(Generation, Reply)>();
         let (ready_tx, ready) = mpsc::channel::<Result<Duration, EngineError>>();
-        std::thread::Builder::new()
+        let handle = std::thread::Builder::new()
             .name("betr-llm".into())
             .spawn(move || worker(options, ready_tx, queue))
             .map_err(|e| EngineError::Runtime(format!("cannot start the model thread: {e}")))?;
         let load_time = ready.recv().map_err(|_| EngineError::WorkerGone)??;
-        Ok(Engine { jobs, load_time })
+        Ok(Engine {
+            jobs: Some(jobs),
+            worker: Some(handle),
+            load_time,
+        })
     }
 
     pub fn load_time(&self) -> Duration {
@@ -127,6 +145,8 @@ impl Engine {
     pub async fn generate(&self, generation: Generation) -> Result<Generated, EngineError> {
         let (tx, rx) = tokio::sync::oneshot::channel();
         self.jobs
+            .as_ref()
+            .ok_or(EngineError::WorkerGone)?
             .send((generation, tx))
             .map_err(|_| EngineError::WorkerGone)?;
         rx.await.map_err(|_| EngineError::WorkerGone)?
@@ -136,6 +156,8 @@ impl Engine {
     pub fn generate_blocking(&self, generation: Generation) -> Result<Generated, EngineError> {
         let (tx, rx) = tokio::sync::oneshot::channel();
         self.jobs
+            .as_ref()
+            .ok_or(EngineError::WorkerGone)?
             .send((generation, tx))
             .map_err(|_| EngineError::WorkerGone)?;
         rx.blocking_recv().map_err(|_| EngineError::WorkerGone)?
