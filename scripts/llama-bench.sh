@@ -35,7 +35,17 @@ if [ ! -f "$tool/llama-bench.cpp" ] || [ ! -f "$tool/main.cpp" ]; then
   echo "llama-bench: fetching its sources (llama-cpp-python $sdist_version sdist, 77 MB)" >&2
   tmp=$(mktemp -d)
   trap 'rm -rf "$tmp"' EXIT
-  curl -fL --retry 3 --progress-bar -o "$tmp/sdist.tar.gz" "$sdist_url"
+  python3 - "$sdist_url" "$tmp/sdist.tar.gz" <<'PY'
+import sys, urllib.request
+url, path = sys.argv[1], sys.argv[2]
+for attempt in range(3):
+    try:
+        urllib.request.urlretrieve(url, path)
+        break
+    except OSError as e:
+        if attempt == 2:
+            sys.exit(f"llama-bench: cannot fetch {url}: {e}")
+PY
   echo "$sdist_sha256  $tmp/sdist.tar.gz" | sha256sum -c --quiet - || {
     echo "llama-bench: the sdist does not match its SHA-256" >&2; exit 2; }
   prefix="llama_cpp_python-$sdist_version/vendor/llama.cpp/tools/llama-bench"

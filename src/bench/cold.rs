@@ -11,10 +11,10 @@ use std::time::{Duration, Instant};
 
 use super::{BenchError, Better, Row, Target};
 use crate::domain::Scenario;
+use crate::llm::Message;
 use crate::llm::grammar;
 use crate::llm::local::{Engine, EngineOptions, Generation};
 use crate::llm::prompt::{Context, Templates, Variant};
-use crate::llm::{Message, Role};
 use crate::world;
 
 /// Instructions for the first answers and the warm ones (the goal prompt of scenario 1's
@@ -155,10 +155,5 @@ pub fn rows(name: &str, threads: u32, l: &Latencies) -> Vec<Row> {
 }
 
 fn chat_pair(m: Message) -> (String, String) {
-    let role = match m.role {
-        Role::System => "system",
-        Role::User => "user",
-        Role::Assistant => "assistant",
-    };
-    (role.to_string(), m.content)
+    (m.role.name().to_string(), m.content)
 }

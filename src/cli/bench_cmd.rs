@@ -10,10 +10,10 @@ use clap::{Args, ValueEnum};
 
 use betr::bench::{self, Report, cold, model, scale, ticks};
 use betr::domain::Scenario;
+use betr::llm::Message;
 use betr::llm::grammar;
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
 use betr::llm::prompt::{Context, Templates, Variant};
-use betr::llm::{Message, Role};
 use betr::world;
 
 /// A part of `betr bench`.
@@ -338,12 +338,7 @@ fn llm(
 }
 
 fn chat_pair(m: Message) -> (String, String) {
-    let role = match m.role {
-        Role::System => "system",
-        Role::User => "user",
-        Role::Assistant => "assistant",
-    };
-    (role.to_string(), m.content)
+    (m.role.name().to_string(), m.content)
 }
 
 fn timed(engine: &Engine, generation: Generation) -> Result<(Generated, f64)> {

@@ -12,7 +12,7 @@ pub use engine::{Engine, EngineError, EngineOptions, Generated, Generation};
 
 use super::{
     ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, OutputConstraint, ReplySource,
-    Role, TokenUsage,
+    TokenUsage,
 };
 
 /// A loaded local model behind the `LanguageModel` trait.
@@ -57,14 +57,7 @@ impl LanguageModel for LocalModel {
                 messages: request
                     .messages
                     .iter()
-                    .map(|m| {
-                        let role = match m.role {
-                            Role::System => "system",
-                            Role::User => "user",
-                            Role::Assistant => "assistant",
-                        };
-                        (role.to_string(), m.content.clone())
-                    })
+                    .map(|m| (m.role.name().to_string(), m.content.clone()))
                     .collect(),
                 max_tokens: request.max_tokens,
                 temperature: request.temperature,
