@@ -23,4 +23,4 @@ pub use render::{ASCII, Glyphs, UNICODE, render};
 pub use status::{Outcome, Status};
 pub use text::{ParseError, parse, to_text};
 pub use tick::{Leaves, TickRecord, Ticker};
-pub use tree::{NodeId, NodeKind, Tree, TreeError};
+pub use tree::{NodeId, NodeKind, Tree, TreeError, path_text};

@@ -295,3 +295,16 @@ mod query;
 #[cfg(test)]
 #[path = "tree_tests.rs"]
 mod tests;
+
+/// A node path (child indices from the root, as `Tree::path` gives) as `0.2.1`; the root
+/// is `root`.
+pub fn path_text(path: &[usize]) -> String {
+    if path.is_empty() {
+        "root".to_string()
+    } else {
+        path.iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(".")
+    }
+}

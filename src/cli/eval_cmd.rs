@@ -148,13 +148,6 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
     }
 }
 
-fn runtime() -> Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the async runtime")
-}
-
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
     write_atomic(&dir.join(name), bytes).with_context(|| format!("writing {name}"))
 }
@@ -251,7 +244,7 @@ pub fn goals_with_model(
         prices: p.llm.settings.prices.clone(),
         progress: &bar,
     };
-    let results = runtime()?
+    let results = super::runtime()?
         .block_on(goals_run::run_goals(
             &model,
             &scenario,
@@ -325,7 +318,7 @@ fn sequence_experiment(
         prices: p.llm.settings.prices.clone(),
         progress: &bar,
     };
-    let results = runtime()?
+    let results = super::runtime()?
         .block_on(eval::sequence::run_sequence(
             &model,
             &scenarios,
@@ -407,7 +400,7 @@ pub fn session_experiment(
         prices: p.llm.settings.prices.clone(),
         progress: &bar,
     };
-    let rt = runtime()?;
+    let rt = super::runtime()?;
     match which {
         SessionExperiment::Resolve => {
             let results = rt

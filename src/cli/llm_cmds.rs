@@ -233,13 +233,6 @@ fn read_examples(path: &Path) -> Result<Vec<Example>> {
         .collect())
 }
 
-fn runtime() -> Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the async runtime")
-}
-
 pub fn interpret(
     scenario: &Scenario,
     instruction: Option<&str>,
@@ -255,7 +248,7 @@ pub fn interpret(
     println!("Scenario:    {}", scenario.name);
     println!("Instruction: {instruction}");
     let mut emit = |e: &Event| print_event(e, flags.show_replies);
-    let result = runtime()?.block_on(session::interpret(
+    let result = super::runtime()?.block_on(session::interpret(
         scenario,
         world,
         &instruction,
@@ -313,7 +306,7 @@ pub fn resolve(
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
-    let result = runtime()?.block_on(session::resolve_with_scenes(
+    let result = super::runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,
         llm.model.clone(),

@@ -497,3 +497,12 @@ fn goal_of(scenario: &Scenario, goal: Option<&str>) -> Result<Formula> {
             .with_context(|| format!("scenario {:?} has no goal; pass --goal", scenario.name)),
     }
 }
+
+/// The async runtime of a one-shot command: one thread (the model and the server calls
+/// are awaited one at a time).
+fn runtime() -> Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .context("starting the async runtime")
+}

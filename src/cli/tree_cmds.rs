@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
 
+use betr::bt::path_text;
 use betr::bt::{self, Glyphs, NodeId, NodeKind, TickRecord, Tree};
 use betr::domain::{ActionCall, Condition, Scenario};
-use betr::planner::{Outcome, Plan, Planner, RunEnd, path_text, run_tree};
+use betr::planner::{Outcome, Plan, Planner, RunEnd, run_tree};
 use betr::session::policy::{self, Approval, Fix, Policy};
 use betr::world::{self, World};
 use rerun::TextLogLevel as Level;

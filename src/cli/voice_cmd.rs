@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 
 use betr::llm::config::FileConfig;
@@ -151,11 +151,7 @@ pub fn load(settings: &SttSettings) -> Result<Loaded> {
 }
 
 fn run_transcription(stt: &dyn SpeechToText, audio: &Audio16k) -> Result<Transcript> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the async runtime")?;
-    Ok(runtime.block_on(voice::transcribe(stt, audio))?)
+    Ok(super::runtime()?.block_on(voice::transcribe(stt, audio))?)
 }
 
 fn read(file: &Path) -> Result<Audio16k> {

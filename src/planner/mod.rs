@@ -245,23 +245,11 @@ fn add(tree: &mut Tree, parent: NodeId, kind: NodeKind) -> NodeId {
 
 /// A node of a tree (from a file or a person) that does not fit the scenario.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("node {} ({text}): {reason}", path_text(path))]
+#[error("node {} ({text}): {reason}", crate::bt::path_text(path))]
 pub struct TreeCheckError {
     pub path: Vec<usize>,
     pub text: String,
     pub reason: String,
-}
-
-/// Render a node path as `0.2.1` (the root is `root`).
-pub fn path_text(path: &[usize]) -> String {
-    if path.is_empty() {
-        "root".to_string()
-    } else {
-        path.iter()
-            .map(ToString::to_string)
-            .collect::<Vec<_>>()
-            .join(".")
-    }
 }
 
 /// Check every leaf of `tree` against the domain: conditions must use the vocabulary and

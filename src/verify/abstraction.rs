@@ -200,7 +200,7 @@ impl Model {
                         .resolve(call)
                         .ok_or_else(|| ModelError::UnknownAction {
                             call: call.to_string(),
-                            path: crate::planner::path_text(&path),
+                            path: crate::bt::path_text(&path),
                         })?;
                     let pre: Vec<(usize, bool)> = ground
                         .pre

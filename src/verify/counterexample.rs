@@ -6,9 +6,9 @@ use std::fmt;
 
 use super::abstraction::{Model, State};
 use super::explore::Edge;
+use crate::bt::path_text;
 use crate::bt::{NodeId, Outcome};
 use crate::domain::{ActionCall, Atom, Condition};
-use crate::planner::path_text;
 
 /// An action node as a counterexample names it.
 #[derive(Debug, Clone, PartialEq)]

@@ -25,8 +25,8 @@ pub mod temporal;
 use std::time::{Duration, Instant};
 
 use crate::bt::Tree;
+use crate::bt::path_text;
 use crate::domain::{Condition, Domain};
-use crate::planner::path_text;
 
 pub use abstraction::{Model, ModelError};
 pub use config::{Disturbance, NamedProperty, VerifyConfig};

@@ -17,9 +17,9 @@
 
 use super::abstraction::instance_of;
 use super::{Finding, Rule};
+use crate::bt::path_text;
 use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::{Condition, Domain};
-use crate::planner::path_text;
 
 /// A literal known to hold, and the node that makes it known.
 #[derive(Debug, Clone)]

@@ -96,7 +96,7 @@ fn run(s: &Scenario, tree: &str, failures: bool, properties: &[&str]) -> Report 
 fn rules(r: &Report) -> Vec<(String, Rule)> {
     r.findings
         .iter()
-        .map(|f| (crate::planner::path_text(&f.path), f.rule))
+        .map(|f| (crate::bt::path_text(&f.path), f.rule))
         .collect()
 }
 

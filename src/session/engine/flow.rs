@@ -3,9 +3,10 @@
 
 use std::sync::Arc;
 
+use crate::bt::path_text;
 use crate::bt::{Outcome as TickOutcome, Tree};
 use crate::goal;
-use crate::planner::{Outcome, Plan, Planner, WorldLeaves, path_text};
+use crate::planner::{Outcome, Plan, Planner, WorldLeaves};
 use crate::world;
 
 use super::super::policy;

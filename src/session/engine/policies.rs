@@ -2,8 +2,9 @@
 
 use std::path::PathBuf;
 
+use crate::bt::path_text;
 use crate::interop::{self, TreeFormat};
-use crate::planner::{Planner, path_text};
+use crate::planner::Planner;
 
 use super::super::policy::{self, Fix, Policy};
 use super::super::types::Event;
