@@ -1,8 +1,30 @@
 //! Text from HTTP servers made safe to show: the error message an OpenAI-style server
-//! sends, shortened, with a secret removed. Shared by the chat and the transcription
-//! clients (which otherwise know nothing of each other).
+//! sends, shortened, with a secret removed; and the secret itself, an API key that never
+//! prints. Shared by the chat and the transcription clients (which otherwise know nothing
+//! of each other).
 
 use serde_json::Value as Json;
+
+/// An API key: shown as `<redacted>` by `Debug`, read only where it is sent.
+#[derive(Clone)]
+pub struct Secret(String);
+
+impl Secret {
+    pub fn new(key: impl Into<String>) -> Self {
+        Secret(key.into())
+    }
+
+    /// The key itself, for the authorization header and for removing it from texts.
+    pub fn expose(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::fmt::Debug for Secret {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Secret(<redacted>)")
+    }
+}
 
 /// `text` with every occurrence of `secret` replaced (an empty secret changes nothing).
 pub fn redact(text: &str, secret: Option<&str>) -> String {

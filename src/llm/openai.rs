@@ -14,21 +14,7 @@ use serde_json::{Value as Json, json};
 use super::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, OutputConstraint};
 use super::{ReplySource, TokenUsage};
 
-/// The secret, kept out of `Debug` output.
-#[derive(Clone)]
-pub struct ApiKey(String);
-
-impl ApiKey {
-    pub fn new(key: impl Into<String>) -> Self {
-        ApiKey(key.into())
-    }
-}
-
-impl std::fmt::Debug for ApiKey {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("ApiKey(<redacted>)")
-    }
-}
+pub use crate::http_text::Secret as ApiKey;
 
 /// How the key is sent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -124,7 +110,7 @@ impl OpenAiClient {
         loop {
             attempt += 1;
             let mut req = self.http.post(&self.url).json(&body);
-            if let Some(ApiKey(key)) = &self.settings.api_key {
+            if let Some(key) = self.settings.api_key.as_ref().map(ApiKey::expose) {
                 req = match self.settings.auth_header {
                     AuthHeader::Bearer => req.bearer_auth(key),
                     AuthHeader::ApiKey => req.header("api-key", key),
@@ -256,7 +242,7 @@ impl OpenAiClient {
     }
 
     fn key(&self) -> Option<&str> {
-        self.settings.api_key.as_ref().map(|ApiKey(k)| k.as_str())
+        self.settings.api_key.as_ref().map(ApiKey::expose)
     }
 }
 

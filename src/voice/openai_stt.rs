@@ -16,21 +16,7 @@ use crate::http_retry::RetryPolicy;
 
 use super::{Audio16k, SpeechToText, SttFuture, Transcript, VoiceError};
 
-/// The secret, kept out of `Debug` output.
-#[derive(Clone)]
-pub struct SttKey(String);
-
-impl SttKey {
-    pub fn new(key: impl Into<String>) -> Self {
-        SttKey(key.into())
-    }
-}
-
-impl std::fmt::Debug for SttKey {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("SttKey(<redacted>)")
-    }
-}
+pub use crate::http_text::Secret as SttKey;
 
 #[derive(Debug, Clone)]
 pub struct OpenAiSttSettings {
@@ -105,7 +91,7 @@ impl OpenAiStt {
         loop {
             attempt += 1;
             let mut request = self.http.post(&self.url).multipart(self.form(&wav)?);
-            if let Some(SttKey(key)) = &self.settings.api_key {
+            if let Some(key) = self.settings.api_key.as_ref().map(SttKey::expose) {
                 request = request.bearer_auth(key);
             }
             tracing::debug!(url = %self.url, attempt, bytes = wav.len(), "transcription request");
@@ -211,7 +197,7 @@ impl OpenAiStt {
     }
 
     fn key(&self) -> Option<&str> {
-        self.settings.api_key.as_ref().map(|SttKey(k)| k.as_str())
+        self.settings.api_key.as_ref().map(SttKey::expose)
     }
 }
 
