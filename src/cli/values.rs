@@ -1,11 +1,11 @@
 //! `--set "force of egg = 5 N"`: the library's setting parser (`session::values`) at the
 //! command line's edge.
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 
 use betr::domain::Scenario;
 pub use betr::session::values::{Setting, apply};
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting> {
-    Ok(betr::session::values::parse_setting(scenario, text)?)
+    betr::session::values::parse_setting(scenario, text).context("--set")
 }

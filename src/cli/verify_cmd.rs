@@ -211,7 +211,11 @@ pub(super) fn write_report(
                 match &p.verdict {
                     Verdict::Holds if p.detail.is_empty() => writeln!(out, "  {ok} {}", p.name)?,
                     Verdict::Holds => writeln!(out, "  {ok} {} ({})", p.name, p.detail)?,
-                    Verdict::Unknown(why) => writeln!(out, "  {unknown} {}: {why}", p.name)?,
+                    Verdict::Unknown { states } => writeln!(
+                        out,
+                        "  {unknown} {}: bound reached: stopped after {states} states (raise --max-states)",
+                        p.name
+                    )?,
                     Verdict::Violated(cx) => {
                         writeln!(out, "  {bad} {}", p.name)?;
                         writeln!(out, "    counterexample:")?;

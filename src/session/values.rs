@@ -20,28 +20,38 @@ pub struct Setting {
     pub targets: Vec<(String, String)>,
 }
 
-/// Why a setting could not be read; the message names the text and what was expected.
+/// Why a setting could not be read; each names the text as typed (shortened when long).
+/// Front ends say where it came from (`--set` on the command line, the workbench's input).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct SettingError(pub String);
-
-macro_rules! bail {
-    ($($t:tt)*) => { return Err(SettingError(format!($($t)*))) };
+pub enum SettingError {
+    #[error("{text}: expected `<parameter> of <object> = <value>`, e.g. \"force of egg = 5 N\"")]
+    Form { text: String },
+    #[error("{text}: no object {object:?} in this scenario")]
+    UnknownObject { text: String, object: String },
+    #[error("{text}: no skill declares a value {param:?} (declared: {declared})")]
+    UnknownValue {
+        text: String,
+        param: String,
+        declared: String,
+    },
+    #[error("{text}: {reason}")]
+    BadValue { text: String, reason: String },
 }
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, SettingError> {
     let shown = crate::excerpt::excerpt(text, None);
-    let usage = "expected `<parameter> of <object> = <value>`, e.g. \"force of egg = 5 N\"";
-    let Some((left, value_text)) = text.split_once('=') else {
-        bail!("--set {shown}: {usage}");
+    let form = || SettingError::Form {
+        text: shown.clone(),
     };
-    let Some((param, object)) = left.split_once(" of ") else {
-        bail!("--set {shown}: {usage}");
-    };
+    let (left, value_text) = text.split_once('=').ok_or_else(form)?;
+    let (param, object) = left.split_once(" of ").ok_or_else(form)?;
     let param = param.trim();
     let object = object.trim().trim_matches('"').to_string();
     if scenario.domain.vocabulary.object(&object).is_none() {
-        bail!("--set {shown}: no object {object:?} in this scenario");
+        return Err(SettingError::UnknownObject {
+            text: shown,
+            object,
+        });
     }
     let mut targets = Vec::new();
     let mut declared = None;
@@ -71,18 +81,22 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
                     .map(move |v| format!("{} {} ({})", s.name, v.name, v.description))
             })
             .collect();
-        bail!(
-            "--set {shown}: no skill declares a value {param:?} (declared: {})",
-            if known.is_empty() {
+        return Err(SettingError::UnknownValue {
+            text: shown,
+            param: param.to_string(),
+            declared: if known.is_empty() {
                 "none".to_string()
             } else {
                 known.join(", ")
-            }
-        );
+            },
+        });
     };
-    let value = parse_value(value_text).map_err(|e| SettingError(format!("--set {shown}: {e}")))?;
-    let value =
-        conform(&declared, value).map_err(|e| SettingError(format!("--set {shown}: {e}")))?;
+    let bad = |reason: String| SettingError::BadValue {
+        text: shown.clone(),
+        reason,
+    };
+    let value = parse_value(value_text).map_err(|e| bad(e.to_string()))?;
+    let value = conform(&declared, value).map_err(bad)?;
     Ok(Setting {
         text: text.to_string(),
         object,

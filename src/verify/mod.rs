@@ -100,8 +100,11 @@ pub enum PropertyKind {
 pub enum Verdict {
     Holds,
     Violated(Box<Counterexample>),
-    /// The state bound stopped the exploration before the property could be decided.
-    Unknown(String),
+    /// The state bound stopped the exploration after `states` states, before the property
+    /// could be decided (front ends say how to raise the bound).
+    Unknown {
+        states: usize,
+    },
 }
 
 impl Verdict {
@@ -253,11 +256,8 @@ fn model_check(model: &Model, input: &VerifyInput) -> ModelCheck {
     let started = Instant::now();
     let limits = &input.limits;
     let g = explore::explore(model, limits);
-    let unknown = || {
-        Verdict::Unknown(format!(
-            "bound reached: stopped after {} states (raise --max-states)",
-            g.states.len()
-        ))
+    let unknown = || Verdict::Unknown {
+        states: g.states.len(),
     };
     let cx = |transitions: Vec<(u32, Edge)>, loop_from: Option<usize>, violation: String| {
         Verdict::Violated(Box::new(Counterexample::build(

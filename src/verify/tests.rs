@@ -288,7 +288,7 @@ fn the_state_bound_gives_unknown_not_holds() {
     });
     assert!(matches!(
         verdict(&r, PropertyKind::Success),
-        Verdict::Unknown(_)
+        Verdict::Unknown { .. }
     ));
     assert!(!r.holds());
 }

@@ -72,7 +72,7 @@ pub fn holds(report: &Report, kind: PropertyKind) -> bool {
     match &report.property(kind).unwrap().verdict {
         Verdict::Holds => true,
         Verdict::Violated(_) => false,
-        Verdict::Unknown(why) => panic!("{kind:?} undecided: {why}"),
+        Verdict::Unknown { states } => panic!("{kind:?} undecided after {states} states"),
     }
 }
 

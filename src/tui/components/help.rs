@@ -83,7 +83,10 @@ pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
                         lines.push(format!("  {ok} {}", p.name))
                     }
                     Verdict::Holds => lines.push(format!("  {ok} {} ({})", p.name, p.detail)),
-                    Verdict::Unknown(why) => lines.push(format!("  {unknown} {}: {why}", p.name)),
+                    Verdict::Unknown { states } => lines.push(format!(
+                        "  {unknown} {}: bound reached: stopped after {states} states",
+                        p.name
+                    )),
                     Verdict::Violated(cx) => {
                         lines.push(format!("  {bad} {}", p.name));
                         lines.push("    counterexample:".into());
