@@ -78,7 +78,7 @@ impl Bench {
         let scenario = Arc::new(Scenario::load(&path).unwrap());
         let info = Info {
             scenario: "red_on_blue".into(),
-            backend: "openai".into(),
+            backend: betr::llm::config::Backend::Openai,
             model: "fixture-model".into(),
             auto_approve: false,
             objects: scenario

@@ -107,7 +107,6 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
             m.set_purpose("workbench");
             Arc::new(m) as Arc<dyn LanguageModel>
         });
-    let backend = format!("{:?}", settings.backend).to_lowercase();
     let model_name = match settings.backend {
         betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
         _ => settings.model.clone(),
@@ -127,7 +126,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         scenario: path
             .file_stem()
             .map_or_else(|| scenario.name.clone(), |s| s.to_string_lossy().into()),
-        backend,
+        backend: settings.backend,
         model: model_name,
         auto_approve: args.auto_approve,
         objects: scenario

@@ -16,16 +16,28 @@ use super::openai::{ApiKey, AuthHeader, OpenAiClient, OpenAiSettings, RetryPolic
 use super::usage::{Ledger, Metered, PriceTable};
 use super::{LanguageModel, LlmError};
 
-/// Which backend answers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+/// Which backend answers (the embedded model unless a server is configured).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Backend {
     /// An OpenAI-compatible HTTP server.
     Openai,
     /// The embedded model (llama.cpp in-process, a GGUF file fetched on first use).
+    #[default]
     Local,
     /// Answers from a cassette only.
     Replay,
+}
+
+impl Backend {
+    /// The name settings and flags use (`--backend local`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Openai => "openai",
+            Backend::Local => "local",
+            Backend::Replay => "replay",
+        }
+    }
 }
 
 impl std::str::FromStr for Backend {

@@ -23,7 +23,7 @@ use super::theme::Theme;
 pub struct Info {
     /// The scenario's file stem or name.
     pub scenario: String,
-    pub backend: String,
+    pub backend: crate::llm::config::Backend,
     pub model: String,
     pub auto_approve: bool,
     /// The scenario's objects, for the world pane.
@@ -85,7 +85,7 @@ impl App {
             input: InputLine::default(),
             status: StatusBar {
                 scenario: info.scenario,
-                backend: info.backend,
+                backend: info.backend.name().to_string(),
                 model: info.model,
                 auto_approve: info.auto_approve,
                 ..StatusBar::default()
