@@ -179,7 +179,7 @@ fn silence_never_reaches_the_model() {
 #[test]
 fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
     use betr::tui::dictation::{DictationEvent, DictationService, SttLoader};
-    use betr::tui::{App, Info, KeyBindings, Theme};
+    use betr::tui::{App, Info, KeyBindings, Request, Theme};
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
     use std::sync::Arc;
     use support::microphone::AudioMicrophone;
@@ -206,9 +206,11 @@ fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
     rt.block_on(async {
         let mut press = |app: &mut App, c: char| {
             app.on_key(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE));
-            assert!(app.take_commands().is_empty());
-            for r in app.take_dictation_requests() {
-                service.handle(r);
+            for request in app.take_requests() {
+                match request {
+                    Request::Dictation(r) => service.handle(r),
+                    Request::Session(c) => panic!("a dictation key sent {c:?} to the session"),
+                }
             }
         };
         press(&mut app, 'd');
@@ -244,8 +246,10 @@ fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
         // Enter submits exactly what the input line shows.
         app.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
         assert_eq!(
-            app.take_commands(),
-            [betr::session::Command::Submit(transcript.text.clone())]
+            app.take_requests(),
+            [Request::Session(betr::session::Command::Submit(
+                transcript.text.clone()
+            ))]
         );
     });
     std::fs::remove_dir_all(&dir).unwrap();

@@ -17,7 +17,7 @@ use ratatui::backend::TestBackend;
 use betr::domain::Scenario;
 use betr::session::{Command, Engine, EngineHandle, Event, Setup};
 use betr::tui::dictation::{DictationEvent, DictationService, Microphone, SttLoader};
-use betr::tui::{App, Info, KeyBindings, Theme, ui};
+use betr::tui::{App, Info, KeyBindings, Request, Theme, ui};
 use betr::voice::{Audio16k, SpeechToText, SttFuture, Transcript};
 use support::fake_model::FixtureModel;
 use support::fixtures;
@@ -111,12 +111,14 @@ impl Bench {
     /// A key, as the event loop handles it (must run inside the runtime).
     fn key(&mut self, code: KeyCode) {
         self.app.on_key(KeyEvent::new(code, KeyModifiers::NONE));
-        for c in self.app.take_commands() {
-            self.sent.push(c.clone());
-            assert!(self.engine.send(c));
-        }
-        for r in self.app.take_dictation_requests() {
-            self.dictation.handle(r);
+        for request in self.app.take_requests() {
+            match request {
+                Request::Session(c) => {
+                    self.sent.push(c.clone());
+                    assert!(self.engine.send(c));
+                }
+                Request::Dictation(r) => self.dictation.handle(r),
+            }
         }
     }
 

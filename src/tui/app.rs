@@ -42,6 +42,13 @@ pub enum AppEvent {
     Quit,
 }
 
+/// A request the event loop passes on: to the session engine or to push-to-talk.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Request {
+    Session(Command),
+    Dictation(DictationRequest),
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
     Help,
@@ -60,7 +67,6 @@ pub struct App {
     pub overlay: Option<Overlay>,
     queue: Vec<AppEvent>,
     /// Requests for the push-to-talk service, in order.
-    dictation_requests: Vec<DictationRequest>,
     quit: bool,
 }
 
@@ -93,7 +99,6 @@ impl App {
             dictation: DictationPanel::default(),
             overlay: None,
             queue: Vec::new(),
-            dictation_requests: Vec::new(),
             quit: false,
         }
     }
@@ -102,22 +107,18 @@ impl App {
         self.quit
     }
 
-    /// Commands for the session, in order.
-    pub fn take_commands(&mut self) -> Vec<Command> {
+    /// What the app asks of the session and of the push-to-talk service, in the order
+    /// it was asked (a quit request sets `should_quit` instead).
+    pub fn take_requests(&mut self) -> Vec<Request> {
         let mut out = Vec::new();
         for e in std::mem::take(&mut self.queue) {
             match e {
-                AppEvent::Command(c) => out.push(c),
-                AppEvent::Dictation(r) => self.dictation_requests.push(r),
+                AppEvent::Command(c) => out.push(Request::Session(c)),
+                AppEvent::Dictation(r) => out.push(Request::Dictation(r)),
                 AppEvent::Quit => self.quit = true,
             }
         }
         out
-    }
-
-    /// Requests for the push-to-talk service, in order (after `take_commands`).
-    pub fn take_dictation_requests(&mut self) -> Vec<DictationRequest> {
-        std::mem::take(&mut self.dictation_requests)
     }
 
     /// Whether something animates (a model call under way, a recording's clock).

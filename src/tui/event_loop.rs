@@ -12,7 +12,7 @@ use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::session::{Command, EngineHandle, Event};
 
-use super::app::App;
+use super::app::{App, Request};
 use super::dictation::{DictationEvent, DictationService};
 use super::ui;
 
@@ -114,14 +114,16 @@ pub async fn run<B: Backend>(
             },
             _ = animation.tick(), if app.animating() => app.on_animation(),
         }
-        for command in app.take_commands() {
-            if let Some(t) = tap.as_mut() {
-                t.command(&command);
+        for request in app.take_requests() {
+            match request {
+                Request::Session(command) => {
+                    if let Some(t) = tap.as_mut() {
+                        t.command(&command);
+                    }
+                    engine.send(command);
+                }
+                Request::Dictation(request) => dictation.handle(request),
             }
-            engine.send(command);
-        }
-        for request in app.take_dictation_requests() {
-            dictation.handle(request);
         }
         if app.should_quit() {
             engine.send(Command::Shutdown);

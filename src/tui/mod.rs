@@ -41,7 +41,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationEvent, DictationService};
 
-pub use app::{App, Info};
+pub use app::{App, Info, Request};
 pub use keys::KeyBindings;
 pub use theme::Theme;
 
