@@ -12,7 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::llm::usage::PriceTable;
-use crate::llm::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError};
+use crate::llm::{ChatReply, ChatRequest, LanguageModel, LlmError};
 
 use super::EvalError;
 
@@ -114,20 +114,7 @@ impl Tap {
     }
 }
 
-impl LanguageModel for Tap {
-    fn model(&self) -> &str {
-        self.inner.model()
-    }
-    fn supports_constraint(&self) -> bool {
-        self.inner.supports_constraint()
-    }
-    fn supports_grammar(&self) -> bool {
-        self.inner.supports_grammar()
-    }
-    fn chat<'b>(&'b self, request: &'b ChatRequest) -> ChatFuture<'b> {
-        Box::pin(self.call(request))
-    }
-}
+crate::llm::forwarding_model!(impl for Tap);
 
 /// Totals over calls, with latency percentiles.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]

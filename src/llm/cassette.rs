@@ -90,20 +90,7 @@ impl<M: LanguageModel> Recorder<M> {
     }
 }
 
-impl<M: LanguageModel> LanguageModel for Recorder<M> {
-    fn model(&self) -> &str {
-        self.inner.model()
-    }
-    fn supports_constraint(&self) -> bool {
-        self.inner.supports_constraint()
-    }
-    fn supports_grammar(&self) -> bool {
-        self.inner.supports_grammar()
-    }
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(self.call(request))
-    }
-}
+super::forwarding_model!(impl<M> for Recorder<M>);
 
 /// Answers from a cassette.
 #[derive(Debug)]

@@ -223,6 +223,32 @@ pub trait LanguageModel: Send + Sync {
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a>;
 }
 
+/// `LanguageModel` for a model in front of another (a recorder, a meter, an evaluation
+/// tap): `model` and the capability questions go to the field `inner`, `chat` to the
+/// wrapper's own `async fn call(&self, &ChatRequest)`.
+macro_rules! forwarding_model {
+    (impl $(<$g:ident>)? for $ty:ty) => {
+        impl$(<$g: $crate::llm::LanguageModel>)? $crate::llm::LanguageModel for $ty {
+            fn model(&self) -> &str {
+                self.inner.model()
+            }
+            fn supports_constraint(&self) -> bool {
+                self.inner.supports_constraint()
+            }
+            fn supports_grammar(&self) -> bool {
+                self.inner.supports_grammar()
+            }
+            fn chat<'a>(
+                &'a self,
+                request: &'a $crate::llm::ChatRequest,
+            ) -> $crate::llm::ChatFuture<'a> {
+                Box::pin(self.call(request))
+            }
+        }
+    };
+}
+pub(crate) use forwarding_model;
+
 impl<T: LanguageModel + ?Sized> LanguageModel for Box<T> {
     fn model(&self) -> &str {
         (**self).model()

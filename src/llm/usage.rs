@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use serde::{Deserialize, Serialize};
 
-use super::{ChatFuture, ChatReply, ChatRequest, LanguageModel, LlmError, ReplySource};
+use super::{ChatReply, ChatRequest, LanguageModel, LlmError, ReplySource};
 
 /// US dollars per million tokens.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -221,20 +221,7 @@ impl<M: LanguageModel> Metered<M> {
     }
 }
 
-impl<M: LanguageModel> LanguageModel for Metered<M> {
-    fn model(&self) -> &str {
-        self.inner.model()
-    }
-    fn supports_constraint(&self) -> bool {
-        self.inner.supports_constraint()
-    }
-    fn supports_grammar(&self) -> bool {
-        self.inner.supports_grammar()
-    }
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(self.call(request))
-    }
-}
+super::forwarding_model!(impl<M> for Metered<M>);
 
 /// Where a reply came from (`model`, `recorded`, `hand-written`) and what it cost: only a
 /// model's live answer is billed, at the price of the model it names (else the model the
@@ -267,7 +254,7 @@ pub fn billing(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::llm::TokenUsage;
+    use crate::llm::{ChatFuture, TokenUsage};
     use std::time::Duration;
 
     #[test]
