@@ -340,7 +340,7 @@ impl World for CellWorld {
                 }
                 Err(error) => {
                     self.state.progress.remove(&key);
-                    return Step::Failure(error);
+                    return Step::Failure(error.to_string());
                 }
             }
         }

@@ -17,9 +17,52 @@ use super::values::judge;
 use super::{CellWorld, Effect, Held};
 use crate::domain::{ActionCall, Value};
 
-pub const NO_PATH: &str = "No collision free path found";
-pub const OUT_OF_REACH: &str = "Position out of reach";
-pub const TORQUE: &str = "Torque limit exceeded";
+/// Why the cell refuses an action; the texts are what the skill reports (and what the
+/// model reads when it is asked about the failure).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SkillFailure {
+    #[error("No collision free path found")]
+    NoPath,
+    #[error("Position out of reach")]
+    OutOfReach,
+    #[error("Torque limit exceeded")]
+    Torque,
+    #[error("Object {0:?} is not in the dictionary")]
+    UnknownObject(String),
+    #[error("The {name} {value:?} is not in the cell")]
+    UnknownCategory { name: String, value: String },
+    /// A value the scenario judges wrong, in the scenario's own words.
+    #[error("{0}")]
+    Judged(String),
+    #[error("{0:?} has no lock")]
+    NoLock(String),
+    #[error("The cell cannot perform {skill} on {objects} object(s)")]
+    Unsupported { skill: String, objects: usize },
+    #[error("The gripper holds {held:?}; it needs a free hand to {what} {object:?}")]
+    HandFull {
+        held: String,
+        what: &'static str,
+        object: String,
+    },
+    #[error("{object:?} is fixed in place and cannot be {done}")]
+    Fixed { object: String, done: &'static str },
+    #[error("Payload limit exceeded: {object:?} weighs {mass} kg, an arm carries {payload} kg")]
+    Payload {
+        object: String,
+        mass: f32,
+        payload: f32,
+    },
+    #[error("{0:?} has no lid or door to open")]
+    NoLid(String),
+    #[error("The gripper does not hold {0:?}")]
+    NotHeld(String),
+    #[error("{0:?} cannot be placed on itself")]
+    OnItself(String),
+    #[error("{0:?} has no opening to put things in")]
+    NoOpening(String),
+    #[error("{0:?} cannot be put in itself")]
+    InItself(String),
+}
 /// How many free spots on a large support are tried before giving up.
 const MAX_SPOTS: usize = 24;
 /// Clearance beyond which a spot is as good as any other.
@@ -27,17 +70,17 @@ const ENOUGH_CLEARANCE: f32 = 0.1;
 
 impl CellWorld {
     /// Check an action on its first tick; on success, what it will do when it completes.
-    pub(super) fn start(&self, action: &ActionCall) -> Result<Effect, String> {
+    pub(super) fn start(&self, action: &ActionCall) -> Result<Effect, SkillFailure> {
         let mut ids = Vec::new();
         for a in &action.args {
             match self.id(a) {
                 Some(i) if self.state.known[i] || action.skill == "look_for" => ids.push(i),
-                _ => return Err(format!("Object {a:?} is not in the dictionary")),
+                _ => return Err(SkillFailure::UnknownObject(a.clone())),
             }
         }
         if let Some(skill) = self.domain.skill_for(action) {
             if let Some(error) = judge(action, &skill.values, &self.scene.judges) {
-                return Err(error);
+                return Err(SkillFailure::Judged(error));
             }
             for (name, value) in &action.values {
                 if let Value::Category(c) = value
@@ -47,7 +90,10 @@ impl CellWorld {
                         .any(|v| v.name == *name && v.unit.is_none())
                     && self.id(c).is_none()
                 {
-                    return Err(format!("The {name} {c:?} is not in the cell"));
+                    return Err(SkillFailure::UnknownCategory {
+                        name: name.clone(),
+                        value: c.clone(),
+                    });
                 }
             }
         }
@@ -61,7 +107,7 @@ impl CellWorld {
                 self.free_hand("unlock", *x)?;
                 self.reachable(*x)?;
                 if !self.scene.solids[*x].lockable {
-                    return Err(format!("{:?} has no lock", self.name(*x)));
+                    return Err(SkillFailure::NoLock(self.name(*x).to_string()));
                 }
                 Ok(Effect::Unlock(*x))
             }
@@ -71,7 +117,7 @@ impl CellWorld {
                 .robot
                 .base_to_reach(self.state.base, &self.reach_point(*x))
                 .map(Effect::Base)
-                .ok_or_else(|| OUT_OF_REACH.to_string()),
+                .ok_or(SkillFailure::OutOfReach),
             ("scoop", [x, c]) => {
                 self.free_hand("scoop", *x)?;
                 self.reachable(*x)?;
@@ -84,14 +130,14 @@ impl CellWorld {
                 self.reachable(*x)?;
                 Ok(Effect::Clean(*x))
             }
-            (name, _) => Err(format!(
-                "The cell cannot perform {name} on {} object(s)",
-                ids.len()
-            )),
+            (name, _) => Err(SkillFailure::Unsupported {
+                skill: name.to_string(),
+                objects: ids.len(),
+            }),
         }
     }
 
-    fn reachable(&self, id: usize) -> Result<(), String> {
+    fn reachable(&self, id: usize) -> Result<(), SkillFailure> {
         if self
             .scene
             .robot
@@ -99,17 +145,17 @@ impl CellWorld {
         {
             Ok(())
         } else {
-            Err(OUT_OF_REACH.to_string())
+            Err(SkillFailure::OutOfReach)
         }
     }
 
-    fn free_hand(&self, what: &str, id: usize) -> Result<(), String> {
+    fn free_hand(&self, what: &'static str, id: usize) -> Result<(), SkillFailure> {
         match &self.state.held {
-            Some(h) => Err(format!(
-                "The gripper holds {:?}; it needs a free hand to {what} {:?}",
-                self.name(h.id),
-                self.name(id)
-            )),
+            Some(h) => Err(SkillFailure::HandFull {
+                held: self.name(h.id).to_string(),
+                what,
+                object: self.name(id).to_string(),
+            }),
             None => Ok(()),
         }
     }
@@ -135,24 +181,25 @@ impl CellWorld {
         !collided
     }
 
-    fn grasp(&self, x: usize) -> Result<Effect, String> {
+    fn grasp(&self, x: usize) -> Result<Effect, SkillFailure> {
         let solid = &self.scene.solids[x];
         if solid.fixed {
-            return Err(format!(
-                "{:?} is fixed in place and cannot be grasped",
-                solid.name
-            ));
+            return Err(SkillFailure::Fixed {
+                object: solid.name.clone(),
+                done: "grasped",
+            });
         }
         self.free_hand("grasp", x)?;
         self.reachable(x)?;
         if solid.mass > self.scene.robot.payload {
-            return Err(format!(
-                "Payload limit exceeded: {:?} weighs {} kg, an arm carries {} kg",
-                solid.name, solid.mass, self.scene.robot.payload
-            ));
+            return Err(SkillFailure::Payload {
+                object: solid.name.clone(),
+                mass: solid.mass,
+                payload: self.scene.robot.payload,
+            });
         }
         if !self.approach_is_clear(x) {
-            return Err(NO_PATH.to_string());
+            return Err(SkillFailure::NoPath);
         }
         let (tool, half_width) = self.grip_pose(x);
         Ok(Effect::Grasp(Held {
@@ -163,17 +210,17 @@ impl CellWorld {
         }))
     }
 
-    fn flip(&self, x: usize) -> Result<Effect, String> {
+    fn flip(&self, x: usize) -> Result<Effect, SkillFailure> {
         if self.scene.solids[x].fixed {
-            return Err(format!(
-                "{:?} is fixed in place and cannot be flipped",
-                self.name(x)
-            ));
+            return Err(SkillFailure::Fixed {
+                object: self.name(x).to_string(),
+                done: "flipped",
+            });
         }
         self.free_hand("flip", x)?;
         self.reachable(x)?;
         if !self.approach_is_clear(x) {
-            return Err(NO_PATH.to_string());
+            return Err(SkillFailure::NoPath);
         }
         let pose = self.state.poses[x];
         let b = self.aabb(x);
@@ -185,27 +232,27 @@ impl CellWorld {
         Ok(Effect::Move { id: x, pose })
     }
 
-    fn open_part(&self, x: usize) -> Result<Effect, String> {
+    fn open_part(&self, x: usize) -> Result<Effect, SkillFailure> {
         let s = &self.scene.solids[x];
         let Some(lid) = &s.lid else {
-            return Err(format!("{:?} has no lid or door to open", s.name));
+            return Err(SkillFailure::NoLid(s.name.clone()));
         };
         self.free_hand("open", x)?;
         let handle = lid.body.aabb(&(self.state.poses[x] * lid.closed)).center();
         if !self.scene.robot.reaches(self.state.base, &handle) {
-            return Err(OUT_OF_REACH.to_string());
+            return Err(SkillFailure::OutOfReach);
         }
         if self.state.locked[x] {
-            return Err(TORQUE.to_string());
+            return Err(SkillFailure::Torque);
         }
         Ok(Effect::Open(x))
     }
 
     /// The held object, which must be `x`.
-    fn holding(&self, x: usize) -> Result<&Held, String> {
+    fn holding(&self, x: usize) -> Result<&Held, SkillFailure> {
         match &self.state.held {
             Some(h) if h.id == x => Ok(h),
-            _ => Err(format!("The gripper does not hold {:?}", self.name(x))),
+            _ => Err(SkillFailure::NotHeld(self.name(x).to_string())),
         }
     }
 
@@ -242,10 +289,10 @@ impl CellWorld {
         !collided
     }
 
-    fn place_on(&self, x: usize, s: usize) -> Result<Effect, String> {
+    fn place_on(&self, x: usize, s: usize) -> Result<Effect, SkillFailure> {
         let held = self.holding(x)?.clone();
         if x == s {
-            return Err(format!("{:?} cannot be placed on itself", self.name(x)));
+            return Err(SkillFailure::OnItself(self.name(x).to_string()));
         }
         let body = &self.scene.solids[x].body;
         let rotation = (self.state.poses[x]).rotation;
@@ -257,7 +304,7 @@ impl CellWorld {
         );
         let spots = self.spots(x, s, hx, hy, &held);
         if spots.is_empty() {
-            return Err(OUT_OF_REACH.to_string());
+            return Err(SkillFailure::OutOfReach);
         }
         let approach = self.scene.robot.gripper.approach;
         for (px, py) in spots.into_iter().take(MAX_SPOTS) {
@@ -266,7 +313,7 @@ impl CellWorld {
                 return Ok(Effect::Release { id: x, pose });
             }
         }
-        Err(NO_PATH.to_string())
+        Err(SkillFailure::NoPath)
     }
 
     /// Reachable spots on the top of `s` for a footprint of half size `hx` × `hy`, best
@@ -309,14 +356,11 @@ impl CellWorld {
 
     /// Where `x` rests on the floor of `c`'s cavity, and the direction and length of the
     /// way in.
-    fn cavity_rest(&self, x: usize, c: usize) -> Result<(Pose, Vector3<f32>, f32), String> {
+    fn cavity_rest(&self, x: usize, c: usize) -> Result<(Pose, Vector3<f32>, f32), SkillFailure> {
         let Some((cavity, half, opening)) =
             self.scene.solids[c].body.cavity_at(&self.state.poses[c])
         else {
-            return Err(format!(
-                "{:?} has no opening to put things in",
-                self.name(c)
-            ));
+            return Err(SkillFailure::NoOpening(self.name(c).to_string()));
         };
         // The lowest point of the cavity in the world, whichever way the container is turned.
         let r = cavity.rotation.to_rotation_matrix();
@@ -345,17 +389,17 @@ impl CellWorld {
         })
     }
 
-    fn put_in(&self, x: usize, c: usize) -> Result<Effect, String> {
+    fn put_in(&self, x: usize, c: usize) -> Result<Effect, SkillFailure> {
         let held = self.holding(x)?.clone();
         if x == c {
-            return Err(format!("{:?} cannot be put in itself", self.name(x)));
+            return Err(SkillFailure::InItself(self.name(x).to_string()));
         }
         self.reachable(c)?;
         let (pose, direction, travel) = self.cavity_rest(x, c)?;
         if self.release_path_clear(&held, &pose, direction, travel) {
             Ok(Effect::Release { id: x, pose })
         } else {
-            Err(NO_PATH.to_string())
+            Err(SkillFailure::NoPath)
         }
     }
 }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::CellWorld;
-use super::skills::{NO_PATH, OUT_OF_REACH, TORQUE};
+use super::skills::SkillFailure;
 use crate::domain::{ActionCall, Condition, Scenario};
 use crate::world::{Step, World};
 
@@ -72,7 +72,7 @@ fn a_cube_on_top_blocks_the_way_down() {
     let mut w = cell("red_on_blue.toml", None);
     assert_eq!(
         act(&mut w, r#"grasp "blue cube""#),
-        Step::Failure(NO_PATH.into())
+        Step::Failure(SkillFailure::NoPath.to_string())
     );
     let mut clear = cell("red_on_blue.toml", Some("clear"));
     assert_eq!(act(&mut clear, r#"grasp "blue cube""#), Step::Success);
@@ -83,7 +83,7 @@ fn a_cube_on_top_blocks_the_way_down() {
     assert_eq!(act(&mut both, r#"grasp "blue cube""#), Step::Success);
     assert_eq!(
         act(&mut both, r#"place "blue cube" "green cube""#),
-        Step::Failure(NO_PATH.into())
+        Step::Failure(SkillFailure::NoPath.to_string())
     );
 }
 
@@ -95,7 +95,7 @@ fn an_upside_down_cup_closes_its_opening() {
     assert_eq!(act(&mut w, r#"grasp "green cube""#), Step::Success);
     assert_eq!(
         act(&mut w, r#"put_in "green cube" "red cup""#),
-        Step::Failure(NO_PATH.into())
+        Step::Failure(SkillFailure::NoPath.to_string())
     );
     let mut w = cell("flip_cup.toml", None);
     assert_eq!(act(&mut w, r#"flip "red cup""#), Step::Success);
@@ -117,7 +117,7 @@ fn a_closed_lid_blocks_and_an_open_one_does_not() {
     assert_eq!(act(&mut w, r#"grasp "test tube""#), Step::Success);
     assert_eq!(
         act(&mut w, r#"put_in "test tube" "centrifuge""#),
-        Step::Failure(NO_PATH.into())
+        Step::Failure(SkillFailure::NoPath.to_string())
     );
     let mut w = cell("centrifuge.toml", None);
     assert_eq!(act(&mut w, r#"open "centrifuge""#), Step::Success);
@@ -136,13 +136,13 @@ fn a_locked_door_does_not_open_and_a_closed_one_blocks() {
     assert!(!holds(&w, r#""cupboard" unlocked"#));
     assert_eq!(
         act(&mut w, r#"open "cupboard""#),
-        Step::Failure(TORQUE.into())
+        Step::Failure(SkillFailure::Torque.to_string())
     );
     let mut w = cell("cupboard.toml", Some("clear"));
     assert_eq!(act(&mut w, r#"grasp "plate""#), Step::Success);
     assert_eq!(
         act(&mut w, r#"put_in "plate" "cupboard""#),
-        Step::Failure(NO_PATH.into())
+        Step::Failure(SkillFailure::NoPath.to_string())
     );
     let mut w = cell("cupboard.toml", Some("clear"));
     assert_eq!(act(&mut w, r#"open "cupboard""#), Step::Success);
@@ -159,7 +159,7 @@ fn reach_and_driving_and_the_robots_map() {
     assert!(holds(&w, r#""tray" near robot"#));
     assert_eq!(
         act(&mut w, r#"grasp "banana""#),
-        Step::Failure(OUT_OF_REACH.into())
+        Step::Failure(SkillFailure::OutOfReach.to_string())
     );
     assert_eq!(act(&mut w, r#"move_base "banana""#), Step::Success);
     assert!(holds(&w, r#""banana" near robot"#));
