@@ -9,6 +9,7 @@
 
 pub mod bench;
 pub mod bt;
+pub mod config_file;
 pub mod dataset;
 pub mod domain;
 pub mod eval;

@@ -9,9 +9,10 @@ use anyhow::{Context as _, Result};
 use clap::Args;
 
 use betr::bt::{self, Glyphs};
+use betr::config_file::FileConfig;
 use betr::domain::{Example, Scenario};
 use betr::llm::LanguageModel;
-use betr::llm::config::{Backend, FileConfig, Layer, Settings};
+use betr::llm::config::{Backend, Layer, Settings};
 use betr::llm::prompt::{DEFAULT_EXAMPLES_SHOWN, Templates, Variant};
 use betr::llm::usage::{Ledger, Metered};
 use betr::session::types::DEFAULT_CANDIDATES;
@@ -171,7 +172,8 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         ..Layer::default()
     };
     let settings = Settings::resolve(
-        file.as_ref().map(|(f, p)| (p.as_path(), f.clone())),
+        file.as_ref()
+            .map(|(f, p)| (p.as_path(), f.llm.clone(), f.prices.clone())),
         Layer::from_env(&var)?,
         flag_layer,
     )?;

@@ -11,7 +11,7 @@ use std::time::Duration;
 use anyhow::{Result, bail};
 use clap::Args;
 
-use betr::llm::config::FileConfig;
+use betr::config_file::FileConfig;
 use betr::model::Progress;
 use betr::tui::dictation::SttLoader;
 use betr::voice::{self, Audio16k, SpeechToText, SttBackend, SttLayer, SttSettings, Transcript};

@@ -164,64 +164,6 @@ impl Layer {
     }
 }
 
-/// The contents of `betr.toml`.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FileConfig {
-    #[serde(default)]
-    pub llm: Layer,
-    #[serde(default)]
-    pub prices: PriceTable,
-    /// Speech-to-text settings, read by `voice::config`.
-    #[serde(default)]
-    pub stt: crate::voice::SttLayer,
-}
-
-impl FileConfig {
-    pub fn read(path: &Path) -> Result<FileConfig, LlmError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| LlmError::Config(format!("cannot read {}: {e}", path.display())))?;
-        let file: FileConfig = toml::from_str(&text)
-            .map_err(|e| LlmError::Config(format!("{}: {e}", path.display())))?;
-        if file.llm.api_key.is_some() {
-            return Err(LlmError::Config(format!(
-                "{}: `api_key` is not allowed in a file; put the key in an environment variable and name it with `api_key_env`",
-                path.display()
-            )));
-        }
-        if file.stt.api_key.is_some() {
-            return Err(LlmError::Config(format!(
-                "{}: `api_key` is not allowed under [stt]; put the key in an environment variable and name it with `api_key_env`",
-                path.display()
-            )));
-        }
-        Ok(file)
-    }
-
-    /// The file to read: `explicit`, else `$BETR_CONFIG`, else `./betr.toml`, else
-    /// `$XDG_CONFIG_HOME/betr/betr.toml` (or `~/.config/betr/betr.toml`), if it exists.
-    pub fn locate(
-        explicit: Option<&Path>,
-        var: &dyn Fn(&str) -> Option<String>,
-    ) -> Option<PathBuf> {
-        if let Some(p) = explicit {
-            return Some(p.to_path_buf());
-        }
-        if let Some(p) = var("BETR_CONFIG").filter(|v| !v.is_empty()) {
-            return Some(PathBuf::from(p));
-        }
-        let local = PathBuf::from("betr.toml");
-        if local.is_file() {
-            return Some(local);
-        }
-        let config_home = var("XDG_CONFIG_HOME")
-            .filter(|v| !v.is_empty())
-            .map(PathBuf::from)
-            .or_else(|| var("HOME").map(|h| Path::new(&h).join(".config")))?;
-        Some(config_home.join("betr").join("betr.toml")).filter(|p| p.is_file())
-    }
-}
-
 /// Resolved settings.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
@@ -257,17 +199,18 @@ pub struct Settings {
 pub const DEFAULT_THREADS: u32 = 1;
 
 impl Settings {
-    /// Defaults, then `file`, then `env`, then `flags`.
+    /// Defaults, then the settings file's (its path, its `[llm]` layer and its prices),
+    /// then `env`, then `flags`.
     pub fn resolve(
-        file: Option<(&Path, FileConfig)>,
+        file: Option<(&Path, Layer, PriceTable)>,
         env: Layer,
         flags: Layer,
     ) -> Result<Settings, LlmError> {
         let mut layer = Layer::default();
         let (path, prices) = match file {
-            Some((p, f)) => {
-                layer.merge(f.llm);
-                (Some(p.to_path_buf()), f.prices)
+            Some((p, llm, prices)) => {
+                layer.merge(llm);
+                (Some(p.to_path_buf()), prices)
             }
             None => (None, PriceTable::default()),
         };
@@ -430,7 +373,7 @@ mod tests {
 
     #[test]
     fn later_layers_win() {
-        let file: FileConfig = toml::from_str(
+        let file: crate::config_file::FileConfig = toml::from_str(
             "[llm]\nmodel = \"a\"\nbase_url = \"http://f/v1\"\nstructured = true\n[prices.a]\nprompt_per_mtok = 1.0\ncompletion_per_mtok = 2.0\n",
         )
         .unwrap();
@@ -439,7 +382,12 @@ mod tests {
             base_url: Some("http://flag/v1".into()),
             ..Layer::default()
         };
-        let s = Settings::resolve(Some((Path::new("betr.toml"), file)), env, flags).unwrap();
+        let s = Settings::resolve(
+            Some((Path::new("betr.toml"), file.llm, file.prices)),
+            env,
+            flags,
+        )
+        .unwrap();
         assert_eq!(s.model.as_deref(), Some("b"));
         assert_eq!(s.base_url, "http://flag/v1");
         assert!(s.structured);
@@ -448,25 +396,22 @@ mod tests {
     }
 
     #[test]
-    fn the_documented_example_is_valid() {
+    fn the_documented_example_resolves() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("betr.example.toml");
-        let file = FileConfig::read(&path).unwrap();
+        let file = crate::config_file::FileConfig::read(&path).unwrap();
         assert_eq!(file.llm.backend, Some(Backend::Openai));
         assert!(file.prices.price("gpt-4o-2024-08-06").is_some());
-        assert_eq!(file.stt.backend, Some(crate::voice::SttBackend::Local));
-        let s = Settings::resolve(Some((&path, file)), Layer::default(), Layer::default()).unwrap();
+        let s = Settings::resolve(
+            Some((&path, file.llm, file.prices)),
+            Layer::default(),
+            Layer::default(),
+        )
+        .unwrap();
         assert_eq!(s.retry.max_retries, 3);
     }
 
     #[test]
     fn keys_and_bad_values_are_refused() {
-        let dir = std::env::temp_dir().join(format!("betr-config-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("betr.toml");
-        std::fs::write(&path, "[llm]\napi_key = \"sk-x\"\n").unwrap();
-        let e = FileConfig::read(&path).unwrap_err().to_string();
-        assert!(e.contains("api_key_env") && !e.contains("sk-x"), "{e}");
-        std::fs::remove_dir_all(&dir).unwrap();
         assert!(Layer::from_env(&|k| (k == "BETR_BACKEND").then(|| "gpt".into())).is_err());
         let local = Settings::resolve(
             None,
