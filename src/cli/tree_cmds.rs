@@ -15,8 +15,7 @@ use betr::world::{self, World};
 use rerun::TextLogLevel as Level;
 
 use super::values::Setting;
-use super::viz_flags::VizFlags;
-use betr::viz::run_streamed;
+use super::viz_flags::{VizFlags, run_streamed};
 
 const WORLD_FAILED: u8 = 1;
 

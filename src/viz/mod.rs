@@ -24,8 +24,6 @@ use rerun::sink::{FileSink, GrpcSink, LogSink};
 use rerun::{RecordingStream, RecordingStreamBuilder, TextLog};
 
 use crate::bt::{TickRecord, Tree};
-use crate::domain::Domain;
-use crate::planner::{RunReport, run_tree};
 use crate::session::Event;
 use crate::world::cell::snapshot::SceneSnapshot;
 use crate::world::{CellWorld, World};
@@ -112,6 +110,19 @@ pub struct Viz {
 }
 
 impl Viz {
+    /// A run begins: the tree it ticks and the world before its first tick.
+    pub fn run_start(&mut self, tree: &Tree, world: &dyn World) {
+        self.set_tree(Arc::new(tree.clone()));
+        if let Some(scene) = CellWorld::scene_of(world) {
+            self.scene(&scene);
+        }
+    }
+
+    /// A tick of the run, and the world after it.
+    pub fn run_tick(&mut self, record: &TickRecord, world: &dyn World) {
+        self.tick(record, CellWorld::scene_of(world).as_ref());
+    }
+
     /// Open the sinks; `None` when there are none. A viewer that cannot be reached is
     /// left out (see [`Viz::notice`]); a file that cannot be created is an error.
     pub fn open(sinks: &Sinks) -> Result<Option<Viz>, VizError> {
@@ -335,30 +346,6 @@ impl Viz {
         }
         Self::warn(self.rec.flush_blocking());
     }
-}
-
-/// `planner::run_tree` with the tree, every tick and the cell after it streamed to `viz`
-/// (the scene before the first tick too).
-pub fn run_streamed(
-    tree: &Tree,
-    world: &mut dyn World,
-    domain: &Domain,
-    max_ticks: u64,
-    mut viz: Option<&mut Viz>,
-    mut on_tick: impl FnMut(&TickRecord) -> bool,
-) -> RunReport {
-    if let Some(v) = viz.as_deref_mut() {
-        v.set_tree(Arc::new(tree.clone()));
-        if let Some(scene) = CellWorld::scene_of(world) {
-            v.scene(&scene);
-        }
-    }
-    run_tree(tree, world, domain, max_ticks, |r, w| {
-        if let Some(v) = viz.as_deref_mut() {
-            v.tick(r, CellWorld::scene_of(w).as_ref());
-        }
-        on_tick(r)
-    })
 }
 
 impl Drop for Viz {

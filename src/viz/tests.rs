@@ -5,9 +5,18 @@ use rerun::RecordingStreamBuilder;
 use rerun::log::{Chunk, LogMsg};
 
 use super::*;
-use crate::domain::Scenario;
-use crate::planner::{Outcome, Planner, RunEnd};
+use crate::domain::{Domain, Scenario};
+use crate::planner::{Outcome, Planner, RunEnd, RunReport, run_tree};
 use crate::world::cell::snapshot::PartShape;
+
+/// A run of `tree` streamed to `viz` as the command line does it.
+fn run_streamed(tree: &Tree, world: &mut dyn World, domain: &Domain, viz: &mut Viz) -> RunReport {
+    viz.run_start(tree, world);
+    run_tree(tree, world, domain, 100, |r, w| {
+        viz.run_tick(r, w);
+        true
+    })
+}
 
 fn scenario1() -> Scenario {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml");
@@ -61,14 +70,7 @@ fn scenario1_before_and_after_repair_streams_scene_tree_and_ticks() {
     let mut viz = Viz::with_stream(rec);
     viz.instruction("Put the blue cube on the green cube");
     let mut exec = world.fork();
-    let before = run_streamed(
-        &plan.tree,
-        exec.as_mut(),
-        &scenario.domain,
-        100,
-        Some(&mut viz),
-        |_| true,
-    );
+    let before = run_streamed(&plan.tree, exec.as_mut(), &scenario.domain, &mut viz);
     assert!(matches!(before.end, RunEnd::Failure { action: Some(_) }));
     assert_eq!(viz.ticks(), before.ticks as i64);
     // The failing grasp's way down is drawn, red where the red cube is in it.
@@ -87,14 +89,7 @@ fn scenario1_before_and_after_repair_streams_scene_tree_and_ticks() {
         .repair(plan.tree, node, &conditions, world.as_ref())
         .unwrap();
     let mut exec = world.fork();
-    let after = run_streamed(
-        &repaired.tree,
-        exec.as_mut(),
-        &scenario.domain,
-        100,
-        Some(&mut viz),
-        |_| true,
-    );
+    let after = run_streamed(&repaired.tree, exec.as_mut(), &scenario.domain, &mut viz);
     assert_eq!(after.end, RunEnd::Success);
     assert_eq!(viz.ticks(), (before.ticks + after.ticks) as i64);
     let scene = CellWorld::scene_of(exec.as_ref()).unwrap();
