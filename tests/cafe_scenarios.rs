@@ -4,16 +4,12 @@
 //! failing state, succeeds with no further repair.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn betr(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_betr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the betr binary runs")
-}
+mod support;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use support::repo::betr;
 
 fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()

@@ -6,8 +6,8 @@
 //! scenarios fail without a value, fail with a wrong one in their own words, and succeed
 //! with a good one that reaches every node using that skill with that object.
 
+mod support;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use betr::bt::{self, NodeId, NodeKind, Status, Tree};
 use betr::domain::{ActionCall, Condition, Scenario, Value};
@@ -377,17 +377,8 @@ fn parameter_scenarios_ask_for_a_value_judge_it_and_take_a_good_one() {
 }
 
 fn betr(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_betr"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the betr binary runs");
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    (out.status.code().unwrap_or(-1), text)
+    let (code, text) = support::repo::code_and_text(&support::repo::betr(args));
+    (code.unwrap_or(-1), text)
 }
 
 #[test]

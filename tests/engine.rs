@@ -147,13 +147,7 @@ impl Session {
     }
 }
 
-fn rt() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap()
-}
+use support::repo::runtime as rt;
 
 fn tree_of(events: &[Event]) -> Option<(Arc<bt::Tree>, Vec<bt::NodeId>)> {
     events.iter().rev().find_map(|e| match e {

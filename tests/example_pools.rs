@@ -5,17 +5,15 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
+mod support;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use betr::dataset;
-use betr::domain::Scenario;
 use betr::goal::Formula;
 use betr::llm::examples::terms;
 
-fn scenario(path: &str) -> Scenario {
-    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
-}
+use support::repo::scenario;
 
 /// `&` and `|` never side by side at one level of the text.
 fn mixes_operators(goal: &str) -> bool {

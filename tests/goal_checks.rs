@@ -5,7 +5,8 @@
 //! simulation as the only choices.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-use std::path::Path;
+
+mod support;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -71,9 +72,7 @@ impl LanguageModel for ByDraw {
     }
 }
 
-fn scenario(path: &str) -> Scenario {
-    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
-}
+use support::repo::scenario;
 
 async fn read(scenario: &Scenario, model: &ByDraw, instruction: &str) -> (Formula, usize) {
     let w = world::load(scenario).unwrap();

@@ -9,7 +9,7 @@ mod support;
 
 use std::path::Path;
 
-use betr::domain::{ActionCall, Condition, LearnedRule, Scenario};
+use betr::domain::{ActionCall, Condition, LearnedRule};
 use betr::session::knowledge::{Knowledge, Refusal, check_rule, learned_in_tree, offered_rule};
 use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
@@ -165,9 +165,7 @@ fn knowledge_is_listed_shown_and_revoked() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-fn scenario(rel: &str) -> Scenario {
-    Scenario::load(&fixtures::root().join(rel)).unwrap()
-}
+use support::repo::scenario;
 
 fn empty_knowledge() -> Knowledge {
     Knowledge {

@@ -6,10 +6,9 @@
 
 mod support;
 
-use std::path::Path;
 use std::sync::Arc;
 
-use betr::domain::{Condition, Scenario};
+use betr::domain::Condition;
 use betr::llm::local::LocalModel;
 use betr::llm::prompt::{Context, Templates, Variant};
 use betr::llm::{ChatRequest, LanguageModel, OutputConstraint, grammar, reply};
@@ -20,9 +19,7 @@ fn local() -> &'static Arc<LocalModel> {
     support::embedded::language_model()
 }
 
-fn scenario(path: &str) -> Scenario {
-    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
-}
+use support::repo::scenario;
 
 #[tokio::test]
 async fn interprets_scenario_1_exactly() {

@@ -194,13 +194,7 @@ async fn feed_until<T>(
         .expect("timed out");
 }
 
-fn rt() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap()
-}
+use support::repo::runtime as rt;
 
 #[test]
 fn planned_tree() {

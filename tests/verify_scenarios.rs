@@ -8,8 +8,6 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 mod support;
 
-use std::process::Command;
-
 use betr::bt::{self, NodeKind, Outcome};
 use betr::domain::Scenario;
 use betr::planner::Planner;
@@ -183,15 +181,7 @@ fn the_unrepaired_sweep_violates_its_scenario_property() {
 }
 
 fn betr(args: &[&str]) -> (Option<i32>, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_betr"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
-    )
+    support::repo::code_and_text(&support::repo::betr(args))
 }
 
 #[test]

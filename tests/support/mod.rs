@@ -1,6 +1,7 @@
 //! Test support: a fake OpenAI-compatible server, the hand-written fixture replies, and
 //! the verification helpers.
 #![allow(dead_code)]
+#![allow(clippy::unwrap_used)] // test helpers: a failure is a failed test
 
 pub mod cli;
 pub mod embedded;
@@ -9,4 +10,5 @@ pub mod fake_openai;
 pub mod fixtures;
 pub mod microphone;
 pub mod multipart;
+pub mod repo;
 pub mod verify;

@@ -1,0 +1,51 @@
+//! The repository the tests run in: its scenario files, the `betr` binary run from its
+//! root (where `scenarios/` and `../shared` are), and an async runtime.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use betr::domain::Scenario;
+
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A file of the repository by its relative path.
+pub fn path(rel: &str) -> PathBuf {
+    root().join(rel)
+}
+
+/// A scenario by its path relative to the repository (a failure names the file).
+pub fn scenario(rel: &str) -> Scenario {
+    Scenario::load(&path(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// The binary run from the repository's root.
+pub fn betr(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_betr"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("the betr binary runs")
+}
+
+/// The exit code (`None` when killed) and stdout followed by stderr.
+pub fn code_and_text(out: &Output) -> (Option<i32>, String) {
+    (
+        out.status.code(),
+        format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+    )
+}
+
+/// A runtime for tests that drive the engine or the workbench by hand.
+pub fn runtime() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .expect("a tokio runtime")
+}
