@@ -12,7 +12,7 @@
 
 use anyhow::Result;
 
-use betr::domain::Scenario;
+use betr::scenario::Scenario;
 use betr::world::CellWorld;
 
 use betr::bench::towers::{Repaired, plan_and_repair, write_scenario};

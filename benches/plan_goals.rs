@@ -8,9 +8,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use betr::dataset::{self, Difficulty};
-use betr::domain::Scenario;
 use betr::goal::Formula;
 use betr::planner::{Outcome, Planner};
+use betr::scenario::Scenario;
 use betr::world;
 
 const REPETITIONS: usize = 7;

@@ -15,8 +15,8 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use betr::dataset;
-use betr::domain::Scenario;
 use betr::goal::Formula;
+use betr::scenario::Scenario;
 use betr::verify::{self, Limits, Report, VerifyConfig, VerifyInput};
 use betr::world::{self, CellWorld, World};
 

@@ -11,8 +11,8 @@ use std::process::{Command, Output};
 
 use betr::bench::towers;
 use betr::bt::NodeKind;
-use betr::domain::Scenario;
 use betr::llm::local::{Engine, EngineOptions, Generation};
+use betr::scenario::Scenario;
 use betr::world;
 
 fn repo() -> &'static Path {

@@ -6,9 +6,9 @@
 use std::path::Path;
 
 use betr::dataset::{self, Case};
-use betr::domain::Scenario;
 use betr::goal::Formula;
 use betr::planner::{Outcome, Planner, RunEnd, run_tree};
+use betr::scenario::Scenario;
 use betr::world;
 
 fn cases() -> Vec<Case> {

@@ -10,8 +10,9 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use betr::bt::{self, NodeId, NodeKind, Status, Tree};
-use betr::domain::{ActionCall, Condition, Scenario, Value};
+use betr::domain::{ActionCall, Condition, Value};
 use betr::planner::{self, Outcome, Plan, Planner, RunEnd, run_tree};
+use betr::scenario::Scenario;
 use betr::world::{self, World};
 
 fn path(rel: &str) -> PathBuf {

@@ -18,8 +18,8 @@ mod support;
 use std::path::Path;
 use std::process::Command;
 
-use betr::domain::Scenario;
 use betr::model::WHISPER_TINY_EN;
+use betr::scenario::Scenario;
 use betr::session::{self, Event, Options};
 use betr::voice::{self, Audio16k, LocalSettings, LocalWhisper, VoiceError, word_error_rate};
 use support::cli::{betr_with, text, tmp};

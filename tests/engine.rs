@@ -14,8 +14,8 @@ use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use betr::bt::{self, NodeKind};
-use betr::domain::Scenario;
 use betr::llm::LanguageModel;
+use betr::scenario::Scenario;
 use betr::session::{Command, Engine, EngineHandle, Event, PolicyStore, Setup};
 use support::fake_model::FixtureModel;
 use support::fixtures;

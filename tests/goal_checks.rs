@@ -10,11 +10,11 @@ mod support;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use betr::domain::Scenario;
 use betr::goal::{Formula, equivalent};
 use betr::llm::{
     ChatFuture, ChatReply, ChatRequest, LanguageModel, OutputConstraint, ReplySource, TokenUsage,
 };
+use betr::scenario::Scenario;
 use betr::session::{self, Event, Options, Proposal};
 use betr::world;
 

@@ -12,10 +12,11 @@ use std::process::Command;
 
 use betr::bt::{self, NodeKind, Tree};
 use betr::dataset;
-use betr::domain::{Scenario, Value};
+use betr::domain::Value;
 use betr::goal::Formula;
 use betr::interop::{self, TreeFormat};
 use betr::planner::Planner;
+use betr::scenario::Scenario;
 use betr::world;
 use support::cli::{betr, text, tmp};
 use support::verify::{repaired, root};

@@ -371,7 +371,7 @@ mod engine {
     use std::sync::Arc;
     use std::time::Duration;
 
-    use betr::domain::Scenario;
+    use betr::scenario::Scenario;
     use betr::session::{Command, Engine, Event, Knowledge, Setup};
     use tokio::sync::mpsc::UnboundedReceiver;
 

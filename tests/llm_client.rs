@@ -11,10 +11,10 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use betr::bt;
-use betr::domain::Scenario;
 use betr::llm::openai::{ApiKey, AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
 use betr::llm::{ChatRequest, LanguageModel, LlmError, Message, ReplySource};
 use betr::planner::Planner;
+use betr::scenario::Scenario;
 use betr::session::{self, Ending, Event, Options};
 use support::fake_openai::{Behavior, FakeServer};
 

@@ -9,8 +9,8 @@ mod support;
 
 use std::path::{Path, PathBuf};
 
-use betr::domain::Scenario;
 use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
+use betr::scenario::Scenario;
 use betr::session::{self, Ending, Event, Options, Proposal};
 use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};

@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 use std::path::{Path, PathBuf};
 
-use betr::domain::{Scenario, ScenarioError};
+use betr::scenario::{Scenario, ScenarioError};
 use betr::world;
 
 fn error(text: &str) -> ScenarioError {

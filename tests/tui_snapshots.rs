@@ -14,7 +14,7 @@ use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Terminal;
 use ratatui::backend::TestBackend;
 
-use betr::domain::Scenario;
+use betr::scenario::Scenario;
 use betr::session::{Command, Engine, EngineHandle, Event, Setup};
 use betr::tui::dictation::{DictationEvent, DictationService, Microphone, SttLoader};
 use betr::tui::{App, Info, KeyBindings, Request, Theme, ui};

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use betr::domain::Scenario;
+use betr::scenario::Scenario;
 use support::cli::{KEY, KEY_VAR, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;

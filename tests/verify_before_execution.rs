@@ -9,9 +9,10 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use betr::dataset;
-use betr::domain::{Condition, Scenario};
+use betr::domain::Condition;
 use betr::goal::{Dnf, Formula};
 use betr::planner::Outcome;
+use betr::scenario::Scenario;
 use betr::verify::{self, Limits, VerifyConfig, VerifyInput, plan_in_model};
 use betr::world;
 use support::cli::{betr, text, tmp};

@@ -10,8 +10,9 @@
 mod support;
 
 use betr::bt::{NodeId, NodeKind, Outcome, Tree};
-use betr::domain::{Atom, Condition, Scenario};
+use betr::domain::{Atom, Condition};
 use betr::planner::{RunEnd, run_tree};
+use betr::scenario::Scenario;
 use betr::verify::counterexample::{Counterexample, Event};
 use betr::verify::{self, PropertyKind, Rule, VerifyConfig};
 use betr::world::{self, World};

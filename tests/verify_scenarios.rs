@@ -9,8 +9,8 @@
 mod support;
 
 use betr::bt::{self, NodeKind, Outcome};
-use betr::domain::Scenario;
 use betr::planner::Planner;
+use betr::scenario::Scenario;
 use betr::verify::counterexample::Event;
 use betr::verify::{PropertyKind, Rule};
 use betr::world;

@@ -10,11 +10,11 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::{BenchError, Better, Row, Target};
-use crate::domain::Scenario;
 use crate::llm::Message;
 use crate::llm::grammar;
 use crate::llm::local::{Engine, EngineOptions, Generation};
 use crate::llm::prompt::{Context, Templates, Variant};
+use crate::scenario::Scenario;
 use crate::world;
 
 /// Instructions for the first answers and the warm ones (the goal prompt of scenario 1's

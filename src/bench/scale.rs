@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use super::towers::{self, Repaired};
 use super::{BenchError, Better, Row, Target};
-use crate::domain::Scenario;
 use crate::planner::{RunEnd, run_tree};
+use crate::scenario::Scenario;
 use crate::world::{self, World};
 
 /// The reference Python planner's time for scenario 1 on this machine kind, from the

@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::BenchError;
-use crate::domain::{Condition, Scenario};
+use crate::domain::Condition;
 use crate::planner::{Outcome, Plan, Planner};
+use crate::scenario::Scenario;
 use crate::world::World;
 
 pub const TOWER: usize = 3;

@@ -9,11 +9,11 @@ use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
 
 use betr::bench::{self, Report, cold, model, scale, ticks};
-use betr::domain::Scenario;
 use betr::llm::Message;
 use betr::llm::grammar;
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
 use betr::llm::prompt::{Context, Templates, Variant};
+use betr::scenario::Scenario;
 use betr::world;
 
 /// A part of `betr bench`.

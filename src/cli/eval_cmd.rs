@@ -11,10 +11,10 @@ use anyhow::{Context, Result};
 use clap::Subcommand;
 
 use betr::dataset;
-use betr::domain::Scenario;
 use betr::eval::run::RunConfig;
 use betr::eval::{self, chart, chart_runs, goals, goals_run, params, resolve};
 use betr::llm::LanguageModel;
+use betr::scenario::Scenario;
 use betr::store::write_atomic;
 
 use super::eval_setup::{Bar, RunFlags, prepare};

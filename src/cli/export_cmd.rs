@@ -7,9 +7,9 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 
 use betr::bt::{NodeId, Tree};
-use betr::domain::Scenario;
 use betr::interop::{self, TreeFormat};
 use betr::planner::Planner;
+use betr::scenario::Scenario;
 use betr::session::policy;
 use betr::world;
 

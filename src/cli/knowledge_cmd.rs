@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 
-use betr::domain::Scenario;
+use betr::scenario::Scenario;
 use betr::session::knowledge::{
     KeptRule, Knowledge, Provenance, check_rule, kept_conditions, offered_rule, rule_for_fix,
 };

@@ -10,11 +10,11 @@ use clap::Args;
 
 use betr::bt::{self, Glyphs};
 use betr::config_file::FileConfig;
-use betr::domain::{Example, Scenario};
 use betr::llm::LanguageModel;
 use betr::llm::config::{Backend, Layer, Settings};
 use betr::llm::prompt::{DEFAULT_EXAMPLES_SHOWN, Templates, Variant};
 use betr::llm::usage::{Ledger, Metered};
+use betr::scenario::{Example, Scenario};
 use betr::session::types::DEFAULT_CANDIDATES;
 use betr::session::{self, Ending, Event, Options};
 

@@ -21,9 +21,10 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 
-use betr::domain::{Condition, Scenario};
+use betr::domain::Condition;
 use betr::excerpt::excerpt;
 use betr::goal::Formula;
+use betr::scenario::Scenario;
 
 #[derive(Parser)]
 #[command(

@@ -8,8 +8,9 @@ use anyhow::{Context, Result, bail};
 
 use betr::bt::path_text;
 use betr::bt::{self, Glyphs, NodeId, NodeKind, TickRecord, Tree};
-use betr::domain::{ActionCall, Condition, Scenario};
+use betr::domain::{ActionCall, Condition};
 use betr::planner::{Outcome, Plan, Planner, RunEnd, run_tree};
+use betr::scenario::Scenario;
 use betr::session::policy::{self, Approval, Fix, Policy};
 use betr::world::{self, World};
 use rerun::TextLogLevel as Level;

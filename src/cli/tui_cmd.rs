@@ -77,7 +77,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         }
         None => Arc::new(DefaultMicrophone),
     };
-    let mut scenario = betr::domain::Scenario::load(&path)?;
+    let mut scenario = betr::scenario::Scenario::load(&path)?;
     let knowledge_flags = super::knowledge_cmd::KnowledgeFlags {
         dir: super::knowledge_cmd::PolicyDir {
             policy_dir: args.policy_dir.clone(),

@@ -3,7 +3,7 @@
 
 use anyhow::{Context as _, Result};
 
-use betr::domain::Scenario;
+use betr::scenario::Scenario;
 pub use betr::session::values::{Setting, apply};
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting> {

@@ -6,9 +6,9 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 
-use betr::domain::Scenario;
 use betr::interop::TreeFormat;
 use betr::planner::Outcome;
+use betr::scenario::Scenario;
 use betr::session::policy;
 use betr::verify::{
     self, Limits, NamedProperty, Property, Report, Rule, Verdict, VerifyConfig, VerifyInput,

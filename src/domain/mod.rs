@@ -6,12 +6,9 @@ pub mod learned;
 
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};
-pub mod scenario;
-mod scenario_file;
 pub mod skill;
 pub mod vocabulary;
 
 pub use learned::{LearnError, LearnedRule};
-pub use scenario::{Example, Scenario, ScenarioError, SourceFile};
 pub use skill::{AtomPattern, Domain, GroundSkill, Param, Skill, ValueParam};
 pub use vocabulary::{Object, Predicate, Vocabulary, VocabularyError};

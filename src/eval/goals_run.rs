@@ -9,8 +9,8 @@ use std::path::Path;
 use std::sync::Arc;
 
 use crate::dataset::{Case, Difficulty};
-use crate::domain::Scenario;
 use crate::llm::LanguageModel;
+use crate::scenario::Scenario;
 use crate::session::{self, Event, Options};
 use crate::world::World;
 

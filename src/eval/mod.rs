@@ -94,7 +94,7 @@ pub enum EvalError {
     #[error(transparent)]
     Prompt(#[from] crate::llm::prompt::PromptError),
     #[error(transparent)]
-    Scenario(#[from] crate::domain::ScenarioError),
+    Scenario(#[from] crate::scenario::ScenarioError),
 }
 
 impl EvalError {

@@ -8,7 +8,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::domain::{Scenario, Value};
+use crate::domain::Value;
+use crate::scenario::Scenario;
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;

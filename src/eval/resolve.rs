@@ -11,7 +11,8 @@ use std::time::Instant;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::domain::{Condition, Scenario};
+use crate::domain::Condition;
+use crate::scenario::Scenario;
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;

@@ -13,8 +13,8 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::domain::Scenario;
 use crate::llm::LanguageModel;
+use crate::scenario::Scenario;
 use crate::session::knowledge::{KeptRule, Knowledge, Provenance, kept_conditions, rule_for_fix};
 use crate::session::{Event, Options};
 

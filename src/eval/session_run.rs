@@ -1,7 +1,7 @@
 //! The only contact between the experiments and the session: one headless resolve with
 //! every proposal approved, returning the events it emitted and how it ended.
 
-use crate::domain::Scenario;
+use crate::scenario::Scenario;
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;

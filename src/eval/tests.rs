@@ -1,7 +1,7 @@
 use std::path::Path;
 
 use super::run::{Journal, mean_sd, percentile};
-use crate::domain::Scenario;
+use crate::scenario::Scenario;
 
 fn cafe() -> Scenario {
     Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))

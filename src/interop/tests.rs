@@ -2,7 +2,7 @@ use std::path::Path;
 
 use super::*;
 use crate::bt;
-use crate::domain::Scenario;
+use crate::scenario::Scenario;
 
 fn scenario(rel: &str) -> Scenario {
     Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).expect("scenario")

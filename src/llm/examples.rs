@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use crate::domain::Example;
+use crate::scenario::Example;
 
 /// BM25's usual constants: term-frequency saturation and length normalisation.
 const K1: f64 = 1.2;

@@ -9,8 +9,9 @@
 
 use std::collections::HashMap;
 
-use crate::domain::{Example, Vocabulary};
+use crate::domain::Vocabulary;
 use crate::goal::Formula;
+use crate::scenario::Example;
 
 use super::examples::terms;
 

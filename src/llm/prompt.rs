@@ -10,7 +10,8 @@
 use std::path::Path;
 
 use super::{ChatRequest, Message};
-use crate::domain::{ANY_OBJECT, ActionCall, Condition, Example, Scenario, ValueParam, Vocabulary};
+use crate::domain::{ANY_OBJECT, ActionCall, Condition, ValueParam, Vocabulary};
+use crate::scenario::{Example, Scenario};
 
 /// How many worked examples a prompt shows when it chooses them per request.
 pub const DEFAULT_EXAMPLES_SHOWN: usize = 6;

@@ -142,7 +142,7 @@ pub fn value(param: &ValueParam) -> OutputConstraint {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::domain::Scenario;
+    use crate::scenario::Scenario;
 
     #[test]
     fn large_vocabularies_fall_back_to_parts() {

@@ -5,8 +5,9 @@ use std::path::Path;
 
 use super::*;
 use crate::bt::{self, NodeKind};
-use crate::domain::{Scenario, Value};
+use crate::domain::Value;
 use crate::goal::Formula;
+use crate::scenario::Scenario;
 use crate::world;
 
 const MINI_CAFE: &str = r#"

@@ -5,10 +5,11 @@
 //! answered; an unusable reply is reported as an event, not an error.
 
 use crate::bt::NodeId;
-use crate::domain::{ActionCall, Condition, Scenario, ValueParam};
+use crate::domain::{ActionCall, Condition, ValueParam};
 use crate::llm::prompt::{self, Context};
 use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
+use crate::scenario::Scenario;
 
 use super::screen::Screen;
 use super::shortlist::{Shortlist, shortlist, without_implied};

@@ -5,11 +5,12 @@
 //! example, or no word of the request asks for a part of it (such parts can be taken out,
 //! giving a candidate of its own). Words are matched through the scene's [`Lexicon`].
 
-use crate::domain::{Condition, Scenario};
+use crate::domain::Condition;
 use crate::goal::Formula;
 use crate::llm::examples::terms;
 use crate::llm::lexicon::{Lexicon, is_number, same_word};
 use crate::planner::{Outcome, Planner};
+use crate::scenario::Scenario;
 use crate::world::World;
 
 /// Why a candidate goal cannot be what the person meant, or may not be.
@@ -80,7 +81,7 @@ pub fn check_goal(
 /// copy an example's place, or its extra "hand empty", into unrelated answers).
 pub fn copied_from_example(
     goal: &Formula,
-    shown: &[&crate::domain::Example],
+    shown: &[&crate::scenario::Example],
     request: &str,
 ) -> Option<String> {
     let asked: Vec<String> = terms(request);
@@ -92,7 +93,7 @@ pub fn copied_from_example(
 
 fn is_copied(
     atom: &crate::domain::Atom,
-    shown: &[&crate::domain::Example],
+    shown: &[&crate::scenario::Example],
     asked: &[String],
 ) -> bool {
     let in_example = shown
@@ -179,7 +180,7 @@ pub(super) fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) 
 /// mean the pasted condition in other words, and keeps it.
 pub(super) fn without_copied(
     goal: &Formula,
-    shown: &[&crate::domain::Example],
+    shown: &[&crate::scenario::Example],
     request: &str,
 ) -> Option<Formula> {
     let Formula::And(items) = goal else {
@@ -350,7 +351,7 @@ pub(super) fn assess(
     scenario: &Scenario,
     world: &dyn World,
     goal: &Formula,
-    (shown, lexicon): (&[&crate::domain::Example], &Lexicon),
+    (shown, lexicon): (&[&crate::scenario::Example], &Lexicon),
     request: &str,
 ) -> Option<GoalProblem> {
     let doubt = |reason: String| GoalProblem {
@@ -424,7 +425,7 @@ mod tests {
 
     #[test]
     fn a_condition_pasted_from_an_example_is_found() {
-        let example = crate::domain::Example {
+        let example = crate::scenario::Example {
             instruction: "Put the sponge in the bowl and leave your gripper empty".into(),
             goal: r#""sponge" in "bowl" & ~"any object" grasped"#.into(),
         };
@@ -444,7 +445,7 @@ mod tests {
 
     #[test]
     fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
-        let example = crate::domain::Example {
+        let example = crate::scenario::Example {
             instruction: "It's really stuffy in here, and leave your gripper empty".into(),
             goal: r#"Active_AC & ~"any object" grasped"#.into(),
         };

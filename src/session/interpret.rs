@@ -11,13 +11,13 @@
 //! number the request says ("table six" read as table 1) draws more candidates too, and
 //! one that uses the number wins the vote.
 
-use crate::domain::Scenario;
 use crate::goal::{self, Formula};
 use crate::llm::examples::terms;
 use crate::llm::lexicon::Lexicon;
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
+use crate::scenario::Scenario;
 use crate::world::World;
 
 use super::ask::ask;

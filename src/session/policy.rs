@@ -301,7 +301,7 @@ pub fn rfc3339(secs: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::domain::Scenario;
+    use crate::scenario::Scenario;
 
     fn scenario() -> Scenario {
         Scenario::load(

@@ -12,8 +12,8 @@
 use std::sync::Arc;
 
 use crate::bt::Tree;
-use crate::domain::Scenario;
 use crate::llm::LanguageModel;
+use crate::scenario::Scenario;
 
 use super::engine::{Command, Engine, Setup};
 use super::types::{Ending, Event, Options, Proposal, Resolved, SessionError};

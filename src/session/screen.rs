@@ -90,7 +90,7 @@ fn verdict(before: Option<&FailureAt>, after: &Outcome) -> Result<Verdict, Strin
 /// A copy of the tree and the planning world in which proposals are tried before they
 /// are offered. Owned, so a model call can carry it across its awaits.
 pub struct Screen {
-    pub scenario: std::sync::Arc<crate::domain::Scenario>,
+    pub scenario: std::sync::Arc<crate::scenario::Scenario>,
     pub tree: Tree,
     pub world: Box<dyn World>,
     pub failure: FailureAt,

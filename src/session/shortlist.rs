@@ -234,8 +234,8 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
-    use crate::domain::Scenario;
     use crate::planner::Planner;
+    use crate::scenario::Scenario;
     use crate::session::screen::FailureAt;
     use crate::world::load;
 

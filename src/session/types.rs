@@ -4,13 +4,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::bt::{NodeId, TickRecord, Tree};
-use crate::domain::{ActionCall, Condition, ScenarioError, Value};
+use crate::domain::{ActionCall, Condition, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
 use crate::llm::prompt::{PromptError, Templates, Variant};
 use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
+use crate::scenario::ScenarioError;
 use crate::verify::Report;
 use crate::world::cell::snapshot::SceneSnapshot;
 

@@ -8,8 +8,9 @@
 
 use crate::bt::Tree;
 use crate::domain::action::parse_value;
-use crate::domain::{Scenario, Value, ValueParam};
+use crate::domain::{Value, ValueParam};
 use crate::planner;
+use crate::scenario::Scenario;
 
 /// One parsed `--set`: the value, the object, and every (skill, parameter) it applies to.
 #[derive(Debug, Clone, PartialEq)]

@@ -27,7 +27,8 @@ use toml::Spanned;
 
 use super::temporal::Property;
 use crate::domain::skill::{AtomTemplate, LiteralTemplate, Term, parse_template};
-use crate::domain::{Param, Scenario, ScenarioError, SourceFile, Vocabulary};
+use crate::domain::{Param, Vocabulary};
+use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
 /// A declared disturbance, not yet grounded over objects.
 #[derive(Debug, Clone, PartialEq)]
@@ -137,7 +138,7 @@ fn read_disturbance(
         Ok::<_, ScenarioError>(t)
     };
     let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
-    let (add, del) = crate::domain::scenario::effect_templates(file, &raw.add, &raw.del, literal)?;
+    let (add, del) = crate::scenario::effect_templates(file, &raw.add, &raw.del, literal)?;
     if add.is_empty() && del.is_empty() {
         return Err(file.error_in_string(
             &raw.description.span(),

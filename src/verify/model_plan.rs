@@ -211,7 +211,7 @@ mod tests {
     use std::path::Path;
 
     use super::*;
-    use crate::domain::Scenario;
+    use crate::scenario::Scenario;
     use crate::verify::VerifyConfig;
 
     fn load(rel: &str) -> (Scenario, VerifyConfig) {

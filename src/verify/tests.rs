@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::*;
 use crate::bt::parse;
-use crate::domain::Scenario;
+use crate::scenario::Scenario;
 use crate::world;
 
 const DOMAIN: &str = r#"

@@ -5,8 +5,9 @@ use rerun::RecordingStreamBuilder;
 use rerun::log::{Chunk, LogMsg};
 
 use super::*;
-use crate::domain::{Domain, Scenario};
+use crate::domain::Domain;
 use crate::planner::{Outcome, Planner, RunEnd, RunReport, run_tree};
+use crate::scenario::Scenario;
 use crate::world::cell::snapshot::PartShape;
 
 /// A run of `tree` streamed to `viz` as the command line does it.

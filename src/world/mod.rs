@@ -10,7 +10,8 @@ pub mod symbolic;
 
 use std::any::Any;
 
-use crate::domain::{ActionCall, Condition, Scenario, ScenarioError};
+use crate::domain::{ActionCall, Condition};
+use crate::scenario::{Scenario, ScenarioError};
 
 pub use cell::CellWorld;
 pub use symbolic::SymbolicWorld;

@@ -25,8 +25,9 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::{Snapshot, Step, World, WorldError};
-use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain, Scenario, ScenarioError};
+use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain};
 use crate::goal::Formula;
+use crate::scenario::{Scenario, ScenarioError};
 
 /// What happens when a rule's requirement does not hold.
 #[derive(Debug, Clone, PartialEq)]
@@ -301,7 +302,7 @@ mod tests {
     use std::path::Path;
 
     use super::*;
-    use crate::domain::Scenario;
+    use crate::scenario::Scenario;
 
     const TEXT: &str = r#"
 [scenario]

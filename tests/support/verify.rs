@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use betr::bt::{self, ActionStep, Leaves, NodeId, Outcome, Ticker, Tree};
-use betr::domain::{ActionCall, Atom, Condition, Scenario};
+use betr::domain::{ActionCall, Atom, Condition};
 use betr::planner::{Outcome as PlanOutcome, Planner};
+use betr::scenario::Scenario;
 use betr::verify::abstraction::instance_of;
 use betr::verify::{self, Counterexample, Limits, PropertyKind, Report, Verdict, VerifyConfig};
 use betr::world;

@@ -3,7 +3,8 @@ use std::path::PathBuf;
 use proptest::prelude::*;
 
 use super::*;
-use crate::domain::{Object, Predicate, Scenario};
+use crate::domain::{Object, Predicate};
+use crate::scenario::Scenario;
 
 fn cafe() -> Vocabulary {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");

@@ -27,10 +27,11 @@ use std::time::Duration;
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
 use crate::bt::{NodeId, TickRecord, Ticker, Tree};
-use crate::domain::{Condition, Scenario};
+use crate::domain::Condition;
 use crate::goal::Formula;
 use crate::llm::LanguageModel;
 use crate::llm::usage::{Ledger, UsageTotals};
+use crate::scenario::Scenario;
 use crate::world::{self, World};
 
 use super::ask::Tried;

@@ -5,8 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::domain::{ActionCall, Condition, LearnError, LearnedRule, Scenario};
+use crate::domain::{ActionCall, Condition, LearnError, LearnedRule};
 use crate::planner::Outcome;
+use crate::scenario::Scenario;
 use crate::verify::plan_in_model;
 
 use super::{Knowledge, domain_of};

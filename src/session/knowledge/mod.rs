@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::domain::{ActionCall, Condition, LearnError, LearnedRule, Scenario};
+use crate::domain::{ActionCall, Condition, LearnError, LearnedRule};
+use crate::scenario::Scenario;
 
 mod check;
 

@@ -30,7 +30,8 @@ use std::sync::Arc;
 use nalgebra::{Point3, Vector2};
 
 use super::{Snapshot, Step, World, WorldError};
-use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain, Scenario, ScenarioError};
+use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain};
+use crate::scenario::{Scenario, ScenarioError};
 use geometry::{Counter, Obstacle, Pose, REST_TOLERANCE, is_upright, overlaps_any};
 use scene::Scene;
 

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use super::CellWorld;
 use super::skills::SkillFailure;
-use crate::domain::{ActionCall, Condition, Scenario};
+use crate::domain::{ActionCall, Condition};
+use crate::scenario::Scenario;
 use crate::world::{Step, World};
 
 fn scenario(rel: &str) -> Scenario {

@@ -10,7 +10,7 @@ use super::super::geometry::{Body, Opening, Pose, ShapeSpec, flipped, rotation_d
 use super::super::robot::Robot;
 use super::super::values::Judge;
 use super::{Entry, Initial, Lid, RawSolid, Scene, Solid, near};
-use crate::domain::{Scenario, ScenarioError, SourceFile};
+use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
 fn shape_of(file: &SourceFile, name: &str, raw: &RawSolid) -> Result<ShapeSpec, ScenarioError> {
     let err = |m: String| near(file, &format!("\"{name}\""), format!("solid {name:?}: {m}"));

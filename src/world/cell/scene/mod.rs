@@ -48,7 +48,7 @@ use toml::Spanned;
 use super::geometry::{Body, Pose};
 use super::robot::{Gripper, Robot};
 use super::values::Judge;
-use crate::domain::{Scenario, ScenarioError, SourceFile};
+use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
 mod build;
 use build::build;

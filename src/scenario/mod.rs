@@ -13,10 +13,12 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::scenario_file::{RawFile, RawPool, RawSkill, value_range};
-use super::skill::{Domain, Param, Skill, ValueParam, parse_template};
-use super::vocabulary::{Object, Predicate, Vocabulary};
+mod file;
+
+use crate::domain::skill::{Domain, Param, Skill, ValueParam, parse_template};
+use crate::domain::vocabulary::{Object, Predicate, Vocabulary};
 use crate::goal::Formula;
+use file::{RawFile, RawPool, RawSkill, value_range};
 
 /// One file of a scenario, kept so later readers (the world) can locate their errors.
 #[derive(Debug, Clone, PartialEq)]
@@ -367,18 +369,18 @@ pub(crate) fn effect_templates(
     file: &SourceFile,
     add: &[Spanned<String>],
     del: &[Spanned<String>],
-    literal: impl Fn(&Spanned<String>) -> Result<super::skill::LiteralTemplate, ScenarioError>,
+    literal: impl Fn(&Spanned<String>) -> Result<crate::domain::skill::LiteralTemplate, ScenarioError>,
 ) -> Result<
     (
-        Vec<super::skill::AtomTemplate>,
-        Vec<super::skill::AtomTemplate>,
+        Vec<crate::domain::skill::AtomTemplate>,
+        Vec<crate::domain::skill::AtomTemplate>,
     ),
     ScenarioError,
 > {
     let mut added = Vec::new();
     for s in add {
         let t = literal(s)?;
-        if t.negated || t.atom.args.contains(&super::skill::Term::Every) {
+        if t.negated || t.atom.args.contains(&crate::domain::skill::Term::Every) {
             return Err(file.error_in_string(
                 &s.span(),
                 0,
@@ -484,11 +486,11 @@ fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, S
 
 /// A template's predicate must exist with the right arity, and its constants must fit.
 fn check_template(
-    t: &super::skill::AtomTemplate,
+    t: &crate::domain::skill::AtomTemplate,
     params: &[Param],
     vocabulary: &Vocabulary,
 ) -> Result<(), String> {
-    use super::skill::Term;
+    use crate::domain::skill::Term;
     let Some(pred) = vocabulary.predicate(&t.predicate) else {
         return Err(format!("unknown predicate {:?}", t.predicate));
     };
@@ -502,7 +504,9 @@ fn check_template(
     }
     for (term, types) in t.args.iter().zip(&pred.arg_types) {
         match term {
-            Term::Const(c) if c != super::condition::ANY_OBJECT && !vocabulary.fits(c, types) => {
+            Term::Const(c)
+                if c != crate::domain::condition::ANY_OBJECT && !vocabulary.fits(c, types) =>
+            {
                 return Err(format!(
                     "{c:?} is not a known object of type {}",
                     types.join(" or ")
