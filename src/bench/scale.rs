@@ -11,8 +11,8 @@ use crate::planner::{RunEnd, run_tree};
 use crate::scenario::Scenario;
 use crate::world::{self, World};
 
-/// The reference Python planner's time for scenario 1 on this machine kind, from the
-/// issue tracker's measurement (its path planner is ABB-internal, so it cannot run here).
+/// The reference Python planner's time for scenario 1 on this machine kind, as measured
+/// when it could be run (its path planner is ABB-internal, so it cannot run here).
 pub const PAPER_PLANNER_MS: (f64, f64) = (2.3, 4.4);
 /// Ticks allowed when running the repaired tree to success.
 const RUN_TICKS: u64 = 10_000;
