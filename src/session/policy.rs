@@ -86,10 +86,23 @@ pub struct Policy {
 pub enum PolicyError {
     #[error("cannot read policy {path}: {detail}")]
     Read { path: String, detail: String },
-    #[error("policy {path}: {detail}")]
-    Invalid { path: String, detail: String },
+    #[error("policy {path}: {error}")]
+    Invalid {
+        path: String,
+        error: Box<PolicyTreeError>,
+    },
     #[error("cannot write policy {path}: {detail}")]
     Write { path: String, detail: String },
+}
+
+/// Why a policy's tree cannot be used: its text (with the position), or a leaf the domain
+/// does not know (with the node's path).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PolicyTreeError {
+    #[error(transparent)]
+    Text(#[from] bt::ParseError),
+    #[error(transparent)]
+    Check(#[from] planner::TreeCheckError),
 }
 
 /// Where policies live.
@@ -200,9 +213,9 @@ pub fn load(path: &Path, domain: &Domain) -> Result<Policy, PolicyError> {
         path: path.display().to_string(),
         detail: e.to_string(),
     })?;
-    parse(&text, domain).map_err(|detail| PolicyError::Invalid {
+    parse(&text, domain).map_err(|error| PolicyError::Invalid {
         path: path.display().to_string(),
-        detail,
+        error: Box::new(error),
     })
 }
 
@@ -225,9 +238,9 @@ pub fn parse_node_path(text: &str) -> Option<Vec<usize>> {
 }
 
 /// Read a policy's text.
-pub fn parse(text: &str, domain: &Domain) -> Result<Policy, String> {
-    let tree = bt::parse(text).map_err(|e| e.to_string())?;
-    planner::check_tree(domain, &tree).map_err(|e| e.to_string())?;
+pub fn parse(text: &str, domain: &Domain) -> Result<Policy, PolicyTreeError> {
+    let tree = bt::parse(text)?;
+    planner::check_tree(domain, &tree)?;
     let header: Vec<&str> = text.lines().take_while(|l| l.starts_with('#')).collect();
     let mut fixes: Vec<Fix> = Vec::new();
     for line in &header {

@@ -28,6 +28,18 @@ const KEY_TOKENS: usize = 256;
 const MAX_FILES: usize = 24;
 const FORMAT: u32 = 1;
 
+/// Why a prompt state could not be saved (the call it follows has answered already).
+#[derive(Debug, thiserror::Error)]
+pub enum SaveError {
+    #[error("cannot write the prompt state to {path}: {error}")]
+    Io {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("llama.cpp could not save the prompt state to {0}")]
+    Llama(PathBuf),
+}
+
 /// What a state file was made from, checked before the state is loaded.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct Meta {
@@ -131,16 +143,37 @@ impl PromptStates {
 
     /// Save sequence 0 of `ctx`, holding `tokens`, as the state for prompts that start like
     /// `tokens`; then drop the least recently used files beyond the limit.
-    pub fn save(&self, ctx: &LlamaContext<'_>, tokens: &[LlamaToken]) -> Result<(), String> {
+    pub fn save(&self, ctx: &LlamaContext<'_>, tokens: &[LlamaToken]) -> Result<(), SaveError> {
         let Some((state, meta_path)) = self.paths(tokens) else {
             return Ok(());
         };
-        std::fs::create_dir_all(&self.dir)
-            .map_err(|e| format!("cannot create {}: {e}", self.dir.display()))?;
+        std::fs::create_dir_all(&self.dir).map_err(|error| SaveError::Io {
+            path: self.dir.clone(),
+            error,
+        })?;
         let partial = state.with_extension(format!("state.{}.partial", std::process::id()));
-        ctx.state_seq_save_file(&partial, 0, tokens)
-            .map_err(|e| format!("cannot save the prompt state: {e}"))?;
-        let bytes = std::fs::metadata(&partial).map(|m| m.len()).unwrap_or(0);
+        let saved = self.save_as(ctx, tokens, &partial, (&state, &meta_path));
+        if saved.is_err() {
+            let _ = std::fs::remove_file(&partial);
+        }
+        saved
+    }
+
+    /// Save to `partial`, then the metadata, then rename `partial` to `state`.
+    fn save_as(
+        &self,
+        ctx: &LlamaContext<'_>,
+        tokens: &[LlamaToken],
+        partial: &Path,
+        (state, meta_path): (&Path, &Path),
+    ) -> Result<(), SaveError> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |error| SaveError::Io { path, error }
+        };
+        ctx.state_seq_save_file(partial, 0, tokens)
+            .map_err(|_| SaveError::Llama(partial.to_path_buf()))?;
+        let bytes = std::fs::metadata(partial).map_err(io(partial))?.len();
         let meta = Meta {
             format: FORMAT,
             model: self.model.clone(),
@@ -148,13 +181,14 @@ impl PromptStates {
             tokens: tokens.len(),
             bytes,
         };
-        let json = serde_json::to_vec(&meta).map_err(|e| e.to_string())?;
+        let json = serde_json::to_vec(&meta).map_err(|e| SaveError::Io {
+            path: meta_path.to_path_buf(),
+            error: e.into(),
+        })?;
         // The metadata goes first and the state is renamed last, so a metadata file never
         // vouches for a state that is not whole (a reader checks the size too).
-        crate::store::write_atomic(&meta_path, &json)
-            .map_err(|e| format!("cannot write {}: {e}", meta_path.display()))?;
-        std::fs::rename(&partial, &state)
-            .map_err(|e| format!("cannot write {}: {e}", state.display()))?;
+        crate::store::write_atomic(meta_path, &json).map_err(io(meta_path))?;
+        std::fs::rename(partial, state).map_err(io(state))?;
         self.prune();
         Ok(())
     }
