@@ -281,10 +281,13 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             stt,
         } => {
             let scenario = load(&scenario)?;
-            let instruction = match &audio {
-                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
-                None => instruction,
-            };
+            let instruction = voice_cmd::instruction(
+                instruction,
+                audio.as_deref(),
+                llm.config.as_deref(),
+                &stt,
+                yes,
+            )?;
             llm_cmds::interpret(&scenario, instruction.as_deref(), &llm)
         }
         Command::Resolve {
@@ -303,10 +306,13 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => {
             let mut loaded = load(&scenario)?;
             knowledge.apply(&mut loaded)?;
-            let instruction = match &audio {
-                Some(audio) => Some(voice_cmd::dictate(audio, llm.config.as_deref(), &stt, yes)?),
-                None => instruction,
-            };
+            let instruction = voice_cmd::instruction(
+                instruction,
+                audio.as_deref(),
+                llm.config.as_deref(),
+                &stt,
+                yes,
+            )?;
             llm_cmds::resolve(
                 &loaded,
                 &llm_cmds::ResolveArgs {

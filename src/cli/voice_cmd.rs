@@ -181,10 +181,25 @@ pub fn transcribe(file: &Path, config: Option<&Path>, flags: &SttFlags) -> Resul
     Ok(ExitCode::SUCCESS)
 }
 
+/// The instruction a command works on: dictated from `audio` when given (transcribed and
+/// confirmed as `dictate` does), else the one typed (`None`: the scenario's).
+pub fn instruction(
+    typed: Option<String>,
+    audio: Option<&Path>,
+    config: Option<&Path>,
+    flags: &SttFlags,
+    yes: bool,
+) -> Result<Option<String>> {
+    match audio {
+        Some(audio) => Ok(Some(dictate(audio, config, flags, yes)?)),
+        None => Ok(typed),
+    }
+}
+
 /// For `interpret` / `resolve --audio`: transcribe the file, print the transcript, and
 /// return the instruction the user confirmed or corrected on the terminal (or, with
 /// `yes`, the transcript as printed).
-pub fn dictate(audio: &Path, config: Option<&Path>, flags: &SttFlags, yes: bool) -> Result<String> {
+fn dictate(audio: &Path, config: Option<&Path>, flags: &SttFlags, yes: bool) -> Result<String> {
     let audio = read(audio)?;
     let loaded = load(&settings(config, flags)?)?;
     let transcript = run_transcription(loaded.stt.as_ref(), &audio)?;
