@@ -18,9 +18,12 @@
 use std::collections::{BTreeSet, HashMap};
 
 use super::config::Disturbance;
-use crate::bt::{NodeId, NodeKind, Tree};
+
+mod read;
+use crate::bt::{NodeId, Tree};
 use crate::domain::{ANY_OBJECT, ActionCall, Atom, AtomPattern, Condition, Domain};
 use crate::goal::Formula;
+use read::{RawNode, RawTree, Universe, observed_disturbances, read_tree};
 
 /// A set of facts as a bitset over `Model::atoms`.
 pub type State = Box<[u64]>;
@@ -171,72 +174,15 @@ impl Model {
         disturbances: &[Disturbance],
         properties: &[&Formula],
     ) -> Result<Model, ModelError> {
-        let mut conds = Conds::default();
-        // Raw per-node data first; atoms become bits once the universe is known.
-        let mut raw_nodes: Vec<(NodeId, RawNode)> = Vec::new();
-        let mut raw_actions = Vec::new();
-        let mut order: HashMap<NodeId, usize> = HashMap::new();
-        for id in tree.preorder() {
-            order.insert(id, order.len());
-        }
-        for id in tree.preorder() {
-            let kind = tree.kind(id).map_err(|_| ModelError::UnknownAction {
-                call: id.to_string(),
-                path: String::new(),
-            })?;
-            let children: Vec<usize> = tree
-                .children(id)
-                .unwrap_or_default()
-                .iter()
-                .filter_map(|c| order.get(c).copied())
-                .collect();
-            let node = match kind {
-                NodeKind::Sequence => RawNode::Sequence(children),
-                NodeKind::Fallback => RawNode::Fallback(children),
-                NodeKind::Condition(c) => RawNode::Condition(conds.id(c), c.negated),
-                NodeKind::Action(call) => {
-                    let path = tree.path(id).unwrap_or_default();
-                    let ground = domain
-                        .resolve(call)
-                        .ok_or_else(|| ModelError::UnknownAction {
-                            call: call.to_string(),
-                            path: crate::bt::path_text(&path),
-                        })?;
-                    let pre: Vec<(usize, bool)> = ground
-                        .pre
-                        .iter()
-                        .map(|p| (conds.id(p), p.negated))
-                        .collect();
-                    raw_actions.push((id, path, call.clone(), pre, ground.add, ground.del));
-                    RawNode::Action(raw_actions.len() - 1)
-                }
-            };
-            raw_nodes.push((id, node));
-        }
+        let RawTree {
+            mut conds,
+            nodes: raw_nodes,
+            actions: raw_actions,
+        } = read_tree(domain, tree)?;
         for atom in properties.iter().flat_map(|f| f.atoms()) {
             conds.id(&Condition::pos(atom));
         }
-        // A disturbance matters only when it changes an observed atom; its guard is then
-        // observed too, which can make further disturbances matter (a fixpoint).
-        let mut grounds = ground_disturbances(domain, disturbances)?;
-        let mut kept: Vec<Ground> = Vec::new();
-        loop {
-            let before = kept.len();
-            let (relevant, rest): (Vec<Ground>, Vec<Ground>) = grounds
-                .into_iter()
-                .partition(|g| changes_observed(g, &conds.list));
-            grounds = rest;
-            for g in &relevant {
-                for p in &g.pre {
-                    conds.id(p);
-                }
-            }
-            kept.extend(relevant);
-            if kept.len() == before {
-                break;
-            }
-        }
-        let grounds = kept;
+        let grounds = observed_disturbances(domain, disturbances, &mut conds)?;
         let ground_pre: Vec<Vec<(usize, bool)>> = grounds
             .iter()
             .map(|g| g.pre.iter().map(|p| (conds.id(p), p.negated)).collect())
@@ -248,67 +194,18 @@ impl Model {
             .filter(|c| !c.negated)
             .map(|c| c.atom.clone())
             .collect();
-        for (_, _, _, _, add, _) in &raw_actions {
-            candidates.extend(add.iter().cloned());
+        for action in &raw_actions {
+            candidates.extend(action.add.iter().cloned());
         }
         for g in &grounds {
             candidates.extend(g.add.iter().cloned());
         }
-        let exact: std::collections::HashSet<&Atom> = conds
-            .list
-            .iter()
-            .filter(|c| !c.atom.has_wildcard())
-            .map(|c| &c.atom)
-            .collect();
-        let mut wild: HashMap<&str, Vec<&Atom>> = HashMap::new();
-        for c in conds.list.iter().filter(|c| c.atom.has_wildcard()) {
-            wild.entry(c.atom.predicate.as_str())
-                .or_default()
-                .push(&c.atom);
-        }
-        let observed = |a: &Atom| {
-            exact.contains(a)
-                || wild
-                    .get(a.predicate.as_str())
-                    .is_some_and(|ps| ps.iter().any(|p| instance_of(p, a)))
-        };
-        let atoms: Vec<Atom> = candidates.into_iter().filter(|a| observed(a)).collect();
-        let index: HashMap<&Atom, usize> = atoms.iter().enumerate().map(|(i, a)| (a, i)).collect();
-        let mut by_predicate: HashMap<&str, Vec<usize>> = HashMap::new();
-        for (i, a) in atoms.iter().enumerate() {
-            by_predicate
-                .entry(a.predicate.as_str())
-                .or_default()
-                .push(i);
-        }
-        let matching = |pattern: &Atom| -> Vec<usize> {
-            if !pattern.has_wildcard() {
-                return index.get(pattern).copied().into_iter().collect();
-            }
-            by_predicate
-                .get(pattern.predicate.as_str())
-                .map(|is| {
-                    is.iter()
-                        .copied()
-                        .filter(|&i| instance_of(pattern, &atoms[i]))
-                        .collect()
-                })
-                .unwrap_or_default()
-        };
-        let deleted = |p: &AtomPattern| -> Vec<usize> {
-            by_predicate
-                .get(p.predicate.as_str())
-                .map(|is| {
-                    is.iter()
-                        .copied()
-                        .filter(|&i| p.matches(&atoms[i]))
-                        .collect()
-                })
-                .unwrap_or_default()
-        };
-        let added = |adds: &[Atom]| -> Vec<usize> {
-            adds.iter().filter_map(|a| index.get(a).copied()).collect()
-        };
+        let universe = Universe::new(candidates, &conds.list);
+        let (matching, deleted, added) = (
+            |a: &Atom| universe.matching(a),
+            |p: &AtomPattern| universe.deleted(p),
+            |adds: &[Atom]| universe.added(adds),
+        );
 
         let conditions: Vec<CondBits> = conds
             .list
@@ -336,18 +233,19 @@ impl Model {
             })
         };
         let mut actions = Vec::with_capacity(raw_actions.len());
-        for (id, path, call, pre, add, del) in &raw_actions {
-            let pre = pre
+        for a in &raw_actions {
+            let pre = a
+                .pre
                 .iter()
                 .map(|&(c, n)| signed(c, n, &mut conditions))
                 .collect();
             actions.push(CAction {
-                node: *id,
-                path: path.clone(),
-                call: call.clone(),
+                node: a.node,
+                path: a.path.clone(),
+                call: a.call.clone(),
                 pre,
-                add: added(add),
-                del: del.iter().flat_map(&deleted).collect(),
+                add: added(&a.add),
+                del: a.del.iter().flat_map(&deleted).collect(),
             });
         }
         for (_, node) in raw_nodes {
@@ -376,16 +274,15 @@ impl Model {
             .iter()
             .map(|f| compile_formula(f, &conds.ids))
             .collect();
-        let words = atoms.len().div_ceil(64).max(1);
+        let words = universe.atoms.len().div_ceil(64).max(1);
         let mut state = vec![0u64; words].into_boxed_slice();
         for c in initial.iter().filter(|c| !c.negated) {
-            if let Some(&i) = index.get(&c.atom) {
+            if let Some(&i) = universe.index.get(&c.atom) {
                 state[i / 64] |= 1 << (i % 64);
             }
         }
-        drop(index);
         Ok(Model {
-            atoms,
+            atoms: universe.atoms,
             conditions,
             nodes,
             actions,
@@ -499,13 +396,6 @@ impl Model {
     pub fn words(&self) -> usize {
         self.words
     }
-}
-
-enum RawNode {
-    Sequence(Vec<usize>),
-    Fallback(Vec<usize>),
-    Condition(usize, bool),
-    Action(usize),
 }
 
 /// Whether a disturbance adds or deletes an atom that one of `observed` can see.
