@@ -63,6 +63,133 @@ impl Candidate {
     }
 }
 
+/// What every candidate goal for one request is judged against: the scene, the examples
+/// the prompt showed, the words of the vocabulary and the place numbers the request says.
+struct Judge<'a> {
+    scenario: &'a Scenario,
+    world: Box<dyn World>,
+    instruction: &'a str,
+    shown: Vec<&'a crate::scenario::Example>,
+    lexicon: Lexicon,
+    place_numbers: Vec<String>,
+}
+
+impl Judge<'_> {
+    /// Why `goal` should not be used, if it should not.
+    fn assess(&self, goal: &Formula) -> Option<GoalProblem> {
+        assess(
+            self.scenario,
+            self.world.as_ref(),
+            goal,
+            (&self.shown, &self.lexicon),
+            self.instruction,
+        )
+    }
+
+    /// The place numbers the request says that no condition of `goal` is about.
+    fn missing_numbers(&self, goal: &Formula) -> Vec<String> {
+        unanswered_names(goal, self.instruction, &self.lexicon)
+            .into_iter()
+            .filter(|w| self.place_numbers.contains(w))
+            .collect()
+    }
+
+    /// A clean candidate that leaves out no number the request says.
+    fn answers_numbers(&self, c: &Candidate) -> bool {
+        c.clean()
+            && c.read
+                .as_ref()
+                .is_ok_and(|a| self.missing_numbers(&a.goal).is_empty())
+    }
+
+    /// Candidates made from an answer that failed a check: without what it pasted from an
+    /// example, or without the parts no word of the request asks for; and, when checks
+    /// are on, with the place renumbered when the request numbers another one of its kind
+    /// ("table six" read as Table1). Each is checked like the others.
+    fn derived(
+        &self,
+        read: &Result<GoalAnswer, ReplyError>,
+        problem: Option<&GoalProblem>,
+        check_goals: bool,
+        first: bool,
+        emit: &mut (dyn FnMut(&Event) + Send),
+    ) -> Vec<Candidate> {
+        let pruned = match read {
+            Ok(a) if problem.is_some() => without_copied(&a.goal, &self.shown, self.instruction)
+                .or_else(|| without_unasked(&a.goal, self.instruction, &self.lexicon)),
+            _ => None,
+        };
+        let renumber = match read {
+            Ok(a) if check_goals => renumbered(
+                &a.goal,
+                &self.missing_numbers(&a.goal),
+                &self.scenario.domain.vocabulary,
+            ),
+            _ => None,
+        };
+        if let Some((goal, from, to)) = &renumber {
+            emit(&Event::Notice {
+                message: format!(
+                    "the request numbers a place the answer does not: {to} is the only one like {from} with that number, so {goal} is a candidate too"
+                ),
+            });
+        }
+        let mut out = Vec::new();
+        for goal in pruned.into_iter().chain(renumber.map(|(g, _, _)| g)) {
+            let problem = self.assess(&goal);
+            if let Some(p) = &problem {
+                emit(&Event::CandidateRejected {
+                    candidate: goal.to_string(),
+                    proposal: None,
+                    reason: p.reason.clone(),
+                    author: Some("betr, from the model's answer".into()),
+                });
+            }
+            out.push(Candidate {
+                text: format!("Goal: {goal}"),
+                read: Ok(GoalAnswer {
+                    goal,
+                    reasoning: None,
+                    substitutions: Vec::new(),
+                }),
+                problem,
+                first,
+            });
+        }
+        out
+    }
+
+    /// The goal chosen among `candidates`, with the doubt raised about it: a clean one
+    /// that answers every number the request says, else a clean one, else — when it is the
+    /// model's own first answer or no round is left — a doubtful one (those set aside in
+    /// earlier rounds vote too).
+    fn choose(
+        &self,
+        candidates: &[Candidate],
+        set_aside: &[Candidate],
+        last_round: bool,
+    ) -> Option<(GoalAnswer, Option<String>)> {
+        let first_doubtful = candidates.iter().any(|c| c.first && c.doubtful());
+        vote(candidates, |c| self.answers_numbers(c))
+            .or_else(|| vote(candidates, Candidate::clean))
+            .map(|a| (a, None))
+            .or_else(|| {
+                if !(first_doubtful || last_round) {
+                    return None;
+                }
+                let pool: Vec<&Candidate> = candidates.iter().chain(set_aside).collect();
+                vote_refs(&pool, Candidate::doubtful).map(|a| {
+                    let why = pool
+                        .iter()
+                        .find(|c| c.doubtful() && c.read.as_ref().is_ok_and(|r| same(r, &a)))
+                        .and_then(|c| c.problem.as_ref())
+                        .map(|p| p.reason.clone());
+                    (a, why)
+                })
+            })
+    }
+}
+
 /// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
 /// as the module says (`options.check_goals` off: the first usable answer, as the paper's
 /// single call).
@@ -87,9 +214,15 @@ pub async fn interpret(
         .examples
         .as_deref()
         .unwrap_or(&scenario.examples);
-    let shown = options.variant.choose(pool, instruction);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
-    let place_numbers = lexicon.place_numbers(&terms(instruction));
+    let judge = Judge {
+        scenario,
+        world,
+        instruction,
+        shown: options.variant.choose(pool, instruction),
+        place_numbers: lexicon.place_numbers(&terms(instruction)),
+        lexicon,
+    };
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
@@ -102,19 +235,6 @@ pub async fn interpret(
         1
     };
     let mut last_error = ReplyError::NoConditions;
-    // The place numbers the request says that no condition of `goal` is about.
-    let missing_numbers = |goal: &Formula| -> Vec<String> {
-        unanswered_names(goal, instruction, &lexicon)
-            .into_iter()
-            .filter(|w| place_numbers.contains(w))
-            .collect()
-    };
-    let answers_numbers = |c: &Candidate| {
-        c.clean()
-            && c.read
-                .as_ref()
-                .is_ok_and(|a| missing_numbers(&a.goal).is_empty())
-    };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
     for round in 0..rounds {
@@ -156,13 +276,7 @@ pub async fn interpret(
                     doubt: false,
                 }),
                 Ok(_) if !options.check_goals => None,
-                Ok(a) => assess(
-                    scenario,
-                    world.as_ref(),
-                    &a.goal,
-                    (&shown, &lexicon),
-                    instruction,
-                ),
+                Ok(a) => judge.assess(&a.goal),
             };
             if first.is_none() {
                 first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
@@ -182,62 +296,21 @@ pub async fn interpret(
                 }),
                 (Ok(_), None) => {}
             }
-            // An answer without what it pasted from an example, or without the parts no
-            // word of the request asks for, is a candidate of its own, checked like the
-            // others.
-            let pruned = match &read {
-                Ok(a) if problem.is_some() => without_copied(&a.goal, &shown, instruction)
-                    .or_else(|| without_unasked(&a.goal, instruction, &lexicon)),
-                _ => None,
-            };
-            // A place the model chose when the request numbers another ("table six"
-            // read as Table1) is put right when one place of that kind has the number.
-            let renumber = match &read {
-                Ok(a) if options.check_goals => {
-                    renumbered(&a.goal, &missing_numbers(&a.goal), vocabulary)
-                }
-                _ => None,
-            };
+            let first_draw = round == 0 && draw == 0;
+            let derived = judge.derived(
+                &read,
+                problem.as_ref(),
+                options.check_goals,
+                first_draw,
+                emit,
+            );
             candidates.push(Candidate {
                 text: r.text,
                 read,
                 problem,
-                first: round == 0 && draw == 0,
+                first: first_draw,
             });
-            if let Some((goal, from, to)) = &renumber {
-                emit(&Event::Notice {
-                    message: format!(
-                        "the request numbers a place the answer does not: {to} is the only one like {from} with that number, so {goal} is a candidate too"
-                    ),
-                });
-            }
-            for goal in pruned.into_iter().chain(renumber.map(|(g, _, _)| g)) {
-                let problem = assess(
-                    scenario,
-                    world.as_ref(),
-                    &goal,
-                    (&shown, &lexicon),
-                    instruction,
-                );
-                if let Some(p) = &problem {
-                    emit(&Event::CandidateRejected {
-                        candidate: goal.to_string(),
-                        proposal: None,
-                        reason: p.reason.clone(),
-                        author: Some("betr, from the model's answer".into()),
-                    });
-                }
-                candidates.push(Candidate {
-                    text: format!("Goal: {goal}"),
-                    read: Ok(GoalAnswer {
-                        goal,
-                        reasoning: None,
-                        substitutions: Vec::new(),
-                    }),
-                    problem,
-                    first: round == 0 && draw == 0,
-                });
-            }
+            candidates.extend(derived);
             // More draws only for a first answer that is wrong: one that passes (or
             // passes once what it pasted is taken out) is taken, and a doubtful one is
             // kept, since sampled alternatives to the model's best answer are worse more
@@ -248,12 +321,12 @@ pub async fn interpret(
             let misses = candidates
                 .first()
                 .and_then(|c| c.read.as_ref().ok())
-                .map(|a| missing_numbers(&a.goal));
+                .map(|a| judge.missing_numbers(&a.goal));
             if draw == 0
                 && let Some(missed) = misses.as_ref().filter(|m| !m.is_empty())
                 && let Some(Ok(a)) = candidates.first().map(|c| &c.read)
                 && options.check_goals
-                && !candidates.iter().any(answers_numbers)
+                && !candidates.iter().any(|c| judge.answers_numbers(c))
             {
                 emit(&Event::Notice {
                     message: format!(
@@ -272,24 +345,7 @@ pub async fn interpret(
         // round is left: a doubtful sample after a wrong first answer is asked about again
         // (told why), and stays eligible for the last round's vote.
         let last_round = round + 1 == rounds;
-        let first_doubtful = candidates.iter().any(|c| c.first && c.doubtful());
-        let chosen = vote(&candidates, answers_numbers)
-            .or_else(|| vote(&candidates, Candidate::clean))
-            .map(|a| (a, None))
-            .or_else(|| {
-                if !(first_doubtful || last_round) {
-                    return None;
-                }
-                let pool: Vec<&Candidate> = candidates.iter().chain(&set_aside).collect();
-                vote_refs(&pool, Candidate::doubtful).map(|a| {
-                    let why = pool
-                        .iter()
-                        .find(|c| c.doubtful() && c.read.as_ref().is_ok_and(|r| same(r, &a)))
-                        .and_then(|c| c.problem.as_ref())
-                        .map(|p| p.reason.clone());
-                    (a, why)
-                })
-            });
+        let chosen = judge.choose(&candidates, &set_aside, last_round);
         if let Some((answer, doubt)) = chosen {
             emit_goal(scenario, &answer, emit);
             if let Some(why) = &doubt {
