@@ -208,7 +208,7 @@ fn screen_one(
     (proposal, author): (&Proposal, Option<&str>),
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<(), String> {
-    match screen.check(proposal) {
+    match screen.check(proposal).map_err(|e| e.to_string()) {
         Ok(()) => Ok(()),
         Err(why) => {
             emit(&Event::CandidateRejected {

@@ -5,7 +5,7 @@
 //! approve them, and an approved change is checked the same way before it is kept.
 
 use crate::bt::{NodeId, NodeKind, Tree};
-use crate::domain::ActionCall;
+use crate::domain::{ActionCall, Condition};
 use crate::planner::{Outcome, Plan, Planner, RepairError, run_tree, set_value};
 use crate::world::World;
 
@@ -63,27 +63,54 @@ pub enum Verdict {
     FailsItself,
 }
 
+/// Why a change did not help, in words the model can be told.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotHelped {
+    #[error("{action}! still fails with the same error: {error}")]
+    SameFailure { action: ActionCall, error: String },
+    #[error("after the change, {condition} cannot be achieved: {reason}")]
+    Unreachable {
+        condition: Condition,
+        reason: String,
+    },
+    #[error("after the change, {0}")]
+    Exhausted(String),
+    /// A value after which the action that needed it still fails (with another error).
+    #[error("{action}! failed: {error}")]
+    ValueFails { action: ActionCall, error: String },
+    #[error(
+        "the tree then succeeds without {0}! ever completing: the change closes the action's branch instead of giving it what it lacks"
+    )]
+    GoesAround(ActionCall),
+    #[error("{0}")]
+    NotApplied(String),
+}
+
 /// Whether a change helped: the failure is gone or has moved on.
-pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), String> {
+pub fn helped(before: Option<&FailureAt>, after: &Outcome) -> Result<(), NotHelped> {
     verdict(before, after).map(|_| ())
 }
 
-fn verdict(before: Option<&FailureAt>, after: &Outcome) -> Result<Verdict, String> {
+fn verdict(before: Option<&FailureAt>, after: &Outcome) -> Result<Verdict, NotHelped> {
     match (before, after) {
         (_, Outcome::Success) => Ok(Verdict::Succeeds),
-        (Some(f), Outcome::ActionFailed { action, error, .. }) if f.recurs_in(after) => Err(
-            format!("{action}! still fails with the same error: {error}"),
-        ),
+        (Some(f), Outcome::ActionFailed { action, error, .. }) if f.recurs_in(after) => {
+            Err(NotHelped::SameFailure {
+                action: action.clone(),
+                error: error.clone(),
+            })
+        }
         (_, Outcome::ActionFailed { .. }) => Ok(Verdict::MovesOn),
         (
             _,
             Outcome::Unreachable {
                 condition, reason, ..
             },
-        ) => Err(format!(
-            "after the change, {condition} cannot be achieved: {reason}"
-        )),
-        (_, Outcome::Exhausted { reason }) => Err(format!("after the change, {reason}")),
+        ) => Err(NotHelped::Unreachable {
+            condition: condition.clone(),
+            reason: reason.clone(),
+        }),
+        (_, Outcome::Exhausted { reason }) => Err(NotHelped::Exhausted(reason.clone())),
     }
 }
 
@@ -101,7 +128,7 @@ impl Screen {
     /// words the model can be told. A value passes only when the action that needed it
     /// no longer fails at all (a different error of the same action, such as "the hammer
     /// slips" after "no grasp force", means the value is wrong).
-    pub fn check(&self, proposal: &Proposal) -> Result<(), String> {
+    pub fn check(&self, proposal: &Proposal) -> Result<(), NotHelped> {
         self.try_change(proposal).map(|_| ())
     }
 
@@ -139,13 +166,18 @@ impl Screen {
     }
 
     /// As [`Screen::check`], saying whether the whole tree then succeeds.
-    pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, String> {
-        let plan = self.replan(proposal).map_err(|e| e.to_string())?;
+    pub fn try_change(&self, proposal: &Proposal) -> Result<Verdict, NotHelped> {
+        let plan = self
+            .replan(proposal)
+            .map_err(|e| NotHelped::NotApplied(e.to_string()))?;
         if let (Proposal::Value { .. }, Outcome::ActionFailed { action, error, .. }) =
             (proposal, &plan.outcome)
             && self.failure.action.same_invocation(action)
         {
-            return Err(format!("{action}! failed: {error}"));
+            return Err(NotHelped::ValueFails {
+                action: action.clone(),
+                error: error.clone(),
+            });
         }
         let verdict = verdict(Some(&self.failure), &plan.outcome)?;
         // A missing precondition lets the action succeed. A condition after which the
@@ -156,10 +188,7 @@ impl Screen {
             && verdict == Verdict::Succeeds
             && !self.completes_failed_action(&plan.tree)
         {
-            return Err(format!(
-                "the tree then succeeds without {}! ever completing: the change closes the action's branch instead of giving it what it lacks",
-                self.failure.action
-            ));
+            return Err(NotHelped::GoesAround(self.failure.action.clone()));
         }
         Ok(match &plan.outcome {
             Outcome::ActionFailed { node, .. } if node.index() >= self.tree.capacity() => {

@@ -52,7 +52,7 @@ impl Engine {
             Err(e) => return self.did_not_help(&pending, &tree, before.as_ref(), e.to_string()),
         };
         if let Err(reason) = helped(before.as_ref(), &plan.outcome) {
-            return self.did_not_help(&pending, &tree, before.as_ref(), reason);
+            return self.did_not_help(&pending, &tree, before.as_ref(), reason.to_string());
         }
         self.emit(Event::Repaired {
             added_nodes: plan.new_nodes.len(),
