@@ -71,6 +71,28 @@ pub struct RunReport {
     pub last: Option<TickRecord>,
 }
 
+/// How many ticks a tree may take: in the world it acts in (a run, a verified
+/// execution), and in each run the planner simulates while it grows or repairs a tree.
+/// One place for both, so every command and the workbench agree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunLimits {
+    pub run_ticks: u64,
+    pub plan_ticks: u64,
+}
+
+impl RunLimits {
+    pub const DEFAULT: RunLimits = RunLimits {
+        run_ticks: 10_000,
+        plan_ticks: 2_000,
+    };
+}
+
+impl Default for RunLimits {
+    fn default() -> Self {
+        RunLimits::DEFAULT
+    }
+}
+
 /// Tick `tree` in `world` until the root returns Success or Failure, or `max_ticks` pass.
 ///
 /// Success counts only from a tick in which no action completed: an action that completes

@@ -20,7 +20,7 @@ use crate::domain::{ActionCall, Condition, Domain};
 use crate::goal::Dnf;
 use crate::world::World;
 
-pub use exec::{RunEnd, RunReport, WorldLeaves, run_tree};
+pub use exec::{RunEnd, RunLimits, RunReport, WorldLeaves, run_tree};
 
 /// Bounds that keep planning finite.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,7 +38,7 @@ impl Default for PlanOptions {
         PlanOptions {
             max_iterations: 400,
             max_depth: 12,
-            max_ticks: 2000,
+            max_ticks: RunLimits::DEFAULT.plan_ticks,
         }
     }
 }

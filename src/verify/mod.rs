@@ -184,7 +184,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             max_states: 200_000,
-            max_ticks: 10_000,
+            max_ticks: crate::planner::RunLimits::DEFAULT.run_ticks,
             action_failures: false,
         }
     }

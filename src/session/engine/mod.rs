@@ -59,8 +59,8 @@ pub struct Setup {
     pub policies: Option<PolicyStore>,
     /// Time between ticks when running (zero: as fast as possible).
     pub tick_interval: Duration,
-    /// Running stops after this many ticks of one run.
-    pub max_ticks: u64,
+    /// Running stops after `limits.run_ticks` ticks of one run.
+    pub limits: crate::planner::RunLimits,
     /// Emit `Event::Scene` after every tick and reset of a cell world (for a 3D view).
     pub scenes: bool,
     /// The learned knowledge: approved fixes of conditions are offered as rules and kept
@@ -85,7 +85,7 @@ impl Setup {
             auto_approve: false,
             policies: None,
             tick_interval: Duration::ZERO,
-            max_ticks: 10_000,
+            limits: crate::planner::RunLimits::DEFAULT,
             scenes: false,
             knowledge: None,
         }
@@ -271,7 +271,7 @@ impl Engine {
             auto_approve: setup.auto_approve,
             policies: setup.policies,
             tick_interval: setup.tick_interval,
-            max_ticks: setup.max_ticks,
+            max_ticks: setup.limits.run_ticks,
             scenes: setup.scenes,
             knowledge: setup.knowledge,
             offers: Vec::new(),
