@@ -15,6 +15,7 @@ pub mod towers;
 
 use std::fmt::Write as _;
 use std::path::Path;
+use std::process::Command;
 
 use serde::Serialize;
 
@@ -29,6 +30,34 @@ pub enum BenchError {
     Io(#[from] std::io::Error),
     #[error("cannot write the scenario text: {0}")]
     Format(#[from] std::fmt::Error),
+}
+
+/// Run an anchor's command: its standard output, or an error naming `what` with the end
+/// of its standard error (when that was captured).
+pub fn run_anchor(what: &str, command: &mut Command) -> Result<String, BenchError> {
+    let anchor = |detail: String| BenchError::Anchor {
+        what: what.to_string(),
+        detail,
+    };
+    let program = command.get_program().to_string_lossy().into_owned();
+    let out = command
+        .output()
+        .map_err(|e| anchor(format!("cannot run {program}: {e}")))?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(5).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        return Err(anchor(format!(
+            "{program} failed ({}){}",
+            out.status,
+            if tail.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", tail.join(" / "))
+            }
+        )));
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
 /// Which way a measure is better.

@@ -32,21 +32,14 @@ pub struct Speeds {
 /// Build (or find) llama-bench with `script`, against the llama.cpp built in the cargo
 /// profile directory `profile`; its path. The script's progress goes to stderr.
 pub fn llama_bench_binary(script: &Path, profile: &Path) -> Result<PathBuf, BenchError> {
-    let out = Command::new("bash")
-        .arg(script)
-        .arg(std::path::absolute(profile)?)
-        .stderr(Stdio::inherit())
-        .output()
-        .map_err(|e| anchor(format!("cannot run {}: {e}", script.display())))?;
-    if !out.status.success() {
-        return Err(anchor(format!(
-            "{} failed ({})",
-            script.display(),
-            out.status
-        )));
-    }
-    let path = String::from_utf8_lossy(&out.stdout).trim().to_string();
-    let path = PathBuf::from(path);
+    let out = super::run_anchor(
+        "building llama-bench",
+        Command::new("bash")
+            .arg(script)
+            .arg(std::path::absolute(profile)?)
+            .stderr(Stdio::inherit()),
+    )?;
+    let path = PathBuf::from(out.trim());
     if !path.is_file() {
         return Err(anchor(format!(
             "{} named {}, which is not a file",
@@ -79,25 +72,18 @@ pub fn llama_bench(
     threads: u32,
     sizes: ModelSizes,
 ) -> Result<Speeds, BenchError> {
-    let out = Command::new(binary)
-        .arg("-m")
-        .arg(model)
-        .args(["-t", &threads.to_string()])
-        .args(["-p", &sizes.prompt.to_string()])
-        .args(["-n", &sizes.generate.to_string()])
-        .args(["-r", &sizes.repeats.max(1).to_string()])
-        .args(["-o", "json"])
-        .stderr(Stdio::null())
-        .output()
-        .map_err(|e| anchor(format!("cannot run {}: {e}", binary.display())))?;
-    if !out.status.success() {
-        return Err(anchor(format!(
-            "{} failed ({})",
-            binary.display(),
-            out.status
-        )));
-    }
-    parse_llama_bench(&String::from_utf8_lossy(&out.stdout))
+    let out = super::run_anchor(
+        "llama-bench",
+        Command::new(binary)
+            .arg("-m")
+            .arg(model)
+            .args(["-t", &threads.to_string()])
+            .args(["-p", &sizes.prompt.to_string()])
+            .args(["-n", &sizes.generate.to_string()])
+            .args(["-r", &sizes.repeats.max(1).to_string()])
+            .args(["-o", "json"]),
+    )?;
+    parse_llama_bench(&out)
 }
 
 fn parse_llama_bench(json: &str) -> Result<Speeds, BenchError> {

@@ -134,21 +134,21 @@ pub fn pytrees_python(venv: &Path) -> Result<PathBuf, BenchError> {
     if python.is_file() && has(&python) {
         return Ok(python);
     }
-    let anchor = |detail: String| BenchError::Anchor {
-        what: format!("installing {PY_TREES} into {}", venv.display()),
-        detail,
-    };
-    eprintln!(
-        "bench: installing {PY_TREES} into {} (once)",
-        venv.display()
-    );
-    run(Command::new("python3").arg("-m").arg("venv").arg(venv)).map_err(anchor)?;
-    run(Command::new(&python).args(["-m", "pip", "install", "--quiet", PY_TREES]))
-        .map_err(anchor)?;
+    let what = format!("installing {PY_TREES} into {}", venv.display());
+    eprintln!("bench: {what} (once)");
+    super::run_anchor(
+        &what,
+        Command::new("python3").arg("-m").arg("venv").arg(venv),
+    )?;
+    super::run_anchor(
+        &what,
+        Command::new(&python).args(["-m", "pip", "install", "--quiet", PY_TREES]),
+    )?;
     if !has(&python) {
-        return Err(anchor(
-            "py_trees 2.6.0 is not importable after installing".into(),
-        ));
+        return Err(BenchError::Anchor {
+            what,
+            detail: "py_trees 2.6.0 is not importable after installing".into(),
+        });
     }
     Ok(python)
 }
@@ -160,16 +160,18 @@ pub fn pytrees_ticks(
     nodes: usize,
     time: Duration,
 ) -> Result<TickRate, BenchError> {
-    let anchor = |detail: String| BenchError::Anchor {
-        what: format!("py_trees ({})", script.display()),
-        detail,
-    };
-    let out = run(Command::new(python)
-        .arg(script)
-        .arg(nodes.to_string())
-        .arg(format!("{:.3}", time.as_secs_f64())))
-    .map_err(anchor)?;
-    parse_pytrees(&out).ok_or_else(|| anchor(format!("unexpected output: {}", out.trim())))
+    let what = format!("py_trees ({})", script.display());
+    let out = super::run_anchor(
+        &what,
+        Command::new(python)
+            .arg(script)
+            .arg(nodes.to_string())
+            .arg(format!("{:.3}", time.as_secs_f64())),
+    )?;
+    parse_pytrees(&out).ok_or_else(|| BenchError::Anchor {
+        what,
+        detail: format!("unexpected output: {}", out.trim()),
+    })
 }
 
 /// `py_trees nodes=1021 ticks=… ticks_per_s=3021.5 visited_per_tick=23 …`
@@ -184,24 +186,6 @@ fn parse_pytrees(out: &str) -> Option<TickRate> {
         ticks_per_s: field("ticks_per_s")?.parse().ok()?,
         visited_per_tick: field("visited_per_tick")?.parse().ok()?,
     })
-}
-
-/// Run a command; its stdout, or what went wrong.
-fn run(command: &mut Command) -> Result<String, String> {
-    let out = command
-        .output()
-        .map_err(|e| format!("cannot run {:?}: {e}", command.get_program()))?;
-    if !out.status.success() {
-        let err = String::from_utf8_lossy(&out.stderr);
-        let tail: Vec<&str> = err.lines().rev().take(5).collect();
-        return Err(format!(
-            "{:?} failed ({}): {}",
-            command.get_program(),
-            out.status,
-            tail.into_iter().rev().collect::<Vec<_>>().join(" / ")
-        ));
-    }
-    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
 #[cfg(test)]
