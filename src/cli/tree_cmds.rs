@@ -167,37 +167,7 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
         }
     }
     if !settings.is_empty() {
-        if let Outcome::ActionFailed { action, error, .. } = &plan.outcome {
-            println!("{action}! failed in simulation: {error}");
-        }
-        let mut tree = plan.tree;
-        for setting in settings {
-            let changed = super::values::apply(&mut tree, setting);
-            if changed == 0 {
-                bail!(
-                    "--set {:?}: no action of the tree uses {} with {:?}",
-                    setting.text,
-                    setting
-                        .targets
-                        .iter()
-                        .map(|(s, _)| s.as_str())
-                        .collect::<Vec<_>>()
-                        .join(" or "),
-                    setting.object
-                );
-            }
-            println!(
-                "Setting {} = {} for {:?} on {changed} action(s)",
-                setting
-                    .targets
-                    .first()
-                    .map(|(_, n)| n.as_str())
-                    .unwrap_or_default(),
-                setting.value,
-                setting.object
-            );
-        }
-        plan = planner.grow(tree, world.as_ref());
+        plan = apply_settings(plan, settings, &planner, world.as_ref())?;
     }
     // What each change was and the nodes it added, for the saved policy's header.
     let mut changes: Vec<(String, Vec<NodeId>)> = settings
@@ -205,57 +175,21 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
         .map(|s| (format!("set {}", s.text), Vec::new()))
         .collect();
     for (i, conditions) in additions.iter().enumerate() {
-        let names = conditions
-            .iter()
-            .map(ToString::to_string)
-            .collect::<Vec<_>>()
-            .join(" & ");
         let at_action = if i == 0 { at } else { None };
-        let change = match (&plan.outcome, at_action) {
-            (_, Some(action)) => format!("insert {names} before {action}!"),
-            (Outcome::ActionFailed { action, .. }, None) => {
-                format!("insert {names} as the first precondition(s) of {action}!")
-            }
-            _ => format!("insert {names}"),
-        };
-        plan = match (&plan.outcome, at_action) {
-            (_, Some(action)) => {
-                println!("Inserting {names} before {action}!");
-                planner.repair_at(plan.tree, action, conditions, world.as_ref())?
-            }
-            (
-                Outcome::ActionFailed {
-                    node,
-                    action,
-                    error,
-                },
-                None,
-            ) => {
-                println!(
-                    "{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)"
-                );
-                planner.repair(plan.tree, *node, conditions, world.as_ref())?
-            }
-            (Outcome::Success, None) => {
-                bail!("the tree already succeeds before --add {names:?}: nothing fails to repair")
-            }
-            (other, None) => bail!("cannot repair: {}", describe(other, &plan.tree)),
-        };
-        println!(
-            "  added {} node(s), {} expansion(s)",
-            plan.new_nodes.len(),
-            plan.expansions
-        );
-        changes.push((change, plan.new_nodes.clone()));
+        let (repaired, change) =
+            add_conditions(plan, conditions, at_action, &planner, world.as_ref())?;
+        plan = repaired;
         if let Some(v) = viz.as_mut() {
             v.log(
                 Level::INFO,
                 format!(
-                    "repaired: inserted {names}, {} node(s) added",
+                    "repaired: inserted {}, {} node(s) added",
+                    joined(conditions),
                     plan.new_nodes.len()
                 ),
             );
         }
+        changes.push((change, plan.new_nodes.clone()));
     }
     println!();
     let mut exec = world.fork();
@@ -291,6 +225,104 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
             Ok(ExitCode::from(WORLD_FAILED))
         }
     }
+}
+
+/// Set each `--set` value on every action of the tree that uses it, then grow the tree
+/// again; says what was set.
+fn apply_settings(
+    plan: Plan,
+    settings: &[Setting],
+    planner: &Planner,
+    world: &dyn World,
+) -> Result<Plan> {
+    if let Outcome::ActionFailed { action, error, .. } = &plan.outcome {
+        println!("{action}! failed in simulation: {error}");
+    }
+    let mut tree = plan.tree;
+    for setting in settings {
+        let changed = super::values::apply(&mut tree, setting);
+        if changed == 0 {
+            bail!(
+                "--set {:?}: no action of the tree uses {} with {:?}",
+                setting.text,
+                setting
+                    .targets
+                    .iter()
+                    .map(|(s, _)| s.as_str())
+                    .collect::<Vec<_>>()
+                    .join(" or "),
+                setting.object
+            );
+        }
+        println!(
+            "Setting {} = {} for {:?} on {changed} action(s)",
+            setting
+                .targets
+                .first()
+                .map(|(_, n)| n.as_str())
+                .unwrap_or_default(),
+            setting.value,
+            setting.object
+        );
+    }
+    Ok(planner.grow(tree, world))
+}
+
+/// Insert `conditions` before `at`, or as the first preconditions of the action that
+/// fails in simulation; the repaired plan and the change in words (for the policy).
+fn add_conditions(
+    plan: Plan,
+    conditions: &[Condition],
+    at: Option<&ActionCall>,
+    planner: &Planner,
+    world: &dyn World,
+) -> Result<(Plan, String)> {
+    let names = joined(conditions);
+    let change = match (&plan.outcome, at) {
+        (_, Some(action)) => format!("insert {names} before {action}!"),
+        (Outcome::ActionFailed { action, .. }, None) => {
+            format!("insert {names} as the first precondition(s) of {action}!")
+        }
+        _ => format!("insert {names}"),
+    };
+    let repaired = match (&plan.outcome, at) {
+        (_, Some(action)) => {
+            println!("Inserting {names} before {action}!");
+            planner.repair_at(plan.tree, action, conditions, world)?
+        }
+        (
+            Outcome::ActionFailed {
+                node,
+                action,
+                error,
+            },
+            None,
+        ) => {
+            println!(
+                "{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)"
+            );
+            planner.repair(plan.tree, *node, conditions, world)?
+        }
+        (Outcome::Success, None) => {
+            bail!("the tree already succeeds before --add {names:?}: nothing fails to repair")
+        }
+        (other, None) => bail!("cannot repair: {}", describe(other, &plan.tree)),
+    };
+    println!(
+        "  added {} node(s), {} expansion(s)",
+        repaired.new_nodes.len(),
+        repaired.expansions
+    );
+    Ok((repaired, change))
+}
+
+/// Conditions as `A & ~B`.
+fn joined(conditions: &[Condition]) -> String {
+    conditions
+        .iter()
+        .map(ToString::to_string)
+        .collect::<Vec<_>>()
+        .join(" & ")
 }
 
 /// How a run ended, as one line of the event log.
