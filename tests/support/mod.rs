@@ -5,6 +5,7 @@
 
 pub mod cli;
 pub mod embedded;
+pub mod engine;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;
