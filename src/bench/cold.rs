@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use super::{BenchError, Better, Row, Target};
-use crate::llm::Message;
+use crate::domain::Condition;
 use crate::llm::grammar;
 use crate::llm::local::{Engine, EngineOptions, Generation};
 use crate::llm::prompt::{Context, Templates, Variant};
@@ -25,6 +25,52 @@ const INSTRUCTIONS: [&str; 4] = [
     "Stack the green cube on the blue cube",
     "Hold the red cube",
 ];
+
+/// A scenario's goal prompt as the product sends it to the embedded model (the built-in
+/// templates, the default variant, the scene's facts, the goal grammar), for timing.
+pub struct GoalPrompt {
+    pub scenario: Scenario,
+    facts: Vec<Condition>,
+    gbnf: String,
+}
+
+impl GoalPrompt {
+    pub fn load(path: &Path) -> Result<GoalPrompt, BenchError> {
+        let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
+        let scenario = Scenario::load(path).map_err(|e| setup(&e))?;
+        let facts = world::load(&scenario).map_err(|e| setup(&e))?.facts();
+        let gbnf = grammar::goal_grammar(&scenario.domain.vocabulary, true, false);
+        Ok(GoalPrompt {
+            scenario,
+            facts,
+            gbnf,
+        })
+    }
+
+    /// The generation for `instruction`: greedy, one line, with or without the grammar.
+    pub fn generation(&self, instruction: &str, grammar: bool) -> Result<Generation, BenchError> {
+        let ctx = Context {
+            scenario: &self.scenario,
+            facts: &self.facts,
+            instruction,
+            variant: &Variant::default(),
+        };
+        let messages = ctx
+            .goal(&Templates::builtin())
+            .map_err(|e| BenchError::Setup(e.to_string()))?
+            .into_iter()
+            .map(|m| (m.role.name().to_string(), m.content))
+            .collect();
+        Ok(Generation {
+            messages,
+            max_tokens: 60,
+            temperature: 0.0,
+            seed: 0,
+            stop: vec!["\n".into()],
+            grammar: grammar.then(|| self.gbnf.clone()),
+        })
+    }
+}
 
 /// Latencies of one model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,31 +96,8 @@ pub fn latencies(
     warm_calls: usize,
 ) -> Result<Latencies, BenchError> {
     let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
-    let scenario = Scenario::load(scenario).map_err(|e| setup(&e))?;
-    let facts = world::load(&scenario).map_err(|e| setup(&e))?.facts();
-    let gbnf = grammar::goal_grammar(&scenario.domain.vocabulary, true, false);
-    let variant = Variant::default();
-    let job = |instruction: &str| -> Result<Generation, BenchError> {
-        let ctx = Context {
-            scenario: &scenario,
-            facts: &facts,
-            instruction,
-            variant: &variant,
-        };
-        Ok(Generation {
-            messages: ctx
-                .goal(&Templates::builtin())
-                .map_err(|e| setup(&e))?
-                .into_iter()
-                .map(chat_pair)
-                .collect(),
-            max_tokens: 60,
-            temperature: 0.0,
-            seed: 0,
-            stop: vec!["\n".into()],
-            grammar: Some(gbnf.clone()),
-        })
-    };
+    let prompt = GoalPrompt::load(scenario)?;
+    let job = |instruction: &str| prompt.generation(instruction, true);
     if states.exists() {
         std::fs::remove_dir_all(states)?;
     }
@@ -152,8 +175,4 @@ pub fn rows(name: &str, threads: u32, l: &Latencies) -> Vec<Row> {
             note: format!("median; goal prompt of scenario 1, {threads} thread(s)"),
         },
     ]
-}
-
-fn chat_pair(m: Message) -> (String, String) {
-    (m.role.name().to_string(), m.content)
 }

@@ -125,10 +125,12 @@ pub struct Machine {
 
 impl Machine {
     pub fn read() -> Machine {
+        let load = load_average();
         Machine {
-            cores: std::thread::available_parallelism().map_or(1, usize::from),
-            load_before: load_average(),
-            load_after: load_average(),
+            cores: cores() as usize,
+            // The end's load is read again when the run ends.
+            load_before: load,
+            load_after: load,
             cpu: std::fs::read_to_string("/proc/cpuinfo")
                 .ok()
                 .and_then(|t| {
@@ -140,6 +142,14 @@ impl Machine {
                 .unwrap_or_default(),
         }
     }
+}
+
+/// The cores this process may use.
+pub fn cores() -> u32 {
+    std::thread::available_parallelism()
+        .ok()
+        .and_then(|n| u32::try_from(n.get()).ok())
+        .unwrap_or(1)
 }
 
 /// The load averages (zero where the system does not say).

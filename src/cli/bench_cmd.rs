@@ -9,12 +9,7 @@ use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
 
 use betr::bench::{self, Report, cold, model, scale, ticks};
-use betr::llm::Message;
-use betr::llm::grammar;
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
-use betr::llm::prompt::{Context, Templates, Variant};
-use betr::scenario::Scenario;
-use betr::world;
 
 /// A part of `betr bench`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -189,8 +184,7 @@ fn model_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
         .find(|d| d.join("build").is_dir())
         .context("betr does not run from a cargo target directory, where llama-bench is built against its llama.cpp")?;
     let binary = model::llama_bench_binary(Path::new("scripts/llama-bench.sh"), profile)?;
-    let cores =
-        u32::try_from(std::thread::available_parallelism().map_or(1, usize::from)).unwrap_or(1);
+    let cores = bench::cores();
     let threads: Vec<u32> = match args.threads {
         Some(t) => vec![t.max(1)],
         None if args.quick => vec![cores],
@@ -209,10 +203,7 @@ fn model_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
 fn cold_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     // Every core, unless told: the idle-core count the product uses would depend on what
     // the part before left running.
-    let threads = args.threads.map_or_else(
-        || u32::try_from(std::thread::available_parallelism().map_or(1, usize::from)).unwrap_or(1),
-        |t| t.max(1),
-    );
+    let threads = args.threads.map_or_else(bench::cores, |t| t.max(1));
     // Both embedded models, unless one was chosen.
     let models: Vec<PathBuf> = if args.model_path.is_some() || args.model.is_some() {
         vec![model_file(args, None)?]
@@ -264,35 +255,12 @@ fn llm(
         None => super::model_cmd::ensure(model)?,
     };
     println!("model: {}", path.display());
-    let scenario = Scenario::load(scenario)?;
-    let facts = world::load(&scenario)?.facts();
-    let instruction = scenario
+    let prompt = cold::GoalPrompt::load(scenario)?;
+    let instruction = prompt
+        .scenario
         .instruction
         .clone()
         .context("the scenario has no instruction")?;
-    let variant = Variant::default();
-    let prompt = |instruction: &str| -> Result<Vec<(String, String)>> {
-        let ctx = Context {
-            scenario: &scenario,
-            facts: &facts,
-            instruction,
-            variant: &variant,
-        };
-        Ok(ctx
-            .goal(&Templates::builtin())?
-            .into_iter()
-            .map(chat_pair)
-            .collect())
-    };
-    let gbnf = grammar::goal_grammar(&scenario.domain.vocabulary, true, false);
-    let generation = |messages, grammar: Option<String>| Generation {
-        messages,
-        max_tokens: 60,
-        temperature: 0.0,
-        seed: 0,
-        stop: vec!["\n".into()],
-        grammar,
-    };
 
     let started = Instant::now();
     let engine = Engine::load(EngineOptions {
@@ -310,10 +278,7 @@ fn llm(
         "{:<34} {:>9} {:>8} {:>8} {:>11} {:>10}  answer",
         "call", "latency", "prompt", "cached", "prompt t/s", "gen t/s"
     );
-    let cold = timed(
-        &engine,
-        generation(prompt(&instruction)?, Some(gbnf.clone())),
-    )?;
+    let cold = timed(&engine, prompt.generation(&instruction, true)?)?;
     report("cold (grammar)", &cold);
     // The same prompt prefix (role, vocabulary, objects, examples, scene) with other
     // instructions: only the request's own tokens are evaluated.
@@ -322,23 +287,16 @@ fn llm(
         "Stack the green cube on the blue cube",
         "Hold the red cube",
     ];
-    for (label, grammar) in [
-        ("warm (grammar)", Some(gbnf.clone())),
-        ("warm (no grammar)", None),
-    ] {
+    for (label, grammar) in [("warm (grammar)", true), ("warm (no grammar)", false)] {
         for i in 0..repeats.max(1) {
             let g = timed(
                 &engine,
-                generation(prompt(others[i % others.len()])?, grammar.clone()),
+                prompt.generation(others[i % others.len()], grammar)?,
             )?;
             report(label, &g);
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-fn chat_pair(m: Message) -> (String, String) {
-    (m.role.name().to_string(), m.content)
 }
 
 fn timed(engine: &Engine, generation: Generation) -> Result<(Generated, f64)> {

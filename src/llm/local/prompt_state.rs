@@ -41,7 +41,7 @@ pub enum SaveError {
 }
 
 /// What a state file was made from, checked before the state is loaded.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct Meta {
     format: u32,
     model: String,
@@ -114,14 +114,12 @@ impl PromptStates {
             Err(_) => return None,
         };
         let size = std::fs::metadata(&state).map(|m| m.len()).unwrap_or(0);
-        let expected = Meta {
-            format: FORMAT,
-            model: self.model.clone(),
-            build: self.build.clone(),
-            tokens: meta.tokens,
-            bytes: size,
-        };
-        if meta != expected || meta.tokens > ctx.n_ctx() as usize {
+        let fits = meta.format == FORMAT
+            && meta.model == self.model
+            && meta.build == self.build
+            && meta.bytes == size
+            && meta.tokens <= ctx.n_ctx() as usize;
+        if !fits {
             self.discard(&state, &meta_path, "made for another model, build or size");
             return None;
         }
