@@ -233,7 +233,6 @@ pub fn goals_with_model(
     let dir =
         eval::output_dir(flags.out.as_deref(), "goals").context("creating the output directory")?;
     eval::run::check_settings(&dir, "goals", &p.settings)?;
-    let world = betr::world::load(&scenario)?;
     p.llm.model.set_purpose("eval goals");
     let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let bar = Bar::new();
@@ -248,7 +247,6 @@ pub fn goals_with_model(
         .block_on(goals_run::run_goals(
             &model,
             &scenario,
-            world.as_ref(),
             &cases,
             &p.llm.options,
             &cfg,

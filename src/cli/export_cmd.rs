@@ -3,15 +3,16 @@
 
 use std::path::Path;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 
 use betr::bt::{NodeId, Tree};
 use betr::interop::{self, TreeFormat};
-use betr::planner::Planner;
 use betr::scenario::Scenario;
 use betr::session::policy;
-use betr::world;
+
+use super::engine_driver::{Driver, Start};
 
 /// What `betr export` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -50,10 +51,11 @@ pub fn export(
     let (scenario_path, tree, new_nodes) = if is_scenario {
         let path = super::find_scenario(source)?;
         let scenario = load(&path)?;
-        let goal = super::goal_of(&scenario, None)?;
-        let world = world::load(&scenario)?;
-        let plan = Planner::new(&scenario.domain).plan(&goal.to_dnf(), world.as_ref())?;
-        (path, plan.tree, Vec::new())
+        super::goal_of(&scenario, None)?;
+        let mut session = Driver::start(Start::new(&scenario))?;
+        session.plan(None)?;
+        let tree = Arc::unwrap_or_clone(session.tree()?);
+        (path, tree, Vec::new())
     } else {
         let text = std::fs::read_to_string(source)
             .with_context(|| format!("reading tree file {}", source.display()))?;
@@ -86,9 +88,15 @@ pub fn export(
     let text = match format {
         Format::Btcpp => interop::to_btcpp(&tree, &scenario.domain, &name)?,
         Format::Dot => {
-            let world = world::load(&scenario)?;
-            let record = super::tree_cmds::final_record(&scenario, &tree, world.as_ref());
-            interop::to_dot(&tree, record.as_ref(), &new_nodes, &name)
+            // Coloured by a run of the tree in the scenario's world.
+            let mut session = Driver::start(Start::new(&scenario))?;
+            if is_scenario {
+                session.plan(None)?;
+            } else {
+                session.load(source.to_path_buf(), false)?;
+            }
+            let run = session.run(|_| {})?;
+            interop::to_dot(&tree, run.last.as_deref(), &new_nodes, &name)
         }
     };
     match out {

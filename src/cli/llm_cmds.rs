@@ -8,7 +8,7 @@ use std::sync::Arc;
 use anyhow::{Context as _, Result};
 use clap::Args;
 
-use betr::bt::{self, Glyphs};
+use betr::bt::{self, Glyphs, TickRecord};
 use betr::config_file::FileConfig;
 use betr::llm::LanguageModel;
 use betr::llm::config::{Backend, Layer, Settings};
@@ -245,14 +245,12 @@ pub fn interpret(
         .map(str::to_string)
         .or_else(|| scenario.instruction.clone())
         .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
-    let world = betr::world::load(scenario)?;
     llm.model.set_purpose("interpret");
     println!("Scenario:    {}", scenario.name);
     println!("Instruction: {instruction}");
     let mut emit = |e: &Event| print_event(e, flags.show_replies);
-    let result = super::runtime()?.block_on(session::interpret(
+    let result = super::runtime()?.block_on(session::interpret::interpret_in_scenario(
         scenario,
-        world,
         &instruction,
         llm.model.as_ref(),
         &llm.options,
@@ -300,9 +298,16 @@ pub fn resolve(
             v.instruction(i);
         }
     }
+    // The statuses of the last run of the tree, shown with it at the end.
+    let mut last: Option<Arc<TickRecord>> = None;
     let mut emit = |e: &Event| {
         if let Some(v) = viz.as_mut() {
             v.on_event(e);
+        }
+        match e {
+            Event::Ticked { record } => last = Some(record.clone()),
+            Event::TreeChanged { .. } => last = None,
+            _ => {}
         }
         print_event(e, flags.show_replies);
     };
@@ -325,16 +330,7 @@ pub fn resolve(
         }
     };
     println!();
-    let world = betr::world::load(scenario)?;
-    let mut sim = world.fork();
-    let report = betr::planner::run_tree(
-        &resolved.tree,
-        sim.as_mut(),
-        &scenario.domain,
-        10_000,
-        |_, _| true,
-    );
-    for line in bt::render(&resolved.tree, report.last.as_ref(), glyphs) {
+    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
         println!("{line}");
     }
     let success = matches!(resolved.ending, Ending::Success { .. });
@@ -497,11 +493,13 @@ fn print_event_line(event: &Event) {
         }
         // What a live front end shows; the printed log keeps to the loop's steps.
         Event::TreeChanged { .. }
+        | Event::Planned { .. }
         | Event::Ticked { .. }
         | Event::WorldChanged { .. }
         | Event::Scene { .. }
         | Event::Usage { .. }
         | Event::RunState { .. }
+        | Event::Verifying { .. }
         | Event::Verified { .. }
         | Event::PolicySaved { .. }
         | Event::Exported { .. }

@@ -1,6 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
 mod bench_cmd;
+mod engine_driver;
 mod eval_cmd;
 mod eval_setup;
 mod export_cmd;
@@ -76,7 +77,7 @@ pub enum Command {
         #[arg(long, default_value_t = 200_000)]
         max_states: usize,
         /// Ticks within which the tree must succeed from every reachable state.
-        #[arg(long, default_value_t = betr::planner::RunLimits::DEFAULT.run_ticks)]
+        #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
         max_ticks: u64,
         #[command(flatten)]
         knowledge: knowledge_cmd::KnowledgeFlags,
@@ -135,7 +136,7 @@ pub enum Command {
         #[arg(long)]
         trace: bool,
         /// Give up after this many ticks.
-        #[arg(long, default_value_t = betr::planner::RunLimits::DEFAULT.run_ticks)]
+        #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
         max_ticks: u64,
         /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
         #[arg(long)]

@@ -4,7 +4,7 @@
 use anyhow::{Context as _, Result};
 
 use betr::scenario::Scenario;
-pub use betr::session::values::{Setting, apply};
+pub use betr::session::values::Setting;
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting> {
     betr::session::values::parse_setting(scenario, text).context("--set")

@@ -7,14 +7,13 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 
 use betr::interop::TreeFormat;
-use betr::planner::Outcome;
 use betr::scenario::Scenario;
+use betr::session::Prediction;
 use betr::session::policy;
-use betr::verify::{
-    self, Limits, NamedProperty, Property, Report, Rule, Verdict, VerifyConfig, VerifyInput,
-    plan_in_model,
-};
-use betr::world;
+use betr::session::types::VerifyRequest;
+use betr::verify::{NamedProperty, Property, Report, Rule, Verdict};
+
+use super::engine_driver::{Driver, Start};
 
 /// What `betr verify` was asked.
 pub struct Args {
@@ -29,9 +28,7 @@ pub struct Args {
 }
 
 pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
-    let config = VerifyConfig::from_scenario(scenario)?;
-    let world = world::load(scenario)?;
-    let mut properties = config.properties.clone();
+    let mut properties = Vec::new();
     for text in &args.properties {
         let property = Property::parse_checked(text, &scenario.domain.vocabulary)
             .map_err(|e| anyhow::anyhow!("--property {text:?}: {e}"))?;
@@ -40,70 +37,62 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
             property,
         });
     }
-    let disturbances = if args.no_disturbances {
-        Vec::new()
-    } else {
-        config.disturbances.clone()
+    let promela = match &args.export {
+        Some(export) => {
+            let [format, file] = export.as_slice() else {
+                bail!("--export takes a format and a file: --export promela model.pml");
+            };
+            if format != "promela" {
+                bail!("--export {format:?}: the only format is promela");
+            }
+            Some(PathBuf::from(file))
+        }
+        None => None,
     };
-    let initial = world.facts();
-    let (tree, origin, note) = match &args.tree {
+    let mut session = Driver::start(Start::new(scenario))?;
+    let origin = match &args.tree {
         Some(path) => {
-            let (tree, format) = super::export_cmd::load_tree(scenario, path)?;
-            (tree, origin_of_file(path, format, scenario), String::new())
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("reading tree file {}", path.display()))?;
+            session.load(path.clone(), false)?;
+            origin_of_file(path, TreeFormat::of(path, &text), &text, scenario)
         }
         None => {
             let goal = super::goal_of(scenario, None)?;
-            let planned = plan_in_model(
-                &scenario.domain,
-                &initial,
-                &goal.to_dnf(),
-                &properties,
-                &disturbances,
-            )?;
-            let mut note = String::new();
-            for c in &planned.constraints {
-                note.push_str(&format!(
-                    "Added:    {}? before {}! (property: {})\n",
-                    c.condition, c.action, c.property
-                ));
-            }
-            match &planned.plan.outcome {
-                Outcome::Success => {}
-                Outcome::Unreachable { condition, .. } => {
-                    note.push_str(&format!("Note:     {condition} cannot be achieved\n"));
-                }
-                Outcome::ActionFailed { action, error, .. } => {
-                    note.push_str(&format!(
-                        "Note:     {action}! failed in the model ({error})\n"
-                    ));
-                }
-                Outcome::Exhausted { reason } => {
-                    note.push_str(&format!("Note:     planning stopped: {reason}\n"));
-                }
-            }
-            (
-                planned.plan.tree,
-                format!("planned in the planner's model for {goal} (no simulation)"),
-                note,
-            )
+            session.plan(None)?;
+            format!("planned in the planner's model for {goal} (no simulation)")
         }
     };
-    let input = VerifyInput {
-        domain: &scenario.domain,
-        tree: &tree,
-        initial: &initial,
-        disturbances: &disturbances,
-        properties: &properties,
-        limits: Limits {
-            max_states: args.max_states,
-            max_ticks: args.max_ticks,
-            action_failures: args.failures || config.action_failures,
-        },
-    };
+    let (scope, report) = session.verify(VerifyRequest {
+        properties,
+        no_disturbances: args.no_disturbances,
+        action_failures: args.failures,
+        max_states: Some(args.max_states),
+        max_ticks: Some(args.max_ticks),
+        promela,
+    })?;
+    let tree = session.tree()?;
 
     println!("Scenario: {}", scenario.name);
-    println!("Tree:     {origin} ({} nodes)", tree.len());
-    print!("{note}");
+    println!("Tree:     {origin} ({} nodes)", scope.nodes);
+    for c in &scope.added {
+        println!(
+            "Added:    {}? before {}! (property: {})",
+            c.condition, c.action, c.property
+        );
+    }
+    match &scope.planned {
+        None | Some(Prediction::Success) => {}
+        Some(Prediction::Unreachable { condition, .. }) => {
+            println!("Note:     {condition} cannot be achieved");
+        }
+        Some(Prediction::ActionFails { action, error, .. }) => {
+            println!("Note:     {action}! failed in the model ({error})");
+        }
+        Some(Prediction::Exhausted { reason }) => {
+            println!("Note:     planning stopped: {reason}");
+        }
+    }
     for learned in betr::session::knowledge::learned_in_tree(&scenario.domain, &tree) {
         println!(
             "Learned:  {}? before {}! (rule {})",
@@ -114,37 +103,21 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
     }
     println!(
         "Checking: action failures {}, {} disturbance(s){}\n",
-        if input.limits.action_failures {
-            "on"
-        } else {
-            "off"
-        },
-        disturbances.len(),
-        if args.no_disturbances && !config.disturbances.is_empty() {
+        if scope.action_failures { "on" } else { "off" },
+        scope.disturbances,
+        if scope.disturbances_left_out {
             " (--no-disturbances)"
         } else {
             ""
         }
     );
-
-    if let Some(export) = &args.export {
-        let [format, file] = export.as_slice() else {
-            bail!("--export takes a format and a file: --export promela model.pml");
-        };
-        if format != "promela" {
-            bail!("--export {format:?}: the only format is promela");
-        }
-        let model = verify::export_promela(&input)?;
-        betr::store::write_atomic(Path::new(file), model.text.as_bytes())
-            .with_context(|| format!("writing the Promela model to {file}"))?;
-        let claims: Vec<&str> = model.claims.iter().map(|(n, _)| n.as_str()).collect();
+    if let Some((file, claims)) = &scope.promela {
         println!(
-            "Promela model written to {file} (ltl claims: {})\n",
+            "Promela model written to {} (ltl claims: {})\n",
+            file.display(),
             claims.join(", ")
         );
     }
-
-    let report = verify::verify(&input);
     write_report(&mut std::io::stdout(), &report, args.ascii)?;
     Ok(if report.holds() {
         ExitCode::SUCCESS
@@ -155,11 +128,10 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
 
 /// How a tree file came to be, for the report: a policy with its fixes is a repaired
 /// tree; anything else was loaded as written.
-fn origin_of_file(path: &Path, format: TreeFormat, scenario: &Scenario) -> String {
-    let fixes = std::fs::read_to_string(path)
-        .ok()
+fn origin_of_file(path: &Path, format: TreeFormat, text: &str, scenario: &Scenario) -> String {
+    let fixes = Some(text)
         .filter(|_| format == TreeFormat::Text)
-        .and_then(|text| policy::parse(&text, &scenario.domain).ok())
+        .and_then(|text| policy::parse(text, &scenario.domain).ok())
         .map_or(0, |p| p.fixes.len());
     if fixes > 0 {
         format!(

@@ -4,12 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 
-use betr::bt::{TickRecord, Tree};
-use betr::domain::Domain;
-use betr::planner::{RunReport, run_tree};
 use betr::session::{Command, Event};
 use betr::viz::{Sinks, Viewer, Viz};
-use betr::world::World;
 
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct VizFlags {
@@ -55,25 +51,4 @@ impl betr::tui::Tap for VizTap {
     fn notice(&self) -> Option<String> {
         self.0.notice().map(str::to_string)
     }
-}
-
-/// `run_tree` with the tree, every tick and the cell after it streamed to `viz` (the scene
-/// before the first tick too).
-pub fn run_streamed(
-    tree: &Tree,
-    world: &mut dyn World,
-    domain: &Domain,
-    max_ticks: u64,
-    mut viz: Option<&mut Viz>,
-    mut on_tick: impl FnMut(&TickRecord) -> bool,
-) -> RunReport {
-    if let Some(v) = viz.as_deref_mut() {
-        v.run_start(tree, world);
-    }
-    run_tree(tree, world, domain, max_ticks, |r, w| {
-        if let Some(v) = viz.as_deref_mut() {
-            v.run_tick(r, w);
-        }
-        on_tick(r)
-    })
 }

@@ -25,12 +25,13 @@ use super::run::{Journal, RunConfig, Tap, UsageSummary, drive};
 pub async fn run_goals(
     model: &Arc<dyn LanguageModel>,
     scenario: &Scenario,
-    world: &dyn World,
     cases: &[Case],
     options: &Options,
     cfg: &RunConfig<'_>,
     dir: &Path,
 ) -> Result<GoalsResults, EvalError> {
+    // Each instruction is read against the scenario's first state.
+    let world = crate::world::load(scenario)?;
     let journal = Journal::new(dir);
     let recorded: Vec<CaseResult> = journal.read()?;
     let key = |run: usize, difficulty: &str, index: usize| format!("{run}/{difficulty}/{index}");

@@ -90,7 +90,6 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
         max_tokens: 100,
         ..Default::default()
     };
-    let world = crate::world::load(&s).expect("cafe world");
     let cfg = RunConfig {
         runs: 2,
         concurrency: 3,
@@ -106,7 +105,6 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
         .block_on(run_goals(
             &(model.clone() as std::sync::Arc<dyn crate::llm::LanguageModel>),
             &s,
-            world.as_ref(),
             &cases,
             &options,
             &cfg,

@@ -193,6 +193,18 @@ impl Judge<'_> {
 /// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
 /// as the module says (`options.check_goals` off: the first usable answer, as the paper's
 /// single call).
+/// [`interpret`] against the scenario's first state.
+pub async fn interpret_in_scenario(
+    scenario: &Scenario,
+    instruction: &str,
+    model: &dyn LanguageModel,
+    options: &Options,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<Interpretation, SessionError> {
+    let world = crate::world::load(scenario)?;
+    interpret(scenario, world, instruction, model, options, emit).await
+}
+
 pub async fn interpret(
     scenario: &Scenario,
     world: Box<dyn World>,

@@ -157,13 +157,16 @@ impl PolicyStore {
 
     /// Write `policy` to `path` atomically.
     pub fn save(&self, path: &Path, policy: &Policy) -> Result<(), PolicyError> {
-        crate::store::write_atomic(path, render(policy).as_bytes()).map_err(|e| {
-            PolicyError::Write {
-                path: path.display().to_string(),
-                detail: e.to_string(),
-            }
-        })
+        save(path, policy)
     }
+}
+
+/// Write `policy` to `path` atomically (never half-written).
+pub fn save(path: &Path, policy: &Policy) -> Result<(), PolicyError> {
+    crate::store::write_atomic(path, render(policy).as_bytes()).map_err(|e| PolicyError::Write {
+        path: path.display().to_string(),
+        detail: e.to_string(),
+    })
 }
 
 fn stem(scenario: &Path) -> String {

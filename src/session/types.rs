@@ -71,6 +71,38 @@ impl Default for Options {
     }
 }
 
+/// What `Verify` checks besides the scenario's `[verify]` table, and how far.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct VerifyRequest {
+    /// Properties checked besides the scenario's.
+    pub properties: Vec<crate::verify::NamedProperty>,
+    /// Leave the scenario's disturbances out.
+    pub no_disturbances: bool,
+    /// Let every action fail as well (the scenario may ask for it too).
+    pub action_failures: bool,
+    /// Bounds of the exploration (none: the defaults).
+    pub max_states: Option<usize>,
+    pub max_ticks: Option<u64>,
+    /// Also write the model that is checked as Promela to this file.
+    pub promela: Option<PathBuf>,
+}
+
+/// What a verification checks, told before its report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VerifyScope {
+    pub nodes: usize,
+    /// Preconditions the safety properties added when the tree was planned in the model.
+    pub added: Vec<crate::verify::model_plan::Constraint>,
+    /// How planning in the model ended, when it did not reach success there.
+    pub planned: Option<super::planned::Prediction>,
+    pub action_failures: bool,
+    pub disturbances: usize,
+    /// The scenario has disturbances and the request left them out.
+    pub disturbances_left_out: bool,
+    /// The Promela model written, with its LTL claims' names.
+    pub promela: Option<(PathBuf, Vec<String>)>,
+}
+
 /// What a model proposes for a failure.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Proposal {
@@ -170,6 +202,11 @@ pub enum Event {
     },
     Approved,
     Rejected,
+    /// The planner planned or grew the tree: what it did and what its simulation predicts
+    /// (emitted before the `TreeChanged` that shows the tree).
+    Planned {
+        summary: super::planned::PlanSummary,
+    },
     /// The tree was changed: how many nodes were added, and on how many actions a value
     /// was set.
     Repaired {
@@ -241,6 +278,10 @@ pub enum Event {
     /// Running (ticking on its own) or paused.
     RunState {
         running: bool,
+    },
+    /// A verification asked for started: what it checks.
+    Verifying {
+        scope: Arc<VerifyScope>,
     },
     /// `verify` finished; `origin` says where the verified tree came from.
     Verified {

@@ -490,6 +490,8 @@ impl App {
             }
             // For the 3D view; the world pane shows facts.
             Event::Scene { .. } => {}
+            // The engine's notices say these in the log; the report shows what was checked.
+            Event::Planned { .. } | Event::Verifying { .. } => {}
         }
     }
 }

@@ -300,6 +300,7 @@ impl Viz {
                 }
                 self.log(L::INFO, format!("proposal: {proposal}"));
             }
+            Event::Planned { summary } => self.log(L::INFO, summary.log_line()),
             Event::Approved => self.log(L::INFO, "approved"),
             Event::Rejected => self.log(L::WARN, "rejected"),
             Event::Repaired { added_nodes, .. } => {
@@ -333,6 +334,7 @@ impl Viz {
             }
             Event::Usage { .. }
             | Event::RunState { .. }
+            | Event::Verifying { .. }
             | Event::Verified { .. }
             | Event::RuleOffered { .. }
             | Event::Knowledge { .. } => {}

@@ -5,6 +5,7 @@
 
 use crate::bt::Tree;
 use crate::domain::action::parse_value;
+use crate::domain::{ActionCall, Condition};
 use crate::planner::Planner;
 
 use super::super::ask::{Tried, missing_value};
@@ -260,6 +261,80 @@ impl Engine {
         });
         self.pending = None;
         self.failure = None;
+        self.set_tree(plan.tree, plan.new_nodes, change);
+        self.check_change();
+    }
+}
+
+impl Engine {
+    /// Conditions a person inserts by name: before `before`, or as the first
+    /// preconditions of the action that failed. Made as written, whether or not it fixes
+    /// the failure: the next run shows what it did.
+    pub(super) fn insert(
+        &mut self,
+        conditions: &[Condition],
+        before: Option<&ActionCall>,
+        author: String,
+    ) {
+        let Some(tree) = self.tree.clone() else {
+            return self.error("no tree: plan first");
+        };
+        if conditions.is_empty() {
+            return self.error("nothing to insert: no condition given");
+        }
+        let names = conditions
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join(" & ");
+        let planner = Planner::new(&self.scenario.domain);
+        let started = std::time::Instant::now();
+        let (result, change) = match (before, &self.failure) {
+            (Some(action), _) => (
+                planner.repair_at(tree.clone(), action, conditions, self.planning.as_ref()),
+                format!("insert {names} before {action}!"),
+            ),
+            (None, Some(failure)) => (
+                planner.repair(
+                    tree.clone(),
+                    failure.node,
+                    conditions,
+                    self.planning.as_ref(),
+                ),
+                format!(
+                    "insert {names} as the first precondition(s) of {}!",
+                    failure.action
+                ),
+            ),
+            (None, None) => {
+                return self.error(format!(
+                    "nowhere to insert {names}: no action has failed (run the tree first, or name the action to insert it before)"
+                ));
+            }
+        };
+        let plan = match result {
+            Ok(plan) => plan,
+            Err(e) => return self.error(format!("cannot insert {names}: {e}")),
+        };
+        self.planned(&plan, started.elapsed());
+        self.emit(Event::Repaired {
+            added_nodes: plan.new_nodes.len(),
+            valued_nodes: 0,
+        });
+        self.undo.push(UndoEntry {
+            tree,
+            fixes: self.fixes.len(),
+        });
+        self.fixes.push(AppliedFix {
+            change: change.clone(),
+            nodes: plan.new_nodes.clone(),
+            author,
+            approval: Approval::Edited,
+            at: now_rfc3339(),
+        });
+        self.pending = None;
+        self.failure = None;
+        self.drop_offers();
         self.set_tree(plan.tree, plan.new_nodes, change);
         self.check_change();
     }

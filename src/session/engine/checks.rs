@@ -10,9 +10,12 @@
 use std::sync::Arc;
 
 use crate::bt::{Tree, to_text};
-use crate::verify::{self, Limits, Report, VerifyConfig, VerifyInput, plan_in_model};
+use crate::verify::{
+    self, Disturbance, Limits, NamedProperty, Report, VerifyConfig, VerifyInput, plan_in_model,
+};
 
-use super::super::types::Event;
+use super::super::planned::Prediction;
+use super::super::types::{Event, VerifyRequest, VerifyScope};
 use super::Engine;
 use super::requests::Internal;
 
@@ -23,6 +26,51 @@ pub(super) enum Gate {
     Checking { id: u64, run_after: bool },
     /// The changed tree fails verification.
     Violated,
+}
+
+/// What one verification checks: the scenario's properties and disturbances with what
+/// the request added or left out, within its bounds.
+struct Checks {
+    properties: Vec<NamedProperty>,
+    disturbances: Vec<Disturbance>,
+    limits: Limits,
+}
+
+impl Checks {
+    fn of(config: VerifyConfig, request: &VerifyRequest) -> Checks {
+        let defaults = Limits::default();
+        let mut properties = config.properties;
+        properties.extend(request.properties.iter().cloned());
+        Checks {
+            properties,
+            disturbances: if request.no_disturbances {
+                Vec::new()
+            } else {
+                config.disturbances
+            },
+            limits: Limits {
+                max_states: request.max_states.unwrap_or(defaults.max_states),
+                max_ticks: request.max_ticks.unwrap_or(defaults.max_ticks),
+                action_failures: request.action_failures || config.action_failures,
+            },
+        }
+    }
+
+    fn input<'a>(
+        &'a self,
+        domain: &'a crate::domain::Domain,
+        tree: &'a Tree,
+        initial: &'a [crate::domain::Condition],
+    ) -> VerifyInput<'a> {
+        VerifyInput {
+            domain,
+            tree,
+            initial,
+            disturbances: &self.disturbances,
+            properties: &self.properties,
+            limits: self.limits,
+        }
+    }
 }
 
 /// What failed in a report, in one line: the first finding or violated property, with the
@@ -63,7 +111,7 @@ impl Engine {
     }
 
     /// Structural checks and model checking, off the engine's thread.
-    pub(super) fn verify(&mut self) {
+    pub(super) fn verify(&mut self, request: VerifyRequest) {
         let Some(tree) = self.tree.clone() else {
             return self.error("nothing to verify: submit an instruction or plan first");
         };
@@ -71,8 +119,12 @@ impl Engine {
             Ok(c) => c,
             Err(e) => return self.error(format!("cannot verify: {e}")),
         };
+        let left_out = request.no_disturbances && !config.disturbances.is_empty();
+        let checks = Checks::of(config, &request);
         let fresh = self.last.is_none() && self.fixes.is_empty() && self.loaded_from.is_none();
         let current = tree;
+        let mut added = Vec::new();
+        let mut planned_note = None;
         let (tree, origin) = match (&self.task, fresh) {
             (Some(task), true) => {
                 let initial = self.planning.facts();
@@ -80,20 +132,23 @@ impl Engine {
                     &self.scenario.domain,
                     &initial,
                     &task.goal.to_dnf(),
-                    &config.properties,
-                    &config.disturbances,
+                    &checks.properties,
+                    &checks.disturbances,
                 ) {
                     Ok(p) => p,
                     Err(e) => return self.error(format!("cannot plan in the model: {e}")),
                 };
-                let added: Vec<String> = planned
+                let prediction = Prediction::of(&planned.plan.outcome, &planned.plan.tree);
+                planned_note = (!prediction.is_success()).then_some(prediction);
+                added.clone_from(&planned.constraints);
+                let guards: Vec<String> = planned
                     .constraints
                     .iter()
                     .map(|c| format!("{}? before {}! ({})", c.condition, c.action, c.property))
                     .collect();
                 let mut origin = "planned in the planner's model (no simulation)".to_string();
-                if !added.is_empty() {
-                    origin.push_str(&format!("; the properties added {}", added.join(", ")));
+                if !guards.is_empty() {
+                    origin.push_str(&format!("; the properties added {}", guards.join(", ")));
                 }
                 let tree = planned.plan.tree;
                 if to_text(&tree) != to_text(&current) {
@@ -104,9 +159,42 @@ impl Engine {
             }
             _ => (current, self.origin()),
         };
+        let promela = match &request.promela {
+            Some(path) => match self.write_promela(&tree, &checks, path) {
+                Ok(claims) => Some((path.clone(), claims)),
+                Err(message) => return self.error(message),
+            },
+            None => None,
+        };
+        self.emit(Event::Verifying {
+            scope: Arc::new(VerifyScope {
+                nodes: tree.len(),
+                added,
+                planned: planned_note,
+                action_failures: checks.limits.action_failures,
+                disturbances: checks.disturbances.len(),
+                disturbances_left_out: left_out,
+                promela,
+            }),
+        });
         self.verifications += 1;
         self.notice("verifying the tree …");
-        self.spawn_check(tree, config, None, origin);
+        self.spawn_check(tree, checks, None, origin);
+    }
+
+    /// Write the model `checks` would check as Promela; its LTL claims' names.
+    fn write_promela(
+        &self,
+        tree: &Tree,
+        checks: &Checks,
+        path: &std::path::Path,
+    ) -> Result<Vec<String>, String> {
+        let initial = self.planning.facts();
+        let model = verify::export_promela(&checks.input(&self.scenario.domain, tree, &initial))
+            .map_err(|e| format!("cannot build the Promela model: {e}"))?;
+        crate::store::write_atomic(path, model.text.as_bytes())
+            .map_err(|e| format!("cannot write the Promela model to {}: {e}", path.display()))?;
+        Ok(model.claims.into_iter().map(|(name, _)| name).collect())
     }
 
     /// Check the tree an applied change produced before it may run.
@@ -126,25 +214,16 @@ impl Engine {
         });
         self.notice("verifying the changed tree in the model before it runs …");
         let origin = self.origin();
-        self.spawn_check(tree, config, Some(id), origin);
+        let checks = Checks::of(config, &VerifyRequest::default());
+        self.spawn_check(tree, checks, Some(id), origin);
     }
 
-    fn spawn_check(&self, tree: Tree, config: VerifyConfig, gate: Option<u64>, origin: String) {
+    fn spawn_check(&self, tree: Tree, checks: Checks, gate: Option<u64>, origin: String) {
         let scenario = self.scenario.clone();
         let initial = self.planning.facts();
         let tx = self.internal_tx.clone();
         tokio::task::spawn_blocking(move || {
-            let input = VerifyInput {
-                domain: &scenario.domain,
-                tree: &tree,
-                initial: &initial,
-                disturbances: &config.disturbances,
-                properties: &config.properties,
-                limits: Limits {
-                    action_failures: config.action_failures,
-                    ..Limits::default()
-                },
-            };
+            let input = checks.input(&scenario.domain, &tree, &initial);
             let report = Arc::new(verify::verify(&input));
             let _ = tx.send(Internal::Verified {
                 report,

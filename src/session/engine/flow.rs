@@ -2,13 +2,15 @@
 //! undoing and verifying.
 
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use crate::bt::path_text;
 use crate::bt::{Outcome as TickOutcome, Tree};
 use crate::goal;
-use crate::planner::{Outcome, Plan, Planner, WorldLeaves};
+use crate::planner::{Plan, Planner, WorldLeaves};
 use crate::world;
 
+use super::super::planned::PlanSummary;
 use super::super::policy;
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Task};
@@ -106,14 +108,15 @@ impl Engine {
         if let Some(store) = &self.policies {
             let path = store.path_for(&self.scenario_path, &task.goal);
             if path.is_file() {
-                return self.load_policy(Some(path));
+                return self.load_policy(Some(path), true);
             }
         }
         let planner = Planner::new(&self.scenario.domain);
+        let started = Instant::now();
         match planner.plan(&task.goal.to_dnf(), self.planning.as_ref()) {
             Ok(plan) => {
                 let why = format!("planned for {}", task.goal);
-                self.note_outcome(&plan);
+                self.planned(&plan, started.elapsed());
                 self.set_tree(plan.tree, Vec::new(), why);
             }
             Err(e) => self.emit(Event::Failed {
@@ -122,23 +125,11 @@ impl Engine {
         }
     }
 
-    /// Say what the planner's simulation predicts.
-    fn note_outcome(&self, plan: &Plan) {
-        let what = match &plan.outcome {
-            Outcome::Success => "the simulation reaches success".to_string(),
-            Outcome::ActionFailed { action, error, .. } => {
-                format!("the simulation predicts {action}! fails: {error}")
-            }
-            Outcome::Unreachable {
-                condition, reason, ..
-            } => format!("{condition} cannot be achieved: {reason}"),
-            Outcome::Exhausted { reason } => reason.clone(),
-        };
-        self.notice(format!(
-            "{} node(s), {} expansion(s); {what}",
-            plan.tree.len(),
-            plan.expansions
-        ));
+    /// Say what the planner did and what its simulation predicts.
+    pub(super) fn planned(&self, plan: &Plan, elapsed: Duration) {
+        let summary = PlanSummary::of(plan, elapsed);
+        self.notice(summary.log_line());
+        self.emit(Event::Planned { summary });
     }
 
     /// Make `tree` the tree, tell front ends, and start the execution world afresh.

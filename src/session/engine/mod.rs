@@ -122,11 +122,29 @@ pub enum Command {
     /// Restore the tree from before the last applied change.
     Undo,
     Verify,
+    /// Verify with more properties, other bounds or a Promela file.
+    VerifyWith(super::types::VerifyRequest),
     SavePolicy,
     /// Write the tree beside its policy as BT.CPP XML and Graphviz DOT.
     Export,
     /// Load a policy file (none: the saved policy of the current task).
     LoadPolicy(Option<PathBuf>),
+    /// Make a tree file (a policy, betr tree text or BT.CPP XML) the tree; `grow`: expand
+    /// what it leaves unachieved in this world, else run it as written.
+    LoadTree {
+        path: PathBuf,
+        grow: bool,
+    },
+    /// Insert `conditions` as a person wrote them: before the action `before`, or as the
+    /// first preconditions of the action that failed; kept whether or not it helps (the
+    /// next run shows that).
+    Insert {
+        conditions: Vec<Condition>,
+        before: Option<crate::domain::ActionCall>,
+        author: String,
+    },
+    /// Save the tree as a policy at this path, whatever the policy directory.
+    SavePolicyTo(PathBuf),
     /// A fresh execution world and ticker.
     ResetWorld,
     /// Keep the offered fix as a rule of its skill (`only`: for the fix's objects alone).
@@ -375,10 +393,18 @@ impl Engine {
             Command::Edit(text) => self.edit(&text),
             Command::SetValue(text) => self.set_value(&text),
             Command::Undo => self.undo(),
-            Command::Verify => self.verify(),
-            Command::SavePolicy => self.save_policy(),
+            Command::Verify => self.verify(super::types::VerifyRequest::default()),
+            Command::VerifyWith(request) => self.verify(request),
+            Command::SavePolicy => self.save_policy_to(None),
             Command::Export => self.export(),
-            Command::LoadPolicy(path) => self.load_policy(path),
+            Command::LoadPolicy(path) => self.load_policy(path, true),
+            Command::LoadTree { path, grow } => self.load_policy(Some(path), grow),
+            Command::Insert {
+                conditions,
+                before,
+                author,
+            } => self.insert(&conditions, before.as_ref(), author),
+            Command::SavePolicyTo(path) => self.save_policy_to(Some(path)),
             Command::ResetWorld => self.reset_world(true),
             Command::KeepRule { only } => self.keep_rule(only),
             Command::DeclineRule => self.decline_rule(),

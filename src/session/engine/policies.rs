@@ -11,14 +11,18 @@ use super::super::types::Event;
 use super::{AppliedFix, Engine, Task};
 
 impl Engine {
-    pub(super) fn save_policy(&mut self) {
+    /// Save the tree as a policy at `to`, else where the policy directory keeps the task's.
+    pub(super) fn save_policy_to(&mut self, to: Option<PathBuf>) {
         let (Some(tree), Some(task)) = (&self.tree, &self.task) else {
             return self.error("nothing to save: plan a tree first");
         };
-        let Some(store) = &self.policies else {
-            return self.error("policies are not kept in this session (no policy directory)");
+        let path = match (to, &self.policies) {
+            (Some(path), _) => path,
+            (None, Some(store)) => store.path_for(&self.scenario_path, &task.goal),
+            (None, None) => {
+                return self.error("policies are not kept in this session (no policy directory)");
+            }
         };
-        let path = store.path_for(&self.scenario_path, &task.goal);
         let fixes: Vec<Fix> = self
             .fixes
             .iter()
@@ -43,7 +47,7 @@ impl Engine {
             fixes,
             tree: tree.clone(),
         };
-        match store.save(&path, &saved) {
+        match policy::save(&path, &saved) {
             Ok(()) => self.emit(Event::PolicySaved {
                 path,
                 fixes: saved.fixes.len(),
@@ -89,8 +93,9 @@ impl Engine {
         self.emit(Event::Exported { paths });
     }
 
-    /// Load a policy file (default: the saved policy of the current task) as the tree.
-    pub(super) fn load_policy(&mut self, path: Option<PathBuf>) {
+    /// Load a policy file (default: the saved policy of the current task) as the tree;
+    /// `grow`: expand what it leaves unachieved in this world.
+    pub(super) fn load_policy(&mut self, path: Option<PathBuf>, grow: bool) {
         let path = match (path, &self.policies, &self.task) {
             (Some(p), _, _) => p,
             (None, Some(store), Some(task)) => store.path_for(&self.scenario_path, &task.goal),
@@ -156,8 +161,6 @@ impl Engine {
                 at: f.at.clone(),
             })
             .collect();
-        // A saved tree may need more expansion in this world (a variant); usually none.
-        let plan = Planner::new(&self.scenario.domain).grow(saved.tree, self.planning.as_ref());
         self.emit(Event::PolicyLoaded {
             path: path.clone(),
             fixes: self.fixes.len(),
@@ -165,6 +168,14 @@ impl Engine {
         self.loaded_from = Some(path.clone());
         self.planned_in_model = false;
         let why = format!("loaded policy {}", path.display());
-        self.set_tree(plan.tree, plan.new_nodes, why);
+        if grow {
+            // A saved tree may need more expansion in this world (a variant); usually none.
+            let started = std::time::Instant::now();
+            let plan = Planner::new(&self.scenario.domain).grow(saved.tree, self.planning.as_ref());
+            self.planned(&plan, started.elapsed());
+            self.set_tree(plan.tree, plan.new_nodes, why);
+        } else {
+            self.set_tree(saved.tree, Vec::new(), why);
+        }
     }
 }
