@@ -13,7 +13,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use betr::bt::{self, NodeKind};
-use betr::session::{Command, Event};
+use betr::session::{Command, Event, NoModel};
 use support::engine::{FIX, INSTRUCTION, Session, model, setup, tree_of};
 use support::repo::runtime as rt;
 
@@ -283,7 +283,9 @@ fn the_repaired_tree_is_exported_and_a_fresh_engine_runs_the_btcpp_file() {
 fn without_a_model_a_person_can_still_resolve() {
     rt().block_on(async {
         let mut s = Session::start(setup(
-            Err("the local backend is not built yet".into()),
+            Err(NoModel::Unavailable(
+                "the local backend is not built yet".into(),
+            )),
             None,
         ));
         s.send(Command::Submit(INSTRUCTION.into()));

@@ -14,12 +14,9 @@ use betr::domain::ActionCall;
 use betr::goal::Formula;
 use betr::scenario::Scenario;
 use betr::session::types::{VerifyRequest, VerifyScope};
-use betr::session::{Command, Engine, EngineHandle, Event, PlanSummary, RunLimits, Setup};
+use betr::session::{Command, Engine, EngineHandle, Event, NoModel, PlanSummary, RunLimits, Setup};
 use betr::verify::Report;
 use betr::viz::Viz;
-
-/// Why one-shot commands have no model: a failure is reported, not asked about.
-const NO_MODEL: &str = "this command runs without a language model";
 
 /// A running engine and its events.
 pub struct Driver {
@@ -105,7 +102,11 @@ impl Driver {
                 .map(|f| f.path.clone())
                 .unwrap_or_default(),
         };
-        let mut setup = Setup::new(Arc::new(start.scenario.clone()), path, Err(NO_MODEL.into()));
+        let mut setup = Setup::new(
+            Arc::new(start.scenario.clone()),
+            path,
+            Err(NoModel::NotUsed("this command")),
+        );
         setup.variant = start.variant.map(str::to_string);
         setup.limits = start.limits;
         setup.scenes = start.viz.is_some();

@@ -13,7 +13,7 @@ use clap::Args;
 
 use betr::llm::LanguageModel;
 use betr::llm::usage::Ledger;
-use betr::session::{PolicyStore, Setup};
+use betr::session::{NoModel, PolicyStore, Setup};
 use betr::tui::dictation::{DefaultMicrophone, DictationService, Microphone, WavMicrophone};
 use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
@@ -97,11 +97,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // First use fetches the local model with a progress bar, before the screen switches;
     // a failed fetch leaves the workbench usable without a model and says why.
     let model = llm_cmds::ensure_local_model(&settings)
-        .map_err(|e| format!("{e:#}"))
+        .map_err(|e| NoModel::Unavailable(format!("{e:#}")))
         .and_then(|()| {
             settings
                 .build(ledger.clone(), &var)
-                .map_err(|e| e.to_string())
+                .map_err(|e| NoModel::Unavailable(e.to_string()))
         })
         .map(|m| {
             m.set_purpose("workbench");
@@ -112,7 +112,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         _ => settings.model.clone(),
     }
     .unwrap_or_else(|| "(no model)".into());
-    let no_model = model.as_ref().err().cloned();
+    let no_model = model.as_ref().err().map(ToString::to_string);
     let policy_dir = args
         .policy_dir
         .clone()

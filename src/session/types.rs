@@ -15,6 +15,18 @@ use crate::scenario::ScenarioError;
 use crate::verify::Report;
 use crate::world::cell::snapshot::SceneSnapshot;
 
+/// Why a session has no language model (it still plans, ticks and takes the conditions a
+/// person types).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NoModel {
+    /// The front end works without one: its failures are reported, not asked about.
+    #[error("{0} runs without a language model")]
+    NotUsed(&'static str),
+    /// The configured model could not be fetched or built.
+    #[error("{0}")]
+    Unavailable(String),
+}
+
 /// How the loop asks and how long it keeps trying.
 #[derive(Debug, Clone)]
 pub struct Options {

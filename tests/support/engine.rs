@@ -10,7 +10,7 @@ use std::time::Duration;
 use betr::bt;
 use betr::llm::LanguageModel;
 use betr::scenario::Scenario;
-use betr::session::{Command, Engine, EngineHandle, Event, PolicyStore, Setup};
+use betr::session::{Command, Engine, EngineHandle, Event, NoModel, PolicyStore, Setup};
 use tokio::sync::mpsc::UnboundedReceiver;
 
 use super::fake_model::FixtureModel;
@@ -29,7 +29,7 @@ pub fn model(delay: Duration) -> FixtureModel {
     m
 }
 
-pub fn setup(model: Result<Arc<dyn LanguageModel>, String>, policies: Option<PathBuf>) -> Setup {
+pub fn setup(model: Result<Arc<dyn LanguageModel>, NoModel>, policies: Option<PathBuf>) -> Setup {
     let path = scenario_path();
     let scenario = Arc::new(Scenario::load(&path).unwrap());
     Setup {

@@ -28,6 +28,19 @@ pub(super) enum Gate {
     Violated,
 }
 
+/// Why the Promela model could not be written.
+#[derive(Debug, thiserror::Error)]
+enum PromelaError {
+    #[error("cannot build the Promela model: {0}")]
+    Build(#[from] verify::ModelError),
+    #[error("cannot write the Promela model to {}: {source}", path.display())]
+    Write {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
 /// What one verification checks: the scenario's properties and disturbances with what
 /// the request added or left out, within its bounds.
 struct Checks {
@@ -162,7 +175,7 @@ impl Engine {
         let promela = match &request.promela {
             Some(path) => match self.write_promela(&tree, &checks, path) {
                 Ok(claims) => Some((path.clone(), claims)),
-                Err(message) => return self.error(message),
+                Err(e) => return self.error(e.to_string()),
             },
             None => None,
         };
@@ -188,12 +201,15 @@ impl Engine {
         tree: &Tree,
         checks: &Checks,
         path: &std::path::Path,
-    ) -> Result<Vec<String>, String> {
+    ) -> Result<Vec<String>, PromelaError> {
         let initial = self.planning.facts();
-        let model = verify::export_promela(&checks.input(&self.scenario.domain, tree, &initial))
-            .map_err(|e| format!("cannot build the Promela model: {e}"))?;
-        crate::store::write_atomic(path, model.text.as_bytes())
-            .map_err(|e| format!("cannot write the Promela model to {}: {e}", path.display()))?;
+        let model = verify::export_promela(&checks.input(&self.scenario.domain, tree, &initial))?;
+        crate::store::write_atomic(path, model.text.as_bytes()).map_err(|source| {
+            PromelaError::Write {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
         Ok(model.claims.into_iter().map(|(name, _)| name).collect())
     }
 

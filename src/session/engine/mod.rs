@@ -36,7 +36,7 @@ use crate::world::{self, World};
 
 use super::ask::Tried;
 use super::policy::{Approval, PolicyStore};
-use super::types::{Event, Options, Proposal, SessionError};
+use super::types::{Event, NoModel, Options, Proposal, SessionError};
 
 use requests::Internal;
 
@@ -49,7 +49,7 @@ pub struct Setup {
     pub variant: Option<String>,
     /// The model, or why there is none (the session still plans, ticks and takes
     /// conditions a person types).
-    pub model: Result<Arc<dyn LanguageModel>, String>,
+    pub model: Result<Arc<dyn LanguageModel>, NoModel>,
     /// The ledger the model is metered into, for usage totals (none: counted here).
     pub ledger: Option<Ledger>,
     pub options: Options,
@@ -73,7 +73,7 @@ impl Setup {
     pub fn new(
         scenario: Arc<Scenario>,
         scenario_path: impl Into<PathBuf>,
-        model: Result<Arc<dyn LanguageModel>, String>,
+        model: Result<Arc<dyn LanguageModel>, NoModel>,
     ) -> Setup {
         Setup {
             scenario,
@@ -206,7 +206,7 @@ pub struct Engine {
     scenario: Arc<Scenario>,
     scenario_path: PathBuf,
     variant: Option<String>,
-    model: Result<Arc<dyn LanguageModel>, String>,
+    model: Result<Arc<dyn LanguageModel>, NoModel>,
     ledger: Option<Ledger>,
     options: Options,
     auto_approve: bool,

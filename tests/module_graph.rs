@@ -1,0 +1,173 @@
+//! The shape of the code, checked from its source: the top-level modules depend on each
+//! other one way (no cycle), the command line reaches the planner and the world only
+//! through the session layer, and library code returns typed errors, not strings.
+//!
+//! Test code (`tests.rs`, `*_tests.rs`, and everything after a file's `#[cfg(test)]`) is
+//! left out: tests may reach anywhere.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// Every `.rs` file under `dir`.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let entries = std::fs::read_dir(&d).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
+        for entry in entries {
+            let path = entry.expect("a directory entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The product code of a file: nothing for test files, the part before `#[cfg(test)]`
+/// otherwise.
+fn product_code(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    if name == "tests.rs" || name.ends_with("_tests.rs") {
+        return String::new();
+    }
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    match text.find("#[cfg(test)]") {
+        Some(at) => text[..at].to_string(),
+        None => text,
+    }
+}
+
+/// Code lines only: comments and doc comments dropped (they may name anything).
+fn code_lines(text: &str) -> impl Iterator<Item = &str> {
+    text.lines().filter(|l| !l.trim_start().starts_with("//"))
+}
+
+/// The top-level module a file belongs to (`src/session/engine/flow.rs` → `session`).
+fn top_module(src: &Path, file: &Path) -> Option<String> {
+    let rel = file.strip_prefix(src).ok()?;
+    let first = rel.components().next()?.as_os_str().to_str()?;
+    Some(first.trim_end_matches(".rs").to_string())
+}
+
+/// Which top-level modules each module's product code names (`crate::X` or `betr::X`).
+fn dependencies(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let modules: BTreeSet<String> = rust_files(src)
+        .iter()
+        .filter_map(|f| top_module(src, f))
+        .filter(|m| m != "lib" && m != "main")
+        .collect();
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in rust_files(src) {
+        let Some(from) = top_module(src, &file) else {
+            continue;
+        };
+        let code = product_code(&file);
+        let entry = graph.entry(from.clone()).or_default();
+        for line in code_lines(&code) {
+            for prefix in ["crate::", "betr::"] {
+                for (at, _) in line.match_indices(prefix) {
+                    let rest = &line[at + prefix.len()..];
+                    let name: String = rest
+                        .chars()
+                        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                        .collect();
+                    if name != from && modules.contains(&name) {
+                        entry.insert(name);
+                    }
+                }
+            }
+        }
+    }
+    graph
+}
+
+/// A cycle through `start`, if there is one.
+fn cycle_from(graph: &BTreeMap<String, BTreeSet<String>>, start: &str) -> Option<Vec<String>> {
+    let mut stack = vec![(start.to_string(), vec![start.to_string()])];
+    let mut seen = BTreeSet::new();
+    while let Some((node, path)) = stack.pop() {
+        for next in graph.get(&node).into_iter().flatten() {
+            if next == start {
+                let mut cycle = path.clone();
+                cycle.push(start.to_string());
+                return Some(cycle);
+            }
+            if seen.insert(next.clone()) {
+                let mut longer = path.clone();
+                longer.push(next.clone());
+                stack.push((next.clone(), longer));
+            }
+        }
+    }
+    None
+}
+
+fn src() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+#[test]
+fn top_level_modules_depend_one_way() {
+    let graph = dependencies(&src());
+    assert!(graph.len() > 10, "the graph was not read: {graph:?}");
+    assert!(
+        graph["session"].contains("planner"),
+        "the reader misses imports: {graph:?}"
+    );
+    let cycles: Vec<String> = graph
+        .keys()
+        .filter_map(|m| cycle_from(&graph, m))
+        .map(|c| c.join(" → "))
+        .collect();
+    assert!(cycles.is_empty(), "import cycles: {cycles:#?}");
+}
+
+#[test]
+fn the_command_line_reaches_planner_and_world_through_the_session() {
+    let graph = dependencies(&src());
+    let cli = &graph["cli"];
+    assert!(
+        cli.contains("session"),
+        "the reader misses imports: {cli:?}"
+    );
+    for forbidden in ["planner", "world"] {
+        assert!(
+            !cli.contains(forbidden),
+            "src/cli imports {forbidden} directly: {cli:?}"
+        );
+    }
+}
+
+#[test]
+fn library_code_returns_typed_errors() {
+    let src = src();
+    let mut found = Vec::new();
+    for file in rust_files(&src) {
+        if top_module(&src, &file).as_deref() == Some("cli") {
+            // The binary's edge phrases errors for people (anyhow).
+            continue;
+        }
+        let code = product_code(&file);
+        for (n, line) in code.lines().enumerate() {
+            if line.trim_start().starts_with("//") {
+                continue;
+            }
+            let compact: String = line.split_whitespace().collect();
+            if compact.contains("Result<") && compact.contains(",String>") {
+                found.push(format!("{}:{}: {}", file.display(), n + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "Result<_, String> in library code:\n{}",
+        found.join("\n")
+    );
+}
