@@ -15,7 +15,7 @@
 //! child). The root returning Success on a tick where no action was reached is success; it
 //! returning Failure that way is a dead end.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 use super::config::Disturbance;
 
@@ -23,7 +23,7 @@ mod read;
 use crate::bt::{NodeId, Tree};
 use crate::domain::{ANY_OBJECT, ActionCall, Atom, AtomPattern, Condition, Domain};
 use crate::goal::Formula;
-use read::{RawNode, RawTree, Universe, observed_disturbances, read_tree};
+use read::{RawNode, RawTree, Universe, observed_disturbances, read_tree, universe_of};
 
 /// A set of facts as a bitset over `Model::atoms`.
 pub type State = Box<[u64]>;
@@ -187,87 +187,46 @@ impl Model {
             .iter()
             .map(|g| g.pre.iter().map(|p| (conds.id(p), p.negated)).collect())
             .collect();
-
-        // The universe: atoms that can be true and that some condition observes.
-        let mut candidates: BTreeSet<Atom> = initial
-            .iter()
-            .filter(|c| !c.negated)
-            .map(|c| c.atom.clone())
-            .collect();
-        for action in &raw_actions {
-            candidates.extend(action.add.iter().cloned());
-        }
-        for g in &grounds {
-            candidates.extend(g.add.iter().cloned());
-        }
-        let universe = Universe::new(candidates, &conds.list);
-        let (matching, deleted, added) = (
-            |a: &Atom| universe.matching(a),
-            |p: &AtomPattern| universe.deleted(p),
-            |adds: &[Atom]| universe.added(adds),
-        );
-
-        let conditions: Vec<CondBits> = conds
-            .list
-            .iter()
-            .map(|c| CondBits {
-                condition: c.clone(),
-                bits: matching(&c.atom),
-            })
-            .collect();
-        // Negated conditions are nodes over the positive id plus a sign.
-        let mut nodes = Vec::with_capacity(raw_nodes.len());
-        let mut signs: HashMap<(usize, bool), usize> = HashMap::new();
-        let mut conditions = conditions;
-        let mut signed = |id: usize, negated: bool, conditions: &mut Vec<CondBits>| -> usize {
-            if !negated {
-                return id;
-            }
-            *signs.entry((id, negated)).or_insert_with(|| {
-                let base = &conditions[id];
-                conditions.push(CondBits {
-                    condition: base.condition.negate(),
-                    bits: base.bits.clone(),
-                });
-                conditions.len() - 1
-            })
-        };
-        let mut actions = Vec::with_capacity(raw_actions.len());
-        for a in &raw_actions {
-            let pre = a
-                .pre
+        let universe = universe_of(initial, &raw_actions, &grounds, &conds.list);
+        let mut signs = Signs::new(
+            conds
+                .list
                 .iter()
-                .map(|&(c, n)| signed(c, n, &mut conditions))
-                .collect();
-            actions.push(CAction {
+                .map(|c| CondBits {
+                    condition: c.clone(),
+                    bits: universe.matching(&c.atom),
+                })
+                .collect(),
+        );
+        let actions = raw_actions
+            .iter()
+            .map(|a| CAction {
                 node: a.node,
                 path: a.path.clone(),
                 call: a.call.clone(),
-                pre,
-                add: added(&a.add),
-                del: a.del.iter().flat_map(&deleted).collect(),
-            });
-        }
-        for (_, node) in raw_nodes {
-            nodes.push(match node {
+                pre: a.pre.iter().map(|&(c, n)| signs.id(c, n)).collect(),
+                add: universe.added(&a.add),
+                del: a.del.iter().flat_map(|p| universe.deleted(p)).collect(),
+            })
+            .collect();
+        let nodes = raw_nodes
+            .into_iter()
+            .map(|(_, node)| match node {
                 RawNode::Sequence(c) => CNode::Sequence(c),
                 RawNode::Fallback(c) => CNode::Fallback(c),
-                RawNode::Condition(c, n) => CNode::Condition(signed(c, n, &mut conditions)),
+                RawNode::Condition(c, n) => CNode::Condition(signs.id(c, n)),
                 RawNode::Action(a) => CNode::Action(a),
-            });
-        }
+            })
+            .collect();
         let disturbances = grounds
             .iter()
             .zip(&ground_pre)
             .map(|(g, pre)| CDisturbance {
                 description: g.description.clone(),
                 grounding: g.grounding.clone(),
-                pre: pre
-                    .iter()
-                    .map(|&(c, n)| signed(c, n, &mut conditions))
-                    .collect(),
-                add: added(&g.add),
-                del: g.del.iter().flat_map(&deleted).collect(),
+                pre: pre.iter().map(|&(c, n)| signs.id(c, n)).collect(),
+                add: universe.added(&g.add),
+                del: g.del.iter().flat_map(|p| universe.deleted(p)).collect(),
             })
             .collect();
         let properties = properties
@@ -275,20 +234,15 @@ impl Model {
             .map(|f| compile_formula(f, &conds.ids))
             .collect();
         let words = universe.atoms.len().div_ceil(64).max(1);
-        let mut state = vec![0u64; words].into_boxed_slice();
-        for c in initial.iter().filter(|c| !c.negated) {
-            if let Some(&i) = universe.index.get(&c.atom) {
-                state[i / 64] |= 1 << (i % 64);
-            }
-        }
+        let initial = initial_state(&universe, initial, words);
         Ok(Model {
             atoms: universe.atoms,
-            conditions,
+            conditions: signs.conditions,
             nodes,
             actions,
             disturbances,
             properties,
-            initial: state,
+            initial,
             words,
         })
     }
@@ -468,4 +422,48 @@ fn ground_disturbances(
         }
     }
     Ok(out)
+}
+
+/// The conditions' bits, with a negated condition added once as a node over its positive
+/// atom's bits plus a sign.
+struct Signs {
+    conditions: Vec<CondBits>,
+    negated: HashMap<usize, usize>,
+}
+
+impl Signs {
+    fn new(conditions: Vec<CondBits>) -> Signs {
+        Signs {
+            conditions,
+            negated: HashMap::new(),
+        }
+    }
+
+    /// The id of condition `id`, negated when `negated`.
+    fn id(&mut self, id: usize, negated: bool) -> usize {
+        if !negated {
+            return id;
+        }
+        let conditions = &mut self.conditions;
+        *self.negated.entry(id).or_insert_with(|| {
+            let base = &conditions[id];
+            let negation = CondBits {
+                condition: base.condition.negate(),
+                bits: base.bits.clone(),
+            };
+            conditions.push(negation);
+            conditions.len() - 1
+        })
+    }
+}
+
+/// The initial state's bits: the initially true atoms of the universe.
+fn initial_state(universe: &Universe, initial: &[Condition], words: usize) -> Box<[u64]> {
+    let mut state = vec![0u64; words].into_boxed_slice();
+    for c in initial.iter().filter(|c| !c.negated) {
+        if let Some(&i) = universe.index.get(&c.atom) {
+            state[i / 64] |= 1 << (i % 64);
+        }
+    }
+    state
 }

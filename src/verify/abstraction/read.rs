@@ -192,3 +192,25 @@ pub(super) enum RawNode {
     Condition(usize, bool),
     Action(usize),
 }
+
+/// The universe: atoms that can be true (initially, or added by an action or a
+/// disturbance) and that some condition observes.
+pub(super) fn universe_of(
+    initial: &[Condition],
+    actions: &[RawAction],
+    grounds: &[Ground],
+    observed: &[Condition],
+) -> Universe {
+    let mut candidates: BTreeSet<Atom> = initial
+        .iter()
+        .filter(|c| !c.negated)
+        .map(|c| c.atom.clone())
+        .collect();
+    for action in actions {
+        candidates.extend(action.add.iter().cloned());
+    }
+    for g in grounds {
+        candidates.extend(g.add.iter().cloned());
+    }
+    Universe::new(candidates, observed)
+}
