@@ -4,6 +4,7 @@
 //! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
+pub mod edit;
 pub mod engine;
 pub mod goal_checks;
 pub mod interpret;
@@ -17,6 +18,7 @@ pub mod value_bounds;
 pub mod values;
 
 pub use ask::missing_value;
+pub use edit::{Edit, EditError, parse_edit};
 pub use engine::{Command, Engine, EngineHandle, Setup};
 pub use goal_checks::check_goal;
 pub use interpret::{Interpretation, interpret};

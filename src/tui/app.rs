@@ -5,9 +5,12 @@
 
 mod session;
 
+use std::sync::Arc;
+
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
-use crate::session::Command;
+use crate::scenario::Scenario;
+use crate::session::{Command, parse_edit};
 
 use super::components::dictation::DictationPanel;
 use super::components::input::{InputLine, Mode, Submitted};
@@ -58,6 +61,8 @@ pub enum Overlay {
 }
 
 pub struct App {
+    /// The session's scenario: what a person types is read over its vocabulary.
+    scenario: Arc<Scenario>,
     pub keys: KeyBindings,
     pub theme: Theme,
     pub tree: TreePane,
@@ -73,7 +78,7 @@ pub struct App {
 }
 
 impl App {
-    pub fn new(info: Info, keys: KeyBindings, theme: Theme) -> App {
+    pub fn new(scenario: Arc<Scenario>, info: Info, keys: KeyBindings, theme: Theme) -> App {
         let mut llm = LlmPane::default();
         if let Some(why) = &info.no_model {
             llm.error = Some(strings::no_model(why));
@@ -82,6 +87,7 @@ impl App {
             llm.log(strings::keys_file_error(e));
         }
         App {
+            scenario,
             keys,
             theme,
             tree: TreePane::default(),
@@ -152,7 +158,11 @@ impl App {
                 }
                 Some(Submitted::Edit(text)) => {
                     self.llm.error = None;
-                    self.queue.push(AppEvent::Command(Command::Edit(text)));
+                    match parse_edit(&self.scenario, &text) {
+                        Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
+                        // Shown as the engine's errors are; nothing reaches the session.
+                        Err(e) => self.show_error(e.to_string()),
+                    }
                 }
                 None => {}
             }

@@ -20,6 +20,15 @@ fn setup() -> Setup {
     Setup::new(scenario, path, Err("no model in this test".into()))
 }
 
+fn app(setup: &Setup) -> App {
+    App::new(
+        setup.scenario.clone(),
+        Info::default(),
+        KeyBindings::default(),
+        Theme::default(),
+    )
+}
+
 fn press(c: char) -> QueueEvent {
     QueueEvent::Input(TermEvent::Key(KeyEvent::new(
         KeyCode::Char(c),
@@ -56,7 +65,7 @@ struct Bench {
 }
 
 impl Bench {
-    fn new(queue: &Queue) -> Bench {
+    fn new(app: App, queue: &Queue) -> Bench {
         // Dictation is unavailable, so the microphone is never opened.
         let dictation = DictationService::reporting_to(
             Arc::new(DefaultMicrophone),
@@ -65,7 +74,7 @@ impl Bench {
         );
         Bench {
             terminal: Terminal::new(TestBackend::new(100, 30)).unwrap(),
-            app: App::new(Info::default(), KeyBindings::default(), Theme::default()),
+            app,
             dictation,
         }
     }
@@ -73,9 +82,11 @@ impl Bench {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn keys_and_session_events_share_the_queue_and_quitting_stops_the_engine() {
-    let (engine, events) = Engine::spawn(setup()).unwrap();
+    let setup = setup();
+    let app = app(&setup);
+    let (engine, events) = Engine::spawn(setup).unwrap();
     let queue = Queue::new();
-    let mut bench = Bench::new(&queue);
+    let mut bench = Bench::new(app, &queue);
     let mut recorder = Recorder {
         queue: queue.sender(),
         events: Vec::new(),
@@ -120,9 +131,11 @@ async fn keys_and_session_events_share_the_queue_and_quitting_stops_the_engine()
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_loop_ends_with_the_session_and_takes_in_what_was_waiting() {
-    let (engine, events) = Engine::spawn(setup()).unwrap();
+    let setup = setup();
+    let app = app(&setup);
+    let (engine, events) = Engine::spawn(setup).unwrap();
     let queue = Queue::new();
-    let mut bench = Bench::new(&queue);
+    let mut bench = Bench::new(app, &queue);
     let sender = queue.sender();
     // Queued before the session's events, so taken in before the session ends.
     sender

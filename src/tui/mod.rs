@@ -128,11 +128,12 @@ pub async fn run(
         stderr_to,
         tree,
     } = workbench;
+    let scenario = setup.scenario.clone();
     let (engine, events) = Engine::spawn(setup)?;
     if let Some(path) = tree {
         engine.send(crate::session::Command::LoadPolicy(Some(path)));
     }
-    let mut app = App::new(info, keys, theme);
+    let mut app = App::new(scenario, info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let queue = event_loop::Queue::new();
