@@ -197,7 +197,14 @@ fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
     });
     let (mut service, mut heard) =
         DictationService::new(AudioMicrophone::playing(audio), Ok(loader));
-    let mut app = App::new(Info::default(), KeyBindings::default(), Theme::default());
+    let scenario =
+        Scenario::load(&fixtures::root().join("scenarios/cell/red_on_blue.toml")).unwrap();
+    let mut app = App::new(
+        Arc::new(scenario),
+        Info::default(),
+        KeyBindings::default(),
+        Theme::default(),
+    );
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()

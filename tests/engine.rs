@@ -13,8 +13,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use betr::bt::{self, NodeKind};
-use betr::session::{Command, Event, NoModel};
-use support::engine::{FIX, INSTRUCTION, Session, model, setup, tree_of};
+use betr::domain::{Condition, Value};
+use betr::scenario::Scenario;
+use betr::session::{Command, Edit, Event, NoModel, Setup, values};
+use support::engine::{FIX, INSTRUCTION, Session, edit, model, setup, tree_of};
 use support::repo::runtime as rt;
 
 #[test]
@@ -67,14 +69,28 @@ fn reject_leaves_the_tree_and_an_invalid_edit_is_refused() {
         s.run_to_proposal().await;
         s.send(Command::Reject);
         s.until("rejected", |e| matches!(e, Event::Rejected)).await;
-        s.send(Command::Edit("\"purple cube\" on \"blue cube\"".into()));
+        // An edit that cannot be read never reaches the engine: an unknown object, a
+        // dangling `|`.
+        let e = edit("\"purple cube\" on \"blue cube\"").unwrap_err();
+        assert!(e.to_string().contains("purple cube"), "{e}");
+        assert!(edit("~\"blue cube\" on \"blue cube\" | ").is_err());
+        // The engine refuses what was read but does not fit: a value where the failure
+        // calls for conditions, and conditions outside the vocabulary from a sender that did
+        // not read them over it.
+        s.send(edit("5 N").unwrap());
+        let got = s
+            .until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(
+            format!("{got:?}").contains("calls for conditions"),
+            "{got:?}"
+        );
+        let unknown = Condition::parse("\"purple cube\" on \"blue cube\"").unwrap();
+        s.send(Command::Edit(Edit::Conditions(vec![unknown])));
         let got = s
             .until("an error", |e| matches!(e, Event::Error { .. }))
             .await;
         assert!(format!("{got:?}").contains("purple cube"), "{got:?}");
-        s.send(Command::Edit("~\"blue cube\" on \"blue cube\" | ".into()));
-        s.until("an error", |e| matches!(e, Event::Error { .. }))
-            .await;
         // Neither the rejection nor the bad edits changed the tree.
         let changes = s
             .seen
@@ -83,7 +99,7 @@ fn reject_leaves_the_tree_and_an_invalid_edit_is_refused() {
             .count();
         assert_eq!(changes, 1, "only the planned tree");
         // A valid edit is applied like an approved proposal.
-        s.send(Command::Edit(FIX.into()));
+        s.send(edit(FIX).unwrap());
         let got = s
             .until("the edited tree", |e| {
                 matches!(e, Event::TreeChanged { .. })
@@ -299,11 +315,62 @@ fn without_a_model_a_person_can_still_resolve() {
         s.send(Command::Run);
         s.until("the failure", |e| matches!(e, Event::ActionFailed { .. }))
             .await;
-        s.send(Command::Edit(FIX.into()));
+        s.send(edit(FIX).unwrap());
         s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
             .await;
         s.send(Command::Run);
         s.until("success", |e| matches!(e, Event::Success { .. }))
             .await;
+    });
+}
+
+/// A value a person set (`force of egg = 5 N`, read by the front end) is checked against
+/// the skill's declaration and put on every action that uses it; one beyond what the robot
+/// can do, or sent before there is a tree, is refused.
+#[test]
+fn a_value_set_by_a_person_is_checked_then_put_on_its_actions() {
+    rt().block_on(async {
+        let path = support::fixtures::root().join("scenarios/cell/params/egg.toml");
+        let scenario = Arc::new(Scenario::load(&path).unwrap());
+        let setting = values::parse_setting(&scenario, "force of egg = 5 N").unwrap();
+        let too_strong = values::Setting {
+            value: Value::Number {
+                value: 120.0,
+                unit: "N".into(),
+            },
+            ..setting.clone()
+        };
+        let mut s = Session::start(Setup::new(
+            scenario,
+            path,
+            Err(NoModel::NotUsed("this test")),
+        ));
+        s.send(Command::SetValue(setting.clone()));
+        let got = s
+            .until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(format!("{got:?}").contains("plan first"), "{got:?}");
+        s.send(Command::Plan);
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::SetValue(too_strong));
+        let got = s
+            .until("an error", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(
+            format!("{got:?}").contains("more than the robot can do"),
+            "{got:?}"
+        );
+        s.send(Command::SetValue(setting));
+        let got = s
+            .until("the valued tree", |e| {
+                matches!(e, Event::TreeChanged { .. })
+            })
+            .await;
+        assert!(
+            got.iter()
+                .any(|e| matches!(e, Event::Repaired { valued_nodes, .. } if *valued_nodes > 0)),
+            "{got:?}"
+        );
     });
 }

@@ -94,14 +94,14 @@ impl Bench {
         let model = FixtureModel::new(fixtures::every_reply());
         let setup = Setup {
             knowledge,
-            ..Setup::new(scenario, path, Ok(Arc::new(model)))
+            ..Setup::new(scenario.clone(), path, Ok(Arc::new(model)))
         };
         let (engine, events) = Engine::spawn(setup).unwrap();
         let (dictation, heard) = DictationService::new(microphone, Ok(loader));
         Bench {
             engine,
             events,
-            app: App::new(info, KeyBindings::default(), Theme::default()),
+            app: App::new(scenario, info, KeyBindings::default(), Theme::default()),
             dictation,
             heard,
             sent: Vec::new(),
@@ -235,6 +235,44 @@ fn failure_with_a_pending_proposal_then_approval() {
         let screen = b.screen(120, 40);
         assert!(screen.contains("SUCCESS"), "{screen}");
         insta::assert_snapshot!("after_run_to_success", screen);
+    });
+}
+
+/// An edit the app cannot read is shown where the engine's errors are (above the log and
+/// in it) and never sent; one the engine refuses is shown the same way.
+#[test]
+fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.step_to_failure().await;
+        b.key(KeyCode::Char('x'));
+        b.until(|e| matches!(e, Event::Rejected)).await;
+        b.key(KeyCode::Char('e'));
+        b.type_text("\"purple cube\" on \"blue cube\"");
+        b.key(KeyCode::Enter);
+        assert!(
+            !b.sent.iter().any(|c| matches!(c, Command::Edit(_))),
+            "{:?}",
+            b.sent
+        );
+        let shown = b.app.llm.error.clone().unwrap_or_default();
+        assert!(shown.contains("unknown object \"purple cube\""), "{shown}");
+        assert_eq!(
+            b.app.llm.log_lines().last(),
+            Some(&format!("error: {shown}"))
+        );
+
+        b.key(KeyCode::Char('e'));
+        b.type_text("5 N");
+        b.key(KeyCode::Enter);
+        b.until(|e| matches!(e, Event::Error { .. })).await;
+        let shown = b.app.llm.error.clone().unwrap_or_default();
+        assert!(shown.contains("calls for conditions"), "{shown}");
+        assert!(
+            b.app.llm.log_lines().contains(&format!("error: {shown}")),
+            "{:?}",
+            b.app.llm.log_lines()
+        );
     });
 }
 

@@ -205,7 +205,7 @@ pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> 
 /// tree again.
 fn apply_setting(session: &mut Driver, setting: &Setting) -> Result<()> {
     let change = session
-        .change(Command::SetValue(setting.text.clone()))
+        .change(Command::SetValue(setting.clone()))
         .with_context(|| format!("--set {:?}", setting.text))?;
     println!(
         "Setting {} = {} for {:?} on {} action(s)",

@@ -14,7 +14,7 @@ use clap::Args;
 use betr::llm::LanguageModel;
 use betr::llm::usage::Ledger;
 use betr::session::{NoModel, PolicyStore, Setup};
-use betr::tui::dictation::{DefaultMicrophone, DictationService, Microphone, WavMicrophone};
+use betr::tui::dictation::{DefaultMicrophone, Microphone, WavMicrophone};
 use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
 use super::llm_cmds::{self, LlmFlags};
@@ -171,7 +171,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         info,
         keys,
         theme,
-        dictation: DictationService::new(microphone, loader),
+        microphone,
+        stt: loader,
         stderr_to: log_path(),
         tree: args.tree.clone(),
     };

@@ -4,6 +4,7 @@
 //! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
+pub mod edit;
 pub mod engine;
 pub mod goal_checks;
 pub mod interpret;
@@ -19,6 +20,7 @@ pub mod values;
 
 pub use crate::planner::RunLimits;
 pub use ask::missing_value;
+pub use edit::{Edit, EditError, parse_edit};
 pub use engine::{Command, Engine, EngineHandle, Setup};
 pub use goal_checks::check_goal;
 pub use interpret::{Interpretation, interpret};

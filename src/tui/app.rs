@@ -1,16 +1,21 @@
 //! The one state of the workbench. Keys become commands for the session (queued, sent
 //! by the event loop); session events update the components. Drawing reads this state
-//! (`ui::draw`); nothing here talks to a terminal.
+//! (`ui::draw`); nothing here talks to a terminal. What session events do is in
+//! `session`.
+
+mod session;
+
+use std::sync::Arc;
 
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
-use crate::session::{Command, Event};
+use crate::scenario::Scenario;
+use crate::session::{Command, parse_edit};
 
 use super::components::dictation::DictationPanel;
-use super::components::help::report_lines;
 use super::components::input::{InputLine, Mode, Submitted};
-use super::components::llm_pane::{LlmPane, ProposalView};
-use super::components::status_bar::{Ending, Message, StatusBar};
+use super::components::llm_pane::LlmPane;
+use super::components::status_bar::{Message, StatusBar};
 use super::components::tree_pane::TreePane;
 use super::components::world_pane::WorldPane;
 use super::dictation::{DictationEvent, DictationRequest};
@@ -56,6 +61,8 @@ pub enum Overlay {
 }
 
 pub struct App {
+    /// The session's scenario: what a person types is read over its vocabulary.
+    scenario: Arc<Scenario>,
     pub keys: KeyBindings,
     pub theme: Theme,
     pub tree: TreePane,
@@ -65,13 +72,13 @@ pub struct App {
     pub status: StatusBar,
     pub dictation: DictationPanel,
     pub overlay: Option<Overlay>,
+    /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
-    /// Requests for the push-to-talk service, in order.
     quit: bool,
 }
 
 impl App {
-    pub fn new(info: Info, keys: KeyBindings, theme: Theme) -> App {
+    pub fn new(scenario: Arc<Scenario>, info: Info, keys: KeyBindings, theme: Theme) -> App {
         let mut llm = LlmPane::default();
         if let Some(why) = &info.no_model {
             llm.error = Some(strings::no_model(why));
@@ -80,6 +87,7 @@ impl App {
             llm.log(strings::keys_file_error(e));
         }
         App {
+            scenario,
             keys,
             theme,
             tree: TreePane::default(),
@@ -150,7 +158,11 @@ impl App {
                 }
                 Some(Submitted::Edit(text)) => {
                     self.llm.error = None;
-                    self.queue.push(AppEvent::Command(Command::Edit(text)));
+                    match parse_edit(&self.scenario, &text) {
+                        Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
+                        // Shown as the engine's errors are; nothing reaches the session.
+                        Err(e) => self.show_error(e.to_string()),
+                    }
                 }
                 None => {}
             }
@@ -254,6 +266,12 @@ impl App {
         self.status.message = Some(Message { text, error });
     }
 
+    /// An error of something the person asked for: above the log, and in it.
+    fn show_error(&mut self, message: String) {
+        self.llm.log(format!("error: {message}"));
+        self.llm.error = Some(message);
+    }
+
     /// What the push-to-talk service reports.
     pub fn on_dictation(&mut self, event: DictationEvent) {
         match event {
@@ -300,198 +318,6 @@ impl App {
                 self.dictation.idle();
                 self.message(strings::RECORDING_DISCARDED.to_string(), false);
             }
-        }
-    }
-
-    pub fn on_session(&mut self, event: Event) {
-        match event {
-            Event::TreeChanged {
-                tree,
-                new_nodes,
-                learned,
-                why,
-            } => {
-                let added = new_nodes.len();
-                self.tree.set_tree(tree, new_nodes, learned);
-                self.status.ending = None;
-                self.llm.log(if added > 0 {
-                    format!("{why}: {added} new node(s)")
-                } else {
-                    why
-                });
-            }
-            Event::Ticked { record } => {
-                self.status.ticks = record.tick;
-                self.tree.set_record(record);
-            }
-            Event::WorldChanged { facts, reset } => {
-                let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
-                // Relations between objects first: they change; "near robot" rarely does.
-                facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
-                self.world.facts = facts;
-                if reset {
-                    self.status.ticks = 0;
-                    self.status.ending = None;
-                    self.world.last_error = None;
-                    self.tree.clear_statuses();
-                }
-            }
-            Event::ActionFailed {
-                action,
-                node,
-                error,
-                ..
-            } => {
-                let text = strings::failed(&action.to_string(), &error);
-                self.tree.set_failing(node);
-                self.world.last_error = Some(text.clone());
-                self.world.error_resolved = false;
-                self.status.ending = Some(Ending::Failed);
-                self.llm.log(text);
-            }
-            Event::Asking { what } => {
-                self.status.awaiting = Some(&strings::AWAITING_MODEL);
-                self.llm.error = None;
-                self.llm.asking = Some(what);
-            }
-            Event::Replied { attribution, .. } => {
-                self.llm.asking = None;
-                self.llm.replied_by = Some(attribution);
-            }
-            Event::InvalidReply { error } => self.llm.log(format!("unusable reply: {error}")),
-            Event::CandidateRejected {
-                candidate, reason, ..
-            } => {
-                self.llm.log(format!("set aside {candidate}: {reason}"));
-            }
-            Event::Goal {
-                goal, reasoning, ..
-            } => {
-                self.status.awaiting = None;
-                self.llm.goal = Some(goal.to_string());
-                self.llm.reasoning = reasoning;
-            }
-            Event::Proposal {
-                proposal,
-                reasoning,
-                ..
-            } => {
-                self.llm.asking = None;
-                self.llm.reasoning = reasoning;
-                self.llm.proposal = Some(ProposalView::of(&proposal));
-                self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
-            }
-            Event::Approved => {
-                self.status.awaiting = None;
-                self.llm.proposal = None;
-                self.llm.log("approved");
-            }
-            Event::Rejected => {
-                self.status.awaiting = None;
-                self.llm.proposal = None;
-                self.llm
-                    .log("rejected: the tree is unchanged (e to type conditions)");
-            }
-            Event::Repaired {
-                added_nodes,
-                valued_nodes,
-            } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
-            Event::DidNotHelp { reason } => {
-                self.status.awaiting = None;
-                self.llm
-                    .log(format!("the change did not help and was undone: {reason}"));
-            }
-            Event::Success { ticks } => {
-                self.status.ending = Some(Ending::Success);
-                self.world.error_resolved = true;
-                self.llm.log(strings::success(ticks));
-            }
-            Event::GaveUp { reason } => {
-                self.status.awaiting = None;
-                self.llm.log(reason);
-            }
-            Event::Usage { totals } => self.status.usage = totals,
-            Event::RunState { running } => self.status.running = running,
-            Event::Verified { report, origin } => {
-                let holds = report.holds();
-                let mut lines = vec![strings::verified_tree(&origin)];
-                lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
-                self.llm
-                    .log(if holds { "verified" } else { "NOT verified" });
-            }
-            Event::ChangeViolates { report } => {
-                self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
-                let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
-                lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
-                self.llm.log(strings::CHANGE_VIOLATES);
-            }
-            Event::PolicySaved { path, fixes } => {
-                self.llm
-                    .log(strings::policy_saved(&path.display().to_string(), fixes));
-            }
-            Event::Exported { paths } => {
-                let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
-                self.llm.log(strings::exported(&names));
-            }
-            Event::PolicyLoaded { path, fixes } => {
-                self.llm
-                    .log(strings::policy_loaded(&path.display().to_string(), fixes));
-            }
-            Event::Error { message } => {
-                self.llm.error = Some(message.clone());
-                self.llm.log(format!("error: {message}"));
-            }
-            Event::Failed { error } => {
-                self.status.awaiting = None;
-                self.llm.asking = None;
-                self.llm.error = Some(error.to_string());
-                self.llm.log(format!("error: {error}"));
-            }
-            Event::Notice { message } => self.llm.log(message),
-            Event::RuleOffered { rule, only, .. } => {
-                let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
-                let text = strings::rule_offer(
-                    &rule,
-                    only.as_deref(),
-                    (
-                        &key(Action::KeepRule),
-                        &key(Action::KeepRuleOnly),
-                        &key(Action::DeclineRule),
-                    ),
-                );
-                // Shown where a proposal would be, until it is answered: the log keeps the
-                // steps of the repair in view.
-                self.llm.offer = Some(text);
-            }
-            Event::RuleKept { id, rule, path } => {
-                self.llm.offer = None;
-                let text = strings::rule_kept(&id, &rule, &path.display().to_string());
-                self.llm.log(text.clone());
-                self.message(text, false);
-            }
-            Event::RuleRefused { rule, reason } => {
-                self.llm.offer = None;
-                let text = strings::rule_refused(&rule, &reason);
-                self.llm.log(text.clone());
-                self.message(text, true);
-            }
-            Event::Knowledge { path, rules } => {
-                let mut lines = vec![strings::knowledge_title(
-                    &path.display().to_string(),
-                    rules.len(),
-                )];
-                if rules.is_empty() {
-                    lines.push(strings::NO_RULES.to_string());
-                }
-                lines.extend(rules);
-                self.overlay = Some(Overlay::Report(lines));
-            }
-            // For the 3D view; the world pane shows facts.
-            Event::Scene { .. } => {}
-            // The engine's notices say these in the log; the report shows what was checked.
-            Event::Planned { .. } | Event::Verifying { .. } => {}
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Push-to-talk for the workbench: the bridge between the app's key presses and the
 //! `voice` module. The app asks ([`DictationRequest`]); this service owns the recording
-//! and the speech-to-text model and answers with [`DictationEvent`]s on a channel the
-//! event loop reads, so the screen never waits on audio or on a model.
+//! and the speech-to-text model and answers with [`DictationEvent`]s through a sink (in the
+//! workbench, into the event loop's queue), so the screen never waits on audio or on a
+//! model.
 //!
 //! The microphone is a trait so tests (and machines without a sound card) can stand in a
 //! recording; the model is loaded on first use (fetched first when it is not cached, with
@@ -13,7 +14,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use tokio::sync::OnceCell;
-use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
+use tokio::sync::mpsc::{UnboundedReceiver, unbounded_channel};
 
 use crate::voice::{self, Audio16k, Level, Recorder, SpeechToText, Transcript, VoiceError};
 
@@ -143,6 +144,10 @@ impl Microphone for WavMicrophone {
     }
 }
 
+/// Where the service's events go: called from the audio thread and from tasks, so it
+/// must not block (a send on an unbounded channel).
+pub type DictationSink = Arc<dyn Fn(DictationEvent) + Send + Sync>;
+
 /// Builds the speech-to-text backend (blocking: it may fetch and load a model), reporting
 /// progress through the callback; the error says what to do.
 pub type SttLoader =
@@ -157,24 +162,37 @@ pub struct DictationService {
     recording: Option<Box<dyn Recording>>,
     /// A recording is being stopped or transcribed.
     busy: Arc<AtomicBool>,
-    events: UnboundedSender<DictationEvent>,
+    events: DictationSink,
 }
 
 impl DictationService {
+    /// A service whose events arrive on a channel of their own.
     pub fn new(
         microphone: Arc<dyn Microphone>,
         loader: Result<SttLoader, String>,
     ) -> (DictationService, UnboundedReceiver<DictationEvent>) {
-        let (events, rx) = unbounded_channel();
-        let service = DictationService {
+        let (tx, rx) = unbounded_channel();
+        // The app is gone only when the workbench is closing: nothing is left to tell.
+        let sink: DictationSink = Arc::new(move |event| {
+            let _ = tx.send(event);
+        });
+        (DictationService::reporting_to(microphone, loader, sink), rx)
+    }
+
+    /// A service whose events go to `events`.
+    pub fn reporting_to(
+        microphone: Arc<dyn Microphone>,
+        loader: Result<SttLoader, String>,
+        events: DictationSink,
+    ) -> DictationService {
+        DictationService {
             microphone,
             loader,
             stt: Arc::new(OnceCell::new()),
             recording: None,
             busy: Arc::new(AtomicBool::new(false)),
             events,
-        };
-        (service, rx)
+        }
     }
 
     /// Act on a request. Must run inside a tokio runtime: stopping and transcribing run as
@@ -188,8 +206,7 @@ impl DictationService {
     }
 
     fn send(&self, event: DictationEvent) {
-        // The app is gone only when the workbench is closing.
-        let _ = self.events.send(event);
+        (self.events)(event);
     }
 
     fn start(&mut self) {
@@ -215,7 +232,7 @@ impl DictationService {
         let (levels, forwarding) = (self.events.clone(), open.clone());
         let on_level = Box::new(move |level: Level| {
             if forwarding.load(Ordering::Acquire) {
-                let _ = levels.send(DictationEvent::Level(level));
+                levels(DictationEvent::Level(level));
             }
         });
         // Opening the device is quick (the stream starts on its own thread); doing it here
@@ -257,7 +274,7 @@ impl DictationService {
         tokio::spawn(async move {
             let outcome = stop_and_transcribe(recording, &stt, &loader, &events).await;
             busy.store(false, Ordering::SeqCst);
-            let _ = events.send(match outcome {
+            events(match outcome {
                 Ok(transcript) => DictationEvent::Heard(transcript),
                 Err(message) => DictationEvent::Failed(message),
             });
@@ -277,13 +294,13 @@ async fn stop_and_transcribe(
     recording: Box<dyn Recording>,
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
-    events: &UnboundedSender<DictationEvent>,
+    events: &DictationSink,
 ) -> Result<Transcript, String> {
     let audio = tokio::task::spawn_blocking(move || recording.stop())
         .await
         .map_err(|e| format!("the recording could not be stopped: {e}"))?
         .map_err(|e| e.to_string())?;
-    let _ = events.send(DictationEvent::Transcribing {
+    events(DictationEvent::Transcribing {
         seconds: audio.seconds(),
     });
     let model = ready_model(stt, loader, events).await?;
@@ -297,14 +314,14 @@ async fn stop_and_transcribe(
 async fn ready_model(
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
-    events: &UnboundedSender<DictationEvent>,
+    events: &DictationSink,
 ) -> Result<Arc<dyn SpeechToText>, String> {
     stt.get_or_try_init(|| {
         let (loader, events) = (loader.clone(), events.clone());
         async move {
             tokio::task::spawn_blocking(move || {
                 loader(&mut |message: &str| {
-                    let _ = events.send(DictationEvent::Preparing(message.to_string()));
+                    events(DictationEvent::Preparing(message.to_string()));
                 })
             })
             .await

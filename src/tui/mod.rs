@@ -4,8 +4,9 @@
 //! components' `draw`), components that handle keys and queue app events, key bindings
 //! that also generate the help overlay (`keys`), colours (`theme`) and every user-facing
 //! text (`strings`). The session knows nothing of this module. Push-to-talk runs beside the
-//! session: `dictation` owns the microphone and the speech-to-text model and reports on a
-//! channel of its own.
+//! session: `dictation` owns the microphone and the speech-to-text model. Everything the
+//! app reacts to (keys, session events, dictation events, animation ticks) arrives on the
+//! event loop's one queue (`event_loop`).
 //!
 //! The terminal is restored on every exit path: a guard's `Drop` on normal returns and
 //! errors, and a panic hook (installed before raw mode is entered) on panics.
@@ -35,11 +36,9 @@ use crossterm::terminal::{
 use ratatui::Terminal;
 use ratatui::backend::CrosstermBackend;
 
-use tokio::sync::mpsc::UnboundedReceiver;
-
 use crate::session::{Engine, SessionError, Setup};
 
-use dictation::{DictationEvent, DictationService};
+use dictation::{DictationService, Microphone, SttLoader};
 
 pub use app::{App, Info, Request};
 pub use keys::KeyBindings;
@@ -104,8 +103,10 @@ pub struct Workbench {
     pub info: Info,
     pub keys: KeyBindings,
     pub theme: Theme,
-    /// Push-to-talk: the service and the channel its events arrive on.
-    pub dictation: (DictationService, UnboundedReceiver<DictationEvent>),
+    /// Push-to-talk: where recordings come from.
+    pub microphone: Arc<dyn Microphone>,
+    /// Push-to-talk: how the speech-to-text model is loaded, or why dictation cannot work.
+    pub stt: Result<SttLoader, String>,
     /// Where standard error goes while the screen is up (the log file).
     pub stderr_to: Option<PathBuf>,
     /// A tree file to open instead of planning (betr text, a policy, BT.CPP XML).
@@ -122,28 +123,29 @@ pub async fn run(
         info,
         keys,
         theme,
-        dictation: (mut dictation, mut heard),
+        microphone,
+        stt,
         stderr_to,
         tree,
     } = workbench;
-    let (engine, mut events) = Engine::spawn(setup)?;
+    let scenario = setup.scenario.clone();
+    let (engine, events) = Engine::spawn(setup)?;
     if let Some(path) = tree {
         engine.send(crate::session::Command::LoadPolicy(Some(path)));
     }
-    let mut app = App::new(info, keys, theme);
+    let mut app = App::new(scenario, info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
+    let queue = event_loop::Queue::new();
+    let mut dictation = DictationService::reporting_to(microphone, stt, queue.dictation_sink());
     let stop = Arc::new(AtomicBool::new(false));
-    let mut input = event_loop::spawn_input_reader(stop.clone());
+    event_loop::spawn_input_reader(queue.sender(), stop.clone());
     event_loop::run(
         &mut terminal,
         &mut app,
         &engine,
-        event_loop::Inputs {
-            session: &mut events,
-            terminal: &mut input,
-            dictation: &mut heard,
-        },
+        events,
+        queue,
         &mut dictation,
         &mut tap,
     )

@@ -10,7 +10,9 @@ use std::time::Duration;
 use betr::bt;
 use betr::llm::LanguageModel;
 use betr::scenario::Scenario;
-use betr::session::{Command, Engine, EngineHandle, Event, NoModel, PolicyStore, Setup};
+use betr::session::{
+    Command, EditError, Engine, EngineHandle, Event, NoModel, PolicyStore, Setup, parse_edit,
+};
 use tokio::sync::mpsc::UnboundedReceiver;
 
 use super::fake_model::FixtureModel;
@@ -21,6 +23,12 @@ pub const FIX: &str = "~\"any object\" on \"blue cube\"";
 
 pub fn scenario_path() -> PathBuf {
     fixtures::root().join("scenarios/cell/red_on_blue.toml")
+}
+
+/// The edit a person typed, read over scenario 1 as the workbench reads it.
+pub fn edit(text: &str) -> Result<Command, EditError> {
+    let scenario = Scenario::load(&scenario_path()).unwrap();
+    parse_edit(&scenario, text).map(Command::Edit)
 }
 
 pub fn model(delay: Duration) -> FixtureModel {

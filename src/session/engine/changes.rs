@@ -4,15 +4,15 @@
 //! changed tree runs from the scenario's first state.
 
 use crate::bt::Tree;
-use crate::domain::action::parse_value;
-use crate::domain::{ActionCall, Condition};
+use crate::domain::{ActionCall, Condition, Value, ValueParam};
 use crate::planner::Planner;
 
 use super::super::ask::{Tried, missing_value};
+use super::super::edit::Edit;
 use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
-use super::super::values::{self, conform};
+use super::super::values::{self, Setting, conform};
 use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
 
 impl Engine {
@@ -134,9 +134,10 @@ impl Engine {
         }
     }
 
-    /// What a person wrote for the pending proposal (or the current failure): validated
-    /// against the vocabulary, then applied. On an error nothing changes.
-    pub(super) fn edit(&mut self, text: &str) {
+    /// What a person wrote for the pending proposal (or the current failure), read by the
+    /// front end: checked against what is pending and the vocabulary, then applied. On an
+    /// error nothing changes.
+    pub(super) fn edit(&mut self, edit: Edit) {
         let base = match (&self.pending, &self.failure) {
             (Some(p), _) => Some((p.proposal.clone(), p.failure.clone())),
             (None, Some(f)) => self.blank_proposal(f).map(|p| (p, Some(f.clone()))),
@@ -145,7 +146,7 @@ impl Engine {
         let Some((base, failure)) = base else {
             return self.error("nothing to edit: no action has failed and nothing is proposed");
         };
-        let edited = match self.edited(&base, text) {
+        let edited = match self.edited(&base, edit) {
             Ok(p) => p,
             Err(e) => return self.error(e),
         };
@@ -180,41 +181,42 @@ impl Engine {
         })
     }
 
-    fn edited(&self, base: &Proposal, text: &str) -> Result<Proposal, String> {
-        let text = text.trim();
-        match base {
-            Proposal::Conditions { action, node, .. } => {
-                let formula = self
-                    .scenario
-                    .parse_goal(text)
-                    .map_err(|e| format!("'{text}': {e}"))?;
-                match formula.to_dnf().0.as_slice() {
-                    [one] if !one.is_empty() => Ok(Proposal::Conditions {
-                        action: action.clone(),
-                        node: *node,
-                        conditions: one.clone(),
-                    }),
-                    _ => Err(format!(
-                        "'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}"
-                    )),
+    /// `base` with the edit in it: conditions for an action, a value for a parameter.
+    fn edited(&self, base: &Proposal, edit: Edit) -> Result<Proposal, String> {
+        match (base, edit) {
+            (Proposal::Conditions { action, node, .. }, Edit::Conditions(conditions)) => {
+                // The front end read them over the same vocabulary; a sender that did not
+                // is refused here.
+                if conditions.is_empty() {
+                    return Err(format!("no conditions for {action}"));
                 }
+                for c in &conditions {
+                    self.scenario
+                        .domain
+                        .vocabulary
+                        .check_atom(&c.atom)
+                        .map_err(|e| format!("'{}': {e}", Edit::Conditions(conditions.clone())))?;
+                }
+                Ok(Proposal::Conditions {
+                    action: action.clone(),
+                    node: *node,
+                    conditions,
+                })
             }
-            Proposal::Value {
-                skill,
-                object,
-                param,
-                ..
-            } => {
+            (
+                Proposal::Value {
+                    skill,
+                    object,
+                    param,
+                    ..
+                },
+                Edit::Value(value),
+            ) => {
+                let shown = value_text(&value);
                 let declared = self
-                    .scenario
-                    .domain
-                    .skills
-                    .iter()
-                    .find(|s| &s.name == skill)
-                    .and_then(|s| s.values.iter().find(|v| &v.name == param))
+                    .declared_value(skill, param)
                     .ok_or_else(|| format!("{skill} declares no value {param}"))?;
-                let value = parse_value(text).map_err(|e| format!("'{text}': {e}"))?;
-                let value = conform(declared, value).map_err(|e| format!("'{text}': {e}"))?;
+                let value = conform(declared, value).map_err(|e| format!("'{shown}': {e}"))?;
                 Ok(Proposal::Value {
                     skill: skill.clone(),
                     object: object.clone(),
@@ -222,24 +224,46 @@ impl Engine {
                     value,
                 })
             }
+            (Proposal::Conditions { action, .. }, edit @ Edit::Value(_)) => Err(format!(
+                "'{edit}': {action} calls for conditions ('A & ~B'), not a value"
+            )),
+            (Proposal::Value { skill, param, .. }, edit @ Edit::Conditions(_)) => Err(format!(
+                "'{edit}': {skill} calls for a value of {param}, not conditions"
+            )),
         }
     }
 
-    /// `force of egg = 5 N`: a value on every action that uses it, then re-plan.
-    pub(super) fn set_value(&mut self, text: &str) {
+    /// The declaration of `skill`'s value `param`.
+    fn declared_value(&self, skill: &str, param: &str) -> Option<&ValueParam> {
+        self.scenario
+            .domain
+            .skills
+            .iter()
+            .find(|s| s.name == skill)
+            .and_then(|s| s.values.iter().find(|v| v.name == param))
+    }
+
+    /// `force of egg = 5 N`, read by the front end: checked against the skills' declared
+    /// values, set on every action that uses it, then re-plan.
+    pub(super) fn set_value(&mut self, setting: &Setting) {
         let Some(tree) = self.tree.clone() else {
             return self.error("no tree: plan first");
         };
-        let setting = match values::parse_setting(&self.scenario, text) {
-            Ok(s) => s,
-            Err(e) => return self.error(e.to_string()),
-        };
+        for (skill, param) in &setting.targets {
+            let checked = match self.declared_value(skill, param) {
+                Some(declared) => conform(declared, setting.value.clone()).map(|_| ()),
+                None => Err(format!("{skill} declares no value {param}")),
+            };
+            if let Err(e) = checked {
+                return self.error(format!("{:?}: {e}", setting.text));
+            }
+        }
         let mut changed = tree.clone();
-        let valued = values::apply(&mut changed, &setting);
+        let valued = values::apply(&mut changed, setting);
         if valued == 0 {
             return self.error(format!(
-                "{text:?}: no action of the tree uses that value with {:?}",
-                setting.object
+                "{:?}: no action of the tree uses that value with {:?}",
+                setting.text, setting.object
             ));
         }
         let plan = Planner::new(&self.scenario.domain).grow(changed, self.planning.as_ref());
@@ -337,6 +361,14 @@ impl Engine {
         self.drop_offers();
         self.set_tree(plan.tree, plan.new_nodes, change);
         self.check_change();
+    }
+}
+
+/// A value as a person would type it (a category without its quotes).
+fn value_text(value: &Value) -> String {
+    match value {
+        Value::Category(c) => c.clone(),
+        number => number.to_string(),
     }
 }
 

@@ -115,10 +115,12 @@ pub enum Command {
     /// Drop the pending proposal.
     Reject,
     /// Conditions (`A & ~B`) or a value (`5 N`) a person wrote for the pending proposal or
-    /// the current failure; validated, then applied.
-    Edit(String),
-    /// A value for every action using a skill with an object: `force of egg = 5 N`.
-    SetValue(String),
+    /// the current failure, read by [`super::parse_edit`]; checked against what is pending,
+    /// then applied.
+    Edit(super::Edit),
+    /// A value for every action using a skill with an object (`force of egg = 5 N`, read by
+    /// [`super::values::parse_setting`]).
+    SetValue(super::values::Setting),
     /// Restore the tree from before the last applied change.
     Undo,
     Verify,
@@ -390,8 +392,8 @@ impl Engine {
             Command::Pause => self.set_running(false),
             Command::Approve => self.approve(),
             Command::Reject => self.reject(),
-            Command::Edit(text) => self.edit(&text),
-            Command::SetValue(text) => self.set_value(&text),
+            Command::Edit(edit) => self.edit(edit),
+            Command::SetValue(setting) => self.set_value(&setting),
             Command::Undo => self.undo(),
             Command::Verify => self.verify(super::types::VerifyRequest::default()),
             Command::VerifyWith(request) => self.verify(request),

@@ -1,0 +1,192 @@
+//! What a person writes for the pending proposal or the current failure, read over the
+//! scenario's vocabulary by the front end before it reaches the engine: conditions that
+//! must hold before the failed action (`~"any object" on "blue cube"`, `A & ~B`) or a value
+//! for the parameter it lacks (`5 N`, `"shovel"`). The engine checks the result against
+//! what it is working on (conditions for a failure that calls for them, a value within
+//! what the robot can do).
+//!
+//! The text says which it is: conditions are tried first; a number is a value, and so is
+//! a quoted category, or a word that is no condition in a domain that declares categorical
+//! values (a tool's name).
+
+use std::fmt;
+
+use crate::domain::action::{ActionError, parse_value};
+use crate::domain::{Condition, Value, VocabularyError};
+use crate::goal::{Formula, GoalError};
+use crate::scenario::Scenario;
+
+/// A person's edit, read.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Edit {
+    /// Conditions that must hold before the failed action: one, or a conjunction.
+    Conditions(Vec<Condition>),
+    /// A value for the parameter the failed action lacks.
+    Value(Value),
+}
+
+impl fmt::Display for Edit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Edit::Conditions(conditions) => {
+                for (i, c) in conditions.iter().enumerate() {
+                    if i > 0 {
+                        f.write_str(" & ")?;
+                    }
+                    write!(f, "{c}")?;
+                }
+                Ok(())
+            }
+            Edit::Value(value) => write!(f, "{value}"),
+        }
+    }
+}
+
+/// Why an edit could not be read; each names the text as typed (trimmed) and what was
+/// wrong where: the column of a syntax error, the atom the vocabulary does not know, the
+/// byte of a value that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum EditError {
+    #[error("'{text}': {error}")]
+    Syntax { text: String, error: GoalError },
+    #[error("'{text}': {error}")]
+    Vocabulary {
+        text: String,
+        error: VocabularyError,
+    },
+    #[error("'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}")]
+    NotAConjunction { text: String, formula: String },
+    #[error("'{text}': {error}")]
+    Value { text: String, error: ActionError },
+}
+
+/// Read `text` as conditions over `scenario`'s vocabulary, or else as a value.
+pub fn parse_edit(scenario: &Scenario, text: &str) -> Result<Edit, EditError> {
+    let text = text.trim();
+    let not_conditions = match parse_conditions(scenario, text) {
+        Ok(conditions) => return Ok(Edit::Conditions(conditions)),
+        Err(e) => e,
+    };
+    match parse_value(text) {
+        Ok(value @ Value::Number { .. }) => Ok(Edit::Value(value)),
+        Ok(value) if text.starts_with('"') || declares_categories(scenario) => {
+            Ok(Edit::Value(value))
+        }
+        // A number with a bad unit is a value gone wrong, not a condition.
+        Err(error) if text.starts_with(|c: char| c.is_ascii_digit() || "+-.".contains(c)) => {
+            Err(EditError::Value {
+                text: text.to_string(),
+                error,
+            })
+        }
+        _ => Err(not_conditions),
+    }
+}
+
+/// One condition or a conjunction, every atom in the vocabulary.
+fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>, EditError> {
+    let formula = Formula::parse(text).map_err(|error| EditError::Syntax {
+        text: text.to_string(),
+        error,
+    })?;
+    for atom in formula.atoms() {
+        scenario
+            .domain
+            .vocabulary
+            .check_atom(&atom)
+            .map_err(|error| EditError::Vocabulary {
+                text: text.to_string(),
+                error,
+            })?;
+    }
+    match formula.to_dnf().0.as_slice() {
+        [one] if !one.is_empty() => Ok(one.clone()),
+        _ => Err(EditError::NotAConjunction {
+            text: text.to_string(),
+            formula: formula.to_string(),
+        }),
+    }
+}
+
+/// Whether a skill of the domain takes a value given by category (such as a tool).
+fn declares_categories(scenario: &Scenario) -> bool {
+    scenario
+        .domain
+        .skills
+        .iter()
+        .flat_map(|s| &s.values)
+        .any(|v| v.unit.is_none())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::*;
+
+    fn scenario(file: &str) -> Scenario {
+        Scenario::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scenarios/cell")
+                .join(file),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn conditions_are_read_over_the_vocabulary() {
+        let s = scenario("red_on_blue.toml");
+        let edit = parse_edit(&s, "  ~\"any object\" on \"blue cube\" ").unwrap();
+        assert_eq!(edit.to_string(), "~\"any object\" on \"blue cube\"");
+        let Edit::Conditions(conditions) = edit else {
+            panic!("{edit:?}");
+        };
+        assert!(conditions[0].negated);
+    }
+
+    #[test]
+    fn numbers_and_quoted_categories_are_values() {
+        let s = scenario("params/egg.toml");
+        assert_eq!(
+            parse_edit(&s, "5 N").unwrap(),
+            Edit::Value(Value::Number {
+                value: 5.0,
+                unit: "N".into()
+            })
+        );
+        assert_eq!(
+            parse_edit(&s, "\"shovel\"").unwrap(),
+            Edit::Value(Value::Category("shovel".into()))
+        );
+        // A bare word is a tool where the domain has tools, not elsewhere.
+        let sand = scenario("params/sand.toml");
+        assert_eq!(
+            parse_edit(&sand, "shovel").unwrap(),
+            Edit::Value(Value::Category("shovel".into()))
+        );
+        assert!(matches!(
+            parse_edit(&scenario("red_on_blue.toml"), "shovel"),
+            Err(EditError::Syntax { .. } | EditError::Vocabulary { .. })
+        ));
+    }
+
+    #[test]
+    fn errors_say_what_was_wrong_and_where() {
+        let s = scenario("red_on_blue.toml");
+        let e = parse_edit(&s, "\"purple cube\" on \"blue cube\"").unwrap_err();
+        assert!(matches!(e, EditError::Vocabulary { .. }), "{e:?}");
+        assert!(e.to_string().contains("\"purple cube\""), "{e}");
+        let e = parse_edit(&s, "~\"blue cube\" on \"blue cube\" | ").unwrap_err();
+        assert!(matches!(e, EditError::Syntax { .. }), "{e:?}");
+        assert!(e.to_string().contains("column"), "{e}");
+        let e = parse_edit(
+            &s,
+            "\"red cube\" on \"blue cube\" | \"red cube\" on \"green cube\"",
+        )
+        .unwrap_err();
+        assert!(matches!(e, EditError::NotAConjunction { .. }), "{e:?}");
+        let e = parse_edit(&s, "1e999 N").unwrap_err();
+        assert!(matches!(e, EditError::Value { .. }), "{e:?}");
+        assert!(e.to_string().starts_with("'1e999 N': at byte 0"), "{e}");
+    }
+}

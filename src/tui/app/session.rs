@@ -1,0 +1,281 @@
+//! What the session's events do to the app's state, one function per group of events:
+//! `on_session` routes each event to its group.
+
+use crate::session::Event;
+
+use super::super::components::help::report_lines;
+use super::super::components::llm_pane::ProposalView;
+use super::super::components::status_bar::Ending;
+use super::super::keys::Action;
+use super::super::strings;
+use super::{App, Overlay};
+
+impl App {
+    pub fn on_session(&mut self, event: Event) {
+        match event {
+            e @ (Event::Asking { .. }
+            | Event::Replied { .. }
+            | Event::InvalidReply { .. }
+            | Event::CandidateRejected { .. }
+            | Event::Goal { .. }
+            | Event::Usage { .. }) => self.on_model_talk(e),
+            e @ (Event::TreeChanged { .. } | Event::Repaired { .. }) => self.on_tree_change(e),
+            e @ (Event::ActionFailed { .. }
+            | Event::Proposal { .. }
+            | Event::Approved
+            | Event::Rejected
+            | Event::DidNotHelp { .. }
+            | Event::GaveUp { .. }) => self.on_failure_or_proposal(e),
+            e @ (Event::Ticked { .. }
+            | Event::WorldChanged { .. }
+            | Event::RunState { .. }
+            | Event::Success { .. }
+            | Event::Scene { .. }) => self.on_world(e),
+            e @ (Event::Verified { .. }
+            | Event::ChangeViolates { .. }
+            | Event::PolicySaved { .. }
+            | Event::PolicyLoaded { .. }
+            | Event::Exported { .. }) => self.on_policy_or_verification(e),
+            e @ (Event::RuleOffered { .. }
+            | Event::RuleKept { .. }
+            | Event::RuleRefused { .. }
+            | Event::Knowledge { .. }) => self.on_knowledge(e),
+            e @ (Event::Error { .. } | Event::Failed { .. } | Event::Notice { .. }) => {
+                self.on_report(e);
+            }
+            // The engine's notices say these in the log; the report shows what was checked.
+            Event::Planned { .. } | Event::Verifying { .. } => {}
+        }
+    }
+
+    /// The model: a question under way, its answer, a goal read, the tokens spent.
+    fn on_model_talk(&mut self, event: Event) {
+        match event {
+            Event::Asking { what } => {
+                self.status.awaiting = Some(&strings::AWAITING_MODEL);
+                self.llm.error = None;
+                self.llm.asking = Some(what);
+            }
+            Event::Replied { attribution, .. } => {
+                self.llm.asking = None;
+                self.llm.replied_by = Some(attribution);
+            }
+            Event::InvalidReply { error } => self.llm.log(format!("unusable reply: {error}")),
+            Event::CandidateRejected {
+                candidate, reason, ..
+            } => {
+                self.llm.log(format!("set aside {candidate}: {reason}"));
+            }
+            Event::Goal {
+                goal, reasoning, ..
+            } => {
+                self.status.awaiting = None;
+                self.llm.goal = Some(goal.to_string());
+                self.llm.reasoning = reasoning;
+            }
+            Event::Usage { totals } => self.status.usage = totals,
+            _ => {}
+        }
+    }
+
+    /// A new tree (planned, repaired, undone, loaded) and what a repair added.
+    fn on_tree_change(&mut self, event: Event) {
+        match event {
+            Event::TreeChanged {
+                tree,
+                new_nodes,
+                learned,
+                why,
+            } => {
+                let added = new_nodes.len();
+                self.tree.set_tree(tree, new_nodes, learned);
+                self.status.ending = None;
+                self.llm.log(if added > 0 {
+                    format!("{why}: {added} new node(s)")
+                } else {
+                    why
+                });
+            }
+            Event::Repaired {
+                added_nodes,
+                valued_nodes,
+            } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
+            _ => {}
+        }
+    }
+
+    /// A failed action and what becomes of the change proposed for it.
+    fn on_failure_or_proposal(&mut self, event: Event) {
+        match event {
+            Event::ActionFailed {
+                action,
+                node,
+                error,
+                ..
+            } => {
+                let text = strings::failed(&action.to_string(), &error);
+                self.tree.set_failing(node);
+                self.world.last_error = Some(text.clone());
+                self.world.error_resolved = false;
+                self.status.ending = Some(Ending::Failed);
+                self.llm.log(text);
+            }
+            Event::Proposal {
+                proposal,
+                reasoning,
+                ..
+            } => {
+                self.llm.asking = None;
+                self.llm.reasoning = reasoning;
+                self.llm.proposal = Some(ProposalView::of(&proposal));
+                self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
+            }
+            Event::Approved => {
+                self.status.awaiting = None;
+                self.llm.proposal = None;
+                self.llm.log("approved");
+            }
+            Event::Rejected => {
+                self.status.awaiting = None;
+                self.llm.proposal = None;
+                self.llm
+                    .log("rejected: the tree is unchanged (e to type conditions)");
+            }
+            Event::DidNotHelp { reason } => {
+                self.status.awaiting = None;
+                self.llm
+                    .log(format!("the change did not help and was undone: {reason}"));
+            }
+            Event::GaveUp { reason } => {
+                self.status.awaiting = None;
+                self.llm.log(reason);
+            }
+            _ => {}
+        }
+    }
+
+    /// The execution world: ticks, facts, a reset, running or not, success.
+    fn on_world(&mut self, event: Event) {
+        match event {
+            Event::Ticked { record } => {
+                self.status.ticks = record.tick;
+                self.tree.set_record(record);
+            }
+            Event::WorldChanged { facts, reset } => {
+                let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
+                // Relations between objects first: they change; "near robot" rarely does.
+                facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
+                self.world.facts = facts;
+                if reset {
+                    self.status.ticks = 0;
+                    self.status.ending = None;
+                    self.world.last_error = None;
+                    self.tree.clear_statuses();
+                }
+            }
+            Event::RunState { running } => self.status.running = running,
+            Event::Success { ticks } => {
+                self.status.ending = Some(Ending::Success);
+                self.world.error_resolved = true;
+                self.llm.log(strings::success(ticks));
+            }
+            // For the 3D view; the world pane shows facts.
+            Event::Scene { .. } => {}
+            _ => {}
+        }
+    }
+
+    /// Verification reports, and the policy saved, loaded or exported.
+    fn on_policy_or_verification(&mut self, event: Event) {
+        match event {
+            Event::Verified { report, origin } => {
+                let holds = report.holds();
+                let mut lines = vec![strings::verified_tree(&origin)];
+                lines.extend(report_lines(&report, &self.theme));
+                self.overlay = Some(Overlay::Report(lines));
+                self.llm
+                    .log(if holds { "verified" } else { "NOT verified" });
+            }
+            Event::ChangeViolates { report } => {
+                self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
+                let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
+                lines.extend(report_lines(&report, &self.theme));
+                self.overlay = Some(Overlay::Report(lines));
+                self.llm.log(strings::CHANGE_VIOLATES);
+            }
+            Event::PolicySaved { path, fixes } => {
+                self.llm
+                    .log(strings::policy_saved(&path.display().to_string(), fixes));
+            }
+            Event::Exported { paths } => {
+                let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+                self.llm.log(strings::exported(&names));
+            }
+            Event::PolicyLoaded { path, fixes } => {
+                self.llm
+                    .log(strings::policy_loaded(&path.display().to_string(), fixes));
+            }
+            _ => {}
+        }
+    }
+
+    /// Learned rules: an approved fix offered as one, kept, refused, and the kept ones.
+    fn on_knowledge(&mut self, event: Event) {
+        match event {
+            Event::RuleOffered { rule, only, .. } => {
+                let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+                let text = strings::rule_offer(
+                    &rule,
+                    only.as_deref(),
+                    (
+                        &key(Action::KeepRule),
+                        &key(Action::KeepRuleOnly),
+                        &key(Action::DeclineRule),
+                    ),
+                );
+                // Shown where a proposal would be, until it is answered: the log keeps the
+                // steps of the repair in view.
+                self.llm.offer = Some(text);
+            }
+            Event::RuleKept { id, rule, path } => {
+                self.llm.offer = None;
+                let text = strings::rule_kept(&id, &rule, &path.display().to_string());
+                self.llm.log(text.clone());
+                self.message(text, false);
+            }
+            Event::RuleRefused { rule, reason } => {
+                self.llm.offer = None;
+                let text = strings::rule_refused(&rule, &reason);
+                self.llm.log(text.clone());
+                self.message(text, true);
+            }
+            Event::Knowledge { path, rules } => {
+                let mut lines = vec![strings::knowledge_title(
+                    &path.display().to_string(),
+                    rules.len(),
+                )];
+                if rules.is_empty() {
+                    lines.push(strings::NO_RULES.to_string());
+                }
+                lines.extend(rules);
+                self.overlay = Some(Overlay::Report(lines));
+            }
+            _ => {}
+        }
+    }
+
+    /// What the engine says in words: an error, a failure of the task, a notice.
+    fn on_report(&mut self, event: Event) {
+        match event {
+            Event::Error { message } => self.show_error(message),
+            Event::Failed { error } => {
+                self.status.awaiting = None;
+                self.llm.asking = None;
+                self.llm.error = Some(error.to_string());
+                self.llm.log(format!("error: {error}"));
+            }
+            Event::Notice { message } => self.llm.log(message),
+            _ => {}
+        }
+    }
+}
