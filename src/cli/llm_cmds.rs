@@ -136,6 +136,63 @@ pub(super) fn setup(flags: &LlmFlags) -> Result<Llm> {
 }
 
 /// The local model is fetched on first use (with a progress bar) before it is loaded.
+#[derive(clap::Args)]
+pub struct ResolveFlags {
+    pub scenario: PathBuf,
+    /// An instruction instead of the scenario's.
+    #[arg(long, conflicts_with = "audio")]
+    pub instruction: Option<String>,
+    /// Dictate the instruction from a WAV file (printed; confirmed on the terminal or
+    /// by --yes).
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
+    /// Approve every proposal (and a dictated transcript) without asking.
+    #[arg(long, short = 'y')]
+    pub yes: bool,
+    /// Questions about failures before giving up.
+    #[arg(long, default_value_t = 5)]
+    pub max_rounds: usize,
+    /// Where to save the final tree (default: policies/<scenario>.bt on success).
+    #[arg(long)]
+    pub save: Option<PathBuf>,
+    /// Work on the scenario's stated goal instead of reading its instruction (no model
+    /// call for the goal).
+    #[arg(long)]
+    pub stated_goal: bool,
+    /// After success, offer each approved fix as a rule of its skill for later tasks
+    /// (asked on the terminal; with --yes kept without asking), checked before it is
+    /// kept in the knowledge file beside the policies.
+    #[arg(long)]
+    pub learn: bool,
+    #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+    #[command(flatten)]
+    pub stt: super::voice_cmd::SttFlags,
+    #[command(flatten)]
+    pub viz: super::viz_flags::VizFlags,
+}
+
+#[derive(clap::Args)]
+pub struct InterpretArgs {
+    pub scenario: PathBuf,
+    /// The instruction (default: the scenario's).
+    #[arg(conflicts_with = "audio")]
+    pub instruction: Option<String>,
+    /// Dictate the instruction: transcribe this WAV file, print the transcript and use
+    /// it once confirmed (or corrected) on the terminal, or with --yes.
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
+    /// Use a dictated transcript without asking (it is still printed).
+    #[arg(long, short = 'y')]
+    pub yes: bool,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+    #[command(flatten)]
+    pub stt: super::voice_cmd::SttFlags,
+}
+
 pub fn ensure_local_model(settings: &Settings) -> Result<()> {
     if settings.backend == Backend::Local && settings.model_path.is_none() {
         super::model_cmd::ensure(settings.model.as_deref())?;
@@ -235,11 +292,47 @@ fn read_examples(path: &Path) -> Result<Vec<Example>> {
         .collect())
 }
 
-pub fn interpret(
-    scenario: &Scenario,
-    instruction: Option<&str>,
-    flags: &LlmFlags,
-) -> Result<ExitCode> {
+/// `betr interpret`: the instruction typed or dictated, then read.
+pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
+    let scenario = super::load(&args.scenario)?;
+    let instruction = super::voice_cmd::instruction(
+        args.instruction.clone(),
+        args.audio.as_deref(),
+        args.llm.config.as_deref(),
+        &args.stt,
+        args.yes,
+    )?;
+    interpret(&scenario, instruction.as_deref(), &args.llm)
+}
+
+/// `betr resolve`: the instruction typed or dictated, then the whole loop.
+pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode> {
+    let scenario = super::load_with(&args.scenario, &args.knowledge)?;
+    let instruction = super::voice_cmd::instruction(
+        args.instruction.clone(),
+        args.audio.as_deref(),
+        args.llm.config.as_deref(),
+        &args.stt,
+        args.yes,
+    )?;
+    resolve(
+        &scenario,
+        &ResolveArgs {
+            instruction: instruction.as_deref(),
+            yes: args.yes,
+            max_rounds: args.max_rounds,
+            save: args.save.as_deref(),
+            scenario_path: &args.scenario,
+            viz: &args.viz,
+            stated_goal: args.stated_goal,
+            learn: args.learn.then_some(&args.knowledge.dir),
+        },
+        &args.llm,
+        glyphs,
+    )
+}
+
+fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -> Result<ExitCode> {
     let llm = setup(flags)?;
     let instruction = instruction
         .map(str::to_string)
@@ -280,7 +373,7 @@ pub struct ResolveArgs<'a> {
     pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
 }
 
-pub fn resolve(
+fn resolve(
     scenario: &Scenario,
     args: &ResolveArgs,
     flags: &LlmFlags,

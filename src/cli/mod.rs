@@ -55,33 +55,7 @@ pub enum Command {
     PolicySaveTest(PolicySaveTest),
     /// Check the planned (or a saved) tree before it runs: structural rules, then every
     /// reachable state of the abstraction; exit 1 with a counterexample when violated.
-    Verify {
-        scenario: PathBuf,
-        /// A tree file to verify instead of planning one (betr text, a saved policy, or
-        /// BehaviorTree.CPP v4 XML).
-        #[arg(long)]
-        tree: Option<PathBuf>,
-        /// A property to check besides the scenario's: 'always F', 'never F', 'eventually F'.
-        #[arg(long = "property")]
-        properties: Vec<String>,
-        /// Write the model for the SPIN model checker: --export promela FILE.
-        #[arg(long, num_args = 2, value_names = ["FORMAT", "FILE"])]
-        export: Option<Vec<String>>,
-        /// Let every action also fail (leaving the state unchanged).
-        #[arg(long)]
-        failures: bool,
-        /// Ignore the disturbances the scenario declares.
-        #[arg(long)]
-        no_disturbances: bool,
-        /// Stop exploring after this many states (the result is then "unknown").
-        #[arg(long, default_value_t = 200_000)]
-        max_states: usize,
-        /// Ticks within which the tree must succeed from every reachable state.
-        #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
-        max_ticks: u64,
-        #[command(flatten)]
-        knowledge: knowledge_cmd::KnowledgeFlags,
-    },
+    Verify(verify_cmd::VerifyArgs),
     /// Write a tree as BehaviorTree.CPP v4 XML (for BT.CPP and Groot2) or Graphviz DOT
     /// (statuses of the last tick of a run as colours, the last fix's nodes marked).
     Export {
@@ -126,73 +100,12 @@ pub enum Command {
         knowledge: knowledge_cmd::KnowledgeFlags,
     },
     /// Tick the planned tree (or a saved one) in a fresh world until success or failure.
-    Run {
-        scenario: PathBuf,
-        /// A tree file to run instead of planning one (betr text, a saved policy, or
-        /// BehaviorTree.CPP v4 XML).
-        #[arg(long)]
-        tree: Option<PathBuf>,
-        /// Print the running action and failures at every tick.
-        #[arg(long)]
-        trace: bool,
-        /// Give up after this many ticks.
-        #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
-        max_ticks: u64,
-        /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
-        #[arg(long)]
-        variant: Option<String>,
-        #[command(flatten)]
-        viz: viz_flags::VizFlags,
-        #[command(flatten)]
-        knowledge: knowledge_cmd::KnowledgeFlags,
-    },
+    Run(tree_cmds::RunArgs),
     /// Plan, run until an action fails, insert conditions as that action's first
     /// preconditions, re-plan and run to success; print and optionally save the tree.
-    Repair {
-        scenario: PathBuf,
-        /// Conditions to insert (a conjunction: 'A & B'); repeat for successive failures.
-        #[arg(long = "add", required_unless_present = "set")]
-        add: Vec<String>,
-        /// A value parameter for every action that uses it with the object, e.g.
-        /// "force of egg = 5 N" (repeatable; applied before any --add).
-        #[arg(long = "set")]
-        set: Vec<String>,
-        /// Insert the first --add at this action (e.g. 'PickUp "Chips"') instead of the failing one.
-        #[arg(long)]
-        at: Option<String>,
-        /// Start from this tree file instead of planning (betr text, a saved policy, or
-        /// BehaviorTree.CPP v4 XML).
-        #[arg(long)]
-        tree: Option<PathBuf>,
-        /// Write the repaired tree here (atomically).
-        #[arg(long)]
-        save: Option<PathBuf>,
-        /// Plan and repair in the scenario's `[world.variants.NAME]` world.
-        #[arg(long)]
-        variant: Option<String>,
-        #[command(flatten)]
-        viz: viz_flags::VizFlags,
-        #[command(flatten)]
-        knowledge: knowledge_cmd::KnowledgeFlags,
-    },
+    Repair(tree_cmds::RepairArgs),
     /// Ask a language model for the goal an instruction means in the scenario.
-    Interpret {
-        scenario: PathBuf,
-        /// The instruction (default: the scenario's).
-        #[arg(conflicts_with = "audio")]
-        instruction: Option<String>,
-        /// Dictate the instruction: transcribe this WAV file, print the transcript and use
-        /// it once confirmed (or corrected) on the terminal, or with --yes.
-        #[arg(long, value_name = "FILE.wav")]
-        audio: Option<PathBuf>,
-        /// Use a dictated transcript without asking (it is still printed).
-        #[arg(long, short = 'y')]
-        yes: bool,
-        #[command(flatten)]
-        llm: llm_cmds::LlmFlags,
-        #[command(flatten)]
-        stt: voice_cmd::SttFlags,
-    },
+    Interpret(llm_cmds::InterpretArgs),
     /// Transcribe a WAV file (any rate, channels and bit depth) with the configured
     /// speech-to-text backend; print the transcript, and timings on stderr.
     Transcribe {
@@ -206,42 +119,7 @@ pub enum Command {
     /// Interpret the scenario's instruction, plan, simulate; on each failure ask the model
     /// for the missing preconditions (or parameter value), ask for approval, repair, re-run;
     /// save the tree that succeeds.
-    Resolve {
-        scenario: PathBuf,
-        /// An instruction instead of the scenario's.
-        #[arg(long, conflicts_with = "audio")]
-        instruction: Option<String>,
-        /// Dictate the instruction from a WAV file (printed; confirmed on the terminal or
-        /// by --yes).
-        #[arg(long, value_name = "FILE.wav")]
-        audio: Option<PathBuf>,
-        /// Approve every proposal (and a dictated transcript) without asking.
-        #[arg(long, short = 'y')]
-        yes: bool,
-        /// Questions about failures before giving up.
-        #[arg(long, default_value_t = 5)]
-        max_rounds: usize,
-        /// Where to save the final tree (default: policies/<scenario>.bt on success).
-        #[arg(long)]
-        save: Option<PathBuf>,
-        /// Work on the scenario's stated goal instead of reading its instruction (no model
-        /// call for the goal).
-        #[arg(long)]
-        stated_goal: bool,
-        /// After success, offer each approved fix as a rule of its skill for later tasks
-        /// (asked on the terminal; with --yes kept without asking), checked before it is
-        /// kept in the knowledge file beside the policies.
-        #[arg(long)]
-        learn: bool,
-        #[command(flatten)]
-        knowledge: knowledge_cmd::KnowledgeFlags,
-        #[command(flatten)]
-        llm: llm_cmds::LlmFlags,
-        #[command(flatten)]
-        stt: voice_cmd::SttFlags,
-        #[command(flatten)]
-        viz: viz_flags::VizFlags,
-    },
+    Resolve(llm_cmds::ResolveFlags),
 }
 
 /// Hidden: save a policy of `nodes` nodes to `path` `times` times (tests kill it mid-save).
@@ -273,63 +151,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Transcribe { file, config, stt } => {
             voice_cmd::transcribe(&file, config.as_deref(), &stt)
         }
-        Command::Interpret {
-            scenario,
-            instruction,
-            audio,
-            yes,
-            llm,
-            stt,
-        } => {
-            let scenario = load(&scenario)?;
-            let instruction = voice_cmd::instruction(
-                instruction,
-                audio.as_deref(),
-                llm.config.as_deref(),
-                &stt,
-                yes,
-            )?;
-            llm_cmds::interpret(&scenario, instruction.as_deref(), &llm)
-        }
-        Command::Resolve {
-            scenario,
-            instruction,
-            audio,
-            yes,
-            max_rounds,
-            save,
-            stated_goal,
-            learn,
-            knowledge,
-            llm,
-            stt,
-            viz,
-        } => {
-            let mut loaded = load(&scenario)?;
-            knowledge.apply(&mut loaded)?;
-            let instruction = voice_cmd::instruction(
-                instruction,
-                audio.as_deref(),
-                llm.config.as_deref(),
-                &stt,
-                yes,
-            )?;
-            llm_cmds::resolve(
-                &loaded,
-                &llm_cmds::ResolveArgs {
-                    instruction: instruction.as_deref(),
-                    yes,
-                    max_rounds,
-                    save: save.as_deref(),
-                    scenario_path: &scenario,
-                    viz: &viz,
-                    stated_goal,
-                    learn: learn.then_some(&knowledge.dir),
-                },
-                &llm,
-                glyphs,
-            )
-        }
+        Command::Interpret(args) => llm_cmds::interpret_command(&args),
+        Command::Resolve(args) => llm_cmds::resolve_command(&args, glyphs),
         Command::Export {
             source,
             format,
@@ -347,109 +170,23 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             scenario,
             goal,
             knowledge,
-        } => {
-            let mut scenario = load(&scenario)?;
-            knowledge.apply(&mut scenario)?;
-            tree_cmds::plan(&scenario, goal.as_deref(), glyphs)
-        }
-        Command::Run {
-            scenario,
-            tree,
-            trace,
-            max_ticks,
-            variant,
-            viz,
-            knowledge,
-        } => tree_cmds::run(
-            &{
-                let mut s = load(&scenario)?;
-                knowledge.apply(&mut s)?;
-                s
-            },
-            tree.as_deref(),
-            trace,
-            max_ticks,
-            variant.as_deref(),
-            &viz,
-            glyphs,
-        ),
-        Command::Repair {
-            scenario,
-            add,
-            set,
-            at,
-            tree,
-            save,
-            variant,
-            viz,
-            knowledge,
-        } => {
-            let scenario_path = find_scenario(&scenario)?;
-            let mut scenario = Scenario::load(&scenario_path)?;
-            knowledge.apply(&mut scenario)?;
-            let additions = add
-                .iter()
-                .map(|a| parse_conditions(&scenario, a))
-                .collect::<Result<Vec<_>>>()?;
-            let at = at
-                .map(|a| {
-                    betr::domain::ActionCall::parse(&a).with_context(|| {
-                        format!("--at {a:?} is not an action like 'PickUp \"Chips\"'")
-                    })
-                })
-                .transpose()?;
-            let settings = set
-                .iter()
-                .map(|s| values::parse_setting(&scenario, s))
-                .collect::<Result<Vec<_>>>()?;
-            tree_cmds::repair(
-                &scenario,
-                &tree_cmds::RepairRequest {
-                    scenario_path: &scenario_path,
-                    additions: &additions,
-                    settings: &settings,
-                    at: at.as_ref(),
-                    tree_file: tree.as_deref(),
-                    save: save.as_deref(),
-                    variant: variant.as_deref(),
-                    viz: &viz,
-                },
-                glyphs,
-            )
-        }
-        Command::Verify {
-            scenario,
-            tree,
-            properties,
-            export,
-            failures,
-            no_disturbances,
-            max_states,
-            max_ticks,
-            knowledge,
-        } => verify_cmd::verify(
-            &{
-                let mut s = load(&scenario)?;
-                knowledge.apply(&mut s)?;
-                s
-            },
-            &verify_cmd::Args {
-                tree,
-                properties,
-                export,
-                failures,
-                no_disturbances,
-                max_states,
-                max_ticks,
-                ascii: cli.ascii,
-            },
-        ),
+        } => tree_cmds::plan(&load_with(&scenario, &knowledge)?, goal.as_deref(), glyphs),
+        Command::Run(args) => tree_cmds::run_command(&args, glyphs),
+        Command::Repair(args) => tree_cmds::repair_command(&args, glyphs),
+        Command::Verify(args) => verify_cmd::command(&args, cli.ascii),
     }
 }
 
 /// Resolve a scenario argument: a path, or a name under `scenarios/` with or without `.toml`.
 fn load(arg: &Path) -> Result<Scenario> {
     Ok(Scenario::load(&find_scenario(arg)?)?)
+}
+
+/// A scenario with the learned rules the knowledge flags ask for.
+fn load_with(arg: &Path, knowledge: &knowledge_cmd::KnowledgeFlags) -> Result<Scenario> {
+    let mut scenario = load(arg)?;
+    knowledge.apply(&mut scenario)?;
+    Ok(scenario)
 }
 
 /// The file a scenario argument names.

@@ -1,6 +1,6 @@
 //! `betr plan`, `betr run`, `betr repair`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
@@ -15,6 +15,109 @@ use super::values::Setting;
 use super::viz_flags::VizFlags;
 
 const WORLD_FAILED: u8 = 1;
+
+#[derive(clap::Args)]
+pub struct RunArgs {
+    pub scenario: PathBuf,
+    /// A tree file to run instead of planning one (betr text, a saved policy, or
+    /// BehaviorTree.CPP v4 XML).
+    #[arg(long)]
+    pub tree: Option<PathBuf>,
+    /// Print the running action and failures at every tick.
+    #[arg(long)]
+    pub trace: bool,
+    /// Give up after this many ticks.
+    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
+    pub max_ticks: u64,
+    /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
+    #[arg(long)]
+    pub variant: Option<String>,
+    #[command(flatten)]
+    pub viz: super::viz_flags::VizFlags,
+    #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
+}
+
+#[derive(clap::Args)]
+pub struct RepairArgs {
+    pub scenario: PathBuf,
+    /// Conditions to insert (a conjunction: 'A & B'); repeat for successive failures.
+    #[arg(long = "add", required_unless_present = "set")]
+    pub add: Vec<String>,
+    /// A value parameter for every action that uses it with the object, e.g.
+    /// "force of egg = 5 N" (repeatable; applied before any --add).
+    #[arg(long = "set")]
+    pub set: Vec<String>,
+    /// Insert the first --add at this action (e.g. 'PickUp "Chips"') instead of the failing one.
+    #[arg(long)]
+    pub at: Option<String>,
+    /// Start from this tree file instead of planning (betr text, a saved policy, or
+    /// BehaviorTree.CPP v4 XML).
+    #[arg(long)]
+    pub tree: Option<PathBuf>,
+    /// Write the repaired tree here (atomically).
+    #[arg(long)]
+    pub save: Option<PathBuf>,
+    /// Plan and repair in the scenario's `[world.variants.NAME]` world.
+    #[arg(long)]
+    pub variant: Option<String>,
+    #[command(flatten)]
+    pub viz: super::viz_flags::VizFlags,
+    #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
+}
+
+/// `betr run`: the scenario's planned tree (or a tree file) run in a fresh world.
+pub fn run_command(args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode> {
+    let scenario = super::load_with(&args.scenario, &args.knowledge)?;
+    run(
+        &scenario,
+        args.tree.as_deref(),
+        args.trace,
+        args.max_ticks,
+        args.variant.as_deref(),
+        &args.viz,
+        glyphs,
+    )
+}
+
+/// `betr repair`: the flags read against the scenario, then the repair.
+pub fn repair_command(args: &RepairArgs, glyphs: &Glyphs) -> Result<ExitCode> {
+    let scenario_path = super::find_scenario(&args.scenario)?;
+    let scenario = super::load_with(&scenario_path, &args.knowledge)?;
+    let additions = args
+        .add
+        .iter()
+        .map(|a| super::parse_conditions(&scenario, a))
+        .collect::<Result<Vec<_>>>()?;
+    let at = args
+        .at
+        .as_deref()
+        .map(|a| {
+            ActionCall::parse(a)
+                .with_context(|| format!("--at {a:?} is not an action like 'PickUp \"Chips\"'"))
+        })
+        .transpose()?;
+    let settings = args
+        .set
+        .iter()
+        .map(|s| super::values::parse_setting(&scenario, s))
+        .collect::<Result<Vec<_>>>()?;
+    repair(
+        &scenario,
+        &RepairRequest {
+            scenario_path: &scenario_path,
+            additions: &additions,
+            settings: &settings,
+            at: at.as_ref(),
+            tree_file: args.tree.as_deref(),
+            save: args.save.as_deref(),
+            variant: args.variant.as_deref(),
+            viz: &args.viz,
+        },
+        glyphs,
+    )
+}
 
 pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<ExitCode> {
     let goal_given = goal.is_some();
@@ -46,7 +149,7 @@ pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<
     })
 }
 
-pub fn run(
+fn run(
     scenario: &Scenario,
     tree_file: Option<&Path>,
     trace: bool,
@@ -134,7 +237,7 @@ pub struct RepairRequest<'a> {
     pub viz: &'a VizFlags,
 }
 
-pub fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Result<ExitCode> {
+fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Result<ExitCode> {
     let RepairRequest {
         scenario_path,
         additions,

@@ -15,19 +15,43 @@ use betr::verify::{NamedProperty, Property, Report, Rule, Verdict};
 
 use super::engine_driver::{Driver, Start};
 
-/// What `betr verify` was asked.
-pub struct Args {
+/// What `betr verify` is asked.
+#[derive(clap::Args)]
+pub struct VerifyArgs {
+    pub scenario: PathBuf,
+    /// A tree file to verify instead of planning one (betr text, a saved policy, or
+    /// BehaviorTree.CPP v4 XML).
+    #[arg(long)]
     pub tree: Option<PathBuf>,
+    /// A property to check besides the scenario's: 'always F', 'never F', 'eventually F'.
+    #[arg(long = "property")]
     pub properties: Vec<String>,
+    /// Write the model for the SPIN model checker: --export promela FILE.
+    #[arg(long, num_args = 2, value_names = ["FORMAT", "FILE"])]
     pub export: Option<Vec<String>>,
+    /// Let every action also fail (leaving the state unchanged).
+    #[arg(long)]
     pub failures: bool,
+    /// Ignore the disturbances the scenario declares.
+    #[arg(long)]
     pub no_disturbances: bool,
+    /// Stop exploring after this many states (the result is then "unknown").
+    #[arg(long, default_value_t = 200_000)]
     pub max_states: usize,
+    /// Ticks within which the tree must succeed from every reachable state.
+    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
     pub max_ticks: u64,
-    pub ascii: bool,
+    #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
 }
 
-pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
+/// `betr verify`.
+pub fn command(args: &VerifyArgs, ascii: bool) -> Result<ExitCode> {
+    let scenario = super::load_with(&args.scenario, &args.knowledge)?;
+    verify(&scenario, args, ascii)
+}
+
+fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCode> {
     let mut properties = Vec::new();
     for text in &args.properties {
         let property = Property::parse_checked(text, &scenario.domain.vocabulary)
@@ -118,7 +142,7 @@ pub fn verify(scenario: &Scenario, args: &Args) -> Result<ExitCode> {
             claims.join(", ")
         );
     }
-    write_report(&mut std::io::stdout(), &report, args.ascii)?;
+    write_report(&mut std::io::stdout(), &report, ascii)?;
     Ok(if report.holds() {
         ExitCode::SUCCESS
     } else {
