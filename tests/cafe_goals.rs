@@ -3,24 +3,21 @@
 //! why the goal is unreachable. Only contradictory goals may be unreachable.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-use std::path::Path;
+mod support;
 
 use betr::dataset::{self, Case};
 use betr::goal::Formula;
 use betr::planner::{Outcome, Planner, RunEnd, run_tree};
-use betr::scenario::Scenario;
 use betr::world;
 
 fn cases() -> Vec<Case> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/datasets/llm-obtea");
-    dataset::load(&dir).expect("the dataset lies in ../shared/datasets/llm-obtea")
+    dataset::load(&support::repo::dataset_dir())
+        .expect("the dataset lies in ../shared/datasets/llm-obtea")
 }
 
 #[test]
 fn every_gold_goal_is_planned_to_success_or_explained() {
-    let scenario =
-        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
-            .unwrap();
+    let scenario = support::repo::scenario("scenarios/cafe/cafe.toml");
     let world = world::load(&scenario).unwrap();
     let planner = Planner::new(&scenario.domain);
     let mut failures = Vec::new();

@@ -1,13 +1,13 @@
 //! The goal parser, minimal DNF and goal comparison on the 100 gold goals of LLM-OBTEA.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-use std::path::PathBuf;
+mod support;
 
 use betr::dataset::{self, Case, Difficulty};
 use betr::goal::{Formula, equivalent, same_dnf};
 
 fn cases() -> Vec<Case> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/datasets/llm-obtea");
+    let dir = support::repo::dataset_dir();
     dataset::load(&dir).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -1,7 +1,8 @@
 //! Scenario files: every shipped scenario loads, and each kind of mistake in a file is
 //! reported with its file, line and column and what was expected.
 
-#![allow(clippy::unwrap_used)] // tests may panic on what they check
+#![allow(clippy::unwrap_used)]
+mod support;
 use std::path::{Path, PathBuf};
 
 use betr::scenario::{Scenario, ScenarioError};
@@ -35,7 +36,7 @@ fn lines_before(text: &str, needle: &str) -> usize {
 
 #[test]
 fn every_shipped_scenario_loads() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let root = support::repo::path("scenarios");
     let mut files: Vec<PathBuf> = Vec::new();
     let mut stack = vec![root];
     while let Some(dir) = stack.pop() {

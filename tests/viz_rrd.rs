@@ -3,6 +3,8 @@
 //! (`rerun rrd verify`, `rerun rrd print`) from `rerun-sdk==0.36.3`, installed once into
 //! a virtual environment under the target directory when it is missing.
 
+mod support;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -55,19 +57,15 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
     std::fs::create_dir_all(&dir).unwrap();
     let rrd = dir.join("scenario1.rrd");
     let _ = std::fs::remove_file(&rrd);
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new(env!("CARGO_BIN_EXE_betr"))
-        .current_dir(root)
-        .args([
-            "repair",
-            "scenarios/cell/red_on_blue.toml",
-            "--add",
-            "~\"any object\" on \"blue cube\"",
-            "--rrd",
-        ])
-        .arg(&rrd)
-        .output()
-        .unwrap();
+    let rrd_arg = rrd.to_string_lossy();
+    let out = support::repo::betr(&[
+        "repair",
+        "scenarios/cell/red_on_blue.toml",
+        "--add",
+        "~\"any object\" on \"blue cube\"",
+        "--rrd",
+        &rrd_arg,
+    ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),

@@ -20,6 +20,11 @@ pub fn scenario(rel: &str) -> Scenario {
     Scenario::load(&path(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
+/// The goal-interpretation dataset beside the repository (`../shared`).
+pub fn dataset_dir() -> PathBuf {
+    root().join("../shared/datasets/llm-obtea")
+}
+
 /// The binary run from the repository's root.
 pub fn betr(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_betr"))
