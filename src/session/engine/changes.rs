@@ -4,15 +4,32 @@
 //! changed tree runs from the scenario's first state.
 
 use crate::bt::Tree;
-use crate::domain::action::parse_value;
+use crate::domain::action::{ActionError, parse_value};
+use crate::goal::Formula;
 use crate::planner::Planner;
+use crate::scenario::GoalTextError;
 
 use super::super::ask::{Tried, missing_value};
 use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
-use super::super::values::{self, conform};
+use super::super::values::{self, ConformError, conform};
 use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
+
+/// Why what a person wrote for a proposal was refused; each names the text as written.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum EditError {
+    #[error("'{text}': {reason}")]
+    Goal { text: String, reason: GoalTextError },
+    #[error("'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}")]
+    NotAConjunction { text: String, formula: Formula },
+    #[error("{skill} declares no value {param}")]
+    UndeclaredValue { skill: String, param: String },
+    #[error("'{text}': {reason}")]
+    Unreadable { text: String, reason: ActionError },
+    #[error("'{text}': {reason}")]
+    Unfit { text: String, reason: ConformError },
+}
 
 impl Engine {
     pub(super) fn approve(&mut self) {
@@ -146,7 +163,7 @@ impl Engine {
         };
         let edited = match self.edited(&base, text) {
             Ok(p) => p,
-            Err(e) => return self.error(e),
+            Err(e) => return self.error(e.to_string()),
         };
         self.emit(Event::Proposal {
             proposal: edited.clone(),
@@ -179,23 +196,27 @@ impl Engine {
         })
     }
 
-    fn edited(&self, base: &Proposal, text: &str) -> Result<Proposal, String> {
+    fn edited(&self, base: &Proposal, text: &str) -> Result<Proposal, EditError> {
         let text = text.trim();
         match base {
             Proposal::Conditions { action, node, .. } => {
                 let formula = self
                     .scenario
                     .parse_goal(text)
-                    .map_err(|e| format!("'{text}': {e}"))?;
+                    .map_err(|reason| EditError::Goal {
+                        text: text.to_string(),
+                        reason,
+                    })?;
                 match formula.to_dnf().0.as_slice() {
                     [one] if !one.is_empty() => Ok(Proposal::Conditions {
                         action: action.clone(),
                         node: *node,
                         conditions: one.clone(),
                     }),
-                    _ => Err(format!(
-                        "'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}"
-                    )),
+                    _ => Err(EditError::NotAConjunction {
+                        text: text.to_string(),
+                        formula,
+                    }),
                 }
             }
             Proposal::Value {
@@ -211,9 +232,18 @@ impl Engine {
                     .iter()
                     .find(|s| &s.name == skill)
                     .and_then(|s| s.values.iter().find(|v| &v.name == param))
-                    .ok_or_else(|| format!("{skill} declares no value {param}"))?;
-                let value = parse_value(text).map_err(|e| format!("'{text}': {e}"))?;
-                let value = conform(declared, value).map_err(|e| format!("'{text}': {e}"))?;
+                    .ok_or_else(|| EditError::UndeclaredValue {
+                        skill: skill.clone(),
+                        param: param.clone(),
+                    })?;
+                let value = parse_value(text).map_err(|reason| EditError::Unreadable {
+                    text: text.to_string(),
+                    reason,
+                })?;
+                let value = conform(declared, value).map_err(|reason| EditError::Unfit {
+                    text: text.to_string(),
+                    reason,
+                })?;
                 Ok(Proposal::Value {
                     skill: skill.clone(),
                     object: object.clone(),
