@@ -143,16 +143,38 @@ impl Microphone for WavMicrophone {
     }
 }
 
+/// Why dictation gave no transcript, or cannot work at all.
+#[derive(Debug, thiserror::Error)]
+pub enum DictationError {
+    /// The speech-to-text settings cannot work, in the words of the front end that read
+    /// them (it knows where they came from).
+    #[error("{reason}")]
+    Settings { reason: String },
+    /// The embedded model could not be fetched.
+    #[error(transparent)]
+    Fetch(#[from] crate::model::FetchError),
+    /// Recording, loading the model or transcribing failed.
+    #[error(transparent)]
+    Voice(#[from] VoiceError),
+    /// The task stopping the recording ended without an answer.
+    #[error("the recording could not be stopped: {0}")]
+    Stop(tokio::task::JoinError),
+    /// The task loading the model ended without an answer.
+    #[error("the speech-to-text model could not be loaded: {0}")]
+    Load(tokio::task::JoinError),
+}
+
 /// Builds the speech-to-text backend (blocking: it may fetch and load a model), reporting
 /// progress through the callback; the error says what to do.
-pub type SttLoader =
-    Arc<dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, String> + Send + Sync>;
+pub type SttLoader = Arc<
+    dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, DictationError> + Send + Sync,
+>;
 
 /// Owns the recording in progress and the speech-to-text model.
 pub struct DictationService {
     microphone: Arc<dyn Microphone>,
     /// `Err`: why dictation cannot work at all (bad `[stt]` settings).
-    loader: Result<SttLoader, String>,
+    loader: Result<SttLoader, DictationError>,
     stt: Arc<OnceCell<Arc<dyn SpeechToText>>>,
     recording: Option<Box<dyn Recording>>,
     /// A recording is being stopped or transcribed.
@@ -163,7 +185,7 @@ pub struct DictationService {
 impl DictationService {
     pub fn new(
         microphone: Arc<dyn Microphone>,
-        loader: Result<SttLoader, String>,
+        loader: Result<SttLoader, DictationError>,
     ) -> (DictationService, UnboundedReceiver<DictationEvent>) {
         let (events, rx) = unbounded_channel();
         let service = DictationService {
@@ -205,7 +227,7 @@ impl DictationService {
             Ok(l) => l.clone(),
             Err(why) => {
                 return self.send(DictationEvent::Failed(
-                    super::strings::dictation_unavailable(why),
+                    super::strings::dictation_unavailable(&why.to_string()),
                 ));
             }
         };
@@ -244,11 +266,11 @@ impl DictationService {
         };
         // `start` refuses to record without a loader, so this holds; if it ever did not,
         // the person hears why rather than nothing.
-        let loader = match self.loader.clone() {
-            Ok(l) => l,
+        let loader = match &self.loader {
+            Ok(l) => l.clone(),
             Err(why) => {
                 return self.send(DictationEvent::Failed(
-                    super::strings::dictation_unavailable(&why),
+                    super::strings::dictation_unavailable(&why.to_string()),
                 ));
             }
         };
@@ -259,7 +281,7 @@ impl DictationService {
             busy.store(false, Ordering::SeqCst);
             let _ = events.send(match outcome {
                 Ok(transcript) => DictationEvent::Heard(transcript),
-                Err(message) => DictationEvent::Failed(message),
+                Err(e) => DictationEvent::Failed(e.to_string()),
             });
         });
     }
@@ -278,18 +300,15 @@ async fn stop_and_transcribe(
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
     events: &UnboundedSender<DictationEvent>,
-) -> Result<Transcript, String> {
+) -> Result<Transcript, DictationError> {
     let audio = tokio::task::spawn_blocking(move || recording.stop())
         .await
-        .map_err(|e| format!("the recording could not be stopped: {e}"))?
-        .map_err(|e| e.to_string())?;
+        .map_err(DictationError::Stop)??;
     let _ = events.send(DictationEvent::Transcribing {
         seconds: audio.seconds(),
     });
     let model = ready_model(stt, loader, events).await?;
-    voice::transcribe(model.as_ref(), &audio)
-        .await
-        .map_err(|e| e.to_string())
+    Ok(voice::transcribe(model.as_ref(), &audio).await?)
 }
 
 /// The model, loaded once (concurrent callers wait for the same load; a failed load is
@@ -298,7 +317,7 @@ async fn ready_model(
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
     events: &UnboundedSender<DictationEvent>,
-) -> Result<Arc<dyn SpeechToText>, String> {
+) -> Result<Arc<dyn SpeechToText>, DictationError> {
     stt.get_or_try_init(|| {
         let (loader, events) = (loader.clone(), events.clone());
         async move {
@@ -308,7 +327,7 @@ async fn ready_model(
                 })
             })
             .await
-            .map_err(|e| format!("the speech-to-text model could not be loaded: {e}"))?
+            .map_err(DictationError::Load)?
         }
     })
     .await
