@@ -110,7 +110,9 @@ impl SourceFile {
 
     /// An error at byte `offset` of this file.
     pub fn error_at(&self, offset: usize, message: impl std::fmt::Display) -> ScenarioError {
-        let offset = offset.min(self.text.len());
+        // An offset into a string's contents lands inside a character when the string
+        // holds escapes before a multi-byte character: point at that character.
+        let offset = self.text.floor_char_boundary(offset.min(self.text.len()));
         let before = &self.text[..offset];
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);
@@ -264,4 +266,19 @@ pub(crate) fn effect_templates(
         deleted.push(t.atom);
     }
     Ok((added, deleted))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_offset_inside_a_character_points_at_that_character() {
+        let file = SourceFile {
+            path: PathBuf::from("t.toml"),
+            text: "a = \"\\\"é{x}\"\n".into(),
+        };
+        let e = file.error_at(8, "here");
+        assert_eq!((e.line, e.column), (1, 8), "{e}");
+    }
 }
