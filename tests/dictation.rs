@@ -178,7 +178,7 @@ fn silence_never_reaches_the_model() {
 /// line, unsubmitted, close to what was said.
 #[test]
 fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
-    use betr::tui::dictation::{DictationEvent, DictationService, SttLoader};
+    use betr::tui::dictation::{DictationError, DictationEvent, DictationService, SttLoader};
     use betr::tui::{App, Info, KeyBindings, Request, Theme};
     use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
     use std::sync::Arc;
@@ -193,7 +193,7 @@ fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
         report("loading whisper-tiny.en");
         LocalWhisper::load(model_dir(), WHISPER_TINY_EN.name, LocalSettings::default())
             .map(|w| Arc::new(w) as Arc<dyn voice::SpeechToText>)
-            .map_err(|e| e.to_string())
+            .map_err(DictationError::from)
     });
     let (mut service, mut heard) =
         DictationService::new(AudioMicrophone::playing(audio), Ok(loader));

@@ -166,7 +166,9 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // the workbench.
     let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &args.stt)
         .map(super::voice_cmd::workbench_loader)
-        .map_err(|e| format!("{e:#}"));
+        .map_err(|e| betr::tui::dictation::DictationError::Settings {
+            reason: format!("{e:#}"),
+        });
     let workbench = Workbench {
         info,
         keys,

@@ -13,7 +13,7 @@ use clap::Args;
 
 use betr::config_file::FileConfig;
 use betr::model::Progress;
-use betr::tui::dictation::SttLoader;
+use betr::tui::dictation::{DictationError, SttLoader};
 use betr::voice::{self, Audio16k, SpeechToText, SttBackend, SttLayer, SttSettings, Transcript};
 
 /// Speech-to-text flags. Each overrides the matching `BETR_STT*` variable, which overrides
@@ -97,8 +97,7 @@ pub fn workbench_loader(settings: SttSettings) -> SttLoader {
                 report: &mut *report,
                 percent: None,
             };
-            betr::model::fetch_dir(spec, &betr::model::cache_dir(), "python3", &mut progress)
-                .map_err(|e| e.to_string())?;
+            betr::model::fetch_dir(spec, &betr::model::cache_dir(), "python3", &mut progress)?;
         }
         if settings.backend == SttBackend::Local {
             report(&format!("loading {}", settings.model));
@@ -106,7 +105,7 @@ pub fn workbench_loader(settings: SttSettings) -> SttLoader {
         settings
             .build(&|k| std::env::var(k).ok())
             .map(Arc::from)
-            .map_err(|e| e.to_string())
+            .map_err(DictationError::from)
     })
 }
 
@@ -294,7 +293,10 @@ mod tests {
             },
         )
         .unwrap();
-        let e = workbench_loader(settings)(&mut |_: &str| {}).err().unwrap();
+        let e = workbench_loader(settings)(&mut |_: &str| {})
+            .err()
+            .unwrap()
+            .to_string();
         assert!(
             e.contains("whisper-huge") && e.contains("whisper-tiny.en"),
             "{e}"

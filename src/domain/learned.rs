@@ -13,7 +13,8 @@
 
 use super::action::ActionCall;
 use super::condition::Condition;
-use super::skill::{Domain, LiteralTemplate, Skill, Term, parse_template};
+use super::skill::{Domain, LiteralTemplate, Skill, Term};
+use super::template::{TemplateError, parse_template};
 
 /// A precondition of a skill kept from an approved fix.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,8 +72,25 @@ pub enum LearnError {
     Condition {
         rule: String,
         requires: String,
-        reason: String,
+        reason: Box<Misfit>,
     },
+}
+
+/// Why a rule's condition does not fit the skill it names.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Misfit {
+    #[error(transparent)]
+    Template(#[from] TemplateError),
+    #[error("{{*}} stands only in a deletion")]
+    EveryObject,
+    #[error("no object {skill} takes as {{{param}}} fits {predicate}")]
+    NoObjectFits {
+        skill: String,
+        param: String,
+        predicate: String,
+    },
+    #[error("{skill} does not take {}", .objects.join(", "))]
+    NotTaken { skill: String, objects: Vec<String> },
 }
 
 impl LearnedRule {
@@ -151,13 +169,13 @@ impl LearnedRule {
             parse_template(&text, &skill.params).map_err(|reason| LearnError::Condition {
                 rule: self.label(),
                 requires: self.requires.clone(),
-                reason,
+                reason: Box::new(reason.into()),
             })?;
         if template.atom.args.contains(&Term::Every) {
             return Err(LearnError::Condition {
                 rule: self.label(),
                 requires: self.requires.clone(),
-                reason: "{*} stands only in a deletion".into(),
+                reason: Box::new(Misfit::EveryObject),
             });
         }
         Ok(template)
@@ -229,12 +247,14 @@ fn fit(
         return Err(LearnError::Condition {
             rule: rule.label(),
             requires: rule.requires.clone(),
-            reason: format!(
-                "no object {} takes as {{{}}} fits {}",
-                skill.name,
-                skill.params.get(*i).map_or("?", |p| p.name.as_str()),
-                condition.atom.predicate
-            ),
+            reason: Box::new(Misfit::NoObjectFits {
+                skill: skill.name.clone(),
+                param: skill
+                    .params
+                    .get(*i)
+                    .map_or_else(|| "?".to_string(), |p| p.name.clone()),
+                predicate: condition.atom.predicate.clone(),
+            }),
         });
     }
     if let Some(only) = &rule.only
@@ -243,7 +263,10 @@ fn fit(
         return Err(LearnError::Condition {
             rule: rule.label(),
             requires: rule.requires.clone(),
-            reason: format!("{} does not take {}", skill.name, only.join(", ")),
+            reason: Box::new(Misfit::NotTaken {
+                skill: skill.name.clone(),
+                objects: only.clone(),
+            }),
         });
     }
     Ok((condition, fitting))

@@ -7,8 +7,10 @@ pub mod learned;
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};
 pub mod skill;
+pub mod template;
 pub mod vocabulary;
 
-pub use learned::{LearnError, LearnedRule};
+pub use learned::{LearnError, LearnedRule, Misfit};
 pub use skill::{AtomPattern, Domain, GroundSkill, Param, Skill, ValueParam};
+pub use template::{TemplateError, TemplateFitError};
 pub use vocabulary::{Object, Predicate, Vocabulary, VocabularyError};

@@ -329,76 +329,10 @@ impl Domain {
     }
 }
 
-/// Parse a condition template such as `On_{item}_{place}`, `~"{a}" on "{b}"` or
-/// `On_{item}_{*}` against a skill's parameter names.
-pub fn parse_template(text: &str, params: &[Param]) -> Result<LiteralTemplate, String> {
-    // Replace each {name} by a sentinel that both atom syntaxes accept, parse with the one
-    // atom reader, then map the sentinels back to terms.
-    let mut substituted = String::new();
-    let mut terms: Vec<Term> = Vec::new();
-    let mut rest = text;
-    while let Some(open) = rest.find('{') {
-        substituted.push_str(&rest[..open]);
-        let Some(close) = rest[open..].find('}') else {
-            return Err(format!("unclosed '{{' in {text:?}"));
-        };
-        let name = rest[open + 1..open + close].trim();
-        let term = if name == "*" {
-            Term::Every
-        } else {
-            match params.iter().position(|p| p.name == name) {
-                Some(i) => Term::Param(i),
-                None => {
-                    let known: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
-                    return Err(format!(
-                        "{{{name}}} in {text:?} is not a parameter of this skill (parameters: {})",
-                        known.join(", ")
-                    ));
-                }
-            }
-        };
-        substituted.push_str(&format!("ZzParam{}zZ", terms.len()));
-        terms.push(term);
-        rest = &rest[open + close + 1..];
-    }
-    substituted.push_str(rest);
-    let condition = Condition::parse(&substituted)
-        .map_err(|e| format!("in {text:?}: expected {}, found {}", e.expected, e.found))?;
-    if condition.atom.predicate.contains("ZzParam") {
-        return Err(format!(
-            "in {text:?}: a parameter cannot stand for the predicate"
-        ));
-    }
-    let args = condition
-        .atom
-        .args
-        .iter()
-        .map(
-            |a| match a.strip_prefix("ZzParam").and_then(|r| r.strip_suffix("zZ")) {
-                Some(i) => i
-                    .parse::<usize>()
-                    .ok()
-                    .and_then(|i| terms.get(i).cloned())
-                    .ok_or_else(|| format!("in {text:?}: a parameter must be a whole argument")),
-                None if a.contains("ZzParam") => {
-                    Err(format!("in {text:?}: a parameter must be a whole argument"))
-                }
-                None => Ok(Term::Const(a.clone())),
-            },
-        )
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(LiteralTemplate {
-        atom: AtomTemplate {
-            predicate: condition.atom.predicate,
-            args,
-        },
-        negated: condition.negated,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::domain::template::parse_template;
 
     fn params(names: &[&str]) -> Vec<Param> {
         names
@@ -426,24 +360,6 @@ mod tests {
             values: vec![],
             learned: vec![],
         }
-    }
-
-    #[test]
-    fn templates_parse_both_syntaxes() {
-        let ps = params(&["a", "b"]);
-        let t = parse_template("~\"{a}\" on \"{b}\"", &ps).unwrap();
-        assert!(t.negated);
-        assert_eq!(t.atom.args, vec![Term::Param(0), Term::Param(1)]);
-        let t = parse_template("On_{a}_{*}", &ps).unwrap();
-        assert_eq!(t.atom.args, vec![Term::Param(0), Term::Every]);
-        let t = parse_template("\"{a}\" on \"table\"", &ps).unwrap();
-        assert_eq!(t.atom.args[1], Term::Const("table".into()));
-        assert!(
-            parse_template("On_{c}_x", &ps)
-                .unwrap_err()
-                .contains("not a parameter")
-        );
-        assert!(parse_template("\"{a} cube\" on \"x\"", &ps).is_err());
     }
 
     #[test]

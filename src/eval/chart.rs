@@ -14,12 +14,13 @@ pub struct Series {
     pub values: [f64; 3],
 }
 
-#[derive(Debug, thiserror::Error)]
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum ChartError {
     #[error(
-        "no TrueType font found for chart labels (looked for {0}); install fonts-dejavu-core or set BETR_FONT"
+        "no TrueType font found for chart labels (looked for {}); install fonts-dejavu-core or set BETR_FONT",
+        .tried.join(", ")
     )]
-    NoFont(String),
+    NoFont { tried: Vec<String> },
     #[error("drawing {path}: {detail}")]
     Draw { path: PathBuf, detail: String },
 }
@@ -30,7 +31,8 @@ const FONT_CANDIDATES: [&str; 3] = [
     "/usr/share/fonts/dejavu/DejaVuSans.ttf",
 ];
 
-static FONT: OnceLock<Result<(), String>> = OnceLock::new();
+/// The outcome of registering the font, kept for every later chart.
+static FONT: OnceLock<Result<(), ChartError>> = OnceLock::new();
 
 /// Register the label font once per process.
 pub(crate) fn ensure_font() -> Result<(), ChartError> {
@@ -47,10 +49,9 @@ pub(crate) fn ensure_font() -> Result<(), ChartError> {
                 }
             }
         }
-        Err(tried.join(", "))
+        Err(ChartError::NoFont { tried })
     })
     .clone()
-    .map_err(ChartError::NoFont)
 }
 
 /// Grouped bars: accuracy (%) per difficulty for each series.

@@ -293,7 +293,7 @@ fn record(
         name: scenario.name.clone(),
         run,
         success,
-        reason: trace.ending.err(),
+        reason: trace.ending.err().map(|e| e.to_string()),
         goal_as_expected,
         resolved: success && goal_as_expected && values.iter().any(|v| v.accepted),
         values,

@@ -298,7 +298,7 @@ fn record(
         run,
         success,
         ticks: trace.ending.as_ref().ok().copied(),
-        reason: trace.ending.err(),
+        reason: trace.ending.err().map(|e| e.to_string()),
         goal,
         goal_as_expected,
         rounds: trace.rounds,

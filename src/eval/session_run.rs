@@ -10,12 +10,25 @@ use crate::session::{self, Ending, Event, Options, SessionError};
 /// What one resolve did.
 pub struct Trace {
     pub events: Vec<Event>,
-    /// `Ok(ticks)`: the final tree succeeded in simulation; `Err(reason)`: the loop
-    /// stopped without success.
-    pub ending: Result<u64, String>,
+    /// `Ok(ticks)`: the final tree succeeded in simulation; `Err`: why the loop stopped
+    /// without success.
+    pub ending: Result<u64, Unresolved>,
     pub rounds: usize,
     /// The approved proposals kept in the final tree, with who wrote each.
     pub kept: Vec<(session::Proposal, String)>,
+}
+
+/// Why a resolve ended without success.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum Unresolved {
+    /// The loop gave up; its reason as the session gave it.
+    #[error("{reason}")]
+    GaveUp { reason: String },
+    #[error("a proposal was rejected")]
+    Rejected,
+    /// The reply yielded no usable goal.
+    #[error(transparent)]
+    NoGoal(SessionError),
 }
 
 /// Resolve `scenario`'s instruction end to end, approving every proposal. A reply that
@@ -34,13 +47,13 @@ pub async fn resolve_approving(
         Ok(r) => (
             match r.ending {
                 Ending::Success { ticks } => Ok(ticks),
-                Ending::GaveUp { reason } => Err(reason),
-                Ending::Rejected => Err("a proposal was rejected".into()),
+                Ending::GaveUp { reason } => Err(Unresolved::GaveUp { reason }),
+                Ending::Rejected => Err(Unresolved::Rejected),
             },
             r.rounds,
             r.kept,
         ),
-        Err(e @ SessionError::NoGoal { .. }) => (Err(e.to_string()), 0, Vec::new()),
+        Err(e @ SessionError::NoGoal { .. }) => (Err(Unresolved::NoGoal(e)), 0, Vec::new()),
         Err(e) => return Err(e),
     };
     Ok(Trace {

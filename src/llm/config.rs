@@ -40,16 +40,23 @@ impl Backend {
     }
 }
 
+/// A backend name that is none of the known ones.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown backend {name:?} (expected openai, local or replay)")]
+pub struct UnknownBackend {
+    pub name: String,
+}
+
 impl std::str::FromStr for Backend {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownBackend;
+    fn from_str(s: &str) -> Result<Self, UnknownBackend> {
         match s.trim().to_ascii_lowercase().as_str() {
             "openai" => Ok(Backend::Openai),
             "local" => Ok(Backend::Local),
             "replay" => Ok(Backend::Replay),
-            other => Err(format!(
-                "unknown backend {other:?} (expected openai, local or replay)"
-            )),
+            other => Err(UnknownBackend {
+                name: other.to_string(),
+            }),
         }
     }
 }

@@ -6,7 +6,7 @@ use std::collections::{HashMap, HashSet};
 use super::achievers::{self, Candidate};
 use super::exec::{RunEnd, run_tree};
 use super::{Outcome, Plan, Planner};
-use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree, to_text};
+use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree, TreeError, to_text};
 use crate::domain::{Condition, GroundSkill};
 use crate::world::World;
 
@@ -39,6 +39,23 @@ pub(super) fn expansion_of(tree: &Tree, condition: NodeId) -> Option<NodeId> {
     .then_some(parent)
 }
 
+/// Why a failing condition could not be expanded; told as the reason it is unreachable.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum ExpandError {
+    #[error("node {node} is not a condition")]
+    NotACondition { node: NodeId },
+    #[error("expansion depth bound ({bound}) reached")]
+    DepthBound { bound: usize },
+    #[error("no skill has an effect that makes {target} true")]
+    NoAchiever { target: Condition },
+    #[error(
+        "all {total} skill(s) achieving {target} need a condition that is itself being achieved above it"
+    )]
+    Circular { total: usize, target: Condition },
+    #[error(transparent)]
+    Tree(#[from] TreeError),
+}
+
 /// A later sibling subtree undid what an earlier one achieved: move it in front.
 struct Conflict {
     sequence: NodeId,
@@ -51,7 +68,7 @@ pub(super) struct Growth<'p, 'd> {
     tree: Tree,
     before: usize,
     /// Conditions no skill can achieve here, with the reason.
-    dead: HashMap<NodeId, String>,
+    dead: HashMap<NodeId, ExpandError>,
     /// For each expansion (keyed by its Fallback), the skills not tried yet.
     alternatives: HashMap<NodeId, Vec<GroundSkill>>,
     /// Tree texts seen after a reordering, to stop reordering in circles.
@@ -202,7 +219,11 @@ impl<'p, 'd> Growth<'p, 'd> {
         match culprit.and_then(|n| Some((n, self.condition(n)?))) {
             Some((node, condition)) => Next::Done(Outcome::Unreachable {
                 path: self.tree.path(node).unwrap_or_default(),
-                reason: self.dead.get(&node).cloned().unwrap_or_default(),
+                reason: self
+                    .dead
+                    .get(&node)
+                    .map(ToString::to_string)
+                    .unwrap_or_default(),
                 node,
                 condition,
             }),
@@ -253,17 +274,16 @@ impl<'p, 'd> Growth<'p, 'd> {
         node: NodeId,
         sim: &dyn World,
         protected: &[Condition],
-    ) -> Result<(), String> {
+    ) -> Result<(), ExpandError> {
         let domain = self.planner.domain;
         let Some(condition) = self.condition(node) else {
-            return Err("not a condition".into());
+            return Err(ExpandError::NotACondition { node });
         };
         let above = self.goals_above(node);
         if above.len() >= self.planner.options.max_depth {
-            return Err(format!(
-                "expansion depth bound ({}) reached",
-                self.planner.options.max_depth
-            ));
+            return Err(ExpandError::DepthBound {
+                bound: self.planner.options.max_depth,
+            });
         }
         // A wildcard condition is achieved through the object that falsifies it now.
         let mut target = condition.clone();
@@ -278,7 +298,7 @@ impl<'p, 'd> Growth<'p, 'd> {
             candidates = achievers::rank(domain, sim, &target, protected, &above);
         }
         if candidates.is_empty() {
-            return Err(format!("no skill has an effect that makes {target} true"));
+            return Err(ExpandError::NoAchiever { target });
         }
         // A skill that needs a condition already being achieved above would loop.
         let total = candidates.len();
@@ -292,14 +312,9 @@ impl<'p, 'd> Growth<'p, 'd> {
             })
             .collect();
         let Some((first, rest)) = usable.split_first() else {
-            return Err(format!(
-                "all {total} skill(s) achieving {target} need a condition that is itself being achieved above it"
-            ));
+            return Err(ExpandError::Circular { total, target });
         };
-        let fallback = self
-            .tree
-            .wrap(node, NodeKind::Fallback)
-            .map_err(|e| e.to_string())?;
+        let fallback = self.tree.wrap(node, NodeKind::Fallback)?;
         self.attach(fallback, &first.skill)?;
         tracing::debug!(condition = %condition, skill = %first.skill.call, score = first.score, "expanded");
         self.alternatives
@@ -309,17 +324,14 @@ impl<'p, 'd> Growth<'p, 'd> {
     }
 
     /// Add `Sequence(preconditions..., action)` (or the bare action) under `fallback`.
-    fn attach(&mut self, fallback: NodeId, skill: &GroundSkill) -> Result<(), String> {
+    fn attach(&mut self, fallback: NodeId, skill: &GroundSkill) -> Result<(), TreeError> {
         let tree = &mut self.tree;
         let parent = if skill.pre.is_empty() {
             fallback
         } else {
-            let seq = tree
-                .add_child(fallback, NodeKind::Sequence)
-                .map_err(|e| e.to_string())?;
+            let seq = tree.add_child(fallback, NodeKind::Sequence)?;
             for p in &skill.pre {
-                tree.add_child(seq, NodeKind::Condition(p.clone()))
-                    .map_err(|e| e.to_string())?;
+                tree.add_child(seq, NodeKind::Condition(p.clone()))?;
             }
             seq
         };
@@ -332,8 +344,7 @@ impl<'p, 'd> Growth<'p, 'd> {
         {
             call.values = known.values.clone();
         }
-        tree.add_child(parent, NodeKind::Action(call))
-            .map_err(|e| e.to_string())?;
+        tree.add_child(parent, NodeKind::Action(call))?;
         Ok(())
     }
 

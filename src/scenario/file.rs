@@ -120,18 +120,34 @@ pub(super) fn default_ticks() -> u32 {
     1
 }
 
+/// Why a value's declared range was refused; each names the value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(super) enum ValueRangeError {
+    #[error("value {value:?}: min and max are for a number with a unit")]
+    NoUnit { value: String },
+    #[error("value {value:?}: min and max must be finite numbers")]
+    NotFinite { value: String },
+    #[error("value {value:?}: min {min} is above max {max}")]
+    Empty { value: String, min: f64, max: f64 },
+}
+
 /// A declared range is for a number with a unit, finite, and not empty.
-pub(super) fn value_range(v: &RawValueParam) -> Result<(), String> {
+pub(super) fn value_range(v: &RawValueParam) -> Result<(), ValueRangeError> {
+    let value = || v.name.clone();
     if (v.min.is_some() || v.max.is_some()) && v.unit.is_none() {
-        return Err("min and max are for a number with a unit".into());
+        return Err(ValueRangeError::NoUnit { value: value() });
     }
     if v.min.into_iter().chain(v.max).any(|x| !x.is_finite()) {
-        return Err("min and max must be finite numbers".into());
+        return Err(ValueRangeError::NotFinite { value: value() });
     }
-    if let (Some(lo), Some(hi)) = (v.min, v.max)
-        && lo > hi
+    if let (Some(min), Some(max)) = (v.min, v.max)
+        && min > max
     {
-        return Err(format!("min {lo} is above max {hi}"));
+        return Err(ValueRangeError::Empty {
+            value: value(),
+            min,
+            max,
+        });
     }
     Ok(())
 }

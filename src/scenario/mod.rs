@@ -7,18 +7,18 @@
 //! a skill name defined in the child replaces every base skill of that name, and the world
 //! table is merged by the world module. Every error names the file, line and column.
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 use toml::Spanned;
 
+mod build;
 mod file;
 
-use crate::domain::skill::{Domain, Param, Skill, ValueParam, parse_template};
-use crate::domain::vocabulary::{Object, Predicate, Vocabulary};
-use crate::goal::Formula;
-use file::{RawFile, RawPool, RawSkill, value_range};
+use crate::domain::skill::{AtomTemplate, Domain, LiteralTemplate, Term};
+use crate::domain::vocabulary::{Vocabulary, VocabularyError};
+use crate::goal::{Formula, GoalError};
+use file::{RawFile, RawPool};
 
 /// One file of a scenario, kept so later readers (the world) can locate their errors.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,6 +73,27 @@ pub struct ScenarioError {
     pub message: String,
 }
 
+/// Why a goal written against a scenario's vocabulary was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum GoalTextError {
+    /// The text is not a goal formula.
+    #[error(transparent)]
+    Syntax(#[from] GoalError),
+    /// An atom of the formula does not fit the vocabulary.
+    #[error(transparent)]
+    Vocabulary(#[from] VocabularyError),
+}
+
+impl GoalTextError {
+    /// The byte offset into the goal text the error is about (0: the whole goal).
+    pub fn at(&self) -> usize {
+        match self {
+            GoalTextError::Syntax(e) => e.at,
+            GoalTextError::Vocabulary(_) => 0,
+        }
+    }
+}
+
 impl SourceFile {
     pub fn read(path: &Path) -> Result<SourceFile, ScenarioError> {
         let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
@@ -88,8 +109,10 @@ impl SourceFile {
     }
 
     /// An error at byte `offset` of this file.
-    pub fn error_at(&self, offset: usize, message: impl Into<String>) -> ScenarioError {
-        let offset = offset.min(self.text.len());
+    pub fn error_at(&self, offset: usize, message: impl std::fmt::Display) -> ScenarioError {
+        // An offset into a string's contents lands inside a character when the string
+        // holds escapes before a multi-byte character: point at that character.
+        let offset = self.text.floor_char_boundary(offset.min(self.text.len()));
         let before = &self.text[..offset];
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);
@@ -98,7 +121,7 @@ impl SourceFile {
             file: self.path.clone(),
             line,
             column,
-            message: message.into(),
+            message: message.to_string(),
         }
     }
 
@@ -108,7 +131,7 @@ impl SourceFile {
         &self,
         span: &std::ops::Range<usize>,
         inner: usize,
-        message: impl Into<String>,
+        message: impl std::fmt::Display,
     ) -> ScenarioError {
         let quote = match self.text.get(span.start..span.start + 3) {
             Some("'''") | Some("\"\"\"") => 3,
@@ -124,12 +147,6 @@ impl SourceFile {
             self.error_at(at, e.message().trim().to_string())
         })
     }
-}
-
-/// Where a skill came from, so its errors can point into the right file.
-struct SkillSource<'a> {
-    raw: &'a RawSkill,
-    file: &'a SourceFile,
 }
 
 impl Scenario {
@@ -193,164 +210,17 @@ impl Scenario {
         Self::build(files, raws)
     }
 
-    fn build(files: Vec<SourceFile>, raws: Vec<RawFile>) -> Result<Scenario, ScenarioError> {
-        let child = files.len() - 1;
-        let Some(meta) = raws[child].scenario.as_ref() else {
-            return Err(files[child].error_at(0, "missing [scenario] table with at least `name`"));
-        };
-
-        let mut vocabulary = Vocabulary::default();
-        // Where each object stands in the vocabulary, so a large scene loads in linear time.
-        let mut index: HashMap<String, usize> = HashMap::new();
-        for (raw, file) in raws.iter().zip(&files) {
-            for (ty, names) in &raw.objects {
-                for name in names {
-                    let n = name.get_ref().trim();
-                    if n.is_empty() || n.contains('"') {
-                        return Err(file.error_in_string(
-                            &name.span(),
-                            0,
-                            "an object name must be non-empty and contain no quote",
-                        ));
-                    }
-                    match index.get(n).and_then(|&i| vocabulary.objects.get_mut(i)) {
-                        Some(o) if !o.types.contains(ty) => o.types.push(ty.clone()),
-                        Some(_) => {}
-                        None => {
-                            index.insert(n.to_string(), vocabulary.objects.len());
-                            vocabulary.objects.push(Object {
-                                name: n.to_string(),
-                                types: vec![ty.clone()],
-                            });
-                        }
-                    }
-                }
-            }
-        }
-        for (raw, file) in raws.iter().zip(&files) {
-            for p in &raw.predicates {
-                let mut arg_types = Vec::new();
-                for a in &p.args {
-                    let types = split_types(a.get_ref());
-                    for t in &types {
-                        if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
-                            return Err(file.error_in_string(
-                                &a.span(),
-                                0,
-                                format!("unknown type {t:?} (no object has it)"),
-                            ));
-                        }
-                    }
-                    arg_types.push(types);
-                }
-                let predicate = Predicate {
-                    name: p.name.get_ref().clone(),
-                    arg_types,
-                    description: p.description.clone(),
-                };
-                match vocabulary
-                    .predicates
-                    .iter_mut()
-                    .find(|q| q.name == predicate.name)
-                {
-                    Some(q) => *q = predicate,
-                    None => vocabulary.predicates.push(predicate),
-                }
-            }
-        }
-
-        // A skill name defined in a later file replaces that name from earlier files.
-        let mut sources: Vec<SkillSource> = Vec::new();
-        for (raw, file) in raws.iter().zip(&files) {
-            let names: Vec<&str> = raw
-                .skills
-                .iter()
-                .map(|s| s.name.get_ref().as_str())
-                .collect();
-            sources.retain(|s| !names.contains(&s.raw.name.get_ref().as_str()));
-            sources.extend(raw.skills.iter().map(|raw| SkillSource { raw, file }));
-        }
-        let skills = sources
-            .iter()
-            .map(|s| build_skill(s, &vocabulary))
-            .collect::<Result<Vec<_>, _>>()?;
-
-        let file = &files[child];
-        let goal = match &meta.goal {
-            Some(g) => Some(parse_goal(file, g, &vocabulary)?),
-            None => None,
-        };
-        for fix in &meta.expected_fix {
-            parse_goal(file, fix, &vocabulary)?;
-        }
-        let examples = raws
-            .iter()
-            .rev()
-            .find(|r| !r.examples.is_empty())
-            .map(|r| {
-                r.examples
-                    .iter()
-                    .map(|e| Example {
-                        instruction: e.instruction.clone(),
-                        goal: e.goal.clone(),
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        let world_kind = raws
-            .iter()
-            .rev()
-            .find_map(|r| r.world.as_ref()?.get("kind")?.as_str().map(str::to_string))
-            .unwrap_or_else(|| "symbolic".to_string());
-        Ok(Scenario {
-            name: meta.name.clone(),
-            description: meta.description.clone(),
-            instruction: meta.instruction.clone(),
-            goal,
-            expected_fix: meta
-                .expected_fix
-                .iter()
-                .map(|f| f.get_ref().clone())
-                .collect(),
-            examples,
-            conventions: raws
-                .iter()
-                .flat_map(|r| &r.conventions)
-                .map(|c| Convention {
-                    text: c.text.trim().to_string(),
-                    objects: c.objects.clone(),
-                })
-                .collect(),
-            domain: Domain { vocabulary, skills },
-            world_kind,
-            files,
-        })
-    }
-
     /// Parse a goal written by a person against this scenario's vocabulary.
-    pub fn parse_goal(&self, text: &str) -> Result<Formula, String> {
-        let f = Formula::parse(text).map_err(|e| e.to_string())?;
-        for atom in f.atoms() {
-            self.domain
-                .vocabulary
-                .check_atom(&atom)
-                .map_err(|e| e.to_string())?;
-        }
-        Ok(f)
+    pub fn parse_goal(&self, text: &str) -> Result<Formula, GoalTextError> {
+        goal_in(text, &self.domain.vocabulary)
     }
 }
 
-fn parse_goal(
-    file: &SourceFile,
-    text: &Spanned<String>,
-    vocabulary: &Vocabulary,
-) -> Result<Formula, ScenarioError> {
-    let f = Formula::parse(text.get_ref())
-        .map_err(|e| file.error_in_string(&text.span(), e.at, e.to_string()))?;
+/// A goal formula whose every atom fits `vocabulary`.
+fn goal_in(text: &str, vocabulary: &Vocabulary) -> Result<Formula, GoalTextError> {
+    let f = Formula::parse(text)?;
     for atom in f.atoms() {
-        vocabulary
-            .check_atom(&atom)
-            .map_err(|e| file.error_in_string(&text.span(), 0, e.to_string()))?;
+        vocabulary.check_atom(&atom)?;
     }
     Ok(f)
 }
@@ -369,18 +239,12 @@ pub(crate) fn effect_templates(
     file: &SourceFile,
     add: &[Spanned<String>],
     del: &[Spanned<String>],
-    literal: impl Fn(&Spanned<String>) -> Result<crate::domain::skill::LiteralTemplate, ScenarioError>,
-) -> Result<
-    (
-        Vec<crate::domain::skill::AtomTemplate>,
-        Vec<crate::domain::skill::AtomTemplate>,
-    ),
-    ScenarioError,
-> {
+    literal: impl Fn(&Spanned<String>) -> Result<LiteralTemplate, ScenarioError>,
+) -> Result<(Vec<AtomTemplate>, Vec<AtomTemplate>), ScenarioError> {
     let mut added = Vec::new();
     for s in add {
         let t = literal(s)?;
-        if t.negated || t.atom.args.contains(&crate::domain::skill::Term::Every) {
+        if t.negated || t.atom.args.contains(&Term::Every) {
             return Err(file.error_in_string(
                 &s.span(),
                 0,
@@ -404,128 +268,17 @@ pub(crate) fn effect_templates(
     Ok((added, deleted))
 }
 
-fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, ScenarioError> {
-    let raw = source.raw;
-    let file = source.file;
-    let name = raw.name.get_ref().trim();
-    if name.is_empty()
-        || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
-        || !name.starts_with(|c: char| c.is_ascii_alphabetic())
-    {
-        return Err(file.error_in_string(
-            &raw.name.span(),
-            0,
-            "a skill name is letters, digits and _ (starting with a letter)",
-        ));
-    }
-    let mut params = Vec::new();
-    for p in &raw.params {
-        let Some((pname, spec)) = p.get_ref().split_once(':') else {
-            return Err(file.error_in_string(&p.span(), 0, "expected `name: type` (e.g. `item: item`, `target: place|item`, `x: item except makable`)"));
-        };
-        let (types, except) = match spec.split_once(" except ") {
-            Some((t, e)) => (split_types(t), split_types(e)),
-            None => (split_types(spec), Vec::new()),
-        };
-        for t in types.iter().chain(&except) {
-            if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
-                return Err(file.error_in_string(
-                    &p.span(),
-                    0,
-                    format!("unknown type or object {t:?}"),
-                ));
-            }
-        }
-        params.push(Param {
-            name: pname.trim().to_string(),
-            types,
-            except,
-        });
-    }
-    let literal = |s: &Spanned<String>| {
-        let t = parse_template(s.get_ref(), &params)
-            .map_err(|m| file.error_in_string(&s.span(), 0, m))?;
-        check_template(&t.atom, &params, vocabulary)
-            .map_err(|m| file.error_in_string(&s.span(), 0, m))?;
-        Ok::<_, ScenarioError>(t)
-    };
-    let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
-    let (add, del) = effect_templates(file, &raw.add, &raw.del, literal)?;
-    if !raw.cost.is_finite() || raw.cost < 0.0 {
-        return Err(file.error_in_string(&raw.name.span(), 0, "cost must be a finite number >= 0"));
-    }
-    for v in &raw.values {
-        value_range(v).map_err(|m| {
-            file.error_in_string(&raw.name.span(), 0, format!("value {:?}: {m}", v.name))
-        })?;
-    }
-    Ok(Skill {
-        name: name.to_string(),
-        description: raw.description.clone(),
-        params,
-        pre,
-        add,
-        del,
-        cost: raw.cost,
-        ticks: raw.ticks.max(1),
-        values: raw
-            .values
-            .iter()
-            .map(|v| ValueParam {
-                name: v.name.clone(),
-                unit: v.unit.clone(),
-                categories: v.categories.clone(),
-                description: v.description.clone(),
-                min: v.min,
-                max: v.max,
-            })
-            .collect(),
-        learned: Vec::new(),
-    })
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// A template's predicate must exist with the right arity, and its constants must fit.
-fn check_template(
-    t: &crate::domain::skill::AtomTemplate,
-    params: &[Param],
-    vocabulary: &Vocabulary,
-) -> Result<(), String> {
-    use crate::domain::skill::Term;
-    let Some(pred) = vocabulary.predicate(&t.predicate) else {
-        return Err(format!("unknown predicate {:?}", t.predicate));
-    };
-    if pred.arg_types.len() != t.args.len() {
-        return Err(format!(
-            "{:?} takes {} argument(s), found {}",
-            t.predicate,
-            pred.arg_types.len(),
-            t.args.len()
-        ));
+    #[test]
+    fn an_offset_inside_a_character_points_at_that_character() {
+        let file = SourceFile {
+            path: PathBuf::from("t.toml"),
+            text: "a = \"\\\"é{x}\"\n".into(),
+        };
+        let e = file.error_at(8, "here");
+        assert_eq!((e.line, e.column), (1, 8), "{e}");
     }
-    for (term, types) in t.args.iter().zip(&pred.arg_types) {
-        match term {
-            Term::Const(c)
-                if c != crate::domain::condition::ANY_OBJECT && !vocabulary.fits(c, types) =>
-            {
-                return Err(format!(
-                    "{c:?} is not a known object of type {}",
-                    types.join(" or ")
-                ));
-            }
-            Term::Param(i) => {
-                let p = &params[*i];
-                if !p.candidates(vocabulary).any(|o| vocabulary.fits(o, types)) {
-                    return Err(format!(
-                        "parameter {:?} ({}) can never fit {:?}'s argument of type {}",
-                        p.name,
-                        p.types.join("|"),
-                        t.predicate,
-                        types.join(" or ")
-                    ));
-                }
-            }
-            Term::Const(_) | Term::Every => {}
-        }
-    }
-    Ok(())
 }

@@ -11,7 +11,7 @@ use crate::llm::reply::{self, ReplyError, Substitution};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
-use super::screen::Screen;
+use super::screen::{NotHelped, Screen};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
 use super::value_bounds::Bounds;
@@ -194,7 +194,7 @@ async fn draw_and_screen(
                 asked.chosen = Some((proposal, reasoning, substitutions));
                 return Ok(asked);
             }
-            Err(why) => asked.rejected.push((proposal, why)),
+            Err(why) => asked.rejected.push((proposal, why.to_string())),
         }
     }
     Ok(asked)
@@ -207,22 +207,21 @@ fn screen_one(
     bounds: &mut Bounds,
     (proposal, author): (&Proposal, Option<&str>),
     emit: &mut (dyn FnMut(&Event) + Send),
-) -> Result<(), String> {
-    match screen.check(proposal).map_err(|e| e.to_string()) {
-        Ok(()) => Ok(()),
-        Err(why) => {
-            emit(&Event::CandidateRejected {
-                candidate: proposal.to_string(),
-                proposal: Some(proposal.clone()),
-                reason: format!("tried in simulation: {why}"),
-                author: author.map(str::to_string),
-            });
-            if let Some(v) = value_of(proposal) {
-                bounds.learn(v, &why);
-            }
-            Err(why)
-        }
+) -> Result<(), NotHelped> {
+    let Err(why) = screen.check(proposal) else {
+        return Ok(());
+    };
+    let told = why.to_string();
+    emit(&Event::CandidateRejected {
+        candidate: proposal.to_string(),
+        proposal: Some(proposal.clone()),
+        reason: format!("tried in simulation: {told}"),
+        author: author.map(str::to_string),
+    });
+    if let Some(v) = value_of(proposal) {
+        bounds.learn(v, &told);
     }
+    Err(why)
 }
 
 fn value_of(proposal: &Proposal) -> Option<&crate::domain::Value> {
@@ -425,7 +424,7 @@ pub(crate) async fn ask_value(
                 asked.chosen = Some((midway, Some(between), Vec::new()));
                 asked.author = Some(MIDWAY.to_string());
             }
-            Err(why) => asked.rejected.push((midway, why)),
+            Err(why) => asked.rejected.push((midway, why.to_string())),
         }
     }
     Ok(asked)

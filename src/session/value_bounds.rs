@@ -138,6 +138,23 @@ impl Limit {
     }
 }
 
+/// Why a value is turned away before it is tried, in words the person and the model can
+/// be told.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NotAdmitted {
+    /// The world refused this very value, saying `error`.
+    #[error("{value} was refused before ({error})")]
+    RefusedBefore { value: Value, error: String },
+    /// The value lies beyond a bound: `bound` says which side in words, `origin` where
+    /// the bound comes from.
+    #[error("{value} is not {bound}: {origin}")]
+    Beyond {
+        value: Value,
+        bound: String,
+        origin: String,
+    },
+}
+
 /// What the refusals of one failure's values say so far.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Bounds {
@@ -202,9 +219,12 @@ impl Bounds {
 
     /// Ok when `value` is neither refused already nor beyond a bound; else why not, in
     /// words the person and the model can be told.
-    pub fn admits(&self, value: &Value) -> Result<(), String> {
+    pub fn admits(&self, value: &Value) -> Result<(), NotAdmitted> {
         if let Some((_, why)) = self.refused.iter().find(|(r, _)| same_value(r, value)) {
-            return Err(format!("{value} was refused before ({why})"));
+            return Err(NotAdmitted::RefusedBefore {
+                value: value.clone(),
+                error: why.clone(),
+            });
         }
         let Value::Number { value: v, unit } = value else {
             return Ok(());
@@ -213,11 +233,11 @@ impl Bounds {
             if let Some(l) = limit
                 && l.excludes(*v, side)
             {
-                return Err(format!(
-                    "{value} is not {}: {}",
-                    l.words(side, unit),
-                    l.source
-                ));
+                return Err(NotAdmitted::Beyond {
+                    value: value.clone(),
+                    bound: l.words(side, unit),
+                    origin: l.source.clone(),
+                });
             }
         }
         Ok(())
@@ -324,19 +344,25 @@ mod tests {
         b.learn(&n(10.0, "N"), BROKE);
         // The stated limit, not the refused value, is the bound; it is itself allowed.
         assert!(b.admits(&n(6.0, "N")).is_ok());
-        let why = b.admits(&n(15.0, "N")).unwrap_err();
+        let why = b.admits(&n(15.0, "N")).unwrap_err().to_string();
         assert!(why.contains("not at most 6 N"), "{why}");
         assert!(why.contains("10 N"), "{why}");
         assert!(
             b.admits(&n(10.0, "N"))
                 .unwrap_err()
+                .to_string()
                 .contains("refused before")
         );
         assert_eq!(b.midway(), None);
 
         b.learn(&n(1.0, "N"), "1 N is too little force to hold it");
         assert!(b.admits(&n(1.0, "N")).is_err());
-        assert!(b.admits(&n(0.4, "N")).unwrap_err().contains("above 1 N"));
+        assert!(
+            b.admits(&n(0.4, "N"))
+                .unwrap_err()
+                .to_string()
+                .contains("above 1 N")
+        );
         assert_eq!(b.describe("N").unwrap(), "at most 6 N and above 1 N");
         assert_eq!(b.midway(), Some(3.5));
         let summary = b.summary("N").unwrap();
@@ -355,7 +381,7 @@ mod tests {
         };
         let mut b = Bounds::declared(&speed);
         assert!(b.admits(&n(1.5, "m/s")).is_ok());
-        let why = b.admits(&n(10.0, "m/s")).unwrap_err();
+        let why = b.admits(&n(10.0, "m/s")).unwrap_err().to_string();
         assert!(why.contains("not at most 1.5 m/s"), "{why}");
         assert!(why.contains("declared by its skill"), "{why}");
         // A refusal below the declared limit tightens it; one above it does not widen it.

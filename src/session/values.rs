@@ -7,7 +7,7 @@
 //! must be one of the declared categories.
 
 use crate::bt::Tree;
-use crate::domain::action::parse_value;
+use crate::domain::action::{ActionError, parse_value};
 use crate::domain::{Value, ValueParam};
 use crate::planner;
 use crate::scenario::Scenario;
@@ -23,7 +23,7 @@ pub struct Setting {
 
 /// Why a setting could not be read; each names the text as typed (shortened when long).
 /// Front ends say where it came from (`--set` on the command line, the workbench's input).
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SettingError {
     #[error("{text}: expected `<parameter> of <object> = <value>`, e.g. \"force of egg = 5 N\"")]
     Form { text: String },
@@ -36,7 +36,52 @@ pub enum SettingError {
         declared: String,
     },
     #[error("{text}: {reason}")]
-    BadValue { text: String, reason: String },
+    Unreadable { text: String, reason: ActionError },
+    #[error("{text}: {reason}")]
+    Unfit { text: String, reason: ConformError },
+}
+
+/// Why a value does not fit its parameter's declaration; each names the parameter.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConformError {
+    #[error("{value} {unit} is more than the robot can do ({param} at most {max} {unit})")]
+    AboveMax {
+        param: String,
+        value: f64,
+        unit: String,
+        max: f64,
+    },
+    #[error("{value} {unit} is less than the robot can do ({param} at least {min} {unit})")]
+    BelowMin {
+        param: String,
+        value: f64,
+        unit: String,
+        min: f64,
+    },
+    #[error("{param} is given in {unit}, not {given}")]
+    WrongUnit {
+        param: String,
+        unit: String,
+        given: String,
+    },
+    #[error("{category:?} is not one of {}", .categories.join(", "))]
+    UnknownCategory {
+        param: String,
+        category: String,
+        categories: Vec<String>,
+    },
+    #[error("{param} is a number in {unit}, found {value}")]
+    NotANumber {
+        param: String,
+        unit: String,
+        value: Value,
+    },
+    #[error("{param} is one of {}, found {value}", .categories.join(", "))]
+    NotACategory {
+        param: String,
+        categories: Vec<String>,
+        value: Value,
+    },
 }
 
 pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, SettingError> {
@@ -92,12 +137,14 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
             },
         });
     };
-    let bad = |reason: String| SettingError::BadValue {
+    let value = parse_value(value_text).map_err(|reason| SettingError::Unreadable {
         text: shown.clone(),
         reason,
-    };
-    let value = parse_value(value_text).map_err(|e| bad(e.to_string()))?;
-    let value = conform(&declared, value).map_err(bad)?;
+    })?;
+    let value = conform(&declared, value).map_err(|reason| SettingError::Unfit {
+        text: shown.clone(),
+        reason,
+    })?;
     Ok(Setting {
         text: text.to_string(),
         object,
@@ -108,47 +155,56 @@ pub fn parse_setting(scenario: &Scenario, text: &str) -> Result<Setting, Setting
 
 /// Check `value` against the declaration: a number takes the declared unit (a bare
 /// number gets it), a category must be one of the declared categories.
-pub fn conform(declared: &ValueParam, value: Value) -> Result<Value, String> {
+pub fn conform(declared: &ValueParam, value: Value) -> Result<Value, ConformError> {
+    let param = || declared.name.clone();
     match (value, &declared.unit) {
         (Value::Number { value, unit }, Some(want)) if unit.is_empty() || unit == *want => {
             if let Some(max) = declared.max.filter(|m| value > *m) {
-                return Err(format!(
-                    "{value} {want} is more than the robot can do ({} at most {max} {want})",
-                    declared.name
-                ));
+                return Err(ConformError::AboveMax {
+                    param: param(),
+                    value,
+                    unit: want.clone(),
+                    max,
+                });
             }
             if let Some(min) = declared.min.filter(|m| value < *m) {
-                return Err(format!(
-                    "{value} {want} is less than the robot can do ({} at least {min} {want})",
-                    declared.name
-                ));
+                return Err(ConformError::BelowMin {
+                    param: param(),
+                    value,
+                    unit: want.clone(),
+                    min,
+                });
             }
             Ok(Value::Number {
                 value,
                 unit: want.clone(),
             })
         }
-        (Value::Number { unit, .. }, Some(want)) => {
-            Err(format!("{} is given in {want}, not {unit}", declared.name))
-        }
+        (Value::Number { unit, .. }, Some(want)) => Err(ConformError::WrongUnit {
+            param: param(),
+            unit: want.clone(),
+            given: unit,
+        }),
         (Value::Category(c), None)
             if declared.categories.is_empty() || declared.categories.contains(&c) =>
         {
             Ok(Value::Category(c))
         }
-        (Value::Category(c), None) => Err(format!(
-            "{c:?} is not one of {}",
-            declared.categories.join(", ")
-        )),
-        (v, Some(want)) => Err(format!(
-            "{} is a number in {want}, found {v}",
-            declared.name
-        )),
-        (v, None) => Err(format!(
-            "{} is one of {}, found {v}",
-            declared.name,
-            declared.categories.join(", ")
-        )),
+        (Value::Category(category), None) => Err(ConformError::UnknownCategory {
+            param: param(),
+            category,
+            categories: declared.categories.clone(),
+        }),
+        (value, Some(want)) => Err(ConformError::NotANumber {
+            param: param(),
+            unit: want.clone(),
+            value,
+        }),
+        (value, None) => Err(ConformError::NotACategory {
+            param: param(),
+            categories: declared.categories.clone(),
+            value,
+        }),
     }
 }
 

@@ -148,16 +148,38 @@ impl Microphone for WavMicrophone {
 /// must not block (a send on an unbounded channel).
 pub type DictationSink = Arc<dyn Fn(DictationEvent) + Send + Sync>;
 
+/// Why dictation gave no transcript, or cannot work at all.
+#[derive(Debug, thiserror::Error)]
+pub enum DictationError {
+    /// The speech-to-text settings cannot work, in the words of the front end that read
+    /// them (it knows where they came from).
+    #[error("{reason}")]
+    Settings { reason: String },
+    /// The embedded model could not be fetched.
+    #[error(transparent)]
+    Fetch(#[from] crate::model::FetchError),
+    /// Recording, loading the model or transcribing failed.
+    #[error(transparent)]
+    Voice(#[from] VoiceError),
+    /// The task stopping the recording ended without an answer.
+    #[error("the recording could not be stopped: {0}")]
+    Stop(tokio::task::JoinError),
+    /// The task loading the model ended without an answer.
+    #[error("the speech-to-text model could not be loaded: {0}")]
+    Load(tokio::task::JoinError),
+}
+
 /// Builds the speech-to-text backend (blocking: it may fetch and load a model), reporting
 /// progress through the callback; the error says what to do.
-pub type SttLoader =
-    Arc<dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, String> + Send + Sync>;
+pub type SttLoader = Arc<
+    dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, DictationError> + Send + Sync,
+>;
 
 /// Owns the recording in progress and the speech-to-text model.
 pub struct DictationService {
     microphone: Arc<dyn Microphone>,
     /// `Err`: why dictation cannot work at all (bad `[stt]` settings).
-    loader: Result<SttLoader, String>,
+    loader: Result<SttLoader, DictationError>,
     stt: Arc<OnceCell<Arc<dyn SpeechToText>>>,
     recording: Option<Box<dyn Recording>>,
     /// A recording is being stopped or transcribed.
@@ -169,7 +191,7 @@ impl DictationService {
     /// A service whose events arrive on a channel of their own.
     pub fn new(
         microphone: Arc<dyn Microphone>,
-        loader: Result<SttLoader, String>,
+        loader: Result<SttLoader, DictationError>,
     ) -> (DictationService, UnboundedReceiver<DictationEvent>) {
         let (tx, rx) = unbounded_channel();
         // The app is gone only when the workbench is closing: nothing is left to tell.
@@ -182,7 +204,7 @@ impl DictationService {
     /// A service whose events go to `events`.
     pub fn reporting_to(
         microphone: Arc<dyn Microphone>,
-        loader: Result<SttLoader, String>,
+        loader: Result<SttLoader, DictationError>,
         events: DictationSink,
     ) -> DictationService {
         DictationService {
@@ -222,7 +244,7 @@ impl DictationService {
             Ok(l) => l.clone(),
             Err(why) => {
                 return self.send(DictationEvent::Failed(
-                    super::strings::dictation_unavailable(why),
+                    super::strings::dictation_unavailable(&why.to_string()),
                 ));
             }
         };
@@ -261,11 +283,11 @@ impl DictationService {
         };
         // `start` refuses to record without a loader, so this holds; if it ever did not,
         // the person hears why rather than nothing.
-        let loader = match self.loader.clone() {
-            Ok(l) => l,
+        let loader = match &self.loader {
+            Ok(l) => l.clone(),
             Err(why) => {
                 return self.send(DictationEvent::Failed(
-                    super::strings::dictation_unavailable(&why),
+                    super::strings::dictation_unavailable(&why.to_string()),
                 ));
             }
         };
@@ -276,7 +298,7 @@ impl DictationService {
             busy.store(false, Ordering::SeqCst);
             events(match outcome {
                 Ok(transcript) => DictationEvent::Heard(transcript),
-                Err(message) => DictationEvent::Failed(message),
+                Err(e) => DictationEvent::Failed(e.to_string()),
             });
         });
     }
@@ -295,18 +317,15 @@ async fn stop_and_transcribe(
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
     events: &DictationSink,
-) -> Result<Transcript, String> {
+) -> Result<Transcript, DictationError> {
     let audio = tokio::task::spawn_blocking(move || recording.stop())
         .await
-        .map_err(|e| format!("the recording could not be stopped: {e}"))?
-        .map_err(|e| e.to_string())?;
+        .map_err(DictationError::Stop)??;
     events(DictationEvent::Transcribing {
         seconds: audio.seconds(),
     });
     let model = ready_model(stt, loader, events).await?;
-    voice::transcribe(model.as_ref(), &audio)
-        .await
-        .map_err(|e| e.to_string())
+    Ok(voice::transcribe(model.as_ref(), &audio).await?)
 }
 
 /// The model, loaded once (concurrent callers wait for the same load; a failed load is
@@ -315,7 +334,7 @@ async fn ready_model(
     stt: &OnceCell<Arc<dyn SpeechToText>>,
     loader: &SttLoader,
     events: &DictationSink,
-) -> Result<Arc<dyn SpeechToText>, String> {
+) -> Result<Arc<dyn SpeechToText>, DictationError> {
     stt.get_or_try_init(|| {
         let (loader, events) = (loader.clone(), events.clone());
         async move {
@@ -325,7 +344,7 @@ async fn ready_model(
                 })
             })
             .await
-            .map_err(|e| format!("the speech-to-text model could not be loaded: {e}"))?
+            .map_err(DictationError::Load)?
         }
     })
     .await

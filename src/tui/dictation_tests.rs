@@ -92,7 +92,11 @@ fn loader(failures: usize, calls: Arc<AtomicUsize>) -> SttLoader {
         let n = calls.fetch_add(1, Ordering::SeqCst);
         report("loading echo");
         if n < failures {
-            Err("the model is not in the cache; run `betr model fetch --stt`".into())
+            Err(VoiceError::ModelMissing {
+                name: "echo".into(),
+                path: PathBuf::from("/nowhere/echo"),
+            }
+            .into())
         } else {
             Ok(Arc::new(Echo) as Arc<dyn SpeechToText>)
         }
@@ -237,8 +241,12 @@ fn no_microphone_silence_and_bad_settings_are_clear_failures() {
         }
 
         let (mic, stopped) = microphone(speech(1.0));
-        let (mut service, mut rx) =
-            DictationService::new(mic, Err("BETR_STT: unknown backend \"cloud\"".into()));
+        let (mut service, mut rx) = DictationService::new(
+            mic,
+            Err(DictationError::Settings {
+                reason: "BETR_STT: unknown backend \"cloud\"".into(),
+            }),
+        );
         service.handle(DictationRequest::Start);
         match until_done(&mut rx).await.last() {
             Some(DictationEvent::Failed(why)) => {

@@ -73,7 +73,9 @@ impl Bench {
         // Dictation is unavailable, so the microphone is never opened.
         let dictation = DictationService::reporting_to(
             Arc::new(DefaultMicrophone),
-            Err("not in this test".into()),
+            Err(crate::tui::dictation::DictationError::Settings {
+                reason: "not in this test".into(),
+            }),
             queue.dictation_sink(),
         );
         Bench {

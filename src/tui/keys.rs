@@ -36,6 +36,36 @@ pub enum Action {
     Quit,
 }
 
+/// Why a key's name was not understood; each names the text as written.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum KeyError {
+    #[error("unknown key {text:?} (function keys are f1-f12)")]
+    FunctionKey { text: String },
+    #[error(
+        "unknown key {text:?} (expected one character, space, enter, esc, tab, backspace or f1-f12, optionally with ctrl- or alt-)"
+    )]
+    Unknown { text: String },
+}
+
+/// Why a file of key bindings was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum KeysFileError {
+    #[error(transparent)]
+    Toml(#[from] toml::de::Error),
+    /// The key given for an action, by the action's name in the file.
+    #[error("{action}: {error}")]
+    Key {
+        action: &'static str,
+        error: KeyError,
+    },
+    #[error("{key} is bound to both {first:?} and {second:?}")]
+    Shared {
+        key: Key,
+        first: Action,
+        second: Action,
+    },
+}
+
 /// A key with its modifiers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Key {
@@ -66,7 +96,7 @@ impl Key {
 
     /// `space`, `enter`, `esc`, `tab`, `backspace`, `f1`…`f12`, one character, each
     /// optionally prefixed by `ctrl-` or `alt-`.
-    pub fn parse(text: &str) -> Result<Key, String> {
+    pub fn parse(text: &str) -> Result<Key, KeyError> {
         let mut modifiers = KeyModifiers::NONE;
         let mut rest = text.trim();
         loop {
@@ -89,16 +119,20 @@ impl Key {
             "backspace" => KeyCode::Backspace,
             f if f.len() > 1 && f.starts_with('f') => match f[1..].parse::<u8>() {
                 Ok(n @ 1..=12) => KeyCode::F(n),
-                _ => return Err(format!("unknown key {text:?}")),
+                _ => {
+                    return Err(KeyError::FunctionKey {
+                        text: text.to_string(),
+                    });
+                }
             },
             _ => {
                 let mut chars = rest.chars();
                 match (chars.next(), chars.next()) {
                     (Some(c), None) => KeyCode::Char(c),
                     _ => {
-                        return Err(format!(
-                            "unknown key {text:?} (expected one character, space, enter, esc, tab, backspace or f1-f12, optionally with ctrl- or alt-)"
-                        ));
+                        return Err(KeyError::Unknown {
+                            text: text.to_string(),
+                        });
                     }
                 }
             }
@@ -155,10 +189,12 @@ macro_rules! bindings {
                 vec![ $( (Action::$action, self.$field), )* ]
             }
 
-            fn apply(&mut self, patch: Patch) -> Result<(), String> {
+            fn apply(&mut self, patch: Patch) -> Result<(), KeysFileError> {
                 $( if let Some(text) = patch.$field {
-                    self.$field = Key::parse(&text)
-                        .map_err(|e| format!("{}: {e}", stringify!($field)))?;
+                    self.$field = Key::parse(&text).map_err(|error| KeysFileError::Key {
+                        action: stringify!($field),
+                        error,
+                    })?;
                 } )*
                 Ok(())
             }
@@ -209,14 +245,18 @@ impl KeyBindings {
     }
 
     /// The defaults patched by a TOML text; two actions may not share a key.
-    pub fn from_toml(text: &str) -> Result<KeyBindings, String> {
-        let patch: Patch = toml::from_str(text).map_err(|e| e.to_string())?;
+    pub fn from_toml(text: &str) -> Result<KeyBindings, KeysFileError> {
+        let patch: Patch = toml::from_str(text)?;
         let mut keys = KeyBindings::default();
         keys.apply(patch)?;
         let entries = keys.entries();
         for (i, (a, k)) in entries.iter().enumerate() {
             if let Some((b, _)) = entries[..i].iter().find(|(_, other)| other == k) {
-                return Err(format!("{k} is bound to both {b:?} and {a:?}"));
+                return Err(KeysFileError::Shared {
+                    key: *k,
+                    first: *b,
+                    second: *a,
+                });
             }
         }
         Ok(keys)
@@ -296,16 +336,21 @@ mod tests {
         );
         assert_eq!(k.run, Key::plain('r'));
         assert!(KeyBindings::from_toml("jump = \"j\"").is_err());
+        let e = KeyBindings::from_toml("step = \"banana\"").unwrap_err();
+        assert!(e.to_string().contains("step"), "{e}");
         assert!(
-            KeyBindings::from_toml("step = \"banana\"")
-                .unwrap_err()
-                .contains("step")
+            matches!(
+                KeyBindings::from_toml("step = \"q\""),
+                Err(KeysFileError::Shared {
+                    first: Action::Step,
+                    second: Action::Quit,
+                    ..
+                })
+            ),
+            "two actions on one key"
         );
-        assert!(
-            KeyBindings::from_toml("step = \"q\"")
-                .unwrap_err()
-                .contains("bound to both")
-        );
+        let e = KeyBindings::from_toml("step = \"f13\"").unwrap_err();
+        assert!(e.to_string().contains("f1-f12"), "{e}");
         let help = KeyBindings::default().help_lines();
         assert!(
             help.iter()

@@ -106,7 +106,7 @@ pub struct Workbench {
     /// Push-to-talk: where recordings come from.
     pub microphone: Arc<dyn Microphone>,
     /// Push-to-talk: how the speech-to-text model is loaded, or why dictation cannot work.
-    pub stt: Result<SttLoader, String>,
+    pub stt: Result<SttLoader, dictation::DictationError>,
     /// Where standard error goes while the screen is up (the log file).
     pub stderr_to: Option<PathBuf>,
     /// A tree file to open instead of planning (betr text, a policy, BT.CPP XML).

@@ -26,7 +26,8 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::temporal::Property;
-use crate::domain::skill::{AtomTemplate, LiteralTemplate, Term, parse_template};
+use crate::domain::skill::{AtomTemplate, LiteralTemplate};
+use crate::domain::template::parse_template;
 use crate::domain::{Param, Vocabulary};
 use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
@@ -128,13 +129,17 @@ fn read_disturbance(
     let mut params = Vec::new();
     for p in &raw.params {
         let param = parse_param(p.get_ref(), vocabulary)
-            .map_err(|m| file.error_in_string(&p.span(), 0, m))?;
+            .map_err(|e| file.error_in_string(&p.span(), 0, e))?;
         params.push(param);
     }
     let literal = |s: &Spanned<String>| {
         let t = parse_template(s.get_ref(), &params)
-            .map_err(|m| file.error_in_string(&s.span(), 0, m))?;
-        check_predicate(&t.atom, vocabulary).map_err(|m| file.error_in_string(&s.span(), 0, m))?;
+            .map_err(|e| file.error_in_string(&s.span(), e.at(), e))?;
+        // Disturbance parameters range over whatever their types admit, so only the
+        // predicate and the constants are checked.
+        t.atom
+            .check(vocabulary, None)
+            .map_err(|e| file.error_in_string(&s.span(), 0, e))?;
         Ok::<_, ScenarioError>(t)
     };
     let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
@@ -155,10 +160,21 @@ fn read_disturbance(
     })
 }
 
+/// Why a disturbance parameter could not be read.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+enum ParamError {
+    #[error("expected `name: type` (e.g. `a: cube`, `x: item except makable`)")]
+    Form,
+    #[error("parameter {name:?} has no type")]
+    NoType { name: String },
+    #[error("unknown type or object {name:?}")]
+    UnknownType { name: String },
+}
+
 /// `name: type`, `name: a|b`, `name: type except other` (the skill parameter syntax).
-fn parse_param(text: &str, vocabulary: &Vocabulary) -> Result<Param, String> {
+fn parse_param(text: &str, vocabulary: &Vocabulary) -> Result<Param, ParamError> {
     let Some((name, spec)) = text.split_once(':') else {
-        return Err("expected `name: type` (e.g. `a: cube`, `x: item except makable`)".to_string());
+        return Err(ParamError::Form);
     };
     let split = |s: &str| -> Vec<String> {
         s.split('|')
@@ -171,12 +187,16 @@ fn parse_param(text: &str, vocabulary: &Vocabulary) -> Result<Param, String> {
         None => (split(spec), Vec::new()),
     };
     if types.is_empty() {
-        return Err(format!("parameter {:?} has no type", name.trim()));
+        return Err(ParamError::NoType {
+            name: name.trim().to_string(),
+        });
     }
-    for t in types.iter().chain(&except) {
-        if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
-            return Err(format!("unknown type or object {t:?}"));
-        }
+    if let Some(t) = types
+        .iter()
+        .chain(&except)
+        .find(|t| !vocabulary.is_type(t) && vocabulary.object(t).is_none())
+    {
+        return Err(ParamError::UnknownType { name: t.clone() });
     }
     Ok(Param {
         name: name.trim().to_string(),
@@ -185,47 +205,12 @@ fn parse_param(text: &str, vocabulary: &Vocabulary) -> Result<Param, String> {
     })
 }
 
-/// The predicate exists with the right arity and every constant argument is an object.
-fn check_predicate(t: &AtomTemplate, vocabulary: &Vocabulary) -> Result<(), String> {
-    let Some(pred) = vocabulary.predicate(&t.predicate) else {
-        let known: Vec<&str> = vocabulary
-            .predicates
-            .iter()
-            .map(|p| p.name.as_str())
-            .collect();
-        return Err(format!(
-            "unknown predicate {:?} (known: {})",
-            t.predicate,
-            known.join(", ")
-        ));
-    };
-    if pred.arg_types.len() != t.args.len() {
-        return Err(format!(
-            "{:?} takes {} argument(s), found {}",
-            t.predicate,
-            pred.arg_types.len(),
-            t.args.len()
-        ));
-    }
-    for (term, types) in t.args.iter().zip(&pred.arg_types) {
-        if let Term::Const(c) = term
-            && c != crate::domain::ANY_OBJECT
-            && !vocabulary.fits(c, types)
-        {
-            return Err(format!(
-                "{c:?} is not a known object of type {}",
-                types.join(" or ")
-            ));
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use std::path::Path;
 
     use super::*;
+    use crate::domain::skill::Term;
 
     const HEAD: &str = r#"
 [scenario]

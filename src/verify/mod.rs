@@ -251,106 +251,159 @@ pub fn export_promela(input: &VerifyInput) -> Result<promela::PromelaModel, Mode
     ))
 }
 
+/// Explore every state reachable in `model`, then check each property over them.
 fn model_check(model: &Model, input: &VerifyInput) -> ModelCheck {
-    use explore::{Edge, Eventually, Liveness};
     let started = Instant::now();
-    let limits = &input.limits;
-    let g = explore::explore(model, limits);
-    let unknown = || Verdict::Unknown {
+    let g = explore::explore(model, &input.limits);
+    let explored = Explored { model, g: &g };
+    let mut properties = vec![
+        explored.success(input.limits.max_ticks),
+        explored.preconditions(),
+    ];
+    properties.extend(
+        input
+            .properties
+            .iter()
+            .zip(&model.properties)
+            .enumerate()
+            .map(|(i, (p, e))| explored.user_property(i, p, e)),
+    );
+    ModelCheck {
+        atoms: model.atoms.len(),
         states: g.states.len(),
-    };
-    let cx = |transitions: Vec<(u32, Edge)>, loop_from: Option<usize>, violation: String| {
+        transitions: g.transitions,
+        complete: g.complete,
+        elapsed: started.elapsed(),
+        properties,
+    }
+}
+
+/// A model with the graph of its reachable states: what each property check reads.
+struct Explored<'a> {
+    model: &'a Model,
+    g: &'a explore::Graph,
+}
+
+impl Explored<'_> {
+    /// The verdict when the state bound stopped the exploration before it was decided.
+    fn unknown(&self) -> Verdict {
+        Verdict::Unknown {
+            states: self.g.states.len(),
+        }
+    }
+
+    /// A violation shown along `transitions` from the initial state; from `loop_from` on,
+    /// the steps repeat forever.
+    fn violated(
+        &self,
+        transitions: Vec<(u32, explore::Edge)>,
+        loop_from: Option<usize>,
+        violation: String,
+    ) -> Verdict {
         Verdict::Violated(Box::new(Counterexample::build(
-            model,
-            &g.states,
+            self.model,
+            &self.g.states,
             &transitions,
             loop_from,
             violation,
         )))
-    };
-    let mut properties = Vec::new();
+    }
 
-    // Success from every reachable state.
-    let mut detail = String::new();
-    let verdict = match explore::check_liveness(&g, limits.max_ticks) {
-        Liveness::Holds { worst } => {
-            detail = format!("at most {worst} tick(s) from any reachable state");
-            Verdict::Holds
-        }
-        Liveness::DeadEnd(s) => {
-            let mut path = g.path_to(s);
-            path.push((s, Edge::Tick { fail: 0 }));
-            cx(
-                path,
-                None,
-                "dead end: the root returns Failure and no action can run".into(),
-            )
-        }
-        Liveness::Livelock { entry, cycle } => {
-            let mut path = g.path_to(entry);
-            let from = path.len();
-            let mut at = entry;
-            for next in &cycle {
-                path.push((at, Edge::Tick { fail: 0 }));
-                at = *next;
+    /// Whether the tree reaches Success from every reachable state within `max_ticks`.
+    fn success(&self, max_ticks: u64) -> PropertyResult {
+        use explore::{Edge, Liveness};
+        let g = self.g;
+        let mut detail = String::new();
+        let verdict = match explore::check_liveness(g, max_ticks) {
+            Liveness::Holds { worst } => {
+                detail = format!("at most {worst} tick(s) from any reachable state");
+                Verdict::Holds
             }
-            cx(
-                path,
-                Some(from),
-                format!(
-                    "livelock: the tree keeps acting ({} tick(s) repeat) and never succeeds",
-                    cycle.len()
-                ),
-            )
-        }
-        Liveness::TooSlow { state, ticks } => cx(
-            g.path_to(state),
-            None,
-            format!(
-                "from this state the tree needs {ticks} ticks to succeed, more than the bound of {}",
-                limits.max_ticks
-            ),
-        ),
-        Liveness::Unknown => unknown(),
-    };
-    properties.push(PropertyResult {
-        kind: PropertyKind::Success,
-        name: "reaches Success from every reachable state".into(),
-        detail,
-        verdict,
-    });
-
-    // Declared preconditions at every action start.
-    let verdict = match g.first_unmet {
-        Some((s, fail, action, condition)) => {
-            let mut path = g.path_to(s);
-            path.push((s, Edge::Tick { fail }));
-            cx(
-                path,
+            Liveness::DeadEnd(s) => {
+                let mut path = g.path_to(s);
+                path.push((s, Edge::Tick { fail: 0 }));
+                self.violated(
+                    path,
+                    None,
+                    "dead end: the root returns Failure and no action can run".into(),
+                )
+            }
+            Liveness::Livelock { entry, cycle } => {
+                let mut path = g.path_to(entry);
+                let from = path.len();
+                let mut at = entry;
+                for next in &cycle {
+                    path.push((at, Edge::Tick { fail: 0 }));
+                    at = *next;
+                }
+                self.violated(
+                    path,
+                    Some(from),
+                    format!(
+                        "livelock: the tree keeps acting ({} tick(s) repeat) and never succeeds",
+                        cycle.len()
+                    ),
+                )
+            }
+            Liveness::TooSlow { state, ticks } => self.violated(
+                g.path_to(state),
                 None,
                 format!(
-                    "{}! starts while its declared precondition {} does not hold",
-                    model.actions[action].call, model.conditions[condition].condition
+                    "from this state the tree needs {ticks} ticks to succeed, more than the bound of {max_ticks}"
                 ),
-            )
+            ),
+            Liveness::Unknown => self.unknown(),
+        };
+        PropertyResult {
+            kind: PropertyKind::Success,
+            name: "reaches Success from every reachable state".into(),
+            detail,
+            verdict,
         }
-        None if g.complete => Verdict::Holds,
-        None => unknown(),
-    };
-    properties.push(PropertyResult {
-        kind: PropertyKind::Preconditions,
-        name: "every action starts with its declared preconditions true".into(),
-        detail: String::new(),
-        verdict,
-    });
+    }
 
-    for (i, (p, e)) in input.properties.iter().zip(&model.properties).enumerate() {
-        let f = &p.property.formula;
-        let verdict = match p.property.temporal {
+    /// Whether every action starts with its declared preconditions true.
+    fn preconditions(&self) -> PropertyResult {
+        let (model, g) = (self.model, self.g);
+        let verdict = match g.first_unmet {
+            Some((s, fail, action, condition)) => {
+                let mut path = g.path_to(s);
+                path.push((s, explore::Edge::Tick { fail }));
+                self.violated(
+                    path,
+                    None,
+                    format!(
+                        "{}! starts while its declared precondition {} does not hold",
+                        model.actions[action].call, model.conditions[condition].condition
+                    ),
+                )
+            }
+            None if g.complete => Verdict::Holds,
+            None => self.unknown(),
+        };
+        PropertyResult {
+            kind: PropertyKind::Preconditions,
+            name: "every action starts with its declared preconditions true".into(),
+            detail: String::new(),
+            verdict,
+        }
+    }
+
+    /// The user property `index` (`property`, compiled into the model as `expr`).
+    fn user_property(
+        &self,
+        index: usize,
+        property: &NamedProperty,
+        expr: &abstraction::Expr,
+    ) -> PropertyResult {
+        use explore::Eventually;
+        let (model, g) = (self.model, self.g);
+        let f = &property.property.formula;
+        let verdict = match property.property.temporal {
             Temporal::Always | Temporal::Never => {
-                let always = p.property.temporal == Temporal::Always;
-                match explore::first_state_where(model, &g, e, !always) {
-                    Some(s) => cx(
+                let always = property.property.temporal == Temporal::Always;
+                match explore::first_state_where(model, g, expr, !always) {
+                    Some(s) => self.violated(
                         g.path_to(s),
                         None,
                         if always {
@@ -360,17 +413,17 @@ fn model_check(model: &Model, input: &VerifyInput) -> ModelCheck {
                         },
                     ),
                     None if g.complete => Verdict::Holds,
-                    None => unknown(),
+                    None => self.unknown(),
                 }
             }
-            Temporal::Eventually => match explore::check_eventually(model, &g, e) {
+            Temporal::Eventually => match explore::check_eventually(model, g, expr) {
                 Eventually::Holds => Verdict::Holds,
-                Eventually::Unknown => unknown(),
+                Eventually::Unknown => self.unknown(),
                 Eventually::Lasso { mut prefix, cycle } => {
                     let from = prefix.len();
                     let len = cycle.len();
                     prefix.extend(cycle);
-                    cx(
+                    self.violated(
                         prefix,
                         Some(from),
                         format!("{f} never holds: the last {len} step(s) can repeat forever"),
@@ -378,20 +431,12 @@ fn model_check(model: &Model, input: &VerifyInput) -> ModelCheck {
                 }
             },
         };
-        properties.push(PropertyResult {
-            kind: PropertyKind::User(i),
-            name: p.text.clone(),
+        PropertyResult {
+            kind: PropertyKind::User(index),
+            name: property.text.clone(),
             detail: String::new(),
             verdict,
-        });
-    }
-    ModelCheck {
-        atoms: model.atoms.len(),
-        states: g.states.len(),
-        transitions: g.transitions,
-        complete: g.complete,
-        elapsed: started.elapsed(),
-        properties,
+        }
     }
 }
 

@@ -27,15 +27,22 @@ pub enum SttBackend {
     Openai,
 }
 
+/// A speech-to-text backend name that is none of the known ones.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown speech-to-text backend {name:?} (expected local or openai)")]
+pub struct UnknownSttBackend {
+    pub name: String,
+}
+
 impl std::str::FromStr for SttBackend {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
+    type Err = UnknownSttBackend;
+    fn from_str(s: &str) -> Result<Self, UnknownSttBackend> {
         match s.trim().to_ascii_lowercase().as_str() {
             "local" => Ok(SttBackend::Local),
             "openai" => Ok(SttBackend::Openai),
-            other => Err(format!(
-                "unknown speech-to-text backend {other:?} (expected local or openai)"
-            )),
+            other => Err(UnknownSttBackend {
+                name: other.to_string(),
+            }),
         }
     }
 }

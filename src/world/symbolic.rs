@@ -168,7 +168,7 @@ impl SymbolicWorld {
                 }
                 let requires = scenario
                     .parse_goal(r.requires.get_ref())
-                    .map_err(|m| file.error_in_string(&r.requires.span(), 0, m))?;
+                    .map_err(|e| file.error_in_string(&r.requires.span(), e.at(), e))?;
                 let violation = match r.otherwise.as_ref().map(|o| o.get_ref().as_str()) {
                     None | Some("fail") => match r.error {
                         Some(e) if !e.trim().is_empty() => Violation::Fail(e),

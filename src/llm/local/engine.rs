@@ -101,8 +101,9 @@ impl Drop for Engine {
     }
 }
 
-/// llama.cpp's backend may be initialised once per process.
-static BACKEND: OnceLock<Result<LlamaBackend, String>> = OnceLock::new();
+/// llama.cpp's backend may be initialised once per process; a failure is kept and
+/// returned to every later caller.
+static BACKEND: OnceLock<Result<LlamaBackend, EngineError>> = OnceLock::new();
 
 fn backend() -> Result<&'static LlamaBackend, EngineError> {
     let b = BACKEND.get_or_init(|| {
@@ -111,9 +112,9 @@ fn backend() -> Result<&'static LlamaBackend, EngineError> {
                 b.void_logs();
                 b
             })
-            .map_err(|e| e.to_string())
+            .map_err(|e| EngineError::Runtime(e.to_string()))
     });
-    b.as_ref().map_err(|e| EngineError::Runtime(e.clone()))
+    b.as_ref().map_err(Clone::clone)
 }
 
 impl Engine {

@@ -15,6 +15,38 @@ use super::super::types::{Event, Proposal};
 use super::super::values::{self, Setting, conform};
 use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
 
+/// Why what a person wrote does not fit the proposal it is for; each names the edit as
+/// written.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum Refused {
+    #[error("no conditions for {action}")]
+    NoConditions { action: ActionCall },
+    #[error("'{edit}': {reason}")]
+    Vocabulary {
+        edit: String,
+        reason: crate::domain::VocabularyError,
+    },
+    #[error("'{shown}': {reason}")]
+    Value { shown: String, reason: Unfit },
+    #[error("'{edit}': {action} calls for conditions ('A & ~B'), not a value")]
+    ValueForConditions { edit: String, action: ActionCall },
+    #[error("'{edit}': {skill} calls for a value of {param}, not conditions")]
+    ConditionsForValue {
+        edit: String,
+        skill: String,
+        param: String,
+    },
+}
+
+/// Why a value does not fit the parameter it is for.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum Unfit {
+    #[error("{skill} declares no value {param}")]
+    Undeclared { skill: String, param: String },
+    #[error(transparent)]
+    Conform(#[from] super::super::values::ConformError),
+}
+
 impl Engine {
     pub(super) fn approve(&mut self) {
         if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
@@ -148,7 +180,7 @@ impl Engine {
         };
         let edited = match self.edited(&base, edit) {
             Ok(p) => p,
-            Err(e) => return self.error(e),
+            Err(e) => return self.error(e.to_string()),
         };
         self.emit(Event::Proposal {
             proposal: edited.clone(),
@@ -182,20 +214,25 @@ impl Engine {
     }
 
     /// `base` with the edit in it: conditions for an action, a value for a parameter.
-    fn edited(&self, base: &Proposal, edit: Edit) -> Result<Proposal, String> {
+    fn edited(&self, base: &Proposal, edit: Edit) -> Result<Proposal, Refused> {
         match (base, edit) {
             (Proposal::Conditions { action, node, .. }, Edit::Conditions(conditions)) => {
                 // The front end read them over the same vocabulary; a sender that did not
                 // is refused here.
                 if conditions.is_empty() {
-                    return Err(format!("no conditions for {action}"));
+                    return Err(Refused::NoConditions {
+                        action: action.clone(),
+                    });
                 }
                 for c in &conditions {
                     self.scenario
                         .domain
                         .vocabulary
                         .check_atom(&c.atom)
-                        .map_err(|e| format!("'{}': {e}", Edit::Conditions(conditions.clone())))?;
+                        .map_err(|reason| Refused::Vocabulary {
+                            edit: Edit::Conditions(conditions.clone()).to_string(),
+                            reason,
+                        })?;
                 }
                 Ok(Proposal::Conditions {
                     action: action.clone(),
@@ -213,10 +250,9 @@ impl Engine {
                 Edit::Value(value),
             ) => {
                 let shown = value_text(&value);
-                let declared = self
-                    .declared_value(skill, param)
-                    .ok_or_else(|| format!("{skill} declares no value {param}"))?;
-                let value = conform(declared, value).map_err(|e| format!("'{shown}': {e}"))?;
+                let value = self
+                    .fit_value(skill, param, value)
+                    .map_err(|reason| Refused::Value { shown, reason })?;
                 Ok(Proposal::Value {
                     skill: skill.clone(),
                     object: object.clone(),
@@ -224,13 +260,31 @@ impl Engine {
                     value,
                 })
             }
-            (Proposal::Conditions { action, .. }, edit @ Edit::Value(_)) => Err(format!(
-                "'{edit}': {action} calls for conditions ('A & ~B'), not a value"
-            )),
-            (Proposal::Value { skill, param, .. }, edit @ Edit::Conditions(_)) => Err(format!(
-                "'{edit}': {skill} calls for a value of {param}, not conditions"
-            )),
+            (Proposal::Conditions { action, .. }, edit @ Edit::Value(_)) => {
+                Err(Refused::ValueForConditions {
+                    edit: edit.to_string(),
+                    action: action.clone(),
+                })
+            }
+            (Proposal::Value { skill, param, .. }, edit @ Edit::Conditions(_)) => {
+                Err(Refused::ConditionsForValue {
+                    edit: edit.to_string(),
+                    skill: skill.clone(),
+                    param: param.clone(),
+                })
+            }
         }
+    }
+
+    /// `value` as `skill` declares its parameter `param`.
+    fn fit_value(&self, skill: &str, param: &str, value: Value) -> Result<Value, Unfit> {
+        let declared = self
+            .declared_value(skill, param)
+            .ok_or_else(|| Unfit::Undeclared {
+                skill: skill.to_string(),
+                param: param.to_string(),
+            })?;
+        Ok(conform(declared, value)?)
     }
 
     /// The declaration of `skill`'s value `param`.
@@ -250,11 +304,7 @@ impl Engine {
             return self.error("no tree: plan first");
         };
         for (skill, param) in &setting.targets {
-            let checked = match self.declared_value(skill, param) {
-                Some(declared) => conform(declared, setting.value.clone()).map(|_| ()),
-                None => Err(format!("{skill} declares no value {param}")),
-            };
-            if let Err(e) = checked {
+            if let Err(e) = self.fit_value(skill, param, setting.value.clone()) {
                 return self.error(format!("{:?}: {e}", setting.text));
             }
         }

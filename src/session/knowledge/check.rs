@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::domain::{ActionCall, Condition, LearnError, LearnedRule};
-use crate::planner::Outcome;
-use crate::scenario::Scenario;
+use crate::planner::{Outcome, RepairError};
+use crate::scenario::{Scenario, ScenarioError};
 use crate::verify::plan_in_model;
 
 use super::{Knowledge, domain_of};
@@ -29,10 +29,24 @@ pub enum Refusal {
     GoalUnplannable {
         scenario: String,
         goal: String,
-        why: String,
+        why: Box<Unplannable>,
     },
     #[error("it is kept already as {0}")]
     Known(String),
+}
+
+/// Why a goal does not plan to success in the model.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Unplannable {
+    #[error(transparent)]
+    Planning(#[from] RepairError),
+    #[error("{condition} cannot be achieved")]
+    Unreachable { condition: Condition },
+    #[error("{action}! fails: {error}")]
+    ActionFails { action: ActionCall, error: String },
+    /// A bound ran out; the planner's reason.
+    #[error("{0}")]
+    Exhausted(String),
 }
 
 /// The rule a fix teaches, as it would be kept: lifted to the action's parameters where
@@ -124,7 +138,7 @@ pub fn check_rule(
                 return Err(Refusal::GoalUnplannable {
                     scenario: format!("the worked example {:?}", example.instruction),
                     goal: goal.to_string(),
-                    why,
+                    why: Box::new(why),
                 });
             }
         }
@@ -147,7 +161,7 @@ pub fn check_rule(
             return Err(Refusal::GoalUnplannable {
                 scenario: path.display().to_string(),
                 goal: goal.to_string(),
-                why,
+                why: Box::new(why),
             });
         }
     }
@@ -155,10 +169,8 @@ pub fn check_rule(
 }
 
 /// The facts true in the scenario's world at the start.
-fn facts_of(scenario: &Scenario) -> Result<Vec<Condition>, String> {
-    Ok(crate::world::load(scenario)
-        .map_err(|e| e.to_string())?
-        .facts())
+fn facts_of(scenario: &Scenario) -> Result<Vec<Condition>, ScenarioError> {
+    Ok(crate::world::load(scenario)?.facts())
 }
 
 /// Whether `goal` plans to success in the model from `facts`.
@@ -166,14 +178,15 @@ fn plans(
     scenario: &Scenario,
     facts: &[Condition],
     goal: &crate::goal::Formula,
-) -> Result<(), String> {
-    let planned = plan_in_model(&scenario.domain, facts, &goal.to_dnf(), &[], &[])
-        .map_err(|e| e.to_string())?;
+) -> Result<(), Unplannable> {
+    let planned = plan_in_model(&scenario.domain, facts, &goal.to_dnf(), &[], &[])?;
     match planned.plan.outcome {
         Outcome::Success => Ok(()),
-        Outcome::Unreachable { condition, .. } => Err(format!("{condition} cannot be achieved")),
-        Outcome::ActionFailed { action, error, .. } => Err(format!("{action}! fails: {error}")),
-        Outcome::Exhausted { reason } => Err(reason),
+        Outcome::Unreachable { condition, .. } => Err(Unplannable::Unreachable { condition }),
+        Outcome::ActionFailed { action, error, .. } => {
+            Err(Unplannable::ActionFails { action, error })
+        }
+        Outcome::Exhausted { reason } => Err(Unplannable::Exhausted(reason)),
     }
 }
 

@@ -17,7 +17,7 @@ use crate::scenario::Scenario;
 
 mod check;
 
-pub use check::{Refusal, check_rule, domain_scenarios, offered_rule, rule_for_fix};
+pub use check::{Refusal, Unplannable, check_rule, domain_scenarios, offered_rule, rule_for_fix};
 
 /// Each condition of the approved changes `kept` in a tree, with the action it was
 /// inserted before and who proposed it: the fixes that may become rules.

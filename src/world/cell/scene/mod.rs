@@ -237,7 +237,7 @@ fn patch(base: &mut RawSolid, p: RawSolid) {
 }
 
 /// The error at the first mention of `needle` in `file` (or its start).
-fn near(file: &SourceFile, needle: &str, message: impl Into<String>) -> ScenarioError {
+fn near(file: &SourceFile, needle: &str, message: impl std::fmt::Display) -> ScenarioError {
     file.error_at(file.text.find(needle).unwrap_or(0), message)
 }
 

@@ -1,0 +1,294 @@
+//! Building a scenario from the files of its `extends` chain, base first: the vocabulary
+//! (objects, then predicates), the skills, the goals, and the rest of the tables. Every
+//! error points into the file and string it is about.
+
+use std::collections::HashMap;
+
+use toml::Spanned;
+
+use super::file::{RawFile, RawSkill, value_range};
+use super::{
+    Convention, Example, Scenario, ScenarioError, SourceFile, effect_templates, goal_in,
+    split_types,
+};
+use crate::domain::skill::{Domain, Param, Skill, ValueParam};
+use crate::domain::template::parse_template;
+use crate::domain::vocabulary::{Object, Predicate, Vocabulary};
+use crate::goal::Formula;
+
+/// Where a skill came from, so its errors can point into the right file.
+struct SkillSource<'a> {
+    raw: &'a RawSkill,
+    file: &'a SourceFile,
+}
+
+impl Scenario {
+    /// The scenario of a chain of files, base first; the last file is the one loaded and
+    /// holds the `[scenario]` table.
+    pub(super) fn build(
+        files: Vec<SourceFile>,
+        raws: Vec<RawFile>,
+    ) -> Result<Scenario, ScenarioError> {
+        let child = files.len() - 1;
+        let Some(meta) = raws[child].scenario.as_ref() else {
+            return Err(files[child].error_at(0, "missing [scenario] table with at least `name`"));
+        };
+        let mut vocabulary = objects(&files, &raws)?;
+        add_predicates(&mut vocabulary, &files, &raws)?;
+        let skills = skills(&files, &raws, &vocabulary)?;
+        let file = &files[child];
+        let goal = match &meta.goal {
+            Some(g) => Some(located_goal(file, g, &vocabulary)?),
+            None => None,
+        };
+        for fix in &meta.expected_fix {
+            located_goal(file, fix, &vocabulary)?;
+        }
+        Ok(Scenario {
+            name: meta.name.clone(),
+            description: meta.description.clone(),
+            instruction: meta.instruction.clone(),
+            goal,
+            expected_fix: meta
+                .expected_fix
+                .iter()
+                .map(|f| f.get_ref().clone())
+                .collect(),
+            examples: examples(&raws),
+            conventions: conventions(&raws),
+            domain: Domain { vocabulary, skills },
+            world_kind: world_kind(&raws),
+            files,
+        })
+    }
+}
+
+/// The objects of every file, each with every type any file gives it.
+fn objects(files: &[SourceFile], raws: &[RawFile]) -> Result<Vocabulary, ScenarioError> {
+    let mut vocabulary = Vocabulary::default();
+    // Where each object stands in the vocabulary, so a large scene loads in linear time.
+    let mut index: HashMap<String, usize> = HashMap::new();
+    for (raw, file) in raws.iter().zip(files) {
+        for (ty, names) in &raw.objects {
+            for name in names {
+                let n = name.get_ref().trim();
+                if n.is_empty() || n.contains('"') {
+                    return Err(file.error_in_string(
+                        &name.span(),
+                        0,
+                        "an object name must be non-empty and contain no quote",
+                    ));
+                }
+                match index.get(n).and_then(|&i| vocabulary.objects.get_mut(i)) {
+                    Some(o) if !o.types.contains(ty) => o.types.push(ty.clone()),
+                    Some(_) => {}
+                    None => {
+                        index.insert(n.to_string(), vocabulary.objects.len());
+                        vocabulary.objects.push(Object {
+                            name: n.to_string(),
+                            types: vec![ty.clone()],
+                        });
+                    }
+                }
+            }
+        }
+    }
+    Ok(vocabulary)
+}
+
+/// Add every file's predicates to `vocabulary` (whose objects are complete); a later
+/// file's predicate replaces an earlier one of the same name.
+fn add_predicates(
+    vocabulary: &mut Vocabulary,
+    files: &[SourceFile],
+    raws: &[RawFile],
+) -> Result<(), ScenarioError> {
+    for (raw, file) in raws.iter().zip(files) {
+        for p in &raw.predicates {
+            let mut arg_types = Vec::new();
+            for a in &p.args {
+                let types = split_types(a.get_ref());
+                for t in &types {
+                    if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
+                        return Err(file.error_in_string(
+                            &a.span(),
+                            0,
+                            format!("unknown type {t:?} (no object has it)"),
+                        ));
+                    }
+                }
+                arg_types.push(types);
+            }
+            let predicate = Predicate {
+                name: p.name.get_ref().clone(),
+                arg_types,
+                description: p.description.clone(),
+            };
+            match vocabulary
+                .predicates
+                .iter_mut()
+                .find(|q| q.name == predicate.name)
+            {
+                Some(q) => *q = predicate,
+                None => vocabulary.predicates.push(predicate),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The skills of the chain: a skill name defined in a later file replaces that name from
+/// earlier files.
+fn skills(
+    files: &[SourceFile],
+    raws: &[RawFile],
+    vocabulary: &Vocabulary,
+) -> Result<Vec<Skill>, ScenarioError> {
+    let mut sources: Vec<SkillSource> = Vec::new();
+    for (raw, file) in raws.iter().zip(files) {
+        let names: Vec<&str> = raw
+            .skills
+            .iter()
+            .map(|s| s.name.get_ref().as_str())
+            .collect();
+        sources.retain(|s| !names.contains(&s.raw.name.get_ref().as_str()));
+        sources.extend(raw.skills.iter().map(|raw| SkillSource { raw, file }));
+    }
+    sources.iter().map(|s| build_skill(s, vocabulary)).collect()
+}
+
+/// A goal of the `[scenario]` table, its errors located inside its string.
+fn located_goal(
+    file: &SourceFile,
+    text: &Spanned<String>,
+    vocabulary: &Vocabulary,
+) -> Result<Formula, ScenarioError> {
+    goal_in(text.get_ref(), vocabulary).map_err(|e| file.error_in_string(&text.span(), e.at(), e))
+}
+
+/// The worked examples of the last file that has any.
+fn examples(raws: &[RawFile]) -> Vec<Example> {
+    raws.iter()
+        .rev()
+        .find(|r| !r.examples.is_empty())
+        .map(|r| {
+            r.examples
+                .iter()
+                .map(|e| Example {
+                    instruction: e.instruction.clone(),
+                    goal: e.goal.clone(),
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The conventions of every file, base file first.
+fn conventions(raws: &[RawFile]) -> Vec<Convention> {
+    raws.iter()
+        .flat_map(|r| &r.conventions)
+        .map(|c| Convention {
+            text: c.text.trim().to_string(),
+            objects: c.objects.clone(),
+        })
+        .collect()
+}
+
+/// The simulator the last file that names one asks for (`symbolic` when none does).
+fn world_kind(raws: &[RawFile]) -> String {
+    raws.iter()
+        .rev()
+        .find_map(|r| r.world.as_ref()?.get("kind")?.as_str().map(str::to_string))
+        .unwrap_or_else(|| "symbolic".to_string())
+}
+
+/// One skill, its templates checked against the vocabulary.
+fn build_skill(source: &SkillSource, vocabulary: &Vocabulary) -> Result<Skill, ScenarioError> {
+    let raw = source.raw;
+    let file = source.file;
+    let name = raw.name.get_ref().trim();
+    if name.is_empty()
+        || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        || !name.starts_with(|c: char| c.is_ascii_alphabetic())
+    {
+        return Err(file.error_in_string(
+            &raw.name.span(),
+            0,
+            "a skill name is letters, digits and _ (starting with a letter)",
+        ));
+    }
+    let params = skill_params(source, vocabulary)?;
+    let literal = |s: &Spanned<String>| {
+        let t = parse_template(s.get_ref(), &params)
+            .map_err(|e| file.error_in_string(&s.span(), e.at(), e))?;
+        t.atom
+            .check(vocabulary, Some(&params))
+            .map_err(|e| file.error_in_string(&s.span(), 0, e))?;
+        Ok::<_, ScenarioError>(t)
+    };
+    let pre = raw.pre.iter().map(literal).collect::<Result<Vec<_>, _>>()?;
+    let (add, del) = effect_templates(file, &raw.add, &raw.del, literal)?;
+    if !raw.cost.is_finite() || raw.cost < 0.0 {
+        return Err(file.error_in_string(&raw.name.span(), 0, "cost must be a finite number >= 0"));
+    }
+    for v in &raw.values {
+        value_range(v).map_err(|e| file.error_in_string(&raw.name.span(), 0, e))?;
+    }
+    Ok(Skill {
+        name: name.to_string(),
+        description: raw.description.clone(),
+        params,
+        pre,
+        add,
+        del,
+        cost: raw.cost,
+        ticks: raw.ticks.max(1),
+        values: raw
+            .values
+            .iter()
+            .map(|v| ValueParam {
+                name: v.name.clone(),
+                unit: v.unit.clone(),
+                categories: v.categories.clone(),
+                description: v.description.clone(),
+                min: v.min,
+                max: v.max,
+            })
+            .collect(),
+        learned: Vec::new(),
+    })
+}
+
+/// A skill's `params`: `name: type`, `name: a|b` or `name: type except other`, each type
+/// a type or an object of the vocabulary.
+fn skill_params(
+    source: &SkillSource,
+    vocabulary: &Vocabulary,
+) -> Result<Vec<Param>, ScenarioError> {
+    let file = source.file;
+    let mut params = Vec::new();
+    for p in &source.raw.params {
+        let Some((pname, spec)) = p.get_ref().split_once(':') else {
+            return Err(file.error_in_string(&p.span(), 0, "expected `name: type` (e.g. `item: item`, `target: place|item`, `x: item except makable`)"));
+        };
+        let (types, except) = match spec.split_once(" except ") {
+            Some((t, e)) => (split_types(t), split_types(e)),
+            None => (split_types(spec), Vec::new()),
+        };
+        for t in types.iter().chain(&except) {
+            if !vocabulary.is_type(t) && vocabulary.object(t).is_none() {
+                return Err(file.error_in_string(
+                    &p.span(),
+                    0,
+                    format!("unknown type or object {t:?}"),
+                ));
+            }
+        }
+        params.push(Param {
+            name: pname.trim().to_string(),
+            types,
+            except,
+        });
+    }
+    Ok(params)
+}
