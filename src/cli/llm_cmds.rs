@@ -135,7 +135,7 @@ pub(super) fn setup(flags: &LlmFlags) -> Result<Llm> {
     })
 }
 
-/// The local model is fetched on first use (with a progress bar) before it is loaded.
+/// What `betr resolve` is asked.
 #[derive(clap::Args)]
 pub struct ResolveFlags {
     pub scenario: PathBuf,
@@ -174,6 +174,7 @@ pub struct ResolveFlags {
     pub viz: super::viz_flags::VizFlags,
 }
 
+/// What `betr interpret` is asked.
 #[derive(clap::Args)]
 pub struct InterpretArgs {
     pub scenario: PathBuf,
@@ -193,6 +194,7 @@ pub struct InterpretArgs {
     pub stt: super::voice_cmd::SttFlags,
 }
 
+/// The local model is fetched on first use (with a progress bar) before it is loaded.
 pub fn ensure_local_model(settings: &Settings) -> Result<()> {
     if settings.backend == Backend::Local && settings.model_path.is_none() {
         super::model_cmd::ensure(settings.model.as_deref())?;

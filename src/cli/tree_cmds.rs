@@ -16,6 +16,7 @@ use super::viz_flags::VizFlags;
 
 const WORLD_FAILED: u8 = 1;
 
+/// What `betr run` is asked.
 #[derive(clap::Args)]
 pub struct RunArgs {
     pub scenario: PathBuf,
@@ -38,6 +39,7 @@ pub struct RunArgs {
     pub knowledge: super::knowledge_cmd::KnowledgeFlags,
 }
 
+/// What `betr repair` is asked.
 #[derive(clap::Args)]
 pub struct RepairArgs {
     pub scenario: PathBuf,
@@ -158,7 +160,7 @@ fn run(
     viz: &VizFlags,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
-    let mut session = Driver::start(Start {
+    let start = Start {
         variant,
         limits: RunLimits {
             run_ticks: max_ticks,
@@ -166,16 +168,8 @@ fn run(
         },
         viz: viz.open(false)?,
         ..Start::new(scenario)
-    })?;
-    match tree_file {
-        Some(path) => {
-            session.load(path.to_path_buf(), false)?;
-        }
-        None => {
-            super::goal_of(scenario, None)?;
-            session.plan(None)?;
-        }
-    }
+    };
+    let mut session = with_tree(start, tree_file, false)?;
     let tree = session.tree()?;
     let run = session.run(|r| {
         if trace {
@@ -188,6 +182,23 @@ fn run(
         RunEnd::Success => ExitCode::SUCCESS,
         _ => ExitCode::from(WORLD_FAILED),
     })
+}
+
+/// An engine with its tree: the file's (`grow`: expanded in this world) or the one planned
+/// for the scenario's goal.
+fn with_tree(start: Start, tree_file: Option<&Path>, grow: bool) -> Result<Driver> {
+    let scenario = start.scenario;
+    let mut session = Driver::start(start)?;
+    match tree_file {
+        Some(path) => {
+            session.load(path.to_path_buf(), grow)?;
+        }
+        None => {
+            super::goal_of(scenario, None)?;
+            session.plan(None)?;
+        }
+    }
+    Ok(session)
 }
 
 /// How a run ended, as `betr run` and `betr repair` say it.
@@ -248,21 +259,13 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
         variant,
         viz,
     } = *request;
-    let mut session = Driver::start(Start {
+    let start = Start {
         scenario_path: Some(scenario_path),
         variant,
         viz: viz.open(false)?,
         ..Start::new(scenario)
-    })?;
-    match tree_file {
-        Some(path) => {
-            session.load(path.to_path_buf(), true)?;
-        }
-        None => {
-            super::goal_of(scenario, None)?;
-            session.plan(None)?;
-        }
-    }
+    };
+    let mut session = with_tree(start, tree_file, true)?;
     // The run before the repair finds the failure (and shows it in the 3D view).
     let mut before = session.run(|_| {})?;
     if !settings.is_empty() {

@@ -333,17 +333,7 @@ impl Domain {
 mod tests {
     use super::*;
     use crate::domain::template::parse_template;
-
-    fn params(names: &[&str]) -> Vec<Param> {
-        names
-            .iter()
-            .map(|n| Param {
-                name: n.to_string(),
-                types: vec![n.to_string()],
-                except: vec![],
-            })
-            .collect()
-    }
+    use crate::domain::template::tests::params;
 
     fn pick_up() -> Skill {
         let ps = params(&["item"]);

@@ -229,10 +229,11 @@ impl AtomTemplate {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn params(names: &[&str]) -> Vec<Param> {
+    /// Parameters named after their types.
+    pub(crate) fn params(names: &[&str]) -> Vec<Param> {
         names
             .iter()
             .map(|n| Param {
