@@ -9,6 +9,7 @@ mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
 mod policy_cmd;
+mod resolve_cmd;
 mod tree_cmds;
 pub mod tui_cmd;
 mod values;
@@ -105,7 +106,7 @@ pub enum Command {
     /// preconditions, re-plan and run to success; print and optionally save the tree.
     Repair(tree_cmds::RepairArgs),
     /// Ask a language model for the goal an instruction means in the scenario.
-    Interpret(llm_cmds::InterpretArgs),
+    Interpret(resolve_cmd::InterpretArgs),
     /// Transcribe a WAV file (any rate, channels and bit depth) with the configured
     /// speech-to-text backend; print the transcript, and timings on stderr.
     Transcribe {
@@ -119,7 +120,7 @@ pub enum Command {
     /// Interpret the scenario's instruction, plan, simulate; on each failure ask the model
     /// for the missing preconditions (or parameter value), ask for approval, repair, re-run;
     /// save the tree that succeeds.
-    Resolve(llm_cmds::ResolveFlags),
+    Resolve(resolve_cmd::ResolveFlags),
 }
 
 /// Hidden: save a policy of `nodes` nodes to `path` `times` times (tests kill it mid-save).
@@ -151,8 +152,8 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Transcribe { file, config, stt } => {
             voice_cmd::transcribe(&file, config.as_deref(), &stt)
         }
-        Command::Interpret(args) => llm_cmds::interpret_command(&args),
-        Command::Resolve(args) => llm_cmds::resolve_command(&args, glyphs),
+        Command::Interpret(args) => resolve_cmd::interpret_command(&args),
+        Command::Resolve(args) => resolve_cmd::resolve_command(&args, glyphs),
         Command::Export {
             source,
             format,

@@ -1,0 +1,400 @@
+//! `betr interpret` and `betr resolve`: the commands that ask a language model.
+
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+
+use anyhow::{Context as _, Result};
+
+use betr::bt::{self, Glyphs, TickRecord};
+use betr::llm::LanguageModel;
+use betr::llm::usage::Metered;
+use betr::scenario::Scenario;
+use betr::session::{self, Ending, Event};
+
+use super::llm_cmds::{LlmFlags, setup};
+
+/// What `betr resolve` is asked.
+#[derive(clap::Args)]
+pub struct ResolveFlags {
+    pub scenario: PathBuf,
+    /// An instruction instead of the scenario's.
+    #[arg(long, conflicts_with = "audio")]
+    pub instruction: Option<String>,
+    /// Dictate the instruction from a WAV file (printed; confirmed on the terminal or
+    /// by --yes).
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
+    /// Approve every proposal (and a dictated transcript) without asking.
+    #[arg(long, short = 'y')]
+    pub yes: bool,
+    /// Questions about failures before giving up.
+    #[arg(long, default_value_t = 5)]
+    pub max_rounds: usize,
+    /// Where to save the final tree (default: policies/<scenario>.bt on success).
+    #[arg(long)]
+    pub save: Option<PathBuf>,
+    /// Work on the scenario's stated goal instead of reading its instruction (no model
+    /// call for the goal).
+    #[arg(long)]
+    pub stated_goal: bool,
+    /// After success, offer each approved fix as a rule of its skill for later tasks
+    /// (asked on the terminal; with --yes kept without asking), checked before it is
+    /// kept in the knowledge file beside the policies.
+    #[arg(long)]
+    pub learn: bool,
+    #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+    #[command(flatten)]
+    pub stt: super::voice_cmd::SttFlags,
+    #[command(flatten)]
+    pub viz: super::viz_flags::VizFlags,
+}
+
+/// What `betr interpret` is asked.
+#[derive(clap::Args)]
+pub struct InterpretArgs {
+    pub scenario: PathBuf,
+    /// The instruction (default: the scenario's).
+    #[arg(conflicts_with = "audio")]
+    pub instruction: Option<String>,
+    /// Dictate the instruction: transcribe this WAV file, print the transcript and use
+    /// it once confirmed (or corrected) on the terminal, or with --yes.
+    #[arg(long, value_name = "FILE.wav")]
+    pub audio: Option<PathBuf>,
+    /// Use a dictated transcript without asking (it is still printed).
+    #[arg(long, short = 'y')]
+    pub yes: bool,
+    #[command(flatten)]
+    pub llm: LlmFlags,
+    #[command(flatten)]
+    pub stt: super::voice_cmd::SttFlags,
+}
+
+/// `betr interpret`: the instruction typed or dictated, then read.
+pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
+    let scenario = super::load(&args.scenario)?;
+    let instruction = super::voice_cmd::instruction(
+        args.instruction.clone(),
+        args.audio.as_deref(),
+        args.llm.config.as_deref(),
+        &args.stt,
+        args.yes,
+    )?;
+    interpret(&scenario, instruction.as_deref(), &args.llm)
+}
+
+/// `betr resolve`: the instruction typed or dictated, then the whole loop.
+pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode> {
+    let scenario = super::load_with(&args.scenario, &args.knowledge)?;
+    let instruction = super::voice_cmd::instruction(
+        args.instruction.clone(),
+        args.audio.as_deref(),
+        args.llm.config.as_deref(),
+        &args.stt,
+        args.yes,
+    )?;
+    resolve(
+        &scenario,
+        &ResolveArgs {
+            instruction: instruction.as_deref(),
+            yes: args.yes,
+            max_rounds: args.max_rounds,
+            save: args.save.as_deref(),
+            scenario_path: &args.scenario,
+            viz: &args.viz,
+            stated_goal: args.stated_goal,
+            learn: args.learn.then_some(&args.knowledge.dir),
+        },
+        &args.llm,
+        glyphs,
+    )
+}
+
+fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -> Result<ExitCode> {
+    let llm = setup(flags)?;
+    let instruction = instruction
+        .map(str::to_string)
+        .or_else(|| scenario.instruction.clone())
+        .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
+    llm.model.set_purpose("interpret");
+    println!("Scenario:    {}", scenario.name);
+    println!("Instruction: {instruction}");
+    let mut emit = |e: &Event| print_event(e, flags.show_replies);
+    let result = super::runtime()?.block_on(session::interpret::interpret_in_scenario(
+        scenario,
+        &instruction,
+        llm.model.as_ref(),
+        &llm.options,
+        &mut emit,
+    ));
+    print_usage(&llm.model);
+    let reading = result?;
+    if let Some(why) = &reading.doubt {
+        println!("note: kept with a doubt: {why}");
+    }
+    println!(
+        "{} call(s), {} feedback round(s)",
+        reading.calls, reading.feedback_rounds
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+pub struct ResolveArgs<'a> {
+    pub instruction: Option<&'a str>,
+    pub yes: bool,
+    pub max_rounds: usize,
+    pub save: Option<&'a Path>,
+    pub scenario_path: &'a Path,
+    pub viz: &'a super::viz_flags::VizFlags,
+    pub stated_goal: bool,
+    /// Offer the kept fixes as rules, kept in this directory's knowledge file.
+    pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
+}
+
+fn resolve(
+    scenario: &Scenario,
+    args: &ResolveArgs,
+    flags: &LlmFlags,
+    glyphs: &Glyphs,
+) -> Result<ExitCode> {
+    let mut llm = setup(flags)?;
+    llm.options.max_rounds = args.max_rounds;
+    llm.options.use_scenario_goal = args.stated_goal;
+    llm.model.set_purpose("resolve");
+    let mut viz = args.viz.open(false)?;
+    println!("Scenario:    {}", scenario.name);
+    if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
+        println!("Instruction: {i}");
+        if let Some(v) = viz.as_mut() {
+            v.instruction(i);
+        }
+    }
+    // The statuses of the last run of the tree, shown with it at the end.
+    let mut last: Option<Arc<TickRecord>> = None;
+    let mut emit = |e: &Event| {
+        if let Some(v) = viz.as_mut() {
+            v.on_event(e);
+        }
+        match e {
+            Event::Ticked { record } => last = Some(record.clone()),
+            Event::TreeChanged { .. } => last = None,
+            _ => {}
+        }
+        print_event(e, flags.show_replies);
+    };
+    let yes = args.yes;
+    let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
+    let result = super::runtime()?.block_on(session::resolve_with_scenes(
+        scenario,
+        args.instruction,
+        llm.model.clone(),
+        &llm.options,
+        args.viz.viewer.is_some() || args.viz.rrd.is_some(),
+        &mut approve,
+        &mut emit,
+    ));
+    let resolved = match result {
+        Ok(r) => r,
+        Err(e) => {
+            print_usage(&llm.model);
+            return Err(e.into());
+        }
+    };
+    println!();
+    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
+        println!("{line}");
+    }
+    let success = matches!(resolved.ending, Ending::Success { .. });
+    let save = match args.save {
+        Some(p) => Some(p.to_path_buf()),
+        None if success => Some(default_policy_path(args.scenario_path)),
+        None => None,
+    };
+    match save {
+        Some(path) if success || resolved.repairs > 0 => {
+            betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
+                .with_context(|| format!("saving the tree to {}", path.display()))?;
+            let note = if success { "" } else { " (it still fails)" };
+            println!("\nSaved the tree to {}{note}", path.display());
+        }
+        _ => println!("\nNothing saved: no change was kept."),
+    }
+    println!(
+        "{} question(s) about failures, {} change(s) kept",
+        resolved.rounds, resolved.repairs
+    );
+    if let Some(dir) = args.learn.filter(|_| success) {
+        println!();
+        super::knowledge_cmd::offer(scenario, args.scenario_path, &resolved.kept, dir, args.yes)?;
+    }
+    print_usage(&llm.model);
+    Ok(if success {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn default_policy_path(scenario: &Path) -> PathBuf {
+    let stem = scenario
+        .file_stem()
+        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
+    Path::new("policies").join(format!("{stem}.bt"))
+}
+
+fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {
+    if yes {
+        println!("Approve? yes (--yes)");
+        return true;
+    }
+    print!("Approve: {proposal}? [y/N] ");
+    let _ = std::io::stdout().flush();
+    let mut line = String::new();
+    match std::io::stdin().lock().read_line(&mut line) {
+        Ok(0) | Err(_) => {
+            println!("(no answer: not approved)");
+            false
+        }
+        Ok(_) => matches!(line.trim().to_ascii_lowercase().as_str(), "y" | "yes"),
+    }
+}
+
+fn print_event(event: &Event, show_replies: bool) {
+    match event {
+        Event::Replied { text, .. } if show_replies => {
+            print_event_line(event);
+            println!("  ┌ reply text\n{}\n  └", indent(text));
+        }
+        _ => print_event_line(event),
+    }
+}
+
+fn indent(text: &str) -> String {
+    text.lines()
+        .map(|l| format!("  │ {l}"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+fn print_event_line(event: &Event) {
+    match event {
+        Event::Asking { what } => println!("\n→ asking for {what}"),
+        Event::Replied {
+            attribution,
+            prompt_tokens,
+            completion_tokens,
+            latency_ms,
+            ..
+        } => println!(
+            "  reply from {attribution}: {prompt_tokens} prompt + {completion_tokens} completion tokens, {:.2} s",
+            *latency_ms as f64 / 1000.0
+        ),
+        Event::InvalidReply { error } => println!("  unusable reply: {error}"),
+        Event::CandidateRejected {
+            candidate, reason, ..
+        } => {
+            println!("  set aside {candidate}: {reason}");
+        }
+        Event::Goal {
+            goal,
+            reasoning,
+            substitutions,
+            matches_expected,
+        } => {
+            if let Some(r) = reasoning {
+                println!("Reasoning: {r}");
+            }
+            for s in substitutions {
+                println!("  note: {s}");
+            }
+            let check = match matches_expected {
+                Some(true) => "  (equivalent to the scenario's goal)",
+                Some(false) => "  (differs from the scenario's goal)",
+                None => "",
+            };
+            println!("Goal: {goal}{check}");
+        }
+        Event::ActionFailed {
+            action,
+            node_path,
+            error,
+            ..
+        } => {
+            println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
+        }
+        Event::Proposal {
+            proposal,
+            reasoning,
+            substitutions,
+            author,
+        } => {
+            if let Some(r) = reasoning {
+                println!("Reasoning: {r}");
+            }
+            for s in substitutions {
+                println!("  note: {s}");
+            }
+            println!("Proposal: {proposal} (by {author})");
+        }
+        Event::Approved => {}
+        Event::Rejected => println!("Not approved; stopping."),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes: 0,
+        } => println!("Repaired: {added_nodes} node(s) added"),
+        Event::Repaired {
+            added_nodes,
+            valued_nodes,
+        } => {
+            println!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
+        }
+        Event::DidNotHelp { reason } => {
+            println!("The change did not help and was undone: {reason}")
+        }
+        Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
+        Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        Event::ChangeViolates { report } => {
+            println!(
+                "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
+            );
+            let mut err = std::io::stderr();
+            if let Err(e) = super::verify_cmd::write_report(&mut err, report, false) {
+                tracing::warn!("cannot write the report to stderr: {e}");
+            }
+        }
+        // What a live front end shows; the printed log keeps to the loop's steps.
+        Event::TreeChanged { .. }
+        | Event::Planned { .. }
+        | Event::Ticked { .. }
+        | Event::WorldChanged { .. }
+        | Event::Scene { .. }
+        | Event::Usage { .. }
+        | Event::RunState { .. }
+        | Event::Verifying { .. }
+        | Event::Verified { .. }
+        | Event::PolicySaved { .. }
+        | Event::Exported { .. }
+        | Event::PolicyLoaded { .. }
+        | Event::RuleOffered { .. }
+        | Event::RuleKept { .. }
+        | Event::RuleRefused { .. }
+        | Event::Knowledge { .. }
+        | Event::Notice { .. } => {}
+        Event::Error { message } => println!("error: {message}"),
+        // Returned by the loop as its error, and printed once by `main`.
+        Event::Failed { .. } => {}
+    }
+}
+
+fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
+    let ledger = model.ledger();
+    let log = ledger
+        .log_path()
+        .map(|p| format!("; logged to {}", p.display()))
+        .unwrap_or_default();
+    println!("LLM usage: {}{log}", ledger.totals());
+}
