@@ -21,6 +21,7 @@ pub mod interop;
 pub mod llm;
 pub mod model;
 pub mod planner;
+pub mod record;
 pub mod scenario;
 pub mod session;
 pub mod store;

@@ -52,7 +52,7 @@ pub struct UsageRecord {
 }
 
 /// Totals over several calls.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct UsageTotals {
     pub calls: usize,
     pub prompt_tokens: u64,

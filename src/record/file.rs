@@ -1,0 +1,246 @@
+//! Writing a recording as it happens, and reading one back. Each entry is one line written
+//! with one call and flushed, so the file only ever grows by whole entries; a crash can
+//! leave at most a partial last line, which the reader reports and leaves out.
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use super::{Entry, FORMAT, Header, RecordError, VERSION};
+
+/// A recording being written.
+pub struct Recorder {
+    path: PathBuf,
+    file: File,
+    started: Instant,
+}
+
+impl Recorder {
+    /// Create (or replace) `path` and write the header.
+    pub fn create(
+        path: &Path,
+        scenario: &Path,
+        name: &str,
+        variant: Option<&str>,
+    ) -> Result<Recorder, RecordError> {
+        let io = |source| RecordError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = File::create(path).map_err(io)?;
+        let mut recorder = Recorder {
+            path: path.to_path_buf(),
+            file,
+            started: Instant::now(),
+        };
+        let header = Header {
+            format: FORMAT.into(),
+            version: VERSION,
+            scenario: scenario.to_path_buf(),
+            name: name.into(),
+            variant: variant.map(str::to_string),
+            betr: env!("CARGO_PKG_VERSION").into(),
+            started: crate::session::policy::now_rfc3339(),
+        };
+        recorder.line(&header)?;
+        Ok(recorder)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Milliseconds since the recording started.
+    pub fn ms(&self) -> u64 {
+        u64::try_from(self.started.elapsed().as_millis()).unwrap_or(u64::MAX)
+    }
+
+    /// Append one entry.
+    pub fn write(&mut self, entry: &Entry) -> Result<(), RecordError> {
+        self.line(entry)
+    }
+
+    fn line(&mut self, value: &impl serde::Serialize) -> Result<(), RecordError> {
+        let mut text = serde_json::to_string(value).map_err(|e| RecordError::Line {
+            path: self.path.clone(),
+            line: 0,
+            reason: format!("cannot be written as JSON: {e}"),
+        })?;
+        text.push('\n');
+        // One write per entry: a crash leaves whole entries and at most one partial line.
+        self.file
+            .write_all(text.as_bytes())
+            .and_then(|()| self.file.flush())
+            .map_err(|source| RecordError::Io {
+                path: self.path.clone(),
+                source,
+            })
+    }
+}
+
+/// A recording read back: its header, its entries with their line numbers, and whether
+/// its last line was cut (the session ended without closing it, e.g. a crash).
+#[derive(Debug, Clone)]
+pub struct Recording {
+    pub path: PathBuf,
+    pub header: Header,
+    pub entries: Vec<(usize, Entry)>,
+    /// The line number of a partial last line that was left out.
+    pub cut_at: Option<usize>,
+}
+
+/// Read the recording at `path`; a line that is not an entry is an error naming it,
+/// except a partial last line (no newline), which is left out and reported in `cut_at`.
+pub fn read(path: &Path) -> Result<Recording, RecordError> {
+    let io = |source| RecordError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut reader = BufReader::new(File::open(path).map_err(io)?);
+    let mut lines: Vec<(String, bool)> = Vec::new();
+    loop {
+        let mut line = String::new();
+        let n = reader.read_line(&mut line).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        let whole = line.ends_with('\n');
+        lines.push((line.trim_end_matches(['\n', '\r']).to_string(), whole));
+    }
+    let Some((first, _)) = lines.first() else {
+        return Err(RecordError::Empty {
+            path: path.to_path_buf(),
+        });
+    };
+    let header: Header =
+        serde_json::from_str(first).map_err(|e| RecordError::NotARecording {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+    if header.format != FORMAT {
+        return Err(RecordError::NotARecording {
+            path: path.to_path_buf(),
+            reason: format!("its format is {:?}", header.format),
+        });
+    }
+    if header.version != VERSION {
+        return Err(RecordError::Version {
+            path: path.to_path_buf(),
+            found: header.version,
+        });
+    }
+    let mut entries = Vec::new();
+    let mut cut_at = None;
+    let last = lines.len();
+    for (i, (text, whole)) in lines.iter().enumerate().skip(1) {
+        let number = i + 1;
+        if text.trim().is_empty() {
+            continue;
+        }
+        match serde_json::from_str::<Entry>(text) {
+            Ok(entry) => entries.push((number, entry)),
+            Err(_) if !whole && number == last => cut_at = Some(number),
+            Err(e) => {
+                return Err(RecordError::Line {
+                    path: path.to_path_buf(),
+                    line: number,
+                    reason: e.to_string(),
+                });
+            }
+        }
+    }
+    Ok(Recording {
+        path: path.to_path_buf(),
+        header,
+        entries,
+        cut_at,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::record::Recorded;
+
+    fn temp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("betr-record-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn entries_are_read_back_in_order() {
+        let path = temp("order.jsonl");
+        let mut r = Recorder::create(&path, Path::new("s.toml"), "S", None).unwrap();
+        r.write(&Entry::Command {
+            ms: 1,
+            command: "run".into(),
+        })
+        .unwrap();
+        r.write(&Entry::Event {
+            ms: 2,
+            event: Recorded::Success { ticks: 3 },
+        })
+        .unwrap();
+        let back = read(&path).unwrap();
+        assert_eq!(back.header.name, "S");
+        assert_eq!(back.entries.len(), 2);
+        assert_eq!(back.entries[1].0, 3, "line numbers count the header");
+        assert_eq!(
+            back.entries[1].1,
+            Entry::Event {
+                ms: 2,
+                event: Recorded::Success { ticks: 3 }
+            }
+        );
+        assert_eq!(back.cut_at, None);
+    }
+
+    #[test]
+    fn a_partial_last_line_is_left_out_and_reported() {
+        let path = temp("cut.jsonl");
+        let mut r = Recorder::create(&path, Path::new("s.toml"), "S", None).unwrap();
+        r.write(&Entry::Command {
+            ms: 1,
+            command: "run".into(),
+        })
+        .unwrap();
+        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        f.write_all(br#"{"kind":"event","ms":5,"event":{"ev"#).unwrap();
+        let back = read(&path).unwrap();
+        assert_eq!(back.entries.len(), 1);
+        assert_eq!(back.cut_at, Some(3));
+    }
+
+    #[test]
+    fn a_broken_line_in_the_middle_is_an_error_naming_it() {
+        let path = temp("broken.jsonl");
+        Recorder::create(&path, Path::new("s.toml"), "S", None).unwrap();
+        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        f.write_all(b"not json\n{\"kind\":\"command\",\"ms\":1,\"command\":\"x\"}\n")
+            .unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+    }
+
+    #[test]
+    fn another_file_or_version_is_refused() {
+        let path = temp("other.jsonl");
+        std::fs::write(&path, "{\"a\":1}\n").unwrap();
+        assert!(
+            read(&path)
+                .unwrap_err()
+                .to_string()
+                .contains("not a betr recording")
+        );
+        std::fs::write(
+            &path,
+            format!(
+                "{{\"format\":\"{FORMAT}\",\"version\":99,\"scenario\":\"s\",\"name\":\"S\",\"variant\":null,\"betr\":\"0\",\"started\":\"\"}}\n"
+            ),
+        )
+        .unwrap();
+        assert!(read(&path).unwrap_err().to_string().contains("version 99"));
+        std::fs::write(&path, "").unwrap();
+        assert!(read(&path).unwrap_err().to_string().contains("empty"));
+    }
+}
