@@ -20,7 +20,7 @@ mod test_util;
 
 pub use action::ActionStep;
 pub use render::{ASCII, Glyphs, UNICODE, render};
-pub use status::{Outcome, Status};
+pub use status::{Forced, Outcome, Status};
 pub use text::{ParseError, parse, to_text};
-pub use tick::{Leaves, TickRecord, Ticker};
+pub use tick::{ForcedStatuses, Leaves, TickRecord, Ticker};
 pub use tree::{NodeId, NodeKind, Tree, TreeError, path_text};

@@ -151,6 +151,7 @@ mod tests {
             halted: Vec::new(),
             failures: Vec::new(),
             completed: Vec::new(),
+            forced: Vec::new(),
         }
     }
 

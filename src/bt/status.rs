@@ -34,6 +34,33 @@ pub enum Status {
     Halted,
 }
 
+/// A result a person imposes on a node (a debugger's "force"): the node returns it
+/// without its own logic running, so a forced condition is not checked, a forced action
+/// is not stepped, and a forced composite does not tick its children.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Forced {
+    Success,
+    Failure,
+    Running,
+}
+
+impl Forced {
+    /// The outcome the forced node hands to its parent.
+    pub fn outcome(self) -> Outcome {
+        match self {
+            Forced::Success => Outcome::Success,
+            Forced::Failure => Outcome::Failure,
+            Forced::Running => Outcome::Running,
+        }
+    }
+}
+
+impl fmt::Display for Forced {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        self.outcome().fmt(f)
+    }
+}
+
 impl From<Outcome> for Status {
     fn from(outcome: Outcome) -> Self {
         match outcome {

@@ -7,10 +7,16 @@
 //! reaches) and how many ticks have run.
 //!
 //! One private function, `Exec::execute_tick`, wraps every node: it records the visit and
-//! the status and dispatches to the node kind's own logic.
+//! the status and dispatches to the node kind's own logic, unless the node's status is
+//! forced (`Ticker::tick_forced`, a debugger's "force"): then it returns the forced status
+//! without touching the leaves. A forced action is neither stepped nor remembered as
+//! Running (it never started in the world), and one that was Running in the world before
+//! it was forced is halted there, since nothing steps it any more.
+
+use std::collections::BTreeMap;
 
 use super::action::{self, ActionStep};
-use super::status::{Outcome, Status};
+use super::status::{Forced, Outcome, Status};
 use super::tree::{NodeId, NodeKind, Tree};
 use super::{condition, fallback, sequence};
 use crate::domain::{ActionCall, Condition};
@@ -25,6 +31,9 @@ pub trait Leaves {
     /// Stop `action`, which was Running in the previous tick and is no longer reached.
     fn halt(&mut self, node: NodeId, action: &ActionCall);
 }
+
+/// Nodes whose result is forced, with the status each returns.
+pub type ForcedStatuses = BTreeMap<NodeId, Forced>;
 
 /// Everything one tick did.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +53,8 @@ pub struct TickRecord {
     pub failures: Vec<(NodeId, String)>,
     /// Actions that returned Success this tick.
     pub completed: Vec<NodeId>,
+    /// Nodes that returned a forced status this tick (not their own), in tick order.
+    pub forced: Vec<NodeId>,
 }
 
 impl TickRecord {
@@ -98,6 +109,19 @@ impl Ticker {
     /// tick (ids are stable). Afterwards, every action that was Running in the previous tick
     /// and was not reached by this one is halted (`Leaves::halt`) and shows `Halted`.
     pub fn tick(&mut self, tree: &Tree, leaves: &mut dyn Leaves) -> TickRecord {
+        self.tick_forced(tree, leaves, &ForcedStatuses::new())
+    }
+
+    /// Tick as `tick` does, with the nodes in `forced` returning their forced status
+    /// instead of running their own logic (see the module docs). An action that was
+    /// Running and is forced now is halted and listed in `halted`, but shows its forced
+    /// status.
+    pub fn tick_forced(
+        &mut self,
+        tree: &Tree,
+        leaves: &mut dyn Leaves,
+        forced: &ForcedStatuses,
+    ) -> TickRecord {
         self.ticks += 1;
         let mut record = TickRecord {
             tick: self.ticks,
@@ -107,28 +131,32 @@ impl Ticker {
             halted: Vec::new(),
             failures: Vec::new(),
             completed: Vec::new(),
+            forced: Vec::new(),
         };
         let mut exec = Exec {
             tree,
             leaves: &mut *leaves,
             record: &mut record,
             was_running: &self.running,
+            forced,
         };
         record.root = exec.execute_tick(tree.root());
 
         for (id, call) in std::mem::take(&mut self.running) {
-            if record.status(id) == Status::Idle {
-                leaves.halt(id, current_call(tree, id, &call));
-                if let Some(status) = record.statuses.get_mut(id.index()) {
-                    *status = Status::Halted;
-                }
-                record.halted.push(id);
+            let reached = record.status(id) != Status::Idle;
+            if reached && !forced.contains_key(&id) {
+                continue;
             }
+            leaves.halt(id, current_call(tree, id, &call));
+            if !reached && let Some(status) = record.statuses.get_mut(id.index()) {
+                *status = Status::Halted;
+            }
+            record.halted.push(id);
         }
         self.running = record
             .visited
             .iter()
-            .filter(|&&id| record.status(id) == Status::Running)
+            .filter(|&&id| record.status(id) == Status::Running && !forced.contains_key(&id))
             .filter_map(|&id| Some((id, tree.kind(id).ok()?.as_action()?.clone())))
             .collect();
         record
@@ -161,10 +189,12 @@ struct Exec<'a> {
     leaves: &'a mut dyn Leaves,
     record: &'a mut TickRecord,
     was_running: &'a [(NodeId, ActionCall)],
+    forced: &'a ForcedStatuses,
 }
 
 impl Exec<'_> {
-    /// Tick one node: record the visit, run the kind's logic, record the status.
+    /// Tick one node: record the visit, run the kind's logic (or take its forced status),
+    /// record the status.
     fn execute_tick(&mut self, id: NodeId) -> Outcome {
         let tree = self.tree;
         let Ok(kind) = tree.kind(id) else {
@@ -172,6 +202,14 @@ impl Exec<'_> {
             return Outcome::Failure;
         };
         self.record.visited.push(id);
+        if let Some(forced) = self.forced.get(&id) {
+            let outcome = forced.outcome();
+            self.record.forced.push(id);
+            if let Some(status) = self.record.statuses.get_mut(id.index()) {
+                *status = outcome.into();
+            }
+            return outcome;
+        }
         let children = tree.children(id).unwrap_or_default();
         let outcome = match kind {
             NodeKind::Sequence => sequence::tick(children, |c| self.execute_tick(c)),

@@ -12,6 +12,8 @@ struct Script {
     conditions: Vec<(&'static str, Vec<bool>)>,
     actions: Vec<(&'static str, Vec<ActionStep>)>,
     log: Vec<String>,
+    /// Conditions checked, in order.
+    checked: Vec<String>,
 }
 
 fn at<T: Clone>(script: &[T], tick: usize) -> T {
@@ -21,6 +23,7 @@ fn at<T: Clone>(script: &[T], tick: usize) -> T {
 impl Leaves for Script {
     fn check(&mut self, condition: &Condition) -> bool {
         let text = condition.to_string();
+        self.checked.push(text.clone());
         let (_, answers) = self.conditions.iter().find(|(c, _)| *c == text).unwrap();
         at(answers, self.now)
     }
@@ -41,6 +44,17 @@ impl Leaves for Script {
 fn run(ticker: &mut Ticker, tree: &Tree, script: &mut Script) -> TickRecord {
     script.now = ticker.tick_count() as usize;
     ticker.tick(tree, script)
+}
+
+fn run_forced(
+    ticker: &mut Ticker,
+    tree: &Tree,
+    script: &mut Script,
+    forced: &[(NodeId, Forced)],
+) -> TickRecord {
+    script.now = ticker.tick_count() as usize;
+    let forced: ForcedStatuses = forced.iter().copied().collect();
+    ticker.tick_forced(tree, script, &forced)
 }
 
 #[test]
@@ -233,4 +247,99 @@ fn edits_between_ticks() {
     assert_eq!(r.visited, vec![t.root(), check]);
     assert_eq!(r.status(NodeId(40)), I);
     assert_eq!(script.log, ["1: start #1", "2: halt #1"]);
+}
+
+#[test]
+fn a_condition_forced_to_fail_sends_the_fallback_to_its_other_branch() {
+    // [0] fallback
+    // [1]   "blue cube" on "green cube"?   holds, but forced to Failure
+    // [2]   place "blue cube" "green cube"!
+    let mut t = Tree::new(NodeKind::Fallback);
+    let goal = t
+        .add_child(t.root(), cond("\"blue cube\" on \"green cube\""))
+        .unwrap();
+    let place = t
+        .add_child(t.root(), act("place \"blue cube\" \"green cube\""))
+        .unwrap();
+    let mut script = Script {
+        conditions: vec![("\"blue cube\" on \"green cube\"", vec![true])],
+        actions: vec![(
+            "place \"blue cube\" \"green cube\"",
+            vec![ActionStep::Running],
+        )],
+        ..Script::default()
+    };
+    let mut ticker = Ticker::new();
+    // Unforced: the goal holds, the action is not reached.
+    let r = run(&mut ticker, &t, &mut script);
+    assert_eq!(r.statuses, vec![S, S, I]);
+    assert!(r.forced.is_empty());
+    assert_eq!(script.checked.len(), 1);
+    // Forced to fail: not checked, the fallback takes its other branch.
+    let r = run_forced(&mut ticker, &t, &mut script, &[(goal, Forced::Failure)]);
+    assert_eq!(r.statuses, vec![R, F, R]);
+    assert_eq!(r.forced, vec![goal]);
+    assert_eq!(r.running_action(), Some(place));
+    assert_eq!(script.checked.len(), 1, "a forced condition is not checked");
+    // Cleared: the goal is checked again, holds, and the running action is halted.
+    let r = run(&mut ticker, &t, &mut script);
+    assert_eq!(r.statuses, vec![S, S, H]);
+    assert_eq!(r.halted, vec![place]);
+    assert_eq!(script.log, ["2: start #2", "3: halt #2"]);
+}
+
+#[test]
+fn a_forced_action_is_not_stepped_and_a_forced_running_one_never_starts() {
+    // [0] sequence
+    // [1]   grasp "blue cube"!
+    let mut t = Tree::new(NodeKind::Sequence);
+    let grasp = t.add_child(t.root(), act("grasp \"blue cube\"")).unwrap();
+    let mut script = Script {
+        actions: vec![("grasp \"blue cube\"", vec![ActionStep::Running])],
+        ..Script::default()
+    };
+    let mut ticker = Ticker::new();
+    let r = run_forced(&mut ticker, &t, &mut script, &[(grasp, Forced::Success)]);
+    assert_eq!((r.root, r.statuses.clone()), (Outcome::Success, vec![S, S]));
+    assert!(r.completed.is_empty(), "forced, not completed");
+    assert!(
+        script.log.is_empty(),
+        "Leaves::step was called: {:?}",
+        script.log
+    );
+    // Forced Running: shown running, but not started in the world nor remembered, so
+    // nothing is halted once the force is cleared, and the next tick starts it afresh.
+    let r = run_forced(&mut ticker, &t, &mut script, &[(grasp, Forced::Running)]);
+    assert_eq!(r.statuses, vec![R, R]);
+    assert!(ticker.running().is_empty());
+    let r = run(&mut ticker, &t, &mut script);
+    assert_eq!(r.statuses, vec![R, R]);
+    assert!(r.halted.is_empty());
+    assert_eq!(script.log, ["3: start #1"]);
+    // Forced while it runs in the world: halted there, shown with the forced status.
+    let r = run_forced(&mut ticker, &t, &mut script, &[(grasp, Forced::Failure)]);
+    assert_eq!((r.root, r.statuses.clone()), (Outcome::Failure, vec![F, F]));
+    assert_eq!(r.halted, vec![grasp]);
+    assert!(
+        r.failures.is_empty(),
+        "a forced failure is not the action's"
+    );
+    assert_eq!(script.log, ["3: start #1", "4: halt #1"]);
+}
+
+#[test]
+fn a_forced_composite_does_not_tick_its_children() {
+    // [0] sequence            forced Success
+    // [1]   "path" clear?
+    // [2]   Sweep!
+    let mut t = Tree::new(NodeKind::Sequence);
+    t.add_child(t.root(), cond("\"path\" clear")).unwrap();
+    t.add_child(t.root(), act("Sweep")).unwrap();
+    let mut script = Script::default();
+    let mut ticker = Ticker::new();
+    let root = t.root();
+    let r = run_forced(&mut ticker, &t, &mut script, &[(root, Forced::Success)]);
+    assert_eq!(r.statuses, vec![S, I, I]);
+    assert_eq!(r.visited, vec![root]);
+    assert!(script.checked.is_empty() && script.log.is_empty());
 }

@@ -111,6 +111,7 @@ mod tests {
             halted: Vec::new(),
             failures: Vec::new(),
             completed: Vec::new(),
+            forced: Vec::new(),
         };
         let dot = to_dot(&tree, Some(&record), &[ids[3]], "red_on_blue");
         assert!(dot.starts_with("digraph \"red_on_blue\" {"), "{dot}");
