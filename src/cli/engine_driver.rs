@@ -12,6 +12,7 @@ use tokio::sync::mpsc::UnboundedReceiver;
 use betr::bt::{TickRecord, Tree};
 use betr::domain::ActionCall;
 use betr::goal::Formula;
+use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
 use betr::session::types::{VerifyRequest, VerifyScope};
 use betr::session::{Command, Engine, EngineHandle, Event, NoModel, PlanSummary, RunLimits, Setup};
@@ -24,6 +25,7 @@ pub struct Driver {
     handle: EngineHandle,
     events: UnboundedReceiver<Event>,
     viz: Option<Viz>,
+    record: Option<SessionRecorder>,
     tree: Option<Arc<Tree>>,
 }
 
@@ -45,6 +47,7 @@ pub struct Start<'a> {
     pub variant: Option<&'a str>,
     pub limits: RunLimits,
     pub viz: Option<Viz>,
+    pub record: Option<SessionRecorder>,
 }
 
 impl<'a> Start<'a> {
@@ -56,6 +59,7 @@ impl<'a> Start<'a> {
             variant: None,
             limits: RunLimits::DEFAULT,
             viz: None,
+            record: None,
         }
     }
 }
@@ -120,11 +124,15 @@ impl Driver {
             handle,
             events,
             viz: start.viz,
+            record: start.record,
             tree: None,
         })
     }
 
-    pub fn send(&self, command: Command) {
+    pub fn send(&mut self, command: Command) {
+        if let Some(r) = self.record.as_mut() {
+            r.command(&command);
+        }
         self.handle.send(command);
     }
 
@@ -136,6 +144,13 @@ impl Driver {
             .ok_or_else(|| anyhow!("the session stopped unexpectedly"))?;
         if let Some(v) = self.viz.as_mut() {
             v.on_event(&event);
+        }
+        if let Some(r) = self.record.as_mut() {
+            r.event(&event);
+            if let Some(why) = r.stopped() {
+                eprintln!("note: {why}");
+                self.record = None;
+            }
         }
         if let Event::TreeChanged { tree, .. } = &event {
             self.tree = Some(tree.clone());

@@ -9,6 +9,7 @@ mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
 mod policy_cmd;
+mod replay_cmd;
 mod resolve_cmd;
 mod tree_cmds;
 pub mod tui_cmd;
@@ -74,6 +75,9 @@ pub enum Command {
         #[command(flatten)]
         knowledge: knowledge_cmd::KnowledgeFlags,
     },
+    /// Tell a recorded session (--record FILE) again step by step, without the model, or
+    /// convert it into a rerun recording (--to-rrd).
+    Replay(replay_cmd::ReplayArgs),
     /// Reproduce the paper's experiments.
     Eval {
         #[command(subcommand)]
@@ -173,6 +177,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             knowledge,
         } => tree_cmds::plan(&load_with(&scenario, &knowledge)?, goal.as_deref(), glyphs),
         Command::Run(args) => tree_cmds::run_command(&args, glyphs),
+        Command::Replay(args) => replay_cmd::replay(&args),
         Command::Repair(args) => tree_cmds::repair_command(&args, glyphs),
         Command::Verify(args) => verify_cmd::command(&args, cli.ascii),
     }

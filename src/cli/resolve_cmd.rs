@@ -166,6 +166,7 @@ fn resolve(
     llm.options.use_scenario_goal = args.stated_goal;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
+    let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
     println!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
         println!("Instruction: {i}");
@@ -178,6 +179,9 @@ fn resolve(
     let mut emit = |e: &Event| {
         if let Some(v) = viz.as_mut() {
             v.on_event(e);
+        }
+        if let Some(r) = record.as_mut() {
+            r.event(e);
         }
         match e {
             Event::Ticked { record } => last = Some(record.clone()),
@@ -374,6 +378,9 @@ fn print_event_line(event: &Event) {
         | Event::Scene { .. }
         | Event::Usage { .. }
         | Event::RunState { .. }
+        | Event::Forced { .. }
+        | Event::Breakpoints { .. }
+        | Event::BreakpointHit { .. }
         | Event::Verifying { .. }
         | Event::Verified { .. }
         | Event::PolicySaved { .. }

@@ -167,6 +167,7 @@ fn run(
             ..RunLimits::DEFAULT
         },
         viz: viz.open(false)?,
+        record: viz.recorder(scenario, &scenario_file(scenario), variant)?,
         ..Start::new(scenario)
     };
     let mut session = with_tree(start, tree_file, false)?;
@@ -182,6 +183,15 @@ fn run(
         RunEnd::Success => ExitCode::SUCCESS,
         _ => ExitCode::from(WORLD_FAILED),
     })
+}
+
+/// The file a scenario was loaded from.
+fn scenario_file(scenario: &Scenario) -> PathBuf {
+    scenario
+        .files
+        .last()
+        .map(|f| f.path.clone())
+        .unwrap_or_default()
 }
 
 /// An engine with its tree: the file's (`grow`: expanded in this world) or the one planned
@@ -263,6 +273,7 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
         scenario_path: Some(scenario_path),
         variant,
         viz: viz.open(false)?,
+        record: viz.recorder(scenario, scenario_path, variant)?,
         ..Start::new(scenario)
     };
     let mut session = with_tree(start, tree_file, true)?;

@@ -139,6 +139,9 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         no_model,
         keys_error,
     };
+    let record = args
+        .viz
+        .recorder(&scenario, &path, args.variant.as_deref())?;
     let setup = Setup {
         variant: args.variant.clone(),
         ledger: Some(ledger),
@@ -150,8 +153,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         knowledge,
         ..Setup::new(scenario, path, model)
     };
-    // The status bar says it when a viewer is not there.
-    let mut tap = args.viz.open(true)?.map(super::viz_flags::VizTap);
+    // The status bar says it when a viewer is not there or the recording stopped.
+    let mut tap = super::viz_flags::SessionTap {
+        viz: args.viz.open(true)?,
+        record,
+    };
     let theme = Theme::new(if ascii {
         &betr::bt::ASCII
     } else {
@@ -181,7 +187,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     runtime.block_on(betr::tui::run(
         setup,
         workbench,
-        tap.as_mut().map(|t| t as &mut dyn betr::tui::Tap),
+        (!tap.is_empty()).then_some(&mut tap as &mut dyn betr::tui::Tap),
     ))?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,9 +1,12 @@
-//! `--viewer connect[=URL]|spawn` and `--rrd FILE`: where the 3D view streams.
+//! `--viewer connect[=URL]|spawn`, `--rrd FILE` and `--record FILE`: where a session
+//! streams besides the screen: the 3D view, and the session's recording.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context as _, Result};
 
+use betr::record::SessionRecorder;
+use betr::scenario::Scenario;
 use betr::session::{Command, Event};
 use betr::viz::{Sinks, Viewer, Viz};
 
@@ -17,6 +20,11 @@ pub struct VizFlags {
     /// Save a rerun recording of the session to FILE (.rrd).
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
+    /// Record the session to FILE: the tree after each change, every tick, every model
+    /// reply and every approval, written as it happens (`betr replay FILE` shows it again,
+    /// without the model).
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
 }
 
 impl VizFlags {
@@ -34,21 +42,59 @@ impl VizFlags {
     }
 }
 
-/// The workbench's tap: the viz follows the session's events and submitted instructions.
-pub struct VizTap(pub Viz);
+impl VizFlags {
+    /// The recording `--record` asks for, started on `scenario` (its file: `path`).
+    pub fn recorder(
+        &self,
+        scenario: &Scenario,
+        path: &Path,
+        variant: Option<&str>,
+    ) -> Result<Option<SessionRecorder>> {
+        let Some(file) = &self.record else {
+            return Ok(None);
+        };
+        let recorder = SessionRecorder::create(file, path, &scenario.name, variant)
+            .with_context(|| "--record")?;
+        Ok(Some(recorder))
+    }
+}
 
-impl betr::tui::Tap for VizTap {
+/// What follows a session besides the screen: the 3D view (the session's events and
+/// submitted instructions) and the recording (events and commands).
+#[derive(Default)]
+pub struct SessionTap {
+    pub viz: Option<Viz>,
+    pub record: Option<SessionRecorder>,
+}
+
+impl SessionTap {
+    pub fn is_empty(&self) -> bool {
+        self.viz.is_none() && self.record.is_none()
+    }
+}
+
+impl betr::tui::Tap for SessionTap {
     fn event(&mut self, event: &Event) {
-        self.0.on_event(event);
+        if let Some(v) = self.viz.as_mut() {
+            v.on_event(event);
+        }
+        if let Some(r) = self.record.as_mut() {
+            r.event(event);
+        }
     }
 
     fn command(&mut self, command: &Command) {
-        if let Command::Submit(text) = command {
-            self.0.instruction(text);
+        if let (Some(v), Command::Submit(text)) = (self.viz.as_mut(), command) {
+            v.instruction(text);
+        }
+        if let Some(r) = self.record.as_mut() {
+            r.command(command);
         }
     }
 
     fn notice(&self) -> Option<String> {
-        self.0.notice().map(str::to_string)
+        let recording = self.record.as_ref().and_then(SessionRecorder::stopped);
+        let viewer = self.viz.as_ref().and_then(Viz::notice);
+        recording.or(viewer).map(str::to_string)
     }
 }

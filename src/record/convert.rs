@@ -4,10 +4,11 @@
 
 use std::sync::Arc;
 
-use crate::bt::{NodeId, Outcome, Status, TickRecord, Tree};
+use crate::bt::{Forced, NodeId, Outcome, Status, TickRecord, Tree};
 use crate::domain::action::parse_value;
 use crate::domain::{ActionCall, Condition};
 use crate::scenario::Scenario;
+use crate::session::types::BreakReason;
 use crate::session::{Event, Proposal};
 
 use super::{RecordError, Recorded, RecordedProposal};
@@ -100,6 +101,7 @@ impl Encoder {
                     .collect(),
                 completed: self.positions(&record.completed),
                 halted: self.positions(&record.halted),
+                forced: self.positions(&record.forced),
             },
             Event::Asking { what } => Recorded::Asking { what: what.clone() },
             Event::Replied {
@@ -215,9 +217,6 @@ impl Encoder {
             Event::Notice { message } => Recorded::Note {
                 message: message.clone(),
             },
-            Event::Planned { summary } => Recorded::Note {
-                message: summary.log_line(),
-            },
             Event::Exported { paths } => Recorded::Note {
                 message: format!(
                     "exported to {}",
@@ -237,7 +236,32 @@ impl Encoder {
             Event::RuleRefused { rule, reason } => Recorded::Note {
                 message: format!("not kept as a rule: {rule}: {reason}"),
             },
-            Event::Verifying { .. } | Event::Knowledge { .. } | Event::Scene { .. } => {
+            Event::Forced { forced } => Recorded::Forced {
+                forced: forced
+                    .iter()
+                    .map(|(id, f)| (self.at(*id), outcome_letter(f.outcome())))
+                    .collect(),
+            },
+            Event::Breakpoints { nodes, on_failure } => Recorded::Breakpoints {
+                nodes: self.positions(nodes),
+                on_failure: *on_failure,
+            },
+            Event::BreakpointHit {
+                node,
+                node_path,
+                tick,
+                reason,
+            } => Recorded::BreakpointHit {
+                node: self.at(*node),
+                node_path: node_path.clone(),
+                tick: *tick,
+                on_failure: matches!(reason, BreakReason::Failure),
+            },
+            // The engine's notice says what planning did; scenes are re-simulated.
+            Event::Planned { .. }
+            | Event::Verifying { .. }
+            | Event::Knowledge { .. }
+            | Event::Scene { .. } => {
                 return None;
             }
         })
@@ -328,11 +352,16 @@ impl Decoder {
                 failures,
                 completed,
                 halted,
-            } => Event::Ticked {
-                record: Arc::new(self.tick(
+                forced,
+            } => {
+                let mut record = self.tick(
                     *tick, *root, statuses, visited, failures, completed, halted, line,
-                )?),
-            },
+                )?;
+                record.forced = self.nodes(forced, line)?;
+                Event::Ticked {
+                    record: Arc::new(record),
+                }
+            }
             Recorded::Asking { what } => Event::Asking { what: what.clone() },
             Recorded::Replied {
                 attribution,
@@ -439,6 +468,39 @@ impl Decoder {
             Recorded::Note { message } => Event::Notice {
                 message: message.clone(),
             },
+            Recorded::Forced { forced } => Event::Forced {
+                forced: forced
+                    .iter()
+                    .map(|(at, letter)| {
+                        let status = match letter {
+                            'S' => Forced::Success,
+                            'F' => Forced::Failure,
+                            'R' => Forced::Running,
+                            other => return Err(bad(format!("{other:?} is not a forced status"))),
+                        };
+                        Ok((self.node(*at, line)?, status))
+                    })
+                    .collect::<Result<_, RecordError>>()?,
+            },
+            Recorded::Breakpoints { nodes, on_failure } => Event::Breakpoints {
+                nodes: self.nodes(nodes, line)?,
+                on_failure: *on_failure,
+            },
+            Recorded::BreakpointHit {
+                node,
+                node_path,
+                tick,
+                on_failure,
+            } => Event::BreakpointHit {
+                node: self.node(*node, line)?,
+                node_path: node_path.clone(),
+                tick: *tick,
+                reason: if *on_failure {
+                    BreakReason::Failure
+                } else {
+                    BreakReason::Breakpoint
+                },
+            },
         })
     }
 
@@ -492,6 +554,7 @@ impl Decoder {
                 .map(|(at, e)| Ok((self.node(*at, line)?, e.clone())))
                 .collect::<Result<_, RecordError>>()?,
             completed: self.nodes(completed, line)?,
+            forced: Vec::new(),
         })
     }
 

@@ -113,11 +113,10 @@ pub fn read(path: &Path) -> Result<Recording, RecordError> {
             path: path.to_path_buf(),
         });
     };
-    let header: Header =
-        serde_json::from_str(first).map_err(|e| RecordError::NotARecording {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+    let header: Header = serde_json::from_str(first).map_err(|e| RecordError::NotARecording {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
     if header.format != FORMAT {
         return Err(RecordError::NotARecording {
             path: path.to_path_buf(),
@@ -204,8 +203,12 @@ mod tests {
             command: "run".into(),
         })
         .unwrap();
-        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
-        f.write_all(br#"{"kind":"event","ms":5,"event":{"ev"#).unwrap();
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
+        f.write_all(br#"{"kind":"event","ms":5,"event":{"ev"#)
+            .unwrap();
         let back = read(&path).unwrap();
         assert_eq!(back.entries.len(), 1);
         assert_eq!(back.cut_at, Some(3));
@@ -215,7 +218,10 @@ mod tests {
     fn a_broken_line_in_the_middle_is_an_error_naming_it() {
         let path = temp("broken.jsonl");
         Recorder::create(&path, Path::new("s.toml"), "S", None).unwrap();
-        let mut f = std::fs::OpenOptions::new().append(true).open(&path).unwrap();
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(&path)
+            .unwrap();
         f.write_all(b"not json\n{\"kind\":\"command\",\"ms\":1,\"command\":\"x\"}\n")
             .unwrap();
         let e = read(&path).unwrap_err().to_string();

@@ -12,6 +12,8 @@
 
 pub mod convert;
 pub mod file;
+pub mod replay;
+pub mod session;
 
 use std::path::PathBuf;
 
@@ -21,6 +23,8 @@ use crate::llm::usage::UsageTotals;
 
 pub use convert::{Decoder, Encoder};
 pub use file::{Recorder, Recording, read};
+pub use replay::{Replay, ReplayError, Resimulation, Step};
+pub use session::SessionRecorder;
 
 /// What the first line says the file is.
 pub const FORMAT: &str = "betr-recording";
@@ -82,6 +86,9 @@ pub enum Recorded {
         failures: Vec<(usize, String)>,
         completed: Vec<usize>,
         halted: Vec<usize>,
+        /// Nodes that returned a status a person forced.
+        #[serde(default)]
+        forced: Vec<usize>,
     },
     Asking {
         what: String,
@@ -158,6 +165,22 @@ pub enum Recorded {
     Error {
         message: String,
     },
+    /// The nodes whose status a person forced, each with the status (`S`, `F`, `R`).
+    Forced {
+        forced: Vec<(usize, char)>,
+    },
+    /// The nodes with a breakpoint, and whether running stops after a node fails.
+    Breakpoints {
+        nodes: Vec<usize>,
+        on_failure: bool,
+    },
+    /// Running stopped at a breakpoint (`on_failure`: after a node failed).
+    BreakpointHit {
+        node: usize,
+        node_path: String,
+        tick: u64,
+        on_failure: bool,
+    },
     /// Anything else worth a line of the log (plans, rules, notices, exports).
     Note {
         message: String,
@@ -194,9 +217,7 @@ pub enum RecordError {
     Empty { path: PathBuf },
     #[error("{path}, line 1: not a betr recording ({reason})")]
     NotARecording { path: PathBuf, reason: String },
-    #[error(
-        "{path}: a recording of format version {found}; this betr reads version {VERSION}"
-    )]
+    #[error("{path}: a recording of format version {found}; this betr reads version {VERSION}")]
     Version { path: PathBuf, found: u32 },
     #[error("{path}, line {line}: {reason}")]
     Line {

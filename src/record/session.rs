@@ -1,0 +1,112 @@
+//! A session followed into a recording: every event the engine reports and every command a
+//! front end sends. A write that fails stops the recording (what was written stays
+//! readable) and is told once; the session goes on.
+
+use std::path::Path;
+
+use crate::session::{Command, Event};
+
+use super::{Encoder, Entry, RecordError, Recorder};
+
+pub struct SessionRecorder {
+    recorder: Option<Recorder>,
+    encoder: Encoder,
+    /// Why the recording stopped, if a write failed.
+    stopped: Option<String>,
+}
+
+impl SessionRecorder {
+    /// Start recording a session on `scenario` into `path` (replaced if it exists).
+    pub fn create(
+        path: &Path,
+        scenario: &Path,
+        name: &str,
+        variant: Option<&str>,
+    ) -> Result<SessionRecorder, RecordError> {
+        Ok(SessionRecorder {
+            recorder: Some(Recorder::create(path, scenario, name, variant)?),
+            encoder: Encoder::new(),
+            stopped: None,
+        })
+    }
+
+    pub fn event(&mut self, event: &Event) {
+        if let Some(recorded) = self.encoder.encode(event) {
+            self.write(|ms| Entry::Event {
+                ms,
+                event: recorded,
+            });
+        }
+    }
+
+    pub fn command(&mut self, command: &Command) {
+        let command = command_text(command);
+        self.write(|ms| Entry::Command { ms, command });
+    }
+
+    fn write(&mut self, entry: impl FnOnce(u64) -> Entry) {
+        let Some(recorder) = &mut self.recorder else {
+            return;
+        };
+        let entry = entry(recorder.ms());
+        if let Err(e) = recorder.write(&entry) {
+            tracing::warn!(error = %e, "the recording stopped");
+            self.stopped = Some(format!("the recording stopped: {e}"));
+            self.recorder = None;
+        }
+    }
+
+    /// Why the recording stopped, if a write failed (for a front end to tell).
+    pub fn stopped(&self) -> Option<&str> {
+        self.stopped.as_deref()
+    }
+}
+
+/// A command in the words a person would use.
+pub fn command_text(command: &Command) -> String {
+    match command {
+        Command::Submit(text) => format!("submit {text}"),
+        Command::SubmitGoal { goal, .. } => format!("submit goal {goal}"),
+        Command::Plan => "plan".into(),
+        Command::Tick => "tick".into(),
+        Command::Run => "run".into(),
+        Command::Pause => "pause".into(),
+        Command::Approve => "approve".into(),
+        Command::Reject => "reject".into(),
+        Command::Edit(edit) => format!("edit {edit}"),
+        Command::SetValue(setting) => format!("set {}", setting.text),
+        Command::Undo => "undo".into(),
+        Command::Verify | Command::VerifyWith(_) => "verify".into(),
+        Command::SavePolicy => "save policy".into(),
+        Command::SavePolicyTo(path) => format!("save policy to {}", path.display()),
+        Command::Export => "export".into(),
+        Command::LoadPolicy(None) => "load policy".into(),
+        Command::LoadPolicy(Some(path)) => format!("load policy {}", path.display()),
+        Command::LoadTree { path, .. } => format!("load tree {}", path.display()),
+        Command::Insert {
+            conditions, before, ..
+        } => {
+            let names: Vec<String> = conditions.iter().map(ToString::to_string).collect();
+            match before {
+                Some(action) => format!("insert {} before {action}!", names.join(" & ")),
+                None => format!("insert {}", names.join(" & ")),
+            }
+        }
+        Command::ResetWorld => "reset world".into(),
+        // The events that follow name the nodes by their place in the tree.
+        Command::Force { status: None, .. } => "clear a forced status".into(),
+        Command::Force {
+            status: Some(status),
+            ..
+        } => format!("force a node to {status}"),
+        Command::ToggleBreakpoint(_) => "toggle a breakpoint".into(),
+        Command::BreakOnFailure(on) => {
+            format!("break on failure {}", if *on { "on" } else { "off" })
+        }
+        Command::KeepRule { only: false } => "keep rule".into(),
+        Command::KeepRule { only: true } => "keep rule for these objects".into(),
+        Command::DeclineRule => "decline rule".into(),
+        Command::ShowKnowledge => "show knowledge".into(),
+        Command::Shutdown => "quit".into(),
+    }
+}
