@@ -28,4 +28,4 @@ pub use knowledge::{KeptRule, Knowledge, KnowledgeError, Refusal};
 pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use resolve::{resolve, resolve_with_scenes};
-pub use types::{Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};
+pub use types::{BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use crate::bt::{NodeId, TickRecord, Tree};
+use crate::bt::{Forced, NodeId, TickRecord, Tree};
 use crate::domain::{ActionCall, Condition, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
@@ -291,6 +291,25 @@ pub enum Event {
     RunState {
         running: bool,
     },
+    /// The nodes whose status is forced in every tick of the execution world (all of
+    /// them, after every change of the set; empty when cleared).
+    Forced {
+        forced: Vec<(NodeId, Forced)>,
+    },
+    /// The nodes with a breakpoint, and whether running stops after a node fails (all of
+    /// them, after every change).
+    Breakpoints {
+        nodes: Vec<NodeId>,
+        on_failure: bool,
+    },
+    /// Running stopped at a breakpoint: before tick `tick`, which would enter `node`
+    /// (`Breakpoint`), or after tick `tick`, in which `node` failed (`Failure`).
+    BreakpointHit {
+        node: NodeId,
+        node_path: String,
+        tick: u64,
+        reason: BreakReason,
+    },
     /// A verification asked for started: what it checks.
     Verifying {
         scope: Arc<VerifyScope>,
@@ -331,6 +350,16 @@ pub enum Event {
     Notice {
         message: String,
     },
+}
+
+/// Why running stopped at a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BreakReason {
+    /// The next tick would enter a node with a breakpoint; it was not performed.
+    Breakpoint,
+    /// With break-on-failure, the tick just performed made a node fail that succeeded or
+    /// ran in the tick before, or made an action fail.
+    Failure,
 }
 
 /// How the loop ended.

@@ -30,6 +30,9 @@ pub enum Action {
     DeclineRule,
     Knowledge,
     Reset,
+    Breakpoint,
+    Force,
+    BreakOnFailure,
     LogUp,
     LogDown,
     Help,
@@ -221,6 +224,9 @@ bindings! {
     decline_rule: DeclineRule = Key::plain('n'),
     knowledge: Knowledge = Key::plain('g'),
     reset: Reset = Key::plain('w'),
+    breakpoint: Breakpoint = Key::plain('b'),
+    force: Force = Key::plain('f'),
+    break_on_failure: BreakOnFailure = Key::plain('B'),
     log_up: LogUp = Key::plain('['),
     log_down: LogDown = Key::plain(']'),
     help: Help = Key::plain('?'),
@@ -313,7 +319,7 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "[", "]", "?", "q"
+                "g", "w", "b", "f", "B", "[", "]", "?", "q"
             ]
         );
         assert_eq!(

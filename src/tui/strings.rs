@@ -64,6 +64,15 @@ pub const FAILED: &str = "FAILED";
 pub const HELP_WORD: &str = "help";
 pub const NEW_MARK: &str = "+";
 pub const FAILED_MARK: &str = "◀ failed";
+/// After a node with a breakpoint.
+pub const BREAKPOINT_MARK: &str = "● break";
+/// After the node a run stopped at.
+pub const STOPPED_MARK: &str = "◀ stopped here";
+/// In the status bar while a run is stopped at a breakpoint, and while break-on-failure
+/// is on.
+pub const STOPPED: &str = "STOPPED";
+pub const BREAK_ON_FAILURE: &str = "break on failure";
+pub const SELECT_A_NODE: &str = "select a node in the tree first (↑ ↓)";
 
 /// One line per navigation key (fixed, not rebindable).
 pub const NAVIGATION: &[(&str, &str)] = &[
@@ -96,6 +105,9 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         DeclineRule => "do not keep the approved fix as a rule",
         Knowledge => "show the rules learned from approved fixes",
         Reset => "reset the world",
+        Breakpoint => "set / clear a breakpoint on the selected node",
+        Force => "force the selected node: failure, success, running, off",
+        BreakOnFailure => "break on failure: stop running when a node fails",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",
@@ -236,4 +248,43 @@ pub const NO_RULES: &str =
 /// The mark after a condition a learned rule put in the tree.
 pub fn learned_mark(rules: &[String]) -> String {
     format!(" ◆ learned {}", rules.join(", "))
+}
+
+/// The mark after a node whose status is forced.
+pub fn forced_mark(status: crate::bt::Forced) -> String {
+    format!(" ⚑ forced {status}")
+}
+
+/// Why a run stopped at a node: `leaf` is the node as the tree shows it.
+pub fn stopped_at(
+    reason: crate::session::BreakReason,
+    leaf: &str,
+    node_path: &str,
+    tick: u64,
+) -> String {
+    match reason {
+        crate::session::BreakReason::Breakpoint => {
+            format!("stopped at a breakpoint: {leaf} (node {node_path}) before tick {tick}")
+        }
+        crate::session::BreakReason::Failure => {
+            format!("stopped on failure: {leaf} (node {node_path}) failed in tick {tick}")
+        }
+    }
+}
+
+pub fn break_on_failure(on: bool) -> &'static str {
+    if on {
+        "break on failure on: running stops after a tick in which a node fails"
+    } else {
+        "break on failure off"
+    }
+}
+
+/// A change of the forced statuses, for the log.
+pub fn forced_count(count: usize) -> String {
+    if count == 0 {
+        "no status forced".to_string()
+    } else {
+        format!("{count} node status(es) forced")
+    }
 }

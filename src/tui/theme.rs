@@ -17,6 +17,12 @@ pub struct Theme {
     pub new_node: Style,
     /// The action that failed.
     pub failing: Style,
+    /// The mark of a breakpoint.
+    pub breakpoint: Style,
+    /// The mark of a forced status.
+    pub forced: Style,
+    /// The node a run stopped at.
+    pub stopped: Style,
     pub selected: Style,
     pub title: Style,
     pub border: Style,
@@ -42,6 +48,16 @@ impl Theme {
             failing: Style::new()
                 .fg(Color::White)
                 .bg(Color::Red)
+                .add_modifier(Modifier::BOLD),
+            breakpoint: Style::new()
+                .fg(Color::LightRed)
+                .add_modifier(Modifier::BOLD),
+            forced: Style::new()
+                .fg(Color::LightBlue)
+                .add_modifier(Modifier::BOLD),
+            stopped: Style::new()
+                .fg(Color::Black)
+                .bg(Color::Yellow)
                 .add_modifier(Modifier::BOLD),
             selected: Style::new().add_modifier(Modifier::REVERSED),
             title: Style::new().add_modifier(Modifier::BOLD),

@@ -332,8 +332,25 @@ impl Viz {
             Event::RuleRefused { rule, reason } => {
                 self.log(L::WARN, format!("not kept as a rule: {rule}: {reason}"));
             }
+            Event::BreakpointHit {
+                node_path,
+                tick,
+                reason,
+                ..
+            } => {
+                let when = match reason {
+                    crate::session::BreakReason::Breakpoint => "at a breakpoint before",
+                    crate::session::BreakReason::Failure => "after a failure in",
+                };
+                self.log(
+                    L::WARN,
+                    format!("stopped {when} tick {tick} (node {node_path})"),
+                );
+            }
             Event::Usage { .. }
             | Event::RunState { .. }
+            | Event::Forced { .. }
+            | Event::Breakpoints { .. }
             | Event::Verifying { .. }
             | Event::Verified { .. }
             | Event::RuleOffered { .. }

@@ -165,7 +165,7 @@ impl Engine {
                 }
                 let tree = planned.plan.tree;
                 if to_text(&tree) != to_text(&current) {
-                    self.set_tree(tree.clone(), planned.plan.new_nodes, origin.clone());
+                    self.replace_tree(tree.clone(), planned.plan.new_nodes, origin.clone());
                 }
                 self.planned_in_model = true;
                 (tree, origin)

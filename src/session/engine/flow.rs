@@ -117,7 +117,7 @@ impl Engine {
             Ok(plan) => {
                 let why = format!("planned for {}", task.goal);
                 self.planned(&plan, started.elapsed());
-                self.set_tree(plan.tree, Vec::new(), why);
+                self.replace_tree(plan.tree, Vec::new(), why);
             }
             Err(e) => self.emit(Event::Failed {
                 error: SessionError::Plan(e),
@@ -132,8 +132,23 @@ impl Engine {
         self.emit(Event::Planned { summary });
     }
 
+    /// Make a tree that does not grow out of the current one (a plan, an undo, a load)
+    /// the tree: forced statuses and breakpoints are cleared, since their ids would name
+    /// other nodes.
+    pub(super) fn replace_tree(
+        &mut self,
+        tree: Tree,
+        new_nodes: Vec<crate::bt::NodeId>,
+        why: String,
+    ) {
+        self.clear_marks();
+        self.set_tree(tree, new_nodes, why);
+    }
+
     /// Make `tree` the tree, tell front ends, and start the execution world afresh.
+    /// Forced statuses and breakpoints stay on the nodes it still has.
     pub(super) fn set_tree(&mut self, tree: Tree, new_nodes: Vec<crate::bt::NodeId>, why: String) {
+        self.prune_marks(&tree);
         let learned = crate::session::knowledge::learned_in_tree(&self.scenario.domain, &tree)
             .into_iter()
             .map(|l| (l.node, l.rules))
@@ -179,7 +194,10 @@ impl Engine {
             world: self.exec.as_mut(),
             domain: &self.scenario.domain,
         };
-        let record = Arc::new(self.ticker.tick(tree, &mut leaves));
+        let record = Arc::new(
+            self.ticker
+                .tick_forced(tree, &mut leaves, &self.debug.forced),
+        );
         self.run_ticks += 1;
         let failed = record.failures.first().and_then(|(node, error)| {
             let action = tree.kind(*node).ok()?.as_action()?.clone();
@@ -214,6 +232,15 @@ impl Engine {
             (TickOutcome::Failure, Some(failure)) => {
                 self.set_running(false);
                 self.on_failure(failure);
+            }
+            (TickOutcome::Failure, None) if !record.forced.is_empty() => {
+                self.set_running(false);
+                self.emit(Event::GaveUp {
+                    reason: format!(
+                        "the tree failed with {} forced status(es) and no action failing",
+                        record.forced.len()
+                    ),
+                });
             }
             (TickOutcome::Failure, None) => {
                 self.set_running(false);
@@ -259,6 +286,7 @@ impl Engine {
             Err(e) => return self.error(format!("cannot reset the world: {e}")),
         }
         self.ticker = crate::bt::Ticker::new();
+        self.debug.forget_stop();
         self.last = None;
         self.run_ticks = 0;
         self.facts = self.exec.facts();
@@ -283,6 +311,6 @@ impl Engine {
         let undone = self.fixes.len().saturating_sub(entry.fixes);
         self.fixes.truncate(entry.fixes);
         let why = format!("undid the last change ({undone} fix(es) removed)");
-        self.set_tree(entry.tree, Vec::new(), why);
+        self.replace_tree(entry.tree, Vec::new(), why);
     }
 }

@@ -15,6 +15,7 @@
 
 mod changes;
 mod checks;
+mod debug;
 mod flow;
 mod learning;
 mod policies;
@@ -26,7 +27,7 @@ use std::time::Duration;
 
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
-use crate::bt::{NodeId, TickRecord, Ticker, Tree};
+use crate::bt::{Forced, NodeId, TickRecord, Ticker, Tree};
 use crate::domain::Condition;
 use crate::goal::Formula;
 use crate::llm::LanguageModel;
@@ -107,9 +108,22 @@ pub enum Command {
     Plan,
     /// One tick of the tree in the execution world.
     Tick,
-    /// Tick on their own until success, failure, a pause or the tick limit.
+    /// Tick on their own until success, failure, a pause, a breakpoint or the tick limit.
     Run,
     Pause,
+    /// Force `node`'s status in every tick of the execution world (`None` clears it):
+    /// the node returns it without checking, stepping or ticking below it. Kept until
+    /// cleared or the tree is replaced (`Event::Forced`).
+    Force {
+        node: NodeId,
+        status: Option<Forced>,
+    },
+    /// Set or clear a breakpoint on `node`: running stops before a tick that would enter
+    /// it (`Event::Breakpoints`, `Event::BreakpointHit`).
+    ToggleBreakpoint(NodeId),
+    /// Stop running after a tick in which a node that succeeded or ran fails, or an action
+    /// fails.
+    BreakOnFailure(bool),
     /// Apply the pending proposal.
     Approve,
     /// Drop the pending proposal.
@@ -223,6 +237,8 @@ pub struct Engine {
     planning: Box<dyn World>,
     exec: Box<dyn World>,
     ticker: Ticker,
+    /// Forced statuses and breakpoints.
+    debug: debug::Debugger,
     /// Ticks since the last Run command (for the limit).
     run_ticks: u64,
     facts: Vec<Condition>,
@@ -298,6 +314,7 @@ impl Engine {
             planning,
             exec,
             ticker: Ticker::new(),
+            debug: debug::Debugger::default(),
             run_ticks: 0,
             facts,
             task: None,
@@ -351,7 +368,7 @@ impl Engine {
                     Some(c) => self.handle(c),
                 },
                 Some(message) = self.internal_rx.recv() => self.on_internal(message),
-                () = pace(interval), if running => self.tick(),
+                () = pace(interval), if running => self.run_step(),
             }
         }
         if let Some(r) = self.request.take() {
@@ -390,6 +407,9 @@ impl Engine {
             }
             Command::Run => self.start_running(),
             Command::Pause => self.set_running(false),
+            Command::Force { node, status } => self.force(node, status),
+            Command::ToggleBreakpoint(node) => self.toggle_breakpoint(node),
+            Command::BreakOnFailure(on) => self.break_on_failure(on),
             Command::Approve => self.approve(),
             Command::Reject => self.reject(),
             Command::Edit(edit) => self.edit(edit),

@@ -173,9 +173,9 @@ impl Engine {
             let started = std::time::Instant::now();
             let plan = Planner::new(&self.scenario.domain).grow(saved.tree, self.planning.as_ref());
             self.planned(&plan, started.elapsed());
-            self.set_tree(plan.tree, plan.new_nodes, why);
+            self.replace_tree(plan.tree, plan.new_nodes, why);
         } else {
-            self.set_tree(saved.tree, Vec::new(), why);
+            self.replace_tree(saved.tree, Vec::new(), why);
         }
     }
 }

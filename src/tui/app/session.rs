@@ -40,6 +40,10 @@ impl App {
             | Event::RuleKept { .. }
             | Event::RuleRefused { .. }
             | Event::Knowledge { .. }) => self.on_knowledge(e),
+            e
+            @ (Event::Forced { .. } | Event::Breakpoints { .. } | Event::BreakpointHit { .. }) => {
+                self.on_debugger(e)
+            }
             e @ (Event::Error { .. } | Event::Failed { .. } | Event::Notice { .. }) => {
                 self.on_report(e);
             }
@@ -159,6 +163,9 @@ impl App {
         match event {
             Event::Ticked { record } => {
                 self.status.ticks = record.tick;
+                if self.status.ending == Some(Ending::Stopped) {
+                    self.status.ending = None;
+                }
                 self.tree.set_record(record);
             }
             Event::WorldChanged { facts, reset } => {
@@ -259,6 +266,37 @@ impl App {
                 }
                 lines.extend(rules);
                 self.overlay = Some(Overlay::Report(lines));
+            }
+            _ => {}
+        }
+    }
+
+    /// The debugger: forced statuses, breakpoints, and a run stopped at one.
+    fn on_debugger(&mut self, event: Event) {
+        match event {
+            Event::Forced { forced } => {
+                self.llm.log(strings::forced_count(forced.len()));
+                self.tree.set_forced(forced);
+            }
+            Event::Breakpoints { nodes, on_failure } => {
+                if on_failure != self.status.break_on_failure {
+                    self.llm.log(strings::break_on_failure(on_failure));
+                }
+                self.status.break_on_failure = on_failure;
+                self.tree.set_breakpoints(nodes);
+            }
+            Event::BreakpointHit {
+                node,
+                node_path,
+                tick,
+                reason,
+            } => {
+                let leaf = self.tree.label(node, &self.theme);
+                let text = strings::stopped_at(reason, &leaf, &node_path, tick);
+                self.tree.set_stopped(node);
+                self.status.ending = Some(Ending::Stopped);
+                self.llm.log(text.clone());
+                self.message(text, false);
             }
             _ => {}
         }

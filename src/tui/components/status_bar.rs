@@ -15,6 +15,8 @@ use super::super::theme::Theme;
 pub enum Ending {
     Success,
     Failed,
+    /// A run stopped at a breakpoint (or a failure, with break-on-failure).
+    Stopped,
 }
 
 /// A passing message (dictation's outcome), shown until the next key.
@@ -34,6 +36,8 @@ pub struct StatusBar {
     pub ticks: u64,
     pub running: bool,
     pub ending: Option<Ending>,
+    /// Whether running stops after a node fails.
+    pub break_on_failure: bool,
     /// What a failure waits for (the model's proposal, a person's approval).
     pub awaiting: Option<&'static strings::Awaiting>,
     /// Said once when a 3D viewer was asked for and is not there.
@@ -124,7 +128,15 @@ impl StatusBar {
                 spans.push(sep.clone());
                 spans.push(Span::styled(strings::FAILED, theme.error));
             }
+            Some(Ending::Stopped) => {
+                spans.push(sep.clone());
+                spans.push(Span::styled(strings::STOPPED, theme.stopped));
+            }
             None => {}
+        }
+        if self.break_on_failure {
+            spans.push(sep.clone());
+            spans.push(Span::styled(strings::BREAK_ON_FAILURE, theme.status_bar));
         }
         if let Some(viewer) = &self.viewer {
             spans.push(sep.clone());

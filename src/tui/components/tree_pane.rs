@@ -1,6 +1,7 @@
 //! The live behavior tree (tui-tree-widget): each node with its status symbol and
 //! colour, collapsible; nodes added by the last expansion highlighted, the failing action
-//! marked. Items are rebuilt only when the tree or the statuses change, iteratively (no
+//! marked, and the debugger's marks: breakpoints, forced statuses and the node a run
+//! stopped at. Items are rebuilt only when the tree or the statuses change, iteratively (no
 //! recursion, so deep trees are fine); the widget draws only the visible rows.
 
 use std::sync::Arc;
@@ -12,7 +13,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use tui_tree_widget::{Tree as TreeWidget, TreeItem, TreeState};
 
-use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree};
+use crate::bt::{Forced, NodeId, NodeKind, Status, TickRecord, Tree};
 
 use super::super::strings;
 use super::super::theme::Theme;
@@ -21,13 +22,25 @@ use super::super::theme::Theme;
 pub struct TreePane {
     tree: Option<Arc<Tree>>,
     record: Option<Arc<TickRecord>>,
+    marks: Marks,
+    items: Vec<TreeItem<'static, u32>>,
+    state: TreeState<u32>,
+    dirty: bool,
+}
+
+/// What the pane marks on nodes besides their status.
+#[derive(Default)]
+struct Marks {
+    /// Added by the last change.
     new_nodes: Vec<NodeId>,
     /// Conditions learned rules put there, with the rules' ids.
     learned: Vec<(NodeId, Vec<String>)>,
     failing: Option<NodeId>,
-    items: Vec<TreeItem<'static, u32>>,
-    state: TreeState<u32>,
-    dirty: bool,
+    breakpoints: Vec<NodeId>,
+    forced: Vec<(NodeId, Forced)>,
+    /// Where a run stopped (a breakpoint, or a failure with break-on-failure), until the
+    /// next tick.
+    stopped: Option<NodeId>,
 }
 
 impl TreePane {
@@ -43,10 +56,11 @@ impl TreePane {
         }
         let focus = new_nodes.first().copied();
         self.tree = Some(tree);
-        self.new_nodes = new_nodes;
-        self.learned = learned;
+        self.marks.new_nodes = new_nodes;
+        self.marks.learned = learned;
         self.record = None;
-        self.failing = None;
+        self.marks.failing = None;
+        self.marks.stopped = None;
         self.dirty = true;
         if let Some(n) = focus {
             self.select(n);
@@ -55,20 +69,62 @@ impl TreePane {
 
     pub fn set_record(&mut self, record: Arc<TickRecord>) {
         self.record = Some(record);
+        self.marks.stopped = None;
         self.dirty = true;
     }
 
     /// Statuses back to "not ticked" (the world was reset).
     pub fn clear_statuses(&mut self) {
         self.record = None;
-        self.failing = None;
+        self.marks.failing = None;
+        self.marks.stopped = None;
         self.dirty = true;
     }
 
     pub fn set_failing(&mut self, node: NodeId) {
-        self.failing = Some(node);
+        self.marks.failing = Some(node);
         self.dirty = true;
         self.select(node);
+    }
+
+    pub fn set_breakpoints(&mut self, nodes: Vec<NodeId>) {
+        self.marks.breakpoints = nodes;
+        self.dirty = true;
+    }
+
+    pub fn set_forced(&mut self, forced: Vec<(NodeId, Forced)>) {
+        self.marks.forced = forced;
+        self.dirty = true;
+    }
+
+    /// Mark and select the node a run stopped at.
+    pub fn set_stopped(&mut self, node: NodeId) {
+        self.marks.stopped = Some(node);
+        self.dirty = true;
+        self.select(node);
+    }
+
+    /// The selected node, if any.
+    pub fn selected(&self) -> Option<NodeId> {
+        let node = NodeId(*self.state.selected().last()?);
+        self.tree.as_ref()?.contains(node).then_some(node)
+    }
+
+    /// The status forced on `node`, if any.
+    pub fn forced(&self, node: NodeId) -> Option<Forced> {
+        self.marks
+            .forced
+            .iter()
+            .find(|(n, _)| *n == node)
+            .map(|(_, s)| *s)
+    }
+
+    /// `node` as the pane shows it (`grasp "blue cube"!`, `[-] Sequence`).
+    pub fn label(&self, node: NodeId, theme: &Theme) -> String {
+        self.tree
+            .as_ref()
+            .map(|t| node_label(t, node, theme))
+            .unwrap_or_default()
     }
 
     pub fn has_tree(&self) -> bool {
@@ -114,9 +170,7 @@ impl TreePane {
             Some(tree) => vec![build_items(
                 tree,
                 self.record.as_deref(),
-                &self.new_nodes,
-                &self.learned,
-                self.failing,
+                &self.marks,
                 theme,
             )],
             None => Vec::new(),
@@ -177,26 +231,33 @@ fn composite_paths(tree: &Tree) -> Vec<Vec<u32>> {
 fn build_items(
     tree: &Tree,
     record: Option<&TickRecord>,
-    new_nodes: &[NodeId],
-    learned: &[(NodeId, Vec<String>)],
-    failing: Option<NodeId>,
+    marks: &Marks,
     theme: &Theme,
 ) -> TreeItem<'static, u32> {
     let mut built: Vec<Option<TreeItem<'static, u32>>> = vec![None; tree.capacity()];
     let order = tree.preorder();
     for &node in order.iter().rev() {
         let status = record.map_or(Status::Idle, |r| r.status(node));
-        let mut line = node_line(
-            tree,
-            node,
-            status,
-            new_nodes.contains(&node),
-            failing == Some(node),
-            theme,
-        );
-        if let Some((_, rules)) = learned.iter().find(|(n, _)| *n == node) {
+        let mut line = node_line(tree, node, status, marks, theme);
+        if let Some((_, rules)) = marks.learned.iter().find(|(n, _)| *n == node) {
             line.spans
                 .push(Span::styled(strings::learned_mark(rules), theme.dim));
+        }
+        if marks.breakpoints.contains(&node) {
+            line.spans.push(Span::styled(
+                format!(" {}", strings::BREAKPOINT_MARK),
+                theme.breakpoint,
+            ));
+        }
+        if let Some((_, forced)) = marks.forced.iter().find(|(n, _)| *n == node) {
+            line.spans
+                .push(Span::styled(strings::forced_mark(*forced), theme.forced));
+        }
+        if marks.stopped == Some(node) {
+            line.spans.push(Span::styled(
+                format!(" {}", strings::STOPPED_MARK),
+                theme.key,
+            ));
         }
         let children: Vec<TreeItem<'static, u32>> = tree
             .children(node)
@@ -222,29 +283,40 @@ fn build_items(
         .unwrap_or_else(|| TreeItem::new_leaf(tree.root().0, ""))
 }
 
-/// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
-fn node_line(
-    tree: &Tree,
-    node: NodeId,
-    status: Status,
-    new: bool,
-    failing: bool,
-    theme: &Theme,
-) -> Line<'static> {
+/// `[-] Sequence`, `grasp "blue cube"!`.
+fn node_label(tree: &Tree, node: NodeId, theme: &Theme) -> String {
     let g = theme.glyphs;
-    let label = match tree.kind(node) {
+    match tree.kind(node) {
         Ok(NodeKind::Sequence) => format!("{} {}", g.sequence, g.sequence_name),
         Ok(NodeKind::Fallback) => format!("{} {}", g.fallback, g.fallback_name),
         Ok(NodeKind::Condition(c)) => format!("{c}{}", g.condition_suffix),
         Ok(NodeKind::Action(a)) => format!("{a}{}", g.action_suffix),
         Err(_) => String::new(),
-    };
+    }
+}
+
+/// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
+fn node_line(
+    tree: &Tree,
+    node: NodeId,
+    status: Status,
+    marks: &Marks,
+    theme: &Theme,
+) -> Line<'static> {
+    let new = marks.new_nodes.contains(&node);
+    let failing = marks.failing == Some(node);
+    let label = node_label(tree, node, theme);
     let mut spans = vec![
         Span::styled(if new { strings::NEW_MARK } else { " " }, theme.new_node),
-        Span::styled(format!("[{}] ", g.status(status)), theme.status(status)),
+        Span::styled(
+            format!("[{}] ", theme.glyphs.status(status)),
+            theme.status(status),
+        ),
     ];
     let style = if failing {
         theme.failing
+    } else if marks.stopped == Some(node) {
+        theme.stopped
     } else if new {
         theme.new_node.patch(theme.status(status))
     } else {
