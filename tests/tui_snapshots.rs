@@ -319,6 +319,87 @@ fn an_approved_fix_kept_as_a_rule_is_marked_in_the_tree() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The debugger's keys on scenario 1's planned tree: `b` puts a breakpoint on the
+/// selected grasp, `f` forces the selected goal condition to fail; both are marked. Run
+/// stops before the first tick, which would enter the grasp: it is highlighted and the
+/// status bar says why.
+#[test]
+fn a_breakpoint_and_a_forced_node_are_marked_and_the_run_stops_there() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.key(KeyCode::Char('p'));
+        b.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        // Nothing selected yet: the keys say so and send nothing.
+        b.key(KeyCode::Char('b'));
+        assert!(
+            b.screen(120, 40)
+                .contains("select a node in the tree first")
+        );
+        assert!(b.sent.iter().all(|c| *c == Command::Plan), "{:?}", b.sent);
+        // The grasp is the eighth row: root, goal, sequence, fallback, grasped?,
+        // sequence, hand empty?, grasp.
+        for _ in 0..8 {
+            b.key(KeyCode::Down);
+        }
+        b.key(KeyCode::Char('b'));
+        b.until(|e| matches!(e, Event::Breakpoints { .. })).await;
+        b.key(KeyCode::Home);
+        b.key(KeyCode::Down);
+        b.key(KeyCode::Char('f'));
+        b.until(|e| matches!(e, Event::Forced { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("grasp \"blue cube\"! ● break"), "{screen}");
+        assert!(
+            screen.contains("\"blue cube\" on \"green cube\"? ⚑ forced failure"),
+            "{screen}"
+        );
+        insta::assert_snapshot!("breakpoint_and_forced_node", screen);
+
+        b.key(KeyCode::Char('r'));
+        b.until(|e| matches!(e, Event::BreakpointHit { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("◀ stopped here"), "{screen}");
+        assert!(
+            screen.contains(
+                "stopped at a breakpoint: grasp \"blue cube\"! (node 1.0.1.1) before tick 1"
+            ),
+            "{screen}"
+        );
+        insta::assert_snapshot!("stopped_at_breakpoint", screen);
+
+        // The next key takes the message away; the status bar still says the run stopped,
+        // and that break on failure is on once B turns it on. With the goal selected again
+        // (the stop selected the grasp), f cycles its forced status on to success,
+        // running, and off.
+        b.key(KeyCode::Char('B'));
+        b.until(|e| {
+            matches!(
+                e,
+                Event::Breakpoints {
+                    on_failure: true,
+                    ..
+                }
+            )
+        })
+        .await;
+        let screen = b.screen(120, 40);
+        let status_bar = screen.lines().last().unwrap();
+        assert!(status_bar.contains("STOPPED"), "{screen}");
+        assert!(status_bar.contains("break on failure"), "{screen}");
+        b.key(KeyCode::Home);
+        b.key(KeyCode::Down);
+        for want in ["⚑ forced success", "⚑ forced running"] {
+            b.key(KeyCode::Char('f'));
+            b.until(|e| matches!(e, Event::Forced { .. })).await;
+            assert!(b.screen(120, 40).contains(want), "{want}");
+        }
+        b.key(KeyCode::Char('f'));
+        b.until(|e| matches!(e, Event::Forced { forced } if forced.is_empty()))
+            .await;
+        assert!(!b.screen(120, 40).contains("⚑ forced"));
+    });
+}
+
 #[test]
 fn help_overlay_lists_every_binding() {
     rt().block_on(async {

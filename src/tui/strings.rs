@@ -280,11 +280,20 @@ pub fn break_on_failure(on: bool) -> &'static str {
     }
 }
 
-/// A change of the forced statuses, for the log.
-pub fn forced_count(count: usize) -> String {
-    if count == 0 {
-        "no status forced".to_string()
+/// The forced statuses after a change, for the log: each node as the tree shows it.
+pub fn forced_list(forced: &[(String, crate::bt::Forced)]) -> String {
+    if forced.is_empty() {
+        return "no status forced".to_string();
+    }
+    let each: Vec<String> = forced.iter().map(|(n, s)| format!("{n} {s}")).collect();
+    format!("forced: {}", each.join(", "))
+}
+
+/// The breakpoints after a change, for the log.
+pub fn breakpoint_list(nodes: &[String]) -> String {
+    if nodes.is_empty() {
+        "no breakpoint".to_string()
     } else {
-        format!("{count} node status(es) forced")
+        format!("breakpoints: {}", nodes.join(", "))
     }
 }

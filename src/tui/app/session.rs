@@ -275,12 +275,23 @@ impl App {
     fn on_debugger(&mut self, event: Event) {
         match event {
             Event::Forced { forced } => {
-                self.llm.log(strings::forced_count(forced.len()));
+                let named: Vec<_> = forced
+                    .iter()
+                    .map(|(n, s)| (self.tree.label(*n, &self.theme), *s))
+                    .collect();
+                self.llm.log(strings::forced_list(&named));
                 self.tree.set_forced(forced);
             }
             Event::Breakpoints { nodes, on_failure } => {
                 if on_failure != self.status.break_on_failure {
                     self.llm.log(strings::break_on_failure(on_failure));
+                }
+                if nodes != self.tree.breakpoints() {
+                    let named: Vec<_> = nodes
+                        .iter()
+                        .map(|n| self.tree.label(*n, &self.theme))
+                        .collect();
+                    self.llm.log(strings::breakpoint_list(&named));
                 }
                 self.status.break_on_failure = on_failure;
                 self.tree.set_breakpoints(nodes);

@@ -110,6 +110,11 @@ impl TreePane {
         self.tree.as_ref()?.contains(node).then_some(node)
     }
 
+    /// The nodes with a breakpoint.
+    pub fn breakpoints(&self) -> &[NodeId] {
+        &self.marks.breakpoints
+    }
+
     /// The status forced on `node`, if any.
     pub fn forced(&self, node: NodeId) -> Option<Forced> {
         self.marks
