@@ -50,12 +50,51 @@ pub fn server_message(body: &str, secret: Option<&str>) -> String {
     ))
 }
 
-/// At most 300 characters of `text`, trimmed; `(empty body)` for nothing.
+/// `text` safe to show on a terminal: control characters other than newline and tab
+/// (escape sequences, carriage returns, bells) written out as `\u{1b}` instead of
+/// reaching the terminal raw.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(hidden) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 16);
+    for c in text.chars() {
+        if hidden(c) {
+            out.push_str(&format!("\\u{{{:x}}}", u32::from(c)));
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// A character a terminal would act on rather than show.
+fn hidden(c: char) -> bool {
+    c.is_control() && c != '\n' && c != '\t'
+}
+
+/// At most 300 characters of `text`, trimmed and printable; `(empty body)` for nothing.
 pub fn excerpt(text: &str) -> String {
+    let text = printable(text);
     let t = text.trim();
     match t.char_indices().nth(300) {
         Some((i, _)) => format!("{}…", &t[..i]),
         None if t.is_empty() => "(empty body)".into(),
         None => t.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod printable_tests {
+    use super::*;
+
+    #[test]
+    fn escape_sequences_and_carriage_returns_are_written_out() {
+        assert_eq!(printable("plain\ttext\n"), "plain\ttext\n");
+        assert_eq!(
+            printable("\u{1b}[2Jgone\rback\u{7}"),
+            "\\u{1b}[2Jgone\\u{d}back\\u{7}"
+        );
+        assert!(!excerpt("\u{1b}]0;title\u{7}").contains('\u{1b}'));
     }
 }

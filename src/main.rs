@@ -31,8 +31,10 @@ fn main() -> ExitCode {
             None => builder.with_writer(std::io::sink).init(),
         }
     } else {
+        // Colours only for a person at a terminal; a file or a pipe gets plain text.
         tracing_subscriber::fmt()
             .with_env_filter(filter)
+            .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
             .with_writer(std::io::stderr)
             .init();
     }

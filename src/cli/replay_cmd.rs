@@ -1,7 +1,7 @@
 //! `betr replay FILE`: a recorded session told again, step by step, without the model;
 //! `--to-rrd OUT` converts it into a rerun recording with its tick timeline.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context as _, Result};
@@ -41,10 +41,10 @@ pub fn replay(args: &ReplayArgs) -> Result<ExitCode> {
     }
 }
 
-fn to_rrd(replay: &Replay, out: &PathBuf) -> Result<ExitCode> {
+fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
     let mut viz = Viz::open(&Sinks {
         viewer: None,
-        rrd: Some(out.clone()),
+        rrd: Some(out.to_path_buf()),
     })?
     .context("--to-rrd: no recording was opened")?;
     let mut cell = Resimulation::new(replay);

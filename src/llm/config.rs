@@ -370,6 +370,8 @@ impl Settings {
                 }
             }
         };
+        // Every reply is made printable before anything shows or reads it.
+        let model: Box<dyn LanguageModel> = Box::new(super::printable::Printable::new(model));
         Ok(Metered::new(model, ledger, self.prices.clone()))
     }
 }

@@ -14,6 +14,7 @@ pub mod grammar;
 pub mod lexicon;
 pub mod local;
 pub mod openai;
+pub mod printable;
 pub mod prompt;
 pub mod reply;
 pub mod schema;

@@ -182,9 +182,7 @@ impl Encoder {
                 facts: facts.iter().map(ToString::to_string).collect(),
                 reset: *reset,
             },
-            Event::Usage { totals } => Recorded::Usage {
-                totals: totals.clone(),
-            },
+            Event::Usage { totals } => Recorded::Usage { totals: *totals },
             Event::Verified { report, origin } => Recorded::Checked {
                 holds: report.holds(),
                 summary: format!(
@@ -448,9 +446,7 @@ impl Decoder {
                     .collect::<Result<_, _>>()?,
                 reset: *reset,
             },
-            Recorded::Usage { totals } => Event::Usage {
-                totals: totals.clone(),
-            },
+            Recorded::Usage { totals } => Event::Usage { totals: *totals },
             Recorded::Checked { summary, .. } => Event::Notice {
                 message: summary.clone(),
             },

@@ -25,8 +25,14 @@ pub enum Behavior {
     Slow(Duration, String),
     /// 429 with `Retry-After: secs`.
     TooMany { retry_after: String },
+    /// 429 without `Retry-After`.
+    TooManyBare,
     /// 500.
     ServerError,
+    /// 503 without `Retry-After`.
+    Unavailable,
+    /// 200 whose body stops halfway (the connection closes before `content-length` bytes).
+    CutBody,
     /// 401 (the body echoes the key it got, as some servers do, to test redaction).
     Unauthorized,
     /// 404 model not found.
@@ -209,7 +215,24 @@ async fn serve(mut stream: TcpStream, state: Arc<Mutex<State>>) {
                 vec![("Retry-After", retry_after)],
                 json!({"error": {"message": "Rate limit reached", "type": "requests"}}).to_string(),
             ),
+            Behavior::TooManyBare => (
+                429,
+                vec![],
+                json!({"error": {"message": "Rate limit reached", "type": "requests"}}).to_string(),
+            ),
             Behavior::ServerError => (500, vec![], json!({"error": {"message": "internal error"}}).to_string()),
+            Behavior::Unavailable => (503, vec![], json!({"error": {"message": "overloaded"}}).to_string()),
+            Behavior::CutBody => {
+                let whole = ok("Goal: On_Coffee_Table1");
+                let head = format!(
+                    "HTTP/1.1 200 OK\r\ncontent-type: application/json\r\ncontent-length: {}\r\nconnection: close\r\n\r\n",
+                    whole.len()
+                );
+                let _ = stream.write_all(head.as_bytes()).await;
+                let _ = stream.write_all(&whole.as_bytes()[..whole.len() / 2]).await;
+                let _ = stream.shutdown().await;
+                return;
+            }
             Behavior::Unauthorized => {
                 let got = body_header_echo(&state);
                 (401, vec![], json!({"error": {"message": format!("Incorrect API key provided: {got}")}}).to_string())
@@ -291,6 +314,7 @@ fn reason(status: u16) -> &'static str {
         401 => "Unauthorized",
         404 => "Not Found",
         429 => "Too Many Requests",
+        503 => "Service Unavailable",
         _ => "Internal Server Error",
     }
 }
