@@ -1,5 +1,6 @@
 //! A secret API key set in the environment during a run appears in no file the run wrote:
-//! not the cassette, the usage log, the saved tree or the config file, and not in an error.
+//! not the cassette, the usage log, the session recording, the rerun recordings, the saved
+//! tree or the config file, and not in an error.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -34,7 +35,17 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
             &base,
             "--cassette",
             "rec.jsonl",
+            "--record",
+            "session.jsonl",
+            "--rrd",
+            "session.rrd",
         ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    // The recording converted for the 3D view too.
+    let out = betr(
+        &dir,
+        &["replay", "session.jsonl", "--to-rrd", "replayed.rrd"],
     );
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     let out = betr(
@@ -85,6 +96,9 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
     for expected in [
         "betr.toml",
         "rec.jsonl",
+        "session.jsonl",
+        "session.rrd",
+        "replayed.rrd",
         "state/betr/usage.jsonl",
         "policies/no_coffee.bt",
     ] {
