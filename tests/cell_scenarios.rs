@@ -431,6 +431,50 @@ fn the_binary_fails_then_repairs_and_the_saved_tree_runs_in_both_worlds() {
     assert_eq!(code, 0, "{out}");
 }
 
+/// `betr run --break NODE` stops before the tick that would enter the node (named by its
+/// path or its text), prints the statuses so far and exits 3; `--break-on-failure` stops
+/// after a tick in which an action failed while the tree went on.
+#[test]
+fn the_binary_stops_at_a_breakpoint() {
+    let s = "scenarios/cell/red_on_blue.toml";
+    let (code, out) = betr(&["run", s, "--break", "grasp \"blue cube\"!"]);
+    assert_eq!(code, 3, "{out}");
+    assert!(
+        out.contains("BREAKPOINT at grasp \"blue cube\"! (node 1.0.1.1) before tick 1"),
+        "{out}"
+    );
+    assert!(!out.contains("FAILED"), "{out}");
+
+    // Without the obstacle the grasp runs for two ticks; the place starts in the third.
+    let (code, out) = betr(&["run", s, "--variant", "clear", "--break", "1.1", "--ascii"]);
+    assert_eq!(code, 3, "{out}");
+    assert!(
+        out.contains("BREAKPOINT at place \"blue cube\" \"green cube\"! (node 1.1) before tick 3"),
+        "{out}"
+    );
+    assert!(out.contains("grasp \"blue cube\"! [*]"), "{out}");
+
+    let (code, out) = betr(&["run", s, "--break", "1.9"]);
+    assert_eq!(code, 2, "{out}");
+    assert!(out.contains("--break \"1.9\": no node \"1.9\""), "{out}");
+
+    // A fallback that goes on to its next child when the first grasp fails.
+    let tree = std::env::temp_dir().join(format!("betr-break-{}.bt", std::process::id()));
+    std::fs::write(
+        &tree,
+        "fallback\n  \"blue cube\" on \"green cube\"?\n  grasp \"blue cube\"!\n  grasp \"red cube\"!\n",
+    )
+    .unwrap();
+    let tree_text = tree.to_string_lossy().to_string();
+    let (code, out) = betr(&["run", s, "--tree", &tree_text, "--break-on-failure"]);
+    assert_eq!(code, 3, "{out}");
+    assert!(
+        out.contains("BREAKPOINT on failure at grasp \"blue cube\"! (node 1): it failed in tick 1"),
+        "{out}"
+    );
+    let _ = std::fs::remove_file(&tree);
+}
+
 #[test]
 fn the_binary_sets_values() {
     let egg = "scenarios/cell/params/egg.toml";

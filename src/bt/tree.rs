@@ -78,6 +78,10 @@ pub enum TreeError {
     RemoveRoot,
     #[error("no node at path {}", fmt_path(.0))]
     NoNodeAtPath(Vec<usize>),
+    #[error(
+        "no node {0:?} in the tree (name one by its path, like 1.0.1.1, or as a leaf the tree shows, like grasp \"blue cube\"!)"
+    )]
+    NoNodeNamed(String),
     #[error("{kind} at {} has no children", fmt_path(.path))]
     EmptyComposite {
         path: Vec<usize>,

@@ -30,6 +30,52 @@ impl Tree {
         Ok(at)
     }
 
+    /// The nodes `text` names: a node path as `path_text` writes it (`1.0.1.1`, `root`),
+    /// or a leaf as the tree shows it (`grasp "blue cube"!`, `"blue cube" grasped?`; the
+    /// suffix may be left out), which names every leaf with that text, in preorder.
+    pub fn find(&self, text: &str) -> Result<Vec<NodeId>, TreeError> {
+        let text = text.trim();
+        let missing = || TreeError::NoNodeNamed(text.to_string());
+        if text == "root" {
+            return Ok(vec![self.root]);
+        }
+        let is_path = text
+            .split('.')
+            .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+        if is_path {
+            let path = text
+                .split('.')
+                .map(str::parse)
+                .collect::<Result<Vec<usize>, _>>()
+                .map_err(|_| missing())?;
+            return self
+                .node_at_path(&path)
+                .map(|n| vec![n])
+                .map_err(|_| missing());
+        }
+        let (body, action, condition) = match (text.strip_suffix('!'), text.strip_suffix('?')) {
+            (Some(body), _) => (body, true, false),
+            (None, Some(body)) => (body, false, true),
+            (None, None) => (text, true, true),
+        };
+        let action = action.then(|| ActionCall::parse(body).ok()).flatten();
+        let condition = condition.then(|| Condition::parse(body).ok()).flatten();
+        let found: Vec<NodeId> = self
+            .preorder()
+            .into_iter()
+            .filter(|&n| match self.kind(n) {
+                Ok(NodeKind::Action(a)) => action.as_ref() == Some(a),
+                Ok(NodeKind::Condition(c)) => condition.as_ref() == Some(c),
+                _ => false,
+            })
+            .collect();
+        if found.is_empty() {
+            Err(missing())
+        } else {
+            Ok(found)
+        }
+    }
+
     /// Distance from the root (the root has depth 0).
     pub fn depth(&self, id: NodeId) -> Result<usize, TreeError> {
         Ok(self.ancestors(id)?.len())

@@ -154,3 +154,23 @@ fn validate_names_the_path() {
     assert!(Tree::new(act("Sweep")).validate().is_ok());
     assert!(Tree::new(NodeKind::Sequence).validate().is_err());
 }
+
+#[test]
+fn nodes_are_found_by_path_or_by_their_text() {
+    let (mut t, [root, _, c, _, a, b]) = sample();
+    assert_eq!(t.find("root").unwrap(), [root]);
+    assert_eq!(t.find("0.1.0").unwrap(), [a]);
+    assert_eq!(t.find("grasp \"blue cube\"!").unwrap(), [a]);
+    assert_eq!(t.find(" grasp  \"blue cube\" ").unwrap(), [a]);
+    assert_eq!(t.find("\"blue cube\" on \"green cube\"?").unwrap(), [c]);
+    assert_eq!(t.find("PutDown \"Coffee\" \"Table1\"!").unwrap(), [b]);
+    // A condition's text with an action's mark names no condition.
+    assert!(t.find("\"blue cube\" on \"green cube\"!").is_err());
+    let e = t.find("0.7").unwrap_err();
+    assert_eq!(e, TreeError::NoNodeNamed("0.7".into()));
+    assert!(e.to_string().contains("1.0.1.1"), "{e}");
+    assert!(t.find("").is_err());
+    // Every leaf with the text.
+    let again = t.add_child(root, act("grasp \"blue cube\"")).unwrap();
+    assert_eq!(t.find("grasp \"blue cube\"!").unwrap(), [a, again]);
+}

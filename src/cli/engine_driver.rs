@@ -9,13 +9,15 @@ use std::sync::Arc;
 use anyhow::{Result, anyhow, bail};
 use tokio::sync::mpsc::UnboundedReceiver;
 
-use betr::bt::{TickRecord, Tree};
+use betr::bt::{NodeId, TickRecord, Tree};
 use betr::domain::ActionCall;
 use betr::goal::Formula;
 use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
 use betr::session::types::{VerifyRequest, VerifyScope};
-use betr::session::{Command, Engine, EngineHandle, Event, NoModel, PlanSummary, RunLimits, Setup};
+use betr::session::{
+    BreakReason, Command, Engine, EngineHandle, Event, NoModel, PlanSummary, RunLimits, Setup,
+};
 use betr::verify::Report;
 use betr::viz::Viz;
 
@@ -76,6 +78,14 @@ pub enum RunEnd {
     /// limit came (the last record still running).
     Stopped {
         reason: String,
+    },
+    /// A breakpoint stopped the run: before tick `tick`, which would enter `node`, or
+    /// after it, in which `node` failed.
+    Break {
+        node: NodeId,
+        node_path: String,
+        tick: u64,
+        reason: BreakReason,
     },
 }
 
@@ -239,6 +249,19 @@ impl Driver {
                     };
                 }
                 Event::GaveUp { reason } => break RunEnd::Stopped { reason },
+                Event::BreakpointHit {
+                    node,
+                    node_path,
+                    tick,
+                    reason,
+                } => {
+                    break RunEnd::Break {
+                        node,
+                        node_path,
+                        tick,
+                        reason,
+                    };
+                }
                 Event::ChangeViolates { report } => {
                     // A change written on the command line is the person's own: it is run
                     // with the finding in view rather than refused.
@@ -260,6 +283,26 @@ impl Driver {
             end,
             last,
         })
+    }
+
+    /// Put a breakpoint on each of `nodes` and, when asked, stop on failures; kept for
+    /// every later run.
+    pub fn set_breakpoints(&mut self, nodes: &[NodeId], on_failure: bool) -> Result<()> {
+        // Each command toggles: a node named twice gets one breakpoint.
+        let nodes: std::collections::BTreeSet<NodeId> = nodes.iter().copied().collect();
+        for node in &nodes {
+            self.send(Command::ToggleBreakpoint(*node));
+        }
+        if on_failure {
+            self.send(Command::BreakOnFailure(true));
+        }
+        let mut awaited = nodes.len() + usize::from(on_failure);
+        while awaited > 0 {
+            if let Event::Breakpoints { .. } = self.next()? {
+                awaited -= 1;
+            }
+        }
+        Ok(())
     }
 
     /// Send a change and wait until the engine has made it.

@@ -8,13 +8,15 @@ use anyhow::{Context, Result, bail};
 use betr::bt::{self, Glyphs, NodeKind, TickRecord, Tree};
 use betr::domain::{ActionCall, Condition};
 use betr::scenario::Scenario;
-use betr::session::{Command, RunLimits};
+use betr::session::{BreakReason, Command, RunLimits};
 
 use super::engine_driver::{Driver, Run, RunEnd, Start};
 use super::values::Setting;
 use super::viz_flags::VizFlags;
 
 const WORLD_FAILED: u8 = 1;
+/// `betr run --break`: a breakpoint stopped the run (neither success nor failure).
+const STOPPED_AT_BREAKPOINT: u8 = 3;
 
 /// What `betr run` is asked.
 #[derive(clap::Args)]
@@ -33,6 +35,15 @@ pub struct RunArgs {
     /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
     #[arg(long)]
     pub variant: Option<String>,
+    /// Stop before the tick that would enter NODE: a node path as the tree prints it
+    /// (`1.0.1.1`) or a leaf as it shows (`grasp "blue cube"!`, every leaf with that
+    /// text); repeatable. Stopped at a breakpoint, the exit status is 3.
+    #[arg(long = "break", value_name = "NODE")]
+    pub breaks: Vec<String>,
+    /// Stop after a tick in which a node that succeeded or ran fails, or an action fails
+    /// while the tree goes on (exit status 3).
+    #[arg(long)]
+    pub break_on_failure: bool,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
     #[command(flatten)]
@@ -72,15 +83,7 @@ pub struct RepairArgs {
 /// `betr run`: the scenario's planned tree (or a tree file) run in a fresh world.
 pub fn run_command(args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode> {
     let scenario = super::load_with(&args.scenario, &args.knowledge)?;
-    run(
-        &scenario,
-        args.tree.as_deref(),
-        args.trace,
-        args.max_ticks,
-        args.variant.as_deref(),
-        &args.viz,
-        glyphs,
-    )
+    run(&scenario, args, glyphs)
 }
 
 /// `betr repair`: the flags read against the scenario, then the repair.
@@ -151,36 +154,40 @@ pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<
     })
 }
 
-fn run(
-    scenario: &Scenario,
-    tree_file: Option<&Path>,
-    trace: bool,
-    max_ticks: u64,
-    variant: Option<&str>,
-    viz: &VizFlags,
-    glyphs: &Glyphs,
-) -> Result<ExitCode> {
+fn run(scenario: &Scenario, args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode> {
+    let (variant, viz) = (args.variant.as_deref(), &args.viz);
     let start = Start {
         variant,
         limits: RunLimits {
-            run_ticks: max_ticks,
+            run_ticks: args.max_ticks,
             ..RunLimits::DEFAULT
         },
         viz: viz.open(false)?,
         record: viz.recorder(scenario, &scenario_file(scenario), variant)?,
         ..Start::new(scenario)
     };
-    let mut session = with_tree(start, tree_file, false)?;
+    let mut session = with_tree(start, args.tree.as_deref(), false)?;
     let tree = session.tree()?;
+    let mut breaks = Vec::new();
+    for text in &args.breaks {
+        breaks.extend(
+            tree.find(text)
+                .with_context(|| format!("--break {text:?}"))?,
+        );
+    }
+    if !breaks.is_empty() || args.break_on_failure {
+        session.set_breakpoints(&breaks, args.break_on_failure)?;
+    }
     let run = session.run(|r| {
-        if trace {
+        if args.trace {
             print_trace(&tree, r);
         }
     })?;
     print_tree(&tree, run.last.as_deref(), glyphs);
-    println!("\n{}", run_end_text(&run));
+    println!("\n{}", run_end_text(&run, &tree));
     Ok(match run.end {
         RunEnd::Success => ExitCode::SUCCESS,
+        RunEnd::Break { .. } => ExitCode::from(STOPPED_AT_BREAKPOINT),
         _ => ExitCode::from(WORLD_FAILED),
     })
 }
@@ -212,7 +219,7 @@ fn with_tree(start: Start, tree_file: Option<&Path>, grow: bool) -> Result<Drive
 }
 
 /// How a run ended, as `betr run` and `betr repair` say it.
-fn run_end_text(run: &Run) -> String {
+fn run_end_text(run: &Run, tree: &Tree) -> String {
     match &run.end {
         RunEnd::Success => format!("SUCCESS after {} tick(s)", run.ticks),
         RunEnd::ActionFailed {
@@ -230,6 +237,24 @@ fn run_end_text(run: &Run) -> String {
             "FAILED after {} tick(s): the tree's conditions do not hold and nothing it can do changes that",
             run.ticks
         ),
+        RunEnd::Break {
+            node,
+            node_path,
+            tick,
+            reason: BreakReason::Breakpoint,
+        } => format!(
+            "BREAKPOINT at {} (node {node_path}) before tick {tick}",
+            leaf_text(tree, *node)
+        ),
+        RunEnd::Break {
+            node,
+            node_path,
+            tick,
+            reason: BreakReason::Failure,
+        } => format!(
+            "BREAKPOINT on failure at {} (node {node_path}): it failed in tick {tick}",
+            leaf_text(tree, *node)
+        ),
     }
 }
 
@@ -243,6 +268,7 @@ fn failure_text(end: &RunEnd) -> String {
             error,
         } => format!("{action}! (node {node_path}) failed in simulation: {error}"),
         RunEnd::Stopped { reason } => reason.clone(),
+        RunEnd::Break { node_path, .. } => format!("the run stopped at node {node_path}"),
     }
 }
 
@@ -356,6 +382,9 @@ fn add_conditions(
             bail!("the tree already succeeds before --add {names:?}: nothing fails to repair")
         }
         (RunEnd::Stopped { reason }, None) => bail!("cannot repair: {reason}"),
+        (RunEnd::Break { node_path, .. }, None) => {
+            bail!("cannot repair: the run stopped at node {node_path}, before anything failed")
+        }
     }
     let change = session.change(Command::Insert {
         conditions: conditions.to_vec(),
