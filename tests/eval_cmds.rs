@@ -310,6 +310,71 @@ fn an_interrupted_run_resumes_without_asking_finished_cases_again() {
 }
 
 #[test]
+fn a_run_killed_midway_resumes_to_the_same_results() {
+    let dir = tmp("eval-kill");
+    let server = FakeServer::start(vec![], Behavior::Fixtures(goal_fixtures()));
+    let d = dataset_dir().display().to_string();
+    let url = server.base_url();
+    let scenario = cafe();
+    let args = [
+        "eval",
+        "goals",
+        "--dataset",
+        &d,
+        "--scenario",
+        &scenario,
+        "--out",
+        "out",
+        "--backend",
+        "openai",
+        "--base-url",
+        &url,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+    ];
+    let mut child = support::cli::command(&dir, &args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Killed (SIGKILL: no chance to tidy up) once some cases are in the journal.
+    let journal = dir.join("out/cases.jsonl");
+    let started = std::time::Instant::now();
+    while std::fs::read_to_string(&journal).map_or(0, |j| j.lines().count()) < 5 {
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(120),
+            "the run wrote no journal"
+        );
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let before = std::fs::read_to_string(&journal).unwrap();
+    assert!(before.lines().count() >= 5);
+
+    let o = model_goals(&dir, &server, &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r = read_json(&dir.join("out/results.json"));
+    assert_eq!(r["cases"].as_array().unwrap().len(), 100);
+    assert_eq!(tally(&r, "easy"), (27, 30));
+    assert_eq!(tally(&r, "hard"), (35, 40));
+    // Every case the killed run finished is kept as it was, once.
+    let after = std::fs::read_to_string(&journal).unwrap();
+    for line in before.lines().filter(|l| l.ends_with('}')) {
+        assert_eq!(
+            after.lines().filter(|l| *l == line).count(),
+            1,
+            "a finished case was lost or asked again: {line}"
+        );
+    }
+}
+
+#[test]
 fn original_examples_without_a_file_is_refused() {
     let dir = tmp("eval-orig");
     let server = FakeServer::start(vec![], Behavior::Fixtures(goal_fixtures()));

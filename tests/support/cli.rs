@@ -22,7 +22,16 @@ pub fn betr(dir: &Path, args: &[&str]) -> Output {
 
 /// [`betr`] with extra environment variables.
 pub fn betr_with(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_betr"))
+    command(dir, args)
+        .envs(env.iter().copied())
+        .output()
+        .unwrap()
+}
+
+/// The command [`betr`] runs, for a test that starts it and stops it midway.
+pub fn command(dir: &Path, args: &[&str]) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_betr"));
+    command
         .args(args)
         .current_dir(dir)
         .env("HOME", dir)
@@ -40,10 +49,8 @@ pub fn betr_with(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
         .env_remove("BETR_STT_MODEL")
         .env_remove("BETR_STT_BASE_URL")
         .env_remove("BETR_STT_API_KEY_ENV")
-        .env_remove("BETR_STT_LANGUAGE")
-        .envs(env.iter().copied())
-        .output()
-        .unwrap()
+        .env_remove("BETR_STT_LANGUAGE");
+    command
 }
 
 pub fn text(o: &Output) -> String {
