@@ -4,7 +4,8 @@
 //! the policy, quit; the screen is checked at each step (polling `capture-pane` with a
 //! timeout), then the restored terminal, the exit status and the saved policy. A second
 //! session rejects, edits, undoes, verifies and saves, and a fresh workbench reuses the
-//! saved policy without asking the model.
+//! saved policy without asking the model. Two more use the debugger: a run stopped at a
+//! breakpoint, and a condition forced to fail.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -465,6 +466,106 @@ fn a_person_dictates_the_instruction_in_the_workbench() {
         ],
         20,
     );
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The debugger as a person uses it: plan scenario 1, select the grasp in the tree, put a
+/// breakpoint on it, run: the run stops before the first tick, which would enter the
+/// grasp, and the screen says so; a step goes past it (the grasp is ticked and fails).
+#[test]
+fn a_person_stops_a_run_at_a_breakpoint() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-breakpoint");
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", ""));
+    tmux.wait_for(&["press i to type an instruction"], 20);
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["grasp \"blue cube\"!", "[o] Fallback"], 20);
+    // The grasp is the eighth row: root, goal, sequence, fallback, grasped?, sequence,
+    // hand empty?, grasp.
+    for _ in 0..8 {
+        tmux.keys(&["Down"]);
+    }
+    tmux.keys(&["b"]);
+    tmux.wait_for(
+        &[
+            "grasp \"blue cube\"! ● break",
+            "breakpoints: grasp \"blue cube\"!",
+        ],
+        10,
+    );
+
+    tmux.keys(&["r"]);
+    let screen = tmux.wait_for(
+        &[
+            "stopped at a breakpoint: grasp \"blue cube\"! (node 1.0.1.1) before tick 1",
+            // Not ticked yet.
+            "[-] grasp \"blue cube\"! ● break ◀ stopped here",
+        ],
+        20,
+    );
+    assert!(!screen.contains("◀ failed"), "{screen}");
+
+    // A step performs the tick the run stopped before.
+    tmux.keys(&["Space"]);
+    tmux.wait_for(&["tick 1", "grasp \"blue cube\"! ◀ failed ● break"], 20);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Forcing a status as a person does: scenario 1 without the red cube on the blue one
+/// runs to success; the goal condition, forced to fail, sends the fallback to its other
+/// branch (the grasp runs again); cleared, the goal holds again and the grasp is halted.
+#[test]
+fn a_person_forces_the_goal_condition_to_fail() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-force");
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", "--variant clear"));
+    tmux.wait_for(&["press i to type an instruction"], 20);
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["grasp \"blue cube\"!", "[o] Fallback"], 20);
+    tmux.keys(&["r"]);
+    tmux.wait_for(
+        &[
+            "SUCCESS",
+            "[✓] \"blue cube\" on \"green cube\"?",
+            "[-] grasp \"blue cube\"!",
+        ],
+        30,
+    );
+
+    // The goal is the second row.
+    tmux.keys(&["Down"]);
+    tmux.keys(&["Down"]);
+    tmux.keys(&["f"]);
+    tmux.wait_for(&["\"blue cube\" on \"green cube\"? ⚑ forced failure"], 10);
+    tmux.keys(&["Space"]);
+    tmux.wait_for(
+        &[
+            "[✕] \"blue cube\" on \"green cube\"? ⚑ forced failure",
+            "[*] grasp \"blue cube\"!",
+        ],
+        10,
+    );
+
+    // f cycles on to success, running, and off.
+    for _ in 0..3 {
+        tmux.keys(&["f"]);
+    }
+    tmux.wait_for(&["no status forced"], 10);
+    tmux.keys(&["Space"]);
+    let screen = tmux.wait_for(
+        &[
+            "[✓] \"blue cube\" on \"green cube\"?",
+            "[‖] grasp \"blue cube\"!",
+        ],
+        10,
+    );
+    assert!(!screen.contains("⚑ forced"), "{screen}");
     tmux.keys(&["q"]);
     tmux.wait_for(&["betr exited with status 0"], 10);
     drop(tmux);
