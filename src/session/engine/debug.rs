@@ -40,8 +40,8 @@ impl Debugger {
 impl Engine {
     /// Force `node`'s status (none: clear it).
     pub(super) fn force(&mut self, node: NodeId, status: Option<Forced>) {
-        if let Err(e) = self.check_node(node, "force") {
-            return self.error(e);
+        if let Some(why) = self.unmarkable(node, "force") {
+            return self.error(why);
         }
         let changed = match status {
             Some(s) => self.debug.forced.insert(node, s) != Some(s),
@@ -53,8 +53,8 @@ impl Engine {
     }
 
     pub(super) fn toggle_breakpoint(&mut self, node: NodeId) {
-        if let Err(e) = self.check_node(node, "break at") {
-            return self.error(e);
+        if let Some(why) = self.unmarkable(node, "break at") {
+            return self.error(why);
         }
         if !self.debug.breakpoints.remove(&node) {
             self.debug.breakpoints.insert(node);
@@ -70,11 +70,11 @@ impl Engine {
     }
 
     /// Why `node` cannot be marked, if it cannot.
-    fn check_node(&self, node: NodeId, what: &str) -> Result<(), String> {
+    fn unmarkable(&self, node: NodeId, what: &str) -> Option<String> {
         match &self.tree {
-            None => Err(format!("nothing to {what}: plan first")),
-            Some(tree) if !tree.contains(node) => Err(format!("no node {node} in the tree")),
-            Some(_) => Ok(()),
+            None => Some(format!("nothing to {what}: plan first")),
+            Some(tree) if !tree.contains(node) => Some(format!("no node {node} in the tree")),
+            Some(_) => None,
         }
     }
 
