@@ -292,3 +292,33 @@ fn an_instruction_that_tries_prompt_injection_approves_nothing() {
     assert!(!log.contains("Repaired:"), "{log}");
     case.nothing_changed(&out);
 }
+
+#[test]
+fn a_model_file_that_is_not_a_model_or_is_cut_short_is_refused_clearly() {
+    let case = Case::new("model-file");
+    let garbage = case.dir.join("garbage.gguf");
+    std::fs::write(&garbage, b"<html>\x1b[2J not a model").unwrap();
+    let cut = case.dir.join("cut.gguf");
+    // The GGUF magic and version, then nothing a model needs.
+    std::fs::write(&cut, b"GGUF\x03\x00\x00\x00\x00").unwrap();
+    for (file, phrase) in [
+        (&garbage, "is not a GGUF model file"),
+        (&cut, "a truncated or corrupt GGUF file?"),
+    ] {
+        let path = file.to_string_lossy().to_string();
+        let out = betr(
+            &case.dir,
+            &[
+                "interpret",
+                &case.scenario,
+                "--backend",
+                "local",
+                "--model-path",
+                &path,
+            ],
+        );
+        assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+        told(&out, phrase);
+        no_raw_controls(&out);
+    }
+}

@@ -169,3 +169,32 @@ async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
         assert!(answer.substitutions.is_empty(), "{}", r.text);
     }
 }
+
+#[tokio::test]
+async fn a_reply_cut_by_the_token_limit_is_refused_after_bounded_calls() {
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let mut calls = 0;
+    let reading = session::interpret(
+        &s,
+        world::load(&s).unwrap(),
+        s.instruction.as_deref().unwrap(),
+        local(),
+        // Three tokens: no goal fits, every answer is cut.
+        &Options {
+            max_tokens: 3,
+            ..Options::default()
+        },
+        &mut |e| {
+            if matches!(e, session::Event::Replied { .. }) {
+                calls += 1;
+            }
+        },
+    )
+    .await;
+    let error = reading
+        .err()
+        .expect("a cut answer is not a goal")
+        .to_string();
+    assert!(error.contains("no usable goal"), "{error}");
+    assert!((1..=12).contains(&calls), "{calls} calls");
+}

@@ -61,12 +61,35 @@ pub struct Generated {
     pub generation_time: Duration,
 }
 
+/// Refuse a file that does not start as a GGUF model does, before llama.cpp reads it.
+fn check_gguf(path: &std::path::Path) -> Result<(), EngineError> {
+    use std::io::Read;
+    let mut magic = [0u8; 4];
+    let read = std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut magic));
+    match read {
+        Ok(()) if &magic == b"GGUF" => Ok(()),
+        Ok(()) => Err(EngineError::NotGguf {
+            path: path.to_path_buf(),
+            found: format!(
+                "it starts with the bytes {}",
+                magic.map(|b| format!("{b:02x}")).join(" ")
+            ),
+        }),
+        Err(e) => Err(EngineError::NotGguf {
+            path: path.to_path_buf(),
+            found: e.to_string(),
+        }),
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EngineError {
     #[error("model file {0} does not exist (run `betr model fetch`, or pass --model-path)")]
     Missing(PathBuf),
     #[error("cannot load model {path}: {detail}")]
     Load { path: PathBuf, detail: String },
+    #[error("{path} is not a GGUF model file ({found})")]
+    NotGguf { path: PathBuf, found: String },
     #[error("the model has no usable chat template: {0}")]
     Template(String),
     #[error("the prompt has {tokens} tokens but the context holds {context}")]
@@ -172,12 +195,15 @@ fn worker(
 ) {
     let started = Instant::now();
     let setup = (|| {
+        check_gguf(&options.model_path)?;
         let backend = backend()?;
         let model =
             LlamaModel::load_from_file(backend, &options.model_path, &LlamaModelParams::default())
                 .map_err(|e| EngineError::Load {
                     path: options.model_path.clone(),
-                    detail: e.to_string(),
+                    detail: format!(
+                        "llama.cpp could not read it (a truncated or corrupt GGUF file?): {e}"
+                    ),
                 })?;
         Ok::<_, EngineError>((backend, model))
     })();
