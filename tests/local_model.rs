@@ -191,10 +191,10 @@ async fn a_reply_cut_by_the_token_limit_is_refused_after_bounded_calls() {
         },
     )
     .await;
-    let error = reading
-        .err()
-        .expect("a cut answer is not a goal")
-        .to_string();
+    let Err(error) = reading else {
+        panic!("a cut answer is not a goal");
+    };
+    let error = error.to_string();
     assert!(error.contains("no usable goal"), "{error}");
     assert!((1..=12).contains(&calls), "{calls} calls");
 }
