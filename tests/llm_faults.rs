@@ -322,3 +322,83 @@ fn a_model_file_that_is_not_a_model_or_is_cut_short_is_refused_clearly() {
         no_raw_controls(&out);
     }
 }
+
+/// The workbench's engine with an OpenAI-compatible client at `server` (two quick retries).
+fn workbench_session(server: &FakeServer) -> support::engine::Session {
+    use betr::llm::openai::{AuthHeader, OpenAiClient, OpenAiSettings, RetryPolicy};
+    let client = OpenAiClient::new(OpenAiSettings {
+        base_url: server.base_url(),
+        model: "fake-model".into(),
+        api_key_env: None,
+        api_key: None,
+        auth_header: AuthHeader::Bearer,
+        timeout: Duration::from_secs(3),
+        connect_timeout: Duration::from_secs(1),
+        retry: RetryPolicy {
+            max_retries: 2,
+            initial_backoff: Duration::from_millis(10),
+            max_backoff: Duration::from_millis(50),
+        },
+        structured: false,
+        max_tokens_field: "max_tokens".into(),
+    })
+    .unwrap();
+    let model: std::sync::Arc<dyn betr::llm::LanguageModel> =
+        std::sync::Arc::new(betr::llm::printable::Printable::new(client));
+    support::engine::Session::start(support::engine::setup(Ok(model), None))
+}
+
+#[test]
+fn the_workbench_is_told_each_fault_in_one_line_and_keeps_its_tree() {
+    use betr::session::{Command, Event};
+    let faults = [
+        (Behavior::ServerError, "500"),
+        (Behavior::Unavailable, "503"),
+        (Behavior::TooManyBare, "429"),
+        (Behavior::EmptyChoices, "choices"),
+        (Behavior::CutBody, ""),
+        (Behavior::Malformed, ""),
+        (
+            Behavior::Reply("\u{1b}[2J\u{1b}]0;pwned\u{7}".into()),
+            "no usable goal",
+        ),
+    ];
+    let rt = support::repo::runtime();
+    for (behavior, phrase) in faults {
+        let label = format!("{behavior:?}");
+        let server = FakeServer::start(vec![], behavior);
+        rt.block_on(async {
+            let mut s = workbench_session(&server);
+            // A tree first, then an instruction the model fails to read.
+            s.send(Command::Plan);
+            s.until("the plan", |e| matches!(e, Event::TreeChanged { .. }))
+                .await;
+            s.send(Command::Submit(support::engine::INSTRUCTION.into()));
+            let got = s
+                .until("the failure", |e| matches!(e, Event::Failed { .. }))
+                .await;
+            let Some(Event::Failed { error }) = got.last() else {
+                unreachable!("until stops at the failure")
+            };
+            let message = error.to_string();
+            assert!(!message.contains('\n'), "{label}: {message:?}");
+            assert!(message.contains(phrase), "{label}: {message}");
+            assert!(
+                !message.chars().any(|c| c.is_control()),
+                "{label}: {message:?}"
+            );
+            assert!(
+                !got.iter().any(|e| matches!(
+                    e,
+                    Event::TreeChanged { .. } | Event::Proposal { .. } | Event::Repaired { .. }
+                )),
+                "{label}: the tree changed"
+            );
+        });
+        assert!(
+            chat_calls(&server) <= 12,
+            "{label}: {} calls",
+            chat_calls(&server)
+        );
+    }
+}
