@@ -257,11 +257,7 @@ impl Journal {
         if !text.is_empty() && !text.ends_with('\n') {
             self.write_line("")?;
         }
-        Ok(text
-            .lines()
-            .filter(|l| !l.trim().is_empty())
-            .filter_map(|l| serde_json::from_str(l).ok())
-            .collect())
+        Ok(records(&text))
     }
 
     /// Append one record as a single write, then sync it to disk.
@@ -284,6 +280,15 @@ impl Journal {
         };
         write().map_err(|e| EvalError::io(&self.path, e))
     }
+}
+
+/// The records of a journal's text: every line that reads as a `T`; the others (the tail
+/// of a write cut short, blank lines) are left out.
+pub fn records<T: DeserializeOwned>(text: &str) -> Vec<T> {
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect()
 }
 
 /// `DIR/run.json`: the settings the recorded cases were made with. Resuming with other

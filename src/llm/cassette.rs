@@ -38,6 +38,31 @@ pub fn prompt_hash(request: &ChatRequest) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// A line of a cassette that is not an entry.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}: {detail}")]
+pub struct EntryError {
+    /// 1-based.
+    pub line: usize,
+    pub detail: String,
+}
+
+/// The entries of a cassette's text, in order; blank lines are skipped.
+pub fn read_entries(text: &str) -> Result<Vec<Entry>, EntryError> {
+    let mut entries = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let entry = serde_json::from_str(line).map_err(|e| EntryError {
+            line: i + 1,
+            detail: e.to_string(),
+        })?;
+        entries.push(entry);
+    }
+    Ok(entries)
+}
+
 /// Wraps a backend and appends every successful exchange to a cassette.
 pub struct Recorder<M> {
     inner: M,
@@ -106,18 +131,26 @@ impl Replay {
     /// Read a cassette. `model` selects the recordings of that model; without it, the
     /// cassette must hold exactly one model.
     pub fn open(path: &Path, model: Option<&str>, structured: bool) -> Result<Replay, LlmError> {
+        let text = std::fs::read_to_string(path).map_err(|e| LlmError::Cassette {
+            path: path.display().to_string(),
+            detail: e.to_string(),
+        })?;
+        Self::from_text(path, &text, model, structured)
+    }
+
+    /// A cassette from its text, as if read from `path` (which names it in errors).
+    pub fn from_text(
+        path: &Path,
+        text: &str,
+        model: Option<&str>,
+        structured: bool,
+    ) -> Result<Replay, LlmError> {
         let err = |detail: String| LlmError::Cassette {
             path: path.display().to_string(),
             detail,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
         let mut entries = HashMap::new();
-        for (i, line) in text.lines().enumerate() {
-            if line.trim().is_empty() {
-                continue;
-            }
-            let entry: Entry =
-                serde_json::from_str(line).map_err(|e| err(format!("line {}: {e}", i + 1)))?;
+        for entry in read_entries(text).map_err(|e| err(e.to_string()))? {
             entries.insert((entry.model.clone(), entry.prompt_hash.clone()), entry);
         }
         let mut models: Vec<&str> = entries.keys().map(|(m, _)| m.as_str()).collect();

@@ -3,7 +3,7 @@
 //! leave at most a partial last line, which the reader reports and leaves out.
 
 use std::fs::File;
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -93,21 +93,20 @@ pub struct Recording {
 /// Read the recording at `path`; a line that is not an entry is an error naming it,
 /// except a partial last line (no newline), which is left out and reported in `cut_at`.
 pub fn read(path: &Path) -> Result<Recording, RecordError> {
-    let io = |source| RecordError::Io {
+    let text = std::fs::read_to_string(path).map_err(|source| RecordError::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let mut reader = BufReader::new(File::open(path).map_err(io)?);
-    let mut lines: Vec<(String, bool)> = Vec::new();
-    loop {
-        let mut line = String::new();
-        let n = reader.read_line(&mut line).map_err(io)?;
-        if n == 0 {
-            break;
-        }
-        let whole = line.ends_with('\n');
-        lines.push((line.trim_end_matches(['\n', '\r']).to_string(), whole));
-    }
+    })?;
+    parse(path, &text)
+}
+
+/// A recording from its text, as if read from `path` (which names it in errors).
+pub fn parse(path: &Path, text: &str) -> Result<Recording, RecordError> {
+    // Each line with whether it ended in a newline (only the last one can lack it).
+    let lines: Vec<(&str, bool)> = text
+        .split_inclusive('\n')
+        .map(|line| (line.trim_end_matches(['\n', '\r']), line.ends_with('\n')))
+        .collect();
     let Some((first, _)) = lines.first() else {
         return Err(RecordError::Empty {
             path: path.to_path_buf(),
@@ -132,12 +131,12 @@ pub fn read(path: &Path) -> Result<Recording, RecordError> {
     let mut entries = Vec::new();
     let mut cut_at = None;
     let last = lines.len();
-    for (i, (text, whole)) in lines.iter().enumerate().skip(1) {
+    for (i, (line, whole)) in lines.iter().enumerate().skip(1) {
         let number = i + 1;
-        if text.trim().is_empty() {
+        if line.trim().is_empty() {
             continue;
         }
-        match serde_json::from_str::<Entry>(text) {
+        match serde_json::from_str::<Entry>(line) {
             Ok(entry) => entries.push((number, entry)),
             Err(_) if !whole && number == last => cut_at = Some(number),
             Err(e) => {

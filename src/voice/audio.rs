@@ -92,11 +92,24 @@ impl Audio16k {
 
     /// Read a WAV file.
     pub fn from_wav(path: &Path) -> Result<Audio16k, VoiceError> {
+        let file = std::fs::File::open(path).map_err(|e| VoiceError::Wav {
+            path: path.to_path_buf(),
+            detail: format!("cannot read the file: {e}"),
+        })?;
+        Self::read_wav(std::io::BufReader::new(file), path)
+    }
+
+    /// Read a WAV file's bytes; `name` names them in errors.
+    pub fn from_wav_bytes(bytes: &[u8], name: &Path) -> Result<Audio16k, VoiceError> {
+        Self::read_wav(std::io::Cursor::new(bytes), name)
+    }
+
+    fn read_wav(source: impl std::io::Read, path: &Path) -> Result<Audio16k, VoiceError> {
         let wav_error = |detail: String| VoiceError::Wav {
             path: path.to_path_buf(),
             detail,
         };
-        let mut reader = hound::WavReader::open(path).map_err(|e| match e {
+        let mut reader = hound::WavReader::new(source).map_err(|e| match e {
             hound::Error::IoError(io) => wav_error(format!("cannot read the file: {io}")),
             other => wav_error(format!("not a WAV file betr can read: {other}")),
         })?;
