@@ -12,7 +12,11 @@ fn main() -> ExitCode {
     let args = cli::Cli::parse();
     let filter =
         tracing_subscriber::EnvFilter::try_from_env("BETR_LOG").unwrap_or_else(|_| "warn".into());
-    let workbench = matches!(args.command, None | Some(cli::Command::Tui(_)));
+    let workbench = match &args.command {
+        None | Some(cli::Command::Tui(_)) => true,
+        Some(cli::Command::Replay(r)) => !r.print && r.to_rrd.is_none(),
+        _ => false,
+    };
     if workbench {
         // The terminal belongs to the screen: log to a file (or nowhere).
         let file = cli::tui_cmd::log_path().and_then(|p| {

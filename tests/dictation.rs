@@ -217,6 +217,7 @@ fn push_to_talk_puts_the_embedded_models_transcript_in_the_input_line() {
                 match request {
                     Request::Dictation(r) => service.handle(r),
                     Request::Session(c) => panic!("a dictation key sent {c:?} to the session"),
+                    Request::Replay(m) => panic!("a dictation key asked for a replay's {m:?}"),
                 }
             }
         };

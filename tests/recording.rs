@@ -1,6 +1,7 @@
 //! Session recordings end to end: a `betr resolve` session against the fake OpenAI server
 //! recorded with `--record`, replayed with no server running (the model's replies, the
-//! failure and the proposal come from the file), converted to a rerun recording; a
+//! failure and the proposal come from the file; printed with `--print`, the workbench
+//! refused without a terminal), converted to a rerun recording; a
 //! `betr repair` session likewise; a recording cut mid-entry (as a crash leaves it) replays
 //! up to its last whole entry; and the events read back carry the statuses of the
 //! recorded ticks node for node.
@@ -82,7 +83,7 @@ fn a_resolve_session_is_recorded_and_replayed_without_the_model() {
         .count();
     assert!(ticks > 5, "{ticks} ticks");
 
-    let out = betr(&dir, &["replay", &record_s]);
+    let out = betr(&dir, &["replay", &record_s, "--print"]);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(0), "{log}");
     assert!(
@@ -91,6 +92,10 @@ fn a_resolve_session_is_recorded_and_replayed_without_the_model() {
     );
     assert!(log.contains("proposal by"), "{log}");
     assert!(log.contains("✓ success"), "{log}");
+    // Without --print the replay is the workbench, which needs a terminal.
+    let out = betr(&dir, &["replay", &record_s]);
+    assert_ne!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(text(&out).contains("--print"), "{}", text(&out));
 
     let rrd = dir.join("session.rrd");
     let rrd_s = rrd.to_string_lossy().to_string();
@@ -169,7 +174,7 @@ fn a_recording_cut_mid_entry_replays_up_to_its_last_whole_entry() {
     drop(f);
     let replay = Replay::load(&record, None).unwrap();
     assert!(replay.cut_at.is_some());
-    let out = betr(&dir, &["replay", &record_s]);
+    let out = betr(&dir, &["replay", &record_s, "--print"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     assert!(text(&out).contains("partial entry"), "{}", text(&out));
     assert!(text(&out).contains("failed: No collision free path found"));
@@ -180,7 +185,7 @@ fn a_recording_cut_mid_entry_replays_up_to_its_last_whole_entry() {
     broken.extend_from_slice(b"{oops\n");
     broken.extend_from_slice(&whole[first_newline + 1..]);
     std::fs::write(&record, broken).unwrap();
-    let out = betr(&dir, &["replay", &record_s]);
+    let out = betr(&dir, &["replay", &record_s, "--print"]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(text(&out).contains("line 2"), "{}", text(&out));
     std::fs::remove_dir_all(&dir).unwrap();
@@ -242,7 +247,7 @@ fn a_session_killed_midway_leaves_a_recording_that_replays() {
             .any(|(_, s)| matches!(s, Step::Event(Event::ActionFailed { .. }))),
         "the failure before the kill is in the recording"
     );
-    let out = betr(&dir, &["replay", &record_s]);
+    let out = betr(&dir, &["replay", &record_s, "--print"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     assert!(text(&out).contains("asking the model"), "{}", text(&out));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -17,7 +17,7 @@ use ratatui::backend::TestBackend;
 use betr::scenario::Scenario;
 use betr::session::{Command, Engine, EngineHandle, Event, Setup};
 use betr::tui::dictation::{DictationEvent, DictationService, Microphone, SttLoader};
-use betr::tui::{App, Info, KeyBindings, Request, Theme, ui};
+use betr::tui::{App, Info, KeyBindings, KeyMode, Request, Theme, ui};
 use betr::voice::{Audio16k, SpeechToText, SttFuture, Transcript};
 use support::fake_model::FixtureModel;
 use support::fixtures;
@@ -118,6 +118,7 @@ impl Bench {
                     assert!(self.engine.send(c));
                 }
                 Request::Dictation(r) => self.dictation.handle(r),
+                Request::Replay(m) => panic!("a move in the live workbench: {m:?}"),
             }
         }
     }
@@ -406,7 +407,7 @@ fn help_overlay_lists_every_binding() {
         let mut b = Bench::start();
         b.key(KeyCode::Char('?'));
         let screen = b.screen(120, 40);
-        for (key, what) in KeyBindings::default().help_lines() {
+        for (key, what) in KeyBindings::default().help_lines(KeyMode::Workbench) {
             assert!(screen.contains(&key), "{key} missing:\n{screen}");
             assert!(screen.contains(what), "{what} missing:\n{screen}");
         }

@@ -75,8 +75,9 @@ pub enum Command {
         #[command(flatten)]
         knowledge: knowledge_cmd::KnowledgeFlags,
     },
-    /// Tell a recorded session (--record FILE) again step by step, without the model, or
-    /// convert it into a rerun recording (--to-rrd).
+    /// Open a recorded session (--record FILE) in the workbench, read-only, to step through
+    /// forward and back without the model; print it as text (--print), or convert it into a
+    /// rerun recording (--to-rrd).
     Replay(replay_cmd::ReplayArgs),
     /// Reproduce the paper's experiments.
     Eval {
@@ -177,7 +178,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             knowledge,
         } => tree_cmds::plan(&load_with(&scenario, &knowledge)?, goal.as_deref(), glyphs),
         Command::Run(args) => tree_cmds::run_command(&args, glyphs),
-        Command::Replay(args) => replay_cmd::replay(&args),
+        Command::Replay(args) => replay_cmd::replay(&args, cli.ascii),
         Command::Repair(args) => tree_cmds::repair_command(&args, glyphs),
         Command::Verify(args) => verify_cmd::command(&args, cli.ascii),
     }

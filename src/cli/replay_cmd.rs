@@ -1,5 +1,7 @@
-//! `betr replay FILE`: a recorded session told again, step by step, without the model;
-//! `--to-rrd OUT` converts it into a rerun recording with its tick timeline.
+//! `betr replay FILE`: a recorded session opened in the workbench, read-only, to step
+//! through forward and back without an engine or a model; `--print` tells it as text, one
+//! line per step; `--to-rrd OUT` converts it into a rerun recording with its tick
+//! timeline.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -8,6 +10,8 @@ use anyhow::{Context as _, Result};
 
 use betr::record::{Replay, Resimulation, Step};
 use betr::session::Event;
+use betr::tui::replay::{Player, ReplayScreen};
+use betr::tui::{KeyBindings, Theme};
 use betr::viz::{Sinks, Viz};
 
 /// What `betr replay` is asked.
@@ -20,25 +24,76 @@ pub struct ReplayArgs {
     pub scenario: Option<PathBuf>,
     /// Write it as a rerun recording (.rrd): the tree, every tick on the `tick` timeline,
     /// the cell re-simulated after each tick, and the session's log.
-    #[arg(long, value_name = "OUT")]
+    #[arg(long, value_name = "OUT", conflicts_with = "print")]
     pub to_rrd: Option<PathBuf>,
+    /// Print the steps as text (one line per step, a run of ticks on one line) instead of
+    /// opening the workbench.
+    #[arg(long)]
+    pub print: bool,
+    /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml, as `betr tui`).
+    #[arg(long, value_name = "FILE")]
+    pub keys: Option<PathBuf>,
 }
 
-pub fn replay(args: &ReplayArgs) -> Result<ExitCode> {
+pub fn replay(args: &ReplayArgs, ascii: bool) -> Result<ExitCode> {
     let replay = Replay::load(&args.file, args.scenario.as_deref())?;
+    if let Some(out) = &args.to_rrd {
+        cut_note(&args.file, &replay);
+        return to_rrd(&replay, out);
+    }
+    if args.print {
+        cut_note(&args.file, &replay);
+        print_steps(&replay);
+        return Ok(ExitCode::SUCCESS);
+    }
+    workbench(replay, args, ascii)
+}
+
+/// Said when the recording's last entry was cut (the session did not end cleanly).
+fn cut_note(file: &Path, replay: &Replay) {
     if let Some(line) = replay.cut_at {
         eprintln!(
-            "note: {}: the recording ends in a partial entry at line {line} (the session did not end cleanly); replayed up to it",
+            "note: {}: {}",
+            file.display(),
+            betr::tui::strings::replay_cut(line)
+        );
+    }
+}
+
+/// The workbench on the recording, read-only, at its end.
+fn workbench(replay: Replay, args: &ReplayArgs, ascii: bool) -> Result<ExitCode> {
+    use std::io::IsTerminal as _;
+    if !std::io::stdout().is_terminal() {
+        anyhow::bail!(
+            "{}: standard output is not a terminal, and the replay opens the workbench; --print prints the steps as text",
             args.file.display()
         );
     }
-    match &args.to_rrd {
-        Some(out) => to_rrd(&replay, out),
-        None => {
-            print_steps(&replay);
-            Ok(ExitCode::SUCCESS)
-        }
+    let var = |k: &str| std::env::var(k).ok();
+    let keys_path = args
+        .keys
+        .clone()
+        .or_else(|| super::tui_cmd::default_keys_path(&var));
+    let (keys, keys_error) = match &keys_path {
+        Some(p) => KeyBindings::load(p),
+        None => (KeyBindings::default(), None),
+    };
+    let theme = Theme::new(if ascii {
+        &betr::bt::ASCII
+    } else {
+        &betr::bt::UNICODE
+    });
+    let cut = replay.cut_at;
+    let player = Player::of(replay, keys, theme);
+    let mut screen = ReplayScreen::open(player, usize::MAX);
+    // Said on the screen, where the person looks (standard error is under it).
+    if let Some(e) = keys_error {
+        screen.say(betr::tui::strings::keys_file_error(&e), true);
+    } else if let Some(line) = cut {
+        screen.say(betr::tui::strings::replay_cut(line), true);
     }
+    betr::tui::replay::run(screen, super::tui_cmd::log_path().as_deref())?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
@@ -111,7 +166,7 @@ fn print_steps(replay: &Replay) {
             };
             continue;
         }
-        if let Some(line) = describe(step) {
+        if let Some(line) = betr::record::describe(step) {
             flush(&mut ticks);
             println!("{}  {line}", time(*ms));
         }
@@ -126,57 +181,4 @@ fn time(ms: u64) -> String {
         (ms / 1000) % 60,
         ms % 1000
     )
-}
-
-/// A step in one line (none for what only a live screen shows).
-fn describe(step: &Step) -> Option<String> {
-    let event = match step {
-        Step::Command(text) => return Some(format!("> {text}")),
-        Step::Event(event) => event,
-    };
-    Some(match event {
-        Event::TreeChanged { tree, why, .. } => format!("tree ({} nodes): {why}", tree.len()),
-        Event::Goal { goal, .. } => format!("goal: {goal}"),
-        Event::Asking { what } => format!("asking the model for {what}"),
-        Event::Replied {
-            attribution, text, ..
-        } => format!(
-            "reply from {attribution}: {}",
-            betr::excerpt::excerpt(text.trim(), None)
-        ),
-        Event::InvalidReply { error } => format!("unusable reply: {error}"),
-        Event::CandidateRejected {
-            candidate, reason, ..
-        } => format!("set aside {candidate}: {reason}"),
-        Event::ActionFailed {
-            action,
-            node_path,
-            error,
-            ..
-        } => format!("✗ {action}! (node {node_path}) failed: {error}"),
-        Event::Proposal {
-            proposal, author, ..
-        } => format!("proposal by {author}: {proposal}"),
-        Event::Approved => "approved".into(),
-        Event::Rejected => "rejected".into(),
-        Event::Repaired {
-            added_nodes,
-            valued_nodes,
-        } => format!("repaired: {added_nodes} node(s) added, a value set on {valued_nodes}"),
-        Event::DidNotHelp { reason } => format!("did not help: {reason}"),
-        Event::Success { ticks } => format!("✓ success after {ticks} tick(s)"),
-        Event::GaveUp { reason } => format!("gave up: {reason}"),
-        Event::BreakpointHit {
-            node_path, tick, ..
-        } => format!("stopped at the breakpoint on node {node_path} (tick {tick})"),
-        Event::PolicySaved { path, fixes } => {
-            format!("policy saved to {} ({fixes} fix(es))", path.display())
-        }
-        Event::PolicyLoaded { path, fixes } => {
-            format!("policy loaded from {} ({fixes} fix(es))", path.display())
-        }
-        Event::Error { message } => format!("error: {message}"),
-        Event::Notice { message } => message.clone(),
-        _ => return None,
-    })
 }

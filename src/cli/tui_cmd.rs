@@ -192,7 +192,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn default_keys_path(var: &dyn Fn(&str) -> Option<String>) -> Option<PathBuf> {
+/// Where the key bindings file is looked for when none is given.
+pub fn default_keys_path(var: &dyn Fn(&str) -> Option<String>) -> Option<PathBuf> {
     let config = var("XDG_CONFIG_HOME")
         .filter(|d| !d.is_empty())
         .map(PathBuf::from)

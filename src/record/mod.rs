@@ -11,6 +11,7 @@
 //! docs/RECORDING.md.
 
 pub mod convert;
+pub mod describe;
 pub mod file;
 pub mod replay;
 pub mod session;
@@ -22,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::llm::usage::UsageTotals;
 
 pub use convert::{Decoder, Encoder};
+pub use describe::{brief, describe};
 pub use file::{Recorder, Recording, read};
 pub use replay::{Replay, ReplayError, Resimulation, Step};
 pub use session::SessionRecorder;

@@ -1,7 +1,8 @@
 //! The one state of the workbench. Keys become commands for the session (queued, sent
 //! by the event loop); session events update the components. Drawing reads this state
 //! (`ui::draw`); nothing here talks to a terminal. What session events do is in
-//! `session`.
+//! `session`. In a replay (`KeyMode::Replay`) the same state is built from a recording's
+//! events, and keys become moves in the recording instead of commands.
 
 mod session;
 
@@ -20,7 +21,8 @@ use super::components::status_bar::{Message, StatusBar};
 use super::components::tree_pane::TreePane;
 use super::components::world_pane::WorldPane;
 use super::dictation::{DictationEvent, DictationRequest};
-use super::keys::{Action, KeyBindings};
+use super::keys::{Action, KeyBindings, KeyMode};
+use super::replay::Move;
 use super::strings;
 use super::theme::Theme;
 
@@ -45,14 +47,17 @@ pub struct Info {
 pub enum AppEvent {
     Command(Command),
     Dictation(DictationRequest),
+    Replay(Move),
     Quit,
 }
 
-/// A request the event loop passes on: to the session engine or to push-to-talk.
+/// A request the event loop passes on: to the session engine or to push-to-talk; in a
+/// replay, a move in the recording.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Request {
     Session(Command),
     Dictation(DictationRequest),
+    Replay(Move),
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -73,6 +78,8 @@ pub struct App {
     pub status: StatusBar,
     pub dictation: DictationPanel,
     pub overlay: Option<Overlay>,
+    /// The live workbench, or a replay (whose keys move in the recording).
+    pub mode: KeyMode,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
     quit: bool,
@@ -107,9 +114,49 @@ impl App {
             },
             dictation: DictationPanel::default(),
             overlay: None,
+            mode: KeyMode::Workbench,
             queue: Vec::new(),
             quit: false,
         }
+    }
+
+    /// The app of a replay: nothing it does reaches an engine; the input line lists the
+    /// replay's keys.
+    pub fn replaying(scenario: Arc<Scenario>, info: Info, keys: KeyBindings, theme: Theme) -> App {
+        let mut app = App::new(scenario, info, keys, theme);
+        app.mode = KeyMode::Replay;
+        let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+        let pair = |a: Action, b: Action| format!("{} {}", key(a), key(b));
+        let hint = strings::replay_hint(&[
+            ("step", pair(Action::EventForward, Action::EventBack)),
+            ("tick", pair(Action::TickForward, Action::TickBack)),
+            (
+                "failure",
+                pair(Action::NextFailure, Action::PreviousFailure),
+            ),
+            (
+                "model call",
+                pair(Action::NextModelCall, Action::PreviousModelCall),
+            ),
+            ("start/end", pair(Action::Start, Action::End)),
+            ("help", key(Action::Help)),
+            ("quit", key(Action::Quit)),
+        ]);
+        app.input.set_idle(strings::REPLAY_INPUT_TITLE, hint);
+        app.tree.empty_text = Some(strings::REPLAY_TREE_EMPTY);
+        app
+    }
+
+    /// A command of the replayed session, in the log as the person gave it.
+    pub fn on_replayed_command(&mut self, text: &str) {
+        self.llm.log(strings::replayed_command(text));
+    }
+
+    /// Keep what the person did to the view of `previous` (the tree's folds, selection
+    /// and scroll, the log's scroll) in this app of the same replay at another position.
+    pub fn adopt_view(&mut self, previous: &mut App) {
+        self.tree.adopt_view(&mut previous.tree);
+        self.llm.adopt_scroll(&previous.llm);
     }
 
     pub fn should_quit(&self) -> bool {
@@ -124,6 +171,7 @@ impl App {
             match e {
                 AppEvent::Command(c) => out.push(Request::Session(c)),
                 AppEvent::Dictation(r) => out.push(Request::Dictation(r)),
+                AppEvent::Replay(m) => out.push(Request::Replay(m)),
                 AppEvent::Quit => self.quit = true,
             }
         }
@@ -179,7 +227,7 @@ impl App {
         if self.overlay.take().is_some() {
             return;
         }
-        match self.keys.action(&key) {
+        match self.keys.action_in(self.mode, &key) {
             Some(action) => self.on_action(action),
             None => {
                 self.tree.event(&key);
@@ -250,6 +298,22 @@ impl App {
             Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
                 self.queue.push(AppEvent::Quit);
+                return;
+            }
+            // Bound in a replay only: moves in the recording.
+            Action::EventForward
+            | Action::EventBack
+            | Action::TickForward
+            | Action::TickBack
+            | Action::NextFailure
+            | Action::PreviousFailure
+            | Action::NextModelCall
+            | Action::PreviousModelCall
+            | Action::Start
+            | Action::End => {
+                if let Some(m) = Move::of(action) {
+                    self.queue.push(AppEvent::Replay(m));
+                }
                 return;
             }
         };

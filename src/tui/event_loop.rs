@@ -236,6 +236,8 @@ fn dispatch(app: &mut App, event: QueueEvent, out: &mut Outlets, animated: &mut 
                 out.engine.send(command);
             }
             Request::Dictation(request) => out.dictation.handle(request),
+            // Asked only in a replay, which has no event loop of this kind.
+            Request::Replay(_) => {}
         }
     }
     if app.should_quit() {

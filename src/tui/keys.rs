@@ -2,6 +2,10 @@
 //! is generated from the same struct, so it cannot drift; a TOML file of overrides
 //! (`step = "t"`, `quit = "ctrl-q"`) is applied as a patch, and a bad file is reported
 //! while the defaults stay.
+//!
+//! Each action belongs to the live workbench, to the replay of a recording, or to both
+//! (help, quit, the log's scrolling): a replay has no engine, so editing, approval and run
+//! keys are not bound there, and the two sets may reuse each other's keys.
 
 use std::fmt;
 use std::path::Path;
@@ -37,6 +41,54 @@ pub enum Action {
     LogDown,
     Help,
     Quit,
+    /// Replay: one step (an event or a command) forward.
+    EventForward,
+    EventBack,
+    /// Replay: to the next tick.
+    TickForward,
+    TickBack,
+    /// Replay: to the next failed action.
+    NextFailure,
+    PreviousFailure,
+    /// Replay: to the next question to the model or its reply.
+    NextModelCall,
+    PreviousModelCall,
+    /// Replay: the start and the end of the recording.
+    Start,
+    End,
+}
+
+/// Which screen keys are read for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum KeyMode {
+    /// The live workbench over a session engine.
+    #[default]
+    Workbench,
+    /// A recording replayed, read-only.
+    Replay,
+}
+
+/// Where an action is bound.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Scope {
+    Both,
+    Workbench,
+    Replay,
+}
+
+impl Scope {
+    fn holds(self, mode: KeyMode) -> bool {
+        match self {
+            Scope::Both => true,
+            Scope::Workbench => mode == KeyMode::Workbench,
+            Scope::Replay => mode == KeyMode::Replay,
+        }
+    }
+
+    /// Whether two actions of these scopes can be pressed on one screen.
+    fn meets(self, other: Scope) -> bool {
+        self == Scope::Both || other == Scope::Both || self == other
+    }
 }
 
 /// Why a key's name was not understood; each names the text as written.
@@ -45,7 +97,7 @@ pub enum KeyError {
     #[error("unknown key {text:?} (function keys are f1-f12)")]
     FunctionKey { text: String },
     #[error(
-        "unknown key {text:?} (expected one character, space, enter, esc, tab, backspace or f1-f12, optionally with ctrl- or alt-)"
+        "unknown key {text:?} (expected one character, space, enter, esc, tab, backspace, left, right, up, down or f1-f12, optionally with ctrl- or alt-)"
     )]
     Unknown { text: String },
 }
@@ -61,7 +113,7 @@ pub enum KeysFileError {
         action: &'static str,
         error: KeyError,
     },
-    #[error("{key} is bound to both {first:?} and {second:?}")]
+    #[error("{key} is bound to both {first:?} and {second:?} on one screen")]
     Shared {
         key: Key,
         first: Action,
@@ -78,8 +130,13 @@ pub struct Key {
 
 impl Key {
     pub const fn plain(c: char) -> Key {
+        Key::code(KeyCode::Char(c))
+    }
+
+    /// A key without modifiers.
+    pub const fn code(code: KeyCode) -> Key {
         Key {
-            code: KeyCode::Char(c),
+            code,
             modifiers: KeyModifiers::NONE,
         }
     }
@@ -97,8 +154,9 @@ impl Key {
         event.code == self.code && mods == want
     }
 
-    /// `space`, `enter`, `esc`, `tab`, `backspace`, `f1`…`f12`, one character, each
-    /// optionally prefixed by `ctrl-` or `alt-`.
+    /// `space`, `enter`, `esc`, `tab`, `backspace`, `left`, `right`, `up`, `down` (or
+    /// `←` `→` `↑` `↓`), `f1`…`f12`, one character, each optionally prefixed by `ctrl-` or
+    /// `alt-`.
     pub fn parse(text: &str) -> Result<Key, KeyError> {
         let mut modifiers = KeyModifiers::NONE;
         let mut rest = text.trim();
@@ -120,6 +178,10 @@ impl Key {
             "esc" => KeyCode::Esc,
             "tab" => KeyCode::Tab,
             "backspace" => KeyCode::Backspace,
+            "left" | "←" => KeyCode::Left,
+            "right" | "→" => KeyCode::Right,
+            "up" | "↑" => KeyCode::Up,
+            "down" | "↓" => KeyCode::Down,
             f if f.len() > 1 && f.starts_with('f') => match f[1..].parse::<u8>() {
                 Ok(n @ 1..=12) => KeyCode::F(n),
                 _ => {
@@ -159,6 +221,10 @@ impl fmt::Display for Key {
             KeyCode::Esc => f.write_str("esc"),
             KeyCode::Tab => f.write_str("tab"),
             KeyCode::Backspace => f.write_str("backspace"),
+            KeyCode::Left => f.write_str("←"),
+            KeyCode::Right => f.write_str("→"),
+            KeyCode::Up => f.write_str("↑"),
+            KeyCode::Down => f.write_str("↓"),
             KeyCode::F(n) => write!(f, "f{n}"),
             other => write!(f, "{other:?}"),
         }
@@ -166,7 +232,7 @@ impl fmt::Display for Key {
 }
 
 macro_rules! bindings {
-    ($( $field:ident : $action:ident = $default:expr ),* $(,)?) => {
+    ($( $field:ident : $action:ident = $default:expr, $scope:ident );* $(;)?) => {
         /// The key of every action.
         #[derive(Debug, Clone, PartialEq, Eq)]
         pub struct KeyBindings {
@@ -189,7 +255,11 @@ macro_rules! bindings {
         impl KeyBindings {
             /// Every action with its key, in help order.
             pub fn entries(&self) -> Vec<(Action, Key)> {
-                vec![ $( (Action::$action, self.$field), )* ]
+                self.scoped().into_iter().map(|(a, k, _)| (a, k)).collect()
+            }
+
+            fn scoped(&self) -> Vec<(Action, Key, Scope)> {
+                vec![ $( (Action::$action, self.$field, Scope::$scope), )* ]
             }
 
             fn apply(&mut self, patch: Patch) -> Result<(), KeysFileError> {
@@ -206,40 +276,64 @@ macro_rules! bindings {
 }
 
 bindings! {
-    step: Step = Key::plain(' '),
-    run: Run = Key::plain('r'),
-    plan: Plan = Key::plain('p'),
-    instruction: Instruction = Key::plain('i'),
-    dictate: Dictate = Key::plain('d'),
-    approve: Approve = Key::plain('a'),
-    reject: Reject = Key::plain('x'),
-    edit: Edit = Key::plain('e'),
-    undo: Undo = Key::plain('u'),
-    verify: Verify = Key::plain('v'),
-    save: Save = Key::plain('s'),
-    load: Load = Key::plain('l'),
-    export: Export = Key::plain('o'),
-    keep_rule: KeepRule = Key::plain('m'),
-    keep_rule_only: KeepRuleOnly = Key::plain('M'),
-    decline_rule: DeclineRule = Key::plain('n'),
-    knowledge: Knowledge = Key::plain('g'),
-    reset: Reset = Key::plain('w'),
-    breakpoint: Breakpoint = Key::plain('b'),
-    force: Force = Key::plain('f'),
-    break_on_failure: BreakOnFailure = Key::plain('B'),
-    log_up: LogUp = Key::plain('['),
-    log_down: LogDown = Key::plain(']'),
-    help: Help = Key::plain('?'),
-    quit: Quit = Key::plain('q'),
+    step: Step = Key::plain(' '), Workbench;
+    run: Run = Key::plain('r'), Workbench;
+    plan: Plan = Key::plain('p'), Workbench;
+    instruction: Instruction = Key::plain('i'), Workbench;
+    dictate: Dictate = Key::plain('d'), Workbench;
+    approve: Approve = Key::plain('a'), Workbench;
+    reject: Reject = Key::plain('x'), Workbench;
+    edit: Edit = Key::plain('e'), Workbench;
+    undo: Undo = Key::plain('u'), Workbench;
+    verify: Verify = Key::plain('v'), Workbench;
+    save: Save = Key::plain('s'), Workbench;
+    load: Load = Key::plain('l'), Workbench;
+    export: Export = Key::plain('o'), Workbench;
+    keep_rule: KeepRule = Key::plain('m'), Workbench;
+    keep_rule_only: KeepRuleOnly = Key::plain('M'), Workbench;
+    decline_rule: DeclineRule = Key::plain('n'), Workbench;
+    knowledge: Knowledge = Key::plain('g'), Workbench;
+    reset: Reset = Key::plain('w'), Workbench;
+    breakpoint: Breakpoint = Key::plain('b'), Workbench;
+    force: Force = Key::plain('f'), Workbench;
+    break_on_failure: BreakOnFailure = Key::plain('B'), Workbench;
+    event_forward: EventForward = Key::code(KeyCode::Right), Replay;
+    event_back: EventBack = Key::code(KeyCode::Left), Replay;
+    tick_forward: TickForward = Key::plain('.'), Replay;
+    tick_back: TickBack = Key::plain(','), Replay;
+    next_failure: NextFailure = Key::plain('n'), Replay;
+    previous_failure: PreviousFailure = Key::plain('N'), Replay;
+    next_model_call: NextModelCall = Key::plain('m'), Replay;
+    previous_model_call: PreviousModelCall = Key::plain('M'), Replay;
+    start: Start = Key::plain('g'), Replay;
+    end: End = Key::plain('G'), Replay;
+    log_up: LogUp = Key::plain('['), Both;
+    log_down: LogDown = Key::plain(']'), Both;
+    help: Help = Key::plain('?'), Both;
+    quit: Quit = Key::plain('q'), Both;
 }
 
 impl KeyBindings {
-    /// The action bound to `event`, if any.
+    /// The live workbench's action bound to `event`, if any.
     pub fn action(&self, event: &KeyEvent) -> Option<Action> {
-        self.entries()
+        self.action_in(KeyMode::Workbench, event)
+    }
+
+    /// The action bound to `event` on the `mode` screen, if any.
+    pub fn action_in(&self, mode: KeyMode, event: &KeyEvent) -> Option<Action> {
+        self.entries_in(mode)
             .into_iter()
             .find(|(_, k)| k.matches(event))
             .map(|(a, _)| a)
+    }
+
+    /// The actions of the `mode` screen with their keys, in help order.
+    pub fn entries_in(&self, mode: KeyMode) -> Vec<(Action, Key)> {
+        self.scoped()
+            .into_iter()
+            .filter(|(_, _, scope)| scope.holds(mode))
+            .map(|(a, k, _)| (a, k))
+            .collect()
     }
 
     /// The key of `action`.
@@ -250,14 +344,17 @@ impl KeyBindings {
             .map(|(_, k)| k)
     }
 
-    /// The defaults patched by a TOML text; two actions may not share a key.
+    /// The defaults patched by a TOML text; two actions of one screen may not share a key.
     pub fn from_toml(text: &str) -> Result<KeyBindings, KeysFileError> {
         let patch: Patch = toml::from_str(text)?;
         let mut keys = KeyBindings::default();
         keys.apply(patch)?;
-        let entries = keys.entries();
-        for (i, (a, k)) in entries.iter().enumerate() {
-            if let Some((b, _)) = entries[..i].iter().find(|(_, other)| other == k) {
+        let entries = keys.scoped();
+        for (i, (a, k, scope)) in entries.iter().enumerate() {
+            if let Some((b, _, _)) = entries[..i]
+                .iter()
+                .find(|(_, other, theirs)| other == k && scope.meets(*theirs))
+            {
                 return Err(KeysFileError::Shared {
                     key: *k,
                     first: *b,
@@ -287,18 +384,19 @@ impl KeyBindings {
         }
     }
 
-    /// The help overlay's lines: every binding, then the fixed navigation keys.
-    pub fn help_lines(&self) -> Vec<(String, &'static str)> {
+    /// The help overlay's lines on the `mode` screen: every binding, then the fixed
+    /// navigation keys.
+    pub fn help_lines(&self, mode: KeyMode) -> Vec<(String, &'static str)> {
         let mut lines: Vec<(String, &'static str)> = self
-            .entries()
+            .entries_in(mode)
             .into_iter()
             .map(|(a, k)| (k.to_string(), super::strings::action_help(a)))
             .collect();
-        lines.extend(
-            super::strings::NAVIGATION
-                .iter()
-                .map(|(k, what)| ((*k).to_string(), *what)),
-        );
+        let navigation = match mode {
+            KeyMode::Workbench => super::strings::NAVIGATION,
+            KeyMode::Replay => super::strings::REPLAY_NAVIGATION,
+        };
+        lines.extend(navigation.iter().map(|(k, what)| ((*k).to_string(), *what)));
         lines
     }
 }
@@ -314,7 +412,11 @@ mod tests {
     #[test]
     fn defaults_are_the_documented_keys() {
         let k = KeyBindings::default();
-        let text: Vec<String> = k.entries().iter().map(|(_, k)| k.to_string()).collect();
+        let text: Vec<String> = k
+            .entries_in(KeyMode::Workbench)
+            .iter()
+            .map(|(_, k)| k.to_string())
+            .collect();
         assert_eq!(
             text,
             [
@@ -357,10 +459,64 @@ mod tests {
         );
         let e = KeyBindings::from_toml("step = \"f13\"").unwrap_err();
         assert!(e.to_string().contains("f1-f12"), "{e}");
-        let help = KeyBindings::default().help_lines();
+        let help = KeyBindings::default().help_lines(KeyMode::Workbench);
         assert!(
             help.iter()
                 .any(|(k, what)| k == "space" && what.contains("tick"))
         );
+    }
+
+    #[test]
+    fn the_replay_has_its_own_keys_and_none_that_edit_or_run() {
+        let k = KeyBindings::default();
+        let text: Vec<String> = k
+            .entries_in(KeyMode::Replay)
+            .iter()
+            .map(|(_, k)| k.to_string())
+            .collect();
+        assert_eq!(
+            text,
+            [
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "[", "]", "?", "q"
+            ]
+        );
+        let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);
+        assert_eq!(
+            k.action_in(KeyMode::Replay, &right),
+            Some(Action::EventForward)
+        );
+        // The tree's expand key in the workbench.
+        assert_eq!(k.action_in(KeyMode::Workbench, &right), None);
+        assert_eq!(
+            k.action_in(KeyMode::Replay, &press('N', KeyModifiers::SHIFT)),
+            Some(Action::PreviousFailure)
+        );
+        assert_eq!(
+            k.action(&press('n', KeyModifiers::NONE)),
+            Some(Action::DeclineRule)
+        );
+        for live in ['a', 'x', 'e', 'r', ' ', 'u', 'i', 'd', 'p'] {
+            assert_eq!(
+                k.action_in(KeyMode::Replay, &press(live, KeyModifiers::NONE)),
+                None,
+                "{live:?} does something in a replay"
+            );
+        }
+        // One key for a replay action and a workbench action is fine; not with a shared one.
+        let k = KeyBindings::from_toml("tick_forward = \"a\"\nevent_forward = \"right\"").unwrap();
+        assert_eq!(k.tick_forward, Key::plain('a'));
+        assert!(matches!(
+            KeyBindings::from_toml("end = \"q\""),
+            Err(KeysFileError::Shared {
+                first: Action::End,
+                second: Action::Quit,
+                ..
+            })
+        ));
+        assert_eq!(Key::parse("←").unwrap(), Key::code(KeyCode::Left));
+        let help = k.help_lines(KeyMode::Replay);
+        assert!(help.iter().all(|(key, _)| key != "space"), "{help:?}");
+        // The arrows move in the recording; Enter folds the tree.
+        assert!(!help.iter().any(|(key, _)| key == "← →"), "{help:?}");
     }
 }

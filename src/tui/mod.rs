@@ -6,7 +6,8 @@
 //! text (`strings`). The session knows nothing of this module. Push-to-talk runs beside the
 //! session: `dictation` owns the microphone and the speech-to-text model. Everything the
 //! app reacts to (keys, session events, dictation events, animation ticks) arrives on the
-//! event loop's one queue (`event_loop`).
+//! event loop's one queue (`event_loop`). A recording is replayed read-only on the same
+//! app and drawing, with no engine (`replay`).
 //!
 //! The terminal is restored on every exit path: a guard's `Drop` on normal returns and
 //! errors, and a panic hook (installed before raw mode is entered) on panics.
@@ -16,6 +17,7 @@ pub mod components;
 pub mod dictation;
 pub mod event_loop;
 pub mod keys;
+pub mod replay;
 pub mod stderr;
 pub mod strings;
 pub mod theme;
@@ -41,7 +43,7 @@ use crate::session::{Engine, SessionError, Setup};
 use dictation::{DictationService, Microphone, SttLoader};
 
 pub use app::{App, Info, Request};
-pub use keys::KeyBindings;
+pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
 #[derive(Debug, thiserror::Error)]

@@ -83,6 +83,15 @@ pub const NAVIGATION: &[(&str, &str)] = &[
     ("Ctrl-C", "quit"),
 ];
 
+/// The navigation keys of a replay: the arrows move in the recording, so a node is
+/// collapsed and expanded with Enter.
+pub const REPLAY_NAVIGATION: &[(&str, &str)] = &[
+    ("↑ ↓ / k j", "move in the tree"),
+    ("Enter", "collapse / expand a node"),
+    ("PgUp PgDn Home End", "scroll the tree"),
+    ("Ctrl-C", "quit"),
+];
+
 /// What a key-bound action does, for the help overlay.
 pub fn action_help(action: super::keys::Action) -> &'static str {
     use super::keys::Action::*;
@@ -112,6 +121,16 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",
         Quit => "quit",
+        EventForward => "one step forward (an event or a command)",
+        EventBack => "one step back",
+        TickForward => "forward to the next tick",
+        TickBack => "back to the previous tick",
+        NextFailure => "forward to the next failed action",
+        PreviousFailure => "back to the previous failed action",
+        NextModelCall => "forward to the next model call (question or reply)",
+        PreviousModelCall => "back to the previous model call",
+        Start => "the start of the recording",
+        End => "the end of the recording",
     }
 }
 
@@ -296,4 +315,47 @@ pub fn breakpoint_list(nodes: &[String]) -> String {
     } else {
         format!("breakpoints: {}", nodes.join(", "))
     }
+}
+
+pub const REPLAY: &str = "REPLAY";
+pub const REPLAY_INPUT_TITLE: &str = " Replay (read-only) ";
+pub const REPLAY_TREE_EMPTY: &str = "No tree yet at this point of the recording.";
+pub const REPLAY_AT_START: &str = "the start of the recording";
+/// Under a proposal in a replay: the answer is further on in the recording.
+pub const REPLAY_PROPOSAL_HINT: &str = "recorded: step on to see how it was answered";
+
+/// Where a replay stands: `REPLAY  step 123/4567  tick 42  0:12.345`.
+pub fn replay_position(step: usize, steps: usize, tick: u64, ms: u64) -> String {
+    format!(
+        "{REPLAY}  step {step}/{steps}  tick {tick}  {}",
+        replay_time(ms)
+    )
+}
+
+/// Milliseconds since the session started as `m:ss.mmm`.
+pub fn replay_time(ms: u64) -> String {
+    format!("{}:{:02}.{:03}", ms / 60_000, (ms / 1000) % 60, ms % 1000)
+}
+
+/// The input line of a replay: its keys.
+pub fn replay_hint(keys: &[(&str, String)]) -> String {
+    let each: Vec<String> = keys.iter().map(|(what, k)| format!("{k} {what}")).collect();
+    each.join(" · ")
+}
+
+/// A command of the recorded session in the log, as the person gave it.
+pub fn replayed_command(text: &str) -> String {
+    format!("> {text}")
+}
+
+/// A move in a replay that finds nothing to go to.
+pub fn replay_nothing(what: &str) -> String {
+    format!("no {what}")
+}
+
+/// A recording whose last entry was cut (the session did not end cleanly).
+pub fn replay_cut(line: usize) -> String {
+    format!(
+        "the recording ends in a partial entry at line {line} (the session did not end cleanly); replayed up to it"
+    )
 }

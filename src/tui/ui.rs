@@ -7,7 +7,8 @@ use ratatui::layout::{Constraint, Layout};
 
 use super::app::{App, Overlay};
 use super::components::help::{draw_help, draw_report};
-use super::keys::Action;
+use super::keys::{Action, KeyMode};
+use super::strings;
 
 pub fn draw(frame: &mut Frame, app: &mut App) {
     let area = frame.area();
@@ -35,12 +36,15 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     };
     let theme = app.theme;
     let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
-    let hint = format!(
-        "{} approve · {} reject · {} edit",
-        key(Action::Approve),
-        key(Action::Reject),
-        key(Action::Edit)
-    );
+    let hint = match app.mode {
+        KeyMode::Workbench => format!(
+            "{} approve · {} reject · {} edit",
+            key(Action::Approve),
+            key(Action::Reject),
+            key(Action::Edit)
+        ),
+        KeyMode::Replay => strings::REPLAY_PROPOSAL_HINT.to_string(),
+    };
     let help_key = key(Action::Help);
     app.tree.draw(frame, tree_area, &theme);
     app.llm.draw(frame, llm_area, &theme, &hint);
@@ -53,7 +57,7 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     }
     app.status.draw(frame, status, &theme, &help_key);
     match &app.overlay {
-        Some(Overlay::Help) => draw_help(frame, area, &app.keys, &theme),
+        Some(Overlay::Help) => draw_help(frame, area, &app.keys, app.mode, &theme),
         Some(Overlay::Report(lines)) => draw_report(frame, area, lines, &theme),
         None => {}
     }

@@ -7,7 +7,7 @@ use ratatui::widgets::{Block, Borders, Clear, Paragraph, Wrap};
 
 use crate::verify::{Report, Verdict};
 
-use super::super::keys::KeyBindings;
+use super::super::keys::{KeyBindings, KeyMode};
 use super::super::strings;
 use super::super::theme::Theme;
 
@@ -22,8 +22,8 @@ fn centered(area: Rect, width: u16, height: u16) -> Rect {
     h
 }
 
-pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, theme: &Theme) {
-    let entries = keys.help_lines();
+pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, mode: KeyMode, theme: &Theme) {
+    let entries = keys.help_lines(mode);
     let key_width = entries
         .iter()
         .map(|(k, _)| k.chars().count())

@@ -29,9 +29,16 @@ pub struct InputLine {
     text: String,
     /// Cursor position in characters.
     cursor: usize,
+    /// The title and text while closed, when not the workbench's (a replay's keys).
+    idle: Option<(&'static str, String)>,
 }
 
 impl InputLine {
+    /// What the line says while closed.
+    pub fn set_idle(&mut self, title: &'static str, hint: String) {
+        self.idle = Some((title, hint));
+    }
+
     pub fn open(&mut self, mode: Mode, text: &str) {
         self.mode = Some(mode);
         self.text = text.to_string();
@@ -118,10 +125,13 @@ impl InputLine {
 
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
         let (title, line) = match self.mode {
-            None => (
-                strings::INPUT_TITLE_IDLE,
-                Line::from(Span::styled(strings::INPUT_HINT, theme.dim)),
-            ),
+            None => match &self.idle {
+                Some((title, hint)) => (*title, Line::from(Span::styled(hint.clone(), theme.dim))),
+                None => (
+                    strings::INPUT_TITLE_IDLE,
+                    Line::from(Span::styled(strings::INPUT_HINT, theme.dim)),
+                ),
+            },
             Some(mode) => (
                 match mode {
                     Mode::Instruction => strings::INPUT_TITLE_INSTRUCTION,

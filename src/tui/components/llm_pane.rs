@@ -120,6 +120,12 @@ impl LlmPane {
         self.log_scroll = self.log_scroll.saturating_sub(SCROLL_ROWS);
     }
 
+    /// Scroll the log as far up as `previous` was.
+    pub fn adopt_scroll(&mut self, previous: &LlmPane) {
+        self.log_scroll = previous.log_scroll;
+        self.log_hidden.set(previous.log_hidden.get());
+    }
+
     pub fn animate(&mut self) {
         self.spin = (self.spin + 1) % SPINNER.len();
     }

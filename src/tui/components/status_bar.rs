@@ -1,5 +1,7 @@
 //! The status bar: scenario, backend and model, calls, tokens and cost so far, tick
-//! count, run/pause state, the last outcome, and the auto-approve warning.
+//! count, run/pause state, the last outcome, and the auto-approve warning. In a replay,
+//! the timeline instead: the step it stands on of how many, the tick, the step's time and
+//! what the step was.
 
 use ratatui::Frame;
 use ratatui::layout::Rect;
@@ -26,6 +28,18 @@ pub struct Message {
     pub error: bool,
 }
 
+/// Where a replay stands.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Timeline {
+    /// Steps applied (0: none yet).
+    pub step: usize,
+    pub steps: usize,
+    /// Milliseconds since the session started, at the last step applied.
+    pub ms: u64,
+    /// The last step applied, in one line.
+    pub what: String,
+}
+
 #[derive(Default)]
 pub struct StatusBar {
     pub scenario: String,
@@ -44,6 +58,8 @@ pub struct StatusBar {
     pub viewer: Option<String>,
     /// Takes the bar's middle while it is there.
     pub message: Option<Message>,
+    /// In a replay: where it stands (drawn instead of the session's state).
+    pub replay: Option<Timeline>,
 }
 
 impl StatusBar {
@@ -57,6 +73,9 @@ impl StatusBar {
         } else {
             format!("{help_key} {}", strings::HELP_WORD)
         };
+        if let Some(timeline) = &self.replay {
+            return self.draw_replay(frame, area, theme, timeline, (&sep, help));
+        }
         if let Some(message) = &self.message {
             // The message gets the width; the help key stays at the right edge.
             let style = if message.error {
@@ -147,6 +166,57 @@ impl StatusBar {
             spans.push(Span::styled(strings::AUTO_APPROVE, theme.error));
         }
         spans.push(sep);
+        spans.push(Span::styled(help, theme.status_bar));
+        frame.render_widget(
+            Paragraph::new(Line::from(spans)).style(theme.status_bar),
+            area,
+        );
+    }
+
+    /// `REPLAY  step 123/4567  tick 42  0:12.345 │ what the step was │ SUCCESS │ ? help`;
+    /// a message (a move that found nothing) stands where the step's words do.
+    fn draw_replay(
+        &self,
+        frame: &mut Frame,
+        area: Rect,
+        theme: &Theme,
+        timeline: &Timeline,
+        (sep, help): (&Span<'static>, String),
+    ) {
+        let position = format!(
+            " {}",
+            strings::replay_position(timeline.step, timeline.steps, self.ticks, timeline.ms)
+        );
+        let ending = match self.ending {
+            Some(Ending::Success) => Some((strings::SUCCESS, theme.success.patch(theme.title))),
+            Some(Ending::Failed) => Some((strings::FAILED, theme.error)),
+            Some(Ending::Stopped) => Some((strings::STOPPED, theme.stopped)),
+            None => None,
+        };
+        let sep_width = sep.content.chars().count();
+        let fixed = position.chars().count()
+            + 2 * sep_width
+            + help.chars().count()
+            + ending.map_or(0, |(e, _)| e.chars().count() + sep_width);
+        let room = usize::from(area.width).saturating_sub(fixed);
+        let (what, style) = match &self.message {
+            Some(m) if m.error => (m.text.as_str(), theme.status_bar.patch(theme.error)),
+            Some(m) => (m.text.as_str(), theme.status_bar),
+            None => (timeline.what.as_str(), theme.status_bar),
+        };
+        let mut spans = vec![
+            Span::styled(position, theme.status_bar.patch(theme.title)),
+            sep.clone(),
+            Span::styled(
+                format!("{:<room$}", crate::excerpt::shortened(what, room)),
+                style,
+            ),
+        ];
+        if let Some((text, style)) = ending {
+            spans.push(sep.clone());
+            spans.push(Span::styled(text, style));
+        }
+        spans.push(sep.clone());
         spans.push(Span::styled(help, theme.status_bar));
         frame.render_widget(
             Paragraph::new(Line::from(spans)).style(theme.status_bar),

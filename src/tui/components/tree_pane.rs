@@ -20,6 +20,8 @@ use super::super::theme::Theme;
 
 #[derive(Default)]
 pub struct TreePane {
+    /// What the pane says with no tree, when not the workbench's hint.
+    pub empty_text: Option<&'static str>,
     tree: Option<Arc<Tree>>,
     record: Option<Arc<TickRecord>>,
     marks: Marks,
@@ -136,6 +138,28 @@ impl TreePane {
         self.tree.is_some()
     }
 
+    /// Take `previous`'s folds, selection and scroll when it shows the same tree; a node
+    /// this pane marks as failing or stopped that `previous` did not is selected still.
+    pub fn adopt_view(&mut self, previous: &mut TreePane) {
+        let same = match (&self.tree, &previous.tree) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        };
+        if !same {
+            return;
+        }
+        self.state = std::mem::take(&mut previous.state);
+        let focus = [
+            (self.marks.stopped, previous.marks.stopped),
+            (self.marks.failing, previous.marks.failing),
+        ]
+        .into_iter()
+        .find_map(|(now, before)| now.filter(|n| Some(*n) != before));
+        if let Some(node) = focus {
+            self.select(node);
+        }
+    }
+
     fn select(&mut self, node: NodeId) {
         if let Some(tree) = &self.tree {
             let mut path: Vec<u32> = Vec::new();
@@ -189,7 +213,7 @@ impl TreePane {
             .border_style(theme.border)
             .title(Span::styled(strings::TREE_TITLE, theme.title));
         if self.items.is_empty() {
-            let text = Paragraph::new(strings::TREE_EMPTY)
+            let text = Paragraph::new(self.empty_text.unwrap_or(strings::TREE_EMPTY))
                 .style(theme.dim)
                 .wrap(Wrap { trim: true })
                 .block(block);
