@@ -1,7 +1,8 @@
 //! Whole-screen snapshots of the workbench (ratatui `TestBackend` + insta), reached the
 //! way a person reaches them: key events into the app, its commands into a real session
 //! engine on scenario 1, the engine's events back into the app. The model is in-process
-//! and answers from the hand-written fixtures.
+//! and answers from the hand-written fixtures. A recording of such a session is replayed
+//! too, with the replay's keys.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -544,4 +545,39 @@ fn a_recording_can_be_discarded_and_a_silent_one_is_refused() {
         assert!(!screen.contains("never heard"), "{screen}");
         assert!(b.sent.is_empty(), "{:?}", b.sent);
     });
+}
+
+/// A recorded session replayed: from the end, back to the failure, then on to the
+/// proposal, with the replay's keys; the help lists them and none that edits or runs.
+#[test]
+fn a_replay_steps_back_to_the_failure_and_on_to_the_proposal() {
+    use betr::tui::replay::{Player, ReplayScreen};
+    let file = support::cli::tmp("snapshot-replay").join("session.jsonl");
+    let replay = support::recorded::scenario_1(&file);
+    let player = Player::of(replay, KeyBindings::default(), Theme::default());
+    let mut s = ReplayScreen::open(player, usize::MAX);
+    let screen = |s: &mut ReplayScreen| {
+        let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+        terminal.draw(|f| ui::draw(f, &mut s.app)).unwrap();
+        terminal.backend().to_string()
+    };
+    let key = |s: &mut ReplayScreen, code: KeyCode| s.key(KeyEvent::new(code, KeyModifiers::NONE));
+    key(&mut s, KeyCode::Char('N'));
+    key(&mut s, KeyCode::Char('m'));
+    key(&mut s, KeyCode::Char('m'));
+    while s.app.llm.proposal.is_none() {
+        key(&mut s, KeyCode::Right);
+    }
+    let at_proposal = screen(&mut s);
+    assert!(at_proposal.contains("◀ failed"), "{at_proposal}");
+    assert!(at_proposal.contains("REPLAY  step"), "{at_proposal}");
+    insta::assert_snapshot!("replay_at_the_proposal", at_proposal);
+    key(&mut s, KeyCode::Char('?'));
+    let help = screen(&mut s);
+    for (key, what) in KeyBindings::default().help_lines(KeyMode::Replay) {
+        assert!(help.contains(&key), "{key} missing:\n{help}");
+        assert!(help.contains(what), "{what} missing:\n{help}");
+    }
+    assert!(!help.contains("approve the proposal"), "{help}");
+    insta::assert_snapshot!("replay_help", help);
 }

@@ -5,131 +5,22 @@
 //! timeout), then the restored terminal, the exit status and the saved policy. A second
 //! session rejects, edits, undoes, verifies and saves, and a fresh workbench reuses the
 //! saved policy without asking the model. Two more use the debugger: a run stopped at a
-//! breakpoint, and a condition forced to fail.
+//! breakpoint, and a condition forced to fail. One more replays a recorded session with
+//! no server running, stepping back to the failure and on to the proposal.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use betr::scenario::Scenario;
 use support::cli::{KEY, KEY_VAR, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
-
-/// tmux servers started by this process (each test has its own).
-static SERVERS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-
-/// A tmux server of our own (its own socket), killed when dropped.
-struct Tmux {
-    socket: String,
-    session: String,
-}
-
-impl Tmux {
-    fn run(&self, args: &[&str]) -> Output {
-        Command::new("tmux")
-            .arg("-L")
-            .arg(&self.socket)
-            .args(args)
-            .output()
-            .expect("tmux is required for this test (scripts/test.sh installs it)")
-    }
-
-    fn start(command: &str) -> Tmux {
-        let t = Tmux {
-            socket: format!(
-                "betr-test-{}-{}",
-                std::process::id(),
-                SERVERS.fetch_add(1, std::sync::atomic::Ordering::SeqCst)
-            ),
-            session: "betr".into(),
-        };
-        let out = t.run(&[
-            "new-session",
-            "-d",
-            "-s",
-            &t.session,
-            "-x",
-            "120",
-            "-y",
-            "40",
-            command,
-        ]);
-        assert!(
-            out.status.success(),
-            "tmux: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        t
-    }
-
-    fn screen(&self) -> String {
-        String::from_utf8_lossy(
-            &self
-                .run(&["capture-pane", "-p", "-t", &self.session])
-                .stdout,
-        )
-        .into_owned()
-    }
-
-    fn keys(&self, keys: &[&str]) {
-        let mut args = vec!["send-keys", "-t", &self.session];
-        args.extend_from_slice(keys);
-        assert!(self.run(&args).status.success());
-    }
-
-    fn text(&self, text: &str) {
-        assert!(
-            self.run(&["send-keys", "-t", &self.session, "-l", text])
-                .status
-                .success()
-        );
-    }
-
-    /// Poll the screen until it contains every one of `wanted`; panic with the screen
-    /// after `secs` seconds.
-    fn wait_for(&self, wanted: &[&str], secs: u64) -> String {
-        self.wait_until(wanted, secs, |screen| {
-            wanted.iter().all(|w| screen.contains(w))
-        })
-    }
-
-    /// Poll the screen until it contains one of `wanted`.
-    fn wait_for_any(&self, wanted: &[&str], secs: u64) -> String {
-        self.wait_until(wanted, secs, |screen| {
-            wanted.iter().any(|w| screen.contains(w))
-        })
-    }
-
-    fn wait_until(&self, wanted: &[&str], secs: u64, done: impl Fn(&str) -> bool) -> String {
-        let deadline = Instant::now() + Duration::from_secs(secs);
-        loop {
-            let screen = self.screen();
-            if done(&screen) {
-                return screen;
-            }
-            assert!(
-                Instant::now() < deadline,
-                "timed out waiting for {wanted:?}; the screen:\n{screen}"
-            );
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-}
-
-impl Drop for Tmux {
-    fn drop(&mut self) {
-        let _ = self.run(&["kill-server"]);
-    }
-}
-
-fn quote(p: &Path) -> String {
-    format!("'{}'", p.display())
-}
+use support::tmux::{Tmux, quote};
 
 /// The shell command that opens the workbench on scenario 1 in `dir`, with the model
 /// answered by `server`, then says how it exited.
@@ -570,4 +461,102 @@ fn a_person_forces_the_goal_condition_to_fail() {
     tmux.wait_for(&["betr exited with status 0"], 10);
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A recorded session in the workbench, read-only: `betr resolve` on scenario 1 recorded
+/// against the fake server, the server stopped, then `betr replay` in tmux opens at the
+/// end; the keys go back to the failure, on to the question about it and the proposal,
+/// and the screen shows each; approving does nothing; q quits.
+#[test]
+fn a_person_replays_a_recorded_session_without_the_model() {
+    let dir = tmp("tmux-replay");
+    let record = dir.join("session.jsonl");
+    {
+        let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+        let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+        let out = support::cli::betr(
+            &dir,
+            &[
+                "resolve",
+                &scenario.to_string_lossy(),
+                "--yes",
+                "--base-url",
+                &server.base_url(),
+                "--model",
+                "fake-model",
+                "--api-key-env",
+                KEY_VAR,
+                "--record",
+                &record.to_string_lossy(),
+            ],
+        );
+        assert_eq!(out.status.code(), Some(0), "{}", support::cli::text(&out));
+    }
+    // No server from here on, and no key: the replay needs neither.
+    let tmux = Tmux::start(&format!(
+        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         {bin} replay session.jsonl; echo \"betr exited with status $?\"; sleep 60",
+        dir = quote(&dir),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+    ));
+    let end = tmux.wait_for(&["REPLAY  step", "SUCCESS", "Replay (read-only)"], 20);
+    let (position, steps) = replay_position(&end);
+    assert_eq!(position, steps, "it opens at the end:\n{end}");
+
+    tmux.keys(&["N"]);
+    let screen = tmux.wait_for(
+        &[
+            "grasp \"blue cube\"! ◀ failed",
+            "FAILED",
+            "No proposal pending",
+            "✗ grasp \"blue cube\"! (node 1.0.1.1) failed",
+        ],
+        10,
+    );
+    assert!(replay_position(&screen).0 < position, "{screen}");
+    tmux.keys(&["m"]);
+    tmux.wait_for(&["asking the model for"], 10);
+    tmux.keys(&["m"]);
+    tmux.wait_for(&["reply from"], 10);
+    let mut proposal = None;
+    for _ in 0..20 {
+        tmux.keys(&["Right"]);
+        std::thread::sleep(Duration::from_millis(100));
+        let screen = tmux.screen();
+        if screen.contains("Proposal for grasp \"blue cube\"!:") {
+            proposal = Some(screen);
+            break;
+        }
+    }
+    let screen = proposal.unwrap_or_else(|| panic!("no proposal:\n{}", tmux.screen()));
+    assert!(
+        screen.contains("~\"any object\" on \"blue cube\""),
+        "{screen}"
+    );
+    assert!(screen.contains("◀ failed"), "{screen}");
+    // Approving belongs to the live workbench: nothing moves.
+    let at = replay_position(&screen).0;
+    tmux.keys(&["a"]);
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(replay_position(&tmux.screen()).0, at);
+
+    tmux.keys(&["q"]);
+    let screen = tmux.wait_for(&["betr exited with status 0"], 10);
+    assert!(
+        !screen.contains("REPLAY"),
+        "the alternate screen was left:\n{screen}"
+    );
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The step a replay's status bar stands on, and of how many (`step 12/45`).
+fn replay_position(screen: &str) -> (usize, usize) {
+    let at = screen
+        .find("REPLAY  step ")
+        .expect("the replay's status bar")
+        + 13;
+    let field = screen[at..].split_whitespace().next().unwrap();
+    let (p, n) = field.split_once('/').unwrap();
+    (p.parse().unwrap(), n.parse().unwrap())
 }

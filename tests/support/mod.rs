@@ -11,5 +11,7 @@ pub mod fake_openai;
 pub mod fixtures;
 pub mod microphone;
 pub mod multipart;
+pub mod recorded;
 pub mod repo;
+pub mod tmux;
 pub mod verify;
