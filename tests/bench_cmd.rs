@@ -1,4 +1,5 @@
-//! `betr bench` runs each part and prints its table (tiny sizes: nothing here is timed);
+//! `betr bench` runs each part and prints its table (tiny sizes: nothing here is timed;
+//! replay's seeks are measured, not judged);
 //! planning at scale keeps its plans; the embedded engine's saved prompt state is used by
 //! the next engine and refused when it is not whole.
 
@@ -68,6 +69,28 @@ fn ticks_and_scale_print_their_rows_against_py_trees_and_the_targets() {
     assert!(ticks[0]["betr"].as_f64().unwrap() > 0.0);
     assert_eq!(rows_of(&report, "scale").len(), 3);
     assert!(report["machine"]["cores"].as_u64().unwrap() >= 1);
+}
+
+#[test]
+fn replay_prints_its_seek_rows_against_the_target() {
+    let (out, report) = bench(&["replay"], &[]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("| replay | seek to a random step of a recording, mean (ms) |"),
+        "{table}"
+    );
+    assert!(
+        table.contains("| every step fed from the start |"),
+        "{table}"
+    );
+    assert!(table.contains("≤ 50.0 ms"), "{table}");
+    let rows = rows_of(&report, "replay");
+    assert_eq!(rows.len(), 3, "{rows:?}");
+    for row in rows {
+        assert!(row["betr"].as_f64().unwrap() > 0.0, "{row}");
+        assert_eq!(row["target"]["kind"], "at_most", "{row}");
+        assert_eq!(row["target"]["value"], 50.0, "{row}");
+    }
 }
 
 #[test]

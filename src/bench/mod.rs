@@ -4,11 +4,13 @@
 //! The parts: the tick loop against py_trees on the same tree (`ticks`); planning and
 //! repair at scale, scenario 1 end to end and towers of up to 10,000 cubes (`scale`); the
 //! embedded model's prompt and generation speed against llama.cpp's own `llama-bench`
-//! built from the same source with the same settings (`model`); and the first answer of a
-//! one-shot command against a warm one (`cold`). Nothing here is timed inside tests.
+//! built from the same source with the same settings (`model`); the first answer of a
+//! one-shot command against a warm one (`cold`); and seeking in a long recording through
+//! the replay workbench's own seek (`replay`). Nothing here is timed inside tests.
 
 pub mod cold;
 pub mod model;
+pub mod replay;
 pub mod scale;
 pub mod ticks;
 pub mod towers;

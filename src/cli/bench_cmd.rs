@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
 
-use betr::bench::{self, Report, cold, model, scale, ticks};
+use betr::bench::{self, Report, cold, model, replay, scale, ticks};
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
 
 /// A part of `betr bench`.
@@ -22,6 +22,9 @@ pub enum Part {
     Model,
     /// The first answer of a one-shot command against a warm one, for both embedded models.
     Cold,
+    /// Seeking to random steps of a 10,000-tick recording on a 500-node tree, as the replay
+    /// workbench seeks.
+    Replay,
     /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
     /// not part of the default set.
     Llm,
@@ -29,7 +32,7 @@ pub enum Part {
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// The parts to run (default: ticks, scale, model, cold).
+    /// The parts to run (default: ticks, scale, model, cold, replay).
     #[arg(value_enum)]
     parts: Vec<Part>,
     /// Tiny sizes and short runs: checks that every part runs, measures little.
@@ -72,7 +75,13 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         );
     }
     let parts: Vec<Part> = if args.parts.is_empty() {
-        vec![Part::Ticks, Part::Scale, Part::Model, Part::Cold]
+        vec![
+            Part::Ticks,
+            Part::Scale,
+            Part::Model,
+            Part::Cold,
+            Part::Replay,
+        ]
     } else {
         args.parts.clone()
     };
@@ -84,6 +93,14 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
             Part::Scale => scale_part(args)?,
             Part::Model => model_part(args)?,
             Part::Cold => cold_part(args)?,
+            Part::Replay => replay::rows(&replay::seek_times(
+                &args.scenario,
+                if args.quick {
+                    replay::Sizes::QUICK
+                } else {
+                    replay::Sizes::FULL
+                },
+            )?),
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {

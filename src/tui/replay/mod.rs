@@ -112,6 +112,11 @@ impl Player {
         }
     }
 
+    /// How many steps a seek to `p` feeds.
+    pub fn fed(&self, p: usize) -> usize {
+        self.index.feed(p).len()
+    }
+
     /// The app after the first `p` steps (the end when `p` is past it), with its timeline.
     pub fn seek(&self, p: usize) -> App {
         let p = p.min(self.len());
