@@ -91,7 +91,10 @@ impl SeekIndex {
     /// The steps to feed, in order, for the state after the first `p` steps (`p` past the
     /// end counts as the end).
     pub fn feed(&self, p: usize) -> Vec<usize> {
-        let p = p.min(self.positions() - 1);
+        let Some(end) = self.positions().checked_sub(1) else {
+            return Vec::new();
+        };
+        let p = p.min(end);
         let before = self.essential.partition_point(|&i| (i as usize) < p);
         let mut out: Vec<usize> = self.essential[..before]
             .iter()
@@ -100,10 +103,10 @@ impl SeekIndex {
         // The segment `p` falls in: its last tick and change of facts before `p`, in
         // order (either may be among the essential steps already, when no step of its kind
         // follows it in the segment).
-        for i in [self.last_tick[p], self.last_facts[p]] {
-            if i == NONE {
+        for i in [self.last_tick.get(p), self.last_facts.get(p)] {
+            let Some(&i) = i.filter(|&&i| i != NONE) else {
                 continue;
-            }
+            };
             let i = i as usize;
             let at = out.partition_point(|&x| x < i);
             if out.get(at) != Some(&i) {
@@ -184,6 +187,8 @@ mod tests {
         assert_eq!(index.feed(7), [0, 5, 6]);
         assert_eq!(index.feed(12), [0, 5, 6, 7, 8, 10, 11]);
         assert_eq!(index.feed(99), index.feed(12));
+        assert_eq!(SeekIndex::default().feed(3), Vec::<usize>::new());
+        assert_eq!(SeekIndex::new(&[]).feed(0), Vec::<usize>::new());
         for p in 0..=steps.len() {
             assert_eq!(index.feed(p), by_hand(&steps, p), "at {p}");
         }

@@ -203,6 +203,13 @@ fn keys_move_to_the_failure_the_proposal_and_back_to_the_end() {
     assert!(screen(&mut s.app).contains("no earlier step"));
     s.key(key(KeyCode::Char('G')));
     assert_eq!(screen(&mut s.app), end);
+    // Small terminals draw without panicking.
+    for (w, h) in [(80, 24), (40, 12), (20, 6), (1, 1)] {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).expect("a test terminal");
+        terminal
+            .draw(|f| super::super::ui::draw(f, &mut s.app))
+            .expect("drawn");
+    }
     s.key(key(KeyCode::Char('q')));
     assert!(s.should_quit());
 }
