@@ -18,6 +18,12 @@ pub const MIN_SECONDS: f64 = 0.3;
 pub const SILENCE_PEAK_DBFS: f64 = -45.0;
 /// The floor reported for digital silence.
 pub const FLOOR_DBFS: f64 = -120.0;
+/// The sample rates a WAV file may declare: telephone speech to the fastest common
+/// recording interfaces. Resampling from a lower rate makes more samples than the file
+/// holds bytes (16,000 for each at 1 Hz), and from a far higher one needs a filter of
+/// millions of taps per phase, so a header that claims such a rate is refused.
+pub const MIN_WAV_RATE: u32 = 8_000;
+pub const MAX_WAV_RATE: u32 = 384_000;
 
 /// 16 kHz mono audio.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -118,6 +124,12 @@ impl Audio16k {
             return Err(wav_error(
                 "the header declares no channels or a zero rate".into(),
             ));
+        }
+        if !(MIN_WAV_RATE..=MAX_WAV_RATE).contains(&spec.sample_rate) {
+            return Err(wav_error(format!(
+                "the header declares {} Hz; betr reads {MIN_WAV_RATE} to {MAX_WAV_RATE} Hz",
+                spec.sample_rate
+            )));
         }
         let samples: Vec<f32> = match (spec.sample_format, spec.bits_per_sample) {
             (hound::SampleFormat::Float, 32) => {

@@ -146,3 +146,37 @@ fn wav_bytes_round_trip() {
     assert!(err < 1e-4, "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A WAV file of 300 8-bit mono samples at `rate` Hz.
+fn wav_at(rate: u32) -> Vec<u8> {
+    let mut bytes = b"RIFF".to_vec();
+    bytes.extend_from_slice(&(36u32 + 300).to_le_bytes());
+    bytes.extend_from_slice(b"WAVEfmt ");
+    bytes.extend_from_slice(&16u32.to_le_bytes());
+    bytes.extend_from_slice(&1u16.to_le_bytes());
+    bytes.extend_from_slice(&1u16.to_le_bytes());
+    bytes.extend_from_slice(&rate.to_le_bytes());
+    bytes.extend_from_slice(&rate.to_le_bytes());
+    bytes.extend_from_slice(&1u16.to_le_bytes());
+    bytes.extend_from_slice(&8u16.to_le_bytes());
+    bytes.extend_from_slice(b"data");
+    bytes.extend_from_slice(&300u32.to_le_bytes());
+    bytes.extend((0..300u32).map(|i| (i * 37 % 256) as u8));
+    bytes
+}
+
+#[test]
+fn a_header_claiming_an_absurd_rate_is_refused_before_resampling() {
+    // At 4,294,967,295 Hz the resampling filter would need about 400 GB; at 2 Hz three
+    // bytes would become 24,000 samples.
+    for rate in [u32::MAX, 3_999_999_996, 384_001, 7_999, 2, 1] {
+        let err = Audio16k::from_wav_bytes(&wav_at(rate), Path::new("lying.wav"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(&format!("declares {rate} Hz")), "{err}");
+    }
+    for rate in [MIN_WAV_RATE, 44_100, MAX_WAV_RATE] {
+        let audio = Audio16k::from_wav_bytes(&wav_at(rate), Path::new("a.wav")).unwrap();
+        assert!(audio.samples().len() <= 2 * 300, "{rate}");
+    }
+}
