@@ -1,6 +1,7 @@
 //! Audio as the speech-to-text models want it: 16 kHz mono `f32` in [-1, 1]. WAV files of
-//! any rate, channel count and sample format (8/16/24/32-bit integer, 32-bit float) are
-//! read with `hound`, mixed down to mono and resampled with [`super::resample`]; levels
+//! any common rate, channel count and sample format (8/16/24/32-bit integer, 32-bit float,
+//! clipped to full scale) are read with `hound`, mixed down to mono and resampled with
+//! [`super::resample`]; levels
 //! (RMS and peak in dBFS) drive a meter and tell an empty or silent recording apart.
 
 use std::path::Path;
@@ -133,10 +134,19 @@ impl Audio16k {
         }
         let samples: Vec<f32> = match (spec.sample_format, spec.bits_per_sample) {
             (hound::SampleFormat::Float, 32) => {
-                reader
-                    .samples::<f32>()
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| wav_error(format!("damaged sample data: {e}")))?
+                // Full scale is ±1: louder samples are clipped (so mixing channels cannot
+                // overflow), and a sample that is not a number is damage.
+                let mut out = Vec::new();
+                for (i, s) in reader.samples::<f32>().enumerate() {
+                    let s = s.map_err(|e| wav_error(format!("damaged sample data: {e}")))?;
+                    if !s.is_finite() {
+                        return Err(wav_error(format!(
+                            "damaged sample data: sample {i} is {s}, not a number of the waveform"
+                        )));
+                    }
+                    out.push(s.clamp(-1.0, 1.0));
+                }
+                out
             }
             (hound::SampleFormat::Int, bits @ 1..=32) => {
                 let scale = 2f64.powi(i32::from(bits) - 1);

@@ -180,3 +180,33 @@ fn a_header_claiming_an_absurd_rate_is_refused_before_resampling() {
         assert!(audio.samples().len() <= 2 * 300, "{rate}");
     }
 }
+
+/// A 32-bit float WAV file of `samples` at 16 kHz mono.
+fn float_wav(samples: &[f32]) -> Vec<u8> {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: SAMPLE_RATE,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    let mut w = hound::WavWriter::new(&mut bytes, spec).unwrap();
+    for &s in samples {
+        w.write_sample(s).unwrap();
+    }
+    w.finalize().unwrap();
+    bytes.into_inner()
+}
+
+#[test]
+fn float_samples_that_are_not_numbers_are_damage_and_loud_ones_are_clipped() {
+    for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        let err = Audio16k::from_wav_bytes(&float_wav(&[0.1, bad, 0.2]), Path::new("f.wav"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("damaged sample data: sample 1 is"), "{err}");
+    }
+    let loud =
+        Audio16k::from_wav_bytes(&float_wav(&[3e38, -3e38, 0.5]), Path::new("f.wav")).unwrap();
+    assert_eq!(loud.samples(), &[1.0, -1.0, 0.5]);
+}
