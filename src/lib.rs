@@ -14,6 +14,7 @@ pub mod dataset;
 pub mod domain;
 pub mod eval;
 pub mod excerpt;
+pub mod fuzz;
 pub mod goal;
 pub mod http_retry;
 pub mod http_text;

@@ -5,6 +5,7 @@ mod engine_driver;
 mod eval_cmd;
 mod eval_setup;
 mod export_cmd;
+mod fuzz_cmd;
 mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
@@ -55,6 +56,9 @@ pub enum Command {
     Tui(tui_cmd::TuiArgs),
     #[command(hide = true)]
     PolicySaveTest(PolicySaveTest),
+    /// Hidden: fuzz a reader of outside input (or all of them); see docs/FUZZ.md.
+    #[command(hide = true)]
+    Fuzz(fuzz_cmd::FuzzArgs),
     /// Check the planned (or a saved) tree before it runs: structural rules, then every
     /// reachable state of the abstraction; exit 1 with a counterexample when violated.
     Verify(verify_cmd::VerifyArgs),
@@ -151,6 +155,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
+        Command::Fuzz(args) => fuzz_cmd::run(&args),
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model { action } => model_cmd::run(action),
         Command::Knowledge { action } => knowledge_cmd::run(action),
