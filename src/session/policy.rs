@@ -259,8 +259,11 @@ pub fn parse(text: &str, domain: &Domain) -> Result<Policy, PolicyTreeError> {
         } else if let (Some(fix), Some(nodes)) =
             (fixes.last_mut(), line.strip_prefix("#   nodes: "))
         {
+            // Values are read trimmed, as `header_value` reads them: a blank (a carriage
+            // return before the line's end) is not part of a node path or a time.
             fix.nodes = nodes
                 .split(", ")
+                .map(str::trim)
                 .filter(|n| !n.is_empty())
                 .map(str::to_string)
                 .collect();
@@ -270,7 +273,7 @@ pub fn parse(text: &str, domain: &Domain) -> Result<Policy, PolicyTreeError> {
             if let [model, approval, at] = parts.as_slice() {
                 fix.model = (*model).to_string();
                 fix.approval = Approval::parse(approval).unwrap_or(Approval::Person);
-                fix.at = at.trim_start_matches("at ").to_string();
+                fix.at = at.strip_prefix("at ").unwrap_or(at).trim().to_string();
             }
         }
     }
@@ -377,6 +380,24 @@ mod tests {
         assert_eq!(back.fixes, policy.fixes);
         assert_eq!(bt::to_text(&back.tree), bt::to_text(&policy.tree));
         assert!(parse("fallback\n  Nonsense_Thing?\n", &s.domain).is_err());
+    }
+
+    #[test]
+    fn header_values_are_read_trimmed_so_a_rendered_policy_reads_back_the_same() {
+        let s = scenario();
+        let text = "# fix 1: x\n#   nodes: \r0.1, x, \r\r\n#   model: m; auto-approved; at t\r\r\nfallback\n  \"blue cube\" on \"green cube\"?\n";
+        let policy = parse(text, &s.domain).unwrap();
+        assert_eq!(policy.fixes[0].nodes, ["0.1", "x"]);
+        assert_eq!(policy.fixes[0].at, "t");
+        let back = parse(&render(&policy), &s.domain).unwrap();
+        assert_eq!(back.fixes, policy.fixes);
+        assert_eq!(render(&back), render(&policy));
+        // Only the `at ` the header writes is taken off the time.
+        let spaced = text.replace("auto-approved; at t\r\r", "auto-approved;   at at t");
+        let policy = parse(&spaced, &s.domain).unwrap();
+        assert_eq!(policy.fixes[0].at, "at at t");
+        let back = parse(&render(&policy), &s.domain).unwrap();
+        assert_eq!(back.fixes, policy.fixes);
     }
 
     #[test]
