@@ -54,10 +54,18 @@ pub fn read_entries(text: &str) -> Result<Vec<Entry>, EntryError> {
         if line.trim().is_empty() {
             continue;
         }
-        let entry = serde_json::from_str(line).map_err(|e| EntryError {
+        let entry: Entry = serde_json::from_str(line).map_err(|e| EntryError {
             line: i + 1,
             detail: e.to_string(),
         })?;
+        // A number beyond f32 reads as an infinite temperature, which JSON cannot hold:
+        // the entry could not be written again, nor its request hashed as recorded.
+        if !entry.request.temperature.is_finite() {
+            return Err(EntryError {
+                line: i + 1,
+                detail: "the request's temperature is not a finite number".into(),
+            });
+        }
         entries.push(entry);
     }
     Ok(entries)
@@ -283,6 +291,29 @@ mod tests {
         let other = Replay::open(&path, Some("gpt-x"), false).unwrap();
         assert!(block(other.chat(&a)).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_temperature_beyond_f32_is_refused_with_its_line() {
+        let request = ChatRequest::new(vec![Message::user("x")]);
+        let entry = Entry {
+            model: "m".into(),
+            reply_model: String::new(),
+            prompt_hash: prompt_hash(&request),
+            request,
+            reply: "r".into(),
+            usage: TokenUsage::default(),
+            latency_ms: 1,
+            source: ReplySource::Model,
+            recorded_unix: 0,
+        };
+        let line = serde_json::to_string(&entry).unwrap();
+        assert_eq!(read_entries(&line).unwrap(), vec![entry]);
+        let hot = line.replace("\"temperature\":0.0", "\"temperature\":1e39");
+        assert_ne!(hot, line);
+        let e = read_entries(&format!("{line}\n\n{hot}\n")).unwrap_err();
+        assert_eq!(e.line, 3);
+        assert!(e.detail.contains("temperature"), "{e}");
     }
 
     #[test]
