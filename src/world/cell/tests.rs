@@ -254,3 +254,35 @@ fn scene_errors_name_file_line_and_column() {
     assert_eq!(e.line, 5, "{e}");
     assert!(e.message.contains("\"cube\" has no solid"), "{e}");
 }
+
+#[test]
+fn numbers_that_are_not_finite_or_too_large_are_refused_where_they_are_written() {
+    // 0.1e308 reads as an infinite f32, whose bounding box made reach_point clamp NaN.
+    for (value, column) in [
+        ("[0.2, 0.1e308, 0.01]", 8),
+        ("[0.2, nan, 0.01]", 8),
+        ("[0.2, 20000.0, 0.01]", 8),
+    ] {
+        let p = scratch(
+            "finite",
+            &format!(
+                "{HEAD}[world.solids.\"cube\"]\nshape = \"box\"\nsize = {value}\non = \"table\"\nfixed = true\n"
+            ),
+        );
+        let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+            .err()
+            .unwrap();
+        assert_eq!((e.line, e.column), (8, column), "{value}: {e}");
+        assert!(e.message.contains("finite numbers"), "{e}");
+    }
+    let p = scratch(
+        "finite-robot",
+        &format!(
+            "{HEAD}[world.robot]\nreach = inf\n[world.solids.\"cube\"]\nshape = \"box\"\nsize = [0.04, 0.04, 0.04]\non = \"table\"\n"
+        ),
+    );
+    let e = CellWorld::from_scenario(&Scenario::load(&p).unwrap(), None)
+        .err()
+        .unwrap();
+    assert_eq!(e.line, 7, "{e}");
+}

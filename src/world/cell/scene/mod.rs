@@ -51,7 +51,9 @@ use super::values::Judge;
 use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
 mod build;
+mod finite;
 use build::build;
+use finite::modest;
 
 /// The skills the cell can perform, by name.
 pub const SKILLS: &[&str] = &[
@@ -97,10 +99,15 @@ struct RawWorld {
 #[derive(Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
 struct RawRobot {
+    #[serde(default, deserialize_with = "modest")]
     shoulders: Option<Vec<[f32; 3]>>,
+    #[serde(default, deserialize_with = "modest")]
     reach: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     payload: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     base: Option<[f32; 2]>,
+    #[serde(default, deserialize_with = "modest")]
     drive_margin: Option<f32>,
     gripper: Option<RawGripper>,
 }
@@ -108,10 +115,15 @@ struct RawRobot {
 #[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct RawGripper {
+    #[serde(deserialize_with = "modest")]
     finger: [f32; 3],
+    #[serde(deserialize_with = "modest")]
     palm: [f32; 2],
+    #[serde(deserialize_with = "modest")]
     clearance: f32,
+    #[serde(deserialize_with = "modest")]
     grip_depth: f32,
+    #[serde(deserialize_with = "modest")]
     approach: f32,
 }
 
@@ -123,6 +135,7 @@ struct RawVariant {
     #[serde(default)]
     solids: IndexMap<String, RawSolid>,
     unknown: Option<Vec<Spanned<String>>>,
+    #[serde(default, deserialize_with = "modest")]
     base: Option<[f32; 2]>,
 }
 
@@ -130,20 +143,30 @@ struct RawVariant {
 #[serde(deny_unknown_fields)]
 struct RawSolid {
     shape: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "modest")]
     size: Option<[f32; 3]>,
+    #[serde(default, deserialize_with = "modest")]
     radius: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     height: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     length: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     wall: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
     bottom: Option<f32>,
     opening: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "modest")]
     mass: Option<f32>,
     fixed: Option<bool>,
     on: Option<Spanned<String>>,
     #[serde(rename = "in")]
     inside: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "modest")]
     xy: Option<[f32; 2]>,
+    #[serde(default, deserialize_with = "modest")]
     at: Option<[f32; 3]>,
+    #[serde(default, deserialize_with = "modest")]
     rotation: Option<[f32; 3]>,
     upside_down: Option<bool>,
     lid: Option<RawLid>,
@@ -155,10 +178,13 @@ struct RawSolid {
 #[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct RawLid {
+    #[serde(deserialize_with = "modest")]
     size: [f32; 3],
+    #[serde(deserialize_with = "modest")]
     closed: [f32; 3],
+    #[serde(deserialize_with = "modest")]
     open: [f32; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "modest")]
     open_rotation: [f32; 3],
 }
 
