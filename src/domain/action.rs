@@ -206,14 +206,14 @@ pub fn parse_action_prefix(text: &str, start: usize) -> Result<(ActionCall, usiz
         let body = &text[j + 1..j + close];
         let mut at = j + 1;
         for item in body.split(',') {
-            let Some((name, value)) = item.split_once('=') else {
+            let Some((written, value)) = item.split_once('=') else {
                 return Err(ActionError {
                     at,
                     expected: "name = value",
                     found: format!("{:?}", item.trim()),
                 });
             };
-            let name = name.trim();
+            let name = written.trim();
             if name.is_empty()
                 || !name
                     .chars()
@@ -225,7 +225,8 @@ pub fn parse_action_prefix(text: &str, start: usize) -> Result<(ActionCall, usiz
                     found: format!("{name:?}"),
                 });
             }
-            let value_at = at + name.len() + 1;
+            // The value starts after the name as written (blanks around it included).
+            let value_at = at + written.len() + 1;
             let value = parse_value(value).map_err(|e| ActionError {
                 at: e.at + value_at,
                 ..e
@@ -317,6 +318,17 @@ mod tests {
         );
         assert_eq!(a.to_string(), "grasp \"egg\" {force = 5 N}");
         assert!(a.same_invocation(&ActionCall::new("grasp", ["egg"])));
+    }
+
+    #[test]
+    fn a_value_error_points_into_the_value_after_a_blank_name_end() {
+        // U+2028 is a blank of three bytes, trimmed off the name.
+        let text = "wipe \"table\" {tool\u{2028} = \"sr\" on ponge\"}";
+        let e = ActionCall::parse(text).unwrap_err();
+        assert_eq!(e.at, text.find("\"sr").unwrap(), "{e}");
+        assert!(text.is_char_boundary(e.at));
+        let e = ActionCall::parse("grasp \"egg\" {force  = 5 N, speed =  \"fast}").unwrap_err();
+        assert_eq!(e.at, "grasp \"egg\" {force  = 5 N, speed =  ".len(), "{e}");
     }
 
     #[test]
