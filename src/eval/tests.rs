@@ -1,6 +1,6 @@
 use std::path::Path;
 
-use super::run::{Journal, mean_sd, percentile};
+use super::run::{CallRecord, Journal, mean_sd, percentile, records};
 use crate::scenario::Scenario;
 
 fn cafe() -> Scenario {
@@ -33,6 +33,23 @@ fn a_line_cut_short_is_skipped_and_the_next_record_starts_a_new_line() {
     let read: Vec<Vec<u32>> = j.read().expect("read");
     assert_eq!(read, vec![vec![1], vec![2], vec![5]]);
     std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
+fn numbers_read_from_the_journal_are_the_numbers_written() {
+    // Latencies are durations in milliseconds with up to 17 significant digits.
+    for latency_ms in [10_635.123_456_789_013, 923_017.729_336_999_9, 0.1 + 0.2] {
+        let record = CallRecord {
+            prompt_tokens: 1,
+            completion_tokens: 2,
+            latency_ms,
+            price_usd: Some(latency_ms / 7.0),
+            source: "model".into(),
+        };
+        let line = serde_json::to_string(&record).expect("json");
+        let read: Vec<CallRecord> = records(&format!("{line}\n"));
+        assert_eq!(read, vec![record], "{line}");
+    }
 }
 
 /// A model that answers `Goal: Active_AC` after a short wait and counts the calls in flight.
