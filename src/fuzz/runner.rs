@@ -73,10 +73,23 @@ fn install_hook() {
                 previous(info);
                 return;
             }
-            let location = info
+            let mut location = info
                 .location()
                 .map(|l| format!("{}:{}:{}", l.file(), l.line(), l.column()))
                 .unwrap_or_else(|| "unknown place".into());
+            // A panic inside the standard library (a slice index, `clamp` with NaN) is
+            // told by the betr function that called it.
+            if location.starts_with("/rustc/") {
+                let trace = std::backtrace::Backtrace::force_capture().to_string();
+                let caller = trace
+                    .lines()
+                    .map(str::trim)
+                    .filter_map(|l| l.split_once(": ").map(|(_, f)| f))
+                    .find(|f| f.starts_with("betr::") && !f.starts_with("betr::fuzz"));
+                if let Some(caller) = caller {
+                    location = format!("{location} in {caller}");
+                }
+            }
             let payload = info.payload();
             let message = payload
                 .downcast_ref::<&str>()
