@@ -95,7 +95,13 @@ fn record(file: &Path) {
 }
 
 fn player() -> Player {
-    let file = std::env::temp_dir().join(format!("betr-replay-seek-{}.jsonl", std::process::id()));
+    // One file per call: tests run as threads of one process under `cargo test`.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let file = std::env::temp_dir().join(format!(
+        "betr-replay-seek-{}-{call}.jsonl",
+        std::process::id()
+    ));
     record(&file);
     let replay = Replay::load(&file, None).expect("the recording reads back");
     let _ = std::fs::remove_file(&file);
