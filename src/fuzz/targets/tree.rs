@@ -2,17 +2,17 @@
 //! (`ActionCall::parse`, `parse_value`).
 //!
 //! Properties: a parsed tree prints to text that parses to a tree printing the same text,
-//! with as many nodes; an error names a line of the input and a column inside that line,
-//! and quotes that line; a parsed action or value prints and reads back the same; an
-//! action error's offset lies in the text on a character boundary.
+//! with as many nodes, and ticks; an error names a line of the input and a column inside
+//! that line, and quotes that line; a parsed action or value prints and reads back the
+//! same; an action error's offset lies in the text on a character boundary.
 
 use super::{
     Rng, Target, Violation, atoms_of, check_line_column, check_offset, ensure, random_tree,
     strings, text_of,
 };
-use crate::bt;
+use crate::bt::{self, ActionStep, Leaves, NodeId, Ticker};
 use crate::domain::action::parse_value;
-use crate::domain::{ActionCall, Atom, Domain};
+use crate::domain::{ActionCall, Atom, Condition, Domain};
 use crate::fuzz::Corpus;
 
 /// Lines of an input whose actions and values are checked too.
@@ -97,7 +97,9 @@ impl TreeTarget {
                     len == tree.len(),
                     "a printed tree reads back as many nodes",
                     || format!("{} nodes, then {len}: {printed:?}", tree.len()),
-                )
+                )?;
+                tick(&tree);
+                Ok(())
             }
             Err(e) => {
                 check_line_column(
@@ -150,6 +152,35 @@ impl TreeTarget {
     }
 }
 
+/// Leaves that answer from the text of what they are asked: a condition holds when its
+/// text has an even length, an action runs for a tick, then succeeds or fails.
+struct TextLeaves;
+
+impl Leaves for TextLeaves {
+    fn check(&mut self, condition: &Condition) -> bool {
+        condition.to_string().len().is_multiple_of(2)
+    }
+
+    fn step(&mut self, _: NodeId, action: &ActionCall, started: bool) -> ActionStep {
+        match (started, action.skill.len() % 2) {
+            (true, _) => ActionStep::Running,
+            (false, 0) => ActionStep::Success,
+            (false, _) => ActionStep::Failure("it failed".into()),
+        }
+    }
+
+    fn halt(&mut self, _: NodeId, _: &ActionCall) {}
+}
+
+/// A tree read from text is ticked like any tree (three ticks, then halted).
+fn tick(tree: &bt::Tree) {
+    let mut ticker = Ticker::new();
+    for _ in 0..3 {
+        ticker.tick(tree, &mut TextLeaves);
+    }
+    ticker.halt_all(tree, &mut TextLeaves);
+}
+
 /// One domain per vocabulary, with atoms to build trees from.
 fn distinct_domains(corpus: &Corpus) -> Vec<(Domain, Vec<Atom>)> {
     let mut out: Vec<(Domain, Vec<Atom>)> = Vec::new();
@@ -172,7 +203,7 @@ pub(super) fn tree_text(rng: &mut Rng, domains: &[(Domain, Vec<Atom>)]) -> Strin
     };
     if rng.chance(8) {
         // Deep nesting: a chain of composites, each indented under the one before.
-        let depth = rng.between(100, 700);
+        let depth = rng.between(100, 1000);
         let mut text = String::new();
         for d in 0..depth {
             text.push_str(&"  ".repeat(d));
