@@ -86,7 +86,12 @@ impl Corpus {
         goals.dedup();
         let replies = replies(root, &scenarios)?;
         let mut journal_lines = Vec::new();
-        for path in files_under(&root.join("eval-results"), "jsonl") {
+        // Journals of past runs when there are any, and the journal regressions, which
+        // every checkout has.
+        let journals = files_under(&root.join("eval-results"), "jsonl")
+            .into_iter()
+            .chain(files_under(&root.join("fuzz/regressions/journal"), "jsonl"));
+        for path in journals {
             let text = read(&path)?;
             journal_lines.extend(
                 text.lines()
