@@ -2,7 +2,9 @@
 //! text, the scenarios they load, their goals and example goals, and the tree planned for
 //! each goal), the goals of the LLM-OBTEA dataset beside the repository, the hand-written
 //! model replies of the test fixtures, the BehaviorTree.CPP fixtures and the journals of
-//! the recorded evaluations. Nothing is copied into the project.
+//! the recorded evaluations (with a line of each experiment's journal kept under
+//! `fuzz/seeds/journal/`, since `eval-results/` is not part of a checkout). The dataset is
+//! read where it lies, never copied into the project.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -86,10 +88,11 @@ impl Corpus {
         goals.dedup();
         let replies = replies(root, &scenarios)?;
         let mut journal_lines = Vec::new();
-        // Journals of past runs when there are any, and the journal regressions, which
-        // every checkout has.
+        // Journals of past runs when there are any, and what every checkout has: a line
+        // of each experiment's journal (`fuzz/seeds/journal/`) and the journal regressions.
         let journals = files_under(&root.join("eval-results"), "jsonl")
             .into_iter()
+            .chain(files_under(&root.join("fuzz/seeds/journal"), "jsonl"))
             .chain(files_under(&root.join("fuzz/regressions/journal"), "jsonl"));
         for path in journals {
             let text = read(&path)?;
