@@ -16,7 +16,10 @@ inputs=$2
 shift 2
 
 cargo build --release --locked
-# Run a copy: another build during a long run would replace the binary under it.
+# Run a copy of this run's own: another build during a long run would replace the binary
+# under it, and runs side by side (one target per core) must not overwrite each other's.
 mkdir -p target/fuzz
-cp target/release/betr target/fuzz/betr
-exec target/fuzz/betr fuzz "$target" "$inputs" "$@"
+bin="target/fuzz/betr-$$"
+cp target/release/betr "$bin"
+trap 'rm -f "$bin"' EXIT
+"$bin" fuzz "$target" "$inputs" "$@"
