@@ -116,14 +116,6 @@ impl Corpus {
             xml,
         })
     }
-
-    /// The scenario whose relative path ends with `name`, else the first.
-    pub fn scenario_named(&self, name: &str) -> Option<&ScenarioSeed> {
-        self.scenarios
-            .iter()
-            .find(|s| !name.is_empty() && (s.rel.ends_with(name) || name.ends_with(&s.rel)))
-            .or_else(|| self.scenarios.first())
-    }
 }
 
 /// The tree planned for the scenario's goal in its world, finished or not.
