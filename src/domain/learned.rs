@@ -369,6 +369,7 @@ mod tests {
             .map(|name| crate::domain::Object {
                 name: name.into(),
                 types: vec!["item".into()],
+                called: Vec::new(),
             })
             .collect();
         Domain {

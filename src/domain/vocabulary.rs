@@ -9,6 +9,10 @@ use super::condition::{ANY_OBJECT, Atom, Condition};
 pub struct Object {
     pub name: String,
     pub types: Vec<String>,
+    /// What people call it when its name does not say so (`Chips`: crisps, fries), as
+    /// the scene's `[called]` table lists; shown to the model beside the name and taken
+    /// as the object's words when an answer is checked against the request.
+    pub called: Vec<String>,
 }
 
 impl Object {
@@ -205,10 +209,12 @@ mod tests {
                 Object {
                     name: "Coffee".into(),
                     types: vec!["item".into(), "makable".into()],
+                    called: Vec::new(),
                 },
                 Object {
                     name: "Table1".into(),
                     types: vec!["place".into()],
+                    called: Vec::new(),
                 },
             ],
             predicates: vec![Predicate {

@@ -332,10 +332,12 @@ mod tests {
                 Object {
                     name: "AC".into(),
                     types: vec!["appliance".into()],
+                    called: Vec::new(),
                 },
                 Object {
                     name: "TubeLight".into(),
                     types: vec!["appliance".into()],
+                    called: Vec::new(),
                 },
             ],
             predicates: vec![Predicate {

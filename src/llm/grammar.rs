@@ -170,6 +170,7 @@ mod tests {
         let o = |n: &str, t: &str| Object {
             name: n.into(),
             types: vec![t.into()],
+            called: Vec::new(),
         };
         let p = |n: &str, args: &[&str]| Predicate {
             name: n.into(),

@@ -2,7 +2,8 @@
 //! goal can be checked part by part against what was asked.
 //!
 //! A symbol answers to the words of its own name (`WindowTable6` → window, table, 6;
-//! `IsClean` → clean) and to the words the scene's example pool pairs with it: a word of
+//! `IsClean` → clean), an object to what the scene says it is called (`Chips` → crisps,
+//! fries), and both to the words the scene's example pool pairs with it: a word of
 //! the pool's instructions that occurs mostly in examples whose goal uses the symbol
 //! ("sweep" with `IsClean`, "deliver" with `On`). Nothing is written by hand per
 //! scene: a new scene's pool teaches its own words.
@@ -51,6 +52,15 @@ impl Lexicon {
                 .filter(|t| !GENERIC.contains(&t.as_str()))
                 .collect();
             words.insert(name.to_string(), own);
+        }
+        // What an object is called is its own too ("fries" is `Chips`'s word).
+        for object in &vocabulary.objects {
+            let list = words.entry(object.name.clone()).or_default();
+            for word in object.called.iter().flat_map(|c| terms(c)) {
+                if !GENERIC.contains(&word.as_str()) && !list.contains(&word) {
+                    list.push(word);
+                }
+            }
         }
         let mut object_words: Vec<String> = vocabulary
             .objects
@@ -189,6 +199,7 @@ mod tests {
         let object = |n: &str, t: &str| Object {
             name: n.into(),
             types: vec![t.into()],
+            called: Vec::new(),
         };
         let predicate = |n: &str, args: &[&str]| Predicate {
             name: n.into(),

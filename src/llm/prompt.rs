@@ -434,7 +434,9 @@ fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
         .join("\n")
 }
 
-/// The objects grouped by type, types in first-seen order.
+/// The objects grouped by type, types in first-seen order; an object the scene says people
+/// call otherwise has those words beside its name, once (the model is told that "fries"
+/// are `Chips` rather than left to guess between neighbours).
 pub fn objects_text(vocabulary: &Vocabulary) -> String {
     let mut types: Vec<&str> = Vec::new();
     for o in &vocabulary.objects {
@@ -444,19 +446,25 @@ pub fn objects_text(vocabulary: &Vocabulary) -> String {
             }
         }
     }
-    types
-        .iter()
-        .map(|t| {
-            let names: Vec<&str> = vocabulary
-                .objects
-                .iter()
-                .filter(|o| o.types.iter().any(|ot| ot == t))
-                .map(|o| o.name.as_str())
-                .collect();
-            format!("- {t}: {}", names.join(", "))
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
+    let mut glossed: Vec<&str> = Vec::new();
+    let mut lines: Vec<String> = Vec::new();
+    for t in types {
+        let mut names: Vec<String> = Vec::new();
+        for o in vocabulary
+            .objects
+            .iter()
+            .filter(|o| o.types.iter().any(|ot| ot == t))
+        {
+            if o.called.is_empty() || glossed.contains(&o.name.as_str()) {
+                names.push(o.name.clone());
+            } else {
+                glossed.push(&o.name);
+                names.push(format!("{} ({})", o.name, o.called.join(", ")));
+            }
+        }
+        lines.push(format!("- {t}: {}", names.join(", ")));
+    }
+    lines.join("\n")
 }
 
 fn examples_text(examples: &[&Example]) -> String {

@@ -21,7 +21,9 @@ fn goal_prompt_has_every_part() {
     let text = &m[1].content;
     for part in [
         "On_<item>_<place>: the item is at the place",
-        "Bar, Bar2, WaterStation",
+        // What the scene says objects are called, beside their names.
+        "Bar (bar counter), Bar2 (second bar, other bar counter), WaterStation (water dispenser)",
+        "- appliance: AC (air conditioning, air conditioner, aircon), TubeLight",
         "## Examples",
         // Retrieval puts the pool's examples that share the most words first.
         "Instruction: There are no tissues at window table six",
@@ -107,5 +109,27 @@ fn a_convention_is_told_only_in_a_scene_with_its_objects() {
     assert!(
         cafe.contains("use Chips).\n\n## How to write a goal"),
         "{cafe}"
+    );
+}
+
+#[test]
+fn an_object_in_two_types_is_glossed_once() {
+    use crate::domain::{Object, Vocabulary};
+    let object = |name: &str, types: &[&str], called: &[&str]| Object {
+        name: name.into(),
+        types: types.iter().map(|t| (*t).to_string()).collect(),
+        called: called.iter().map(|c| (*c).to_string()).collect(),
+    };
+    let vocabulary = Vocabulary {
+        objects: vec![
+            object("Coffee", &["item", "makable"], &["espresso"]),
+            object("Chips", &["item"], &["crisps", "fries"]),
+            object("Table1", &["place"], &[]),
+        ],
+        predicates: Vec::new(),
+    };
+    assert_eq!(
+        objects_text(&vocabulary),
+        "- item: Coffee (espresso), Chips (crisps, fries)\n- makable: Coffee\n- place: Table1"
     );
 }

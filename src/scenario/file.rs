@@ -12,6 +12,9 @@ pub(super) struct RawFile {
     pub(super) scenario: Option<RawMeta>,
     #[serde(default)]
     pub(super) objects: IndexMap<String, Vec<Spanned<String>>>,
+    /// What people call objects whose names do not say it: object name → words.
+    #[serde(default)]
+    pub(super) called: IndexMap<Spanned<String>, Vec<Spanned<String>>>,
     #[serde(default)]
     pub(super) predicates: Vec<RawPredicate>,
     #[serde(default)]

@@ -15,6 +15,7 @@ fn cell() -> Vocabulary {
     let obj = |n: &str, t: &str| Object {
         name: n.into(),
         types: vec![t.into()],
+        called: Vec::new(),
     };
     Vocabulary {
         objects: vec![
