@@ -10,8 +10,15 @@ use std::process::Command;
 
 const RERUN_SDK: &str = "rerun-sdk==0.36.3";
 
-/// The `rerun` program of the pinned Python package, installed on first use.
+/// The `rerun` program of the pinned Python package, installed on first use (once per
+/// test binary: two tests installing into one venv at once see each other's half-done
+/// install).
 fn rerun_cli() -> PathBuf {
+    static RERUN: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    RERUN.get_or_init(install_rerun_cli).clone()
+}
+
+fn install_rerun_cli() -> PathBuf {
     let venv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rerun-venv");
     let rerun = venv.join("bin").join("rerun");
     let version_ok = |rerun: &Path| {
@@ -116,4 +123,100 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
             "{entity} not in `rerun rrd print`:\n{listing}"
         );
     }
+}
+
+/// A session writing an `.rrd` is killed with SIGKILL while it waits for the model: the
+/// file holds the plan, the failing run and the question up to there (flushed whenever the
+/// session comes to rest), the viewer's own reader reads it, and `rerun rrd optimize`
+/// makes a complete file of it (the footer a finished recording ends with).
+#[test]
+fn a_session_killed_while_waiting_leaves_an_rrd_the_viewer_reads() {
+    use std::time::{Duration, Instant};
+    use support::fake_openai::{Behavior, FakeServer};
+
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd_kill");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("killed.rrd");
+    let rrd_arg = rrd.to_string_lossy().to_string();
+    let scenario = support::repo::root().join("scenarios/cell/red_on_blue.toml");
+    let scenario_arg = scenario.to_string_lossy().to_string();
+    let server = FakeServer::start(
+        vec![],
+        Behavior::Slow(Duration::from_secs(60), "Goal: x".into()),
+    );
+    let base = server.base_url();
+    let mut child = support::cli::command(
+        &dir,
+        &[
+            "resolve",
+            &scenario_arg,
+            "--yes",
+            "--stated-goal",
+            "--base-url",
+            &base,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            support::cli::KEY_VAR,
+            "--rrd",
+            &rrd_arg,
+        ],
+    )
+    .stdout(std::process::Stdio::null())
+    .stderr(std::process::Stdio::null())
+    .spawn()
+    .unwrap();
+    let started = Instant::now();
+    while server.received().is_empty() {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "the session never asked the model"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // The question is on its way; the flush at rest happens as it is asked.
+    std::thread::sleep(Duration::from_millis(500));
+    child.kill().unwrap();
+    child.wait().unwrap();
+
+    let rerun = rerun_cli();
+    let print = Command::new(&rerun)
+        .args(["rrd", "print"])
+        .arg(&rrd)
+        .output()
+        .unwrap();
+    let listing = String::from_utf8_lossy(&print.stdout);
+    for entity in ["/world/solids/blue_cube", "/tree/graph", "/events"] {
+        assert!(
+            listing.contains(entity),
+            "{entity} not in `rerun rrd print` of the killed session's file:\n{listing}\n{}",
+            String::from_utf8_lossy(&print.stderr)
+        );
+    }
+    let whole = dir.join("optimized.rrd");
+    let optimize = Command::new(&rerun)
+        .args(["rrd", "optimize"])
+        .arg(&rrd)
+        .arg("-o")
+        .arg(&whole)
+        .output()
+        .unwrap();
+    assert!(
+        optimize.status.success(),
+        "rerun rrd optimize: {}",
+        String::from_utf8_lossy(&optimize.stderr)
+    );
+    let verify = Command::new(&rerun)
+        .args(["rrd", "verify"])
+        .arg(&whole)
+        .output()
+        .unwrap();
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify: {}\n{}",
+        String::from_utf8_lossy(&verify.stdout),
+        String::from_utf8_lossy(&verify.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

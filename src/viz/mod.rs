@@ -101,12 +101,19 @@ fn listening(url: &str) -> bool {
         .any(|a| TcpStream::connect_timeout(&a, Duration::from_millis(500)).is_ok())
 }
 
+/// How long a flush at a resting point may wait for the sinks.
+const FLUSH_TIMEOUT: Duration = Duration::from_secs(2);
+
 /// Streams one session.
 pub struct Viz {
     rec: RecordingStream,
     tree: Option<Arc<Tree>>,
     step: i64,
     notice: Option<String>,
+    /// An `.rrd` file is written: flushed whenever the session comes to rest, so a
+    /// session killed while it waits (for the model, for a person) leaves a file that
+    /// holds everything up to there.
+    file: bool,
 }
 
 impl Viz {
@@ -169,6 +176,7 @@ impl Viz {
         };
         let mut viz = Viz::with_stream(rec);
         viz.notice = notice;
+        viz.file = sinks.rrd.is_some();
         Ok(Some(viz))
     }
 
@@ -182,6 +190,7 @@ impl Viz {
             tree: None,
             step: 0,
             notice: None,
+            file: false,
         }
     }
 
@@ -355,6 +364,21 @@ impl Viz {
             | Event::Verified { .. }
             | Event::RuleOffered { .. }
             | Event::Knowledge { .. } => {}
+        }
+        let at_rest = matches!(
+            event,
+            Event::Asking { .. }
+                | Event::Proposal { .. }
+                | Event::ActionFailed { .. }
+                | Event::Success { .. }
+                | Event::GaveUp { .. }
+                | Event::Error { .. }
+                | Event::Failed { .. }
+                | Event::BreakpointHit { .. }
+                | Event::Planned { .. }
+        );
+        if at_rest && self.file {
+            Self::warn(self.rec.flush_with_timeout(FLUSH_TIMEOUT));
         }
     }
 
