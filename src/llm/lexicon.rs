@@ -183,6 +183,49 @@ impl Lexicon {
     }
 }
 
+/// `goal` with the alternatives of every `|` in the order `request` (as [`terms`] gives
+/// it) names them: a behavior tree tries a fallback's alternatives in order, and "fries or
+/// a dessert" asks for the fries first. An alternative is placed by the first word of the
+/// request that it answers to and its sibling alternatives do not (the table both are
+/// brought to places neither); one that no such word names keeps its place after those
+/// that are named.
+pub fn in_request_order(lexicon: &Lexicon, goal: &Formula, request: &[String]) -> Formula {
+    match goal {
+        Formula::Atom(_) => goal.clone(),
+        Formula::Not(inner) => Formula::Not(Box::new(in_request_order(lexicon, inner, request))),
+        Formula::And(items) => Formula::And(
+            items
+                .iter()
+                .map(|i| in_request_order(lexicon, i, request))
+                .collect(),
+        ),
+        Formula::Or(items) => {
+            let items: Vec<Formula> = items
+                .iter()
+                .map(|i| in_request_order(lexicon, i, request))
+                .collect();
+            let covered: Vec<Vec<String>> =
+                items.iter().map(|i| lexicon.covered(i, request)).collect();
+            let first_own_word = |k: usize| {
+                request.iter().position(|w| {
+                    covered[k].contains(w)
+                        && covered
+                            .iter()
+                            .enumerate()
+                            .any(|(j, other)| j != k && !other.contains(w))
+                })
+            };
+            let mut order: Vec<(usize, Formula)> = items
+                .into_iter()
+                .enumerate()
+                .map(|(k, item)| (first_own_word(k).unwrap_or(usize::MAX), item))
+                .collect();
+            order.sort_by_key(|(at, _)| *at);
+            Formula::Or(order.into_iter().map(|(_, item)| item).collect())
+        }
+    }
+}
+
 /// Two words that are one after crude stemming ("close" and "closed" → "clos").
 pub fn same_word(a: &str, b: &str) -> bool {
     let shorter = a.len().min(b.len());
@@ -271,5 +314,74 @@ mod tests {
         assert!(covered.contains(&"6".to_string()));
         let unrelated = Formula::parse("IsClean_Floor").expect("parses");
         assert!(lexicon.covered(&unrelated, &request).is_empty());
+    }
+}
+
+#[cfg(test)]
+mod order_tests {
+    use super::*;
+    use crate::domain::{Object, Predicate};
+
+    fn lexicon() -> Lexicon {
+        let object = |n: &str, t: &str, called: &[&str]| Object {
+            name: n.into(),
+            types: vec![t.into()],
+            called: called.iter().map(|c| (*c).to_string()).collect(),
+        };
+        let vocabulary = Vocabulary {
+            objects: vec![
+                object("Chips", "item", &["crisps", "fries"]),
+                object("Dessert", "item", &[]),
+                object("Coffee", "item", &[]),
+                object("Table3", "place", &[]),
+                object("AC", "appliance", &["air conditioning"]),
+            ],
+            predicates: vec![
+                Predicate {
+                    name: "On".into(),
+                    arg_types: vec![vec!["item".into()], vec!["place".into()]],
+                    description: String::new(),
+                },
+                Predicate {
+                    name: "Active".into(),
+                    arg_types: vec![vec!["appliance".into()]],
+                    description: String::new(),
+                },
+            ],
+        };
+        Lexicon::new(&vocabulary, &[])
+    }
+
+    fn ordered(goal: &str, request: &str) -> String {
+        let goal = Formula::parse(goal).expect("parses");
+        in_request_order(&lexicon(), &goal, &terms(request)).to_string()
+    }
+
+    #[test]
+    fn alternatives_follow_the_order_the_request_names_them() {
+        // What an object is called places it too; the table both go to places neither.
+        assert_eq!(
+            ordered(
+                "On_Dessert_Table3 | On_Chips_Table3",
+                "I'm at the third table, bring me fries or a dessert"
+            ),
+            "On_Chips_Table3 | On_Dessert_Table3"
+        );
+        // Inside a conjunction, and already in order: unchanged.
+        assert_eq!(
+            ordered(
+                "Active_AC & (On_Coffee_Table3 | On_Dessert_Table3)",
+                "Turn on the air conditioning and bring a coffee or a dessert to table 3"
+            ),
+            "Active_AC & (On_Coffee_Table3 | On_Dessert_Table3)"
+        );
+        // An alternative no word names keeps its place after the named ones.
+        assert_eq!(
+            ordered(
+                "Active_AC | On_Coffee_Table3 | On_Dessert_Table3",
+                "a dessert, or else a coffee, at table three"
+            ),
+            "On_Dessert_Table3 | On_Coffee_Table3 | Active_AC"
+        );
     }
 }

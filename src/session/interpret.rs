@@ -9,11 +9,12 @@
 //! When none survives, the model is told why, in the same conversation, and asked again
 //! (reflective feedback), for a bounded number of rounds. A first answer that leaves out a
 //! number the request says ("table six" read as table 1) draws more candidates too, and
-//! one that uses the number wins the vote.
+//! one that uses the number wins the vote. The chosen goal's alternatives are put in the
+//! order the request names them, since a behavior tree tries them in that order.
 
 use crate::goal::{self, Formula};
 use crate::llm::examples::terms;
-use crate::llm::lexicon::Lexicon;
+use crate::llm::lexicon::{Lexicon, in_request_order};
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
@@ -358,7 +359,18 @@ pub async fn interpret(
         // (told why), and stays eligible for the last round's vote.
         let last_round = round + 1 == rounds;
         let chosen = judge.choose(&candidates, &set_aside, last_round);
-        if let Some((answer, doubt)) = chosen {
+        if let Some((mut answer, doubt)) = chosen {
+            if options.check_goals {
+                let ordered = in_request_order(&judge.lexicon, &answer.goal, &terms(instruction));
+                if ordered != answer.goal {
+                    emit(&Event::Notice {
+                        message: format!(
+                            "alternatives put in the order the request names them: {ordered}"
+                        ),
+                    });
+                    answer.goal = ordered;
+                }
+            }
             emit_goal(scenario, &answer, emit);
             if let Some(why) = &doubt {
                 emit(&Event::Notice {
