@@ -202,6 +202,31 @@ fn a_condition_forced_to_fail_sends_the_fallback_to_its_other_branch_until_clear
     });
 }
 
+/// Cycling a node's forced status three times at once, as keys pressed faster than the
+/// engine answers: each command cycles from what the engine holds, so the node ends at
+/// running (failure → success → running), and a fourth clears it.
+#[test]
+fn forcing_cycles_from_the_engines_own_status_however_fast_it_is_asked() {
+    rt().block_on(async {
+        let (mut s, tree) = clear_cell().await;
+        let goal = node(&tree, "\"blue cube\" on \"green cube\"");
+        for _ in 0..3 {
+            s.send(Command::CycleForce(goal));
+        }
+        s.until(
+            "forced to running",
+            |e| matches!(e, Event::Forced { forced } if *forced == [(goal, Forced::Running)]),
+        )
+        .await;
+        s.send(Command::CycleForce(goal));
+        s.until(
+            "cleared",
+            |e| matches!(e, Event::Forced { forced } if forced.is_empty()),
+        )
+        .await;
+    });
+}
+
 #[test]
 fn break_on_failure_stops_after_the_tick_in_which_a_node_fails() {
     rt().block_on(async {

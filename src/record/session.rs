@@ -99,6 +99,7 @@ pub fn command_text(command: &Command) -> String {
             status: Some(status),
             ..
         } => format!("force a node to {status}"),
+        Command::CycleForce(_) => "force a node to its next status".into(),
         Command::ToggleBreakpoint(_) => "toggle a breakpoint".into(),
         Command::BreakOnFailure(on) => {
             format!("break on failure {}", if *on { "on" } else { "off" })

@@ -10,7 +10,6 @@ use std::sync::Arc;
 
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
-use crate::bt::Forced;
 use crate::scenario::Scenario;
 use crate::session::{Command, parse_edit};
 
@@ -266,10 +265,7 @@ impl App {
                 if action == Action::Breakpoint {
                     Command::ToggleBreakpoint(node)
                 } else {
-                    Command::Force {
-                        node,
-                        status: next_forced(self.tree.forced(node)),
-                    }
+                    Command::CycleForce(node)
                 }
             }
             Action::BreakOnFailure => Command::BreakOnFailure(!self.status.break_on_failure),
@@ -398,40 +394,5 @@ impl App {
                 self.message(strings::RECORDING_DISCARDED.to_string(), false);
             }
         }
-    }
-}
-
-/// The forced status after `current` as the force key cycles: none, failure, success,
-/// running, none.
-fn next_forced(current: Option<Forced>) -> Option<Forced> {
-    match current {
-        None => Some(Forced::Failure),
-        Some(Forced::Failure) => Some(Forced::Success),
-        Some(Forced::Success) => Some(Forced::Running),
-        Some(Forced::Running) => None,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_force_key_cycles_through_every_status_and_back_to_none() {
-        let mut seen = Vec::new();
-        let mut at = None;
-        for _ in 0..4 {
-            at = next_forced(at);
-            seen.push(at);
-        }
-        assert_eq!(
-            seen,
-            [
-                Some(Forced::Failure),
-                Some(Forced::Success),
-                Some(Forced::Running),
-                None
-            ]
-        );
     }
 }

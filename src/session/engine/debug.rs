@@ -52,6 +52,11 @@ impl Engine {
         }
     }
 
+    pub(super) fn cycle_force(&mut self, node: NodeId) {
+        let next = next_forced(self.debug.forced.get(&node).copied());
+        self.force(node, next);
+    }
+
     pub(super) fn toggle_breakpoint(&mut self, node: NodeId) {
         if let Some(why) = self.unmarkable(node, "break at") {
             return self.error(why);
@@ -222,9 +227,38 @@ fn newly_failed(tree: &Tree, before: Option<&TickRecord>, after: &TickRecord) ->
         .or_else(|| failed.first().copied())
 }
 
+/// The status after `current` in the cycle failure → success → running → none.
+pub fn next_forced(current: Option<Forced>) -> Option<Forced> {
+    match current {
+        None => Some(Forced::Failure),
+        Some(Forced::Failure) => Some(Forced::Success),
+        Some(Forced::Success) => Some(Forced::Running),
+        Some(Forced::Running) => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn forcing_cycles_through_every_status_and_back_to_none() {
+        let mut seen = Vec::new();
+        let mut at = None;
+        for _ in 0..4 {
+            at = next_forced(at);
+            seen.push(at);
+        }
+        assert_eq!(
+            seen,
+            [
+                Some(Forced::Failure),
+                Some(Forced::Success),
+                Some(Forced::Running),
+                None
+            ]
+        );
+    }
     use crate::bt::{NodeKind, Outcome};
     use crate::domain::Condition;
 

@@ -118,6 +118,10 @@ pub enum Command {
         node: NodeId,
         status: Option<Forced>,
     },
+    /// Force `node` to the next status of the cycle failure → success → running → none,
+    /// from the status the engine holds: a front end that cycled from the status it last
+    /// heard of would skip a step when keys come faster than events.
+    CycleForce(NodeId),
     /// Set or clear a breakpoint on `node`: running stops before a tick that would enter
     /// it (`Event::Breakpoints`, `Event::BreakpointHit`).
     ToggleBreakpoint(NodeId),
@@ -408,6 +412,7 @@ impl Engine {
             Command::Run => self.start_running(),
             Command::Pause => self.set_running(false),
             Command::Force { node, status } => self.force(node, status),
+            Command::CycleForce(node) => self.cycle_force(node),
             Command::ToggleBreakpoint(node) => self.toggle_breakpoint(node),
             Command::BreakOnFailure(on) => self.break_on_failure(on),
             Command::Approve => self.approve(),

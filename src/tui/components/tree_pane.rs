@@ -117,15 +117,6 @@ impl TreePane {
         &self.marks.breakpoints
     }
 
-    /// The status forced on `node`, if any.
-    pub fn forced(&self, node: NodeId) -> Option<Forced> {
-        self.marks
-            .forced
-            .iter()
-            .find(|(n, _)| *n == node)
-            .map(|(_, s)| *s)
-    }
-
     /// `node` as the pane shows it (`grasp "blue cube"!`, `[-] Sequence`).
     pub fn label(&self, node: NodeId, theme: &Theme) -> String {
         self.tree
