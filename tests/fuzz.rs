@@ -16,7 +16,7 @@ fn corpus() -> &'static Corpus {
 /// Run `inputs` inputs of `name`; none may fail.
 fn fuzz(name: &str, inputs: u64) {
     let target = fuzz::target(name, corpus()).expect("a target");
-    assert!(!target.seeds().is_empty(), "{name} has no seeds");
+    assert!(!target.material().seeds.is_empty(), "{name} has no seeds");
     let options = RunOptions {
         seed: 1,
         inputs,

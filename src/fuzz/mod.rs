@@ -101,15 +101,21 @@ pub enum FuzzError {
     },
 }
 
+/// What a target's inputs are made from.
+pub struct Material {
+    /// Inputs taken from the repository or written by hand.
+    pub seeds: Vec<Vec<u8>>,
+    /// Tokens of the format, inserted by mutations.
+    pub tokens: Vec<String>,
+    /// One level of nesting (opening, closing), repeated by mutations.
+    pub brackets: Vec<(String, String)>,
+}
+
 /// What the runner needs of a target.
 pub trait Target: Sync {
     fn name(&self) -> &'static str;
-    /// Inputs taken from the repository or written by hand.
-    fn seeds(&self) -> &[Vec<u8>];
-    /// Tokens of the format, inserted by mutations.
-    fn tokens(&self) -> &[String];
-    /// One level of nesting (opening, closing), repeated by mutations.
-    fn brackets(&self) -> &[(String, String)];
+    /// The seeds and the format's pieces that mutations work from.
+    fn material(&self) -> &Material;
     /// Whether the format is text (mutations keep to character boundaries).
     fn is_text(&self) -> bool {
         true

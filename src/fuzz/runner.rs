@@ -122,7 +122,8 @@ pub fn check_caught(target: &dyn Target, input: &[u8]) -> Result<(), Violation> 
 /// mutations (sometimes none, so seeds are checked as they are).
 pub fn make_input(target: &dyn Target, seed: u64, index: u64) -> Vec<u8> {
     let mut rng = Rng::for_input(seed, index);
-    let seeds = target.seeds();
+    let material = target.material();
+    let seeds = &material.seeds;
     let mut data = if seeds.is_empty() || rng.chance(20) {
         target.generate(&mut rng)
     } else {
@@ -132,8 +133,8 @@ pub fn make_input(target: &dyn Target, seed: u64, index: u64) -> Vec<u8> {
         return data;
     }
     let grammar = Grammar {
-        tokens: target.tokens(),
-        brackets: target.brackets(),
+        tokens: &material.tokens,
+        brackets: &material.brackets,
         seeds,
         text: target.is_text(),
     };
@@ -238,6 +239,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), FuzzError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fuzz::Material;
 
     struct Picky;
 
@@ -245,14 +247,13 @@ mod tests {
         fn name(&self) -> &'static str {
             "picky"
         }
-        fn seeds(&self) -> &[Vec<u8>] {
-            &[]
-        }
-        fn tokens(&self) -> &[String] {
-            &[]
-        }
-        fn brackets(&self) -> &[(String, String)] {
-            &[]
+        fn material(&self) -> &Material {
+            static NONE: Material = Material {
+                seeds: Vec::new(),
+                tokens: Vec::new(),
+                brackets: Vec::new(),
+            };
+            &NONE
         }
         fn generate(&self, rng: &mut Rng) -> Vec<u8> {
             vec![(rng.next_u64() % 4) as u8]

@@ -10,12 +10,11 @@ use super::{
 use crate::bt::{self, NodeKind, Tree};
 use crate::domain::{Atom, Domain};
 use crate::fuzz::Corpus;
+use crate::fuzz::Material;
 use crate::interop::{from_btcpp, to_btcpp};
 
 pub struct BtcppTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     domains: Vec<(Domain, Vec<Atom>)>,
 }
 
@@ -44,53 +43,55 @@ impl BtcppTarget {
             }
         }
         BtcppTarget {
-            seeds,
-            tokens: strings(&[
-                "<ReactiveSequence>",
-                "</ReactiveSequence>",
-                "<ReactiveFallback>",
-                "</ReactiveFallback>",
-                "<Sequence>",
-                "</Sequence>",
-                "<Fallback>",
-                "</Fallback>",
-                "<Inverter>",
-                "</Inverter>",
-                "<SubTree ID=\"x\"/>",
-                "<Condition ID=\"on\" arg1=\"blue cube\" arg2=\"green cube\"/>",
-                "<Action ID=\"grasp\" x=\"egg\" force=\"5 N\"/>",
-                "<BehaviorTree ID=\"T\">",
-                "</BehaviorTree>",
-                "<root BTCPP_format=\"4\">",
-                "</root>",
-                " ID=\"",
-                " name=\"n\"",
-                " arg1=\"",
-                " _skipIf=\"x\"",
-                " port=\"{bb}\"",
-                " main_tree_to_execute=\"T\"",
-                "BTCPP_format=\"3\"",
-                "/>",
-                "</",
-                "<!-- c -->",
-                "<![CDATA[x]]>",
-                "<?xml version=\"1.0\"?>",
-                "<!DOCTYPE root [<!ENTITY e \"blue cube\">]>",
-                "&e;",
-                "&amp;",
-                "&#x0;",
-                "&#1114112;",
-                "&#xD800;",
-                "xmlns:a=\"u\"",
-                "<a:b/>",
-            ]),
-            brackets: super::pairs(&[
-                ("<ReactiveSequence>", "</ReactiveSequence>"),
-                ("<Inverter>", "</Inverter>"),
-                ("<Fallback>", "</Fallback>"),
-                ("<a>", "</a>"),
-                ("<!--", "-->"),
-            ]),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "<ReactiveSequence>",
+                    "</ReactiveSequence>",
+                    "<ReactiveFallback>",
+                    "</ReactiveFallback>",
+                    "<Sequence>",
+                    "</Sequence>",
+                    "<Fallback>",
+                    "</Fallback>",
+                    "<Inverter>",
+                    "</Inverter>",
+                    "<SubTree ID=\"x\"/>",
+                    "<Condition ID=\"on\" arg1=\"blue cube\" arg2=\"green cube\"/>",
+                    "<Action ID=\"grasp\" x=\"egg\" force=\"5 N\"/>",
+                    "<BehaviorTree ID=\"T\">",
+                    "</BehaviorTree>",
+                    "<root BTCPP_format=\"4\">",
+                    "</root>",
+                    " ID=\"",
+                    " name=\"n\"",
+                    " arg1=\"",
+                    " _skipIf=\"x\"",
+                    " port=\"{bb}\"",
+                    " main_tree_to_execute=\"T\"",
+                    "BTCPP_format=\"3\"",
+                    "/>",
+                    "</",
+                    "<!-- c -->",
+                    "<![CDATA[x]]>",
+                    "<?xml version=\"1.0\"?>",
+                    "<!DOCTYPE root [<!ENTITY e \"blue cube\">]>",
+                    "&e;",
+                    "&amp;",
+                    "&#x0;",
+                    "&#1114112;",
+                    "&#xD800;",
+                    "xmlns:a=\"u\"",
+                    "<a:b/>",
+                ]),
+                brackets: super::pairs(&[
+                    ("<ReactiveSequence>", "</ReactiveSequence>"),
+                    ("<Inverter>", "</Inverter>"),
+                    ("<Fallback>", "</Fallback>"),
+                    ("<a>", "</a>"),
+                    ("<!--", "-->"),
+                ]),
+            },
             domains,
         }
     }
@@ -130,16 +131,8 @@ impl Target for BtcppTarget {
         "btcpp"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

@@ -4,6 +4,7 @@
 //! that reads as the same entry; a replay answers each request of its model with the
 //! reply of the last entry for that request; an error names a line of the input.
 
+use crate::fuzz::Material;
 use std::future::Future;
 use std::path::Path;
 use std::pin::pin;
@@ -15,9 +16,7 @@ use crate::llm::cassette::{Entry, Replay, prompt_hash, read_entries};
 use crate::llm::{ChatRequest, LanguageModel, Message, OutputConstraint, ReplySource, TokenUsage};
 
 pub struct CassetteTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
 }
 
 impl CassetteTarget {
@@ -31,38 +30,40 @@ impl CassetteTarget {
             seeds.push(format!("{}\n", lines.join("\n")).into_bytes());
         }
         CassetteTarget {
-            seeds,
-            tokens: strings(&[
-                "\"model\":",
-                "\"reply_model\":",
-                "\"prompt_hash\":",
-                "\"request\":",
-                "\"messages\":",
-                "\"role\":\"user\"",
-                "\"role\":\"system\"",
-                "\"content\":",
-                "\"temperature\":",
-                "\"max_tokens\":",
-                "\"stop\":",
-                "\"constraint\":",
-                "\"seed\":",
-                "\"reply\":",
-                "\"usage\":",
-                "\"latency_ms\":",
-                "\"source\":",
-                "{\"kind\":\"hand-written\",\"note\":\"n\"}",
-                "\"recorded_unix\":",
-                "null",
-                "true",
-                "\\u0000",
-                "\\ud800",
-                "\\\"",
-                "1e38",
-                "3.4028236e38",
-                "-0.0",
-                "1.00000000000000000001",
-            ]),
-            brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "\"model\":",
+                    "\"reply_model\":",
+                    "\"prompt_hash\":",
+                    "\"request\":",
+                    "\"messages\":",
+                    "\"role\":\"user\"",
+                    "\"role\":\"system\"",
+                    "\"content\":",
+                    "\"temperature\":",
+                    "\"max_tokens\":",
+                    "\"stop\":",
+                    "\"constraint\":",
+                    "\"seed\":",
+                    "\"reply\":",
+                    "\"usage\":",
+                    "\"latency_ms\":",
+                    "\"source\":",
+                    "{\"kind\":\"hand-written\",\"note\":\"n\"}",
+                    "\"recorded_unix\":",
+                    "null",
+                    "true",
+                    "\\u0000",
+                    "\\ud800",
+                    "\\\"",
+                    "1e38",
+                    "3.4028236e38",
+                    "-0.0",
+                    "1.00000000000000000001",
+                ]),
+                brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            },
         }
     }
 }
@@ -158,16 +159,8 @@ impl Target for CassetteTarget {
         "cassette"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

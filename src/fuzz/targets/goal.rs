@@ -7,6 +7,7 @@
 //! counts the characters before it; `parse_goal` agrees with `Formula::parse` and accepts
 //! only atoms of the vocabulary; a parsed condition prints and reads back the same.
 
+use crate::fuzz::Material;
 use std::sync::Arc;
 
 use super::{
@@ -21,9 +22,7 @@ use crate::scenario::{GoalTextError, Scenario};
 const TRUTH_TABLE_ATOMS: usize = 8;
 
 pub struct GoalTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     /// One scenario per domain (the cafe, the cell).
     scenarios: Vec<Arc<Scenario>>,
     atoms: Vec<Atom>,
@@ -47,9 +46,11 @@ impl GoalTarget {
         let mut tokens = strings(&["&", "|", "~", "(", ")", " ", "_", "\"any object\"", " on "]);
         tokens.extend(atoms.iter().take(40).map(ToString::to_string));
         GoalTarget {
-            seeds: corpus.goals.iter().map(|g| g.as_bytes().to_vec()).collect(),
-            tokens,
-            brackets: pairs(&[("(", ")"), ("~", ""), ("~(", ")"), ("( ", " )")]),
+            material: Material {
+                seeds: corpus.goals.iter().map(|g| g.as_bytes().to_vec()).collect(),
+                tokens,
+                brackets: pairs(&[("(", ")"), ("~", ""), ("~(", ")"), ("( ", " )")]),
+            },
             scenarios,
             atoms,
         }
@@ -155,16 +156,8 @@ impl Target for GoalTarget {
         "goal"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

@@ -7,6 +7,7 @@
 //! a line that reads as the same record; a journal of the lines written reads the same
 //! records again.
 
+use crate::fuzz::Material;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -19,47 +20,47 @@ use crate::eval::sequence::SequenceStep;
 use crate::fuzz::Corpus;
 
 pub struct JournalTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     lines: Vec<String>,
 }
 
 impl JournalTarget {
     pub fn new(corpus: &Corpus) -> JournalTarget {
         JournalTarget {
-            seeds: corpus
-                .journal_lines
-                .iter()
-                .map(|l| format!("{l}\n").into_bytes())
-                .collect(),
-            tokens: strings(&[
-                "\"run\":",
-                "\"difficulty\":",
-                "\"index\":",
-                "\"scenario\":",
-                "\"success\":",
-                "\"calls\":[",
-                "\"latency_ms\":",
-                "\"price_usd\":",
-                "\"proposals\":[",
-                "\"values\":[",
-                "null",
-                "true",
-                "false",
-                "0.1",
-                "15042.769424",
-                "23017.729336999997",
-                "1.7976931348623157e308",
-                "2.2250738585072014e-308",
-                "4.9e-324",
-                "0.30000000000000004",
-                "123456789012345678901234567890",
-                "\\u0000",
-                "\\ud800\\udc00",
-                "\n",
-            ]),
-            brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            material: Material {
+                seeds: corpus
+                    .journal_lines
+                    .iter()
+                    .map(|l| format!("{l}\n").into_bytes())
+                    .collect(),
+                tokens: strings(&[
+                    "\"run\":",
+                    "\"difficulty\":",
+                    "\"index\":",
+                    "\"scenario\":",
+                    "\"success\":",
+                    "\"calls\":[",
+                    "\"latency_ms\":",
+                    "\"price_usd\":",
+                    "\"proposals\":[",
+                    "\"values\":[",
+                    "null",
+                    "true",
+                    "false",
+                    "0.1",
+                    "15042.769424",
+                    "23017.729336999997",
+                    "1.7976931348623157e308",
+                    "2.2250738585072014e-308",
+                    "4.9e-324",
+                    "0.30000000000000004",
+                    "123456789012345678901234567890",
+                    "\\u0000",
+                    "\\ud800\\udc00",
+                    "\n",
+                ]),
+                brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            },
             lines: corpus.journal_lines.clone(),
         }
     }
@@ -99,16 +100,8 @@ impl Target for JournalTarget {
         "journal"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

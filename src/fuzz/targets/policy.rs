@@ -9,15 +9,14 @@ use super::{Rng, Target, Violation, check_line_column, ensure, random_tree, stri
 use crate::bt;
 use crate::domain::{Atom, Domain};
 use crate::fuzz::Corpus;
+use crate::fuzz::Material;
 use crate::fuzz::mutate::random_char;
 use crate::session::policy::{
     self, Approval, Fix, Policy, PolicyTreeError, parse_node_path, render, scenario_of,
 };
 
 pub struct PolicyTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     /// Scenario path (relative), domain, atoms, planned tree.
     scenes: Vec<(String, Domain, Vec<Atom>, Option<bt::Tree>)>,
 }
@@ -56,32 +55,34 @@ impl PolicyTarget {
             })
             .collect();
         PolicyTarget {
-            seeds,
-            tokens: strings(&[
-                "# betr policy\n",
-                "# scenario: ",
-                "# instruction: ",
-                "# goal: ",
-                "# saved at: ",
-                "# fix 1: ",
-                "#   nodes: ",
-                "#   model: ",
-                "; approved by a person; at ",
-                "; auto-approved; at ",
-                "; written by a person; at ",
-                ", ",
-                "root",
-                "0.1.2",
-                "18446744073709551616.1",
-                " (",
-                ")",
-                "sequence\n",
-                "fallback\n",
-                "  ",
-                "?\n",
-                "!\n",
-            ]),
-            brackets: super::pairs(&[("  ", ""), ("# ", "\n"), ("(", ")")]),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "# betr policy\n",
+                    "# scenario: ",
+                    "# instruction: ",
+                    "# goal: ",
+                    "# saved at: ",
+                    "# fix 1: ",
+                    "#   nodes: ",
+                    "#   model: ",
+                    "; approved by a person; at ",
+                    "; auto-approved; at ",
+                    "; written by a person; at ",
+                    ", ",
+                    "root",
+                    "0.1.2",
+                    "18446744073709551616.1",
+                    " (",
+                    ")",
+                    "sequence\n",
+                    "fallback\n",
+                    "  ",
+                    "?\n",
+                    "!\n",
+                ]),
+                brackets: super::pairs(&[("  ", ""), ("# ", "\n"), ("(", ")")]),
+            },
             scenes,
         }
     }
@@ -126,16 +127,8 @@ impl Target for PolicyTarget {
         "policy"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

@@ -8,6 +8,7 @@
 //! (`Encoder`) to an entry that decodes and encodes to itself again; a decoding error
 //! names the entry's line.
 
+use crate::fuzz::Material;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -26,9 +27,7 @@ use crate::scenario::Scenario;
 const DECODED_AT_MOST: usize = 200;
 
 pub struct RecordingTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     /// Scenario path (relative), scenario, planned tree text.
     scenes: Vec<(String, Arc<Scenario>, String)>,
 }
@@ -47,29 +46,31 @@ impl RecordingTarget {
             .map(|k| recording(&mut Rng::new(k), &scenes[k as usize]).into_bytes())
             .collect();
         RecordingTarget {
-            seeds,
-            tokens: strings(&[
-                "{\"kind\":\"event\",\"ms\":1,\"event\":",
-                "{\"kind\":\"command\",\"ms\":1,\"command\":\"run\"}\n",
-                "{\"event\":\"tick\",",
-                "{\"event\":\"tree\",\"text\":\"sequence\\n  Sweep!\\n\",\"new_nodes\":[0,1],\"why\":\"\"}",
-                "{\"event\":\"approved\"}",
-                "\"statuses\":\"",
-                "\"root\":\"",
-                "\"node\":",
-                "\"visited\":[",
-                "\"failures\":[[",
-                "\"forced\":[[0,\"S\"]]",
-                "\"type\":\"conditions\"",
-                "\"type\":\"value\"",
-                "RSFH-",
-                "18446744073709551615",
-                "18446744073709551616",
-                "\"version\":2",
-                "\\n",
-                "\\u0000",
-            ]),
-            brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "{\"kind\":\"event\",\"ms\":1,\"event\":",
+                    "{\"kind\":\"command\",\"ms\":1,\"command\":\"run\"}\n",
+                    "{\"event\":\"tick\",",
+                    "{\"event\":\"tree\",\"text\":\"sequence\\n  Sweep!\\n\",\"new_nodes\":[0,1],\"why\":\"\"}",
+                    "{\"event\":\"approved\"}",
+                    "\"statuses\":\"",
+                    "\"root\":\"",
+                    "\"node\":",
+                    "\"visited\":[",
+                    "\"failures\":[[",
+                    "\"forced\":[[0,\"S\"]]",
+                    "\"type\":\"conditions\"",
+                    "\"type\":\"value\"",
+                    "RSFH-",
+                    "18446744073709551615",
+                    "18446744073709551616",
+                    "\"version\":2",
+                    "\\n",
+                    "\\u0000",
+                ]),
+                brackets: super::pairs(&[("[", "]"), ("{\"a\":", "}")]),
+            },
             scenes,
         }
     }
@@ -280,16 +281,8 @@ impl Target for RecordingTarget {
         "recording"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

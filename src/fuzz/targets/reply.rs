@@ -12,13 +12,12 @@
 use super::{Rng, Target, Violation, atoms_of, ensure, random_formula, strings, text_of};
 use crate::domain::{Atom, Condition, Value, ValueParam, Vocabulary};
 use crate::fuzz::Corpus;
+use crate::fuzz::Material;
 use crate::goal::Formula;
 use crate::llm::reply::{self, MIN_SIMILARITY, Substitution};
 
 pub struct ReplyTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     vocabularies: Vec<Vocabulary>,
     params: Vec<ValueParam>,
     atoms: Vec<Atom>,
@@ -88,13 +87,15 @@ impl ReplyTarget {
         }
         tokens.extend(params.iter().flat_map(|p| p.categories.clone()));
         ReplyTarget {
-            seeds: corpus
-                .replies
-                .iter()
-                .map(|r| r.text.as_bytes().to_vec())
-                .collect(),
-            tokens,
-            brackets: super::pairs(&[("(", ")"), ("[", "]"), ("{\"a\": ", "}"), ("**", "**")]),
+            material: Material {
+                seeds: corpus
+                    .replies
+                    .iter()
+                    .map(|r| r.text.as_bytes().to_vec())
+                    .collect(),
+                tokens,
+                brackets: super::pairs(&[("(", ")"), ("[", "]"), ("{\"a\": ", "}"), ("**", "**")]),
+            },
             vocabularies,
             params,
             atoms,
@@ -209,16 +210,8 @@ impl Target for ReplyTarget {
         "reply"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

@@ -8,6 +8,7 @@
 //! read back the same; an error in the input names a line of it and a column inside that
 //! line (or no place at all, line 0 and column 0).
 
+use crate::fuzz::Material;
 use std::path::{Path, PathBuf};
 
 use super::{Rng, Target, Violation, check_line_column, ensure, random_formula, strings, text_of};
@@ -17,9 +18,7 @@ use crate::scenario::{Scenario, ScenarioError};
 use crate::verify::VerifyConfig;
 
 pub struct ScenarioTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     root: PathBuf,
     /// Every file read as a base or pool, by path, to check errors located in them.
     files: Vec<(PathBuf, String)>,
@@ -43,60 +42,62 @@ impl ScenarioTarget {
             })
             .collect();
         ScenarioTarget {
-            seeds: corpus
-                .toml_files
-                .iter()
-                .map(|(_, t)| t.as_bytes().to_vec())
-                .collect(),
-            tokens: strings(&[
-                "[scenario]\n",
-                "[[skills]]\n",
-                "[[predicates]]\n",
-                "[objects]\n",
-                "[world]\n",
-                "[verify]\n",
-                "[[examples]]\n",
-                "[[conventions]]\n",
-                "[world.solids.\"x\"]\n",
-                "name = ",
-                "goal = ",
-                "extends = ",
-                "example_pool = ",
-                "instruction = ",
-                "expected_fix = [",
-                "params = [",
-                "pre = [",
-                "add = [",
-                "del = [",
-                "args = [",
-                "cost = ",
-                "ticks = ",
-                "values = [{ name = \"force\", unit = \"N\", min = 1, max = 0 }]\n",
-                "kind = \"cell\"\n",
-                "kind = \"symbolic\"\n",
-                "properties = ['never \"red cube\" grasped']\n",
-                "\"\"\"",
-                "'''",
-                "\\u0000",
-                "\\U0010FFFF",
-                "\\uD800",
-                "\\",
-                "= [",
-                "{ ",
-                " }",
-                "1979-05-27T07:32:00Z",
-                "+inf",
-                "0b101",
-                "0o7",
-                "1_000",
-                "{*}",
-                "\"{x}\"",
-                "x: item",
-                " except ",
-                "|",
-                "\"any object\"",
-            ]),
-            brackets: super::pairs(&[("[", "]"), ("{a = ", "}"), ("[[", "]]"), ("\"", "\"")]),
+            material: Material {
+                seeds: corpus
+                    .toml_files
+                    .iter()
+                    .map(|(_, t)| t.as_bytes().to_vec())
+                    .collect(),
+                tokens: strings(&[
+                    "[scenario]\n",
+                    "[[skills]]\n",
+                    "[[predicates]]\n",
+                    "[objects]\n",
+                    "[world]\n",
+                    "[verify]\n",
+                    "[[examples]]\n",
+                    "[[conventions]]\n",
+                    "[world.solids.\"x\"]\n",
+                    "name = ",
+                    "goal = ",
+                    "extends = ",
+                    "example_pool = ",
+                    "instruction = ",
+                    "expected_fix = [",
+                    "params = [",
+                    "pre = [",
+                    "add = [",
+                    "del = [",
+                    "args = [",
+                    "cost = ",
+                    "ticks = ",
+                    "values = [{ name = \"force\", unit = \"N\", min = 1, max = 0 }]\n",
+                    "kind = \"cell\"\n",
+                    "kind = \"symbolic\"\n",
+                    "properties = ['never \"red cube\" grasped']\n",
+                    "\"\"\"",
+                    "'''",
+                    "\\u0000",
+                    "\\U0010FFFF",
+                    "\\uD800",
+                    "\\",
+                    "= [",
+                    "{ ",
+                    " }",
+                    "1979-05-27T07:32:00Z",
+                    "+inf",
+                    "0b101",
+                    "0o7",
+                    "1_000",
+                    "{*}",
+                    "\"{x}\"",
+                    "x: item",
+                    " except ",
+                    "|",
+                    "\"any object\"",
+                ]),
+                brackets: super::pairs(&[("[", "]"), ("{a = ", "}"), ("[[", "]]"), ("\"", "\"")]),
+            },
             root: corpus.root.clone(),
             files: corpus.toml_files.clone(),
             scenes,
@@ -150,16 +151,8 @@ impl Target for ScenarioTarget {
         "scenario"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

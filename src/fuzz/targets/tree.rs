@@ -14,6 +14,7 @@ use crate::bt::{self, ActionStep, Leaves, NodeId, Ticker};
 use crate::domain::action::parse_value;
 use crate::domain::{ActionCall, Atom, Condition, Domain};
 use crate::fuzz::Corpus;
+use crate::fuzz::Material;
 
 /// Lines of an input whose actions and values are checked too.
 const LINES_CHECKED: usize = 40;
@@ -35,9 +36,7 @@ sequence
 ";
 
 pub struct TreeTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
     domains: Vec<(Domain, Vec<Atom>)>,
 }
 
@@ -52,31 +51,38 @@ impl TreeTarget {
                 .map(|t| bt::to_text(t).into_bytes()),
         );
         TreeTarget {
-            seeds,
-            tokens: strings(&[
-                "sequence\n",
-                "fallback\n",
-                "  ",
-                "\n  ",
-                "?",
-                "!",
-                "~",
-                "# ",
-                "\"",
-                " {",
-                "}",
-                " = ",
-                ", ",
-                " N",
-                " m/s",
-                "force",
-                "\"any object\"",
-                " on ",
-                "_",
-                "\t",
-                "\r",
-            ]),
-            brackets: super::pairs(&[("sequence\n  ", ""), ("  ", ""), ("{", "}"), ("\"", "\"")]),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "sequence\n",
+                    "fallback\n",
+                    "  ",
+                    "\n  ",
+                    "?",
+                    "!",
+                    "~",
+                    "# ",
+                    "\"",
+                    " {",
+                    "}",
+                    " = ",
+                    ", ",
+                    " N",
+                    " m/s",
+                    "force",
+                    "\"any object\"",
+                    " on ",
+                    "_",
+                    "\t",
+                    "\r",
+                ]),
+                brackets: super::pairs(&[
+                    ("sequence\n  ", ""),
+                    ("  ", ""),
+                    ("{", "}"),
+                    ("\"", "\""),
+                ]),
+            },
             domains: distinct_domains(corpus),
         }
     }
@@ -235,16 +241,8 @@ impl Target for TreeTarget {
         "tree"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn generate(&self, rng: &mut Rng) -> Vec<u8> {

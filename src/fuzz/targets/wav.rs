@@ -7,6 +7,7 @@
 //! is written (`to_wav_bytes`) and read back with as many samples, each what 16-bit
 //! PCM keeps of it; every error says something.
 
+use crate::fuzz::Material;
 use std::path::Path;
 
 use super::{Rng, Target, Violation, ensure, strings};
@@ -16,9 +17,7 @@ use crate::voice::Audio16k;
 const PEAK_GROWTH_LIMIT_KB: u64 = 512 * 1024;
 
 pub struct WavTarget {
-    seeds: Vec<Vec<u8>>,
-    tokens: Vec<String>,
-    brackets: Vec<(String, String)>,
+    material: Material,
 }
 
 impl WavTarget {
@@ -48,18 +47,20 @@ impl WavTarget {
             })
             .collect();
         WavTarget {
-            seeds,
-            tokens: strings(&[
-                "RIFF",
-                "WAVE",
-                "fmt ",
-                "data",
-                "fact",
-                "LIST",
-                "JUNK",
-                "\u{0}\u{0}\u{0}\u{0}",
-            ]),
-            brackets: Vec::new(),
+            material: Material {
+                seeds,
+                tokens: strings(&[
+                    "RIFF",
+                    "WAVE",
+                    "fmt ",
+                    "data",
+                    "fact",
+                    "LIST",
+                    "JUNK",
+                    "\u{0}\u{0}\u{0}\u{0}",
+                ]),
+                brackets: Vec::new(),
+            },
         }
     }
 }
@@ -178,16 +179,8 @@ impl Target for WavTarget {
         "wav"
     }
 
-    fn seeds(&self) -> &[Vec<u8>] {
-        &self.seeds
-    }
-
-    fn tokens(&self) -> &[String] {
-        &self.tokens
-    }
-
-    fn brackets(&self) -> &[(String, String)] {
-        &self.brackets
+    fn material(&self) -> &Material {
+        &self.material
     }
 
     fn is_text(&self) -> bool {
