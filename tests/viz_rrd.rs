@@ -58,6 +58,26 @@ fn install_rerun_cli() -> PathBuf {
     rerun
 }
 
+/// `rerun rrd ARGS…` with the pinned CLI.
+fn rerun_rrd(args: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new(rerun_cli())
+        .arg("rrd")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Whether `rerun rrd verify` accepts `file`, with what it said.
+fn verified(file: &Path) -> (bool, String) {
+    let out = rerun_rrd(&["verify".as_ref(), file.as_os_str()]);
+    let said = format!(
+        "rerun rrd verify: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), said)
+}
+
 #[test]
 fn scenario1_recording_verifies_and_lists_the_entities() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd");
@@ -82,24 +102,10 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
     assert!(stdout.contains("SUCCESS"), "{stdout}");
     assert!(rrd.metadata().unwrap().len() > 0);
 
-    let rerun = rerun_cli();
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify"])
-        .arg(&rrd)
-        .output()
-        .unwrap();
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify: {}\n{}",
-        String::from_utf8_lossy(&verify.stdout),
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    let (ok, said) = verified(&rrd);
+    assert!(ok, "{said}");
 
-    let print = Command::new(&rerun)
-        .args(["rrd", "print"])
-        .arg(&rrd)
-        .output()
-        .unwrap();
+    let print = rerun_rrd(&["print".as_ref(), rrd.as_os_str()]);
     assert!(
         print.status.success(),
         "{}",
@@ -180,12 +186,7 @@ fn a_session_killed_while_waiting_leaves_an_rrd_the_viewer_reads() {
     child.kill().unwrap();
     child.wait().unwrap();
 
-    let rerun = rerun_cli();
-    let print = Command::new(&rerun)
-        .args(["rrd", "print"])
-        .arg(&rrd)
-        .output()
-        .unwrap();
+    let print = rerun_rrd(&["print".as_ref(), rrd.as_os_str()]);
     let listing = String::from_utf8_lossy(&print.stdout);
     for entity in ["/world/solids/blue_cube", "/tree/graph", "/events"] {
         assert!(
@@ -195,28 +196,18 @@ fn a_session_killed_while_waiting_leaves_an_rrd_the_viewer_reads() {
         );
     }
     let whole = dir.join("optimized.rrd");
-    let optimize = Command::new(&rerun)
-        .args(["rrd", "optimize"])
-        .arg(&rrd)
-        .arg("-o")
-        .arg(&whole)
-        .output()
-        .unwrap();
+    let optimize = rerun_rrd(&[
+        "optimize".as_ref(),
+        rrd.as_os_str(),
+        "-o".as_ref(),
+        whole.as_os_str(),
+    ]);
     assert!(
         optimize.status.success(),
         "rerun rrd optimize: {}",
         String::from_utf8_lossy(&optimize.stderr)
     );
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify"])
-        .arg(&whole)
-        .output()
-        .unwrap();
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify: {}\n{}",
-        String::from_utf8_lossy(&verify.stdout),
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    let (ok, said) = verified(&whole);
+    assert!(ok, "{said}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
