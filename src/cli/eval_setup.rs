@@ -148,6 +148,8 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         options.goal_feedback_rounds.to_string(),
     );
     settings.insert("shortlist".into(), options.shortlist.to_string());
+    settings.insert("read_by_parts".into(), options.read_by_parts.to_string());
+    settings.insert("value_levels".into(), options.value_levels.to_string());
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     for (k, v) in [
@@ -183,8 +185,14 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
             },
             if llm.options.check_goals {
                 format!(
-                    "checked ({} candidates, {} feedback rounds)",
-                    llm.options.candidates, llm.options.goal_feedback_rounds
+                    "checked ({} candidates, {} feedback rounds{})",
+                    llm.options.candidates,
+                    llm.options.goal_feedback_rounds,
+                    if llm.options.read_by_parts {
+                        ", a wish at a time"
+                    } else {
+                        ", whole request"
+                    }
                 )
             } else {
                 "unchecked".to_string()

@@ -89,6 +89,14 @@ pub struct LlmFlags {
     /// Times the model is told why its goals were refused and asked again (default 2).
     #[arg(long, value_name = "N")]
     pub feedback_rounds: Option<usize>,
+    /// Read a request of several wishes whole, instead of one wish at a time with the
+    /// goals joined as the request joins them.
+    #[arg(long)]
+    pub whole_request: bool,
+    /// Ask a numeric parameter's first value as a number, instead of as a level (very low
+    /// … very high) of the range the robot can do that betr turns into a number.
+    #[arg(long)]
+    pub value_as_number: bool,
     /// Let the model name a failure's missing condition out of the whole vocabulary,
     /// instead of choosing among the conditions over the action's objects that fix the
     /// failure when tried in simulation.
@@ -202,6 +210,8 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         check_goals: !flags.no_checks,
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
         goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
+        read_by_parts: !flags.whole_request,
+        value_levels: !flags.value_as_number,
         shortlist: !flags.no_shortlist,
         ..Options::default()
     };

@@ -17,6 +17,7 @@ pub mod openai;
 pub mod printable;
 pub mod prompt;
 pub mod reply;
+pub mod request_parts;
 pub mod schema;
 pub mod usage;
 

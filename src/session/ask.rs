@@ -15,6 +15,7 @@ use super::screen::{NotHelped, Screen};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
 use super::value_bounds::Bounds;
+use super::value_levels::{as_levels, level_value};
 
 /// Ask, constraining the reply the way the backend can: a grammar for the local model
 /// (built only when used), a JSON schema for servers that take one, else plain text.
@@ -373,14 +374,22 @@ pub(crate) async fn ask_value(
     let unit = param.unit.as_deref().unwrap_or("");
     let summary = bounds.summary(unit);
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
+    // The first question about a number asks for a level of the robot's range; once the
+    // world has answered, the next ones ask for numbers.
+    let levels = if tried.is_empty() && options.value_levels {
+        as_levels(param)
+    } else {
+        None
+    };
+    let asked_as = levels.as_ref().unwrap_or(param);
     let messages = ctx.value(
         &options.templates,
         action,
-        param,
+        asked_as,
         error,
         (&tried_lines, summary.as_deref()),
     )?;
-    let value_grammar = || grammar::value_grammar(param.unit.as_deref(), &param.categories);
+    let value_grammar = || grammar::value_grammar(asked_as.unit.as_deref(), &asked_as.categories);
     let proposal = |value| Proposal::Value {
         skill: action.skill.clone(),
         object: action.args.first().cloned().unwrap_or_default(),
@@ -388,8 +397,25 @@ pub(crate) async fn ask_value(
         value,
     };
     let read = |text: &str| {
-        reply::value(text, param, options.min_similarity)
-            .map(|a| (proposal(a.value), a.reasoning, a.substitutions))
+        let answer = reply::value(text, asked_as, options.min_similarity)?;
+        let (value, reasoning) = match &levels {
+            None => (answer.value, answer.reasoning),
+            Some(_) => {
+                let number =
+                    level_value(param, &answer.value).ok_or_else(|| ReplyError::BadValue {
+                        text: answer.value.to_string(),
+                        reason: "not one of the levels offered".into(),
+                    })?;
+                // The level the model chose is shown with the number it stands for.
+                let said = format!("Level {} of what the robot can do: {number}.", answer.value);
+                let reasoning = match answer.reasoning {
+                    Some(r) => format!("{said} {r}"),
+                    None => said,
+                };
+                (number, Some(reasoning))
+            }
+        };
+        Ok((proposal(value), reasoning, answer.substitutions))
     };
     let mut asked = draw_and_screen(
         model,

@@ -7,9 +7,10 @@
 //! in the model's cache, so each costs only its own tokens) and the survivors vote: the
 //! largest group of logically equivalent goals wins, the earliest drawn breaking ties.
 //! When none survives, the model is told why, in the same conversation, and asked again
-//! (reflective feedback), for a bounded number of rounds. A first answer that leaves out a
-//! number the request says ("table six" read as table 1) draws more candidates too, and
-//! one that uses the number wins the vote. The chosen goal's alternatives are put in the
+//! (reflective feedback), for a bounded number of rounds. A first answer that plainly
+//! misread the request — it leaves out a number the request says ("table six" read as
+//! table 1), or puts an object nobody named in the place of one the request names
+//! ("fries" read as coffee) — draws more candidates too, and one that does not wins. The chosen goal's alternatives are put in the
 //! order the request names them, since a behavior tree tries them in that order.
 
 use crate::goal::{self, Formula};
@@ -23,9 +24,12 @@ use crate::world::World;
 
 use super::ask::ask;
 use super::goal_checks::{
-    GoalProblem, assess, renumbered, unanswered_names, without_copied, without_unasked,
+    GoalProblem, assess, renumbered, swapped_object, unanswered_names, without_copied,
+    without_unasked,
 };
+use super::interpret_parts::{PartsRead, read_parts};
 use super::types::{Event, Options, SessionError};
+use crate::llm::request_parts::split;
 
 /// Sampling temperature of the extra candidates: enough to make them differ from the
 /// first answer, low enough to stay on the request.
@@ -95,12 +99,31 @@ impl Judge<'_> {
             .collect()
     }
 
-    /// A clean candidate that leaves out no number the request says.
-    fn answers_numbers(&self, c: &Candidate) -> bool {
+    /// How `goal` has misread the request, if it plainly has: it leaves out a number the
+    /// request says ("table six" read as table 1), or it puts an object nobody named in
+    /// the place of one the request names ("fries" read as coffee).
+    fn misread(&self, goal: &Formula) -> Option<String> {
+        let numbers = self.missing_numbers(goal);
+        if !numbers.is_empty() {
+            return Some(format!(
+                "the request says {}, and no condition of {goal} is about it",
+                numbers.join(", ")
+            ));
+        }
+        swapped_object(goal, self.instruction, &self.lexicon).map(|(object, words)| {
+            format!(
+                "the request says {}, which no condition of {goal} answers, and never names {object}",
+                words.join(", ")
+            )
+        })
+    }
+
+    /// A clean candidate that has not plainly misread the request.
+    fn answers_request(&self, c: &Candidate) -> bool {
         c.clean()
             && c.read
                 .as_ref()
-                .is_ok_and(|a| self.missing_numbers(&a.goal).is_empty())
+                .is_ok_and(|a| self.misread(&a.goal).is_none())
     }
 
     /// Candidates made from an answer that failed a check: without what it pasted from an
@@ -161,7 +184,7 @@ impl Judge<'_> {
     }
 
     /// The goal chosen among `candidates`, with the doubt raised about it: a clean one
-    /// that answers every number the request says, else a clean one, else — when it is the
+    /// that has not plainly misread the request, else a clean one, else — when it is the
     /// model's own first answer or no round is left — a doubtful one (those set aside in
     /// earlier rounds vote too).
     fn choose(
@@ -171,7 +194,7 @@ impl Judge<'_> {
         last_round: bool,
     ) -> Option<(GoalAnswer, Option<String>)> {
         let first_doubtful = candidates.iter().any(|c| c.first && c.doubtful());
-        vote(candidates, |c| self.answers_numbers(c))
+        vote(candidates, |c| self.answers_request(c))
             .or_else(|| vote(candidates, Candidate::clean))
             .map(|a| (a, None))
             .or_else(|| {
@@ -191,9 +214,6 @@ impl Judge<'_> {
     }
 }
 
-/// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
-/// as the module says (`options.check_goals` off: the first usable answer, as the paper's
-/// single call).
 /// [`interpret`] against the scenario's first state.
 pub async fn interpret_in_scenario(
     scenario: &Scenario,
@@ -206,7 +226,65 @@ pub async fn interpret_in_scenario(
     interpret(scenario, world, instruction, model, options, emit).await
 }
 
+/// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
+/// as the module says (`options.check_goals` off: the first usable answer, as the paper's
+/// single call). A request of several wishes is read a wish at a time
+/// (`options.read_by_parts`, see [`super::interpret_parts`]) when checks are on.
 pub async fn interpret(
+    scenario: &Scenario,
+    world: Box<dyn World>,
+    instruction: &str,
+    model: &dyn LanguageModel,
+    options: &Options,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<Interpretation, SessionError> {
+    let mut earlier_calls = 0;
+    if options.check_goals && options.read_by_parts {
+        let lexicon = Lexicon::new(&scenario.domain.vocabulary, example_pool(scenario, options));
+        let parts = split(instruction, &lexicon);
+        if parts.len() > 1 {
+            let forked = world.fork();
+            match read_parts(scenario, forked, &parts, instruction, model, options, emit).await? {
+                PartsRead::Read(found) => {
+                    announce(scenario, &found, emit);
+                    return Ok(found);
+                }
+                PartsRead::Whole { calls } => earlier_calls = calls,
+            }
+        }
+    }
+    let mut found = read_goal(scenario, world, instruction, model, options, emit).await?;
+    found.calls += earlier_calls;
+    announce(scenario, &found, emit);
+    Ok(found)
+}
+
+/// The examples a goal prompt chooses from: another prompt's, for an ablation, or the
+/// scenario's pool.
+pub(super) fn example_pool<'a>(
+    scenario: &'a Scenario,
+    options: &'a Options,
+) -> &'a [crate::scenario::Example] {
+    options
+        .variant
+        .examples
+        .as_deref()
+        .unwrap_or(&scenario.examples)
+}
+
+/// Tell the front end the goal chosen, and the doubt raised about it.
+fn announce(scenario: &Scenario, found: &Interpretation, emit: &mut (dyn FnMut(&Event) + Send)) {
+    emit_goal(scenario, &found.answer, emit);
+    if let Some(why) = &found.doubt {
+        emit(&Event::Notice {
+            message: format!("check the goal before it runs: {why}"),
+        });
+    }
+}
+
+/// One reading of `instruction` as a goal — candidates, checks, vote, feedback — without
+/// announcing it.
+pub(super) async fn read_goal(
     scenario: &Scenario,
     world: Box<dyn World>,
     instruction: &str,
@@ -222,11 +300,7 @@ pub async fn interpret(
         variant: &options.variant,
     };
     let mut messages = ctx.goal(&options.templates)?;
-    let pool = options
-        .variant
-        .examples
-        .as_deref()
-        .unwrap_or(&scenario.examples);
+    let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
     let judge = Judge {
         scenario,
@@ -328,25 +402,20 @@ pub async fn interpret(
             // passes once what it pasted is taken out) is taken, and a doubtful one is
             // kept, since sampled alternatives to the model's best answer are worse more
             // often than better.
-            // One exception: a first answer that leaves out a number the request says
-            // ("table six" read as table 1) has misread a place; candidates that use the
-            // number are drawn.
-            let misses = candidates
+            // One exception: a first answer that plainly misread the request (left out a
+            // number it says, or put an unnamed object in the place of a named one); more
+            // candidates are drawn, and one that does not misread wins the vote.
+            let misread = candidates
                 .first()
                 .and_then(|c| c.read.as_ref().ok())
-                .map(|a| judge.missing_numbers(&a.goal));
+                .and_then(|a| judge.misread(&a.goal));
             if draw == 0
-                && let Some(missed) = misses.as_ref().filter(|m| !m.is_empty())
-                && let Some(Ok(a)) = candidates.first().map(|c| &c.read)
+                && let Some(why) = misread
                 && options.check_goals
-                && !candidates.iter().any(|c| judge.answers_numbers(c))
+                && !candidates.iter().any(|c| judge.answers_request(c))
             {
                 emit(&Event::Notice {
-                    message: format!(
-                        "the request says {}, and no condition of {} is about it: drawing more candidates",
-                        missed.join(", "),
-                        a.goal
-                    ),
+                    message: format!("{why}: drawing more candidates"),
                 });
                 continue;
             }
@@ -370,12 +439,6 @@ pub async fn interpret(
                     });
                     answer.goal = ordered;
                 }
-            }
-            emit_goal(scenario, &answer, emit);
-            if let Some(why) = &doubt {
-                emit(&Event::Notice {
-                    message: format!("check the goal before it runs: {why}"),
-                });
             }
             return Ok(Interpretation {
                 answer,

@@ -8,6 +8,7 @@ pub mod edit;
 pub mod engine;
 pub mod goal_checks;
 pub mod interpret;
+mod interpret_parts;
 pub mod knowledge;
 pub mod planned;
 pub mod policy;
@@ -16,6 +17,7 @@ pub mod screen;
 pub mod shortlist;
 pub mod types;
 pub mod value_bounds;
+mod value_levels;
 pub mod values;
 
 pub use crate::planner::RunLimits;

@@ -41,6 +41,12 @@ pub struct Options {
     pub candidates: usize,
     /// Times the model is told why its candidate goals were refused and asked again.
     pub goal_feedback_rounds: usize,
+    /// With checks on, read a request of several wishes one wish at a time and join the
+    /// goals as the request joins them; off: the request is read whole.
+    pub read_by_parts: bool,
+    /// Ask the first value of a numeric parameter as a level of the robot's declared
+    /// range (very low … very high), turned into a number by betr; off: as a number.
+    pub value_levels: bool,
     /// `resolve`: work on the scenario's stated goal instead of reading the instruction
     /// (so the failure under study is reached whatever a model would read); the
     /// instruction still reaches the questions about failures.
@@ -70,6 +76,8 @@ impl Default for Options {
             check_goals: true,
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,
+            read_by_parts: true,
+            value_levels: true,
             use_scenario_goal: false,
             shortlist: true,
             temperature: 0.0,

@@ -1,0 +1,220 @@
+//! Tests of the checks a candidate goal must pass.
+
+use super::*;
+use std::path::Path;
+
+fn cafe() -> (Scenario, Box<dyn World>) {
+    let s = Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+        .expect("cafe scenario");
+    let w = crate::world::load(&s).expect("cafe world");
+    (s, w)
+}
+
+fn check(goal: &str) -> Result<(), String> {
+    let (s, w) = cafe();
+    let f = s.parse_goal(goal).expect("goal parses");
+    check_goal(&s, w.as_ref(), &f).map_err(|p| p.reason)
+}
+
+#[test]
+fn checks_refuse_what_cannot_be_meant() {
+    assert!(check("On_Coffee_Table1").is_ok());
+    assert!(check("Active_AC & ~Active_HallLight").is_ok());
+    let e = check("Active_AC & ~Active_AC").unwrap_err();
+    assert!(e.contains("contradicts"), "{e}");
+    let e = check("RobotNear_Bar | ~RobotNear_Bar").unwrap_err();
+    assert!(e.contains("every situation"), "{e}");
+    // Already true in the cafe's first state.
+    let e = check("On_Chips_Bar").unwrap_err();
+    assert!(e.contains("already"), "{e}");
+    let e = check("RobotNear_Table1 & RobotNear_Table2").unwrap_err();
+    assert!(e.contains("cannot"), "{e}");
+}
+
+#[test]
+fn a_condition_pasted_from_an_example_is_found() {
+    let example = crate::scenario::Example {
+        instruction: "Put the sponge in the bowl and leave your gripper empty".into(),
+        goal: r#""sponge" in "bowl" & ~"any object" grasped"#.into(),
+    };
+    let shown = [&example];
+    let request = "Put the blue cube on the green cube";
+    let pasted =
+        Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#).expect("parses");
+    let why = copied_from_example(&pasted, &shown, request).expect("found");
+    assert!(why.contains("grasped"), "{why}");
+    let plain = Formula::parse(r#""blue cube" on "green cube""#).expect("parses");
+    assert!(copied_from_example(&plain, &shown, request).is_none());
+    // Asked for in other words ("hand empty" is not "grasped", but the object is
+    // named): not a copy.
+    let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
+    assert!(copied_from_example(&named, &shown, "take the sponge out").is_none());
+}
+
+#[test]
+fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
+    let example = crate::scenario::Example {
+        instruction: "It's really stuffy in here, and leave your gripper empty".into(),
+        goal: r#"Active_AC & ~"any object" grasped"#.into(),
+    };
+    let shown = [&example];
+    let pasted =
+        Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#).expect("parses");
+    let rest =
+        without_copied(&pasted, &shown, "Put the blue cube on the green cube").expect("pruned");
+    assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
+    // "hot" is not covered by the curtain: the AC may be what it asks for.
+    let indirect = Formula::parse("Closed_Curtain & Active_AC").expect("parses");
+    assert!(without_copied(&indirect, &shown, "It's hot here, close the curtain").is_none());
+    assert!(same_word("clos", "close") && same_word("cube", "cube") && !same_word("ac", "at"));
+}
+
+#[test]
+fn a_condition_no_word_asks_for_is_taken_out() {
+    let (scenario, _) = cafe();
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "Please take a sandwich to the second table.";
+    let appended = g("On_Sandwiches_Table2 & RobotNear_Table2");
+    assert_eq!(
+        unasked(&appended, request, &lexicon),
+        vec![g("RobotNear_Table2")]
+    );
+    assert_eq!(
+        without_unasked(&appended, request, &lexicon),
+        Some(g("On_Sandwiches_Table2"))
+    );
+    // Every part answers to words of its own: nothing goes.
+    let request = "Mop the floor, and bring a teacup to table two.";
+    let both = g("IsClean_Floor & On_Teacup_Table2");
+    assert!(unasked(&both, request, &lexicon).is_empty());
+    assert_eq!(without_unasked(&both, request, &lexicon), None);
+    // A single condition is never taken out, however indirect the request.
+    assert_eq!(
+        without_unasked(&g("Active_AC"), "I'm melting.", &lexicon),
+        None
+    );
+    // A word said as often as conditions claim it asks for each of them.
+    let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
+    let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
+    assert!(unasked(&bars, request, &lexicon).is_empty());
+}
+
+#[test]
+fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
+    let (scenario, _) = cafe();
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "I'm at the third table, bring me either some fries or a dessert.";
+    let (object, words) = swapped_object(
+        &g("(Exists_Dessert | Exists_Coffee) & RobotNear_Table3"),
+        request,
+        &lexicon,
+    )
+    .expect("a swap");
+    assert_eq!(object, "Coffee");
+    assert!(words.iter().any(|w| same_word(w, "fries")), "{words:?}");
+    assert!(swapped_object(&g("On_Chips_Table3 | On_Dessert_Table3"), request, &lexicon).is_none());
+    // Every object named, though a word is left over: no swap.
+    assert!(swapped_object(&g("On_Milk_Table2"), "A glass of milk to table 2", &lexicon).is_none());
+    // Nothing named is left out: no swap, whatever the goal's objects.
+    assert!(swapped_object(&g("Active_AC"), "It's so hot in here", &lexicon).is_none());
+}
+
+#[test]
+fn a_place_read_with_the_wrong_number_is_renumbered_when_unambiguous() {
+    let (scenario, _) = cafe();
+    let vocabulary = &scenario.domain.vocabulary;
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let six = ["6".to_string()];
+    let (goal, from, to) =
+        renumbered(&g("On_Coffee_Table1"), &six, vocabulary).expect("renumbered");
+    assert_eq!(goal, g("On_Coffee_WindowTable6"));
+    assert_eq!((from.as_str(), to.as_str()), ("Table1", "WindowTable6"));
+    // Every occurrence of the place, and nothing else, changes.
+    let (goal, ..) = renumbered(
+        &g("On_Chips_Table2 & (On_Milk_Table2 | RobotNear_Bar)"),
+        &six,
+        vocabulary,
+    )
+    .expect("renumbered");
+    assert_eq!(
+        goal,
+        g("On_Chips_WindowTable6 & (On_Milk_WindowTable6 | RobotNear_Bar)")
+    );
+    // Two numbered places, or two numbers left out: which is which is not known.
+    assert!(renumbered(&g("On_Coffee_Table1 & RobotNear_Table2"), &six, vocabulary).is_none());
+    let two = ["6".to_string(), "2".to_string()];
+    assert!(renumbered(&g("On_Coffee_Table1"), &two, vocabulary).is_none());
+    // No place numbered 12.
+    assert!(renumbered(&g("On_Coffee_Table1"), &["12".to_string()], vocabulary).is_none());
+}
+
+#[test]
+fn a_goal_may_offer_only_the_choices_the_request_gives() {
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "Bring me a banana or an orange, and switch off the hall light.";
+    assert!(
+        more_alternatives_than_asked(
+            &g("On_Banana_Bar | On_Orange_Bar | ~Active_HallLight"),
+            request
+        )
+        .is_some()
+    );
+    assert_eq!(
+        more_alternatives_than_asked(
+            &g("(On_Banana_Bar | On_Orange_Bar) & ~Active_HallLight"),
+            request
+        ),
+        None
+    );
+    // A list ending in "or" offers one choice per item.
+    let listed = g("On_Coffee_Bar | On_Cake_Bar | On_Tea_Bar");
+    assert_eq!(
+        more_alternatives_than_asked(&listed, "Coffee, cake, or tea at the bar."),
+        None
+    );
+    // "Neither ... nor" offers no choice: the disjunction is under a negation.
+    let neither = g("~(On_Mop_Entrance | On_Mop_Exit)");
+    assert_eq!(
+        more_alternatives_than_asked(
+            &neither,
+            "Keep the mop away from the entrance and the exit."
+        ),
+        None
+    );
+    assert_eq!(
+        more_alternatives_than_asked(
+            &g("IsClean_Chairs | Exists_Coffee"),
+            "Clean the chairs; if not, make coffee."
+        ),
+        None
+    );
+}
+
+#[test]
+fn a_goal_true_through_a_place_nobody_named_is_wrong() {
+    let (scenario, world) = cafe();
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    // The chips lie on the bar already; the request says nothing of the bar.
+    assert_eq!(
+        unsaid_object_holding(
+            &g("On_Chips_Bar"),
+            world.as_ref(),
+            "Bring me the chips",
+            &lexicon
+        ),
+        Some("Bar".to_string())
+    );
+    // The hall light is on already, and the request names it: a doubt, not a mistake.
+    assert_eq!(
+        unsaid_object_holding(
+            &g("Active_HallLight"),
+            world.as_ref(),
+            "Could you check that the hall light is on?",
+            &lexicon
+        ),
+        None
+    );
+}

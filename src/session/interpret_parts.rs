@@ -1,0 +1,160 @@
+//! A request of several wishes read one wish at a time.
+//!
+//! Each part (`llm::request_parts`) is read as a request of its own, with the examples
+//! most like it and every check of a whole reading, and the parts' goals are joined as the
+//! request joins them. The joined goal is checked once more against the whole request
+//! (contradictions between parts, a goal that cannot be planned); when it fails, or a part
+//! cannot be read at all, the request is read whole instead.
+
+use crate::goal::Formula;
+use crate::llm::LanguageModel;
+use crate::llm::lexicon::Lexicon;
+use crate::llm::reply::GoalAnswer;
+use crate::llm::request_parts::{Join, Part};
+use crate::scenario::Scenario;
+use crate::world::World;
+
+use super::goal_checks::assess;
+use super::interpret::{Interpretation, example_pool, read_goal};
+use super::types::{Event, Options, SessionError};
+
+/// What reading a request part by part came to.
+pub(super) enum PartsRead {
+    /// Every part read, and the joined goal passed its checks.
+    Read(Interpretation),
+    /// The request is to be read whole; `calls` were spent on the parts.
+    Whole { calls: usize },
+}
+
+/// Read each of `parts` of `instruction` and join their goals; see the module.
+pub(super) async fn read_parts(
+    scenario: &Scenario,
+    world: Box<dyn World>,
+    parts: &[Part],
+    instruction: &str,
+    model: &dyn LanguageModel,
+    options: &Options,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<PartsRead, SessionError> {
+    let quoted: Vec<String> = parts
+        .iter()
+        .map(|p| format!("\u{ab}{}\u{bb}", p.text))
+        .collect();
+    emit(&Event::Notice {
+        message: format!(
+            "the request asks for {} things; each is read on its own: {}",
+            parts.len(),
+            quoted.join(", ")
+        ),
+    });
+    let mut read: Vec<Interpretation> = Vec::new();
+    let mut calls = 0;
+    for part in parts {
+        match read_goal(scenario, world.fork(), &part.text, model, options, emit).await {
+            Ok(found) => {
+                calls += found.calls;
+                read.push(found);
+            }
+            Err(SessionError::NoGoal { attempts, last }) => {
+                calls += attempts;
+                emit(&Event::Notice {
+                    message: format!(
+                        "no goal for \u{ab}{}\u{bb} ({last}): reading the request whole",
+                        part.text
+                    ),
+                });
+                return Ok(PartsRead::Whole { calls });
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    let goal = joined(parts, read.iter().map(|r| r.answer.goal.clone()).collect());
+    let pool = example_pool(scenario, options);
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
+    let shown = options.variant.choose(pool, instruction);
+    let problem = assess(
+        scenario,
+        world.as_ref(),
+        &goal,
+        (&shown, &lexicon),
+        instruction,
+    );
+    if let Some(p) = problem.as_ref().filter(|p| !p.doubt) {
+        emit(&Event::CandidateRejected {
+            candidate: goal.to_string(),
+            proposal: None,
+            reason: p.reason.clone(),
+            author: Some("betr, joining the parts' goals".into()),
+        });
+        emit(&Event::Notice {
+            message: "the parts' goals do not go together: reading the request whole".into(),
+        });
+        return Ok(PartsRead::Whole { calls });
+    }
+    let first = read
+        .iter()
+        .map(|r| r.first.clone())
+        .collect::<Option<Vec<Formula>>>()
+        .map(|firsts| joined(parts, firsts));
+    let reasoning: Vec<String> = read
+        .iter()
+        .filter_map(|r| r.answer.reasoning.clone())
+        .collect();
+    Ok(PartsRead::Read(Interpretation {
+        answer: GoalAnswer {
+            goal,
+            reasoning: (!reasoning.is_empty()).then(|| reasoning.join("\n")),
+            substitutions: read
+                .iter()
+                .flat_map(|r| r.answer.substitutions.clone())
+                .collect(),
+        },
+        first,
+        calls,
+        feedback_rounds: read.iter().map(|r| r.feedback_rounds).max().unwrap_or(0),
+        // A part's own doubt may not hold for the whole ("the light is off already" is
+        // no doubt about "the light off and a tea on the bar"): the whole's is the one.
+        doubt: problem.map(|p| p.reason),
+    }))
+}
+
+/// The goals of `parts` joined as the parts are: alternatives grouped, the groups
+/// conjoined.
+fn joined(parts: &[Part], goals: Vec<Formula>) -> Formula {
+    let mut groups: Vec<Vec<Formula>> = Vec::new();
+    for (part, goal) in parts.iter().zip(goals) {
+        match (part.join, groups.last_mut()) {
+            (Join::Or, Some(group)) => group.push(goal),
+            _ => groups.push(vec![goal]),
+        }
+    }
+    Formula::and(groups.into_iter().map(Formula::or).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn part(join: Join) -> Part {
+        Part {
+            text: String::new(),
+            join,
+        }
+    }
+
+    fn f(text: &str) -> Formula {
+        Formula::parse(text).expect("parses")
+    }
+
+    #[test]
+    fn alternatives_group_and_groups_conjoin() {
+        let parts = [part(Join::And), part(Join::Or), part(Join::And)];
+        let goal = joined(&parts, vec![f("A_X"), f("B_X | C_X"), f("~D_X")]);
+        assert_eq!(goal, f("(A_X | B_X | C_X) & ~D_X"));
+        let parts = [part(Join::And), part(Join::And)];
+        assert_eq!(
+            joined(&parts, vec![f("A_X & B_X"), f("C_X")]),
+            f("A_X & B_X & C_X")
+        );
+    }
+}
