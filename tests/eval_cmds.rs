@@ -184,13 +184,15 @@ fn model_goals(dir: &Path, server: &FakeServer, extra: &[&str]) -> std::process:
         "fake-model",
         "--api-key-env",
         KEY_VAR,
+        // The fixtures answer whole requests; reading by parts is tested elsewhere.
+        "--whole-request",
     ];
     args.extend_from_slice(extra);
     betr(dir, &args)
 }
 
 /// The first answers as they came: the fixtures' gold goals and their 10 wrong ones.
-const MODEL_ROW: &str = "| fake-model (openai), prompt full, 6 retrieved examples, checked (4 candidates, 2 feedback rounds), first call only | 90.0% (27/30) | 90.0% (27/30) | 90.0% (36/40) | 90.0% (90/100) | 100 |";
+const MODEL_ROW: &str = "| fake-model (openai), prompt full, 6 retrieved examples, checked (4 candidates, 2 feedback rounds, whole request), first call only | 90.0% (27/30) | 90.0% (27/30) | 90.0% (36/40) | 90.0% (90/100) | 100 |";
 
 /// Calls per case: one, except where the first answer leaves out a place number the
 /// request says (a wrong fixture answer "Active_AC" to "... to table 2"): then the other
@@ -333,6 +335,7 @@ fn a_run_killed_midway_resumes_to_the_same_results() {
         "fake-model",
         "--api-key-env",
         KEY_VAR,
+        "--whole-request",
     ];
     let mut child = support::cli::command(&dir, &args)
         .stdout(std::process::Stdio::null())

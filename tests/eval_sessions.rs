@@ -229,7 +229,8 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
         case["values"][3]["by"],
         "betr, midway between values the world refused"
     );
-    // The model was told the robot's range, then the bounds in words.
+    // The model was asked first for a level of the robot's range (and answered a number,
+    // which is taken as it is), then told the bounds in words.
     let prompts: Vec<String> = server
         .received()
         .iter()
@@ -237,9 +238,20 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
         .filter(|p| p.contains(egg) && p.contains(task))
         .collect();
     assert!(
-        prompts[0].contains("the robot can do at most 80 N"),
+        prompts[0].contains("as a level of what the robot can do (0 to 80 N): very low = 4 N"),
         "{}",
         prompts[0]
+    );
+    // Once the world has answered, the questions ask for numbers.
+    let numbers = prompts
+        .iter()
+        .position(|p| p.contains("the robot can do at most 80 N"))
+        .expect("a question for a number");
+    assert!(
+        prompts[numbers..]
+            .iter()
+            .all(|p| !p.contains("as a level of")),
+        "{prompts:?}"
     );
     assert!(
         prompts

@@ -35,6 +35,9 @@ pub struct Lexicon {
     object_words: Vec<String>,
     /// Each object's own name words, for the objects whose name has a number.
     numbered: Vec<Vec<String>>,
+    /// Words that name an object by themselves: a one-word name (`Chips`) or a one-word
+    /// thing it is called ("fries"), not a part of a longer name ("area" of `LoungeArea`).
+    whole_names: Vec<String>,
 }
 
 impl Lexicon {
@@ -121,16 +124,35 @@ impl Lexicon {
                 }
             }
         }
+        let mut whole_names: Vec<String> = vocabulary
+            .objects
+            .iter()
+            .flat_map(|o| {
+                std::iter::once(o.name.as_str()).chain(o.called.iter().map(String::as_str))
+            })
+            .map(terms)
+            .filter(|t| t.len() == 1 && !GENERIC.contains(&t[0].as_str()))
+            .map(|mut t| t.remove(0))
+            .collect();
+        whole_names.sort_unstable();
+        whole_names.dedup();
         Lexicon {
             words,
             object_words,
             numbered,
+            whole_names,
         }
     }
 
     /// Whether `word` is part of some object's name ("6" of `WindowTable6`).
     pub fn names_an_object(&self, word: &str) -> bool {
         self.object_words.iter().any(|w| same_word(w, word))
+    }
+
+    /// Whether `word` names an object by itself ("fries", "coffee"), not as a part of a
+    /// longer name ("area", "table").
+    pub fn names_an_object_alone(&self, word: &str) -> bool {
+        self.whole_names.iter().any(|w| same_word(w, word))
     }
 
     /// The numbers of `request` (as [`terms`] gives them) that number a place: a word

@@ -397,25 +397,31 @@ pub(crate) async fn ask_value(
         value,
     };
     let read = |text: &str| {
-        let answer = reply::value(text, asked_as, options.min_similarity)?;
-        let (value, reasoning) = match &levels {
-            None => (answer.value, answer.reasoning),
-            Some(_) => {
-                let number =
-                    level_value(param, &answer.value).ok_or_else(|| ReplyError::BadValue {
-                        text: answer.value.to_string(),
-                        reason: "not one of the levels offered".into(),
-                    })?;
-                // The level the model chose is shown with the number it stands for.
-                let said = format!("Level {} of what the robot can do: {number}.", answer.value);
-                let reasoning = match answer.reasoning {
-                    Some(r) => format!("{said} {r}"),
-                    None => said,
-                };
-                (number, Some(reasoning))
+        let Some(levelled) = &levels else {
+            let a = reply::value(text, param, options.min_similarity)?;
+            return Ok((proposal(a.value), a.reasoning, a.substitutions));
+        };
+        // A model that answers a level question with a number (a server without the
+        // grammar) is taken at its number.
+        let answer = match reply::value(text, levelled, options.min_similarity) {
+            Ok(a) => a,
+            Err(e) => {
+                return reply::value(text, param, options.min_similarity)
+                    .map(|a| (proposal(a.value), a.reasoning, a.substitutions))
+                    .map_err(|_| e);
             }
         };
-        Ok((proposal(value), reasoning, answer.substitutions))
+        let number = level_value(param, &answer.value).ok_or_else(|| ReplyError::BadValue {
+            text: answer.value.to_string(),
+            reason: "not one of the levels offered".into(),
+        })?;
+        // The level the model chose is shown with the number it stands for.
+        let said = format!("Level {} of what the robot can do: {number}.", answer.value);
+        let reasoning = match answer.reasoning {
+            Some(r) => format!("{said} {r}"),
+            None => said,
+        };
+        Ok((proposal(number), Some(reasoning), answer.substitutions))
     };
     let mut asked = draw_and_screen(
         model,

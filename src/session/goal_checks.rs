@@ -154,8 +154,9 @@ pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec
 }
 
 /// An object of `goal` that no word of the request names, when a word of the request
-/// that names an object (not a number: those are [`renumbered`]'s) is answered by no
-/// condition: the goal has put one thing in another's place ("fries" read as coffee).
+/// that names an object by itself ("fries", not the "area" of a lounge area, nor a number:
+/// those are [`renumbered`]'s) is answered by no condition: the goal has put one thing in
+/// another's place ("fries" read as coffee).
 /// Returns that object and the words left unanswered. A goal whose objects are all named
 /// ("a glass of milk" read as the milk) or that leaves no object word out ("it's hot"
 /// read as the AC on) is no swap. Predicates are not judged this way: the words a pool
@@ -167,7 +168,7 @@ pub fn swapped_object(
 ) -> Option<(String, Vec<String>)> {
     let unanswered: Vec<String> = unanswered_names(goal, request, lexicon)
         .into_iter()
-        .filter(|w| !is_number(w))
+        .filter(|w| !is_number(w) && lexicon.names_an_object_alone(w))
         .collect();
     if unanswered.is_empty() {
         return None;

@@ -117,6 +117,15 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     assert!(swapped_object(&g("On_Chips_Table3 | On_Dessert_Table3"), request, &lexicon).is_none());
     // Every object named, though a word is left over: no swap.
     assert!(swapped_object(&g("On_Milk_Table2"), "A glass of milk to table 2", &lexicon).is_none());
+    // A word that is only part of a name ("area" of LoungeArea) names nothing alone.
+    assert!(
+        swapped_object(
+            &g("On_VacuumCup_WaterStation"),
+            "Would you take my vacuum cup to the hydration area?",
+            &lexicon
+        )
+        .is_none()
+    );
     // Nothing named is left out: no swap, whatever the goal's objects.
     assert!(swapped_object(&g("Active_AC"), "It's so hot in here", &lexicon).is_none());
 }
