@@ -1,8 +1,10 @@
 //! How a goal read from an instruction is checked, with a scripted model whose answer
 //! depends on the draw (greedy, or sampled with seed k): a number the request says and the
-//! first answer leaves out draws more candidates; a condition no word of the request asks
-//! for is taken out; a failure is asked about with the conditions that fix it in
-//! simulation as the only choices.
+//! first answer leaves out draws more candidates, and so does an object put in the place
+//! of one the request names; a condition no word of the request asks for is taken out; a
+//! failure is asked about with the conditions that fix it in simulation as the only
+//! choices. And with a model that answers by the request it is asked about: a request of
+//! several wishes is read a wish at a time.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
@@ -197,4 +199,177 @@ async fn a_failure_is_asked_about_with_the_conditions_that_fix_it_as_the_only_ch
         !gbnf.contains("atom ::="),
         "the whole vocabulary is not offered: {gbnf}"
     );
+}
+
+/// Answers by the request the prompt asks about (the line after `## Request`): each entry
+/// is a request and its reply; any other request gets `otherwise`.
+struct ByRequest {
+    replies: Vec<(String, String)>,
+    otherwise: String,
+    asked: Mutex<Vec<String>>,
+}
+
+impl ByRequest {
+    fn new(replies: &[(&str, &str)], otherwise: &str) -> ByRequest {
+        ByRequest {
+            replies: replies
+                .iter()
+                .map(|(r, a)| ((*r).to_string(), (*a).to_string()))
+                .collect(),
+            otherwise: otherwise.into(),
+            asked: Mutex::default(),
+        }
+    }
+}
+
+impl LanguageModel for ByRequest {
+    fn model(&self) -> &str {
+        "scripted"
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            let prompt = &request.messages.last().unwrap().content;
+            let asked = prompt
+                .rsplit_once("## Request\n")
+                .and_then(|(_, rest)| rest.lines().next())
+                .unwrap_or("")
+                .trim()
+                .to_string();
+            self.asked.lock().unwrap().push(asked.clone());
+            let text = self
+                .replies
+                .iter()
+                .find(|(r, _)| *r == asked)
+                .map_or_else(|| self.otherwise.clone(), |(_, a)| a.clone());
+            Ok(ChatReply {
+                text,
+                model: "scripted".into(),
+                usage: TokenUsage {
+                    prompt_tokens: 10,
+                    completion_tokens: 5,
+                },
+                latency: Duration::ZERO,
+                source: ReplySource::HandWritten {
+                    note: "tests/goal_checks.rs".into(),
+                },
+            })
+        })
+    }
+}
+
+async fn read_by_request(
+    scenario: &Scenario,
+    model: &ByRequest,
+    instruction: &str,
+) -> (Formula, usize, Vec<String>) {
+    let w = world::load(scenario).unwrap();
+    let reading = session::interpret::interpret(
+        scenario,
+        w,
+        instruction,
+        model,
+        &Options::default(),
+        &mut |_| {},
+    )
+    .await
+    .unwrap();
+    let asked = model.asked.lock().unwrap().clone();
+    (reading.answer.goal, reading.calls, asked)
+}
+
+#[tokio::test]
+async fn a_request_of_several_wishes_is_read_a_wish_at_a_time() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let f = |t: &str| Formula::parse(t).unwrap();
+    // Two sentences, the thanks kept with the second: each part asked on its own, the
+    // goals joined by and.
+    let model = ByRequest::new(
+        &[
+            (
+                "Please switch off the hall light.",
+                "Goal: ~Active_HallLight",
+            ),
+            (
+                "could you bring some bread to table 2 or to table 3? Thanks!",
+                "Goal: On_Bread_Table2 | On_Bread_Table3",
+            ),
+        ],
+        "Goal: Active_AC",
+    );
+    let request = "Please switch off the hall light. And could you bring some bread to table 2 or to table 3? Thanks!";
+    let (goal, calls, asked) = read_by_request(&cafe, &model, request).await;
+    assert_eq!(
+        goal,
+        f("~Active_HallLight & (On_Bread_Table2 | On_Bread_Table3)"),
+        "{asked:?}"
+    );
+    assert_eq!(calls, 2);
+    assert!(!asked.iter().any(|a| a == request), "{asked:?}");
+
+    // A part offered as the alternative to the one before: joined by or.
+    let model = ByRequest::new(
+        &[
+            ("Could you mop the floor?", "Goal: IsClean_Floor"),
+            ("bring a banana to the bar.", "Goal: On_Banana_Bar"),
+        ],
+        "Goal: Active_AC",
+    );
+    let (goal, calls, _) = read_by_request(
+        &cafe,
+        &model,
+        "Could you mop the floor? If not, bring a banana to the bar.",
+    )
+    .await;
+    assert_eq!(goal, f("IsClean_Floor | On_Banana_Bar"));
+    assert_eq!(calls, 2);
+
+    // Parts whose goals contradict each other: the request is read whole.
+    let request = "Switch on the AC. Also, I want the AC off.";
+    let model = ByRequest::new(
+        &[
+            ("Switch on the AC.", "Goal: Active_AC"),
+            ("I want the AC off.", "Goal: ~Active_AC"),
+            (request, "Goal: Active_AC"),
+        ],
+        "Goal: IsClean_Floor",
+    );
+    let (goal, calls, asked) = read_by_request(&cafe, &model, request).await;
+    assert_eq!(goal, f("Active_AC"), "{asked:?}");
+    assert_eq!(asked.last().map(String::as_str), Some(request));
+    assert_eq!(calls, 3, "{asked:?}");
+}
+
+#[tokio::test]
+async fn an_object_put_in_the_place_of_a_named_one_draws_candidates() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    // "fries" read as coffee: more candidates are drawn, and one that names the fries'
+    // object wins, though the misread one came first.
+    let model = ByDraw::new(
+        "Goal: (Exists_Dessert | Exists_Coffee) & RobotNear_Table3",
+        &[
+            "Goal: (Exists_Dessert | Exists_Coffee) & RobotNear_Table3",
+            "Goal: On_Chips_Table3 | On_Dessert_Table3",
+            "Goal: On_Dessert_Table3 | On_Chips_Table3",
+        ],
+    );
+    let (goal, calls) = read(
+        &cafe,
+        &model,
+        "I'm at the third table, bring me some fries or a dessert.",
+    )
+    .await;
+    assert!(
+        equivalent(
+            &goal,
+            &Formula::parse("On_Chips_Table3 | On_Dessert_Table3").unwrap()
+        )
+        .unwrap(),
+        "{goal}"
+    );
+    assert_eq!(calls, 4);
 }

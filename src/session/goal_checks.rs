@@ -173,8 +173,17 @@ pub fn swapped_object(
     if unanswered.is_empty() {
         return None;
     }
+    unnamed_object(goal.atoms(), request, lexicon).map(|object| (object, unanswered))
+}
+
+/// The first object of `atoms` that no word of `request` names (`"any object"` aside).
+fn unnamed_object(
+    atoms: impl IntoIterator<Item = crate::domain::Atom>,
+    request: &str,
+    lexicon: &Lexicon,
+) -> Option<String> {
     let asked = terms(request);
-    goal.atoms()
+    atoms
         .into_iter()
         .flat_map(|a| a.args)
         .filter(|arg| arg != crate::domain::ANY_OBJECT)
@@ -184,7 +193,6 @@ pub fn swapped_object(
                 .iter()
                 .any(|w| asked.iter().any(|a| same_word(a, w)))
         })
-        .map(|object| (object, unanswered))
 }
 
 /// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
@@ -366,18 +374,11 @@ fn unsaid_object_holding(
     request: &str,
     lexicon: &Lexicon,
 ) -> Option<String> {
-    let asked = terms(request);
-    goal.atoms()
+    let holding = goal
+        .atoms()
         .into_iter()
-        .filter(|a| world.check(&Condition::pos(a.clone())))
-        .flat_map(|a| a.args.clone())
-        .filter(|arg| arg != crate::domain::ANY_OBJECT)
-        .find(|arg| {
-            !lexicon
-                .words(arg)
-                .iter()
-                .any(|w| asked.iter().any(|a| same_word(a, w)))
-        })
+        .filter(|a| world.check(&Condition::pos(a.clone())));
+    unnamed_object(holding, request, lexicon)
 }
 
 /// Every check of a readable candidate, the wrong ones first.
