@@ -58,19 +58,24 @@ impl LanguageModel for ByDraw {
                     .cloned()
                     .unwrap_or_else(|| self.greedy.clone()),
             };
-            Ok(ChatReply {
-                text,
-                model: "scripted".into(),
-                usage: TokenUsage {
-                    prompt_tokens: 10,
-                    completion_tokens: 5,
-                },
-                latency: Duration::ZERO,
-                source: ReplySource::HandWritten {
-                    note: "tests/goal_checks.rs".into(),
-                },
-            })
+            Ok(scripted(text))
         })
+    }
+}
+
+/// A scripted model's reply.
+fn scripted(text: String) -> ChatReply {
+    ChatReply {
+        text,
+        model: "scripted".into(),
+        usage: TokenUsage {
+            prompt_tokens: 10,
+            completion_tokens: 5,
+        },
+        latency: Duration::ZERO,
+        source: ReplySource::HandWritten {
+            note: "tests/goal_checks.rs".into(),
+        },
     }
 }
 
@@ -246,18 +251,7 @@ impl LanguageModel for ByRequest {
                 .iter()
                 .find(|(r, _)| *r == asked)
                 .map_or_else(|| self.otherwise.clone(), |(_, a)| a.clone());
-            Ok(ChatReply {
-                text,
-                model: "scripted".into(),
-                usage: TokenUsage {
-                    prompt_tokens: 10,
-                    completion_tokens: 5,
-                },
-                latency: Duration::ZERO,
-                source: ReplySource::HandWritten {
-                    note: "tests/goal_checks.rs".into(),
-                },
-            })
+            Ok(scripted(text))
         })
     }
 }
