@@ -13,4 +13,4 @@ pub mod vocabulary;
 pub use learned::{LearnError, LearnedRule, Misfit};
 pub use skill::{AtomPattern, Domain, GroundSkill, Param, Skill, ValueParam};
 pub use template::{TemplateError, TemplateFitError};
-pub use vocabulary::{Object, Predicate, Vocabulary, VocabularyError};
+pub use vocabulary::{Object, Predicate, StateWords, Vocabulary, VocabularyError};

@@ -29,6 +29,19 @@ pub struct Predicate {
     pub name: String,
     pub arg_types: Vec<Vec<String>>,
     pub description: String,
+    /// The words people use for the condition and for its opposite, as the scene file
+    /// lists them.
+    pub words: StateWords,
+}
+
+/// The words that say a condition holds ("on", "activate" for an appliance that is on)
+/// and those that say its opposite ("off"), phrases of several words included ("draw
+/// back" the curtain that is closed). A request's word, with the negations before it,
+/// tells which way it asks for the condition.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StateWords {
+    pub says: Vec<String>,
+    pub opposite: Vec<String>,
 }
 
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -221,6 +234,7 @@ mod tests {
                 name: "On".into(),
                 arg_types: vec![vec!["item".into()], vec!["place".into()]],
                 description: "the item is at the place".into(),
+                words: Default::default(),
             }],
         }
     }

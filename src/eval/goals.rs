@@ -344,6 +344,7 @@ mod tests {
                 name: "Active".into(),
                 arg_types: vec![vec!["appliance".into()]],
                 description: String::new(),
+                words: Default::default(),
             }],
         }
     }

@@ -28,6 +28,15 @@ const STOPWORDS: &[&str] = &[
 /// letter or digit, at lower-to-upper case changes and where an acronym ends, stop words
 /// dropped, crude plural and verb endings removed.
 pub fn terms(text: &str) -> Vec<String> {
+    every_term(text)
+        .into_iter()
+        .filter(|w| !STOPWORDS.contains(&w.as_str()))
+        .collect()
+}
+
+/// [`terms`] with the stop words kept: "on", "up" and "so" matter where a request's
+/// small words are read ("turn the light on").
+pub fn every_term(text: &str) -> Vec<String> {
     let mut words = Vec::new();
     let mut current = String::new();
     let mut previous: Option<char> = None;
@@ -60,7 +69,6 @@ pub fn terms(text: &str) -> Vec<String> {
     }
     words
         .into_iter()
-        .filter(|w| !STOPWORDS.contains(&w.as_str()))
         .map(|w| number(&w).map_or_else(|| stem(&w), str::to_string))
         .collect()
 }

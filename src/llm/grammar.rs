@@ -176,6 +176,7 @@ mod tests {
             name: n.into(),
             arg_types: args.iter().map(|a| vec![a.to_string()]).collect(),
             description: String::new(),
+            words: Default::default(),
         };
         Vocabulary {
             objects: vec![

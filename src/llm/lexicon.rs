@@ -270,6 +270,7 @@ mod tests {
             name: n.into(),
             arg_types: args.iter().map(|a| vec![(*a).to_string()]).collect(),
             description: String::new(),
+            words: Default::default(),
         };
         Vocabulary {
             objects: vec![
@@ -363,11 +364,13 @@ mod order_tests {
                     name: "On".into(),
                     arg_types: vec![vec!["item".into()], vec!["place".into()]],
                     description: String::new(),
+                    words: Default::default(),
                 },
                 Predicate {
                     name: "Active".into(),
                     arg_types: vec![vec!["appliance".into()]],
                     description: String::new(),
+                    words: Default::default(),
                 },
             ],
         };

@@ -13,7 +13,7 @@ use super::{
 };
 use crate::domain::skill::{Domain, Param, Skill, ValueParam};
 use crate::domain::template::parse_template;
-use crate::domain::vocabulary::{Object, Predicate, Vocabulary};
+use crate::domain::vocabulary::{Object, Predicate, StateWords, Vocabulary};
 use crate::goal::Formula;
 
 /// Where a skill came from, so its errors can point into the right file.
@@ -138,6 +138,46 @@ fn add_called(
     Ok(())
 }
 
+/// A predicate's words for it and its opposite: each has a letter or digit, and none is
+/// in both lists (it could not tell which way a request asks).
+fn state_words(
+    file: &SourceFile,
+    says: &[Spanned<String>],
+    opposite: &[Spanned<String>],
+) -> Result<StateWords, ScenarioError> {
+    for w in says.iter().chain(opposite) {
+        if !w.get_ref().chars().any(char::is_alphanumeric) {
+            return Err(file.error_in_string(&w.span(), 0, "a word of a predicate has no letters"));
+        }
+    }
+    if let Some(w) = opposite
+        .iter()
+        .find(|o| says.iter().any(|s| same_phrase(s.get_ref(), o.get_ref())))
+    {
+        return Err(file.error_in_string(
+            &w.span(),
+            0,
+            format!("{:?} is both in says and in opposite", w.get_ref()),
+        ));
+    }
+    let plain = |list: &[Spanned<String>]| list.iter().map(|w| w.get_ref().clone()).collect();
+    Ok(StateWords {
+        says: plain(says),
+        opposite: plain(opposite),
+    })
+}
+
+/// The same words, whatever the case and spacing.
+fn same_phrase(a: &str, b: &str) -> bool {
+    let words = |s: &str| {
+        s.to_lowercase()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    words(a) == words(b)
+}
+
 /// Add every file's predicates to `vocabulary` (whose objects are complete); a later
 /// file's predicate replaces an earlier one of the same name.
 fn add_predicates(
@@ -165,6 +205,7 @@ fn add_predicates(
                 name: p.name.get_ref().clone(),
                 arg_types,
                 description: p.description.clone(),
+                words: state_words(file, &p.says, &p.opposite)?,
             };
             match vocabulary
                 .predicates

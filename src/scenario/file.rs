@@ -55,6 +55,11 @@ pub(super) struct RawPredicate {
     #[serde(default)]
     pub(super) args: Vec<Spanned<String>>,
     pub(super) description: String,
+    /// Words that say the condition holds, and words that say its opposite.
+    #[serde(default)]
+    pub(super) says: Vec<Spanned<String>>,
+    #[serde(default)]
+    pub(super) opposite: Vec<Spanned<String>>,
 }
 
 #[derive(Deserialize)]

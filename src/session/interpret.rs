@@ -9,8 +9,10 @@
 //! When none survives, the model is told why, in the same conversation, and asked again
 //! (reflective feedback), for a bounded number of rounds. A first answer that plainly
 //! misread the request — it leaves out a number the request says ("table six" read as
-//! table 1), or puts an object nobody named in the place of one the request names
-//! ("fries" read as coffee) — draws more candidates too, and one that does not wins. The chosen goal's alternatives are put in the
+//! table 1), asks for a condition the other way round from the request's words ("do not
+//! open the curtain" read as open), or puts an object nobody named in the place of one the
+//! request names ("fries" read as coffee) — draws more candidates too, and one that does
+//! not wins; a renumbered or turned-back version of it is a candidate of its own. The chosen goal's alternatives are put in the
 //! order the request names them, since a behavior tree tries them in that order.
 
 use crate::goal::{self, Formula};
@@ -28,6 +30,7 @@ use super::goal_checks::{
     without_unasked,
 };
 use super::interpret_parts::{PartsRead, read_parts};
+use super::polarity::{turned_around, turned_back};
 use super::types::{Event, Options, SessionError};
 use crate::llm::request_parts::split;
 
@@ -100,8 +103,9 @@ impl Judge<'_> {
     }
 
     /// How `goal` has misread the request, if it plainly has: it leaves out a number the
-    /// request says ("table six" read as table 1), or it puts an object nobody named in
-    /// the place of one the request names ("fries" read as coffee).
+    /// request says ("table six" read as table 1), asks for a condition the other way round
+    /// from the request's words ("do not open the curtain" read as open), or puts an object
+    /// nobody named in the place of one the request names ("fries" read as coffee).
     fn misread(&self, goal: &Formula) -> Option<String> {
         let numbers = self.missing_numbers(goal);
         if !numbers.is_empty() {
@@ -110,12 +114,19 @@ impl Judge<'_> {
                 numbers.join(", ")
             ));
         }
+        if let Some(turned) = turned_around(goal, self.instruction, self.vocabulary()) {
+            return Some(turned.to_string());
+        }
         swapped_object(goal, self.instruction, &self.lexicon).map(|(object, words)| {
             format!(
                 "the request says {}, which no condition of {goal} answers, and never names {object}",
                 words.join(", ")
             )
         })
+    }
+
+    fn vocabulary(&self) -> &crate::domain::Vocabulary {
+        &self.scenario.domain.vocabulary
     }
 
     /// A clean candidate that has not plainly misread the request.
@@ -129,7 +140,9 @@ impl Judge<'_> {
     /// Candidates made from an answer that failed a check: without what it pasted from an
     /// example, or without the parts no word of the request asks for; and, when checks
     /// are on, with the place renumbered when the request numbers another one of its kind
-    /// ("table six" read as Table1). Each is checked like the others.
+    /// ("table six" read as Table1), and with the conditions the request asks for the
+    /// other way round turned ("do not open" read as open). Each is checked like the
+    /// others.
     fn derived(
         &self,
         read: &Result<GoalAnswer, ReplyError>,
@@ -158,8 +171,23 @@ impl Judge<'_> {
                 ),
             });
         }
+        let turned = match read {
+            Ok(a) if check_goals => turned_around(&a.goal, self.instruction, self.vocabulary())
+                .and_then(|why| {
+                    let goal = turned_back(&a.goal, self.instruction, self.vocabulary())?;
+                    emit(&Event::Notice {
+                        message: format!("{why}, so {goal} is a candidate too"),
+                    });
+                    Some(goal)
+                }),
+            _ => None,
+        };
         let mut out = Vec::new();
-        for goal in pruned.into_iter().chain(renumber.map(|(g, _, _)| g)) {
+        for goal in pruned
+            .into_iter()
+            .chain(renumber.map(|(g, _, _)| g))
+            .chain(turned)
+        {
             let problem = self.assess(&goal);
             if let Some(p) = &problem {
                 emit(&Event::CandidateRejected {

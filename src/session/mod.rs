@@ -11,6 +11,7 @@ pub mod interpret;
 mod interpret_parts;
 pub mod knowledge;
 pub mod planned;
+pub mod polarity;
 pub mod policy;
 pub mod resolve;
 pub mod screen;

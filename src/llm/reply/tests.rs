@@ -28,11 +28,13 @@ fn cell() -> Vocabulary {
                 name: "on".into(),
                 arg_types: vec![vec!["block".into()], vec!["block".into(), "cup".into()]],
                 description: "a rests on b".into(),
+                words: Default::default(),
             },
             Predicate {
                 name: "upright".into(),
                 arg_types: vec![vec!["cup".into()]],
                 description: "stands upright".into(),
+                words: Default::default(),
             },
         ],
     }

@@ -1,0 +1,275 @@
+//! Whether a goal asks for a condition the other way round from the request: "do not open
+//! the curtain" read as `~Closed_Curtain`, "a moderate temperature" read as
+//! `Low_ACTemperature`. The scene file lists, per predicate, the words that say it holds
+//! and those that say its opposite. A clause of the request with such a word, about an
+//! object the clause names (or the one object the predicate can be about), asks for that
+//! condition, turned around by each negation before the word in the clause ("don't
+//! forget to turn on" asks for it on).
+
+use std::fmt;
+
+use crate::domain::{Atom, Predicate, Vocabulary};
+use crate::goal::Formula;
+use crate::llm::examples::{every_term, terms};
+use crate::llm::lexicon::same_word;
+
+/// Words that turn around what follows them in their clause ("n't" is read as "not").
+const NEGATIONS: &[&str] = &[
+    "not", "no", "never", "nor", "neither", "avoid", "without", "cannot", "forget", "refrain",
+];
+
+/// Words that start a new clause: a negation before them does not reach past them.
+const CLAUSE_STARTS: &[&str] = &["and", "but", "or", "also", "then", "while", "so"];
+
+/// A condition the request asks for one way and the goal has the other way.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TurnedAround {
+    pub atom: Atom,
+    /// Whether the request asks for the atom to hold.
+    pub wanted: bool,
+    /// The request's word that says which way.
+    pub word: String,
+}
+
+impl fmt::Display for TurnedAround {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (asked, has) = if self.wanted {
+            (self.atom.to_string(), format!("~{}", self.atom))
+        } else {
+            (format!("~{}", self.atom), self.atom.to_string())
+        };
+        write!(
+            f,
+            "the request says \"{}\", which asks for {asked}, where the goal has {has}",
+            self.word
+        )
+    }
+}
+
+/// A condition of `goal` that the request asks for the other way round, if any.
+pub fn turned_around(
+    goal: &Formula,
+    request: &str,
+    vocabulary: &Vocabulary,
+) -> Option<TurnedAround> {
+    asked_conditions(request, vocabulary)
+        .into_iter()
+        .find_map(|(subject, wanted, word)| {
+            let pick = |a: &Atom| subject.matches(a);
+            let signs = signs_of(goal, &pick, true);
+            if signs.is_empty() || signs.contains(&wanted) {
+                return None;
+            }
+            Some(TurnedAround {
+                atom: first_matching(goal, &pick)?,
+                wanted,
+                word,
+            })
+        })
+}
+
+/// `goal` with every condition the request asks for the other way round turned around.
+/// `None` when nothing is turned around.
+pub fn turned_back(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+    let mut current = goal.clone();
+    let mut turned: Vec<Atom> = Vec::new();
+    while let Some(t) = turned_around(&current, request, vocabulary) {
+        // Each atom is turned once: a second finding about it would undo the first.
+        if turned.contains(&t.atom) {
+            break;
+        }
+        current = flipped(&current, &t.atom);
+        turned.push(t.atom);
+    }
+    (!turned.is_empty()).then_some(current)
+}
+
+/// What a clause asks about: a predicate and the object it is about.
+struct Subject {
+    predicate: String,
+    object: String,
+}
+
+impl Subject {
+    fn matches(&self, atom: &Atom) -> bool {
+        atom.predicate == self.predicate && atom.args.first() == Some(&self.object)
+    }
+}
+
+/// The conditions the request asks for one way: each with whether it is asked to hold and
+/// the word that says so. A condition asked for both ways is left out.
+fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, bool, String)> {
+    let mut found: Vec<(Subject, bool, String)> = Vec::new();
+    let mut both: Vec<(String, String)> = Vec::new();
+    for clause in clauses(request) {
+        for predicate in &vocabulary.predicates {
+            let Some((wanted, word)) = clause_polarity(&clause, predicate) else {
+                continue;
+            };
+            for object in subjects(&clause, predicate, vocabulary) {
+                let key = (predicate.name.clone(), object.clone());
+                if both.contains(&key) {
+                    continue;
+                }
+                if let Some(i) = found
+                    .iter()
+                    .position(|(s, _, _)| s.predicate == key.0 && s.object == key.1)
+                {
+                    if found[i].1 != wanted {
+                        found.remove(i);
+                        both.push(key);
+                    }
+                    continue;
+                }
+                found.push((
+                    Subject {
+                        predicate: predicate.name.clone(),
+                        object,
+                    },
+                    wanted,
+                    word.clone(),
+                ));
+            }
+        }
+    }
+    found
+}
+
+/// The request's clauses, as [`every_term`] gives their words: split at punctuation and before
+/// the words that start a clause; "n't" is the word "not".
+fn clauses(request: &str) -> Vec<Vec<String>> {
+    let text = request
+        .replace("n't", " not")
+        .replace("n’t", " not")
+        .replace("N'T", " not");
+    let mut out: Vec<Vec<String>> = Vec::new();
+    for piece in text.split([',', '.', ';', ':', '!', '?', '(', ')']) {
+        let mut clause: Vec<String> = Vec::new();
+        for word in every_term(piece) {
+            if CLAUSE_STARTS.contains(&word.as_str()) {
+                if !clause.is_empty() {
+                    out.push(std::mem::take(&mut clause));
+                }
+                continue;
+            }
+            clause.push(word);
+        }
+        if !clause.is_empty() {
+            out.push(clause);
+        }
+    }
+    out
+}
+
+/// Where `phrase` (as [`terms`] gives it) starts in `words`, if it does.
+fn find_phrase(words: &[String], phrase: &[String]) -> Option<usize> {
+    if phrase.is_empty() || phrase.len() > words.len() {
+        return None;
+    }
+    (0..=words.len() - phrase.len())
+        .find(|&i| phrase.iter().zip(&words[i..]).all(|(p, w)| same_word(p, w)))
+}
+
+/// Which way `clause` asks for `predicate`, and the word that says so: the word's own way
+/// turned around once for each negation before it. `None` when the clause has none of
+/// its words, or words that ask both ways.
+fn clause_polarity(clause: &[String], predicate: &Predicate) -> Option<(bool, String)> {
+    let lists = [
+        (true, &predicate.words.says),
+        (false, &predicate.words.opposite),
+    ];
+    let mut ways: Vec<(bool, String)> = Vec::new();
+    for (own_way, list) in lists {
+        for word in list.iter() {
+            let Some(at) = find_phrase(clause, &every_term(word)) else {
+                continue;
+            };
+            let negations = clause[..at]
+                .iter()
+                .filter(|w| NEGATIONS.contains(&w.as_str()))
+                .count();
+            ways.push((own_way == (negations % 2 == 0), word.clone()));
+        }
+    }
+    let (first_way, word) = ways.first()?.clone();
+    ways.iter()
+        .all(|(w, _)| *w == first_way)
+        .then_some((first_way, word))
+}
+
+/// The objects `predicate` can be about that `clause` names (by their name's words in a
+/// row, or what they are called); when it names none, the one object the predicate can be
+/// about, if there is only one and the clause has a word of it.
+fn subjects(clause: &[String], predicate: &Predicate, vocabulary: &Vocabulary) -> Vec<String> {
+    let Some(slot) = predicate.arg_types.first() else {
+        return Vec::new();
+    };
+    let fitting: Vec<&crate::domain::Object> =
+        vocabulary.objects.iter().filter(|o| o.fits(slot)).collect();
+    let named: Vec<String> = fitting
+        .iter()
+        .filter(|o| {
+            std::iter::once(&o.name)
+                .chain(&o.called)
+                .any(|phrase| find_phrase(clause, &terms(phrase)).is_some())
+        })
+        .map(|o| o.name.clone())
+        .collect();
+    match fitting.as_slice() {
+        // The one object a predicate can be about needs no name, only a word of it ("too
+        // low" about the temperature), so that a word alone ("a cool drink") asks nothing.
+        [only] if named.is_empty() => {
+            let own: Vec<String> = std::iter::once(&only.name)
+                .chain(&only.called)
+                .flat_map(|p| terms(p))
+                .collect();
+            if clause.iter().any(|w| own.iter().any(|o| same_word(o, w))) {
+                vec![only.name.clone()]
+            } else {
+                Vec::new()
+            }
+        }
+        _ => named,
+    }
+}
+
+/// The sign (held or negated) of each place `goal` has an atom that `pick` picks.
+fn signs_of(goal: &Formula, pick: &dyn Fn(&Atom) -> bool, positive: bool) -> Vec<bool> {
+    match goal {
+        Formula::Atom(a) => {
+            if pick(a) {
+                vec![positive]
+            } else {
+                Vec::new()
+            }
+        }
+        Formula::Not(inner) => signs_of(inner, pick, !positive),
+        Formula::And(items) | Formula::Or(items) => items
+            .iter()
+            .flat_map(|i| signs_of(i, pick, positive))
+            .collect(),
+    }
+}
+
+/// The first atom of `goal` that `pick` picks.
+fn first_matching(goal: &Formula, pick: &dyn Fn(&Atom) -> bool) -> Option<Atom> {
+    goal.atoms_in_order().into_iter().find(|a| pick(a))
+}
+
+/// `goal` with `atom` negated wherever it stands (a negated one loses its negation).
+pub fn flipped(goal: &Formula, atom: &Atom) -> Formula {
+    match goal {
+        Formula::Atom(a) if a == atom => Formula::Not(Box::new(goal.clone())),
+        Formula::Atom(_) => goal.clone(),
+        Formula::Not(inner) => match inner.as_ref() {
+            Formula::Atom(a) if a == atom => Formula::Atom(a.clone()),
+            _ => Formula::Not(Box::new(flipped(inner, atom))),
+        },
+        Formula::And(items) => Formula::And(items.iter().map(|i| flipped(i, atom)).collect()),
+        Formula::Or(items) => Formula::Or(items.iter().map(|i| flipped(i, atom)).collect()),
+    }
+}
+
+#[cfg(test)]
+#[path = "polarity_tests.rs"]
+mod tests;
