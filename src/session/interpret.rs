@@ -30,6 +30,7 @@ use super::goal_checks::{
     without_unasked,
 };
 use super::interpret_parts::{PartsRead, read_parts};
+use super::placement::{not_put, put_there};
 use super::polarity::{turned_around, turned_back};
 use super::types::{Event, Options, SessionError};
 use crate::llm::request_parts::split;
@@ -117,6 +118,12 @@ impl Judge<'_> {
         if let Some(turned) = turned_around(goal, self.instruction, self.vocabulary()) {
             return Some(turned.to_string());
         }
+        if let Some(sent) = not_put(goal, self.instruction, self.vocabulary()) {
+            return Some(format!(
+                "the request sends {} to {}, and no condition of {goal} puts it there",
+                sent.item, sent.place
+            ));
+        }
         swapped_object(goal, self.instruction, &self.lexicon).map(|(object, words)| {
             format!(
                 "the request says {}, which no condition of {goal} answers, and never names {object}",
@@ -182,11 +189,24 @@ impl Judge<'_> {
                 }),
             _ => None,
         };
+        let placed = match read {
+            Ok(a) if check_goals => put_there(&a.goal, self.instruction, self.vocabulary())
+                .inspect(|goal| {
+                    emit(&Event::Notice {
+                        message: format!(
+                            "the request sends an item to a place that {} only has apart, so {goal} is a candidate too",
+                            a.goal
+                        ),
+                    });
+                }),
+            _ => None,
+        };
         let mut out = Vec::new();
         for goal in pruned
             .into_iter()
             .chain(renumber.map(|(g, _, _)| g))
             .chain(turned)
+            .chain(placed)
         {
             let problem = self.assess(&goal);
             if let Some(p) = &problem {

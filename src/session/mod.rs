@@ -10,6 +10,7 @@ pub mod goal_checks;
 pub mod interpret;
 mod interpret_parts;
 pub mod knowledge;
+pub mod placement;
 pub mod planned;
 pub mod polarity;
 pub mod policy;

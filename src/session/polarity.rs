@@ -162,7 +162,7 @@ fn clauses(request: &str) -> Vec<Vec<String>> {
 }
 
 /// Where `phrase` (as [`terms`] gives it) starts in `words`, if it does.
-fn find_phrase(words: &[String], phrase: &[String]) -> Option<usize> {
+pub(super) fn find_phrase(words: &[String], phrase: &[String]) -> Option<usize> {
     if phrase.is_empty() || phrase.len() > words.len() {
         return None;
     }

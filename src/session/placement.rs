@@ -1,0 +1,258 @@
+//! Whether a goal puts where the request puts: "deliver dessert to table 1" or "a dessert
+//! at the bar" ask for a condition that relates the item to the place, and a goal that has
+//! them only in separate conditions (`Exists_Dessert & RobotNear_Table1`: made, and the
+//! robot there) has not put the dessert anywhere. The relating conditions are the scene's
+//! predicates of two arguments whose slots take the item and the place.
+
+use crate::domain::{Atom, Object, Predicate, Vocabulary};
+use crate::goal::Formula;
+use crate::llm::examples::{every_term, terms};
+use crate::llm::lexicon::same_word;
+
+use super::polarity::find_phrase;
+
+/// Words that send an item to the place named after them.
+const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
+
+/// How far after such a word the place's name may start ("to the third table").
+const PLACE_WITHIN: usize = 3;
+
+/// Verbs of the robot's own moving: an item before one is not sent to a place after it
+/// ("make coffee and come to table 2").
+const MOVING: &[&str] = &[
+    "come", "go", "move", "head", "walk", "drive", "return", "join", "meet", "visit", "approach",
+    "proceed", "stay", "wait", "hover", "hang",
+];
+
+/// An item the request sends to a place.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sent {
+    pub item: String,
+    pub place: String,
+}
+
+/// The first item the request sends to a place that `goal` has in a condition but never
+/// in one with that place, if any.
+pub fn not_put(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Sent> {
+    let relating = relating(vocabulary);
+    if relating.is_empty() {
+        return None;
+    }
+    let atoms = goal.atoms();
+    let asked = said_predicates(request, vocabulary);
+    sent(request, vocabulary, &relating).into_iter().find(|s| {
+        let about_item: Vec<&Atom> = atoms.iter().filter(|a| a.args.contains(&s.item)).collect();
+        let together = about_item.iter().any(|a| a.args.contains(&s.place));
+        // "Hold the cup at the bar" asks for holding in its own words.
+        let unasked = about_item.iter().any(|a| !asked.contains(&a.predicate));
+        unasked && !together
+    })
+}
+
+/// `goal` with each item the request sends to a place put there: in a conjunction, a
+/// condition about the item alone (made, `Exists_Dessert`) becomes the one relating
+/// condition (`On_Dessert_Table1`) and one about the place alone (the robot there) goes.
+/// `None` when nothing changes, or when more than one predicate could relate them.
+pub fn put_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+    let relating = relating(vocabulary);
+    let [relation] = relating.as_slice() else {
+        return None;
+    };
+    let sent = sent(request, vocabulary, &[relation]);
+    if sent.is_empty() {
+        return None;
+    }
+    let asked = said_predicates(request, vocabulary);
+    let rewritten = rewrite(goal, &sent, &relation.name, &asked);
+    (rewritten != *goal).then_some(rewritten)
+}
+
+/// The predicates the request names by their own words ("hold" for the one it says
+/// holding): a condition about an item alone that the request asks for in its own
+/// words ("hold the cup at the bar") is not a misplaced one.
+fn said_predicates(request: &str, vocabulary: &Vocabulary) -> Vec<String> {
+    let words = every_term(request);
+    vocabulary
+        .predicates
+        .iter()
+        .filter(|p| {
+            std::iter::once(&p.name)
+                .chain(&p.words.says)
+                .any(|phrase| find_phrase(&words, &terms(phrase)).is_some())
+        })
+        .map(|p| p.name.clone())
+        .collect()
+}
+
+fn rewrite(goal: &Formula, sent: &[Sent], relation: &str, asked: &[String]) -> Formula {
+    match goal {
+        Formula::And(items) => {
+            let mut items: Vec<Formula> = items
+                .iter()
+                .map(|i| rewrite(i, sent, relation, asked))
+                .collect();
+            for s in sent {
+                let alone = |f: &Formula, object: &str| matches!(f, Formula::Atom(a) if a.args == [object] && !asked.contains(&a.predicate));
+                let item_at = items.iter().position(|f| {
+                    alone(f, &s.item)
+                        || matches!(f, Formula::Or(alts) if alts.iter().all(|a| alone_item(a, sent, &s.place, asked)))
+                });
+                let place_at = items.iter().position(|f| alone(f, &s.place));
+                let (Some(i), Some(p)) = (item_at, place_at) else {
+                    continue;
+                };
+                items[i] = placed(&items[i], sent, &s.place, relation);
+                items.remove(p);
+            }
+            Formula::and(items)
+        }
+        Formula::Or(items) => Formula::Or(
+            items
+                .iter()
+                .map(|i| rewrite(i, sent, relation, asked))
+                .collect(),
+        ),
+        Formula::Not(_) | Formula::Atom(_) => goal.clone(),
+    }
+}
+
+/// Whether `f` is a condition about one item alone that the request sends to `place`.
+fn alone_item(f: &Formula, sent: &[Sent], place: &str, asked: &[String]) -> bool {
+    matches!(f, Formula::Atom(a) if !asked.contains(&a.predicate)
+        && matches!(a.args.as_slice(), [item] if sent.iter().any(|s| &s.item == item && s.place == place)))
+}
+
+/// `f` (a condition about an item alone, or alternatives of such) with each item put at
+/// `place`.
+fn placed(f: &Formula, sent: &[Sent], place: &str, relation: &str) -> Formula {
+    match f {
+        Formula::Atom(a) => match a.args.as_slice() {
+            [item] if sent.iter().any(|s| &s.item == item && s.place == place) => {
+                Formula::Atom(Atom::new(relation, vec![item.clone(), place.to_string()]))
+            }
+            _ => f.clone(),
+        },
+        Formula::Or(alts) => Formula::Or(
+            alts.iter()
+                .map(|a| placed(a, sent, place, relation))
+                .collect(),
+        ),
+        _ => f.clone(),
+    }
+}
+
+/// The predicates of two arguments that take an item and a place.
+fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
+    vocabulary
+        .predicates
+        .iter()
+        .filter(|p| p.arg_types.len() == 2)
+        .collect()
+}
+
+/// The items the request sends to a place, each with its place: an item named before
+/// "to"/"at"/"on" and a place named right after, in one clause, with no verb of the
+/// robot's own moving between them; items named after an earlier place go to the next.
+fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<Sent> {
+    let fits = |o: &Object, slot: usize| {
+        relating
+            .iter()
+            .any(|p| p.arg_types.get(slot).is_some_and(|t| o.fits(t)))
+    };
+    let items: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 0)).collect();
+    let places: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 1)).collect();
+    let mut out: Vec<Sent> = Vec::new();
+    for clause in request.split(['.', ';', '!', '?', ',']) {
+        let words = every_term(clause);
+        let place_spans = mentions(&words, &places, &[]);
+        let covered: Vec<usize> = place_spans
+            .iter()
+            .flat_map(|(at, len, _)| *at..at + len)
+            .collect();
+        let item_spans = mentions(&words, &items, &covered);
+        let mut waiting: Vec<String> = Vec::new();
+        for (at, word) in words.iter().enumerate() {
+            if MOVING.iter().any(|m| same_word(m, word)) {
+                waiting.clear();
+            }
+            if let Some((_, _, item)) = item_spans.iter().find(|(start, _, _)| *start == at)
+                && !waiting.contains(item)
+            {
+                waiting.push(item.clone());
+            }
+            if !TOWARDS.contains(&word.as_str()) || waiting.is_empty() {
+                continue;
+            }
+            let place = place_spans
+                .iter()
+                .find(|(start, _, _)| *start > at && *start <= at + PLACE_WITHIN);
+            if let Some((_, _, place)) = place {
+                for item in waiting.drain(..) {
+                    if item != *place {
+                        out.push(Sent {
+                            item,
+                            place: place.clone(),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Where `words` name one of `objects` by its name's words in a row or by what it is
+/// called, the longest name first, skipping the positions in `taken`: (start, length,
+/// object). A name with a word beside it from a longer name of another object that shares
+/// its words ("the other bar", where the other bar counter is another place than the bar)
+/// names neither.
+fn mentions(words: &[String], objects: &[&Object], taken: &[usize]) -> Vec<(usize, usize, String)> {
+    let mut phrases: Vec<(Vec<String>, &str)> = objects
+        .iter()
+        .flat_map(|o| {
+            std::iter::once(&o.name)
+                .chain(&o.called)
+                .map(move |p| (terms(p), o.name.as_str()))
+        })
+        .filter(|(t, _)| !t.is_empty())
+        .collect();
+    phrases.sort_by_key(|(t, _)| std::cmp::Reverse(t.len()));
+    let mut used: Vec<usize> = taken.to_vec();
+    let mut out = Vec::new();
+    for (phrase, name) in &phrases {
+        let mut start = 0;
+        while start + phrase.len() <= words.len() {
+            let span = start..start + phrase.len();
+            let matches = phrase
+                .iter()
+                .zip(&words[span.clone()])
+                .all(|(p, w)| same_word(p, w));
+            if !matches || span.clone().any(|i| used.contains(&i)) {
+                start += 1;
+                continue;
+            }
+            used.extend(span.clone());
+            let beside: Vec<&String> = [span.start.checked_sub(1), Some(span.end)]
+                .into_iter()
+                .flatten()
+                .filter_map(|i| words.get(i))
+                .collect();
+            let other_longer = phrases.iter().any(|(other, other_name)| {
+                other_name != name
+                    && other.len() > phrase.len()
+                    && phrase.iter().all(|p| other.contains(p))
+                    && beside.iter().any(|b| other.iter().any(|o| same_word(o, b)))
+            });
+            if !other_longer {
+                out.push((start, phrase.len(), name.to_string()));
+            }
+            start = span.end;
+        }
+    }
+    out.sort();
+    out
+}
+
+#[cfg(test)]
+#[path = "placement_tests.rs"]
+mod tests;

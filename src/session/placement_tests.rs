@@ -1,0 +1,171 @@
+use super::*;
+use crate::domain::StateWords;
+
+fn object(name: &str, types: &[&str]) -> Object {
+    Object {
+        name: name.into(),
+        types: types.iter().map(|t| t.to_string()).collect(),
+        called: Vec::new(),
+    }
+}
+
+fn predicate(name: &str, slots: &[&str], says: &[&str]) -> Predicate {
+    Predicate {
+        name: name.into(),
+        arg_types: slots
+            .iter()
+            .map(|s| s.split('|').map(str::to_string).collect())
+            .collect(),
+        description: String::new(),
+        words: StateWords {
+            says: says.iter().map(|w| w.to_string()).collect(),
+            opposite: Vec::new(),
+        },
+    }
+}
+
+fn vocabulary() -> Vocabulary {
+    Vocabulary {
+        objects: vec![
+            object("Dessert", &["item", "makable"]),
+            object("Water", &["item", "makable"]),
+            object("Coffee", &["item", "makable"]),
+            object("Cup", &["item"]),
+            object("Bar", &["place"]),
+            object("Table1", &["place"]),
+            object("Table2", &["place"]),
+            object("CoffeeStation", &["place"]),
+        ],
+        predicates: vec![
+            predicate("On", &["item", "place"], &[]),
+            predicate("Exists", &["makable"], &["make", "prepare"]),
+            predicate("RobotNear", &["place|item"], &["near"]),
+            predicate("Holding", &["item"], &["hold"]),
+        ],
+    }
+}
+
+fn put(goal: &str, request: &str) -> Option<String> {
+    let goal = Formula::parse(goal).expect("test goal parses");
+    put_there(&goal, request, &vocabulary()).map(|g| g.to_string())
+}
+
+fn flagged(goal: &str, request: &str) -> Option<(String, String)> {
+    let goal = Formula::parse(goal).expect("test goal parses");
+    not_put(&goal, request, &vocabulary()).map(|s| (s.item, s.place))
+}
+
+#[test]
+fn an_item_made_and_the_robot_at_the_place_is_not_the_item_put_there() {
+    let request = "Please deliver dessert to table 1.";
+    assert_eq!(
+        flagged("Exists_Dessert & RobotNear_Table1", request),
+        Some(("Dessert".into(), "Table1".into()))
+    );
+    assert_eq!(flagged("On_Dessert_Table1", request), None);
+    assert_eq!(
+        put("Exists_Dessert & RobotNear_Table1", request).as_deref(),
+        Some("On_Dessert_Table1")
+    );
+    assert_eq!(
+        put(
+            "Exists_Dessert & RobotNear_Bar",
+            "I would like a dessert at the bar, please"
+        )
+        .as_deref(),
+        Some("On_Dessert_Bar")
+    );
+}
+
+#[test]
+fn each_alternative_and_each_item_goes_to_its_own_place() {
+    assert_eq!(
+        put(
+            "Exists_Dessert & RobotNear_Table1 | Exists_Water & RobotNear_Table2",
+            "Deliver some dessert to Table 1 or bring water to Table 2"
+        )
+        .as_deref(),
+        Some("On_Dessert_Table1 | On_Water_Table2")
+    );
+    assert_eq!(
+        put(
+            "(Exists_Coffee | Exists_Dessert) & RobotNear_Table2",
+            "A coffee or a dessert at table 2, please"
+        )
+        .as_deref(),
+        Some("On_Coffee_Table2 | On_Dessert_Table2")
+    );
+    // A place's name holds an item's ("coffee" of the coffee station): the item is the
+    // dessert alone.
+    assert_eq!(
+        put(
+            "Exists_Dessert & RobotNear_CoffeeStation",
+            "Deliver dessert to the coffee station"
+        )
+        .as_deref(),
+        Some("On_Dessert_CoffeeStation")
+    );
+}
+
+#[test]
+fn the_robots_own_moving_and_conditions_asked_in_their_words_stay() {
+    // The robot comes to the table; nothing is sent there.
+    assert_eq!(
+        flagged(
+            "Exists_Coffee & RobotNear_Table2",
+            "Make coffee and come to table 2"
+        ),
+        None
+    );
+    assert_eq!(
+        put(
+            "Exists_Coffee & RobotNear_Table2",
+            "Make coffee and come to table 2"
+        ),
+        None
+    );
+    // "hold" asks for holding; "near" for the robot near.
+    assert_eq!(
+        flagged("Holding_Cup & RobotNear_Bar", "Hold the cup near the bar"),
+        None
+    );
+    assert_eq!(
+        put("Holding_Cup & RobotNear_Bar", "Hold the cup near the bar"),
+        None
+    );
+    // A goal that leaves the item out is another misreading, not this one.
+    assert_eq!(
+        flagged("RobotNear_Table1", "Deliver dessert to table 1"),
+        None
+    );
+    // A clause ends at a comma: "the dessert" is not sent to the bar.
+    assert_eq!(
+        flagged(
+            "Exists_Dessert & RobotNear_Bar",
+            "Make the dessert, then wait at the bar"
+        ),
+        None
+    );
+}
+
+#[test]
+fn the_scenes_own_worked_examples_put_what_they_send() {
+    for scene in [
+        "scenarios/cafe/cafe.toml",
+        "scenarios/cell/red_on_blue.toml",
+    ] {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(scene);
+        let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
+        for example in &scenario.examples {
+            let goal = Formula::parse(&example.goal).expect("example goal parses");
+            let vocabulary = &scenario.domain.vocabulary;
+            assert_eq!(
+                not_put(&goal, &example.instruction, vocabulary),
+                None,
+                "{scene}: {:?}",
+                example.instruction
+            );
+            assert_eq!(put_there(&goal, &example.instruction, vocabulary), None);
+        }
+    }
+}
