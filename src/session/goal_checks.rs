@@ -176,6 +176,32 @@ pub fn swapped_object(
     unnamed_object(goal.atoms(), request, lexicon).map(|object| (object, unanswered))
 }
 
+/// `goal` with the object it put in another's place ([`swapped_object`]) replaced by the
+/// one object of a kind with it that the unanswered word names by itself ("fries" read as
+/// `Softdrink`: `Chips`, called fries). `None` when the word names no such object or
+/// several. Returns the goal, and the object replaced and its replacement.
+pub fn swapped_back(
+    goal: &Formula,
+    request: &str,
+    lexicon: &Lexicon,
+    vocabulary: &crate::domain::Vocabulary,
+) -> Option<(Formula, String, String)> {
+    let (from, words) = swapped_object(goal, request, lexicon)?;
+    let kinds = &vocabulary.objects.iter().find(|o| o.name == from)?.types;
+    let names_alone = |o: &crate::domain::Object, word: &str| {
+        std::iter::once(&o.name)
+            .chain(&o.called)
+            .any(|n| matches!(terms(n).as_slice(), [w] if same_word(w, word)))
+    };
+    let mut to = vocabulary.objects.iter().filter(|o| {
+        o.types.iter().any(|t| kinds.contains(t)) && words.iter().any(|w| names_alone(o, w))
+    });
+    let (Some(to), None) = (to.next(), to.next()) else {
+        return None;
+    };
+    Some((rename(goal, &from, &to.name), from, to.name.clone()))
+}
+
 /// The first object of `atoms` that no word of `request` names (`"any object"` aside).
 fn unnamed_object(
     atoms: impl IntoIterator<Item = crate::domain::Atom>,

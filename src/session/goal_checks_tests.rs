@@ -131,6 +131,26 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
 }
 
 #[test]
+fn a_swapped_object_is_put_back_when_the_word_names_one_thing_of_its_kind() {
+    let (scenario, _) = cafe();
+    let vocabulary = &scenario.domain.vocabulary;
+    let lexicon = Lexicon::new(vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "I'm at the third table, bring me either some fries or a dessert.";
+    let (goal, from, to) = swapped_back(
+        &g("On_Dessert_Table3 | On_Softdrink_Table3"),
+        request,
+        &lexicon,
+        vocabulary,
+    )
+    .expect("put back");
+    assert_eq!((from.as_str(), to.as_str()), ("Softdrink", "Chips"));
+    assert_eq!(goal.to_string(), "On_Dessert_Table3 | On_Chips_Table3");
+    // No swap, nothing to put back.
+    assert!(swapped_back(&g("On_Chips_Table3"), request, &lexicon, vocabulary).is_none());
+}
+
+#[test]
 fn a_place_read_with_the_wrong_number_is_renumbered_when_unambiguous() {
     let (scenario, _) = cafe();
     let vocabulary = &scenario.domain.vocabulary;

@@ -26,12 +26,13 @@ use crate::world::World;
 
 use super::ask::ask;
 use super::goal_checks::{
-    GoalProblem, assess, renumbered, swapped_object, unanswered_names, without_copied,
-    without_unasked,
+    GoalProblem, assess, renumbered, swapped_back, swapped_object, unanswered_names,
+    without_copied, without_unasked,
 };
 use super::interpret_parts::{PartsRead, read_parts};
 use super::placement::{not_put, put_there};
 use super::polarity::{turned_around, turned_back};
+use super::side_by_side::{left_out, with_left_out};
 use super::types::{Event, Options, SessionError};
 use crate::llm::request_parts::split;
 
@@ -124,6 +125,12 @@ impl Judge<'_> {
                 sent.item, sent.place
             ));
         }
+        if let Some(gap) = left_out(goal, self.instruction, self.vocabulary()) {
+            return Some(format!(
+                "the request names {} beside {}, and {goal} leaves {} out",
+                gap.left_out, gap.kept, gap.left_out
+            ));
+        }
         swapped_object(goal, self.instruction, &self.lexicon).map(|(object, words)| {
             format!(
                 "the request says {}, which no condition of {goal} answers, and never names {object}",
@@ -201,12 +208,40 @@ impl Judge<'_> {
                 }),
             _ => None,
         };
+        let beside = match read {
+            Ok(a) if check_goals => with_left_out(&a.goal, self.instruction, self.vocabulary())
+                .inspect(|goal| {
+                    emit(&Event::Notice {
+                        message: format!(
+                            "the request names things side by side that {} has only one of, so {goal} is a candidate too",
+                            a.goal
+                        ),
+                    });
+                }),
+            _ => None,
+        };
+        let unswapped = match read {
+            Ok(a) if check_goals => {
+                swapped_back(&a.goal, self.instruction, &self.lexicon, self.vocabulary()).inspect(
+                    |(goal, from, to)| {
+                        emit(&Event::Notice {
+                            message: format!(
+                                "the request names {to} where the answer has {from}, which it never names, so {goal} is a candidate too"
+                            ),
+                        });
+                    },
+                )
+            }
+            _ => None,
+        };
         let mut out = Vec::new();
         for goal in pruned
             .into_iter()
             .chain(renumber.map(|(g, _, _)| g))
+            .chain(unswapped.map(|(g, _, _)| g))
             .chain(turned)
             .chain(placed)
+            .chain(beside)
         {
             let problem = self.assess(&goal);
             if let Some(p) = &problem {

@@ -17,6 +17,7 @@ pub mod policy;
 pub mod resolve;
 pub mod screen;
 pub mod shortlist;
+pub mod side_by_side;
 pub mod types;
 pub mod value_bounds;
 mod value_levels;

@@ -206,7 +206,11 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
 /// object). A name with a word beside it from a longer name of another object that shares
 /// its words ("the other bar", where the other bar counter is another place than the bar)
 /// names neither.
-fn mentions(words: &[String], objects: &[&Object], taken: &[usize]) -> Vec<(usize, usize, String)> {
+pub(super) fn mentions(
+    words: &[String],
+    objects: &[&Object],
+    taken: &[usize],
+) -> Vec<(usize, usize, String)> {
     let mut phrases: Vec<(Vec<String>, &str)> = objects
         .iter()
         .flat_map(|o| {
