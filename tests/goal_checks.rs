@@ -367,3 +367,50 @@ async fn an_object_put_in_the_place_of_a_named_one_draws_candidates() {
     );
     assert_eq!(calls, 4);
 }
+
+#[tokio::test]
+async fn a_misreading_that_can_be_undone_gives_the_undone_goal_as_a_candidate() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let cases = [
+        // A condition the other way round from the request's words.
+        (
+            "Do not open the curtain, please.",
+            "Goal: ~Closed_Curtain",
+            "Closed_Curtain",
+        ),
+        (
+            "Make sure the tube light is on and the hall light is turned off.",
+            "Goal: Active_TubeLight & Active_HallLight",
+            "Active_TubeLight & ~Active_HallLight",
+        ),
+        // An item sent to a place, read as made with the robot at the place.
+        (
+            "I would like a dessert at the bar, please.",
+            "Goal: Exists_Dessert & RobotNear_Bar",
+            "On_Dessert_Bar",
+        ),
+        // One of two things named side by side left out.
+        (
+            "I'm at the third table, could you bring me some fries or a dessert?",
+            "Goal: On_Dessert_Table3",
+            "On_Chips_Table3 | On_Dessert_Table3",
+        ),
+        // An object no word names in the place of one a word names alone.
+        (
+            "I'm at the third table, could you bring me some fries or a dessert?",
+            "Goal: On_Dessert_Table3 | On_Softdrink_Table3",
+            "On_Chips_Table3 | On_Dessert_Table3",
+        ),
+    ];
+    for (request, answer, expected) in cases {
+        // Every sampled draw repeats the misreading: only the undone goal can win.
+        let model = ByDraw::new(answer, &[answer, answer, answer]);
+        let (goal, calls) = read(&cafe, &model, request).await;
+        assert_eq!(goal.to_string(), expected, "{request}");
+        assert_eq!(calls, 1, "{request}: the undone goal passes, no more draws");
+    }
+    // A right answer is taken as it is.
+    let model = ByDraw::new("Goal: Closed_Curtain", &[]);
+    let (goal, _) = read(&cafe, &model, "Do not open the curtain, please.").await;
+    assert_eq!(goal.to_string(), "Closed_Curtain");
+}

@@ -243,6 +243,21 @@ impl Judge<'_> {
             .chain(placed)
             .chain(beside)
         {
+            // A derived goal may put an object where its predicate does not take it
+            // ("fries" put in the place of a made dessert): it is no candidate.
+            if let Err(e) = goal
+                .atoms()
+                .iter()
+                .try_for_each(|a| self.vocabulary().check_atom(a))
+            {
+                emit(&Event::CandidateRejected {
+                    candidate: goal.to_string(),
+                    proposal: None,
+                    reason: e.to_string(),
+                    author: Some("betr, from the model's answer".into()),
+                });
+                continue;
+            }
             let problem = self.assess(&goal);
             if let Some(p) = &problem {
                 emit(&Event::CandidateRejected {
