@@ -316,7 +316,7 @@ pub fn renumbered(
 }
 
 /// `goal` with every argument `from` written `to`.
-fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
+pub(super) fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
     match goal {
         Formula::Atom(a) => Formula::Atom(crate::domain::Atom::new(
             a.predicate.clone(),

@@ -32,7 +32,7 @@ use super::goal_checks::{
 use super::interpret_parts::{PartsRead, read_parts};
 use super::placement::{not_put, put_there};
 use super::polarity::{turned_around, turned_back};
-use super::side_by_side::{left_out, with_left_out};
+use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::types::{Event, Options, SessionError};
 use crate::llm::request_parts::split;
 
@@ -123,6 +123,13 @@ impl Judge<'_> {
             return Some(format!(
                 "the request sends {} to {}, and no condition of {goal} puts it there",
                 sent.item, sent.place
+            ));
+        }
+        if let Some((measure, content)) =
+            measure_for_content(goal, self.instruction, self.vocabulary())
+        {
+            return Some(format!(
+                "the request asks for {content} by the {measure}, and {goal} has the {measure} in its place"
             ));
         }
         if let Some(gap) = left_out(goal, self.instruction, self.vocabulary()) {
@@ -234,6 +241,18 @@ impl Judge<'_> {
             }
             _ => None,
         };
+        let content = match read {
+            Ok(a) if check_goals => with_content(&a.goal, self.instruction, self.vocabulary())
+                .inspect(|goal| {
+                    emit(&Event::Notice {
+                        message: format!(
+                            "the request names a measure of something that {} has in its place, so {goal} is a candidate too",
+                            a.goal
+                        ),
+                    });
+                }),
+            _ => None,
+        };
         let mut out = Vec::new();
         for goal in pruned
             .into_iter()
@@ -242,6 +261,7 @@ impl Judge<'_> {
             .chain(turned)
             .chain(placed)
             .chain(beside)
+            .chain(content)
         {
             // A derived goal may put an object where its predicate does not take it
             // ("fries" put in the place of a made dessert): it is no candidate.

@@ -2,12 +2,14 @@
 //! are asked for, the same way; a goal that has one in its conditions and not the other has
 //! left one out ("fries or a dessert" read as the dessert alone), and the goal with the
 //! left-out one beside it — in the same condition, joined as the request joins them — is
-//! a candidate.
+//! a candidate. And a thing named as the measure of another ("a glass of water"): what is
+//! asked for is the water, and a goal with the glass in its place has the measure for it.
 
 use crate::domain::{Atom, Object, Vocabulary};
 use crate::goal::Formula;
 use crate::llm::examples::every_term;
 
+use super::goal_checks::rename;
 use super::placement::mentions;
 
 /// Words that may stand between a joining word and the thing it joins ("or a dessert",
@@ -115,9 +117,44 @@ fn beside(goal: &Formula, gap: &LeftOut) -> Formula {
     }
 }
 
+/// A measure the request names with what it holds ("a glass of water") that `goal` has
+/// where the thing held is not in it: (measure, thing held).
+pub fn measure_for_content(
+    goal: &Formula,
+    request: &str,
+    vocabulary: &Vocabulary,
+) -> Option<(String, String)> {
+    let atoms = goal.atoms();
+    let has = |object: &str| atoms.iter().any(|a| a.args.iter().any(|x| x == object));
+    joined(request, vocabulary, |w| (w == "of").then_some(()))
+        .into_iter()
+        .map(|(measure, content, ())| (measure, content))
+        .find(|(measure, content)| has(measure) && !has(content))
+}
+
+/// `goal` with the thing held in the place of its measure ([`measure_for_content`]).
+pub fn with_content(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+    let (measure, content) = measure_for_content(goal, request, vocabulary)?;
+    Some(rename(goal, &measure, &content))
+}
+
 /// The pairs of things of a kind the request names side by side, in its order, each with
 /// whether "or" joins them.
 fn side_by_side(request: &str, vocabulary: &Vocabulary) -> Vec<(String, String, bool)> {
+    joined(request, vocabulary, |w| match w {
+        "or" => Some(true),
+        "and" => Some(false),
+        _ => None,
+    })
+}
+
+/// The pairs of things of a kind the request names right before and after a joining word
+/// (`join` says which words join, and how), in its order.
+fn joined<J>(
+    request: &str,
+    vocabulary: &Vocabulary,
+    join: impl Fn(&str) -> Option<J>,
+) -> Vec<(String, String, J)> {
     let objects: Vec<&Object> = vocabulary.objects.iter().collect();
     let kind_of = |name: &str| {
         vocabulary
@@ -128,14 +165,12 @@ fn side_by_side(request: &str, vocabulary: &Vocabulary) -> Vec<(String, String, 
             .unwrap_or_default()
     };
     let mut out = Vec::new();
-    for sentence in request.split(['.', ';', '!', '?']) {
+    for sentence in request.split([';', '!', '?']) {
         let words = every_term(sentence);
         let named = mentions(&words, &objects, &[]);
         for (at, word) in words.iter().enumerate() {
-            let choice = match word.as_str() {
-                "or" => true,
-                "and" => false,
-                _ => continue,
+            let Some(how) = join(word) else {
+                continue;
             };
             let Some((_, _, before)) = named.iter().find(|(start, len, _)| start + len == at)
             else {
@@ -153,7 +188,7 @@ fn side_by_side(request: &str, vocabulary: &Vocabulary) -> Vec<(String, String, 
             };
             let same_kind = kind_of(before).iter().any(|t| kind_of(after).contains(t));
             if before != after && same_kind {
-                out.push((before.clone(), after.clone(), choice));
+                out.push((before.clone(), after.clone(), how));
             }
         }
     }

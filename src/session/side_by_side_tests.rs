@@ -92,7 +92,7 @@ fn only_things_of_a_kind_right_beside_the_joining_word_are_a_pair() {
 }
 
 #[test]
-fn the_scenes_own_worked_examples_leave_nothing_out() {
+fn the_scenes_own_worked_examples_leave_nothing_out_nor_take_a_measure_for_its_content() {
     for scene in [
         "scenarios/cafe/cafe.toml",
         "scenarios/cell/red_on_blue.toml",
@@ -101,12 +101,42 @@ fn the_scenes_own_worked_examples_leave_nothing_out() {
         let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
         for example in &scenario.examples {
             let goal = Formula::parse(&example.goal).expect("example goal parses");
+            let vocabulary = &scenario.domain.vocabulary;
             assert_eq!(
-                left_out(&goal, &example.instruction, &scenario.domain.vocabulary),
+                left_out(&goal, &example.instruction, vocabulary),
+                None,
+                "{scene}: {:?}",
+                example.instruction
+            );
+            assert_eq!(
+                measure_for_content(&goal, &example.instruction, vocabulary),
                 None,
                 "{scene}: {:?}",
                 example.instruction
             );
         }
     }
+}
+
+#[test]
+fn a_measure_read_in_the_place_of_what_it_holds_is_replaced_by_it() {
+    let v = vocabulary();
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "I'd like a glass of milk at the bar.";
+    assert_eq!(
+        measure_for_content(&g("On_Glass_Bar"), request, &v),
+        Some(("Glass".into(), "Milk".into()))
+    );
+    assert_eq!(
+        with_content(&g("On_Glass_Bar"), request, &v)
+            .map(|f| f.to_string())
+            .as_deref(),
+        Some("On_Milk_Bar")
+    );
+    assert_eq!(measure_for_content(&g("On_Milk_Bar"), request, &v), None);
+    // A glass asked for by itself is the glass.
+    assert_eq!(
+        measure_for_content(&g("On_Glass_Bar"), "A glass to the bar", &v),
+        None
+    );
 }
