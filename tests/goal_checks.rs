@@ -1,7 +1,10 @@
 //! How a goal read from an instruction is checked, with a scripted model whose answer
 //! depends on the draw (greedy, or sampled with seed k): a number the request says and the
 //! first answer leaves out draws more candidates, and so does an object put in the place
-//! of one the request names; a condition no word of the request asks for is taken out; a
+//! of one the request names; a misreading that can be undone (a condition turned around,
+//! an item sent to a place but not put there, one of two things named side by side left
+//! out, a swapped object) gives the undone goal as a candidate; a condition no word of
+//! the request asks for is taken out; a
 //! failure is asked about with the conditions that fix it in simulation as the only
 //! choices. And with a model that answers by the request it is asked about: a request of
 //! several wishes is read a wish at a time.

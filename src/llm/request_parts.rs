@@ -2,8 +2,10 @@
 //! ("Please turn on the hall light. And, can you bring water to table 2? Thank you."), and
 //! a small model reads such a request worse than it reads each wish alone: it leaves one
 //! out, mixes their parts, or turns a negation around. A request is cut where a new wish
-//! begins — at the end of a sentence, and before "also", "and then", "alternatively" and
-//! the like after a comma — and each piece that names an object becomes a part. Pieces
+//! begins — at the end of a sentence, before "also", "and then", "alternatively" and the
+//! like after a comma, and before "and", "but" or "or" followed by a verb of asking ("clean
+//! the chairs and deliver coffee", "either clear the table or turn off the light") — and
+//! each piece that names an object becomes a part. Pieces
 //! that name none ("Thank you.", "It looks like it needs a good cleaning.") stay with the
 //! part before them, so no part is read without the thing it is about.
 //!
@@ -52,6 +54,84 @@ const OPENERS: &[(&str, Join)] = &[
     ("if that is not possible", Join::Or),
 ];
 
+/// Words that join two wishes inside a clause when a verb of asking follows them, with how
+/// they join.
+const JOINING: &[(&str, Join)] = &[("and", Join::And), ("but", Join::And), ("or", Join::Or)];
+
+/// Words that begin a wish of their own after a joining word: the verbs requests ask with
+/// and the ways of asking ("could you ...", "make sure ...").
+const ASKING: &[&str] = &[
+    "bring",
+    "deliver",
+    "serve",
+    "take",
+    "put",
+    "place",
+    "fetch",
+    "carry",
+    "give",
+    "send",
+    "make",
+    "prepare",
+    "brew",
+    "turn",
+    "switch",
+    "open",
+    "close",
+    "shut",
+    "clean",
+    "sweep",
+    "wipe",
+    "mop",
+    "tidy",
+    "clear",
+    "wash",
+    "go",
+    "come",
+    "move",
+    "head",
+    "keep",
+    "leave",
+    "hold",
+    "grab",
+    "pick",
+    "set",
+    "draw",
+    "activate",
+    "deactivate",
+    "ensure",
+    "check",
+    "avoid",
+    "stay",
+    "wait",
+    "join",
+    "hand",
+    "remove",
+    "lower",
+    "raise",
+    "increase",
+    "decrease",
+    "could",
+    "can",
+    "would",
+    "will",
+    "please",
+    "do",
+    "don't",
+    "dont",
+    "don’t",
+    "try",
+];
+
+/// Words that may stand between a joining word and the verb ("or maybe bring").
+const BETWEEN: &[&str] = &["either", "also", "then", "just", "maybe", "perhaps"];
+
+/// Words before an "or" that make it "neither ... nor" ("don't bring coffee or serve
+/// dessert" asks for neither), so that it joins no alternatives.
+const NEGATING: &[&str] = &[
+    "not", "don't", "dont", "don’t", "never", "no", "avoid", "without",
+];
+
 /// Words that may begin a sentence and say how it joins the one before; a sentence that
 /// begins with any of [`OPENERS`] joins as they say, one beginning "Or" as an alternative.
 const SENTENCE_OPENERS: &[(&str, Join)] = &[("or", Join::Or), ("and", Join::And)];
@@ -59,33 +139,51 @@ const SENTENCE_OPENERS: &[(&str, Join)] = &[("or", Join::Or), ("and", Join::And)
 /// The parts of `request`, in order: one part when it is a single wish (or names no
 /// object at all).
 pub fn split(request: &str, lexicon: &Lexicon) -> Vec<Part> {
-    let mut pieces: Vec<Part> = Vec::new();
+    // Each piece with the words as written, joining word included, for a piece kept with
+    // another ("pick up and hold a bottle").
+    let mut pieces: Vec<(Part, &str)> = Vec::new();
     for (i, sentence) in sentences(request).into_iter().enumerate() {
-        for (j, clause) in clauses(sentence).into_iter().enumerate() {
-            let (join, text) = opening(clause, j == 0 && i > 0);
+        for (j, (clause, joined)) in clauses(sentence).into_iter().enumerate() {
+            let (join, text) = match joined {
+                Some((join, word)) => (join, clause.get(word..).unwrap_or(clause)),
+                None => opening(clause, j == 0 && i > 0),
+            };
             let text = text.trim();
             if text.chars().any(char::is_alphanumeric) {
-                pieces.push(Part {
+                let part = Part {
                     text: text.to_string(),
                     join,
-                });
+                };
+                pieces.push((
+                    part,
+                    if joined.is_some() {
+                        clause.trim()
+                    } else {
+                        text
+                    },
+                ));
             }
         }
     }
     let names_something = |text: &str| terms(text).iter().any(|w| lexicon.names_an_object(w));
     let mut parts: Vec<Part> = Vec::new();
     let mut leading = String::new();
-    for piece in pieces {
+    for (piece, written) in pieces {
         if !names_something(&piece.text) {
             // Kept with the wish before it, or the one after when there is none yet.
             match parts.last_mut() {
-                Some(last) => push_text(&mut last.text, &piece.text),
-                None => push_text(&mut leading, &piece.text),
+                Some(last) => push_text(&mut last.text, written),
+                None => push_text(&mut leading, written),
             }
             continue;
         }
+        let own = if leading.is_empty() {
+            &piece.text
+        } else {
+            written
+        };
         let mut text = std::mem::take(&mut leading);
-        push_text(&mut text, &piece.text);
+        push_text(&mut text, own);
         let join = if parts.is_empty() {
             Join::And
         } else {
@@ -148,19 +246,77 @@ fn sentences(text: &str) -> Vec<&str> {
     out
 }
 
-/// A sentence cut before each comma-led opener of [`OPENERS`]; each clause keeps its
-/// opener, which [`opening`] reads.
-fn clauses(sentence: &str) -> Vec<&str> {
-    let mut out = Vec::new();
+/// A sentence cut before each comma-led opener of [`OPENERS`], and before each joining
+/// word followed by a verb of asking; a clause cut at a joining word begins with it and
+/// comes with how it joins and the word's length, one cut at an opener keeps the opener
+/// for [`opening`] to read.
+fn clauses(sentence: &str) -> Vec<(&str, Option<(Join, usize)>)> {
+    let mut by_opener = Vec::new();
     let mut start = 0;
     for (at, _) in sentence.match_indices(',') {
         let after = &sentence[at + 1..];
         if opener(after).is_some() && sentence[start..at].chars().any(char::is_alphanumeric) {
-            out.push(&sentence[start..at]);
+            by_opener.push(&sentence[start..at]);
             start = at + 1;
         }
     }
-    out.push(&sentence[start..]);
+    by_opener.push(&sentence[start..]);
+    let mut out = Vec::new();
+    for clause in by_opener {
+        let mut join = None;
+        let mut rest = clause;
+        while let Some((cut, after, how)) = verb_join(rest) {
+            out.push((&rest[..cut], join));
+            join = Some((how, after - cut));
+            rest = &rest[cut..];
+        }
+        out.push((rest, join));
+    }
+    out
+}
+
+/// The first joining word of `clause` that a verb of asking follows, after some words of
+/// the clause: where the word starts, where it ends, and how it joins.
+fn verb_join(clause: &str) -> Option<(usize, usize, Join)> {
+    let words = word_spans(clause);
+    let lower = |k: usize| clause[words[k].0..words[k].1].to_lowercase();
+    for k in 1..words.len() {
+        let Some((_, how)) = JOINING.iter().find(|(w, _)| *w == lower(k)) else {
+            continue;
+        };
+        let mut next = k + 1;
+        while next < words.len() && BETWEEN.contains(&lower(next).as_str()) {
+            next += 1;
+        }
+        if next >= words.len() || !ASKING.contains(&lower(next).as_str()) {
+            continue;
+        }
+        if *how == Join::Or && (0..k).any(|i| NEGATING.contains(&lower(i).as_str())) {
+            continue;
+        }
+        return Some((words[k].0, words[k].1, *how));
+    }
+    None
+}
+
+/// The byte spans of the words of `text` (letters, digits and apostrophes).
+fn word_spans(text: &str) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start: Option<usize> = None;
+    for (at, c) in text.char_indices() {
+        let in_word = c.is_alphanumeric() || c == '\'' || c == '’';
+        match (in_word, start) {
+            (true, None) => start = Some(at),
+            (false, Some(s)) => {
+                out.push((s, at));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        out.push((s, text.len()));
+    }
     out
 }
 
@@ -292,6 +448,48 @@ mod tests {
                 (Join::And, "bring a tea to the bar. Thanks a lot."),
             ]
         );
+    }
+
+    #[test]
+    fn a_joining_word_before_a_verb_of_asking_begins_a_wish() {
+        let lex = cafe_lexicon();
+        let parts = split(
+            "Clean the chairs and deliver coffee to the coffee station.",
+            &lex,
+        );
+        assert_eq!(
+            texts(&parts),
+            vec![
+                (Join::And, "Clean the chairs"),
+                (Join::And, "deliver coffee to the coffee station."),
+            ]
+        );
+        let parts = split(
+            "Could you please either clear the table or turn off the hall light?",
+            &lex,
+        );
+        assert_eq!(
+            texts(&parts),
+            vec![
+                (Join::And, "Could you please either clear the table"),
+                (Join::Or, "turn off the hall light?"),
+            ]
+        );
+        // A verb that names nothing stays with the wish it begins, its "and" kept.
+        let parts = split("Please pick up and hold a bottle of spring water.", &lex);
+        assert_eq!(
+            texts(&parts),
+            vec![(
+                Join::And,
+                "Please pick up and hold a bottle of spring water."
+            )]
+        );
+        // "Don't ... or ..." asks for neither: no alternatives.
+        let request = "Don't bring coffee or serve the dessert.";
+        assert_eq!(texts(&split(request, &lex)), vec![(Join::And, request)]);
+        // "and" before a thing, not a verb, joins two things of one wish.
+        let request = "Bring the milk and the chips to the bar.";
+        assert_eq!(split(request, &lex).len(), 1);
     }
 
     #[test]
