@@ -132,6 +132,9 @@ const NEGATING: &[&str] = &[
     "not", "don't", "dont", "don’t", "never", "no", "avoid", "without",
 ];
 
+/// Words by which a wish refers to the thing of the wish before it.
+const BACK_REFERENCES: &[&str] = &["it", "them", "it's", "its", "they", "those", "these"];
+
 /// Words that may begin a sentence and say how it joins the one before; a sentence that
 /// begins with any of [`OPENERS`] joins as they say, one beginning "Or" as an alternative.
 const SENTENCE_OPENERS: &[(&str, Join)] = &[("or", Join::Or), ("and", Join::And)];
@@ -292,6 +295,10 @@ fn verb_join(clause: &str) -> Option<(usize, usize, Join)> {
             continue;
         }
         if *how == Join::Or && (0..k).any(|i| NEGATING.contains(&lower(i).as_str())) {
+            continue;
+        }
+        // "make a dessert and bring it to table 3": the wish after is about the one before.
+        if (next..words.len()).any(|i| BACK_REFERENCES.contains(&lower(i).as_str())) {
             continue;
         }
         return Some((words[k].0, words[k].1, *how));
@@ -487,6 +494,9 @@ mod tests {
         // "Don't ... or ..." asks for neither: no alternatives.
         let request = "Don't bring coffee or serve the dessert.";
         assert_eq!(texts(&split(request, &lex)), vec![(Join::And, request)]);
+        // A wish about the thing of the one before is read with it.
+        let request = "Make a dessert and bring it to table 3.";
+        assert_eq!(split(request, &lex).len(), 1);
         // "and" before a thing, not a verb, joins two things of one wish.
         let request = "Bring the milk and the chips to the bar.";
         assert_eq!(split(request, &lex).len(), 1);
