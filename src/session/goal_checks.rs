@@ -125,7 +125,7 @@ const PHRASING: &[&str] = &[
 /// twice, and the second conjunct has no word of its own); a request that says "bar" twice
 /// ("not on the bar and bar 2, the milk to the bar") asks for every conjunct about a bar.
 pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula> {
-    let Formula::And(items) = goal else {
+    let Formula::And(items) = factored(goal) else {
         return Vec::new();
     };
     let asked = terms(request);
@@ -221,10 +221,46 @@ fn unnamed_object(
         })
 }
 
+/// `goal` with the conjuncts every alternative shares taken out of the alternatives:
+/// `X & A | X & B` is `X & (A | B)`, so that what each alternative repeats is judged once
+/// ("the robot near table 3" added to both "fries at table 3" and "dessert at table 3").
+/// Any other goal as it is.
+pub(super) fn factored(goal: &Formula) -> Formula {
+    let Formula::Or(alternatives) = goal else {
+        return goal.clone();
+    };
+    let conjuncts = |f: &Formula| match f {
+        Formula::And(items) => items.clone(),
+        other => vec![other.clone()],
+    };
+    let lists: Vec<Vec<Formula>> = alternatives.iter().map(conjuncts).collect();
+    let Some((first, rest)) = lists.split_first() else {
+        return goal.clone();
+    };
+    let common: Vec<Formula> = first
+        .iter()
+        .filter(|c| rest.iter().all(|l| l.contains(c)))
+        .cloned()
+        .collect();
+    let remainders: Vec<Vec<Formula>> = lists
+        .iter()
+        .map(|l| l.iter().filter(|c| !common.contains(c)).cloned().collect())
+        .collect();
+    // An alternative that is only the shared part would absorb the others.
+    if common.is_empty() || remainders.iter().any(Vec::is_empty) {
+        return goal.clone();
+    }
+    let mut items = common;
+    items.push(Formula::Or(
+        remainders.into_iter().map(Formula::and).collect(),
+    ));
+    Formula::and(items)
+}
+
 /// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
 /// first (an appended condition comes last), while more than one is left.
 pub(super) fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Option<Formula> {
-    let mut current = goal.clone();
+    let mut current = factored(goal);
     let mut changed = false;
     while let Some(extra) = unasked(&current, request, lexicon).pop() {
         let Formula::And(items) = &current else {

@@ -247,3 +247,27 @@ fn a_goal_true_through_a_place_nobody_named_is_wrong() {
         None
     );
 }
+
+#[test]
+fn what_every_alternative_repeats_is_judged_once() {
+    let (scenario, _) = cafe();
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let goal = g("RobotNear_Table3 & On_Chips_Table3 | RobotNear_Table3 & On_Dessert_Table3");
+    assert_eq!(
+        factored(&goal).to_string(),
+        "RobotNear_Table3 & (On_Chips_Table3 | On_Dessert_Table3)"
+    );
+    let request = "I'm at the third table, bring me fries or a dessert";
+    assert_eq!(
+        without_unasked(&goal, request, &lexicon)
+            .map(|f| f.to_string())
+            .as_deref(),
+        Some("On_Chips_Table3 | On_Dessert_Table3")
+    );
+    // Nothing shared, or an alternative that is only the shared part: as it is.
+    let apart = g("On_Chips_Table3 | On_Dessert_Table3");
+    assert_eq!(factored(&apart), apart);
+    let absorbing = g("RobotNear_Table3 | RobotNear_Table3 & On_Chips_Table3");
+    assert_eq!(factored(&absorbing), absorbing);
+}
