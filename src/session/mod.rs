@@ -9,6 +9,7 @@ pub mod engine;
 pub mod goal_checks;
 pub mod interpret;
 mod interpret_parts;
+mod judge;
 pub mod knowledge;
 pub mod placement;
 pub mod planned;
