@@ -7,11 +7,13 @@
 
 use crate::domain::Condition;
 use crate::goal::Formula;
-use crate::llm::examples::terms;
+use crate::llm::examples::{every_term, terms};
 use crate::llm::lexicon::{Lexicon, is_number, same_word};
 use crate::planner::{Outcome, Planner};
 use crate::scenario::Scenario;
 use crate::world::World;
+
+use super::placement::mentions;
 
 /// Why a candidate goal cannot be what the person meant, or may not be.
 #[derive(Debug, Clone, PartialEq)]
@@ -177,29 +179,35 @@ pub fn swapped_object(
 }
 
 /// `goal` with the object it put in another's place ([`swapped_object`]) replaced by the
-/// one object of a kind with it that the unanswered word names by itself ("fries" read as
-/// `Softdrink`: `Chips`, called fries). `None` when the word names no such object or
-/// several. Returns the goal, and the object replaced and its replacement.
+/// one object of a kind with it that the request names and the goal leaves out ("fries"
+/// read as `Softdrink`: `Chips`, called fries; "spring water" is `SpringWater`, not the
+/// water its second word names). `None` when the request names no such object or several.
+/// Returns the goal, and the object replaced and its replacement.
 pub fn swapped_back(
     goal: &Formula,
     request: &str,
     lexicon: &Lexicon,
     vocabulary: &crate::domain::Vocabulary,
 ) -> Option<(Formula, String, String)> {
-    let (from, words) = swapped_object(goal, request, lexicon)?;
+    let (from, _) = swapped_object(goal, request, lexicon)?;
     let kinds = &vocabulary.objects.iter().find(|o| o.name == from)?.types;
-    let names_alone = |o: &crate::domain::Object, word: &str| {
-        std::iter::once(&o.name)
-            .chain(&o.called)
-            .any(|n| matches!(terms(n).as_slice(), [w] if same_word(w, word)))
-    };
-    let mut to = vocabulary.objects.iter().filter(|o| {
-        o.types.iter().any(|t| kinds.contains(t)) && words.iter().any(|w| names_alone(o, w))
-    });
-    let (Some(to), None) = (to.next(), to.next()) else {
+    let of_kind: Vec<&crate::domain::Object> = vocabulary
+        .objects
+        .iter()
+        .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
+        .collect();
+    let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
+    let mut named: Vec<String> = mentions(&every_term(request), &of_kind, &[])
+        .into_iter()
+        .map(|(_, _, name)| name)
+        .filter(|name| !in_goal.contains(name))
+        .collect();
+    named.sort();
+    named.dedup();
+    let [to] = named.as_slice() else {
         return None;
     };
-    Some((rename(goal, &from, &to.name), from, to.name.clone()))
+    Some((rename(goal, &from, to), from, to.clone()))
 }
 
 /// The first object of `atoms` that no word of `request` names (`"any object"` aside).

@@ -148,6 +148,18 @@ fn a_swapped_object_is_put_back_when_the_word_names_one_thing_of_its_kind() {
     assert_eq!(goal.to_string(), "On_Dessert_Table3 | On_Chips_Table3");
     // No swap, nothing to put back.
     assert!(swapped_back(&g("On_Chips_Table3"), request, &lexicon, vocabulary).is_none());
+    // A name of two words is the object it names, not the one its last word names.
+    let (goal, _, to) = swapped_back(
+        &g("Holding_Coffee"),
+        "Please pick up and hold the spring water.",
+        &lexicon,
+        vocabulary,
+    )
+    .expect("put back");
+    assert_eq!(
+        (to.as_str(), goal.to_string().as_str()),
+        ("SpringWater", "Holding_SpringWater")
+    );
 }
 
 #[test]
