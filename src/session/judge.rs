@@ -127,12 +127,56 @@ impl Judge<'_> {
                 .is_ok_and(|a| self.misread(&a.goal).is_none())
     }
 
+    /// `goal` with each plain misreading undone that can be, each with what was undone:
+    /// the place renumbered when the request numbers another one of its kind ("table six"
+    /// read as Table1), a swapped object put back, conditions asked the other way round
+    /// turned, items sent to a place put there, a thing left out put beside the one named
+    /// with it, a measure replaced by what it holds.
+    fn undone(&self, goal: &Formula) -> Vec<(Formula, String)> {
+        let (request, vocabulary) = (self.instruction, self.vocabulary());
+        let mut out = Vec::new();
+        if let Some((g, from, to)) = renumbered(goal, &self.missing_numbers(goal), vocabulary) {
+            out.push((
+                g,
+                format!("the request numbers a place the answer does not: {to} is the only one like {from} with that number"),
+            ));
+        }
+        if let Some((g, from, to)) = swapped_back(goal, request, &self.lexicon, vocabulary) {
+            out.push((
+                g,
+                format!("the request names {to} where the answer has {from}, which it never names"),
+            ));
+        }
+        if let Some(why) = turned_around(goal, request, vocabulary)
+            && let Some(g) = turned_back(goal, request, vocabulary)
+        {
+            out.push((g, why.to_string()));
+        }
+        if let Some(g) = put_there(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request sends an item to a place that {goal} only has apart"),
+            ));
+        }
+        if let Some(g) = with_left_out(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request names things side by side that {goal} has only one of"),
+            ));
+        }
+        if let Some(g) = with_content(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request names a measure of something that {goal} has in its place"),
+            ));
+        }
+        out
+    }
+
     /// Candidates made from an answer that failed a check: without what it pasted from an
     /// example, or without the parts no word of the request asks for; and, when checks
-    /// are on, with the place renumbered when the request numbers another one of its kind
-    /// ("table six" read as Table1), and with the conditions the request asks for the
-    /// other way round turned ("do not open" read as open). Each is checked like the
-    /// others.
+    /// are on, any answer with its plain misreadings undone ([`Judge::undone`]). Each is
+    /// checked like the others.
     pub(super) fn derived(
         &self,
         read: &Result<GoalAnswer, ReplyError>,
@@ -146,92 +190,17 @@ impl Judge<'_> {
                 .or_else(|| without_unasked(&a.goal, self.instruction, &self.lexicon)),
             _ => None,
         };
-        let renumber = match read {
-            Ok(a) if check_goals => renumbered(
-                &a.goal,
-                &self.missing_numbers(&a.goal),
-                &self.scenario.domain.vocabulary,
-            ),
-            _ => None,
+        let undone = match read {
+            Ok(a) if check_goals => self.undone(&a.goal),
+            _ => Vec::new(),
         };
-        if let Some((goal, from, to)) = &renumber {
+        for (goal, why) in &undone {
             emit(&Event::Notice {
-                message: format!(
-                    "the request numbers a place the answer does not: {to} is the only one like {from} with that number, so {goal} is a candidate too"
-                ),
+                message: format!("{why}, so {goal} is a candidate too"),
             });
         }
-        let turned = match read {
-            Ok(a) if check_goals => turned_around(&a.goal, self.instruction, self.vocabulary())
-                .and_then(|why| {
-                    let goal = turned_back(&a.goal, self.instruction, self.vocabulary())?;
-                    emit(&Event::Notice {
-                        message: format!("{why}, so {goal} is a candidate too"),
-                    });
-                    Some(goal)
-                }),
-            _ => None,
-        };
-        let placed = match read {
-            Ok(a) if check_goals => put_there(&a.goal, self.instruction, self.vocabulary())
-                .inspect(|goal| {
-                    emit(&Event::Notice {
-                        message: format!(
-                            "the request sends an item to a place that {} only has apart, so {goal} is a candidate too",
-                            a.goal
-                        ),
-                    });
-                }),
-            _ => None,
-        };
-        let beside = match read {
-            Ok(a) if check_goals => with_left_out(&a.goal, self.instruction, self.vocabulary())
-                .inspect(|goal| {
-                    emit(&Event::Notice {
-                        message: format!(
-                            "the request names things side by side that {} has only one of, so {goal} is a candidate too",
-                            a.goal
-                        ),
-                    });
-                }),
-            _ => None,
-        };
-        let unswapped = match read {
-            Ok(a) if check_goals => {
-                swapped_back(&a.goal, self.instruction, &self.lexicon, self.vocabulary()).inspect(
-                    |(goal, from, to)| {
-                        emit(&Event::Notice {
-                            message: format!(
-                                "the request names {to} where the answer has {from}, which it never names, so {goal} is a candidate too"
-                            ),
-                        });
-                    },
-                )
-            }
-            _ => None,
-        };
-        let content = match read {
-            Ok(a) if check_goals => with_content(&a.goal, self.instruction, self.vocabulary())
-                .inspect(|goal| {
-                    emit(&Event::Notice {
-                        message: format!(
-                            "the request names a measure of something that {} has in its place, so {goal} is a candidate too",
-                            a.goal
-                        ),
-                    });
-                }),
-            _ => None,
-        };
         let mut out = Vec::new();
-        for goal in pruned
-            .into_iter()
-            .chain(renumber.map(|(g, _, _)| g))
-            .chain(unswapped.map(|(g, _, _)| g))
-            .chain(turned)
-            .chain(placed)
-            .chain(beside)
-            .chain(content)
-        {
+        for goal in pruned.into_iter().chain(undone.into_iter().map(|(g, _)| g)) {
             // A derived goal may put an object where its predicate does not take it
             // ("fries" put in the place of a made dessert): it is no candidate.
             if let Err(e) = goal

@@ -35,3 +35,29 @@ pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};
+
+/// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),
+/// its scene's path and scenario, and its goal: the misreading checks must find nothing in
+/// what the scenes themselves teach.
+#[cfg(test)]
+pub(crate) fn for_each_worked_example(
+    mut check: impl FnMut(
+        &str,
+        &crate::scenario::Scenario,
+        &crate::scenario::Example,
+        &crate::goal::Formula,
+    ),
+) {
+    for scene in [
+        "scenarios/cafe/cafe.toml",
+        "scenarios/cell/red_on_blue.toml",
+    ] {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(scene);
+        let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
+        assert!(!scenario.examples.is_empty(), "{scene} has worked examples");
+        for example in &scenario.examples {
+            let goal = crate::goal::Formula::parse(&example.goal).expect("example goal parses");
+            check(scene, &scenario, example, &goal);
+        }
+    }
+}

@@ -150,22 +150,18 @@ fn the_robots_own_moving_and_conditions_asked_in_their_words_stay() {
 
 #[test]
 fn the_scenes_own_worked_examples_put_what_they_send() {
-    for scene in [
-        "scenarios/cafe/cafe.toml",
-        "scenarios/cell/red_on_blue.toml",
-    ] {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(scene);
-        let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
-        for example in &scenario.examples {
-            let goal = Formula::parse(&example.goal).expect("example goal parses");
-            let vocabulary = &scenario.domain.vocabulary;
-            assert_eq!(
-                not_put(&goal, &example.instruction, vocabulary),
-                None,
-                "{scene}: {:?}",
-                example.instruction
-            );
-            assert_eq!(put_there(&goal, &example.instruction, vocabulary), None);
-        }
-    }
+    crate::session::for_each_worked_example(|scene, scenario, example, goal| {
+        let vocabulary = &scenario.domain.vocabulary;
+        let request = &example.instruction;
+        assert_eq!(
+            not_put(goal, request, vocabulary),
+            None,
+            "{scene}: {request:?}"
+        );
+        assert_eq!(
+            put_there(goal, request, vocabulary),
+            None,
+            "{scene}: {request:?}"
+        );
+    });
 }

@@ -164,22 +164,13 @@ fn put_down_asks_to_hold_nothing_of_it() {
 
 #[test]
 fn the_scenes_own_worked_examples_are_read_the_way_round_they_ask() {
-    for scene in [
-        "scenarios/cafe/cafe.toml",
-        "scenarios/cell/red_on_blue.toml",
-    ] {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(scene);
-        let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
-        assert!(!scenario.examples.is_empty(), "{scene} has worked examples");
-        for example in &scenario.examples {
-            let goal = Formula::parse(&example.goal).expect("example goal parses");
-            assert_eq!(
-                turned_around(&goal, &example.instruction, &scenario.domain.vocabulary)
-                    .map(|t| t.to_string()),
-                None,
-                "{scene}: {:?}",
-                example.instruction
-            );
-        }
-    }
+    crate::session::for_each_worked_example(|scene, scenario, example, goal| {
+        assert_eq!(
+            turned_around(goal, &example.instruction, &scenario.domain.vocabulary)
+                .map(|t| t.to_string()),
+            None,
+            "{scene}: {:?}",
+            example.instruction
+        );
+    });
 }

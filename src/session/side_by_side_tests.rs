@@ -93,29 +93,17 @@ fn only_things_of_a_kind_right_beside_the_joining_word_are_a_pair() {
 
 #[test]
 fn the_scenes_own_worked_examples_leave_nothing_out_nor_take_a_measure_for_its_content() {
-    for scene in [
-        "scenarios/cafe/cafe.toml",
-        "scenarios/cell/red_on_blue.toml",
-    ] {
-        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(scene);
-        let scenario = crate::scenario::Scenario::load(&path).expect("scene loads");
-        for example in &scenario.examples {
-            let goal = Formula::parse(&example.goal).expect("example goal parses");
-            let vocabulary = &scenario.domain.vocabulary;
-            assert_eq!(
-                left_out(&goal, &example.instruction, vocabulary),
-                None,
-                "{scene}: {:?}",
-                example.instruction
-            );
-            assert_eq!(
-                measure_for_content(&goal, &example.instruction, vocabulary),
-                None,
-                "{scene}: {:?}",
-                example.instruction
-            );
-        }
-    }
+    crate::session::for_each_worked_example(|scene, scenario, example, goal| {
+        let vocabulary = &scenario.domain.vocabulary;
+        let request = &example.instruction;
+        assert_eq!(
+            left_out(goal, request, vocabulary),
+            None,
+            "{scene}: {request:?}"
+        );
+        let measure = measure_for_content(goal, request, vocabulary);
+        assert_eq!(measure, None, "{scene}: {request:?}");
+    });
 }
 
 #[test]
