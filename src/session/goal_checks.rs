@@ -14,6 +14,7 @@ use crate::scenario::Scenario;
 use crate::world::World;
 
 use super::placement::mentions;
+use super::polarity::without_numbering;
 
 /// Why a candidate goal cannot be what the person meant, or may not be.
 #[derive(Debug, Clone, PartialEq)]
@@ -197,7 +198,7 @@ pub fn swapped_back(
         .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
         .collect();
     let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
-    let mut named: Vec<String> = mentions(&every_term(request), &of_kind, &[])
+    let mut named: Vec<String> = mentions(&every_term(&without_numbering(request)), &of_kind, &[])
         .into_iter()
         .map(|(_, _, name)| name)
         .filter(|name| !in_goal.contains(name))

@@ -9,7 +9,7 @@ use crate::goal::Formula;
 use crate::llm::examples::{every_term, terms};
 use crate::llm::lexicon::same_word;
 
-use super::polarity::find_phrase;
+use super::polarity::{find_phrase, without_numbering};
 
 /// Words that send an item to the place named after them.
 const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
@@ -162,7 +162,7 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
     let items: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 0)).collect();
     let places: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 1)).collect();
     let mut out: Vec<Sent> = Vec::new();
-    for clause in request.split(['.', ';', '!', '?', ',']) {
+    for clause in without_numbering(request).split(['.', ';', '!', '?', ',']) {
         let words = every_term(clause);
         let place_spans = mentions(&words, &places, &[]);
         let covered: Vec<usize> = place_spans

@@ -67,6 +67,16 @@ fn an_item_made_and_the_robot_at_the_place_is_not_the_item_put_there() {
         put("Exists_Dessert & RobotNear_Table1", request).as_deref(),
         Some("On_Dessert_Table1")
     );
+    // A number announced by "number" still names the table.
+    let request = "Please deliver the cup to table number one";
+    assert_eq!(
+        flagged("Holding_Cup", request),
+        Some(("Cup".into(), "Table1".into()))
+    );
+    assert_eq!(
+        put("Holding_Cup & RobotNear_Table1", request).as_deref(),
+        Some("On_Cup_Table1")
+    );
     assert_eq!(
         put(
             "Exists_Dessert & RobotNear_Bar",

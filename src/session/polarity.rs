@@ -135,10 +135,34 @@ fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, boo
     found
 }
 
+/// `text` without the words that only announce a number ("table No. 6", "table number
+/// one", "bar nr 2"), which would stand between a name's words and, as "No.", end a
+/// sentence or read as a negation.
+pub(super) fn without_numbering(text: &str) -> String {
+    const NUMBERING: &[&str] = &["no", "no.", "number", "nr", "nr.", "num", "#"];
+    const NUMBER_WORDS: &[&str] = &[
+        "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
+    ];
+    let tokens: Vec<&str> = text.split_whitespace().collect();
+    let announces = |i: usize| {
+        NUMBERING.contains(&tokens[i].to_lowercase().as_str())
+            && tokens.get(i + 1).is_some_and(|next| {
+                let next = next.to_lowercase();
+                let next = next.trim_matches(|c: char| !c.is_alphanumeric());
+                next.starts_with(|c: char| c.is_ascii_digit()) || NUMBER_WORDS.contains(&next)
+            })
+    };
+    (0..tokens.len())
+        .filter(|&i| !announces(i))
+        .map(|i| tokens[i])
+        .collect::<Vec<&str>>()
+        .join(" ")
+}
+
 /// The request's clauses, as [`every_term`] gives their words: split at punctuation and before
 /// the words that start a clause; "n't" is the word "not".
 fn clauses(request: &str) -> Vec<Vec<String>> {
-    let text = request
+    let text = without_numbering(request)
         .replace("n't", " not")
         .replace("n’t", " not")
         .replace("N'T", " not");

@@ -174,3 +174,19 @@ fn the_scenes_own_worked_examples_are_read_the_way_round_they_ask() {
         );
     });
 }
+
+#[test]
+fn words_that_only_announce_a_number_are_left_out() {
+    assert_eq!(
+        without_numbering("Go to table No. 6 now"),
+        "Go to table 6 now"
+    );
+    assert_eq!(
+        without_numbering("table number one, please"),
+        "table one, please"
+    );
+    assert_eq!(
+        without_numbering("No juice, no. Bar nr 2"),
+        "No juice, no. Bar 2"
+    );
+}

@@ -11,6 +11,7 @@ use crate::llm::examples::every_term;
 
 use super::goal_checks::rename;
 use super::placement::mentions;
+use super::polarity::without_numbering;
 
 /// Words that may stand between a joining word and the thing it joins ("or a dessert",
 /// "and either the milk").
@@ -165,7 +166,7 @@ fn joined<J>(
             .unwrap_or_default()
     };
     let mut out = Vec::new();
-    for sentence in request.split([';', '!', '?']) {
+    for sentence in without_numbering(request).split(['.', ';', '!', '?']) {
         let words = every_term(sentence);
         let named = mentions(&words, &objects, &[]);
         for (at, word) in words.iter().enumerate() {
