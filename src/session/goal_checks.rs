@@ -360,6 +360,28 @@ pub fn renumbered(
     ))
 }
 
+/// `goal` with each finding of `find` undone by `undo`, until `find` finds nothing or
+/// finds again what it found before (undoing that twice would turn it back). `None` when
+/// nothing was undone.
+pub(super) fn undo_each<F, K: PartialEq>(
+    goal: &Formula,
+    find: impl Fn(&Formula) -> Option<F>,
+    key: impl Fn(&F) -> K,
+    undo: impl Fn(&Formula, &F) -> Formula,
+) -> Option<Formula> {
+    let mut current = goal.clone();
+    let mut done: Vec<K> = Vec::new();
+    while let Some(finding) = find(&current) {
+        let k = key(&finding);
+        if done.contains(&k) {
+            break;
+        }
+        current = undo(&current, &finding);
+        done.push(k);
+    }
+    (!done.is_empty()).then_some(current)
+}
+
 /// `goal` with every argument `from` written `to`.
 pub(super) fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
     match goal {

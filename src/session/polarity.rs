@@ -13,6 +13,8 @@ use crate::goal::Formula;
 use crate::llm::examples::{every_term, terms};
 use crate::llm::lexicon::same_word;
 
+use super::goal_checks::undo_each;
+
 /// Words that turn around what follows them in their clause ("n't" is read as "not").
 const NEGATIONS: &[&str] = &[
     "not", "no", "never", "nor", "neither", "avoid", "without", "cannot", "forget", "refrain",
@@ -71,17 +73,13 @@ pub fn turned_around(
 /// `goal` with every condition the request asks for the other way round turned around.
 /// `None` when nothing is turned around.
 pub fn turned_back(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
-    let mut current = goal.clone();
-    let mut turned: Vec<Atom> = Vec::new();
-    while let Some(t) = turned_around(&current, request, vocabulary) {
-        // Each atom is turned once: a second finding about it would undo the first.
-        if turned.contains(&t.atom) {
-            break;
-        }
-        current = flipped(&current, &t.atom);
-        turned.push(t.atom);
-    }
-    (!turned.is_empty()).then_some(current)
+    // Each atom is turned once: a second finding about it would undo the first.
+    undo_each(
+        goal,
+        |g| turned_around(g, request, vocabulary),
+        |t| t.atom.clone(),
+        |g, t| flipped(g, &t.atom),
+    )
 }
 
 /// What a clause asks about: a predicate and the object it is about.

@@ -9,7 +9,7 @@ use crate::domain::{Atom, Object, Vocabulary};
 use crate::goal::Formula;
 use crate::llm::examples::every_term;
 
-use super::goal_checks::rename;
+use super::goal_checks::{rename, undo_each};
 use super::placement::mentions;
 use super::polarity::without_numbering;
 
@@ -61,16 +61,12 @@ pub fn left_out(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Optio
 /// by `|` for "or" and `&` for "and" (a negated one always by `&`: "not the cup or the
 /// juice" wants neither).
 pub fn with_left_out(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
-    let mut current = goal.clone();
-    let mut added: Vec<String> = Vec::new();
-    while let Some(gap) = left_out(&current, request, vocabulary) {
-        if added.contains(&gap.left_out) {
-            break;
-        }
-        current = beside(&current, &gap);
-        added.push(gap.left_out);
-    }
-    (!added.is_empty()).then_some(current)
+    undo_each(
+        goal,
+        |g| left_out(g, request, vocabulary),
+        |gap| gap.left_out.clone(),
+        beside,
+    )
 }
 
 fn beside(goal: &Formula, gap: &LeftOut) -> Formula {
