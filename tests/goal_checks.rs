@@ -116,16 +116,23 @@ async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
     // Two numbered places in the answer: which one was meant is not known, so more
     // candidates are drawn and the one that uses the number wins.
     let model = ByDraw::new(
-        "Goal: On_Coffee_Table1 & RobotNear_Table2",
+        "Goal: On_Coffee_Table1 & On_Water_Table2",
         &[
-            "Goal: On_Coffee_Table1 & RobotNear_Table2",
-            "Goal: On_Coffee_WindowTable5",
-            "Goal: On_Coffee_WindowTable5",
+            "Goal: On_Coffee_Table1 & On_Water_Table2",
+            "Goal: On_Coffee_WindowTable5 & On_Water_Table2",
+            "Goal: On_Coffee_WindowTable5 & On_Water_Table2",
         ],
     );
+    let request = "Take a coffee to table five by the window and water to table 2.";
+    let (goal, calls) = read(&cafe, &model, request).await;
+    assert_eq!(goal.to_string(), "On_Coffee_WindowTable5 & On_Water_Table2");
+    assert_eq!(calls, 4);
+
+    // The second place asked by no word: taken out, and the place left renumbered; one call.
+    let model = ByDraw::new("Goal: On_Coffee_Table1 & RobotNear_Table2", &[]);
     let (goal, calls) = read(&cafe, &model, "Take a coffee to table five by the window.").await;
     assert_eq!(goal.to_string(), "On_Coffee_WindowTable5");
-    assert_eq!(calls, 4);
+    assert_eq!(calls, 1);
 
     // No number in the request: the first clean answer is taken, one call.
     let model = ByDraw::new("Goal: On_Coffee_Table1", &["Goal: On_Coffee_Bar"]);

@@ -27,6 +27,10 @@ pub struct GoalProblem {
     pub doubt: bool,
 }
 
+/// Why a goal that is true in the scene now is doubtful.
+pub const HOLDS_ALREADY: &str =
+    "it holds already in the scene now, but the request asks for a change";
+
 /// Check a candidate goal against the skills and the scene: not contradictory,
 /// plannable, and (a doubt) not already true.
 pub fn check_goal(
@@ -72,7 +76,7 @@ pub fn check_goal(
     let holds = |atom: &crate::domain::Atom| world.check(&Condition::pos(atom.clone()));
     if goal.eval(&holds) {
         return Err(GoalProblem {
-            reason: "it holds already in the scene now, but the request asks for a change".into(),
+            reason: HOLDS_ALREADY.into(),
             doubt: true,
         });
     }
@@ -133,8 +137,16 @@ pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula>
     };
     let asked = terms(request);
     let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, &asked)).collect();
+    // Each condition claims the words it answers to: alternatives "chips to table 1 or
+    // juice to table 2" claim "table" twice, so a third condition about a table is one
+    // more than the request says.
+    let by_atom: Vec<Vec<String>> = items
+        .iter()
+        .flat_map(|i| i.atoms())
+        .map(|a| lexicon.covered(&Formula::Atom(a), &asked))
+        .collect();
     let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
-    let claimed = |w: &String| covered.iter().filter(|c| c.contains(w)).count();
+    let claimed = |w: &String| by_atom.iter().filter(|c| c.contains(w)).count();
     items
         .iter()
         .zip(&covered)

@@ -283,3 +283,22 @@ fn what_every_alternative_repeats_is_judged_once() {
     let absorbing = g("RobotNear_Table3 | RobotNear_Table3 & On_Chips_Table3");
     assert_eq!(factored(&absorbing), absorbing);
 }
+
+#[test]
+fn alternatives_claim_each_word_once_per_condition() {
+    let (s, _) = cafe();
+    let lexicon = Lexicon::new(&s.domain.vocabulary, &s.examples);
+    let request = "Switch on the AC, and bring chips to table 1 or juice to table 2.";
+    let goal = s
+        .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2) & RobotNear_Table1")
+        .expect("parses");
+    let extra: Vec<String> = unasked(&goal, request, &lexicon)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    assert_eq!(extra, ["RobotNear_Table1"]);
+    let asked = s
+        .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2)")
+        .expect("parses");
+    assert!(unasked(&asked, request, &lexicon).is_empty());
+}

@@ -87,7 +87,7 @@ pub async fn interpret(
             }
         }
     }
-    let mut found = read_goal(scenario, world, instruction, model, options, emit).await?;
+    let mut found = read_goal(scenario, world, instruction, false, model, options, emit).await?;
     found.calls += earlier_calls;
     announce(scenario, &found, emit);
     Ok(found)
@@ -117,11 +117,12 @@ fn announce(scenario: &Scenario, found: &Interpretation, emit: &mut (dyn FnMut(&
 }
 
 /// One reading of `instruction` as a goal — candidates, checks, vote, feedback — without
-/// announcing it.
+/// announcing it; `one_of_several` when it is one wish of a longer request.
 pub(super) async fn read_goal(
     scenario: &Scenario,
     world: Box<dyn World>,
     instruction: &str,
+    one_of_several: bool,
     model: &dyn LanguageModel,
     options: &Options,
     emit: &mut (dyn FnMut(&Event) + Send),
@@ -143,6 +144,7 @@ pub(super) async fn read_goal(
         shown: options.variant.choose(pool, instruction),
         place_numbers: lexicon.place_numbers(&terms(instruction)),
         lexicon,
+        one_of_several,
     };
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);

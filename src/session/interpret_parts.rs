@@ -50,7 +50,17 @@ pub(super) async fn read_parts(
     let mut read: Vec<Interpretation> = Vec::new();
     let mut calls = 0;
     for part in parts {
-        match read_goal(scenario, world.fork(), &part.text, model, options, emit).await {
+        match read_goal(
+            scenario,
+            world.fork(),
+            &part.text,
+            true,
+            model,
+            options,
+            emit,
+        )
+        .await
+        {
             Ok(found) => {
                 calls += found.calls;
                 read.push(found);

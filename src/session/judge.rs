@@ -16,13 +16,18 @@ use crate::scenario::Scenario;
 use crate::world::World;
 
 use super::goal_checks::{
-    GoalProblem, assess, renumbered, swapped_back, swapped_object, unanswered_names,
+    GoalProblem, HOLDS_ALREADY, assess, renumbered, swapped_back, swapped_object, unanswered_names,
     without_copied, without_unasked,
 };
 use super::placement::{not_put, put_there};
 use super::polarity::{turned_around, turned_back};
 use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::types::Event;
+
+/// How many times a goal's misreadings are undone one after another.
+const UNDO_STEPS: usize = 3;
+/// How many goals undoing one answer's misreadings may make.
+const UNDONE_AT_MOST: usize = 12;
 
 /// One candidate: the reply's text and what it was read as.
 pub(super) struct Candidate {
@@ -51,6 +56,10 @@ pub(super) struct Judge<'a> {
     pub(super) shown: Vec<&'a crate::scenario::Example>,
     pub(super) lexicon: Lexicon,
     pub(super) place_numbers: Vec<String>,
+    /// The request is one wish of several: what it asks for may hold already (the robot
+    /// is not at the bar now, and "stay away from the bar" beside a delivery still asks
+    /// it to stay away), as long as the wishes together ask for a change.
+    pub(super) one_of_several: bool,
 }
 
 impl Judge<'_> {
@@ -63,6 +72,7 @@ impl Judge<'_> {
             (&self.shown, &self.lexicon),
             self.instruction,
         )
+        .filter(|p| !(self.one_of_several && p.reason == HOLDS_ALREADY))
     }
 
     /// The place numbers the request says that no condition of `goal` is about.
@@ -173,6 +183,48 @@ impl Judge<'_> {
         out
     }
 
+    /// `goal` with its plain misreadings undone one after another: a goal can misread a
+    /// request in more than one way ("deliver milk and dessert to the bar" read as the
+    /// dessert made and the robot at the bar: put there, then the milk put beside it), so
+    /// each goal undone is undone again, up to [`UNDO_STEPS`] times and [`UNDONE_AT_MOST`]
+    /// goals, each with what was undone on the way. Goals that put an object where its
+    /// predicate does not take it come out with why, and are not undone further.
+    pub(super) fn undone_in_turn(&self, goal: &Formula) -> Vec<(Formula, Result<String, String>)> {
+        let mut out: Vec<(Formula, Result<String, String>)> = Vec::new();
+        let mut frontier = vec![(goal.clone(), String::new())];
+        for _ in 0..UNDO_STEPS {
+            let mut next = Vec::new();
+            for (from, path) in &frontier {
+                for (g, why) in self.undone(from) {
+                    if g == *goal || out.iter().any(|(seen, _)| *seen == g) {
+                        continue;
+                    }
+                    if out.len() == UNDONE_AT_MOST {
+                        return out;
+                    }
+                    let why = if path.is_empty() {
+                        why
+                    } else {
+                        format!("{path}; then {why}")
+                    };
+                    match g
+                        .atoms()
+                        .iter()
+                        .try_for_each(|a| self.vocabulary().check_atom(a))
+                    {
+                        Ok(()) => {
+                            next.push((g.clone(), why.clone()));
+                            out.push((g, Ok(why)));
+                        }
+                        Err(e) => out.push((g, Err(e.to_string()))),
+                    }
+                }
+            }
+            frontier = next;
+        }
+        out
+    }
+
     /// Candidates made from an answer that failed a check: without what it pasted from an
     /// example, or without the parts no word of the request asks for; and, when checks
     /// are on, any answer with its plain misreadings undone ([`Judge::undone`]). Each is
@@ -190,32 +242,40 @@ impl Judge<'_> {
                 .or_else(|| without_unasked(&a.goal, self.instruction, &self.lexicon)),
             _ => None,
         };
-        let undone = match read {
-            Ok(a) if check_goals => self.undone(&a.goal),
-            _ => Vec::new(),
-        };
-        for (goal, why) in &undone {
-            emit(&Event::Notice {
-                message: format!("{why}, so {goal} is a candidate too"),
-            });
+        // The answer and, when parts were taken out of it, what is left are both undone.
+        let mut undone: Vec<(Formula, Result<String, String>)> = Vec::new();
+        if let Ok(a) = read
+            && check_goals
+        {
+            for from in std::iter::once(&a.goal).chain(pruned.as_ref()) {
+                for (goal, why) in self.undone_in_turn(from) {
+                    if Some(&goal) != pruned.as_ref() && !undone.iter().any(|(g, _)| *g == goal) {
+                        undone.push((goal, why));
+                    }
+                }
+            }
         }
-        let mut out = Vec::new();
-        for goal in pruned.into_iter().chain(undone.into_iter().map(|(g, _)| g)) {
-            // A derived goal may put an object where its predicate does not take it
-            // ("fries" put in the place of a made dessert): it is no candidate.
-            if let Err(e) = goal
-                .atoms()
-                .iter()
-                .try_for_each(|a| self.vocabulary().check_atom(a))
-            {
-                emit(&Event::CandidateRejected {
+        let mut made = Vec::new();
+        for (goal, why) in undone {
+            match why {
+                Ok(why) => {
+                    emit(&Event::Notice {
+                        message: format!("{why}, so {goal} is a candidate too"),
+                    });
+                    made.push(goal);
+                }
+                // A goal undone may put an object where its predicate does not take it
+                // ("fries" put in the place of a made dessert): it is no candidate.
+                Err(reason) => emit(&Event::CandidateRejected {
                     candidate: goal.to_string(),
                     proposal: None,
-                    reason: e.to_string(),
+                    reason,
                     author: Some("betr, from the model's answer".into()),
-                });
-                continue;
+                }),
             }
+        }
+        let mut out = Vec::new();
+        for goal in pruned.into_iter().chain(made) {
             let problem = self.assess(&goal);
             if let Some(p) = &problem {
                 emit(&Event::CandidateRejected {
@@ -307,3 +367,7 @@ fn vote_refs(
 fn same(a: &GoalAnswer, b: &GoalAnswer) -> bool {
     a.goal == b.goal || goal::equivalent(&a.goal, &b.goal).unwrap_or(false)
 }
+
+#[cfg(test)]
+#[path = "judge_tests.rs"]
+mod tests;

@@ -86,57 +86,85 @@ fn said_predicates(request: &str, vocabulary: &Vocabulary) -> Vec<String> {
 
 fn rewrite(goal: &Formula, sent: &[Sent], relation: &str, asked: &[String]) -> Formula {
     match goal {
+        Formula::Atom(_) => Formula::and(put_each(vec![goal.clone()], sent, relation, asked)),
+        _ => within(goal, sent, relation, asked),
+    }
+}
+
+/// [`rewrite`] below the top: each conjunction's items put where the request sends them,
+/// an atom left as it is (it is an item of a conjunction, or an alternative).
+fn within(goal: &Formula, sent: &[Sent], relation: &str, asked: &[String]) -> Formula {
+    match goal {
         Formula::And(items) => {
-            let mut items: Vec<Formula> = items
+            let items: Vec<Formula> = items
                 .iter()
-                .map(|i| rewrite(i, sent, relation, asked))
+                .map(|i| within(i, sent, relation, asked))
                 .collect();
-            for s in sent {
-                let alone = |f: &Formula, object: &str| matches!(f, Formula::Atom(a) if a.args == [object] && !asked.contains(&a.predicate));
-                let item_at = items.iter().position(|f| {
-                    alone(f, &s.item)
-                        || matches!(f, Formula::Or(alts) if alts.iter().all(|a| alone_item(a, sent, &s.place, asked)))
-                });
-                let place_at = items.iter().position(|f| alone(f, &s.place));
-                let (Some(i), Some(p)) = (item_at, place_at) else {
-                    continue;
-                };
-                items[i] = placed(&items[i], sent, &s.place, relation);
-                items.remove(p);
-            }
-            Formula::and(items)
+            Formula::and(put_each(items, sent, relation, asked))
         }
         Formula::Or(items) => Formula::Or(
             items
                 .iter()
-                .map(|i| rewrite(i, sent, relation, asked))
+                .map(|i| within(i, sent, relation, asked))
                 .collect(),
         ),
         Formula::Not(_) | Formula::Atom(_) => goal.clone(),
     }
 }
 
-/// Whether `f` is a condition about one item alone that the request sends to `place`.
-fn alone_item(f: &Formula, sent: &[Sent], place: &str, asked: &[String]) -> bool {
-    matches!(f, Formula::Atom(a) if !asked.contains(&a.predicate)
-        && matches!(a.args.as_slice(), [item] if sent.iter().any(|s| &s.item == item && s.place == place)))
+/// The conjuncts `items` with each item the request sends put at its place: the
+/// condition about the item alone (or alternatives of such, one of them sent there)
+/// becomes the relating condition, and a condition about the place alone goes. With no
+/// condition about the place at all, the item is put there too ("deliver dessert to the
+/// coffee station" read as a dessert made).
+fn put_each(
+    mut items: Vec<Formula>,
+    sent: &[Sent],
+    relation: &str,
+    asked: &[String],
+) -> Vec<Formula> {
+    for s in sent {
+        let alone = |f: &Formula, object: &str| matches!(f, Formula::Atom(a) if a.args == [object] && !asked.contains(&a.predicate));
+        let item_at = items.iter().position(|f| {
+            alone(f, &s.item)
+                || matches!(f, Formula::Or(alts) if alts.iter().all(|a| item_alone(a, asked))
+                    && alts.iter().any(|a| alone(a, &s.item)))
+        });
+        let Some(i) = item_at else {
+            continue;
+        };
+        match items.iter().position(|f| alone(f, &s.place)) {
+            Some(p) => {
+                items[i] = placed(&items[i], &s.place, relation);
+                items.remove(p);
+            }
+            None if !items
+                .iter()
+                .any(|f| f.atoms().iter().any(|a| a.args.contains(&s.place))) =>
+            {
+                items[i] = placed(&items[i], &s.place, relation);
+            }
+            None => {}
+        }
+    }
+    items
+}
+
+/// Whether `f` is a condition about one object alone that the request does not ask for
+/// in the predicate's own words.
+fn item_alone(f: &Formula, asked: &[String]) -> bool {
+    matches!(f, Formula::Atom(a) if !asked.contains(&a.predicate) && a.args.len() == 1)
 }
 
 /// `f` (a condition about an item alone, or alternatives of such) with each item put at
 /// `place`.
-fn placed(f: &Formula, sent: &[Sent], place: &str, relation: &str) -> Formula {
+fn placed(f: &Formula, place: &str, relation: &str) -> Formula {
     match f {
         Formula::Atom(a) => match a.args.as_slice() {
-            [item] if sent.iter().any(|s| &s.item == item && s.place == place) => {
-                Formula::Atom(Atom::new(relation, vec![item.clone(), place.to_string()]))
-            }
+            [item] => Formula::Atom(Atom::new(relation, vec![item.clone(), place.to_string()])),
             _ => f.clone(),
         },
-        Formula::Or(alts) => Formula::Or(
-            alts.iter()
-                .map(|a| placed(a, sent, place, relation))
-                .collect(),
-        ),
+        Formula::Or(alts) => Formula::Or(alts.iter().map(|a| placed(a, place, relation)).collect()),
         _ => f.clone(),
     }
 }
@@ -171,13 +199,21 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
             .collect();
         let item_spans = mentions(&words, &items, &covered);
         let mut waiting: Vec<String> = Vec::new();
+        let mut sent_unnamed = false;
         for (at, word) in words.iter().enumerate() {
             if MOVING.iter().any(|m| same_word(m, word)) {
                 waiting.clear();
+                sent_unnamed = false;
             }
             if let Some((_, _, item)) = item_spans.iter().find(|(start, _, _)| *start == at)
                 && !waiting.contains(item)
             {
+                // Items sent somewhere no name says ("coffee to the table by the door")
+                // are not sent to the place of the next item ("and water to table 2");
+                // with no item between ("coffee to me at table 2"), they are.
+                if std::mem::take(&mut sent_unnamed) {
+                    waiting.clear();
+                }
                 waiting.push(item.clone());
             }
             if !TOWARDS.contains(&word.as_str()) || waiting.is_empty() {
@@ -186,14 +222,16 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
             let place = place_spans
                 .iter()
                 .find(|(start, _, _)| *start > at && *start <= at + PLACE_WITHIN);
-            if let Some((_, _, place)) = place {
-                for item in waiting.drain(..) {
-                    if item != *place {
-                        out.push(Sent {
-                            item,
-                            place: place.clone(),
-                        });
-                    }
+            let Some((_, _, place)) = place else {
+                sent_unnamed = true;
+                continue;
+            };
+            for item in waiting.drain(..) {
+                if item != *place {
+                    out.push(Sent {
+                        item,
+                        place: place.clone(),
+                    });
                 }
             }
         }
@@ -203,9 +241,11 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
 
 /// Where `words` name one of `objects` by its name's words in a row or by what it is
 /// called, the longest name first, skipping the positions in `taken`: (start, length,
-/// object). A name with a word beside it from a longer name of another object that shares
-/// its words ("the other bar", where the other bar counter is another place than the bar)
-/// names neither.
+/// object). A name of several words also names its object with the words spread over a
+/// short stretch, in any order ("table 6 by the window" for window table 6), once no
+/// name has them in a row. A name with a word beside it from a longer name of another
+/// object that shares its words ("the other bar", where the other bar counter is another
+/// place than the bar) names neither.
 pub(super) fn mentions(
     words: &[String],
     objects: &[&Object],
@@ -223,38 +263,77 @@ pub(super) fn mentions(
     phrases.sort_by_key(|(t, _)| std::cmp::Reverse(t.len()));
     let mut used: Vec<usize> = taken.to_vec();
     let mut out = Vec::new();
-    for (phrase, name) in &phrases {
-        let mut start = 0;
-        while start + phrase.len() <= words.len() {
-            let span = start..start + phrase.len();
-            let matches = phrase
-                .iter()
-                .zip(&words[span.clone()])
-                .all(|(p, w)| same_word(p, w));
-            if !matches || span.clone().any(|i| used.contains(&i)) {
-                start += 1;
+    for spread in [false, true] {
+        for (phrase, name) in &phrases {
+            if spread && phrase.len() < 2 {
                 continue;
             }
-            used.extend(span.clone());
-            let beside: Vec<&String> = [span.start.checked_sub(1), Some(span.end)]
-                .into_iter()
-                .flatten()
-                .filter_map(|i| words.get(i))
-                .collect();
-            let other_longer = phrases.iter().any(|(other, other_name)| {
-                other_name != name
-                    && other.len() > phrase.len()
-                    && phrase.iter().all(|p| other.contains(p))
-                    && beside.iter().any(|b| other.iter().any(|o| same_word(o, b)))
-            });
-            if !other_longer {
-                out.push((start, phrase.len(), name.to_string()));
+            let mut start = 0;
+            while start < words.len() {
+                let Some(end) = named_at(words, phrase, start, spread, &used) else {
+                    start += 1;
+                    continue;
+                };
+                let span = start..end;
+                used.extend(span.clone());
+                let beside: Vec<&String> = [span.start.checked_sub(1), Some(span.end)]
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|i| words.get(i))
+                    .collect();
+                let other_longer = phrases.iter().any(|(other, other_name)| {
+                    other_name != name
+                        && other.len() > phrase.len()
+                        && phrase.iter().all(|p| other.contains(p))
+                        && beside.iter().any(|b| other.iter().any(|o| same_word(o, b)))
+                });
+                if !other_longer {
+                    out.push((start, end - start, name.to_string()));
+                }
+                start = end;
             }
-            start = span.end;
         }
     }
     out.sort();
     out
+}
+
+/// How many more words a name's words may be spread over than it has.
+const SPREAD: usize = 2;
+
+/// Where a mention of `phrase` starting at `start` ends: its words in a row or, when
+/// `spread`, each of them once within the name's length and [`SPREAD`] words, beginning
+/// with one of them; none of the words on the way in `used`.
+fn named_at(
+    words: &[String],
+    phrase: &[String],
+    start: usize,
+    spread: bool,
+    used: &[usize],
+) -> Option<usize> {
+    if !spread {
+        let end = start + phrase.len();
+        let row = words.get(start..end)?;
+        let fits = phrase.iter().zip(row).all(|(p, w)| same_word(p, w));
+        return (fits && !(start..end).any(|i| used.contains(&i))).then_some(end);
+    }
+    if !phrase.iter().any(|p| same_word(p, &words[start])) {
+        return None;
+    }
+    let mut left: Vec<&String> = phrase.iter().collect();
+    let stretch = words.len().min(start + phrase.len() + SPREAD);
+    for (i, word) in words.iter().enumerate().take(stretch).skip(start) {
+        if used.contains(&i) {
+            return None;
+        }
+        if let Some(k) = left.iter().position(|p| same_word(p, word)) {
+            left.remove(k);
+            if left.is_empty() {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
 }
 
 #[cfg(test)]

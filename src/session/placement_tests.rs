@@ -35,6 +35,8 @@ fn vocabulary() -> Vocabulary {
             object("Table1", &["place"]),
             object("Table2", &["place"]),
             object("CoffeeStation", &["place"]),
+            object("Chips", &["item"]),
+            object("WindowTable6", &["place"]),
         ],
         predicates: vec![
             predicate("On", &["item", "place"], &[]),
@@ -174,4 +176,72 @@ fn the_scenes_own_worked_examples_put_what_they_send() {
             "{scene}: {request:?}"
         );
     });
+}
+
+#[test]
+fn items_sent_where_no_name_says_are_not_sent_to_the_next_place() {
+    let v = vocabulary();
+    let sent = |request: &str| {
+        sent(request, &v, &relating(&v))
+            .into_iter()
+            .map(|s| format!("{}@{}", s.item, s.place))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        sent("Take a coffee to the sofa by the door and water to table 2."),
+        ["Water@Table2"]
+    );
+    assert_eq!(
+        sent("Bring the coffee to me at table 2."),
+        ["Coffee@Table2"]
+    );
+}
+
+#[test]
+fn a_name_spread_over_a_few_words_is_a_mention() {
+    let v = vocabulary();
+    let objects: Vec<&Object> = v.objects.iter().collect();
+    let named = |request: &str| {
+        mentions(&every_term(request), &objects, &[])
+            .into_iter()
+            .map(|(_, _, name)| name)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        named("chips to table 6 by the window"),
+        ["Chips", "WindowTable6"]
+    );
+    assert_eq!(
+        named("chips to the window table 6"),
+        ["Chips", "WindowTable6"]
+    );
+    // Too far apart: the window is not the table's.
+    assert_eq!(named("by the window, chips go to the table 6"), ["Chips"]);
+}
+
+#[test]
+fn alternatives_and_an_item_with_no_place_at_all_are_put_there() {
+    // One alternative sent there is enough to put both: the other is what the request
+    // names beside it, in other words.
+    assert_eq!(
+        put(
+            "(Exists_Coffee | Exists_Dessert) & RobotNear_Table2",
+            "Bring a coffee or a cake to table 2."
+        )
+        .as_deref(),
+        Some("On_Coffee_Table2 | On_Dessert_Table2")
+    );
+    // Made, and no condition about the station at all.
+    assert_eq!(
+        put("Exists_Dessert", "Deliver dessert to CoffeeStation.").as_deref(),
+        Some("On_Dessert_CoffeeStation")
+    );
+    // A condition about the place that is no place-alone one: left as it is.
+    assert_eq!(
+        put(
+            "Exists_Dessert & ~On_Cup_Bar",
+            "Make dessert, put it on the bar, no cup on the bar."
+        ),
+        None
+    );
 }

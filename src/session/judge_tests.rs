@@ -1,0 +1,62 @@
+//! Tests of the judge: misreadings undone one after another, and a wish of several.
+
+use super::*;
+use std::path::Path;
+
+fn cafe() -> Scenario {
+    Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+        .expect("cafe scenario")
+}
+
+fn judge<'a>(scenario: &'a Scenario, request: &'a str, one_of_several: bool) -> Judge<'a> {
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    Judge {
+        scenario,
+        world: crate::world::load(scenario).expect("cafe world"),
+        instruction: request,
+        shown: Vec::new(),
+        place_numbers: lexicon.place_numbers(&crate::llm::examples::terms(request)),
+        lexicon,
+        one_of_several,
+    }
+}
+
+#[test]
+fn misreadings_are_undone_one_after_another() {
+    let cafe = cafe();
+    let request = "Please bring the chips and a dessert to table 3.";
+    let j = judge(&cafe, request, false);
+    let answer = cafe
+        .parse_goal("Exists_Dessert & RobotNear_Table3")
+        .expect("parses");
+    let undone = j.undone_in_turn(&answer);
+    let last = undone
+        .iter()
+        .find(|(g, why)| why.is_ok() && g.to_string() == "On_Chips_Table3 & On_Dessert_Table3")
+        .map(|(_, why)| why.clone());
+    let why = last
+        .expect("put there, then the chips put beside")
+        .expect("well typed");
+    assert!(why.contains("; then "), "{why}");
+    // What it came to has no misreading left.
+    let done = cafe
+        .parse_goal("On_Chips_Table3 & On_Dessert_Table3")
+        .expect("parses");
+    assert_eq!(j.misread(&done), None);
+    // A step that puts an object where its predicate does not take it comes out refused.
+    assert!(
+        undone
+            .iter()
+            .any(|(g, why)| why.is_err() && g.to_string().contains("Exists_Chips"))
+    );
+}
+
+#[test]
+fn a_wish_of_several_may_hold_already() {
+    let cafe = cafe();
+    let request = "please keep the AC switched off";
+    let goal = cafe.parse_goal("~Active_AC").expect("parses");
+    let whole = judge(&cafe, request, false).assess(&goal);
+    assert_eq!(whole.map(|p| p.reason).as_deref(), Some(HOLDS_ALREADY));
+    assert_eq!(judge(&cafe, request, true).assess(&goal), None);
+}
