@@ -123,10 +123,16 @@ async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
             "Goal: On_Coffee_WindowTable5 & On_Water_Table2",
         ],
     );
-    let request = "Take a coffee to table five by the window and water to table 2.";
+    let request = "A coffee please, I'm at table five by the window, and water to table 2.";
     let (goal, calls) = read(&cafe, &model, request).await;
     assert_eq!(goal.to_string(), "On_Coffee_WindowTable5 & On_Water_Table2");
     assert_eq!(calls, 4);
+    // Said where the coffee goes: the coffee is moved there from the place the request
+    // never names, with no more calls.
+    let request = "Take a coffee to table five by the window and water to table 2.";
+    let (goal, calls) = read(&cafe, &model, request).await;
+    assert_eq!(goal.to_string(), "On_Coffee_WindowTable5 & On_Water_Table2");
+    assert_eq!(calls, 1);
 
     // The second place asked by no word: taken out, and the place left renumbered; one call.
     let model = ByDraw::new("Goal: On_Coffee_Table1 & RobotNear_Table2", &[]);

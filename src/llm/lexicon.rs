@@ -16,6 +16,12 @@ use crate::scenario::Example;
 
 use super::examples::terms;
 
+/// How many examples must use a word with an object before it is taken as the object's
+/// word: one example's "sitting" is not a soft drink's word because the example asked a
+/// sitting guest for one. Objects have their names and what they are called; a
+/// predicate's words are many and varied, and one example teaches one ("lower").
+const MIN_TOGETHER: usize = 2;
+
 /// A word of the pool becomes a symbol's word when at least this share of the examples
 /// that use the word use the symbol too.
 const MIN_SHARE: f64 = 0.5;
@@ -107,6 +113,7 @@ impl Lexicon {
         // A word that names a symbol belongs to that symbol alone: "coffee" is Coffee's
         // word even though most requests for coffee also use On.
         let named: Vec<String> = words.values().flatten().cloned().collect();
+        let objects: Vec<&str> = vocabulary.objects.iter().map(|o| o.name.as_str()).collect();
         let mut learned: Vec<(&(String, String), &usize)> = together.iter().collect();
         learned.sort();
         for ((symbol, word), n) in learned {
@@ -115,6 +122,7 @@ impl Lexicon {
             let names_other = named.iter().any(|x| same_word(x, word));
             if known
                 && !names_other
+                && (*n >= MIN_TOGETHER || !objects.contains(&symbol.as_str()))
                 && *n as f64 / total as f64 >= MIN_SHARE
                 && !GENERIC.contains(&word.as_str())
             {
@@ -248,12 +256,20 @@ pub fn in_request_order(lexicon: &Lexicon, goal: &Formula, request: &[String]) -
     }
 }
 
-/// Two words that are one after crude stemming ("close" and "closed" → "clos").
+/// Two words that are one after crude stemming ("close" and "closed" → "clos"), or
+/// spellings of one longer word.
 pub fn same_word(a: &str, b: &str) -> bool {
     let shorter = a.len().min(b.len());
     let k = shorter.min(5);
-    a == b || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+    a == b
+        || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+        // Spelling variants of longer words ("yoghurt", "yogurt"); short words one letter
+        // apart are different words ("water", "waiter").
+        || (shorter >= SPELLING_VARIANT_FROM && strsim::levenshtein(a, b) <= 1)
 }
+
+/// How long both words must be before one letter more, less or other is a spelling variant.
+const SPELLING_VARIANT_FROM: usize = 6;
 
 #[cfg(test)]
 mod tests {
@@ -337,6 +353,43 @@ mod tests {
         assert!(covered.contains(&"6".to_string()));
         let unrelated = Formula::parse("IsClean_Floor").expect("parses");
         assert!(lexicon.covered(&unrelated, &request).is_empty());
+    }
+
+    #[test]
+    fn spellings_of_a_longer_word_are_one_word() {
+        assert!(same_word("yoghurt", "yogurt"));
+        assert!(!same_word("water", "waiter"));
+        assert!(!same_word("chips", "chops"));
+    }
+
+    #[test]
+    fn an_object_learns_a_word_from_two_examples_not_one() {
+        let v = vocabulary();
+        let example = |instruction: &str, goal: &str| Example {
+            instruction: instruction.into(),
+            goal: goal.into(),
+        };
+        let once = [example(
+            "I'm sitting by the window, a soda please",
+            "On_Coffee_Table1",
+        )];
+        assert!(
+            !Lexicon::new(&v, &once)
+                .words("Coffee")
+                .contains(&"sitt".to_string())
+        );
+        let twice = [
+            example(
+                "I'm sitting by the window, a soda please",
+                "On_Coffee_Table1",
+            ),
+            example("sitting here, a soda", "On_Coffee_Table1"),
+        ];
+        assert!(
+            Lexicon::new(&v, &twice)
+                .words("Coffee")
+                .contains(&"sitt".to_string())
+        );
     }
 }
 

@@ -396,17 +396,27 @@ pub(super) fn undo_each<F, K: PartialEq>(
 
 /// `goal` with every argument `from` written `to`.
 pub(super) fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
-    match goal {
-        Formula::Atom(a) => Formula::Atom(crate::domain::Atom::new(
+    map_atoms(goal, &|a| {
+        crate::domain::Atom::new(
             a.predicate.clone(),
             a.args
                 .iter()
                 .map(|x| if x == from { to.to_string() } else { x.clone() })
                 .collect::<Vec<String>>(),
-        )),
-        Formula::Not(inner) => Formula::Not(Box::new(rename(inner, from, to))),
-        Formula::And(items) => Formula::And(items.iter().map(|i| rename(i, from, to)).collect()),
-        Formula::Or(items) => Formula::Or(items.iter().map(|i| rename(i, from, to)).collect()),
+        )
+    })
+}
+
+/// `goal` with each atom replaced by what `f` makes of it.
+pub(super) fn map_atoms(
+    goal: &Formula,
+    f: &impl Fn(&crate::domain::Atom) -> crate::domain::Atom,
+) -> Formula {
+    match goal {
+        Formula::Atom(a) => Formula::Atom(f(a)),
+        Formula::Not(inner) => Formula::Not(Box::new(map_atoms(inner, f))),
+        Formula::And(items) => Formula::And(items.iter().map(|i| map_atoms(i, f)).collect()),
+        Formula::Or(items) => Formula::Or(items.iter().map(|i| map_atoms(i, f)).collect()),
     }
 }
 

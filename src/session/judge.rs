@@ -19,7 +19,7 @@ use super::goal_checks::{
     GoalProblem, HOLDS_ALREADY, assess, renumbered, swapped_back, swapped_object, unanswered_names,
     without_copied, without_unasked,
 };
-use super::placement::{not_put, put_there};
+use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{turned_around, turned_back};
 use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::types::Event;
@@ -166,6 +166,12 @@ impl Judge<'_> {
             out.push((
                 g,
                 format!("the request sends an item to a place that {goal} only has apart"),
+            ));
+        }
+        if let Some(g) = moved_there(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request sends an item to a place that {goal} has it at another place, which the request never names"),
             ));
         }
         if let Some(g) = with_left_out(goal, request, vocabulary) {

@@ -9,6 +9,7 @@ use crate::goal::Formula;
 use crate::llm::examples::{every_term, terms};
 use crate::llm::lexicon::same_word;
 
+use super::goal_checks::map_atoms;
 use super::polarity::{find_phrase, without_numbering};
 
 /// Words that send an item to the place named after them.
@@ -65,6 +66,43 @@ pub fn put_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Opti
     let asked = said_predicates(request, vocabulary);
     let rewritten = rewrite(goal, &sent, &relation.name, &asked);
     (rewritten != *goal).then_some(rewritten)
+}
+
+/// `goal` with each item the request sends to a place moved there from a place the
+/// request never names ("bring yogurt to the bar" read as yogurt on the second bar):
+/// small models pick a place of the same kind, or one of an example.
+pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+    let relating = relating(vocabulary);
+    let sent = sent(request, vocabulary, &relating);
+    if sent.is_empty() {
+        return None;
+    }
+    let objects: Vec<&Object> = vocabulary.objects.iter().collect();
+    let named: Vec<String> = mentions(&every_term(&without_numbering(request)), &objects, &[])
+        .into_iter()
+        .map(|(_, _, name)| name)
+        .collect();
+    let moved = map_atoms(goal, &|a| {
+        let to = match a.args.as_slice() {
+            [item, place]
+                if relating.iter().any(|p| p.name == a.predicate) && !named.contains(place) =>
+            {
+                // Only an item sent to one place is moved: "chips to table 1 and table 2"
+                // does not say which one the second bar was meant to be.
+                let places: Vec<&Sent> = sent.iter().filter(|s| &s.item == item).collect();
+                match places.as_slice() {
+                    [one] => Some(one.place.clone()),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        match to {
+            Some(place) => Atom::new(a.predicate.clone(), vec![a.args[0].clone(), place]),
+            None => a.clone(),
+        }
+    });
+    (moved != *goal).then_some(moved)
 }
 
 /// The predicates the request names by their own words ("hold" for the one it says

@@ -245,3 +245,36 @@ fn alternatives_and_an_item_with_no_place_at_all_are_put_there() {
         None
     );
 }
+
+#[test]
+fn an_item_at_a_place_the_request_never_names_is_moved_where_it_is_sent() {
+    let v = vocabulary();
+    let moved = |goal: &str, request: &str| {
+        let goal = Formula::parse(goal).expect("test goal parses");
+        moved_there(&goal, request, &v).map(|g| g.to_string())
+    };
+    assert_eq!(
+        moved(
+            "On_Coffee_Table2 & RobotNear_Bar",
+            "Bring a coffee to the bar."
+        )
+        .as_deref(),
+        Some("On_Coffee_Bar & RobotNear_Bar")
+    );
+    // The request names both places: which one was meant is the model's to say.
+    assert_eq!(
+        moved(
+            "On_Coffee_Table2",
+            "Bring a coffee to the bar, not table 2."
+        ),
+        None
+    );
+    // Sent to two places: not moved.
+    assert_eq!(
+        moved(
+            "On_Coffee_Table2",
+            "Coffee to the bar, and coffee to table 1."
+        ),
+        None
+    );
+}
