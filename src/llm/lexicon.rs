@@ -261,12 +261,20 @@ pub fn in_request_order(lexicon: &Lexicon, goal: &Formula, request: &[String]) -
 pub fn same_word(a: &str, b: &str) -> bool {
     let shorter = a.len().min(b.len());
     let k = shorter.min(5);
+    let longer = a.len().max(b.len());
     a == b
-        || (shorter >= 4 && a.get(..k).is_some() && a.get(..k) == b.get(..k))
+        || (shorter >= 4
+            && longer - shorter <= ENDING_AT_MOST
+            && a.get(..k).is_some()
+            && a.get(..k) == b.get(..k))
         // Spelling variants of longer words ("yoghurt", "yogurt"); short words one letter
         // apart are different words ("water", "waiter").
         || (shorter >= SPELLING_VARIANT_FROM && strsim::levenshtein(a, b) <= 1)
 }
+
+/// How much longer one word may be than another with the same beginning and still be
+/// the same word with an ending ("clean", "cleaning"): "water" is not "watermelon".
+const ENDING_AT_MOST: usize = 4;
 
 /// How long both words must be before one letter more, less or other is a spelling variant.
 const SPELLING_VARIANT_FROM: usize = 6;
@@ -360,6 +368,8 @@ mod tests {
         assert!(same_word("yoghurt", "yogurt"));
         assert!(!same_word("water", "waiter"));
         assert!(!same_word("chips", "chops"));
+        assert!(same_word("clean", "cleaning"));
+        assert!(!same_word("water", "watermelon"));
     }
 
     #[test]

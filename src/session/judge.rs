@@ -20,7 +20,7 @@ use super::goal_checks::{
     without_copied, without_unasked,
 };
 use super::placement::{moved_there, not_put, put_there};
-use super::polarity::{turned_around, turned_back};
+use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::types::Event;
 
@@ -98,6 +98,18 @@ impl Judge<'_> {
         if let Some(turned) = turned_around(goal, self.instruction, self.vocabulary()) {
             return Some(turned.to_string());
         }
+        if let Some((atom, wanted, word)) =
+            left_unanswered(goal, self.instruction, self.vocabulary())
+        {
+            let asked = if wanted {
+                atom.to_string()
+            } else {
+                format!("~{atom}")
+            };
+            return Some(format!(
+                "the request says \"{word}\", which asks for {asked}, and {goal} has no condition about it"
+            ));
+        }
         if let Some(sent) = not_put(goal, self.instruction, self.vocabulary()) {
             return Some(format!(
                 "the request sends {} to {}, and no condition of {goal} puts it there",
@@ -161,6 +173,12 @@ impl Judge<'_> {
             && let Some(g) = turned_back(goal, request, vocabulary)
         {
             out.push((g, why.to_string()));
+        }
+        if let Some(g) = with_unanswered(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request asks in its own words for a condition {goal} leaves out"),
+            ));
         }
         if let Some(g) = put_there(goal, request, vocabulary) {
             out.push((

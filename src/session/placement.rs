@@ -123,9 +123,45 @@ fn said_predicates(request: &str, vocabulary: &Vocabulary) -> Vec<String> {
 }
 
 fn rewrite(goal: &Formula, sent: &[Sent], relation: &str, asked: &[String]) -> Formula {
-    match goal {
+    let put = match goal {
         Formula::Atom(_) => Formula::and(put_each(vec![goal.clone()], sent, relation, asked)),
         _ => within(goal, sent, relation, asked),
+    };
+    // An alternative about an item alone ("a dessert to table 1, or water to table 2"
+    // read as a dessert made, or the water there) is put there when no condition of the
+    // goal is about that place.
+    let about: Vec<String> = put.atoms().into_iter().flat_map(|a| a.args).collect();
+    let open: Vec<Sent> = sent
+        .iter()
+        .filter(|s| !about.contains(&s.place))
+        .cloned()
+        .collect();
+    alternatives_put(&put, &open, relation, asked)
+}
+
+/// `goal` with each alternative that is a condition about an item alone, and sent to a
+/// place in `sent`, put there.
+fn alternatives_put(goal: &Formula, sent: &[Sent], relation: &str, asked: &[String]) -> Formula {
+    let each = |items: &[Formula]| -> Vec<Formula> {
+        items
+            .iter()
+            .map(|i| alternatives_put(i, sent, relation, asked))
+            .collect()
+    };
+    match goal {
+        Formula::Or(alts) => Formula::Or(
+            alts.iter()
+                .map(|a| match a {
+                    Formula::Atom(atom) if item_alone(a, asked) => sent
+                        .iter()
+                        .find(|s| atom.args == [s.item.clone()])
+                        .map_or_else(|| a.clone(), |s| placed(a, &s.place, relation)),
+                    _ => alternatives_put(a, sent, relation, asked),
+                })
+                .collect(),
+        ),
+        Formula::And(items) => Formula::And(each(items)),
+        Formula::Not(_) | Formula::Atom(_) => goal.clone(),
     }
 }
 

@@ -278,3 +278,23 @@ fn an_item_at_a_place_the_request_never_names_is_moved_where_it_is_sent() {
         None
     );
 }
+
+#[test]
+fn an_alternative_about_an_item_alone_is_put_where_it_is_sent() {
+    assert_eq!(
+        put(
+            "Active_AC & (Exists_Dessert | On_Water_Table2)",
+            "Turn on the AC, and either bring a dessert to table 1 or water to table 2."
+        )
+        .as_deref(),
+        Some("Active_AC & (On_Dessert_Table1 | On_Water_Table2)")
+    );
+    // The goal has a condition about that place already: left as it is.
+    assert_eq!(
+        put(
+            "RobotNear_Table1 & (Exists_Dessert | On_Water_Table2)",
+            "Wait near table 1, and either bring a dessert to table 1 or water to table 2."
+        ),
+        None
+    );
+}

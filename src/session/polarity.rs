@@ -14,6 +14,7 @@ use crate::llm::examples::{every_term, terms};
 use crate::llm::lexicon::same_word;
 
 use super::goal_checks::undo_each;
+use super::placement::mentions;
 
 /// Words that turn around what follows them in their clause ("n't" is read as "not").
 const NEGATIONS: &[&str] = &[
@@ -82,6 +83,49 @@ pub fn turned_back(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Op
     )
 }
 
+/// A condition the request asks for in its own words, in a sentence that offers no
+/// choice, and that `goal` has no condition about at all ("don't forget to turn on the
+/// hall light" read as the deliveries alone); with whether it is asked to hold and the
+/// word that asks for it.
+pub fn left_unanswered(
+    goal: &Formula,
+    request: &str,
+    vocabulary: &Vocabulary,
+) -> Option<(Atom, bool, String)> {
+    let atoms = goal.atoms();
+    asked_in_sentences(request, vocabulary)
+        .into_iter()
+        .filter(|(_, _, _, choice)| !choice)
+        .find(|(subject, _, _, _)| !atoms.iter().any(|a| subject.matches(a)))
+        .and_then(|(subject, wanted, word, _)| {
+            let atom = Atom::new(subject.predicate.clone(), vec![subject.object.clone()]);
+            let takes_one = vocabulary
+                .predicates
+                .iter()
+                .any(|p| p.name == subject.predicate && p.arg_types.len() == 1);
+            takes_one.then_some((atom, wanted, word))
+        })
+}
+
+/// `goal` with every condition [`left_unanswered`] finds put beside it, the way the
+/// request asks for it. `None` when nothing is left unanswered.
+pub fn with_unanswered(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+    undo_each(
+        goal,
+        |g| left_unanswered(g, request, vocabulary),
+        |(atom, _, _)| atom.clone(),
+        |g, (atom, wanted, _)| {
+            let condition = Formula::Atom(atom.clone());
+            let condition = if *wanted {
+                condition
+            } else {
+                Formula::Not(Box::new(condition))
+            };
+            Formula::and(vec![g.clone(), condition])
+        },
+    )
+}
+
 /// What a clause asks about: a predicate and the object it is about.
 struct Subject {
     predicate: String,
@@ -97,9 +141,29 @@ impl Subject {
 /// The conditions the request asks for one way: each with whether it is asked to hold and
 /// the word that says so. A condition asked for both ways is left out.
 fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, bool, String)> {
-    let mut found: Vec<(Subject, bool, String)> = Vec::new();
+    asked_in_sentences(request, vocabulary)
+        .into_iter()
+        .map(|(subject, wanted, word, _)| (subject, wanted, word))
+        .collect()
+}
+
+/// [`asked_conditions`], each with whether its sentence offers a choice ("or", "either"):
+/// a condition asked there may be one alternative of several.
+fn asked_in_sentences(
+    request: &str,
+    vocabulary: &Vocabulary,
+) -> Vec<(Subject, bool, String, bool)> {
+    let mut found: Vec<(Subject, bool, String, bool)> = Vec::new();
     let mut both: Vec<(String, String)> = Vec::new();
-    for clause in clauses(request) {
+    let text = without_numbering(request);
+    let sentences = text.split(['.', '!', '?', ';']).map(|sentence| {
+        let words = every_term(sentence);
+        let choice = words.iter().any(|w| w == "or" || w == "either");
+        (clauses(sentence), choice)
+    });
+    let with_choice =
+        sentences.flat_map(|(clauses, choice)| clauses.into_iter().map(move |c| (c, choice)));
+    for (clause, choice) in with_choice {
         for predicate in &vocabulary.predicates {
             let Some((wanted, word)) = clause_polarity(&clause, predicate) else {
                 continue;
@@ -111,7 +175,7 @@ fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, boo
                 }
                 if let Some(i) = found
                     .iter()
-                    .position(|(s, _, _)| s.predicate == key.0 && s.object == key.1)
+                    .position(|(s, _, _, _)| s.predicate == key.0 && s.object == key.1)
                 {
                     if found[i].1 != wanted {
                         found.remove(i);
@@ -126,6 +190,7 @@ fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, boo
                     },
                     wanted,
                     word.clone(),
+                    choice,
                 ));
             }
         }
@@ -228,15 +293,11 @@ fn subjects(clause: &[String], predicate: &Predicate, vocabulary: &Vocabulary) -
     };
     let fitting: Vec<&crate::domain::Object> =
         vocabulary.objects.iter().filter(|o| o.fits(slot)).collect();
-    let named: Vec<String> = fitting
-        .iter()
-        .filter(|o| {
-            std::iter::once(&o.name)
-                .chain(&o.called)
-                .any(|phrase| find_phrase(clause, &terms(phrase)).is_some())
-        })
-        .map(|o| o.name.clone())
+    let mut named: Vec<String> = mentions(clause, &fitting, &[])
+        .into_iter()
+        .map(|(_, _, name)| name)
         .collect();
+    named.dedup();
     match fitting.as_slice() {
         // The one object a predicate can be about needs no name, only a word of it ("too
         // low" about the temperature), so that a word alone ("a cool drink") asks nothing.

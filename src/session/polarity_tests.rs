@@ -190,3 +190,58 @@ fn words_that_only_announce_a_number_are_left_out() {
         "No juice, no. Bar 2"
     );
 }
+
+fn with_asked(goal: &str, request: &str) -> Option<String> {
+    let goal = Formula::parse(goal).expect("test goal parses");
+    with_unanswered(&goal, request, &vocabulary()).map(|g| g.to_string())
+}
+
+#[test]
+fn a_condition_asked_in_its_own_words_and_left_out_is_put_beside() {
+    let request = "Don't forget to turn on the hall light. And bring a coffee to table 1.";
+    let goal = Formula::parse("On_Coffee_Table1").expect("parses");
+    let (atom, wanted, word) =
+        left_unanswered(&goal, request, &vocabulary()).expect("the light is asked for");
+    assert_eq!(
+        (atom.to_string(), wanted, word.as_str()),
+        ("Active_HallLight".into(), true, "on")
+    );
+    assert_eq!(
+        with_asked("On_Coffee_Table1", request).as_deref(),
+        Some("On_Coffee_Table1 & Active_HallLight")
+    );
+    // Asked the other way: put beside negated.
+    assert_eq!(
+        with_asked(
+            "On_Coffee_Table1",
+            "Bring a coffee, and switch the tube light off."
+        )
+        .as_deref(),
+        Some("On_Coffee_Table1 & ~Active_TubeLight")
+    );
+    // A sentence that offers a choice may have asked for it as one alternative of several.
+    assert_eq!(
+        with_asked(
+            "On_Coffee_Table1",
+            "Bring a coffee or turn on the hall light."
+        ),
+        None
+    );
+    // Answered, either way round (turning it is another finding's work).
+    assert_eq!(
+        with_asked("On_Coffee_Table1 & ~Active_HallLight", request),
+        None
+    );
+}
+
+#[test]
+fn a_longer_name_is_the_subject_not_a_shorter_one_inside_it() {
+    let mut v = vocabulary();
+    v.objects.push(object("SpringWater", "item", &[]));
+    v.objects.push(object("Water", "item", &[]));
+    v.objects.push(object("Watermelon", "item", &[]));
+    let goal = Formula::parse("On_Coffee_Table1").expect("parses");
+    let found = left_unanswered(&goal, "Please hold a bottle of spring water.", &v)
+        .map(|(atom, _, _)| atom.to_string());
+    assert_eq!(found.as_deref(), Some("Holding_SpringWater"));
+}
