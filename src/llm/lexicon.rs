@@ -71,6 +71,17 @@ impl Lexicon {
                 }
             }
         }
+        // So are the words the scene lists for a predicate, either way round ("come to"
+        // and "near" for the robot near a place, "off" for a device on).
+        for predicate in &vocabulary.predicates {
+            let list = words.entry(predicate.name.clone()).or_default();
+            let said = predicate.words.says.iter().chain(&predicate.words.opposite);
+            for word in said.flat_map(|c| terms(c)) {
+                if !GENERIC.contains(&word.as_str()) && !list.contains(&word) {
+                    list.push(word);
+                }
+            }
+        }
         let mut object_words: Vec<String> = vocabulary
             .objects
             .iter()
@@ -361,6 +372,19 @@ mod tests {
         assert!(covered.contains(&"6".to_string()));
         let unrelated = Formula::parse("IsClean_Floor").expect("parses");
         assert!(lexicon.covered(&unrelated, &request).is_empty());
+    }
+
+    #[test]
+    fn the_words_a_scene_lists_for_a_predicate_are_its_own() {
+        let mut v = vocabulary();
+        if let Some(near) = v.predicates.iter_mut().find(|p| p.name == "RobotNear") {
+            near.words.says = vec!["come to".into()];
+            near.words.opposite = vec!["stay away".into()];
+        }
+        let lexicon = Lexicon::new(&v, &[]);
+        let words = lexicon.words("RobotNear");
+        assert!(words.contains(&"come".to_string()), "{words:?}");
+        assert!(words.contains(&"away".to_string()), "{words:?}");
     }
 
     #[test]

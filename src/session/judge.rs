@@ -219,7 +219,19 @@ impl Judge<'_> {
         for _ in 0..UNDO_STEPS {
             let mut next = Vec::new();
             for (from, path) in &frontier {
-                for (g, why) in self.undone(from) {
+                let undone = self.undone(from).into_iter().flat_map(|(g, why)| {
+                    // What was undone may make a part nothing asks for plain to see.
+                    let pruned = without_unasked(&g, self.instruction, &self.lexicon).map(|p| {
+                        (
+                            p,
+                            format!(
+                                "{why}; then without the parts no word of the request asks for"
+                            ),
+                        )
+                    });
+                    std::iter::once((g, why)).chain(pruned)
+                });
+                for (g, why) in undone {
                     if g == *goal || out.iter().any(|(seen, _)| *seen == g) {
                         continue;
                     }

@@ -60,3 +60,23 @@ fn a_wish_of_several_may_hold_already() {
     assert_eq!(whole.map(|p| p.reason).as_deref(), Some(HOLDS_ALREADY));
     assert_eq!(judge(&cafe, request, true).assess(&goal), None);
 }
+
+#[test]
+fn what_was_undone_may_leave_a_part_nothing_asks_for_which_goes() {
+    let cafe = cafe();
+    let request = "Come to table 3 and pick up my vacuum cup.";
+    let j = judge(&cafe, request, false);
+    let answer = cafe
+        .parse_goal("On_Teacup_Table3 & ~On_VacuumCup_Table1")
+        .expect("parses");
+    let undone: Vec<String> = j
+        .undone_in_turn(&answer)
+        .into_iter()
+        .filter(|(_, why)| why.is_ok())
+        .map(|(g, _)| g.to_string())
+        .collect();
+    assert!(
+        undone.contains(&"RobotNear_Table3 & Holding_VacuumCup".to_string()),
+        "{undone:?}"
+    );
+}
