@@ -32,9 +32,24 @@ pub struct LeftOut {
 }
 
 /// The first pair of things the request names side by side that `goal` has only one of.
+/// A thing counts as had only in a condition whose other objects the request names: "not
+/// on the bar and bar 2" read as chips not on the bar and a bottled drink, never named,
+/// not on bar 2 has left bar 2 out of what the request asks about.
 pub fn left_out(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<LeftOut> {
     let atoms = goal.atoms();
-    let has = |object: &str| atoms.iter().any(|a| a.args.iter().any(|x| x == object));
+    let objects: Vec<&Object> = vocabulary.objects.iter().collect();
+    let named: Vec<String> = mentions(&every_term(&without_numbering(request)), &objects, &[])
+        .into_iter()
+        .map(|(_, _, name)| name)
+        .collect();
+    let has = |object: &str| {
+        atoms.iter().any(|a| {
+            a.args.iter().any(|x| x == object)
+                && a.args.iter().all(|x| {
+                    x == object || named.contains(x) || !objects.iter().any(|o| o.name == *x)
+                })
+        })
+    };
     side_by_side(request, vocabulary)
         .into_iter()
         .find_map(

@@ -128,3 +128,24 @@ fn a_measure_read_in_the_place_of_what_it_holds_is_replaced_by_it() {
         None
     );
 }
+
+#[test]
+fn a_thing_had_only_beside_an_object_nobody_names_is_left_out() {
+    // Bar 2 is in the goal only with the milk, which the request never names.
+    assert_eq!(
+        added(
+            "~On_Chips_Bar & ~On_Milk_Bar2",
+            "Make sure the chips are not on the bar and bar 2."
+        )
+        .as_deref(),
+        Some("~On_Chips_Bar & ~On_Chips_Bar2 & ~On_Milk_Bar2")
+    );
+    // Named, the milk's condition is the request's own: nothing is left out.
+    assert_eq!(
+        added(
+            "~On_Chips_Bar & ~On_Milk_Bar2",
+            "No chips on the bar and bar 2 for the milk."
+        ),
+        None
+    );
+}
