@@ -9,6 +9,7 @@
 //! measure in the place of what it holds ("a glass of water" read as the glass); an
 //! object nobody named in the place of one the request names ("fries" read as coffee).
 
+use crate::domain::VocabularyError;
 use crate::goal::{self, Formula};
 use crate::llm::lexicon::Lexicon;
 use crate::llm::reply::{GoalAnswer, ReplyError};
@@ -213,8 +214,11 @@ impl Judge<'_> {
     /// each goal undone is undone again, up to [`UNDO_STEPS`] times and [`UNDONE_AT_MOST`]
     /// goals, each with what was undone on the way. Goals that put an object where its
     /// predicate does not take it come out with why, and are not undone further.
-    pub(super) fn undone_in_turn(&self, goal: &Formula) -> Vec<(Formula, Result<String, String>)> {
-        let mut out: Vec<(Formula, Result<String, String>)> = Vec::new();
+    pub(super) fn undone_in_turn(
+        &self,
+        goal: &Formula,
+    ) -> Vec<(Formula, Result<String, VocabularyError>)> {
+        let mut out: Vec<(Formula, Result<String, VocabularyError>)> = Vec::new();
         let mut frontier = vec![(goal.clone(), String::new())];
         for _ in 0..UNDO_STEPS {
             let mut next = Vec::new();
@@ -252,7 +256,7 @@ impl Judge<'_> {
                             next.push((g.clone(), why.clone()));
                             out.push((g, Ok(why)));
                         }
-                        Err(e) => out.push((g, Err(e.to_string()))),
+                        Err(e) => out.push((g, Err(e))),
                     }
                 }
             }
@@ -279,7 +283,7 @@ impl Judge<'_> {
             _ => None,
         };
         // The answer and, when parts were taken out of it, what is left are both undone.
-        let mut undone: Vec<(Formula, Result<String, String>)> = Vec::new();
+        let mut undone: Vec<(Formula, Result<String, VocabularyError>)> = Vec::new();
         if let Ok(a) = read
             && check_goals
         {
@@ -302,10 +306,10 @@ impl Judge<'_> {
                 }
                 // A goal undone may put an object where its predicate does not take it
                 // ("fries" put in the place of a made dessert): it is no candidate.
-                Err(reason) => emit(&Event::CandidateRejected {
+                Err(e) => emit(&Event::CandidateRejected {
                     candidate: goal.to_string(),
                     proposal: None,
-                    reason,
+                    reason: e.to_string(),
                     author: Some("betr, from the model's answer".into()),
                 }),
             }
