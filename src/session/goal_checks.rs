@@ -7,24 +7,54 @@
 
 use crate::domain::Condition;
 use crate::goal::Formula;
-use crate::llm::examples::{every_term, terms};
+use crate::llm::examples::terms;
 use crate::llm::lexicon::{Lexicon, is_number, same_word};
 use crate::planner::{Outcome, Planner};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::placement::mentions;
-use super::polarity::without_numbering;
+use super::placement::named_in;
 
 /// Why a candidate goal cannot be what the person meant, or may not be.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalProblem {
     pub reason: String,
-    /// A doubt rather than a proof: the goal holds already (a person may ask for what is
-    /// true), or a condition of it comes from a shown example (an indirect request may
-    /// mean just that). A doubtful first answer is kept unless the part it pasted can be
-    /// taken out; a wrong one (unreadable, contradictory, unplannable) never is.
-    pub doubt: bool,
+    pub kind: ProblemKind,
+}
+
+/// How sure a [`GoalProblem`] is. A doubtful first answer is kept unless the part it
+/// pasted can be taken out; a wrong one (unreadable, contradictory, unplannable) never is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProblemKind {
+    /// Proven wrong: unreadable, contradictory, unplannable, or not what the words say.
+    Wrong,
+    /// A doubt: a condition comes from a shown example or no word asks for it (an
+    /// indirect request may mean just that).
+    Doubt,
+    /// A doubt: the goal holds already in the scene (a person may ask for what is true,
+    /// and one wish of several may hold while the others do not).
+    HoldsAlready,
+}
+
+impl GoalProblem {
+    pub fn wrong(reason: impl Into<String>) -> Self {
+        Self {
+            reason: reason.into(),
+            kind: ProblemKind::Wrong,
+        }
+    }
+
+    pub fn doubt(reason: impl Into<String>) -> Self {
+        Self {
+            reason: reason.into(),
+            kind: ProblemKind::Doubt,
+        }
+    }
+
+    /// A doubt rather than a proof.
+    pub fn is_doubt(&self) -> bool {
+        self.kind != ProblemKind::Wrong
+    }
 }
 
 /// Why a goal that is true in the scene now is doubtful.
@@ -38,10 +68,7 @@ pub fn check_goal(
     world: &dyn World,
     goal: &Formula,
 ) -> Result<(), GoalProblem> {
-    let wrong = |reason: String| GoalProblem {
-        reason,
-        doubt: false,
-    };
+    let wrong = GoalProblem::wrong;
     let dnf = goal.to_dnf();
     if dnf.is_false() {
         return Err(wrong(
@@ -77,7 +104,7 @@ pub fn check_goal(
     if goal.eval(&holds) {
         return Err(GoalProblem {
             reason: HOLDS_ALREADY.into(),
-            doubt: true,
+            kind: ProblemKind::HoldsAlready,
         });
     }
     Ok(())
@@ -210,9 +237,8 @@ pub fn swapped_back(
         .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
         .collect();
     let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
-    let mut named: Vec<String> = mentions(&every_term(&without_numbering(request)), &of_kind, &[])
+    let mut named: Vec<String> = named_in(request, &of_kind)
         .into_iter()
-        .map(|(_, _, name)| name)
         .filter(|name| !in_goal.contains(name))
         .collect();
     named.sort();
@@ -504,24 +530,17 @@ pub(super) fn assess(
     (shown, lexicon): (&[&crate::scenario::Example], &Lexicon),
     request: &str,
 ) -> Option<GoalProblem> {
-    let doubt = |reason: String| GoalProblem {
-        reason,
-        doubt: true,
-    };
+    let doubt = GoalProblem::doubt;
     match check_goal(scenario, world, goal) {
-        Err(p) if !p.doubt => Some(p),
-        _ if let Some(reason) = more_alternatives_than_asked(goal, request) => Some(GoalProblem {
-            reason,
-            doubt: false,
-        }),
+        Err(p) if !p.is_doubt() => Some(p),
+        _ if let Some(reason) = more_alternatives_than_asked(goal, request) => {
+            Some(GoalProblem::wrong(reason))
+        }
         Err(_) if let Some(object) = unsaid_object_holding(goal, world, request, lexicon) => {
-            Some(GoalProblem {
-                reason: format!(
-                    "it holds already in the scene now, through {object}, which the request \
-                     never mentions; the request asks for a change"
-                ),
-                doubt: false,
-            })
+            Some(GoalProblem::wrong(format!(
+                "it holds already in the scene now, through {object}, which the request \
+                 never mentions; the request asks for a change"
+            )))
         }
         checked => copied_from_example(goal, shown, request)
             .map(doubt)

@@ -194,10 +194,7 @@ pub(super) async fn read_goal(
             calls += 1;
             let read = reply::goal(&r.text, vocabulary, options.min_similarity);
             let problem = match &read {
-                Err(e) => Some(GoalProblem {
-                    reason: e.to_string(),
-                    doubt: false,
-                }),
+                Err(e) => Some(GoalProblem::wrong(e.to_string())),
                 Ok(_) if !options.check_goals => None,
                 Ok(a) => judge.assess(&a.goal),
             };

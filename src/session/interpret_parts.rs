@@ -89,7 +89,7 @@ pub(super) async fn read_parts(
         (&shown, &lexicon),
         instruction,
     );
-    if let Some(p) = problem.as_ref().filter(|p| !p.doubt) {
+    if let Some(p) = problem.as_ref().filter(|p| !p.is_doubt()) {
         emit(&Event::CandidateRejected {
             candidate: goal.to_string(),
             proposal: None,

@@ -14,10 +14,7 @@ fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {
             }),
             None => Err(ReplyError::NoConditions),
         },
-        problem: problem.map(|p| GoalProblem {
-            reason: p.to_string(),
-            doubt: false,
-        }),
+        problem: problem.map(|p| GoalProblem::wrong(p.to_string())),
         first: false,
     }
 }

@@ -17,7 +17,7 @@ use crate::scenario::Scenario;
 use crate::world::World;
 
 use super::goal_checks::{
-    GoalProblem, HOLDS_ALREADY, assess, renumbered, swapped_back, swapped_object, unanswered_names,
+    GoalProblem, ProblemKind, assess, renumbered, swapped_back, swapped_object, unanswered_names,
     without_copied, without_unasked,
 };
 use super::placement::{moved_there, not_put, put_there};
@@ -44,7 +44,7 @@ impl Candidate {
         self.read.is_ok() && self.problem.is_none()
     }
     pub(super) fn doubtful(&self) -> bool {
-        self.read.is_ok() && self.problem.as_ref().is_some_and(|p| p.doubt)
+        self.read.is_ok() && self.problem.as_ref().is_some_and(GoalProblem::is_doubt)
     }
 }
 
@@ -73,7 +73,7 @@ impl Judge<'_> {
             (&self.shown, &self.lexicon),
             self.instruction,
         )
-        .filter(|p| !(self.one_of_several && p.reason == HOLDS_ALREADY))
+        .filter(|p| !(self.one_of_several && p.kind == ProblemKind::HoldsAlready))
     }
 
     /// The place numbers the request says that no condition of `goal` is about.

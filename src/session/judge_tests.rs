@@ -57,7 +57,7 @@ fn a_wish_of_several_may_hold_already() {
     let request = "please keep the AC switched off";
     let goal = cafe.parse_goal("~Active_AC").expect("parses");
     let whole = judge(&cafe, request, false).assess(&goal);
-    assert_eq!(whole.map(|p| p.reason).as_deref(), Some(HOLDS_ALREADY));
+    assert_eq!(whole.map(|p| p.kind), Some(ProblemKind::HoldsAlready));
     assert_eq!(judge(&cafe, request, true).assess(&goal), None);
 }
 

@@ -78,10 +78,7 @@ pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Op
         return None;
     }
     let objects: Vec<&Object> = vocabulary.objects.iter().collect();
-    let named: Vec<String> = mentions(&every_term(&without_numbering(request)), &objects, &[])
-        .into_iter()
-        .map(|(_, _, name)| name)
-        .collect();
+    let named = named_in(request, &objects);
     let moved = map_atoms(goal, &|a| {
         let to = match a.args.as_slice() {
             [item, place]
@@ -152,7 +149,7 @@ fn alternatives_put(goal: &Formula, sent: &[Sent], relation: &str, asked: &[Stri
         Formula::Or(alts) => Formula::Or(
             alts.iter()
                 .map(|a| match a {
-                    Formula::Atom(atom) if item_alone(a, asked) => sent
+                    Formula::Atom(atom) if about_alone(a, None, asked) => sent
                         .iter()
                         .find(|s| atom.args == [s.item.clone()])
                         .map_or_else(|| a.clone(), |s| placed(a, &s.place, relation)),
@@ -198,10 +195,10 @@ fn put_each(
     asked: &[String],
 ) -> Vec<Formula> {
     for s in sent {
-        let alone = |f: &Formula, object: &str| matches!(f, Formula::Atom(a) if a.args == [object] && !asked.contains(&a.predicate));
+        let alone = |f: &Formula, object: &str| about_alone(f, Some(object), asked);
         let item_at = items.iter().position(|f| {
             alone(f, &s.item)
-                || matches!(f, Formula::Or(alts) if alts.iter().all(|a| item_alone(a, asked))
+                || matches!(f, Formula::Or(alts) if alts.iter().all(|a| about_alone(a, None, asked))
                     && alts.iter().any(|a| alone(a, &s.item)))
         });
         let Some(i) = item_at else {
@@ -224,10 +221,11 @@ fn put_each(
     items
 }
 
-/// Whether `f` is a condition about one object alone that the request does not ask for
-/// in the predicate's own words.
-fn item_alone(f: &Formula, asked: &[String]) -> bool {
-    matches!(f, Formula::Atom(a) if !asked.contains(&a.predicate) && a.args.len() == 1)
+/// Whether `f` is a condition about one object alone (`object`, or any) that the
+/// request does not ask for in the predicate's own words.
+fn about_alone(f: &Formula, object: Option<&str>, asked: &[String]) -> bool {
+    matches!(f, Formula::Atom(a) if !asked.contains(&a.predicate)
+        && matches!(a.args.as_slice(), [only] if object.is_none_or(|o| o == only)))
 }
 
 /// `f` (a condition about an item alone, or alternatives of such) with each item put at
@@ -311,6 +309,15 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
         }
     }
     out
+}
+
+/// The names of the `objects` the whole `request` mentions (place numbers read as
+/// digits), in the order found; a name may come more than once.
+pub(super) fn named_in(request: &str, objects: &[&Object]) -> Vec<String> {
+    mentions(&every_term(&without_numbering(request)), objects, &[])
+        .into_iter()
+        .map(|(_, _, name)| name)
+        .collect()
 }
 
 /// Where `words` name one of `objects` by its name's words in a row or by what it is

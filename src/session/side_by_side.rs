@@ -10,7 +10,7 @@ use crate::goal::Formula;
 use crate::llm::examples::every_term;
 
 use super::goal_checks::{rename, undo_each};
-use super::placement::mentions;
+use super::placement::{mentions, named_in};
 use super::polarity::without_numbering;
 
 /// Words that may stand between a joining word and the thing it joins ("or a dessert",
@@ -38,10 +38,7 @@ pub struct LeftOut {
 pub fn left_out(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<LeftOut> {
     let atoms = goal.atoms();
     let objects: Vec<&Object> = vocabulary.objects.iter().collect();
-    let named: Vec<String> = mentions(&every_term(&without_numbering(request)), &objects, &[])
-        .into_iter()
-        .map(|(_, _, name)| name)
-        .collect();
+    let named = named_in(request, &objects);
     let has = |object: &str| {
         atoms.iter().any(|a| {
             a.args.iter().any(|x| x == object)
