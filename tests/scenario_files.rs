@@ -183,3 +183,47 @@ fn a_declared_value_range_must_be_a_range_of_numbers() {
     let e = error(&skill(r#"{ name = "force", unit = "N", max = nan }"#));
     assert!(e.message.contains("finite"), "{e}");
 }
+
+#[test]
+fn a_conventions_checkable_form_names_a_relation_and_one_of_its_objects() {
+    let relating = format!(
+        "{HEAD}\n[[predicates]]\nname = \"On\"\nargs = [\"item\", \"item|nothing\"]\ndescription = \"rests on\"\n"
+    );
+    let convention = |body: &str| {
+        format!("{relating}\n[[conventions]]\ntext = \"t\"\nobjects = [\"Nothing\"]\n{body}\n")
+    };
+    let e = error(&convention(
+        "words = [\"bring me\"]\nputs = { relation = \"Holding\", place = \"Nothing\" }",
+    ));
+    assert!(
+        e.message
+            .contains("\"Holding\" is not a predicate of two arguments"),
+        "{e}"
+    );
+    let text = convention("words = [\"bring me\"]\nputs = { relation = \"On\", place = \"Cup\" }");
+    let e = error(&text);
+    assert!(
+        e.message
+            .contains("\"Cup\" is not one of the convention's objects"),
+        "{e}"
+    );
+    assert_eq!(e.line, lines_before(&text, "puts ="));
+    let e = error(&convention("words = [\"bring me\"]"));
+    assert!(e.message.contains("needs `puts`"), "{e}");
+    let e = error(&convention(
+        "puts = { relation = \"On\", place = \"Nothing\" }",
+    ));
+    assert!(e.message.contains("needs `words`"), "{e}");
+    let e = error(&convention(
+        "words = [\"--\"]\nputs = { relation = \"On\", place = \"Nothing\" }",
+    ));
+    assert!(e.message.contains("has no letters"), "{e}");
+    let ok =
+        convention("words = [\"bring me\"]\nputs = { relation = \"On\", place = \"Nothing\" }");
+    let scenario = Scenario::from_text(Path::new("ok.toml"), &ok).unwrap();
+    let puts = scenario.conventions[0].puts.as_ref().unwrap();
+    assert_eq!(
+        (puts.relation.as_str(), puts.place.as_str()),
+        ("On", "Nothing")
+    );
+}

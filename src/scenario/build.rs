@@ -6,10 +6,10 @@ use std::collections::HashMap;
 
 use toml::Spanned;
 
-use super::file::{RawFile, RawSkill, value_range};
+use super::file::{RawFile, RawPuts, RawSkill, value_range};
 use super::{
-    Convention, Example, Scenario, ScenarioError, SourceFile, effect_templates, goal_in,
-    split_types,
+    Convention, ConventionPuts, Example, Scenario, ScenarioError, SourceFile, effect_templates,
+    goal_in, split_types,
 };
 use crate::domain::skill::{Domain, Param, Skill, ValueParam};
 use crate::domain::template::parse_template;
@@ -56,7 +56,7 @@ impl Scenario {
                 .map(|f| f.get_ref().clone())
                 .collect(),
             examples: examples(&raws),
-            conventions: conventions(&raws),
+            conventions: conventions(&files, &raws, &vocabulary)?,
             domain: Domain { vocabulary, skills },
             world_kind: world_kind(&raws),
             files,
@@ -266,15 +266,79 @@ fn examples(raws: &[RawFile]) -> Vec<Example> {
         .unwrap_or_default()
 }
 
-/// The conventions of every file, base file first.
-fn conventions(raws: &[RawFile]) -> Vec<Convention> {
-    raws.iter()
-        .flat_map(|r| &r.conventions)
-        .map(|c| Convention {
-            text: c.text.trim().to_string(),
-            objects: c.objects.clone(),
-        })
-        .collect()
+/// The conventions of every file, base file first. A convention's `puts` names a
+/// predicate of two arguments and one of its own objects, and comes with the words that
+/// invoke it.
+fn conventions(
+    files: &[SourceFile],
+    raws: &[RawFile],
+    vocabulary: &Vocabulary,
+) -> Result<Vec<Convention>, ScenarioError> {
+    let mut out = Vec::new();
+    for (file, raw) in files.iter().zip(raws) {
+        for c in &raw.conventions {
+            let puts = match (&c.puts, c.words.as_slice()) {
+                (None, []) => None,
+                (None, [first, ..]) => {
+                    return Err(file.error_in_string(
+                        &first.span(),
+                        0,
+                        "a convention with words needs `puts`: what they ask for",
+                    ));
+                }
+                (Some(puts), words) => {
+                    let at = puts.span().start;
+                    let RawPuts { relation, place } = puts.get_ref();
+                    if words.is_empty() {
+                        return Err(file.error_at(
+                            at,
+                            "a convention's `puts` needs `words`: the request's words that invoke it",
+                        ));
+                    }
+                    if let Some(w) = words
+                        .iter()
+                        .find(|w| !w.get_ref().chars().any(char::is_alphanumeric))
+                    {
+                        return Err(file.error_in_string(
+                            &w.span(),
+                            0,
+                            "a convention's word has no letters",
+                        ));
+                    }
+                    if vocabulary
+                        .predicate(relation)
+                        .is_none_or(|p| p.arg_types.len() != 2)
+                    {
+                        return Err(file.error_at(
+                            at,
+                            format!(
+                                "`puts` relation {relation:?} is not a predicate of two arguments"
+                            ),
+                        ));
+                    }
+                    if !c.objects.contains(place) {
+                        return Err(file.error_at(
+                            at,
+                            format!(
+                                "`puts` place {place:?} is not one of the convention's objects"
+                            ),
+                        ));
+                    }
+                    Some(ConventionPuts {
+                        words: words.iter().map(|w| w.get_ref().clone()).collect(),
+                        relation: relation.clone(),
+                        place: place.clone(),
+                    })
+                }
+            };
+            out.push(Convention {
+                text: c.text.trim().to_string(),
+                objects: c.objects.clone(),
+                puts,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// The simulator the last file that names one asks for (`symbolic` when none does).

@@ -111,6 +111,19 @@ pub(super) struct RawConvention {
     pub(super) text: String,
     #[serde(default)]
     pub(super) objects: Vec<String>,
+    /// The request's words that invoke it ("bring me").
+    #[serde(default)]
+    pub(super) words: Vec<Spanned<String>>,
+    /// The condition those words ask for each item they name: a predicate of two
+    /// arguments and the place (`{ relation = "on", place = "tray" }`).
+    pub(super) puts: Option<Spanned<RawPuts>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawPuts {
+    pub(super) relation: String,
+    pub(super) place: String,
 }
 
 #[derive(Deserialize)]

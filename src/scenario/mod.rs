@@ -41,6 +41,20 @@ pub struct Convention {
     pub text: String,
     /// The objects it speaks of: it applies to a scene that has all of them.
     pub objects: Vec<String>,
+    /// The same, in a form a goal can be checked against, when the convention gives one.
+    pub puts: Option<ConventionPuts>,
+}
+
+/// What a convention's words ask for each item they name: "bring me the cup" asks for
+/// `relation(cup, place)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConventionPuts {
+    /// The request's words that invoke it ("bring me", "for me").
+    pub words: Vec<String>,
+    /// A predicate of two arguments: the item, then the place.
+    pub relation: String,
+    /// One of the convention's objects.
+    pub place: String,
 }
 
 #[derive(Debug, Clone, PartialEq)]

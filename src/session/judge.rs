@@ -22,6 +22,7 @@ use super::goal_checks::{
 };
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
+use super::relation_words::{convention_followed, relation_as_said};
 use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::types::Event;
 
@@ -111,6 +112,16 @@ impl Judge<'_> {
                 "the request says \"{word}\", which asks for {asked}, and {goal} has no condition about it"
             ));
         }
+        if let Some((said, word)) = relation_as_said(goal, self.instruction, self.vocabulary()) {
+            return Some(format!(
+                "the request says \"{word}\" before the place, which asks for {said}, not {goal}"
+            ));
+        }
+        if let Some((put, word)) = convention_followed(goal, self.instruction, self.scenario) {
+            return Some(format!(
+                "the request says \"{word}\", which here asks for {put}, not {goal}"
+            ));
+        }
         if let Some(sent) = not_put(goal, self.instruction, self.vocabulary()) {
             return Some(format!(
                 "the request sends {} to {}, and no condition of {goal} puts it there",
@@ -179,6 +190,18 @@ impl Judge<'_> {
             out.push((
                 g,
                 format!("the request asks in its own words for a condition {goal} leaves out"),
+            ));
+        }
+        if let Some((g, word)) = relation_as_said(goal, request, vocabulary) {
+            out.push((
+                g,
+                format!("the request says \"{word}\" before the place, which {goal} reads as another relation"),
+            ));
+        }
+        if let Some((g, word)) = convention_followed(goal, request, self.scenario) {
+            out.push((
+                g,
+                format!("the request says \"{word}\", which by this scene's conventions asks for where {goal} does not put it"),
             ));
         }
         if let Some(g) = put_there(goal, request, vocabulary) {

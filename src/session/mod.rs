@@ -15,6 +15,7 @@ pub mod placement;
 pub mod planned;
 pub mod polarity;
 pub mod policy;
+pub mod relation_words;
 pub mod resolve;
 pub mod screen;
 pub mod shortlist;

@@ -16,7 +16,7 @@ use super::polarity::{find_phrase, without_numbering};
 const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
 
 /// How far after such a word the place's name may start ("to the third table").
-const PLACE_WITHIN: usize = 3;
+pub(super) const PLACE_WITHIN: usize = 3;
 
 /// Verbs of the robot's own moving: an item before one is not sent to a place after it
 /// ("make coffee and come to table 2").
@@ -63,8 +63,20 @@ pub fn put_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Opti
     if sent.is_empty() {
         return None;
     }
+    put_sent(goal, request, vocabulary, &sent, &relation.name)
+}
+
+/// `goal` with each item of `sent` put at its place by `relation`, as [`put_there`] does;
+/// `None` when nothing changes.
+pub(super) fn put_sent(
+    goal: &Formula,
+    request: &str,
+    vocabulary: &Vocabulary,
+    sent: &[Sent],
+    relation: &str,
+) -> Option<Formula> {
     let asked = said_predicates(request, vocabulary);
-    let rewritten = rewrite(goal, &sent, &relation.name, &asked);
+    let rewritten = rewrite(goal, sent, relation, &asked);
     (rewritten != *goal).then_some(rewritten)
 }
 
