@@ -3,7 +3,9 @@
 //! first answer leaves out draws more candidates, and so does an object put in the place
 //! of one the request names; a misreading that can be undone (a condition turned around,
 //! an item sent to a place but not put there, one of two things named side by side left
-//! out, a swapped object) gives the undone goal as a candidate; a condition no word of
+//! out, a swapped object, a relation other than the one the request says before the place,
+//! what a convention's words put somewhere left elsewhere) gives the undone goal as a
+//! candidate; a condition no word of
 //! the request asks for is taken out; a
 //! failure is asked about with the conditions that fix it in simulation as the only
 //! choices. And with a model that answers by the request it is asked about: a request of
@@ -155,6 +157,25 @@ async fn a_condition_no_word_asks_for_is_taken_out() {
     let expected = Formula::parse("On_Chips_Table3").unwrap();
     assert!(equivalent(&goal, &expected).unwrap(), "{goal}");
     assert_eq!(calls, 1);
+}
+
+#[tokio::test]
+async fn the_relation_and_the_convention_the_request_says_undo_a_misread_relation() {
+    // "In the crib" asks for in; the answer's on is undone with no more calls.
+    let baby = scenario("scenarios/cell/params/baby.toml");
+    let model = ByDraw::new(r#"Goal: "baby doll" on "crib""#, &[]);
+    let (goal, calls) = read(&baby, &model, "Lay the doll to sleep in the crib, gently.").await;
+    assert_eq!(goal.to_string(), r#""baby doll" in "crib""#);
+    assert_eq!(calls, 1);
+    // "Fetch ... for me": what is brought goes on the tray in this cell, not held.
+    let kit = scenario("scenarios/cell/params/first_aid.toml");
+    let model = ByDraw::new(r#"Goal: "first aid kit" grasped"#, &[]);
+    let (goal, calls) = read(&kit, &model, "Quick, fetch the first aid kit for me.").await;
+    assert_eq!(goal.to_string(), r#""first aid kit" on "tray""#);
+    assert_eq!(calls, 1);
+    // Held, asked in its own words: held.
+    let (goal, _) = read(&kit, &model, "Hold the first aid kit up for me.").await;
+    assert_eq!(goal.to_string(), r#""first aid kit" grasped"#);
 }
 
 #[tokio::test]

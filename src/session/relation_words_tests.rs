@@ -86,3 +86,49 @@ fn a_convention_applies_only_in_a_scene_with_its_objects() {
         None
     );
 }
+
+#[test]
+fn the_cells_stated_goals_and_worked_examples_are_not_misreadings() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell");
+    let mut files = Vec::new();
+    for dir in [root.clone(), root.join("params"), root.join("tasks")] {
+        for entry in std::fs::read_dir(&dir).expect("reads the folder") {
+            let path = entry.expect("entry").path();
+            if path.extension().is_some_and(|e| e == "toml")
+                && !["cell.toml", "examples.toml"]
+                    .contains(&path.file_name().and_then(|n| n.to_str()).unwrap_or(""))
+            {
+                files.push(path);
+            }
+        }
+    }
+    assert!(files.len() >= 15, "{files:?}");
+    let mut checked = 0;
+    for path in files {
+        let s = Scenario::load(&path).expect("loads");
+        let vocabulary = &s.domain.vocabulary;
+        let stated = s.instruction.clone().zip(s.goal.clone());
+        // The pool's examples whose objects this scene has, read in this scene.
+        let examples = s.examples.iter().filter_map(|e| {
+            s.parse_goal(&e.goal)
+                .ok()
+                .map(|g| (e.instruction.clone(), g))
+        });
+        for (request, gold) in stated.into_iter().chain(examples) {
+            assert_eq!(
+                relation_as_said(&gold, &request, vocabulary),
+                None,
+                "{}: {request}",
+                path.display()
+            );
+            assert_eq!(
+                convention_followed(&gold, &request, &s),
+                None,
+                "{}: {request}",
+                path.display()
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 30, "{checked}");
+}
