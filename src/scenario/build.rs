@@ -145,10 +145,8 @@ fn state_words(
     says: &[Spanned<String>],
     opposite: &[Spanned<String>],
 ) -> Result<StateWords, ScenarioError> {
-    for w in says.iter().chain(opposite) {
-        if !w.get_ref().chars().any(char::is_alphanumeric) {
-            return Err(file.error_in_string(&w.span(), 0, "a word of a predicate has no letters"));
-        }
+    if let Some(w) = without_letters(says.iter().chain(opposite)) {
+        return Err(file.error_in_string(&w.span(), 0, "a word of a predicate has no letters"));
     }
     if let Some(w) = opposite
         .iter()
@@ -165,6 +163,15 @@ fn state_words(
         says: plain(says),
         opposite: plain(opposite),
     })
+}
+
+/// The first of `words` with no letter or digit: it could match nothing a person says.
+fn without_letters<'a>(
+    words: impl IntoIterator<Item = &'a Spanned<String>>,
+) -> Option<&'a Spanned<String>> {
+    words
+        .into_iter()
+        .find(|w| !w.get_ref().chars().any(char::is_alphanumeric))
 }
 
 /// The same words, whatever the case and spacing.
@@ -295,10 +302,7 @@ fn conventions(
                             "a convention's `puts` needs `words`: the request's words that invoke it",
                         ));
                     }
-                    if let Some(w) = words
-                        .iter()
-                        .find(|w| !w.get_ref().chars().any(char::is_alphanumeric))
-                    {
+                    if let Some(w) = without_letters(words) {
                         return Err(file.error_in_string(
                             &w.span(),
                             0,

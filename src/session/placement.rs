@@ -254,7 +254,7 @@ fn placed(f: &Formula, place: &str, relation: &str) -> Formula {
 }
 
 /// The predicates of two arguments that take an item and a place.
-fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
+pub(super) fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
     vocabulary
         .predicates
         .iter()

@@ -10,7 +10,7 @@ use crate::llm::examples::every_term;
 use crate::scenario::Scenario;
 
 use super::goal_checks::map_atoms;
-use super::placement::{PLACE_WITHIN, Sent, mentions, named_in, put_sent};
+use super::placement::{PLACE_WITHIN, Sent, mentions, put_sent, relating};
 use super::polarity::{find_phrase, without_numbering};
 
 /// `goal` with each condition relating two objects by a predicate other than the one the
@@ -22,11 +22,7 @@ pub fn relation_as_said(
     request: &str,
     vocabulary: &Vocabulary,
 ) -> Option<(Formula, String)> {
-    let relating: Vec<&Predicate> = vocabulary
-        .predicates
-        .iter()
-        .filter(|p| p.arg_types.len() == 2)
-        .collect();
+    let relating = relating(vocabulary);
     if relating.len() < 2 {
         return None;
     }
@@ -116,7 +112,7 @@ pub fn convention_followed(
                 continue;
             };
             let mut sent: Vec<Sent> = Vec::new();
-            for item in named_in(sentence, &items) {
+            for (_, _, item) in mentions(&words, &items, &[]) {
                 if !sent.iter().any(|s| s.item == item) {
                     sent.push(Sent {
                         item,
