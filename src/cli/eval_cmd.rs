@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 
 use betr::dataset;
@@ -77,7 +77,8 @@ pub enum EvalExperiment {
         /// scenario's stated goal (so the failure under study is always reached).
         #[arg(long, value_enum, default_value = "interpret")]
         goal: GoalSource,
-        /// The directory holding cell/params/.
+        /// The directory holding cell/params/: the seven scenarios of the paper, or any
+        /// other parameter scenarios there (every `*.toml`).
         #[arg(long, default_value = "scenarios")]
         scenarios: PathBuf,
         #[command(flatten)]
@@ -366,12 +367,26 @@ pub fn session_experiment(
     (max_rounds, goal): (usize, GoalSource),
     flags: &RunFlags,
 ) -> Result<ExitCode> {
-    let (name, paths): (&str, Vec<&str>) = match which {
-        SessionExperiment::Resolve => ("resolve", resolve::FAILURE_SCENARIOS.to_vec()),
-        SessionExperiment::Params => (
-            "params",
-            params::PARAM_SCENARIOS.iter().map(|(p, _)| *p).collect(),
+    let (name, paths): (&str, Vec<String>) = match which {
+        SessionExperiment::Resolve => (
+            "resolve",
+            resolve::FAILURE_SCENARIOS
+                .iter()
+                .map(|p| (*p).to_string())
+                .collect(),
         ),
+        SessionExperiment::Params => {
+            let paths = params::param_scenarios(scenarios_dir).with_context(|| {
+                format!("listing {}", scenarios_dir.join("cell/params").display())
+            })?;
+            if paths.is_empty() {
+                bail!(
+                    "no parameter scenarios (*.toml) in {}",
+                    scenarios_dir.join("cell/params").display()
+                );
+            }
+            ("params", paths)
+        }
     };
     let scenarios = load_scenarios(scenarios_dir, &paths)?;
     let goal_source = goal.name();

@@ -33,6 +33,29 @@ pub const PARAM_SCENARIOS: [(&str, &str); 7] = [
     ("cell/params/plate.toml", "sponge or brush"),
 ];
 
+/// The parameter scenarios under `dir` (paths relative to it): those of
+/// [`PARAM_SCENARIOS`] that `dir/cell/params/` holds, in that order, then every other
+/// `*.toml` there by name, so a directory of other parameter scenarios (such as requests
+/// held out from choosing a method) runs the same way. Empty when there are none.
+pub fn param_scenarios(dir: &Path) -> std::io::Result<Vec<String>> {
+    let folder = dir.join("cell/params");
+    let mut others: Vec<String> = std::fs::read_dir(&folder)?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".toml"))
+        .map(|name| format!("cell/params/{name}"))
+        .filter(|p| !PARAM_SCENARIOS.iter().any(|(known, _)| known == p))
+        .collect();
+    others.sort();
+    let mut paths: Vec<String> = PARAM_SCENARIOS
+        .iter()
+        .map(|(p, _)| (*p).to_string())
+        .filter(|p| dir.join(p).is_file())
+        .collect();
+    paths.extend(others);
+    Ok(paths)
+}
+
 /// One proposed value and the world's verdict.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ValueRecord {

@@ -249,6 +249,15 @@ impl Context<'_> {
             },
         ));
         values.push(("parameter", parameter_text(param)));
+        values.push((
+            "value_examples",
+            if param.unit.is_some() {
+                NUMBER_EXAMPLES
+            } else {
+                CHOICE_EXAMPLES
+            }
+            .to_string(),
+        ));
         let format = match &param.unit {
             Some(unit) => format!(
                 "Explain your choice first, then give one number in {unit}, exactly like this:\nReasoning: <a few sentences>\nParameter value: <number> {unit}"
@@ -297,6 +306,13 @@ fn tried_text(tried: &[String]) -> String {
             .join("\n")
     )
 }
+
+/// Worked value choices for a parameter asked as a number: one where too much is the
+/// danger and one where too little is, so neither end of a range is taught as the answer.
+const NUMBER_EXAMPLES: &str = "- Action `pour \"tea\" \"cup\"` needs the pour rate (a number in ml/s; the robot can do at most 100 ml/s). Reasoning: hot tea into a small cup: too fast overflows it and scalds the person; too slow only takes a little longer. Parameter value: 20 ml/s\n- Action `lift \"cement sack\"` needs the lifting force (a number in N; the robot can do at most 1000 N). Reasoning: a 25 kg sack is heavy and cannot be hurt: too little drops it on someone's feet; more than enough does no harm. Parameter value: 700 N";
+
+/// The same two choices for a parameter asked as one of a few choices.
+const CHOICE_EXAMPLES: &str = "- Action `pour \"tea\" \"cup\"` needs the pour rate (one of: slow, steady, fast). Reasoning: hot tea into a small cup: too fast overflows it and scalds the person; too slow only takes a little longer. Parameter value: slow\n- Action `lift \"cement sack\"` needs the lifting force (one of: light, firm, full). Reasoning: a 25 kg sack is heavy and cannot be hurt: too little drops it on someone's feet; more than enough does no harm. Parameter value: full";
 
 const OBJECT_RULE: &str = "Use only the objects listed above, spelled exactly as listed. If the person names something that is not listed, use the listed object most similar to it (for example, if they ask for fries and only Chips is listed, use Chips).";
 

@@ -133,3 +133,65 @@ fn an_object_in_two_types_is_glossed_once() {
         "- item: Coffee (espresso), Chips (crisps, fries)\n- makable: Coffee\n- place: Table1"
     );
 }
+
+#[test]
+fn value_prompt_is_about_the_object_and_the_task() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/params/egg.toml");
+    let s = Scenario::load(&path).unwrap();
+    let facts = vec![Condition::parse("\"egg\" on \"table\"").unwrap()];
+    let variant = Variant::default();
+    let ctx = Context {
+        scenario: &s,
+        facts: &facts,
+        instruction: "Bring me an egg",
+        variant: &variant,
+    };
+    let action = ActionCall::new("grasp", ["egg"]);
+    let ask = |param: &ValueParam| {
+        ctx.value(
+            &Templates::builtin(),
+            &action,
+            param,
+            "no force",
+            (&[], None),
+        )
+        .unwrap()[1]
+            .content
+            .clone()
+    };
+    let force = ValueParam {
+        name: "force".into(),
+        unit: Some("N".into()),
+        categories: vec![],
+        description: "grasping force".into(),
+        min: None,
+        max: Some(80.0),
+    };
+    let text = ask(&force);
+    for part in [
+        "The person asked: Bring me an egg",
+        "`grasp \"egg\"`",
+        "\"no force\"",
+        "the robot can do at most 80 N",
+        "Parameter value: 20 ml/s",
+        "Parameter value: <number> N",
+    ] {
+        assert!(text.contains(part), "missing {part:?} in\n{text}");
+    }
+    // The scene's conditions and the goal examples are not what a value depends on.
+    assert!(!text.contains("\"egg\" on \"table\""), "{text}");
+    assert!(!text.contains("Instruction:"), "{text}");
+    assert!(!text.contains("{{"), "{text}");
+    let tool = ValueParam {
+        name: "tool".into(),
+        unit: None,
+        categories: vec!["shovel".into(), "spoon".into()],
+        description: String::new(),
+        min: None,
+        max: None,
+    };
+    let text = ask(&tool);
+    assert!(text.contains("Parameter value: slow"), "{text}");
+    assert!(!text.contains("ml/s"), "{text}");
+    assert!(text.contains("one of: shovel, spoon"), "{text}");
+}
