@@ -171,6 +171,34 @@ async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
 }
 
 #[tokio::test]
+async fn a_greedy_reply_follows_a_grammar_that_refuses_the_models_own_first_choice() {
+    // The model would answer "blue cube" on "green cube"; a grammar that allows only
+    // another goal must still be followed token by token, ending where the grammar ends.
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let facts = world::load(&s).unwrap().facts();
+    let variant = Variant::default();
+    let ctx = Context {
+        scenario: &s,
+        facts: &facts,
+        instruction: s.instruction.as_deref().unwrap(),
+        variant: &variant,
+    };
+    let mut request = ChatRequest::new(ctx.goal(&Templates::builtin()).unwrap());
+    request.temperature = 0.0;
+    request.max_tokens = 40;
+    request.constraint = Some(OutputConstraint::Grammar {
+        name: "fixed".into(),
+        gbnf: r#"root ::= "Goal: " ("\"red cube\" grasped" | "\"red cube\" upright")"#.into(),
+    });
+    let r = local().chat(&request).await.unwrap();
+    assert!(
+        r.text == "Goal: \"red cube\" grasped" || r.text == "Goal: \"red cube\" upright",
+        "{:?}",
+        r.text
+    );
+}
+
+#[tokio::test]
 async fn a_reply_cut_by_the_token_limit_is_refused_after_bounded_calls() {
     let s = scenario("scenarios/cell/red_on_blue.toml");
     let mut calls = 0;

@@ -19,6 +19,8 @@ use llama_cpp_2::model::params::LlamaModelParams;
 use llama_cpp_2::model::{LlamaChatMessage, LlamaModel};
 use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
+use llama_cpp_2::token::data::LlamaTokenData;
+use llama_cpp_2::token::data_array::LlamaTokenDataArray;
 
 use super::prompt_state::{self, PromptStates};
 
@@ -341,20 +343,21 @@ fn generate(
     }
     let prompt_time = prompt_started.elapsed();
 
-    let mut samplers = Vec::new();
-    if let Some(g) = &job.grammar {
-        samplers.push(
+    let mut grammar = match &job.grammar {
+        Some(g) => Some(
             LlamaSampler::grammar(model, g, "root")
                 .map_err(|e| EngineError::Grammar(e.to_string()))?,
-        );
-    }
-    if job.temperature > 0.0 {
-        samplers.push(LlamaSampler::temp(job.temperature));
-        samplers.push(LlamaSampler::dist(job.seed));
+        ),
+        None => None,
+    };
+    let mut pick = if job.temperature > 0.0 {
+        LlamaSampler::chain_simple([
+            LlamaSampler::temp(job.temperature),
+            LlamaSampler::dist(job.seed),
+        ])
     } else {
-        samplers.push(LlamaSampler::greedy());
-    }
-    let mut sampler = LlamaSampler::chain_simple(samplers);
+        LlamaSampler::greedy()
+    };
 
     let generation_started = Instant::now();
     let vocab = model.vocab();
@@ -364,8 +367,8 @@ fn generate(
     let mut produced = 0u32;
     let mut logits_at = batch.n_tokens() - 1;
     while produced < job.max_tokens {
-        // `sample` also accepts the token into the chain (grammar state included).
-        let token = sampler.sample(ctx, logits_at);
+        let token = next_token(ctx.get_logits_ith(logits_at), grammar.as_mut(), &mut pick)
+            .ok_or_else(|| runtime(&"no token is allowed here"))?;
         if vocab.is_eog(token) {
             break;
         }
@@ -392,4 +395,64 @@ fn generate(
         prompt_time,
         generation_time: generation_started.elapsed(),
     })
+}
+
+/// The next token from `logits`, drawn by `pick` among those `grammar` allows, and
+/// accepted into both. The draw is first made among all tokens and checked against the
+/// grammar alone; only when the grammar refuses it is the grammar applied to the whole
+/// vocabulary and the draw made again. Applying a grammar to every token of a large
+/// vocabulary costs more than evaluating a token, and the first draw is nearly always
+/// allowed. The result is the same: a greedy pick allowed by the grammar is the best
+/// allowed token, and a random draw kept when allowed and otherwise redrawn among the
+/// allowed ones follows the distribution restricted to them.
+fn next_token(
+    logits: &[f32],
+    grammar: Option<&mut LlamaSampler>,
+    pick: &mut LlamaSampler,
+) -> Option<LlamaToken> {
+    let candidates = || {
+        LlamaTokenDataArray::from_iter(
+            (0_i32..)
+                .zip(logits)
+                .map(|(id, logit)| LlamaTokenData::new(LlamaToken::new(id), *logit, 0.0)),
+            false,
+        )
+    };
+    let mut free = candidates();
+    pick.apply(&mut free);
+    let drawn = free.selected_token();
+    let token = match grammar {
+        None => drawn?,
+        Some(grammar) => {
+            let allowed = drawn.filter(|&t| {
+                let logit = usize::try_from(t.0)
+                    .ok()
+                    .and_then(|i| logits.get(i))
+                    .copied()
+                    .unwrap_or(f32::NEG_INFINITY);
+                let mut one =
+                    LlamaTokenDataArray::new(vec![LlamaTokenData::new(t, logit, 0.0)], false);
+                grammar.apply(&mut one);
+                one.data
+                    .first()
+                    .is_some_and(|d| d.logit() > f32::NEG_INFINITY)
+            });
+            let token = match allowed {
+                Some(t) => t,
+                None => {
+                    let mut all = candidates();
+                    grammar.apply(&mut all);
+                    if all.data.iter().all(|d| d.logit() == f32::NEG_INFINITY) {
+                        return None;
+                    }
+                    pick.apply(&mut all);
+                    all.selected_token()?
+                }
+            };
+            grammar.accept(token);
+            token
+        }
+    };
+    pick.accept(token);
+    Some(token)
 }
