@@ -456,3 +456,31 @@ fn next_token(
     pick.accept(token);
     Some(token)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn without_a_grammar_the_pick_decides() {
+        let logits = [0.1, 2.5, -1.0, 2.0];
+        let mut greedy = LlamaSampler::greedy();
+        assert_eq!(
+            next_token(&logits, None, &mut greedy),
+            Some(LlamaToken::new(1))
+        );
+        // A draw at a low temperature lands on the best token; at any temperature it is
+        // one of the vocabulary's.
+        let mut cold =
+            LlamaSampler::chain_simple([LlamaSampler::temp(0.01), LlamaSampler::dist(7)]);
+        assert_eq!(
+            next_token(&logits, None, &mut cold),
+            Some(LlamaToken::new(1))
+        );
+        let mut hot = LlamaSampler::chain_simple([LlamaSampler::temp(5.0), LlamaSampler::dist(7)]);
+        for _ in 0..20 {
+            let t = next_token(&logits, None, &mut hot).unwrap();
+            assert!((0..4).contains(&t.0), "{t:?}");
+        }
+    }
+}
