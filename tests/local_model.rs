@@ -116,20 +116,25 @@ async fn resolves_scenario_1_with_a_condition_that_fixes_it_in_simulation() {
     assert_eq!(report.end, betr::planner::RunEnd::Success);
 }
 
+/// The goal prompt for `instruction` in scenario `s`'s world as it starts.
+fn goal_prompt(s: &betr::scenario::Scenario, instruction: &str) -> Vec<betr::llm::Message> {
+    let facts = world::load(s).unwrap().facts();
+    let variant = Variant::default();
+    let ctx = Context {
+        scenario: s,
+        facts: &facts,
+        instruction,
+        variant: &variant,
+    };
+    ctx.goal(&Templates::builtin()).unwrap()
+}
+
 #[tokio::test]
 async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
     // Ask for a banana in a scene that has none, several times with sampling on: every
     // reply must still parse and use only the scene's objects, with no substitution.
     let s = scenario("scenarios/cell/red_on_blue.toml");
-    let facts = world::load(&s).unwrap().facts();
-    let variant = Variant::default();
-    let ctx = Context {
-        scenario: &s,
-        facts: &facts,
-        instruction: "Put the banana on the pineapple",
-        variant: &variant,
-    };
-    let messages = ctx.goal(&Templates::builtin()).unwrap();
+    let messages = goal_prompt(&s, "Put the banana on the pineapple");
     let vocabulary = &s.domain.vocabulary;
     for seed in 0..4 {
         let mut request = ChatRequest::new(messages.clone());
@@ -175,15 +180,7 @@ async fn a_greedy_reply_follows_a_grammar_that_refuses_the_models_own_first_choi
     // The model would answer "blue cube" on "green cube"; a grammar that allows only
     // another goal must still be followed token by token, ending where the grammar ends.
     let s = scenario("scenarios/cell/red_on_blue.toml");
-    let facts = world::load(&s).unwrap().facts();
-    let variant = Variant::default();
-    let ctx = Context {
-        scenario: &s,
-        facts: &facts,
-        instruction: s.instruction.as_deref().unwrap(),
-        variant: &variant,
-    };
-    let mut request = ChatRequest::new(ctx.goal(&Templates::builtin()).unwrap());
+    let mut request = ChatRequest::new(goal_prompt(&s, s.instruction.as_deref().unwrap()));
     request.temperature = 0.0;
     request.max_tokens = 40;
     request.constraint = Some(OutputConstraint::Grammar {
