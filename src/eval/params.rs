@@ -35,7 +35,7 @@ pub const PARAM_SCENARIOS: [(&str, &str); 7] = [
 
 /// The parameter scenarios under `dir` (paths relative to it): those of
 /// [`PARAM_SCENARIOS`] that `dir/cell/params/` holds, in that order, then every other
-/// `*.toml` there by name, so a directory of other parameter scenarios (such as requests
+/// `*.toml` there by name, so a directory of other parameter scenarios (such as those
 /// held out from choosing a method) runs the same way. Empty when there are none.
 pub fn param_scenarios(dir: &Path) -> std::io::Result<Vec<String>> {
     let folder = dir.join("cell/params");
