@@ -224,9 +224,17 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
             .iter()
             .filter(|c| c.feedback_rounds > 0)
             .count();
+        // The latency columns are per call; a person waits for all of an instruction's.
+        let per_instruction: Vec<f64> = results
+            .cases
+            .iter()
+            .map(|c| c.calls.iter().map(|call| call.latency_ms).sum::<f64>() / 1000.0)
+            .collect();
         notes.push(format!(
-            "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, plannable, no more alternatives than the request offers, not true already, nothing pasted from an example or asked by no word), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback.",
-            calls as f64 / cases
+            "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, plannable, no more alternatives than the request offers, not true already, nothing pasted from an example or asked by no word), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback. Time per instruction, all its calls: median {:.2} s, p95 {:.2} s.",
+            calls as f64 / cases,
+            super::run::percentile(&per_instruction, 50.0),
+            super::run::percentile(&per_instruction, 95.0),
         ));
     }
     if let Some(u) = &results.usage {

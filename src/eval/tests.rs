@@ -137,3 +137,56 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
     }
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+#[test]
+fn the_goals_table_gives_the_time_a_person_waits_per_instruction() {
+    use super::goals::{CaseResult, GoalsResults, Tally};
+    let call = |ms: f64| CallRecord {
+        prompt_tokens: 100,
+        completion_tokens: 5,
+        latency_ms: ms,
+        price_usd: None,
+        source: "model".into(),
+    };
+    let case = |index: usize, calls: Vec<CallRecord>| CaseResult {
+        run: 1,
+        difficulty: "easy".into(),
+        index,
+        instruction: format!("request {index}"),
+        gold: "Exists_Coffee".into(),
+        answer: Some("Exists_Coffee".into()),
+        correct: true,
+        problem: None,
+        reply: None,
+        calls,
+        first_answer: Some("Exists_Coffee".into()),
+        first_correct: Some(true),
+        feedback_rounds: 0,
+    };
+    // Three instructions: one call of 4 s, two calls of 1 + 2 s, three calls of 2 s each.
+    let cases = vec![
+        case(0, vec![call(4000.0)]),
+        case(1, vec![call(1000.0), call(2000.0)]),
+        case(2, vec![call(2000.0), call(2000.0), call(2000.0)]),
+    ];
+    let results = GoalsResults {
+        easy: Tally {
+            correct: 3,
+            total: 3,
+        },
+        medium: Tally::default(),
+        hard: Tally::default(),
+        runs: Vec::new(),
+        usage: Some(super::run::UsageSummary::of(
+            cases.iter().flat_map(|c| &c.calls),
+        )),
+        cases,
+    };
+    let table = super::goals_run::table(&results, "fake", 0.0, 3);
+    // Per call the median is 2 s; per instruction (4, 3 and 6 s) it is 4 s, the p95 6 s.
+    assert!(
+        table.contains("Time per instruction, all its calls: median 4.00 s, p95 6.00 s."),
+        "{table}"
+    );
+    assert!(table.contains("| 2.00 s |"), "{table}");
+}

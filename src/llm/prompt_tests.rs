@@ -195,3 +195,49 @@ fn value_prompt_is_about_the_object_and_the_task() {
     assert!(!text.contains("ml/s"), "{text}");
     assert!(text.contains("one of: shovel, spoon"), "{text}");
 }
+
+#[test]
+fn everything_before_the_examples_is_the_same_for_every_request() {
+    // The embedded model keeps the longest common beginning of the prompts it was sent in
+    // its cache: everything the same for every request of a scene comes first.
+    let s = scenario();
+    let facts = vec![Condition::parse("Holding_Nothing").unwrap()];
+    let variant = Variant::default();
+    let prompt = |instruction: &str| {
+        Context {
+            scenario: &s,
+            facts: &facts,
+            instruction,
+            variant: &variant,
+        }
+        .goal(&Templates::builtin())
+        .unwrap()[1]
+            .content
+            .clone()
+    };
+    let a = prompt("Bring coffee to table six");
+    let b = prompt("Turn on the air conditioning");
+    let common = a
+        .char_indices()
+        .zip(b.chars())
+        .find(|((_, x), y)| x != y)
+        .map_or(a.len(), |((i, _), _)| i);
+    let (shared, rest) = a.split_at(common);
+    for part in [
+        "## Objects in this scene",
+        "## The scene now",
+        "## Examples",
+    ] {
+        assert!(
+            shared.contains(part),
+            "{part:?} is not before the examples in\n{a}"
+        );
+    }
+    assert!(rest.contains("Bring coffee to table six"));
+    let headings: Vec<&str> = rest.lines().filter(|l| l.starts_with("## ")).collect();
+    assert_eq!(
+        headings,
+        ["## Request", "## Answer format"],
+        "after the examples:\n{rest}"
+    );
+}
