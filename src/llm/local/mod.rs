@@ -72,6 +72,14 @@ impl LanguageModel for LocalModel {
                 .generate(generation)
                 .await
                 .map_err(|e| LlmError::Local(e.to_string()))?;
+            tracing::debug!(
+                prompt_tokens = out.prompt_tokens,
+                cached_tokens = out.cached_tokens,
+                completion_tokens = out.completion_tokens,
+                prompt_ms = out.prompt_time.as_millis(),
+                generation_ms = out.generation_time.as_millis(),
+                "local model answered"
+            );
             Ok(ChatReply {
                 text: out.text,
                 model: self.name.clone(),
