@@ -16,7 +16,7 @@ use crate::world::World;
 
 use super::EvalError;
 use super::goals::{CaseResult, GoalsResults, Tally, is_correct, score};
-use super::run::{Journal, RunConfig, Tap, UsageSummary, drive};
+use super::run::{Journal, RunConfig, Tap, UsageSummary, drive, percentile};
 
 /// Ask for every case of every run that `dir`'s journal does not hold yet, score each as
 /// it comes back, and return the results over all recorded cases of runs 1..=runs.
@@ -233,8 +233,8 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
         notes.push(format!(
             "\"First call only\" scores each instruction's first answer as it came; the row below it is the answer after the checks (parses, not contradictory, plannable, no more alternatives than the request offers, not true already, nothing pasted from an example or asked by no word), the vote among candidates and feedback. Calls per instruction: {:.2}; {fed_back} instruction(s) needed feedback. Time per instruction, all its calls: median {:.2} s, p95 {:.2} s.",
             calls as f64 / cases,
-            super::run::percentile(&per_instruction, 50.0),
-            super::run::percentile(&per_instruction, 95.0),
+            percentile(&per_instruction, 50.0),
+            percentile(&per_instruction, 95.0),
         ));
     }
     if let Some(u) = &results.usage {
