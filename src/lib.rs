@@ -22,6 +22,7 @@ pub mod interop;
 pub mod llm;
 pub mod model;
 pub mod planner;
+pub mod reading;
 pub mod record;
 pub mod scenario;
 pub mod session;

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use betr::dataset;
 use betr::goal::Formula;
-use betr::llm::examples::terms;
+use betr::reading::words::terms;
 
 use support::repo::scenario;
 

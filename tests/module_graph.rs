@@ -146,6 +146,28 @@ fn the_command_line_reaches_planner_and_world_through_the_session() {
 }
 
 #[test]
+fn reading_knows_no_model_session_planner_or_world() {
+    let graph = dependencies(&src());
+    let reading = &graph["reading"];
+    assert!(
+        reading.contains("domain"),
+        "the reader misses imports: {reading:?}"
+    );
+    for forbidden in ["llm", "session", "planner", "world"] {
+        assert!(
+            !reading.contains(forbidden),
+            "src/reading imports {forbidden}: {reading:?}"
+        );
+    }
+    // The model's side asks reading how requests are read, never the other way round.
+    assert!(
+        graph["session"].contains("reading"),
+        "the session does not read requests through reading: {:?}",
+        graph["session"]
+    );
+}
+
+#[test]
 fn library_code_returns_typed_errors() {
     let src = src();
     let mut found = Vec::new();

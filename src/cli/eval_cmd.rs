@@ -37,6 +37,12 @@ pub enum EvalExperiment {
         /// Repetitions; run k sends seed k.
         #[arg(long, default_value_t = 1)]
         runs: usize,
+        /// Run every set of requests a suite file names (docs/eval-suite.toml: the cafe
+        /// dataset, held-out cafe requests, the cell's scenarios and the greenhouse's
+        /// held-out requests), each into a folder of its own, and print them side by side;
+        /// --dataset and --scenario are not used.
+        #[arg(long, value_name = "FILE")]
+        suite: Option<PathBuf>,
         #[command(flatten)]
         run: RunFlags,
     },
@@ -117,11 +123,19 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
             ..
         } => goals_from_answers(&dataset, &answers, &scenario, run.out.as_deref()),
         EvalExperiment::Goals {
+            answers: None,
+            suite: Some(suite),
+            runs,
+            run,
+            ..
+        } => goals_suite(&suite, runs, &run),
+        EvalExperiment::Goals {
             dataset,
             answers: None,
             scenario,
             runs,
             run,
+            suite: None,
         } => goals_with_model(&dataset, &scenario, runs, &run),
         EvalExperiment::Resolve {
             runs,
@@ -263,6 +277,78 @@ pub fn goals_with_model(
     write_all(&dir, &results, &results.csv(), &table, || {
         goals_chart(&dir, &p.label, &results)
     })?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `betr eval goals --suite FILE`: every set of the suite, each into `OUT/<set>/` (resumed
+/// like a single run), then the sets side by side in `OUT/suite.md`.
+fn goals_suite(suite: &Path, runs: usize, flags: &RunFlags) -> Result<ExitCode> {
+    let sets = eval::suite::load(suite)?;
+    let p = prepare(flags, &[("suite", suite.display().to_string())])?;
+    let dir = eval::output_dir(flags.out.as_deref(), "goals-suite")
+        .context("creating the output directory")?;
+    p.llm.model.set_purpose("eval goals");
+    let model: Arc<dyn LanguageModel> = p.llm.model.clone();
+    let mut done: Vec<(String, bool, goals::GoalsResults)> = Vec::new();
+    for set in &sets {
+        let set_dir = dir.join(&set.name);
+        std::fs::create_dir_all(&set_dir)
+            .with_context(|| format!("creating {}", set_dir.display()))?;
+        eval::run::check_settings(&set_dir, "goals", &p.settings)?;
+        eprintln!("{}: {} request(s)", set.name, set.cases.len());
+        let bar = Bar::new();
+        let cfg = RunConfig {
+            runs: runs.max(1),
+            concurrency: p.concurrency,
+            limit: flags.limit,
+            prices: p.llm.settings.prices.clone(),
+            progress: &bar,
+        };
+        let cases: Vec<goals_run::SceneCase> = set
+            .cases
+            .iter()
+            .map(|(scene, case)| goals_run::SceneCase {
+                scenario: &set.scenes[*scene],
+                case: case.clone(),
+            })
+            .collect();
+        let results = super::runtime()?
+            .block_on(goals_run::run_goals_in_scenes(
+                &model,
+                &cases,
+                &p.llm.options,
+                &cfg,
+                &set_dir,
+            ))
+            .with_context(|| stopped(&dir))?;
+        let table = goals_run::table(
+            &results,
+            &p.label,
+            p.llm.options.temperature,
+            cfg.runs * cases.len(),
+        );
+        write_all(&set_dir, &results, &results.csv(), &table, || {
+            goals_chart(&set_dir, &p.label, &results)
+        })?;
+        done.push((set.name.clone(), set.tuned, results));
+    }
+    let rows: Vec<eval::suite::SetRow> = done
+        .iter()
+        .map(|(name, tuned, results)| eval::suite::SetRow {
+            name,
+            tuned: *tuned,
+            results,
+        })
+        .collect();
+    let table = format!(
+        "Goal interpretation, {}\n\n{}",
+        p.label,
+        eval::suite::table(&rows)
+    );
+    write_atomic(&dir.join("suite.md"), table.as_bytes())
+        .with_context(|| format!("writing {}", dir.join("suite.md").display()))?;
+    println!("{table}");
+    println!("results in {}", dir.display());
     Ok(ExitCode::SUCCESS)
 }
 

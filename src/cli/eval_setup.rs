@@ -54,6 +54,11 @@ pub struct RunFlags {
     /// Stop after this many newly finished cases (for testing interruption).
     #[arg(long, hide = true)]
     pub limit: Option<usize>,
+    /// Leave out a detector of plain misreadings when goals are judged, to measure what it
+    /// earns (repeatable; the names are listed in docs/ARCHITECTURE.md and in the error
+    /// for an unknown one).
+    #[arg(long, value_name = "NAME")]
+    pub without_misreading: Vec<String>,
     #[command(flatten)]
     pub llm: LlmFlags,
 }
@@ -120,7 +125,9 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
             }
         }
     }
-    let llm = llm_cmds::setup(&llm_flags)?;
+    let mut llm = llm_cmds::setup(&llm_flags)?;
+    betr::reading::misreadings_without(&flags.without_misreading)?;
+    llm.options.without_misreadings = flags.without_misreading.clone();
     let backend = format!("{:?}", llm.settings.backend).to_lowercase();
     let model = llm.model.model().to_string();
     let mut settings: BTreeMap<String, String> = BTreeMap::new();
@@ -151,6 +158,12 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     settings.insert("read_by_parts".into(), options.read_by_parts.to_string());
     settings.insert("value_levels".into(), options.value_levels.to_string());
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
+    if !options.without_misreadings.is_empty() {
+        settings.insert(
+            "without_misreadings".into(),
+            options.without_misreadings.join(" "),
+        );
+    }
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     for (k, v) in [
         ("examples", optional(&llm_flags.examples)),

@@ -44,6 +44,12 @@ pub struct CaseResult {
     /// Feedback rounds the answer needed.
     #[serde(default)]
     pub feedback_rounds: usize,
+    /// The readings offered (the answer first), when the answer came from a model.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub readings: Vec<String>,
+    /// Whether the gold goal is among the readings offered.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gold_in_readings: Option<bool>,
 }
 
 fn first_run() -> usize {
@@ -134,6 +140,8 @@ pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> Case
         calls: Vec::new(),
         first_answer: None,
         first_correct: None,
+        readings: Vec::new(),
+        gold_in_readings: None,
         feedback_rounds: 0,
     }
 }
@@ -231,7 +239,17 @@ impl GoalsResults {
 
     /// The first calls' tallies (easy, medium, hard), when the cases recorded them.
     pub fn first_call(&self) -> Option<[Tally; 3]> {
-        if self.cases.iter().all(|c| c.first_correct.is_none()) {
+        self.tally_by(|c| c.first_correct)
+    }
+
+    /// Per difficulty, the cases whose gold goal is among the readings offered; `None`
+    /// when no case recorded its readings.
+    pub fn gold_in_readings(&self) -> Option<[Tally; 3]> {
+        self.tally_by(|c| c.gold_in_readings)
+    }
+
+    fn tally_by(&self, verdict: impl Fn(&CaseResult) -> Option<bool>) -> Option<[Tally; 3]> {
+        if self.cases.iter().all(|c| verdict(c).is_none()) {
             return None;
         }
         Some(Difficulty::ALL.map(|d| {
@@ -241,7 +259,7 @@ impl GoalsResults {
                 .filter(|c| c.difficulty == d.as_str())
                 .collect();
             Tally {
-                correct: of.iter().filter(|c| c.first_correct == Some(true)).count(),
+                correct: of.iter().filter(|c| verdict(c) == Some(true)).count(),
                 total: of.len(),
             }
         }))

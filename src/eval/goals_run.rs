@@ -20,8 +20,7 @@ use super::run::{Journal, RunConfig, Tap, UsageSummary, drive, percentile};
 
 /// Ask for every case of every run that `dir`'s journal does not hold yet, score each as
 /// it comes back, and return the results over all recorded cases of runs 1..=runs.
-/// `world`: the scene the instructions are given in (candidates are planned in copies).
-#[allow(clippy::too_many_arguments)]
+/// `scenario`: the scene every instruction is given in (candidates are planned in copies).
 pub async fn run_goals(
     model: &Arc<dyn LanguageModel>,
     scenario: &Scenario,
@@ -30,8 +29,31 @@ pub async fn run_goals(
     cfg: &RunConfig<'_>,
     dir: &Path,
 ) -> Result<GoalsResults, EvalError> {
-    // Each instruction is read against the scenario's first state.
-    let world = crate::world::load(scenario)?;
+    let in_scene: Vec<SceneCase> = cases
+        .iter()
+        .map(|case| SceneCase {
+            scenario,
+            case: case.clone(),
+        })
+        .collect();
+    run_goals_in_scenes(model, &in_scene, options, cfg, dir).await
+}
+
+/// A case and the scene its instruction is given in.
+pub struct SceneCase<'a> {
+    pub scenario: &'a Scenario,
+    pub case: Case,
+}
+
+/// [`run_goals`] with each case in its own scene (a domain's scenario files, each with
+/// its instruction and goal).
+pub async fn run_goals_in_scenes(
+    model: &Arc<dyn LanguageModel>,
+    cases: &[SceneCase<'_>],
+    options: &Options,
+    cfg: &RunConfig<'_>,
+    dir: &Path,
+) -> Result<GoalsResults, EvalError> {
     let journal = Journal::new(dir);
     let recorded: Vec<CaseResult> = journal.read()?;
     let key = |run: usize, difficulty: &str, index: usize| format!("{run}/{difficulty}/{index}");
@@ -39,9 +61,9 @@ pub async fn run_goals(
         .iter()
         .map(|c| key(c.run, &c.difficulty, c.index))
         .collect();
-    let jobs: Vec<(usize, &Case)> = (1..=cfg.runs)
+    let jobs: Vec<(usize, &SceneCase)> = (1..=cfg.runs)
         .flat_map(|run| cases.iter().map(move |c| (run, c)))
-        .filter(|(run, c)| !have.contains(&key(*run, c.difficulty.as_str(), c.index)))
+        .filter(|(run, c)| !have.contains(&key(*run, c.case.difficulty.as_str(), c.case.index)))
         .collect();
     let done = cfg.runs * cases.len() - jobs.len();
     // Names are never corrected: the dataset rule scores what the model wrote.
@@ -55,10 +77,18 @@ pub async fn run_goals(
         cfg,
         &journal,
         |c: &CaseResult| format!("run {} {} #{}", c.run, c.difficulty, c.index + 1),
-        |(run, case)| ask_one(model, scenario, world.fork(), case, run, &options, cfg),
+        |(run, c)| {
+            let options = &options;
+            async move {
+                // Each instruction is read against its scenario's first state.
+                let world = crate::world::load(c.scenario)?;
+                ask_one(model, c.scenario, world, &c.case, run, options, cfg).await
+            }
+        },
     )
     .await?;
-    Ok(collect(journal.read()?, cases, cfg.runs))
+    let plain: Vec<Case> = cases.iter().map(|c| c.case.clone()).collect();
+    Ok(collect(journal.read()?, &plain, cfg.runs))
 }
 
 async fn ask_one(
@@ -87,6 +117,13 @@ async fn ask_one(
             result.first_correct = Some(is_correct(vocabulary, case, first.as_deref()));
             result.first_answer = first;
             result.feedback_rounds = r.feedback_rounds;
+            result.readings = r.readings.iter().map(ToString::to_string).collect();
+            result.gold_in_readings = Some(
+                result
+                    .readings
+                    .iter()
+                    .any(|g| is_correct(vocabulary, case, Some(g))),
+            );
             if let Some(why) = r.doubt {
                 result.problem = Some(format!("kept with a doubt: {why}"));
             }
@@ -156,13 +193,22 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
     let mut out = String::from(
         "| system | easy | medium | hard | overall | calls | prompt tokens | completion tokens | cost | latency median | latency p95 |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    if let Some([easy, medium, hard]) = results.first_call() {
+    for (what, tallies) in [
+        ("first call only", results.first_call()),
+        (
+            "gold among the readings offered",
+            results.gold_in_readings(),
+        ),
+    ] {
+        let Some([easy, medium, hard]) = tallies else {
+            continue;
+        };
         let overall = Tally {
             correct: easy.correct + medium.correct + hard.correct,
             total: easy.total + medium.total + hard.total,
         };
         out.push_str(&format!(
-            "| {system}, first call only | {} | {} | {} | {} | {} | | | | | |\n",
+            "| {system}, {what} | {} | {} | {} | {} | {} | | | | | |\n",
             cell(&easy),
             cell(&medium),
             cell(&hard),

@@ -10,6 +10,7 @@ pub mod resolve;
 pub mod run;
 pub mod sequence;
 mod session_run;
+pub mod suite;
 #[cfg(test)]
 mod tests;
 

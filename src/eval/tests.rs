@@ -162,6 +162,8 @@ fn the_goals_table_gives_the_time_a_person_waits_per_instruction() {
         first_answer: Some("Exists_Coffee".into()),
         first_correct: Some(true),
         feedback_rounds: 0,
+        readings: Vec::new(),
+        gold_in_readings: None,
     };
     // Three instructions: one call of 4 s, two calls of 1 + 2 s, three calls of 2 s each.
     let cases = vec![

@@ -20,6 +20,7 @@ mod equiv;
 mod formula;
 mod parse;
 mod qm;
+pub mod rewrite;
 mod truth;
 
 pub use dnf::{Dnf, EXACT_ATOM_LIMIT};

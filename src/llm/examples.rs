@@ -10,101 +10,12 @@
 
 use std::collections::HashMap;
 
+use crate::reading::words::terms;
 use crate::scenario::Example;
 
 /// BM25's usual constants: term-frequency saturation and length normalisation.
 const K1: f64 = 1.2;
 const B: f64 = 0.75;
-
-/// Words that say nothing about what is asked.
-const STOPWORDS: &[&str] = &[
-    "a", "an", "the", "to", "of", "and", "or", "in", "on", "at", "for", "me", "my", "i", "im",
-    "you", "your", "please", "could", "would", "can", "will", "it", "is", "be", "some", "that",
-    "this", "with", "by", "up", "we", "us", "our", "just", "so", "do", "id", "like", "want",
-    "there", "here", "its", "am", "are", "was", "get", "let", "mind", "any", "object",
-];
-
-/// The words of `text` a match is made on: lower case, split at anything that is not a
-/// letter or digit, at lower-to-upper case changes and where an acronym ends, stop words
-/// dropped, crude plural and verb endings removed.
-pub fn terms(text: &str) -> Vec<String> {
-    every_term(text)
-        .into_iter()
-        .filter(|w| !STOPWORDS.contains(&w.as_str()))
-        .collect()
-}
-
-/// [`terms`] with the stop words kept: "on", "up" and "so" matter where a request's
-/// small words are read ("turn the light on").
-pub fn every_term(text: &str) -> Vec<String> {
-    let mut words = Vec::new();
-    let mut current = String::new();
-    let mut previous: Option<char> = None;
-    let mut chars = text.chars().peekable();
-    while let Some(c) = chars.next() {
-        let next = chars.peek().copied();
-        // A word ends at anything else than a letter or digit, at a lower-to-upper case
-        // change (`TubeLight`), where an acronym gives way to a word (`ACTemperature`,
-        // `NFCJuice`) and between letters and digits (`Table3`).
-        let boundary = !c.is_alphanumeric()
-            || previous.is_some_and(|p| {
-                (c.is_uppercase() && (p.is_lowercase() || p.is_ascii_digit()))
-                    || (c.is_uppercase()
-                        && p.is_uppercase()
-                        && next.is_some_and(char::is_lowercase))
-                    || (c.is_ascii_digit() != p.is_ascii_digit() && p.is_alphanumeric())
-            });
-        if boundary && !current.is_empty() {
-            words.push(std::mem::take(&mut current));
-        }
-        if c.is_alphanumeric() {
-            current.extend(c.to_lowercase());
-            previous = Some(c);
-        } else {
-            previous = None;
-        }
-    }
-    if !current.is_empty() {
-        words.push(current);
-    }
-    words
-        .into_iter()
-        .map(|w| number(&w).map_or_else(|| stem(&w), str::to_string))
-        .collect()
-}
-
-/// Numbers written as words, cardinal or ordinal, as digits ("table three", "the third
-/// table" and `Table3` share the word 3).
-fn number(word: &str) -> Option<&'static str> {
-    const NUMBERS: [(&str, &str, &str); 10] = [
-        ("one", "first", "1"),
-        ("two", "second", "2"),
-        ("three", "third", "3"),
-        ("four", "fourth", "4"),
-        ("five", "fifth", "5"),
-        ("six", "sixth", "6"),
-        ("seven", "seventh", "7"),
-        ("eight", "eighth", "8"),
-        ("nine", "ninth", "9"),
-        ("ten", "tenth", "10"),
-    ];
-    NUMBERS
-        .iter()
-        .find(|(cardinal, ordinal, _)| word == *cardinal || word == *ordinal)
-        .map(|(_, _, digit)| *digit)
-}
-
-fn stem(word: &str) -> String {
-    for suffix in ["ing", "ed", "s"] {
-        if let Some(root) = word.strip_suffix(suffix)
-            && root.chars().count() >= 3
-            && !root.ends_with('s')
-        {
-            return root.to_string();
-        }
-    }
-    word.to_string()
-}
 
 /// The `k` examples most like `request`, least similar first (so the closest sits
 /// right before the request). Ties keep pool order; an example whose goal equals one
@@ -180,27 +91,6 @@ mod tests {
             instruction: instruction.into(),
             goal: goal.into(),
         }
-    }
-
-    #[test]
-    fn terms_split_words_and_atoms() {
-        assert_eq!(terms("Active_TubeLight"), ["active", "tube", "light"]);
-        assert_eq!(
-            terms("Could you switch on the lights, please?"),
-            ["switch", "light"]
-        );
-        assert_eq!(
-            terms("\"blue cube\" on \"table\""),
-            ["blue", "cube", "table"]
-        );
-        assert_eq!(terms("WindowTable4"), ["window", "table", "4"]);
-        assert_eq!(terms("Low_ACTemperature"), ["low", "ac", "temperature"]);
-        assert_eq!(terms("NFCJuice"), ["nfc", "juice"]);
-        assert_eq!(terms("the third table"), ["3", "table"]);
-        assert_eq!(
-            terms("QuietTable9, table nine"),
-            ["quiet", "table", "9", "table", "9"]
-        );
     }
 
     #[test]

@@ -11,13 +11,11 @@ pub mod cassette;
 pub mod config;
 pub mod examples;
 pub mod grammar;
-pub mod lexicon;
 pub mod local;
 pub mod openai;
 pub mod printable;
 pub mod prompt;
 pub mod reply;
-pub mod request_parts;
 pub mod schema;
 pub mod usage;
 

@@ -14,7 +14,8 @@ use crate::domain::Vocabulary;
 use crate::goal::Formula;
 use crate::scenario::Example;
 
-use super::examples::terms;
+use super::english::is_generic;
+use super::words::{is_number, same_word, terms};
 
 /// How many examples must use a word with an object before it is taken as the object's
 /// word: one example's "sitting" is not a soft drink's word because the example asked a
@@ -25,14 +26,6 @@ const MIN_TOGETHER: usize = 2;
 /// A word of the pool becomes a symbol's word when at least this share of the examples
 /// that use the word use the symbol too.
 const MIN_SHARE: f64 = 0.5;
-
-/// Whether `word` is written in digits (numbers written as words are digits in [`terms`]).
-pub fn is_number(word: &str) -> bool {
-    !word.is_empty() && word.chars().all(|c| c.is_ascii_digit())
-}
-
-/// Words that never name a symbol: an instruction's "is" or "robot" asks for nothing.
-const GENERIC: &[&str] = &["is", "robot", "nothing", "object", "any"];
 
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Lexicon {
@@ -56,17 +49,14 @@ impl Lexicon {
             .map(|p| p.name.as_str())
             .chain(vocabulary.objects.iter().map(|o| o.name.as_str()));
         for name in names {
-            let own: Vec<String> = terms(name)
-                .into_iter()
-                .filter(|t| !GENERIC.contains(&t.as_str()))
-                .collect();
+            let own: Vec<String> = terms(name).into_iter().filter(|t| !is_generic(t)).collect();
             words.insert(name.to_string(), own);
         }
         // What an object is called is its own too ("fries" is `Chips`'s word).
         for object in &vocabulary.objects {
             let list = words.entry(object.name.clone()).or_default();
             for word in object.called.iter().flat_map(|c| terms(c)) {
-                if !GENERIC.contains(&word.as_str()) && !list.contains(&word) {
+                if !is_generic(&word) && !list.contains(&word) {
                     list.push(word);
                 }
             }
@@ -77,7 +67,7 @@ impl Lexicon {
             let list = words.entry(predicate.name.clone()).or_default();
             let said = predicate.words.says.iter().chain(&predicate.words.opposite);
             for word in said.flat_map(|c| terms(c)) {
-                if !GENERIC.contains(&word.as_str()) && !list.contains(&word) {
+                if !is_generic(&word) && !list.contains(&word) {
                     list.push(word);
                 }
             }
@@ -135,7 +125,7 @@ impl Lexicon {
                 && !names_other
                 && (*n >= MIN_TOGETHER || !objects.contains(&symbol.as_str()))
                 && *n as f64 / total as f64 >= MIN_SHARE
-                && !GENERIC.contains(&word.as_str())
+                && !is_generic(word)
             {
                 let list = words.entry(symbol.clone()).or_default();
                 if !list.contains(word) {
@@ -150,7 +140,7 @@ impl Lexicon {
                 std::iter::once(o.name.as_str()).chain(o.called.iter().map(String::as_str))
             })
             .map(terms)
-            .filter(|t| t.len() == 1 && !GENERIC.contains(&t[0].as_str()))
+            .filter(|t| t.len() == 1 && !is_generic(&t[0]))
             .map(|mut t| t.remove(0))
             .collect();
         whole_names.sort_unstable();
@@ -266,29 +256,6 @@ pub fn in_request_order(lexicon: &Lexicon, goal: &Formula, request: &[String]) -
         }
     }
 }
-
-/// Two words that are one after crude stemming ("close" and "closed" → "clos"), or
-/// spellings of one longer word.
-pub fn same_word(a: &str, b: &str) -> bool {
-    let shorter = a.len().min(b.len());
-    let k = shorter.min(5);
-    let longer = a.len().max(b.len());
-    a == b
-        || (shorter >= 4
-            && longer - shorter <= ENDING_AT_MOST
-            && a.get(..k).is_some()
-            && a.get(..k) == b.get(..k))
-        // Spelling variants of longer words ("yoghurt", "yogurt"); short words one letter
-        // apart are different words ("water", "waiter").
-        || (shorter >= SPELLING_VARIANT_FROM && strsim::levenshtein(a, b) <= 1)
-}
-
-/// How much longer one word may be than another with the same beginning and still be
-/// the same word with an ending ("clean", "cleaning"): "water" is not "watermelon".
-const ENDING_AT_MOST: usize = 4;
-
-/// How long both words must be before one letter more, less or other is a spelling variant.
-const SPELLING_VARIANT_FROM: usize = 6;
 
 #[cfg(test)]
 mod tests {

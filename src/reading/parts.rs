@@ -13,15 +13,13 @@
 //! before ("If not, ...", "Or ...", "Alternatively, ..."); "and" joins groups of
 //! alternatives, as it does in speech ("A. Or B. Also C" is (A or B) and C).
 
-use super::examples::terms;
+pub use super::english::Join;
+use super::english::{
+    BACK_REFERENCES, CONJUNCTIONS, asks, is_negated_form, is_negation, may_precede_verb,
+    wish_openers,
+};
 use super::lexicon::Lexicon;
-
-/// How a part is joined to the part before it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Join {
-    And,
-    Or,
-}
+use super::words::terms;
 
 /// One wish of a request, as the person wrote it, without the connective that joined it.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -30,114 +28,6 @@ pub struct Part {
     /// How it joins the part before it (`And` for the first).
     pub join: Join,
 }
-
-/// Words after a comma that begin a new wish in the same sentence, with how they join it.
-/// "and" and "or" alone do not: "water and chips to table 6" is one wish about two things.
-const OPENERS: &[(&str, Join)] = &[
-    ("and also", Join::And),
-    ("also", Join::And),
-    ("and then", Join::And),
-    ("then", Join::And),
-    ("and after that", Join::And),
-    ("or alternatively", Join::Or),
-    ("or at least", Join::Or),
-    ("alternatively", Join::Or),
-    ("or otherwise", Join::Or),
-    ("otherwise", Join::Or),
-    ("or else", Join::Or),
-    ("or if not", Join::Or),
-    ("if not", Join::Or),
-    ("failing that", Join::Or),
-    ("if you can't", Join::Or),
-    ("if you cannot", Join::Or),
-    ("if that's not possible", Join::Or),
-    ("if that is not possible", Join::Or),
-];
-
-/// Words that join two wishes inside a clause when a verb of asking follows them, with how
-/// they join.
-const JOINING: &[(&str, Join)] = &[("and", Join::And), ("but", Join::And), ("or", Join::Or)];
-
-/// Words that begin a wish of their own after a joining word: the verbs requests ask with
-/// and the ways of asking ("could you ...", "make sure ...").
-const ASKING: &[&str] = &[
-    "bring",
-    "deliver",
-    "serve",
-    "take",
-    "put",
-    "place",
-    "fetch",
-    "carry",
-    "give",
-    "send",
-    "make",
-    "prepare",
-    "brew",
-    "turn",
-    "switch",
-    "open",
-    "close",
-    "shut",
-    "clean",
-    "sweep",
-    "wipe",
-    "mop",
-    "tidy",
-    "clear",
-    "wash",
-    "go",
-    "come",
-    "move",
-    "head",
-    "keep",
-    "leave",
-    "hold",
-    "grab",
-    "pick",
-    "set",
-    "draw",
-    "activate",
-    "deactivate",
-    "ensure",
-    "check",
-    "avoid",
-    "stay",
-    "wait",
-    "join",
-    "hand",
-    "remove",
-    "lower",
-    "raise",
-    "increase",
-    "decrease",
-    "could",
-    "can",
-    "would",
-    "will",
-    "please",
-    "do",
-    "don't",
-    "dont",
-    "don’t",
-    "try",
-];
-
-/// Words that may stand between a joining word and the verb ("or maybe bring").
-const BETWEEN: &[&str] = &["either", "also", "then", "just", "maybe", "perhaps"];
-
-/// Words before an "or" that make it "neither ... nor" ("don't bring coffee or serve
-/// dessert" asks for neither), so that it joins no alternatives.
-const NEGATING: &[&str] = &[
-    "not", "don't", "dont", "don’t", "never", "no", "avoid", "without",
-];
-
-/// Words by which a wish refers to the thing of the wish before it.
-const BACK_REFERENCES: &[&str] = &["it", "them", "it's", "its", "they", "those", "these"];
-
-/// Words that may begin a sentence and say how it joins the one before; a sentence that
-/// begins with any of [`OPENERS`] joins as they say, one beginning "Or" as an alternative.
-const SENTENCE_OPENERS: &[(&str, Join)] = &[("or", Join::Or), ("and", Join::And)];
 
 /// The parts of `request`, in order: one part when it is a single wish (or names no
 /// object at all).
@@ -249,7 +139,7 @@ fn sentences(text: &str) -> Vec<&str> {
     out
 }
 
-/// A sentence cut before each comma-led opener of [`OPENERS`], and before each joining
+/// A sentence cut before each comma-led opener ([`wish_openers`]), and before each joining
 /// word followed by a verb of asking; a clause cut at a joining word begins with it and
 /// comes with how it joins and the word's length, one cut at an opener keeps the opener
 /// for [`opening`] to read.
@@ -284,17 +174,18 @@ fn verb_join(clause: &str) -> Option<(usize, usize, Join)> {
     let words = word_spans(clause);
     let lower = |k: usize| clause[words[k].0..words[k].1].to_lowercase();
     for k in 1..words.len() {
-        let Some((_, how)) = JOINING.iter().find(|(w, _)| *w == lower(k)) else {
+        let Some((_, how)) = CONJUNCTIONS.iter().find(|(w, _)| *w == lower(k)) else {
             continue;
         };
         let mut next = k + 1;
-        while next < words.len() && BETWEEN.contains(&lower(next).as_str()) {
+        while next < words.len() && may_precede_verb(&lower(next)) {
             next += 1;
         }
-        if next >= words.len() || !ASKING.contains(&lower(next).as_str()) {
+        if next >= words.len() || !asks(&lower(next)) {
             continue;
         }
-        if *how == Join::Or && (0..k).any(|i| NEGATING.contains(&lower(i).as_str())) {
+        if *how == Join::Or && (0..k).any(|i| is_negation(&lower(i)) || is_negated_form(&lower(i)))
+        {
             continue;
         }
         // "make a dessert and bring it to table 3": the wish after is about the one before.
@@ -332,11 +223,10 @@ fn opener(text: &str) -> Option<(Join, usize)> {
     let lower = text.to_lowercase();
     let trimmed = lower.trim_start();
     let skipped = lower.len() - trimmed.len();
-    OPENERS
-        .iter()
-        .filter(|(words, _)| starts_with_words(trimmed, words))
-        .max_by_key(|(words, _)| words.len())
-        .map(|(words, join)| (*join, skipped + words.len()))
+    wish_openers()
+        .into_iter()
+        .find(|(words, _)| starts_with_words(trimmed, words))
+        .map(|(words, join)| (join, skipped + words.len()))
 }
 
 fn starts_with_words(text: &str, words: &str) -> bool {
@@ -359,7 +249,7 @@ fn opening(clause: &str, sentence_start: bool) -> (Join, &str) {
     let found = opener(clause).or_else(|| {
         sentence_start
             .then(|| {
-                SENTENCE_OPENERS
+                CONJUNCTIONS
                     .iter()
                     .find(|(words, _)| starts_with_words(trimmed, words))
                     .map(|(words, join)| (*join, skipped + words.len()))

@@ -6,24 +6,15 @@
 
 use crate::domain::{Atom, Object, Predicate, Vocabulary};
 use crate::goal::Formula;
-use crate::llm::examples::{every_term, terms};
-use crate::llm::lexicon::same_word;
+use crate::goal::rewrite::map_atoms;
 
-use super::goal_checks::map_atoms;
+use super::english::{MOVING_VERBS, TOWARDS};
+use super::words::{every_term, same_word, terms};
+
 use super::polarity::{find_phrase, without_numbering};
-
-/// Words that send an item to the place named after them.
-const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
 
 /// How far after such a word the place's name may start ("to the third table").
 pub(super) const PLACE_WITHIN: usize = 3;
-
-/// Verbs of the robot's own moving: an item before one is not sent to a place after it
-/// ("make coffee and come to table 2").
-const MOVING: &[&str] = &[
-    "come", "go", "move", "head", "walk", "drive", "return", "join", "meet", "visit", "approach",
-    "proceed", "stay", "wait", "hover", "hang",
-];
 
 /// An item the request sends to a place.
 #[derive(Debug, Clone, PartialEq)]
@@ -285,7 +276,7 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
         let mut waiting: Vec<String> = Vec::new();
         let mut sent_unnamed = false;
         for (at, word) in words.iter().enumerate() {
-            if MOVING.iter().any(|m| same_word(m, word)) {
+            if MOVING_VERBS.iter().any(|m| same_word(m, word)) {
                 waiting.clear();
                 sent_unnamed = false;
             }

@@ -10,19 +10,12 @@ use std::fmt;
 
 use crate::domain::{Atom, Predicate, Vocabulary};
 use crate::goal::Formula;
-use crate::llm::examples::{every_term, terms};
-use crate::llm::lexicon::same_word;
+use crate::goal::rewrite::{flipped, undo_each};
 
-use super::goal_checks::undo_each;
+use super::english::{NUMBERING, clause_start, is_negation, is_number_word};
+use super::words::{every_term, same_word, terms};
+
 use super::placement::mentions;
-
-/// Words that turn around what follows them in their clause ("n't" is read as "not").
-const NEGATIONS: &[&str] = &[
-    "not", "no", "never", "nor", "neither", "avoid", "without", "cannot", "forget", "refrain",
-];
-
-/// Words that start a new clause: a negation before them does not reach past them.
-const CLAUSE_STARTS: &[&str] = &["and", "but", "or", "also", "then", "while", "so"];
 
 /// A condition the request asks for one way and the goal has the other way.
 #[derive(Debug, Clone, PartialEq)]
@@ -201,18 +194,14 @@ fn asked_in_sentences(
 /// `text` without the words that only announce a number ("table No. 6", "table number
 /// one", "bar nr 2"), which would stand between a name's words and, as "No.", end a
 /// sentence or read as a negation.
-pub(super) fn without_numbering(text: &str) -> String {
-    const NUMBERING: &[&str] = &["no", "no.", "number", "nr", "nr.", "num", "#"];
-    const NUMBER_WORDS: &[&str] = &[
-        "one", "two", "three", "four", "five", "six", "seven", "eight", "nine", "ten",
-    ];
+pub fn without_numbering(text: &str) -> String {
     let tokens: Vec<&str> = text.split_whitespace().collect();
     let announces = |i: usize| {
         NUMBERING.contains(&tokens[i].to_lowercase().as_str())
             && tokens.get(i + 1).is_some_and(|next| {
                 let next = next.to_lowercase();
                 let next = next.trim_matches(|c: char| !c.is_alphanumeric());
-                next.starts_with(|c: char| c.is_ascii_digit()) || NUMBER_WORDS.contains(&next)
+                next.starts_with(|c: char| c.is_ascii_digit()) || is_number_word(next)
             })
     };
     (0..tokens.len())
@@ -233,7 +222,7 @@ fn clauses(request: &str) -> Vec<Vec<String>> {
     for piece in text.split([',', '.', ';', ':', '!', '?', '(', ')']) {
         let mut clause: Vec<String> = Vec::new();
         for word in every_term(piece) {
-            if CLAUSE_STARTS.contains(&word.as_str()) {
+            if clause_start(&word).is_some() {
                 if !clause.is_empty() {
                     out.push(std::mem::take(&mut clause));
                 }
@@ -249,7 +238,7 @@ fn clauses(request: &str) -> Vec<Vec<String>> {
 }
 
 /// Where `phrase` (as [`terms`] gives it) starts in `words`, if it does.
-pub(super) fn find_phrase(words: &[String], phrase: &[String]) -> Option<usize> {
+pub fn find_phrase(words: &[String], phrase: &[String]) -> Option<usize> {
     if phrase.is_empty() || phrase.len() > words.len() {
         return None;
     }
@@ -271,10 +260,7 @@ fn clause_polarity(clause: &[String], predicate: &Predicate) -> Option<(bool, St
             let Some(at) = find_phrase(clause, &every_term(word)) else {
                 continue;
             };
-            let negations = clause[..at]
-                .iter()
-                .filter(|w| NEGATIONS.contains(&w.as_str()))
-                .count();
+            let negations = clause[..at].iter().filter(|w| is_negation(w)).count();
             ways.push((own_way == (negations % 2 == 0), word.clone()));
         }
     }
@@ -337,20 +323,6 @@ fn signs_of(goal: &Formula, pick: &dyn Fn(&Atom) -> bool, positive: bool) -> Vec
 /// The first atom of `goal` that `pick` picks.
 fn first_matching(goal: &Formula, pick: &dyn Fn(&Atom) -> bool) -> Option<Atom> {
     goal.atoms_in_order().into_iter().find(|a| pick(a))
-}
-
-/// `goal` with `atom` negated wherever it stands (a negated one loses its negation).
-pub fn flipped(goal: &Formula, atom: &Atom) -> Formula {
-    match goal {
-        Formula::Atom(a) if a == atom => Formula::Not(Box::new(goal.clone())),
-        Formula::Atom(_) => goal.clone(),
-        Formula::Not(inner) => match inner.as_ref() {
-            Formula::Atom(a) if a == atom => Formula::Atom(a.clone()),
-            _ => Formula::Not(Box::new(flipped(inner, atom))),
-        },
-        Formula::And(items) => Formula::And(items.iter().map(|i| flipped(i, atom)).collect()),
-        Formula::Or(items) => Formula::Or(items.iter().map(|i| flipped(i, atom)).collect()),
-    }
 }
 
 #[cfg(test)]

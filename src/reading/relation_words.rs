@@ -6,10 +6,11 @@
 
 use crate::domain::{Atom, Object, Predicate, Vocabulary};
 use crate::goal::Formula;
-use crate::llm::examples::every_term;
+use crate::goal::rewrite::map_atoms;
+
+use super::words::every_term;
 use crate::scenario::Scenario;
 
-use super::goal_checks::map_atoms;
 use super::placement::{PLACE_WITHIN, Sent, mentions, put_sent, relating};
 use super::polarity::{find_phrase, without_numbering};
 

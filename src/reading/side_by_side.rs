@@ -7,17 +7,13 @@
 
 use crate::domain::{Atom, Object, Vocabulary};
 use crate::goal::Formula;
-use crate::llm::examples::every_term;
+use crate::goal::rewrite::{rename, undo_each};
 
-use super::goal_checks::{rename, undo_each};
+use super::english::may_precede_thing;
+use super::words::every_term;
+
 use super::placement::{mentions, named_in};
 use super::polarity::without_numbering;
-
-/// Words that may stand between a joining word and the thing it joins ("or a dessert",
-/// "and either the milk").
-const FILLERS: &[&str] = &[
-    "a", "an", "the", "some", "any", "either", "maybe", "perhaps", "also",
-];
 
 /// Two things named side by side, one of which the goal leaves out.
 #[derive(Debug, Clone, PartialEq)]
@@ -186,10 +182,7 @@ fn joined<J>(
                 continue;
             };
             let mut next = at + 1;
-            while words
-                .get(next)
-                .is_some_and(|w| FILLERS.contains(&w.as_str()))
-            {
+            while words.get(next).is_some_and(|w| may_precede_thing(w)) {
                 next += 1;
             }
             let Some((_, _, after)) = named.iter().find(|(start, _, _)| *start == next) else {

@@ -1,6 +1,11 @@
 //! Tests of the checks a candidate goal must pass.
 
 use super::*;
+use crate::goal::Formula;
+use crate::reading::names::{
+    factored, renumbered, swapped_back, swapped_object, without_copied, without_unasked,
+};
+use crate::reading::words::same_word;
 use std::path::Path;
 
 fn cafe() -> (Scenario, Box<dyn World>) {

@@ -14,11 +14,12 @@
 //! behavior tree tries them in that order.
 
 use crate::goal::{self, Formula};
-use crate::llm::examples::terms;
-use crate::llm::lexicon::{Lexicon, in_request_order};
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
+use crate::reading::lexicon::{Lexicon, in_request_order};
+use crate::reading::parts::split;
+use crate::reading::words::terms;
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -27,7 +28,6 @@ use super::goal_checks::GoalProblem;
 use super::interpret_parts::{PartsRead, read_parts};
 use super::judge::{Candidate, Judge};
 use super::types::{Event, Options, SessionError};
-use crate::llm::request_parts::split;
 
 /// Sampling temperature of the extra candidates: enough to make them differ from the
 /// first answer, low enough to stay on the request.
@@ -46,7 +46,14 @@ pub struct Interpretation {
     /// A doubt the checks raised about the chosen goal (it holds already, or a condition
     /// of it comes from an example), for the person to look at before it runs.
     pub doubt: Option<String>,
+    /// The distinct readings that passed the checks, the chosen one first, then the others
+    /// by their votes (at most [`MAX_READINGS`]): what a person chooses among when they
+    /// would make the robot do different things.
+    pub readings: Vec<Formula>,
 }
+
+/// How many readings an interpretation offers at most.
+pub const MAX_READINGS: usize = 3;
 
 /// [`interpret`] against the scenario's first state.
 pub async fn interpret_in_scenario(
@@ -142,8 +149,8 @@ pub(super) async fn read_goal(
         world,
         instruction,
         shown: options.variant.choose(pool, instruction),
-        place_numbers: lexicon.place_numbers(&terms(instruction)),
         lexicon,
+        misreadings: crate::reading::misreadings_without(&options.without_misreadings)?,
         one_of_several,
     };
     let vocabulary = &scenario.domain.vocabulary;
@@ -273,12 +280,14 @@ pub(super) async fn read_goal(
                     answer.goal = ordered;
                 }
             }
+            let readings = judge.readings(&answer.goal, &candidates, &set_aside, MAX_READINGS);
             return Ok(Interpretation {
                 answer,
                 first: first.flatten(),
                 calls,
                 feedback_rounds: round,
                 doubt,
+                readings,
             });
         }
         if !last_round {

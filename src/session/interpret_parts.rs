@@ -1,6 +1,6 @@
 //! A request of several wishes read one wish at a time.
 //!
-//! Each part (`llm::request_parts`) is read as a request of its own, with the examples
+//! Each part (`reading::parts`) is read as a request of its own, with the examples
 //! most like it and every check of a whole reading, and the parts' goals are joined as the
 //! request joins them. The joined goal is checked once more against the whole request
 //! (contradictions between parts, a goal that cannot be planned); when it fails, or a part
@@ -8,9 +8,9 @@
 
 use crate::goal::Formula;
 use crate::llm::LanguageModel;
-use crate::llm::lexicon::Lexicon;
 use crate::llm::reply::GoalAnswer;
-use crate::llm::request_parts::{Join, Part};
+use crate::reading::Lexicon;
+use crate::reading::parts::{Join, Part};
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -79,6 +79,7 @@ pub(super) async fn read_parts(
         }
     }
     let goal = joined(parts, read.iter().map(|r| r.answer.goal.clone()).collect());
+    let goal_read = goal.clone();
     let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
     let shown = options.variant.choose(pool, instruction);
@@ -125,6 +126,7 @@ pub(super) async fn read_parts(
         // A part's own doubt may not hold for the whole ("the light is off already" is
         // no doubt about "the light off and a tea on the bar"): the whole's is the one.
         doubt: problem.map(|p| p.reason),
+        readings: vec![goal_read],
     }))
 }
 

@@ -11,19 +11,13 @@
 
 use crate::domain::VocabularyError;
 use crate::goal::{self, Formula};
-use crate::llm::lexicon::Lexicon;
 use crate::llm::reply::{GoalAnswer, ReplyError};
+use crate::reading::names::{without_copied, without_unasked};
+use crate::reading::{Lexicon, Misreading, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::goal_checks::{
-    GoalProblem, ProblemKind, assess, renumbered, swapped_back, swapped_object, unanswered_names,
-    without_copied, without_unasked,
-};
-use super::placement::{moved_there, not_put, put_there};
-use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
-use super::relation_words::{convention_followed, relation_as_said};
-use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
+use super::goal_checks::{GoalProblem, ProblemKind, assess};
 use super::types::Event;
 
 /// How many times a goal's misreadings are undone one after another.
@@ -57,7 +51,8 @@ pub(super) struct Judge<'a> {
     pub(super) instruction: &'a str,
     pub(super) shown: Vec<&'a crate::scenario::Example>,
     pub(super) lexicon: Lexicon,
-    pub(super) place_numbers: Vec<String>,
+    /// The detectors of plain misreadings in use (all registered ones but in experiments).
+    pub(super) misreadings: Vec<&'static dyn Misreading>,
     /// The request is one wish of several: what it asks for may hold already (the robot
     /// is not at the bar now, and "stay away from the bar" beside a delivery still asks
     /// it to stay away), as long as the wishes together ask for a change.
@@ -77,76 +72,16 @@ impl Judge<'_> {
         .filter(|p| !(self.one_of_several && p.kind == ProblemKind::HoldsAlready))
     }
 
-    /// The place numbers the request says that no condition of `goal` is about.
-    pub(super) fn missing_numbers(&self, goal: &Formula) -> Vec<String> {
-        unanswered_names(goal, self.instruction, &self.lexicon)
-            .into_iter()
-            .filter(|w| self.place_numbers.contains(w))
-            .collect()
+    /// The request as every detector reads it.
+    pub(super) fn request(&self) -> Request<'_> {
+        Request::new(self.instruction, self.scenario, &self.lexicon)
     }
 
-    /// How `goal` has misread the request, if it plainly has: it leaves out a number the
-    /// request says ("table six" read as table 1), asks for a condition the other way round
-    /// from the request's words ("do not open the curtain" read as open), or puts an object
-    /// nobody named in the place of one the request names ("fries" read as coffee).
+    /// How `goal` has misread the request, if it plainly has: the first finding of the
+    /// detectors in use (`reading::misreading`).
     pub(super) fn misread(&self, goal: &Formula) -> Option<String> {
-        let numbers = self.missing_numbers(goal);
-        if !numbers.is_empty() {
-            return Some(format!(
-                "the request says {}, and no condition of {goal} is about it",
-                numbers.join(", ")
-            ));
-        }
-        if let Some(turned) = turned_around(goal, self.instruction, self.vocabulary()) {
-            return Some(turned.to_string());
-        }
-        if let Some((atom, wanted, word)) =
-            left_unanswered(goal, self.instruction, self.vocabulary())
-        {
-            let asked = if wanted {
-                atom.to_string()
-            } else {
-                format!("~{atom}")
-            };
-            return Some(format!(
-                "the request says \"{word}\", which asks for {asked}, and {goal} has no condition about it"
-            ));
-        }
-        if let Some((said, word)) = relation_as_said(goal, self.instruction, self.vocabulary()) {
-            return Some(format!(
-                "the request says \"{word}\" before the place, which asks for {said}, not {goal}"
-            ));
-        }
-        if let Some((put, word)) = convention_followed(goal, self.instruction, self.scenario) {
-            return Some(format!(
-                "the request says \"{word}\", which here asks for {put}, not {goal}"
-            ));
-        }
-        if let Some(sent) = not_put(goal, self.instruction, self.vocabulary()) {
-            return Some(format!(
-                "the request sends {} to {}, and no condition of {goal} puts it there",
-                sent.item, sent.place
-            ));
-        }
-        if let Some((measure, content)) =
-            measure_for_content(goal, self.instruction, self.vocabulary())
-        {
-            return Some(format!(
-                "the request asks for {content} by the {measure}, and {goal} has the {measure} in its place"
-            ));
-        }
-        if let Some(gap) = left_out(goal, self.instruction, self.vocabulary()) {
-            return Some(format!(
-                "the request names {} beside {}, and {goal} leaves {} out",
-                gap.left_out, gap.kept, gap.left_out
-            ));
-        }
-        swapped_object(goal, self.instruction, &self.lexicon).map(|(object, words)| {
-            format!(
-                "the request says {}, which no condition of {goal} answers, and never names {object}",
-                words.join(", ")
-            )
-        })
+        let request = self.request();
+        self.misreadings.iter().find_map(|m| m.find(goal, &request))
     }
 
     pub(super) fn vocabulary(&self) -> &crate::domain::Vocabulary {
@@ -161,74 +96,14 @@ impl Judge<'_> {
                 .is_ok_and(|a| self.misread(&a.goal).is_none())
     }
 
-    /// `goal` with each plain misreading undone that can be, each with what was undone:
-    /// the place renumbered when the request numbers another one of its kind ("table six"
-    /// read as Table1), a swapped object put back, conditions asked the other way round
-    /// turned, items sent to a place put there, a thing left out put beside the one named
-    /// with it, a measure replaced by what it holds.
+    /// `goal` with each plain misreading undone that can be, each with what was undone,
+    /// in the order the detectors are registered.
     fn undone(&self, goal: &Formula) -> Vec<(Formula, String)> {
-        let (request, vocabulary) = (self.instruction, self.vocabulary());
-        let mut out = Vec::new();
-        if let Some((g, from, to)) = renumbered(goal, &self.missing_numbers(goal), vocabulary) {
-            out.push((
-                g,
-                format!("the request numbers a place the answer does not: {to} is the only one like {from} with that number"),
-            ));
-        }
-        if let Some((g, from, to)) = swapped_back(goal, request, &self.lexicon, vocabulary) {
-            out.push((
-                g,
-                format!("the request names {to} where the answer has {from}, which it never names"),
-            ));
-        }
-        if let Some(why) = turned_around(goal, request, vocabulary)
-            && let Some(g) = turned_back(goal, request, vocabulary)
-        {
-            out.push((g, why.to_string()));
-        }
-        if let Some(g) = with_unanswered(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request asks in its own words for a condition {goal} leaves out"),
-            ));
-        }
-        if let Some((g, word)) = relation_as_said(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request says \"{word}\" before the place, which {goal} reads as another relation"),
-            ));
-        }
-        if let Some((g, word)) = convention_followed(goal, request, self.scenario) {
-            out.push((
-                g,
-                format!("the request says \"{word}\", which by this scene's conventions asks for where {goal} does not put it"),
-            ));
-        }
-        if let Some(g) = put_there(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request sends an item to a place that {goal} only has apart"),
-            ));
-        }
-        if let Some(g) = moved_there(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request sends an item to a place that {goal} has it at another place, which the request never names"),
-            ));
-        }
-        if let Some(g) = with_left_out(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request names things side by side that {goal} has only one of"),
-            ));
-        }
-        if let Some(g) = with_content(goal, request, vocabulary) {
-            out.push((
-                g,
-                format!("the request names a measure of something that {goal} has in its place"),
-            ));
-        }
-        out
+        let request = self.request();
+        self.misreadings
+            .iter()
+            .flat_map(|m| m.undo(goal, &request))
+            .collect()
     }
 
     /// `goal` with its plain misreadings undone one after another: a goal can misread a
@@ -393,6 +268,46 @@ impl Judge<'_> {
     }
 }
 
+impl Judge<'_> {
+    /// The distinct readings among `candidates` (and those `set_aside`) that passed the
+    /// checks or only raised a doubt, `chosen` first, then by the size of their group of
+    /// equivalent candidates, earlier drawn first on a tie; at most `k`.
+    pub(super) fn readings(
+        &self,
+        chosen: &Formula,
+        candidates: &[Candidate],
+        set_aside: &[Candidate],
+        k: usize,
+    ) -> Vec<Formula> {
+        let eligible: Vec<&GoalAnswer> = candidates
+            .iter()
+            .chain(set_aside)
+            .filter(|c| c.clean() || c.doubtful())
+            .filter_map(|c| c.read.as_ref().ok())
+            .collect();
+        let mut groups: Vec<(usize, &Formula)> = Vec::new();
+        for a in &eligible {
+            if let Some(g) = groups.iter_mut().find(|(_, f)| same_goal(f, &a.goal)) {
+                g.0 += 1;
+            } else {
+                groups.push((1, &a.goal));
+            }
+        }
+        // A stable sort keeps the order drawn among groups of one size.
+        groups.sort_by_key(|g| std::cmp::Reverse(g.0));
+        let mut out = vec![chosen.clone()];
+        for (_, goal) in groups {
+            if out.len() == k {
+                break;
+            }
+            if !out.iter().any(|o| same_goal(o, goal)) {
+                out.push(goal.clone());
+            }
+        }
+        out
+    }
+}
+
 /// The answer of the largest group of equivalent candidates that passed the checks; ties
 /// go to the group drawn first (the greedy answer, when it passed).
 pub(super) fn vote(
@@ -428,7 +343,12 @@ fn vote_refs(
 }
 
 fn same(a: &GoalAnswer, b: &GoalAnswer) -> bool {
-    a.goal == b.goal || goal::equivalent(&a.goal, &b.goal).unwrap_or(false)
+    same_goal(&a.goal, &b.goal)
+}
+
+/// Two goals that are one: written alike, or true in the same situations.
+pub(super) fn same_goal(a: &Formula, b: &Formula) -> bool {
+    a == b || goal::equivalent(a, b).unwrap_or(false)
 }
 
 #[cfg(test)]

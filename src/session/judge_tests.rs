@@ -15,8 +15,8 @@ fn judge<'a>(scenario: &'a Scenario, request: &'a str, one_of_several: bool) -> 
         world: crate::world::load(scenario).expect("cafe world"),
         instruction: request,
         shown: Vec::new(),
-        place_numbers: lexicon.place_numbers(&crate::llm::examples::terms(request)),
         lexicon,
+        misreadings: crate::reading::MISREADINGS.to_vec(),
         one_of_several,
     }
 }

@@ -64,6 +64,9 @@ pub struct Options {
     pub structured: bool,
     /// Constrain replies with a grammar when the model supports it (the local model).
     pub grammar: bool,
+    /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
+    /// evaluation's way to measure what each earns; empty in use.
+    pub without_misreadings: Vec<String>,
 }
 
 /// Candidates per question: the first answer and three sampled ones.
@@ -87,6 +90,7 @@ impl Default for Options {
             templates: Templates::builtin(),
             structured: false,
             grammar: true,
+            without_misreadings: Vec::new(),
         }
     }
 }
@@ -402,6 +406,8 @@ pub enum SessionError {
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Plan(#[from] RepairError),
+    #[error(transparent)]
+    Misreading(#[from] crate::reading::UnknownMisreading),
     #[error("scenario {0:?} has no instruction; give one")]
     NoInstruction(String),
     #[error("scenario {0:?} states no goal to work on instead of reading its instruction")]

@@ -1,0 +1,28 @@
+//! How a request is understood, in one place, with no model, world or planner in it: the
+//! words of a text ([`words`]) and the English every reader knows ([`english`], one list
+//! per kind of word); which words of a scene's requests each predicate and object answers
+//! to ([`lexicon`], from the scenario's data: names, what objects are called, the words
+//! listed for each predicate and its opposite, the example pool); a request cut into the
+//! wishes it is made of ([`parts`]); and the plain misreadings of a request, each a
+//! detector registered in one list ([`misreading`]), built on what a request's words say
+//! about conditions ([`polarity`]), about items sent to places ([`placement`]), about
+//! things named side by side ([`side_by_side`]), about the relation said before a place
+//! and a scene's conventions ([`relation_words`]), and about a goal's objects and
+//! conjuncts ([`names`]).
+//!
+//! The session asks the model and judges its answers with what is here; formula rewrites
+//! that know nothing of words (rename, map atoms, flip) are [`crate::goal::rewrite`]'s.
+
+pub mod english;
+pub mod lexicon;
+pub mod misreading;
+pub mod names;
+pub mod parts;
+pub mod placement;
+pub mod polarity;
+pub mod relation_words;
+pub mod side_by_side;
+pub mod words;
+
+pub use lexicon::Lexicon;
+pub use misreading::{MISREADINGS, Misreading, Request, UnknownMisreading, misreadings_without};
