@@ -182,6 +182,7 @@ fn ask(engine: &Engine, question: &str) -> betr::llm::local::Generated {
     );
     engine
         .generate_blocking(Generation {
+            beams: 1,
             messages: vec![("system".into(), system), ("user".into(), question.into())],
             max_tokens: 8,
             temperature: 0.0,

@@ -71,6 +71,7 @@ impl LanguageModel for ByDraw {
 /// A scripted model's reply.
 fn scripted(text: String) -> ChatReply {
     ChatReply {
+        ranked: Vec::new(),
         text,
         model: "scripted".into(),
         usage: TokenUsage {

@@ -68,6 +68,7 @@ impl GoalPrompt {
             seed: 0,
             stop: vec!["\n".into()],
             grammar: grammar.then(|| self.gbnf.clone()),
+            beams: 1,
         })
     }
 }

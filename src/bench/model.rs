@@ -139,6 +139,7 @@ pub fn betr_speeds(model: &Path, threads: u32, sizes: ModelSizes) -> Result<Spee
                 seed: 0,
                 stop: Vec::new(),
                 grammar: None,
+                beams: 1,
             })
             .map_err(|e| BenchError::Setup(e.to_string()))?;
         let evaluated = g.prompt_tokens.saturating_sub(g.cached_tokens);

@@ -150,6 +150,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     );
     settings.insert("checks".into(), options.check_goals.to_string());
     settings.insert("candidates".into(), options.candidates.to_string());
+    settings.insert("beams".into(), options.beams.to_string());
     settings.insert(
         "feedback_rounds".into(),
         options.goal_feedback_rounds.to_string(),

@@ -82,6 +82,11 @@ pub struct LlmFlags {
     /// for every failure, each tried in simulation before it is offered (default 4).
     #[arg(long, value_name = "N")]
     pub candidates: Option<usize>,
+    /// Local backend: a goal's first answer is the most likely whole answer of N beams
+    /// searched under the grammar, the runners-up candidates too (default 4; 1: one
+    /// greedy answer).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=6))]
+    pub beams: Option<u32>,
     /// Take the first usable goal as it is: no checks, no vote, no feedback (the paper's
     /// single call).
     #[arg(long)]
@@ -209,6 +214,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         },
         check_goals: !flags.no_checks,
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
+        beams: flags.beams.unwrap_or(betr::session::types::DEFAULT_BEAMS),
         goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
         read_by_parts: !flags.whole_request,
         value_levels: !flags.value_as_number,

@@ -39,6 +39,11 @@ pub struct ResolveFlags {
     /// call for the goal).
     #[arg(long)]
     pub stated_goal: bool,
+    /// When the instruction has several readings that make the robot do different things,
+    /// work on reading N (from 1) of those listed; without it they are asked on the
+    /// terminal, and --yes stops (exit 3) rather than choose one.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub reading: Option<u16>,
     /// After success, offer each approved fix as a rule of its skill for later tasks
     /// (asked on the terminal; with --yes kept without asking), checked before it is
     /// kept in the knowledge file beside the policies.
@@ -68,6 +73,10 @@ pub struct InterpretArgs {
     /// Use a dictated transcript without asking (it is still printed).
     #[arg(long, short = 'y')]
     pub yes: bool,
+    /// Print reading N (from 1) of those listed as the goal, when the instruction has
+    /// several that make the robot do different things.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub reading: Option<u16>,
     #[command(flatten)]
     pub llm: LlmFlags,
     #[command(flatten)]
@@ -84,7 +93,7 @@ pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
         &args.stt,
         args.yes,
     )?;
-    interpret(&scenario, instruction.as_deref(), &args.llm)
+    interpret(&scenario, instruction.as_deref(), args.reading, &args.llm)
 }
 
 /// `betr resolve`: the instruction typed or dictated, then the whole loop.
@@ -108,13 +117,19 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
             viz: &args.viz,
             stated_goal: args.stated_goal,
             learn: args.learn.then_some(&args.knowledge.dir),
+            reading: args.reading,
         },
         &args.llm,
         glyphs,
     )
 }
 
-fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -> Result<ExitCode> {
+fn interpret(
+    scenario: &Scenario,
+    instruction: Option<&str>,
+    chosen: Option<u16>,
+    flags: &LlmFlags,
+) -> Result<ExitCode> {
     let llm = setup(flags)?;
     let instruction = instruction
         .map(str::to_string)
@@ -140,7 +155,78 @@ fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -
         "{} call(s), {} feedback round(s)",
         reading.calls, reading.feedback_rounds
     );
+    let world = betr::world::load(scenario)?;
+    let readings =
+        session::readings::distinct_readings(scenario, world.as_ref(), &reading.readings);
+    if readings.len() > 1 {
+        println!();
+        for line in readings_text(&readings) {
+            println!("{line}");
+        }
+    }
+    if let Some(n) = chosen {
+        // One reading (or none the planner can achieve): the goal read is reading 1.
+        let goals: Vec<&betr::goal::Formula> = if readings.is_empty() {
+            vec![&reading.answer.goal]
+        } else {
+            readings.iter().map(|r| &r.goal).collect()
+        };
+        let Some(goal) = goals.get(usize::from(n) - 1) else {
+            let count = goals.len();
+            anyhow::bail!("no reading {n}: the instruction has {count} (1 to {count})");
+        };
+        println!("Goal (reading {n}): {goal}");
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The readings to choose among, numbered from 1, each with its words, goal and first
+/// actions.
+fn readings_text(readings: &[session::Reading]) -> Vec<String> {
+    let mut lines = vec![format!(
+        "The instruction has {} readings that make the robot do different things:",
+        readings.len()
+    )];
+    for (i, r) in readings.iter().enumerate() {
+        lines.push(format!("  {}  {}", i + 1, r.words));
+        lines.push(format!("     goal: {}", r.goal));
+        if !r.first_actions.is_empty() {
+            lines.push(format!("     first: {}", r.first_actions.join(", ")));
+        }
+    }
+    lines
+}
+
+/// The reading to work on: the one `--reading` names, else asked on the terminal; none
+/// with `--yes` (a person must choose) or when the answer names none.
+fn choose_reading(readings: &[session::Reading], chosen: Option<u16>, yes: bool) -> Option<usize> {
+    for line in readings_text(readings) {
+        println!("{line}");
+    }
+    if let Some(n) = chosen {
+        let index = usize::from(n) - 1;
+        if index < readings.len() {
+            println!("Reading {n} (--reading)");
+            return Some(index);
+        }
+        println!("no reading {n}: there are {}", readings.len());
+        return None;
+    }
+    if yes {
+        return None;
+    }
+    print!("Choose a reading [1-{}]: ", readings.len());
+    let _ = std::io::stdout().flush();
+    let mut line = String::new();
+    match std::io::stdin().lock().read_line(&mut line) {
+        Ok(0) | Err(_) => None,
+        Ok(_) => line
+            .trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=readings.len()).contains(n))
+            .map(|n| n - 1),
+    }
 }
 
 pub struct ResolveArgs<'a> {
@@ -153,6 +239,8 @@ pub struct ResolveArgs<'a> {
     pub stated_goal: bool,
     /// Offer the kept fixes as rules, kept in this directory's knowledge file.
     pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
+    /// The reading to work on when the instruction has several (from 1).
+    pub reading: Option<u16>,
 }
 
 fn resolve(
@@ -164,6 +252,7 @@ fn resolve(
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
+    llm.options.choose_reading = true;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
@@ -192,17 +281,23 @@ fn resolve(
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
+    let mut choose = |r: &[session::Reading]| choose_reading(r, args.reading, yes);
     let result = super::runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,
         llm.model.clone(),
         &llm.options,
         args.viz.viewer.is_some() || args.viz.rrd.is_some(),
-        &mut approve,
+        (&mut approve, &mut choose),
         &mut emit,
     ));
     let resolved = match result {
         Ok(r) => r,
+        Err(e @ session::SessionError::ReadingNotChosen { .. }) => {
+            print_usage(&llm.model);
+            eprintln!("error: {e}");
+            return Ok(ExitCode::from(3));
+        }
         Err(e) => {
             print_usage(&llm.model);
             return Err(e.into());
@@ -390,7 +485,9 @@ fn print_event_line(event: &Event) {
         | Event::RuleKept { .. }
         | Event::RuleRefused { .. }
         | Event::Knowledge { .. }
-        | Event::Notice { .. } => {}
+        | Event::Notice { .. }
+        // Listed with the question that asks to choose among them.
+        | Event::Readings { .. } => {}
         Event::Error { message } => println!("error: {message}"),
         // Returned by the loop as its error, and printed once by `main`.
         Event::Failed { .. } => {}

@@ -70,6 +70,7 @@ impl crate::llm::LanguageModel for Slow {
             tokio::time::sleep(std::time::Duration::from_millis(20)).await;
             self.inflight.fetch_sub(1, SeqCst);
             Ok(crate::llm::ChatReply {
+                ranked: Vec::new(),
                 text: format!("Goal: Active_AC\n(seed {:?})", request.seed),
                 model: "slow".into(),
                 usage: crate::llm::TokenUsage::default(),

@@ -28,6 +28,9 @@ pub struct Entry {
     pub latency_ms: u64,
     pub source: ReplySource,
     pub recorded_unix: u64,
+    /// The answers a beam search ranked, best first, when it was asked for.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ranked: Vec<(String, f64)>,
 }
 
 /// The key of a request: the SHA-256 of its canonical JSON (messages, temperature, token
@@ -99,6 +102,7 @@ impl<M: LanguageModel> Recorder<M> {
             latency_ms: u64::try_from(reply.latency.as_millis()).unwrap_or(u64::MAX),
             source: reply.source.clone(),
             recorded_unix: super::usage::unix_now(),
+            ranked: reply.ranked.clone(),
         };
         self.append(&entry)?;
         Ok(reply)
@@ -217,6 +221,7 @@ impl Replay {
             usage: entry.usage,
             latency: started.elapsed(),
             source,
+            ranked: entry.ranked.clone(),
         })
     }
 }
@@ -251,6 +256,7 @@ mod tests {
             let text = request.messages[0].content.to_uppercase();
             Box::pin(async move {
                 Ok(ChatReply {
+                    ranked: Vec::new(),
                     text,
                     model: "echo-1".into(),
                     usage: TokenUsage {
@@ -297,6 +303,7 @@ mod tests {
     fn a_temperature_beyond_f32_is_refused_with_its_line() {
         let request = ChatRequest::new(vec![Message::user("x")]);
         let entry = Entry {
+            ranked: Vec::new(),
             model: "m".into(),
             reply_model: String::new(),
             prompt_hash: prompt_hash(&request),

@@ -93,6 +93,11 @@ pub struct ChatRequest {
     /// use run k → seed k. `None` leaves the choice to the backend.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// With a grammar and temperature 0, a backend that can search for the answers the
+    /// model finds most likely as a whole returns up to this many, ranked (the embedded
+    /// model); others answer once.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beams: Option<u32>,
 }
 
 impl ChatRequest {
@@ -104,6 +109,7 @@ impl ChatRequest {
             stop: Vec::new(),
             constraint: None,
             seed: None,
+            beams: None,
         }
     }
 }
@@ -138,6 +144,9 @@ pub struct ChatReply {
     pub usage: TokenUsage,
     pub latency: Duration,
     pub source: ReplySource,
+    /// When beams were searched: every answer found with its log-probability under the
+    /// model, best first (`text` is the first); empty otherwise.
+    pub ranked: Vec<(String, f64)>,
 }
 
 impl ChatReply {

@@ -198,6 +198,7 @@ impl OpenAiClient {
             })?;
         let count = |k: &str| json.pointer(&format!("/usage/{k}")).and_then(Json::as_u64);
         Ok(ChatReply {
+            ranked: Vec::new(),
             text: content.to_string(),
             model: json
                 .get("model")

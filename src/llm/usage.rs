@@ -283,6 +283,7 @@ mod tests {
         let log = dir.join("u.jsonl");
         let m = Metered::new(Nop, Ledger::new(Some(log.clone())), t);
         let reply = ChatReply {
+            ranked: Vec::new(),
             text: String::new(),
             model: "gpt-4o".into(),
             usage: TokenUsage {

@@ -215,6 +215,17 @@ impl Encoder {
             Event::Notice { message } => Recorded::Note {
                 message: message.clone(),
             },
+            Event::Readings { readings, .. } => Recorded::Note {
+                message: format!(
+                    "readings to choose among: {}",
+                    readings
+                        .iter()
+                        .enumerate()
+                        .map(|(i, r)| format!("{} {}", i + 1, r.goal))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
+            },
             Event::Exported { paths } => Recorded::Note {
                 message: format!(
                     "exported to {}",

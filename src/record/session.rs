@@ -108,6 +108,7 @@ pub fn command_text(command: &Command) -> String {
         Command::KeepRule { only: true } => "keep rule for these objects".into(),
         Command::DeclineRule => "decline rule".into(),
         Command::ShowKnowledge => "show knowledge".into(),
+        Command::ChooseReading(index) => format!("choose reading {}", index + 1),
         Command::Shutdown => "quit".into(),
     }
 }

@@ -35,6 +35,11 @@ pub(crate) async fn ask(
             name: "answer".into(),
             gbnf: grammar(),
         });
+        // Beams search for the most likely whole answer: only for a greedy answer, and
+        // only when the caller asks for them (`options.beams`).
+        if seed.is_none() && options.temperature <= 0.0 && options.beams > 1 {
+            request.beams = Some(options.beams);
+        }
     } else if options.structured && model.supports_constraint() {
         request.constraint = Some(schema);
     }
@@ -146,6 +151,9 @@ async fn draw_and_screen(
     let draws = options.candidates.max(1);
     for draw in 0..draws {
         let mut opts = options.clone();
+        // Questions about failures choose among conditions tried in simulation: one
+        // greedy answer each.
+        opts.beams = 1;
         let seed = if draw > 0 {
             opts.temperature = opts.temperature.max(SAMPLE_TEMPERATURE);
             Some(draw as u64)

@@ -167,6 +167,8 @@ pub(super) async fn read_goal(
     let mut last_error = ReplyError::NoConditions;
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
+    // The model's runners-up to its first answer (beams), judged like any candidate.
+    let mut runners_up: Vec<Candidate> = Vec::new();
     for round in 0..rounds {
         let mut candidates: Vec<Candidate> = Vec::new();
         let draws = if options.check_goals {
@@ -199,6 +201,26 @@ pub(super) async fn read_goal(
             )
             .await?;
             calls += 1;
+            if round == 0 && draw == 0 && options.check_goals {
+                runners_up = r
+                    .ranked
+                    .iter()
+                    .skip(1)
+                    .map(|(text, _)| {
+                        let read = reply::goal(text, vocabulary, options.min_similarity);
+                        let problem = match &read {
+                            Err(e) => Some(GoalProblem::wrong(e.to_string())),
+                            Ok(a) => judge.assess(&a.goal),
+                        };
+                        Candidate {
+                            text: text.clone(),
+                            read,
+                            problem,
+                            first: false,
+                        }
+                    })
+                    .collect();
+            }
             let read = reply::goal(&r.text, vocabulary, options.min_similarity);
             let problem = match &read {
                 Err(e) => Some(GoalProblem::wrong(e.to_string())),
@@ -249,18 +271,34 @@ pub(super) async fn read_goal(
                 .first()
                 .and_then(|c| c.read.as_ref().ok())
                 .and_then(|a| judge.misread(&a.goal));
-            if draw == 0
-                && let Some(why) = misread
+            if draw > 0 {
+                continue;
+            }
+            let settled = match &misread {
+                Some(_) if options.check_goals => {
+                    candidates.iter().any(|c| judge.answers_request(c))
+                }
+                _ => candidates.iter().any(|c| c.clean() || c.doubtful()),
+            };
+            if settled {
+                break;
+            }
+            // Before any sample: the model's own runners-up, which cost no call.
+            if !runners_up.is_empty() {
+                candidates.append(&mut runners_up);
+                if candidates.iter().any(|c| judge.answers_request(c)) {
+                    emit(&Event::Notice {
+                        message: "the first answer fails its checks: the model's next most likely answers are candidates".into(),
+                    });
+                    break;
+                }
+            }
+            if let Some(why) = misread
                 && options.check_goals
-                && !candidates.iter().any(|c| judge.answers_request(c))
             {
                 emit(&Event::Notice {
                     message: format!("{why}: drawing more candidates"),
                 });
-                continue;
-            }
-            if draw == 0 && candidates.iter().any(|c| c.clean() || c.doubtful()) {
-                break;
             }
         }
         // A doubtful answer is taken when it is the model's own first answer, or when no
@@ -280,7 +318,8 @@ pub(super) async fn read_goal(
                     answer.goal = ordered;
                 }
             }
-            let readings = judge.readings(&answer.goal, &candidates, &set_aside, MAX_READINGS);
+            let others: Vec<&Candidate> = set_aside.iter().chain(&runners_up).collect();
+            let readings = judge.readings(&answer.goal, &candidates, &others, MAX_READINGS);
             return Ok(Interpretation {
                 answer,
                 first: first.flatten(),

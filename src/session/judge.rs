@@ -276,12 +276,12 @@ impl Judge<'_> {
         &self,
         chosen: &Formula,
         candidates: &[Candidate],
-        set_aside: &[Candidate],
+        others: &[&Candidate],
         k: usize,
     ) -> Vec<Formula> {
         let eligible: Vec<&GoalAnswer> = candidates
             .iter()
-            .chain(set_aside)
+            .chain(others.iter().copied())
             .filter(|c| c.clean() || c.doubtful())
             .filter_map(|c| c.read.as_ref().ok())
             .collect();

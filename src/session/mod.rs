@@ -13,6 +13,7 @@ mod judge;
 pub mod knowledge;
 pub mod planned;
 pub mod policy;
+pub mod readings;
 pub mod resolve;
 pub mod screen;
 pub mod shortlist;
@@ -30,6 +31,7 @@ pub use interpret::{Interpretation, interpret};
 pub use knowledge::{KeptRule, Knowledge, KnowledgeError, Refusal};
 pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
+pub use readings::Reading;
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};
 

@@ -16,6 +16,7 @@ use crate::llm::LanguageModel;
 use crate::scenario::Scenario;
 
 use super::engine::{Command, Engine, Setup};
+use super::readings::Reading;
 use super::types::{Ending, Event, Options, Proposal, Resolved, SessionError};
 
 /// The whole loop for `scenario`: `instruction` (else the scenario's) → goal → tree → success.
@@ -27,18 +28,35 @@ pub async fn resolve(
     approve: &mut dyn FnMut(&Proposal) -> bool,
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
-    resolve_with_scenes(scenario, instruction, model, options, false, approve, emit).await
+    // Only offered with `options.choose_reading`: the best reading, as without it.
+    let mut best = |_: &[Reading]| Some(0);
+    resolve_with_scenes(
+        scenario,
+        instruction,
+        model,
+        options,
+        false,
+        (approve, &mut best),
+        emit,
+    )
+    .await
 }
 
+/// Says whether a proposal is approved.
+pub type Approver<'a> = &'a mut dyn FnMut(&Proposal) -> bool;
+/// Picks the reading to work on among those offered, or none to stop.
+pub type ReadingChooser<'a> = &'a mut dyn FnMut(&[Reading]) -> Option<usize>;
+
 /// [`resolve`], and with `scenes` the engine also emits the cell's scene after every tick
-/// (`Event::Scene`, for a 3D view).
+/// (`Event::Scene`, for a 3D view). `choose` picks among the readings of the instruction
+/// (with `options.choose_reading`): the index of one, or none to stop.
 pub async fn resolve_with_scenes(
     scenario: &Scenario,
     instruction: Option<&str>,
     model: Arc<dyn LanguageModel>,
     options: &Options,
     scenes: bool,
-    approve: &mut dyn FnMut(&Proposal) -> bool,
+    (approve, choose): (Approver<'_>, ReadingChooser<'_>),
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
     let instruction = instruction
@@ -83,6 +101,17 @@ pub async fn resolve_with_scenes(
         emit(&event);
         match event {
             Event::Goal { goal: g, .. } => goal = Some(g),
+            Event::Readings { readings, .. } => match choose(&readings) {
+                Some(index) if index < readings.len() => {
+                    engine.send(Command::ChooseReading(index));
+                }
+                _ => {
+                    engine.send(Command::Shutdown);
+                    return Err(SessionError::ReadingNotChosen {
+                        count: readings.len(),
+                    });
+                }
+            },
             Event::Asking { .. } if goal.is_some() => rounds += 1,
             Event::TreeChanged { tree: t, .. } => {
                 tree = Some(t);

@@ -64,6 +64,14 @@ pub struct Options {
     pub structured: bool,
     /// Constrain replies with a grammar when the model supports it (the local model).
     pub grammar: bool,
+    /// The first answer to a goal question is the most likely whole answer of this many
+    /// beams searched under the grammar (the embedded model), and the runners-up are
+    /// candidates too, with no more calls; 1: one greedy answer.
+    pub beams: u32,
+    /// When an instruction has more than one reading that would make the robot do
+    /// different things, offer them for the person to choose (`Event::Readings`); off:
+    /// the best one is taken.
+    pub choose_reading: bool,
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
     /// evaluation's way to measure what each earns; empty in use.
     pub without_misreadings: Vec<String>,
@@ -71,6 +79,9 @@ pub struct Options {
 
 /// Candidates per question: the first answer and three sampled ones.
 pub const DEFAULT_CANDIDATES: usize = 4;
+
+/// Beams searched for a goal's first answer.
+pub const DEFAULT_BEAMS: u32 = 4;
 
 impl Default for Options {
     fn default() -> Self {
@@ -90,6 +101,8 @@ impl Default for Options {
             templates: Templates::builtin(),
             structured: false,
             grammar: true,
+            beams: DEFAULT_BEAMS,
+            choose_reading: false,
             without_misreadings: Vec::new(),
         }
     }
@@ -208,6 +221,12 @@ pub enum Event {
         reasoning: Option<String>,
         substitutions: Vec<Substitution>,
         matches_expected: Option<bool>,
+    },
+    /// The instruction has more than one reading that would make the robot do different
+    /// things: the person chooses one (`Command::ChooseReading`), best first.
+    Readings {
+        instruction: String,
+        readings: Vec<super::readings::Reading>,
     },
     /// An action failed in simulation.
     ActionFailed {
@@ -420,6 +439,10 @@ pub enum SessionError {
     TreeFile(Box<crate::interop::TreeFileError>),
     #[error("the session stopped before the loop ended")]
     Stopped,
+    #[error(
+        "the instruction has {count} readings that make the robot do different things, and none was chosen: choose one with --reading N"
+    )]
+    ReadingNotChosen { count: usize },
 }
 
 impl From<crate::interop::TreeFileError> for SessionError {

@@ -63,6 +63,8 @@ pub enum Request {
 pub enum Overlay {
     Help,
     Report(Vec<String>),
+    /// The readings of an instruction, waiting for the person to choose one.
+    Readings(Vec<crate::session::Reading>),
 }
 
 pub struct App {
@@ -223,6 +225,9 @@ impl App {
             self.dictation.idle();
             return;
         }
+        if let Some(Overlay::Readings(readings)) = &self.overlay {
+            return self.on_reading_key(&key, readings.len());
+        }
         if self.overlay.take().is_some() {
             return;
         }
@@ -231,6 +236,28 @@ impl App {
             None => {
                 self.tree.event(&key);
             }
+        }
+    }
+
+    /// A key while readings wait to be chosen: a number chooses one, Esc none; other keys
+    /// leave the choice open.
+    fn on_reading_key(&mut self, key: &KeyEvent, count: usize) {
+        match key.code {
+            KeyCode::Char(c) => {
+                let Some(n) = c.to_digit(10).map(|n| n as usize) else {
+                    return;
+                };
+                if (1..=count).contains(&n) {
+                    self.overlay = None;
+                    self.queue
+                        .push(AppEvent::Command(Command::ChooseReading(n - 1)));
+                }
+            }
+            KeyCode::Esc => {
+                self.overlay = None;
+                self.message(strings::NO_READING_CHOSEN.to_string(), false);
+            }
+            _ => {}
         }
     }
 

@@ -13,6 +13,11 @@ pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, 
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";
 pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
+pub const READINGS_TITLE: &str = " Readings of the instruction (press a number; Esc: none) ";
+pub const READINGS_INTRO: &str =
+    "The instruction can be read in ways that make the robot do different things:";
+pub const NO_READING_CHOSEN: &str =
+    "no reading chosen: type the instruction again (i), said otherwise";
 
 pub const NOW_TRUE: &str = "True now:";
 pub const NOTHING_TRUE: &str = "  (nothing)";

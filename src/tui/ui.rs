@@ -6,7 +6,7 @@ use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout};
 
 use super::app::{App, Overlay};
-use super::components::help::{draw_help, draw_report};
+use super::components::help::{draw_help, draw_readings, draw_report};
 use super::keys::{Action, KeyMode};
 use super::strings;
 
@@ -59,6 +59,7 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     match &app.overlay {
         Some(Overlay::Help) => draw_help(frame, area, &app.keys, app.mode, &theme),
         Some(Overlay::Report(lines)) => draw_report(frame, area, lines, &theme),
+        Some(Overlay::Readings(readings)) => draw_readings(frame, area, readings, &theme),
         None => {}
     }
 }

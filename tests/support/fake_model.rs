@@ -61,6 +61,7 @@ impl LanguageModel for FixtureModel {
                 });
             };
             Ok(ChatReply {
+                ranked: Vec::new(),
                 text: f.text.clone(),
                 model: "fixture-model".into(),
                 usage: TokenUsage {

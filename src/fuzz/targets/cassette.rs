@@ -83,6 +83,7 @@ fn entry(rng: &mut Rng) -> Entry {
         }),
     };
     let request = ChatRequest {
+        beams: None,
         messages: vec![Message::system(text(rng)), Message::user(text(rng))],
         temperature: *rng.pick(&[0.0f32, 0.7, 1.0, 0.1]).unwrap_or(&0.0),
         max_tokens: rng.below(2000) as u32,
@@ -99,6 +100,7 @@ fn entry(rng: &mut Rng) -> Entry {
         .copied()
         .unwrap_or("m");
     Entry {
+        ranked: Vec::new(),
         model: model.into(),
         reply_model: if rng.chance(50) {
             model.into()

@@ -49,6 +49,9 @@ pub struct Generation {
     pub stop: Vec<String>,
     /// A GBNF grammar the reply must follow (root rule `root`).
     pub grammar: Option<String>,
+    /// With a grammar and temperature 0: search this many beams for the answers the model
+    /// finds most likely as a whole ([`super::beam`]); 0 or 1: one greedy answer.
+    pub beams: u32,
 }
 
 /// What a generation produced, with its timings.
@@ -61,6 +64,9 @@ pub struct Generated {
     pub completion_tokens: u32,
     pub prompt_time: Duration,
     pub generation_time: Duration,
+    /// With beams: every answer found with its log-probability, best first (`text` is
+    /// the first).
+    pub ranked: Vec<(String, f64)>,
 }
 
 /// Refuse a file that does not start as a GGUF model does, before llama.cpp reads it.
@@ -221,7 +227,11 @@ fn worker(
         .with_n_ctx(NonZeroU32::new(options.context.max(512)))
         .with_n_batch(512)
         .with_n_threads(threads)
-        .with_n_threads_batch(threads);
+        .with_n_threads_batch(threads)
+        // Beams are cache sequences beside the prompt's; one unified cache keeps the whole
+        // context for each.
+        .with_n_seq_max(super::beam::SEQUENCES)
+        .with_kv_unified(true);
     let mut ctx = match model.new_context(backend, params) {
         Ok(c) => c,
         Err(e) => {
@@ -350,6 +360,42 @@ fn generate(
         ),
         None => None,
     };
+    if job.beams > 1
+        && job.temperature <= 0.0
+        && let Some(grammar) = grammar.take()
+    {
+        let generation_started = Instant::now();
+        let first = ctx.get_logits_ith(batch.n_tokens() - 1).to_vec();
+        let searched = super::beam::search(
+            model,
+            ctx,
+            (tokens.len(), first),
+            grammar,
+            job.beams as usize,
+            (job.max_tokens, &job.stop),
+        )?;
+        for f in &searched.found {
+            tracing::debug!(logprob = f.logprob, text = %f.text, "beam answer");
+        }
+        let text = searched
+            .found
+            .first()
+            .map(|f| f.text.clone())
+            .unwrap_or_default();
+        return Ok(Generated {
+            text,
+            prompt_tokens: tokens.len() as u32,
+            cached_tokens: keep as u32,
+            completion_tokens: searched.decoded,
+            prompt_time,
+            generation_time: generation_started.elapsed(),
+            ranked: searched
+                .found
+                .into_iter()
+                .map(|f| (f.text, f.logprob))
+                .collect(),
+        });
+    }
     let mut pick = if job.temperature > 0.0 {
         LlamaSampler::chain_simple([
             LlamaSampler::temp(job.temperature),
@@ -394,6 +440,7 @@ fn generate(
         completion_tokens: produced,
         prompt_time,
         generation_time: generation_started.elapsed(),
+        ranked: Vec::new(),
     })
 }
 

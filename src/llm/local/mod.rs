@@ -1,6 +1,7 @@
 //! The embedded backend (`--backend local`): a GGUF model run in-process by llama.cpp,
 //! with grammar-constrained decoding so replies can only use the scenario's vocabulary.
 
+mod beam;
 pub mod engine;
 pub mod prompt_state;
 pub mod threads;
@@ -64,6 +65,11 @@ impl LanguageModel for LocalModel {
                 // llama.cpp takes a 32-bit seed; evaluation seeds are small run numbers.
                 seed: request.seed.map_or(0, |s| (s % u64::from(u32::MAX)) as u32),
                 stop: request.stop.clone(),
+                beams: if grammar.is_some() {
+                    request.beams.unwrap_or(1)
+                } else {
+                    1
+                },
                 grammar,
             };
             let started = Instant::now();
@@ -89,6 +95,7 @@ impl LanguageModel for LocalModel {
                 },
                 latency: started.elapsed(),
                 source: ReplySource::Model,
+                ranked: out.ranked,
             })
         })
     }

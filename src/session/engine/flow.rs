@@ -12,6 +12,7 @@ use crate::world;
 
 use super::super::planned::PlanSummary;
 use super::super::policy;
+use super::super::readings::distinct_readings;
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Task};
 
@@ -38,6 +39,7 @@ impl Engine {
     }
 
     pub(super) fn submit(&mut self, text: &str) {
+        self.choosing = None;
         let text = text.trim();
         if text.is_empty() {
             return self.error("nothing to submit: type an instruction or a goal");
@@ -60,6 +62,50 @@ impl Engine {
                 crate::excerpt::excerpt(text, None)
             )),
         }
+    }
+
+    /// Work on what `read` found for `instruction`: its goal, or — when the person chooses
+    /// and more than one reading would make the robot do different things — the choice.
+    pub(super) fn on_interpretation(
+        &mut self,
+        read: super::super::interpret::Interpretation,
+        instruction: String,
+    ) {
+        if self.options.choose_reading && read.readings.len() > 1 {
+            let readings =
+                distinct_readings(&self.scenario, self.planning.as_ref(), &read.readings);
+            if readings.len() > 1 {
+                self.emit(Event::Readings {
+                    instruction: instruction.clone(),
+                    readings: readings.clone(),
+                });
+                self.choosing = Some((instruction, readings));
+                return;
+            }
+        }
+        self.task = Some(Task {
+            goal: read.answer.goal,
+            instruction: Some(instruction),
+        });
+        self.plan();
+    }
+
+    /// Work on reading `index` (from 0) of those offered.
+    pub(super) fn choose_reading(&mut self, index: usize) {
+        let Some((instruction, readings)) = self.choosing.take() else {
+            return self.error("no readings to choose among: type an instruction first (i)");
+        };
+        let Some(reading) = readings.get(index) else {
+            let count = readings.len();
+            self.choosing = Some((instruction, readings));
+            return self.error(format!(
+                "no reading {}: the instruction has {count} readings (1 to {count})",
+                index + 1
+            ));
+        };
+        let goal = reading.goal.clone();
+        self.notice(format!("reading {} chosen: {goal}", index + 1));
+        self.start_task(goal, Some(instruction));
     }
 
     /// The goal a saved policy recorded for this instruction (no model call needed).

@@ -175,6 +175,8 @@ pub enum Command {
     DeclineRule,
     /// The kept rules of the scenario's domain (`Event::Knowledge`).
     ShowKnowledge,
+    /// Work on reading N (from 0) of those `Event::Readings` offered.
+    ChooseReading(usize),
     /// Stop the engine's loop.
     Shutdown,
 }
@@ -274,6 +276,8 @@ pub struct Engine {
     /// Whether the tree was planned in the planner's model (by `Verify` before the first
     /// tick) rather than in simulation.
     planned_in_model: bool,
+    /// The readings of an instruction offered for the person to choose among, with it.
+    choosing: Option<(String, Vec<super::readings::Reading>)>,
 
     events: UnboundedSender<Event>,
     internal_tx: UnboundedSender<Internal>,
@@ -340,6 +344,7 @@ impl Engine {
             last_change: None,
             violation: None,
             planned_in_model: false,
+            choosing: None,
             events,
             internal_tx,
             internal_rx,
@@ -436,6 +441,7 @@ impl Engine {
             Command::KeepRule { only } => self.keep_rule(only),
             Command::DeclineRule => self.decline_rule(),
             Command::ShowKnowledge => self.show_knowledge(),
+            Command::ChooseReading(index) => self.choose_reading(index),
             Command::Shutdown => self.set_running(false),
         }
     }

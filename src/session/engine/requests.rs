@@ -6,23 +6,22 @@ use std::sync::Arc;
 
 use crate::llm::LanguageModel;
 use crate::llm::prompt::Context;
-use crate::llm::reply::GoalAnswer;
 use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
 use super::super::ask::{Asked, FailedAction, Tried, ask_conditions, ask_value, missing_value};
-use super::super::interpret::interpret;
+use super::super::interpret::{Interpretation, interpret};
 use super::super::policy::Approval;
 use super::super::screen::Screen;
 use super::super::types::{Event, SessionError};
-use super::{Engine, Failure, Pending, Request, Task};
+use super::{Engine, Failure, Pending, Request};
 
 /// What background work sends back to the engine.
 pub(crate) enum Internal {
     Goal {
         id: u64,
         instruction: String,
-        result: Result<GoalAnswer, SessionError>,
+        result: Result<Interpretation, SessionError>,
         replies: Vec<Reply>,
     },
     Proposal {
@@ -110,7 +109,6 @@ impl Engine {
                     &mut emit,
                 )
                 .await
-                .map(|i| i.answer)
             };
             let _ = tx.send(Internal::Goal {
                 id,
@@ -241,13 +239,7 @@ impl Engine {
                 }
                 self.request = None;
                 match result {
-                    Ok(answer) => {
-                        self.task = Some(Task {
-                            goal: answer.goal,
-                            instruction: Some(instruction),
-                        });
-                        self.plan();
-                    }
+                    Ok(read) => self.on_interpretation(read, instruction),
                     Err(error) => self.emit(Event::Failed { error }),
                 }
             }

@@ -18,6 +18,7 @@ impl App {
             | Event::InvalidReply { .. }
             | Event::CandidateRejected { .. }
             | Event::Goal { .. }
+            | Event::Readings { .. }
             | Event::Usage { .. }) => self.on_model_talk(e),
             e @ (Event::TreeChanged { .. } | Event::Repaired { .. }) => self.on_tree_change(e),
             e @ (Event::ActionFailed { .. }
@@ -76,6 +77,14 @@ impl App {
                 self.status.awaiting = None;
                 self.llm.goal = Some(goal.to_string());
                 self.llm.reasoning = reasoning;
+            }
+            Event::Readings { readings, .. } => {
+                self.status.awaiting = None;
+                self.llm.log(format!(
+                    "the instruction reads {} ways that make the robot do different things: choose one",
+                    readings.len()
+                ));
+                self.overlay = Some(Overlay::Readings(readings));
             }
             Event::Usage { totals } => self.status.usage = totals,
             _ => {}

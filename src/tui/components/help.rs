@@ -111,7 +111,43 @@ pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
     lines
 }
 
+/// The verification report in a box over the screen.
 pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme) {
+    draw_box(frame, area, lines, theme, strings::VERIFY_TITLE);
+}
+
+/// The readings of an instruction to choose among, each with its number, its words, its
+/// goal and the first actions of its plan.
+pub fn readings_lines(readings: &[crate::session::Reading]) -> Vec<String> {
+    let mut lines = vec![strings::READINGS_INTRO.to_string()];
+    for (i, r) in readings.iter().enumerate() {
+        lines.push(String::new());
+        lines.push(format!("{}  {}", i + 1, r.words));
+        lines.push(format!("   goal: {}", r.goal));
+        if !r.first_actions.is_empty() {
+            lines.push(format!("   first: {}", r.first_actions.join(", ")));
+        }
+    }
+    lines
+}
+
+/// The readings to choose among in a box over the screen.
+pub fn draw_readings(
+    frame: &mut Frame,
+    area: Rect,
+    readings: &[crate::session::Reading],
+    theme: &Theme,
+) {
+    draw_box(
+        frame,
+        area,
+        &readings_lines(readings),
+        theme,
+        strings::READINGS_TITLE,
+    );
+}
+
+fn draw_box(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme, title: &str) {
     let width = area.width.saturating_sub(8).max(20);
     let inner = usize::from(width.saturating_sub(2)).max(1);
     // Wrapped lines take more than one row each.
@@ -124,7 +160,7 @@ pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Them
     let block = Block::default()
         .borders(Borders::ALL)
         .border_style(theme.key)
-        .title(Span::styled(strings::VERIFY_TITLE, theme.title));
+        .title(Span::styled(title.to_string(), theme.title));
     let text: Vec<Line> = lines.iter().map(|l| Line::from(l.clone())).collect();
     frame.render_widget(
         Paragraph::new(text).wrap(Wrap { trim: false }).block(block),

@@ -35,6 +35,7 @@ impl LanguageModel for Scenario1 {
             "Goal: \"blue cube\" on \"green cube\"\n"
         };
         Box::pin(std::future::ready(Ok(ChatReply {
+            ranked: Vec::new(),
             text: text.into(),
             model: "fixture-model".into(),
             usage: TokenUsage {
