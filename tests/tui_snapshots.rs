@@ -595,3 +595,50 @@ fn a_replay_steps_back_to_the_failure_and_on_to_the_proposal() {
     assert!(!help.contains("approve the proposal"), "{help}");
     insta::assert_snapshot!("replay_help", help);
 }
+
+#[test]
+fn readings_to_choose_among_are_shown_over_the_screen() {
+    let path = fixtures::root().join("scenarios/cafe/cafe.toml");
+    let scenario = Arc::new(Scenario::load(&path).unwrap());
+    let world = betr::world::load(&scenario).unwrap();
+    let goals = [
+        scenario
+            .parse_goal("On_Chips_Table3 & On_Dessert_Table3")
+            .unwrap(),
+        scenario
+            .parse_goal("Exists_Dessert & RobotNear_Table3")
+            .unwrap(),
+    ];
+    let readings = betr::session::readings::distinct_readings(&scenario, world.as_ref(), &goals);
+    assert_eq!(readings.len(), 2);
+    let mut app = App::new(
+        scenario,
+        Info::default(),
+        KeyBindings::default(),
+        Theme::default(),
+    );
+    app.on_session(Event::Readings {
+        instruction: "Please bring the chips and a dessert to table 3.".into(),
+        readings,
+    });
+    let draw = |app: &mut App| {
+        let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
+        terminal.draw(|f| ui::draw(f, app)).unwrap();
+        terminal.backend().to_string()
+    };
+    let screen = draw(&mut app);
+    assert!(screen.contains("Readings of the instruction"), "{screen}");
+    insta::assert_snapshot!("readings_overlay", screen);
+    // Keys other than a reading's number leave the choice open.
+    for code in [KeyCode::Char(' '), KeyCode::Char('9'), KeyCode::Enter] {
+        app.on_key(KeyEvent::new(code, KeyModifiers::NONE));
+    }
+    assert!(app.take_requests().is_empty());
+    assert!(draw(&mut app).contains("Readings of the instruction"));
+    app.on_key(KeyEvent::new(KeyCode::Char('2'), KeyModifiers::NONE));
+    assert_eq!(
+        app.take_requests(),
+        vec![Request::Session(Command::ChooseReading(1))]
+    );
+    assert!(!draw(&mut app).contains("Readings of the instruction"));
+}

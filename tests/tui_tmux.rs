@@ -25,7 +25,17 @@ use support::tmux::{Tmux, quote};
 /// The shell command that opens the workbench on scenario 1 in `dir`, with the model
 /// answered by `server`, then says how it exited.
 fn workbench_command(dir: &Path, server: &FakeServer, env: &str, extra: &str) -> String {
-    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    workbench_command_on("scenarios/cell/red_on_blue.toml", dir, server, (env, extra))
+}
+
+/// The same on `scenario` (relative to the crate root).
+fn workbench_command_on(
+    scenario: &str,
+    dir: &Path,
+    server: &FakeServer,
+    (env, extra): (&str, &str),
+) -> String {
+    let scenario = fixtures::root().join(scenario);
     format!(
         "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
          XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {env} {bin} tui {scenario} --backend openai \
@@ -559,4 +569,50 @@ fn replay_position(screen: &str) -> (usize, usize) {
     let field = screen[at..].split_whitespace().next().unwrap();
     let (p, n) = field.split_once('/').unwrap();
     (p.parse().unwrap(), n.parse().unwrap())
+}
+
+/// An answer that misreads the request ("the chips and a dessert to table 3" read as a
+/// dessert made and the robot at table 3) gives two readings that make the robot do
+/// different things: the workbench offers both, and the person takes the second.
+#[test]
+fn a_person_chooses_the_second_reading_of_an_instruction() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-readings");
+    let tmux = Tmux::start(&workbench_command_on(
+        "scenarios/cafe/cafe.toml",
+        &dir,
+        &server,
+        ("", ""),
+    ));
+    tmux.wait_for(&["Behavior tree", "press i to type an instruction"], 20);
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("Please bring the chips and a dessert to table 3.");
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for(&["Readings of the instruction", "goal: ", "first: "], 30);
+    let first = screen
+        .lines()
+        .position(|l| l.contains("goal: On_Chips_Table3 & On_Dessert_Table3"));
+    let second = screen
+        .lines()
+        .position(|l| l.contains("goal: Exists_Dessert & RobotNear_Table3"));
+    assert!(
+        matches!((first, second), (Some(a), Some(b)) if a < b),
+        "the put-there reading first, the model's own second:\n{screen}"
+    );
+    // Other keys leave the choice open; the number chooses.
+    tmux.keys(&["Space"]);
+    tmux.wait_for(&["Readings of the instruction"], 5);
+    tmux.keys(&["2"]);
+    let screen = tmux.wait_for(
+        &[
+            "Goal: Exists_Dessert & RobotNear_Table3",
+            "Make \"Dessert\"!",
+        ],
+        20,
+    );
+    assert!(
+        !screen.contains("Readings of the instruction") && !screen.contains("PutDown"),
+        "the tree is the second reading's:\n{screen}"
+    );
 }

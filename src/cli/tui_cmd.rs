@@ -142,6 +142,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let record = args
         .viz
         .recorder(&scenario, &path, args.variant.as_deref())?;
+    // A person is there to choose among readings that make the robot do different things.
+    let options = betr::session::Options {
+        choose_reading: true,
+        ..options
+    };
     let setup = Setup {
         variant: args.variant.clone(),
         ledger: Some(ledger),
