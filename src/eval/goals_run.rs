@@ -136,6 +136,14 @@ async fn ask_one(
             result.first_correct = Some(false);
             result
         }
+        // A question too long for the model fails its case alone (feedback rounds make a
+        // prompt longer); the next case is asked as usual.
+        Err(session::SessionError::Llm(e @ crate::llm::LlmError::TooLong { .. })) => {
+            let mut result = score(vocabulary, case, None);
+            result.problem = Some(e.to_string());
+            result.first_correct = Some(false);
+            result
+        }
         Err(e) => {
             return Err(EvalError::Session {
                 case: format!(

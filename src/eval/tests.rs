@@ -193,3 +193,93 @@ fn the_goals_table_gives_the_time_a_person_waits_per_instruction() {
     );
     assert!(table.contains("| 2.00 s |"), "{table}");
 }
+
+/// A model whose context a request naming the curtain does not fit.
+struct Small;
+
+impl crate::llm::LanguageModel for Small {
+    fn model(&self) -> &str {
+        "small"
+    }
+    fn chat<'a>(&'a self, request: &'a crate::llm::ChatRequest) -> crate::llm::ChatFuture<'a> {
+        let too_long = request
+            .messages
+            .iter()
+            .any(|m| m.content.contains("Please close the curtain"));
+        Box::pin(async move {
+            if too_long {
+                return Err(crate::llm::LlmError::TooLong {
+                    tokens: 5000,
+                    context: 4096,
+                });
+            }
+            Ok(crate::llm::ChatReply {
+                ranked: Vec::new(),
+                text: "Goal: Active_AC".into(),
+                model: "small".into(),
+                usage: crate::llm::TokenUsage::default(),
+                latency: std::time::Duration::from_millis(1),
+                source: crate::llm::ReplySource::HandWritten {
+                    note: "unit test".into(),
+                },
+            })
+        })
+    }
+}
+
+#[test]
+fn a_case_past_the_context_window_fails_alone() {
+    use super::goals_run::run_goals;
+    use super::run::{RunConfig, Silent};
+    use crate::dataset::{Case, Difficulty};
+    let s = cafe();
+    let case = |index: usize, instruction: &str, gold: &str| Case {
+        difficulty: Difficulty::Easy,
+        index,
+        instruction: instruction.into(),
+        gold: gold.into(),
+    };
+    let cases = vec![
+        case(0, "Please switch the AC on.", "Active_AC"),
+        case(1, "Please close the curtain.", "Closed_Curtain"),
+        case(2, "The AC, on please.", "Active_AC"),
+    ];
+    let dir = std::env::temp_dir().join(format!("betr-too-long-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("dir");
+    let cfg = RunConfig {
+        runs: 1,
+        concurrency: 1,
+        limit: None,
+        prices: Default::default(),
+        progress: &Silent,
+    };
+    let rt = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .expect("runtime");
+    let model: std::sync::Arc<dyn crate::llm::LanguageModel> = std::sync::Arc::new(Small);
+    let results = rt
+        .block_on(run_goals(
+            &model,
+            &s,
+            &cases,
+            &crate::session::Options::default(),
+            &cfg,
+            &dir,
+        ))
+        .expect("the run goes on past the case that does not fit");
+    assert_eq!(results.cases.len(), 3);
+    assert_eq!(results.easy.correct, 2);
+    let failed = &results.cases[1];
+    assert!(!failed.correct);
+    assert!(
+        failed
+            .problem
+            .as_deref()
+            .is_some_and(|p| p.contains("past the model's context")),
+        "{:?}",
+        failed.problem
+    );
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}

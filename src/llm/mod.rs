@@ -209,6 +209,12 @@ pub enum LlmError {
     Cassette { path: String, detail: String },
     #[error("local model: {0}")]
     Local(String),
+    /// The prompt and the reply it may take are longer than the model's context window:
+    /// this question cannot be asked as it is, others can.
+    #[error(
+        "the prompt ({tokens} tokens with the reply's room) is past the model's context of {context} tokens"
+    )]
+    TooLong { tokens: usize, context: u32 },
 }
 
 /// The future a backend returns.

@@ -77,7 +77,12 @@ impl LanguageModel for LocalModel {
                 .engine
                 .generate(generation)
                 .await
-                .map_err(|e| LlmError::Local(e.to_string()))?;
+                .map_err(|e| match e {
+                    EngineError::PromptTooLong { tokens, context } => {
+                        LlmError::TooLong { tokens, context }
+                    }
+                    e => LlmError::Local(e.to_string()),
+                })?;
             tracing::debug!(
                 prompt_tokens = out.prompt_tokens,
                 cached_tokens = out.cached_tokens,
