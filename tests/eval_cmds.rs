@@ -146,6 +146,7 @@ fn goal_fixtures() -> Vec<FixtureReply> {
     cases()
         .iter()
         .map(|c| FixtureReply {
+            seed: None,
             when: vec![
                 "# Task: goal interpretation".into(),
                 format!("## Request\n{}\n", c.instruction),

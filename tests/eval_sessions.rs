@@ -108,6 +108,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     let note = format!("{}: tests/eval_cmds.rs", fixtures::SOURCE);
     let mut replies = vec![
         FixtureReply {
+            seed: None,
             when: vec![
                 "# Task: parameter value".into(),
                 "Bring me an egg".into(),
@@ -117,6 +118,7 @@ fn params_records_values_and_the_worlds_verdicts() {
             note: note.clone(),
         },
         FixtureReply {
+            seed: None,
             when: vec!["# Task: parameter value".into(), "Bring me an egg".into()],
             text: "Reasoning: hold it firmly.\nParameter value: 12 N".into(),
             note,
@@ -176,6 +178,7 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
     // by betr. The other scenarios answer from their fixture files.
     let note = format!("{}: tests/eval_sessions.rs", fixtures::SOURCE);
     let reply = |when: &[&str], value: &str| FixtureReply {
+        seed: None,
         when: when.iter().map(|w| (*w).to_string()).collect(),
         text: format!("Reasoning: a guess.\nParameter value: {value}"),
         note: note.clone(),

@@ -602,12 +602,8 @@ fn readings_to_choose_among_are_shown_over_the_screen() {
     let scenario = Arc::new(Scenario::load(&path).unwrap());
     let world = betr::world::load(&scenario).unwrap();
     let goals = [
-        scenario
-            .parse_goal("On_Chips_Table3 & On_Dessert_Table3")
-            .unwrap(),
-        scenario
-            .parse_goal("Exists_Dessert & RobotNear_Table3")
-            .unwrap(),
+        scenario.parse_goal("On_Dessert_Table3").unwrap(),
+        scenario.parse_goal("On_Chocolate_Table3").unwrap(),
     ];
     let readings = betr::session::readings::distinct_readings(&scenario, world.as_ref(), &goals);
     assert_eq!(readings.len(), 2);
@@ -618,7 +614,7 @@ fn readings_to_choose_among_are_shown_over_the_screen() {
         Theme::default(),
     );
     app.on_session(Event::Readings {
-        instruction: "Please bring the chips and a dessert to table 3.".into(),
+        instruction: "Bring something sweet to table 3.".into(),
         readings,
     });
     let draw = |app: &mut App| {

@@ -269,9 +269,10 @@ impl Judge<'_> {
 }
 
 impl Judge<'_> {
-    /// The distinct readings among `candidates` (and those `set_aside`) that passed the
-    /// checks or only raised a doubt, `chosen` first, then by the size of their group of
-    /// equivalent candidates, earlier drawn first on a tie; at most `k`.
+    /// The distinct readings among `candidates` (and `others`) that pass every check and
+    /// plainly misread nothing, `chosen` first, then by the size of their group of
+    /// equivalent candidates, earlier drawn first on a tie; at most `k`. A doubtful or
+    /// misread answer is no reading to offer: the judge has reasons against it.
     pub(super) fn readings(
         &self,
         chosen: &Formula,
@@ -282,7 +283,7 @@ impl Judge<'_> {
         let eligible: Vec<&GoalAnswer> = candidates
             .iter()
             .chain(others.iter().copied())
-            .filter(|c| c.clean() || c.doubtful())
+            .filter(|c| self.answers_request(c))
             .filter_map(|c| c.read.as_ref().ok())
             .collect();
         let mut groups: Vec<(usize, &Formula)> = Vec::new();

@@ -53,7 +53,7 @@ impl LanguageModel for FixtureModel {
             let Some(f) = self
                 .replies
                 .iter()
-                .find(|f| f.when.iter().all(|w| prompt.contains(w.as_str())))
+                .find(|f| f.answers(&prompt, request.seed))
             else {
                 return Err(LlmError::MalformedReply {
                     url: "fixture-model".into(),

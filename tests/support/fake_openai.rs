@@ -250,7 +250,8 @@ async fn serve(mut stream: TcpStream, state: Arc<Mutex<State>>) {
             ),
             Behavior::Fixtures(fixtures) => {
                 let prompt = prompt_of(&body);
-                match fixtures.iter().find(|f| f.when.iter().all(|w| prompt.contains(w.as_str()))) {
+                let seed = body["seed"].as_u64();
+                match fixtures.iter().find(|f| f.answers(&prompt, seed)) {
                     Some(f) => (200, vec![("x-betr-fixture", f.note.clone())], ok(&f.text)),
                     None => (
                         400,

@@ -21,13 +21,26 @@ pub struct FixtureFile {
 #[serde(deny_unknown_fields)]
 pub struct RawReply {
     pub when: Vec<String>,
+    /// Given only to a request with this seed (a sampled candidate); none: to any.
+    #[serde(default)]
+    pub seed: Option<u64>,
     pub text: String,
+}
+
+impl FixtureReply {
+    /// Whether this reply answers `prompt` asked with `seed`.
+    pub fn answers(&self, prompt: &str, seed: Option<u64>) -> bool {
+        self.when.iter().all(|w| prompt.contains(w.as_str()))
+            && self.seed.is_none_or(|s| seed == Some(s))
+    }
 }
 
 /// A reply ready for the fake server.
 #[derive(Debug, Clone)]
 pub struct FixtureReply {
     pub when: Vec<String>,
+    /// Given only to a request with this seed; none: to any.
+    pub seed: Option<u64>,
     pub text: String,
     /// What the `x-betr-fixture` header says.
     pub note: String,
@@ -74,6 +87,7 @@ pub fn replies(path: &Path, file: &FixtureFile) -> Vec<FixtureReply> {
         .iter()
         .map(|r| FixtureReply {
             when: r.when.clone(),
+            seed: r.seed,
             text: r.text.clone(),
             note: format!("{SOURCE}: tests/fixtures/replies/{name}"),
         })
