@@ -318,7 +318,9 @@ const NUMBER_EXAMPLES: &str = "- Action `pour \"tea\" \"cup\"` needs the pour ra
 /// The same two choices for a parameter asked as one of a few choices.
 const CHOICE_EXAMPLES: &str = "- Action `pour \"tea\" \"cup\"` needs the pour rate (one of: slow, steady, fast). Reasoning: hot tea into a small cup: too fast overflows it and scalds the person; too slow only takes a little longer. Parameter value: slow\n- Action `lift \"cement sack\"` needs the lifting force (one of: light, firm, full). Reasoning: a 25 kg sack is heavy and cannot be hurt: too little drops it on someone's feet; more than enough does no harm. Parameter value: full";
 
-const OBJECT_RULE: &str = "Use only the objects listed above, spelled exactly as listed. If the person names something that is not listed, use the listed object most similar to it (for example, if they ask for fries and only Chips is listed, use Chips).";
+/// Says how to answer for a thing named otherwise than listed; its example names objects
+/// of no scenario, so no domain's objects are suggested to another's requests.
+const OBJECT_RULE: &str = "Use only the objects listed above, spelled exactly as listed. If the person names something that is not listed, use the listed object it most likely means (for example, if they ask for a sofa and only Couch is listed, use Couch).";
 
 fn messages(user: String) -> Vec<Message> {
     vec![Message::system(ROLE), Message::user(user)]
