@@ -107,7 +107,7 @@ fn a_convention_is_told_only_in_a_scene_with_its_objects() {
     // A scene without conventions reads as before: the object rule, then the next part.
     let cafe = goal_prompt("scenarios/cafe/no_coffee.toml");
     assert!(
-        cafe.contains("use Chips).\n\n## How to write a goal"),
+        cafe.contains("use Couch).\n\n## How to write a goal"),
         "{cafe}"
     );
 }
