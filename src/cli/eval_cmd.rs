@@ -247,8 +247,28 @@ pub fn goals_with_model(
     let p = prepare(flags, &[("dataset", dataset_dir.display().to_string())])?;
     let dir =
         eval::output_dir(flags.out.as_deref(), "goals").context("creating the output directory")?;
-    eval::run::check_settings(&dir, "goals", &p.settings)?;
     p.llm.model.set_purpose("eval goals");
+    let in_scene: Vec<goals_run::SceneCase> = cases
+        .iter()
+        .map(|case| goals_run::SceneCase {
+            scenario: &scenario,
+            case: case.clone(),
+        })
+        .collect();
+    goal_set(&p, &in_scene, runs, flags, &dir)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One set of requests read and scored into `dir` (resumed from its journal), with its
+/// table, CSV, JSON and chart written there.
+fn goal_set(
+    p: &super::eval_setup::Prepared,
+    cases: &[goals_run::SceneCase],
+    runs: usize,
+    flags: &RunFlags,
+    dir: &Path,
+) -> Result<goals::GoalsResults> {
+    eval::run::check_settings(dir, "goals", &p.settings)?;
     let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let bar = Bar::new();
     let cfg = RunConfig {
@@ -259,25 +279,24 @@ pub fn goals_with_model(
         progress: &bar,
     };
     let results = super::runtime()?
-        .block_on(goals_run::run_goals(
+        .block_on(goals_run::run_goals_in_scenes(
             &model,
-            &scenario,
-            &cases,
+            cases,
             &p.llm.options,
             &cfg,
-            &dir,
+            dir,
         ))
-        .with_context(|| stopped(&dir))?;
+        .with_context(|| stopped(dir))?;
     let table = goals_run::table(
         &results,
         &p.label,
         p.llm.options.temperature,
         cfg.runs * cases.len(),
     );
-    write_all(&dir, &results, &results.csv(), &table, || {
-        goals_chart(&dir, &p.label, &results)
+    write_all(dir, &results, &results.csv(), &table, || {
+        goals_chart(dir, &p.label, &results)
     })?;
-    Ok(ExitCode::SUCCESS)
+    Ok(results)
 }
 
 /// `betr eval goals --suite FILE`: every set of the suite, each into `OUT/<set>/` (resumed
@@ -288,22 +307,12 @@ fn goals_suite(suite: &Path, runs: usize, flags: &RunFlags) -> Result<ExitCode> 
     let dir = eval::output_dir(flags.out.as_deref(), "goals-suite")
         .context("creating the output directory")?;
     p.llm.model.set_purpose("eval goals");
-    let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let mut done: Vec<(String, bool, goals::GoalsResults)> = Vec::new();
     for set in &sets {
         let set_dir = dir.join(&set.name);
         std::fs::create_dir_all(&set_dir)
             .with_context(|| format!("creating {}", set_dir.display()))?;
-        eval::run::check_settings(&set_dir, "goals", &p.settings)?;
         eprintln!("{}: {} request(s)", set.name, set.cases.len());
-        let bar = Bar::new();
-        let cfg = RunConfig {
-            runs: runs.max(1),
-            concurrency: p.concurrency,
-            limit: flags.limit,
-            prices: p.llm.settings.prices.clone(),
-            progress: &bar,
-        };
         let cases: Vec<goals_run::SceneCase> = set
             .cases
             .iter()
@@ -312,24 +321,7 @@ fn goals_suite(suite: &Path, runs: usize, flags: &RunFlags) -> Result<ExitCode> 
                 case: case.clone(),
             })
             .collect();
-        let results = super::runtime()?
-            .block_on(goals_run::run_goals_in_scenes(
-                &model,
-                &cases,
-                &p.llm.options,
-                &cfg,
-                &set_dir,
-            ))
-            .with_context(|| stopped(&dir))?;
-        let table = goals_run::table(
-            &results,
-            &p.label,
-            p.llm.options.temperature,
-            cfg.runs * cases.len(),
-        );
-        write_all(&set_dir, &results, &results.csv(), &table, || {
-            goals_chart(&set_dir, &p.label, &results)
-        })?;
+        let results = goal_set(&p, &cases, runs, flags, &set_dir)?;
         done.push((set.name.clone(), set.tuned, results));
     }
     let rows: Vec<eval::suite::SetRow> = done
