@@ -391,3 +391,89 @@ fn original_examples_without_a_file_is_refused() {
     assert!(text(&o).contains("not shipped"), "{}", text(&o));
     assert!(server.received().is_empty());
 }
+
+/// A suite of two sets: the 100 cafe requests and the cell's scenario files, each in its
+/// own scene, read by the fake server (the fixtures' answers for both).
+#[test]
+fn a_suite_puts_its_sets_side_by_side() {
+    let dir = tmp("eval-suite");
+    let mut replies = goal_fixtures();
+    replies.extend(fixtures::every_reply());
+    let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
+    let root = fixtures::root();
+    let suite = dir.join("suite.toml");
+    std::fs::write(
+        &suite,
+        format!(
+            "[[set]]\nname = \"cafe\"\nscenario = {:?}\ndataset = {:?}\ntuned = true\n\n\
+             [[set]]\nname = \"cell\"\nscenarios = {:?}\n",
+            cafe(),
+            dataset_dir().display().to_string(),
+            root.join("scenarios/cell").display().to_string(),
+        ),
+    )
+    .unwrap();
+    let url = server.base_url();
+    let suite_arg = suite.display().to_string();
+    let o = betr(
+        &dir,
+        &[
+            "eval",
+            "goals",
+            "--suite",
+            &suite_arg,
+            "--out",
+            "out",
+            "--backend",
+            "openai",
+            "--base-url",
+            &url,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            KEY_VAR,
+            "--whole-request",
+            "--concurrency",
+            "4",
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let table = std::fs::read_to_string(dir.join("out/suite.md")).unwrap();
+    // The cafe's first answers as in the single run.
+    assert!(
+        table.contains("| cafe | yes | 100 | 90.0% (90/100) |"),
+        "{table}"
+    );
+    let cell = table
+        .lines()
+        .find(|l| l.starts_with("| cell | no |"))
+        .unwrap_or_else(|| panic!("no cell row:\n{table}"));
+    assert!(
+        cell.starts_with("| cell | no | 21 | 100.0% (21/21) |"),
+        "{cell}"
+    );
+    for set in ["cafe", "cell"] {
+        assert!(dir.join("out").join(set).join("results.json").is_file());
+    }
+    // A set with neither a dataset nor scenario files is refused, naming it.
+    std::fs::write(&suite, "[[set]]\nname = \"x\"\nscenario = \"a.toml\"\n").unwrap();
+    let o = betr(
+        &dir,
+        &[
+            "eval",
+            "goals",
+            "--suite",
+            &suite_arg,
+            "--backend",
+            "openai",
+            "--base-url",
+            &url,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            KEY_VAR,
+        ],
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("set \"x\" needs either"), "{}", text(&o));
+}

@@ -246,11 +246,18 @@ pub fn table(rows: &[SetRow]) -> String {
     for row in rows {
         let r = row.results;
         let after = Some([r.easy, r.medium, r.hard]);
+        let share = |t: &Tally| {
+            if t.total == 0 {
+                "–".to_string()
+            } else {
+                format!("{:.0}", t.percent())
+            }
+        };
         let by_difficulty = format!(
-            "{:.0} / {:.0} / {:.0} %",
-            r.easy.percent(),
-            r.medium.percent(),
-            r.hard.percent()
+            "{} / {} / {} %",
+            share(&r.easy),
+            share(&r.medium),
+            share(&r.hard)
         );
         let n = r.cases.len().max(1);
         let calls: usize = r.cases.iter().map(|c| c.calls.len()).sum();
