@@ -1,5 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
+#[macro_use]
+pub mod out;
 mod bench_cmd;
 mod engine_driver;
 mod eval_cmd;

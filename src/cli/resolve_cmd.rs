@@ -1,6 +1,6 @@
 //! `betr interpret` and `betr resolve`: the commands that ask a language model.
 
-use std::io::{BufRead, Write};
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -10,6 +10,7 @@ use anyhow::{Context as _, Result};
 use betr::bt::{self, Glyphs, TickRecord};
 use betr::llm::LanguageModel;
 use betr::llm::usage::Metered;
+use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
 use betr::session::{self, Ending, Event};
 
@@ -115,14 +116,14 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
 }
 
 fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -> Result<ExitCode> {
-    let llm = setup(flags)?;
     let instruction = instruction
         .map(str::to_string)
         .or_else(|| scenario.instruction.clone())
         .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
+    let llm = setup(flags)?;
     llm.model.set_purpose("interpret");
-    println!("Scenario:    {}", scenario.name);
-    println!("Instruction: {instruction}");
+    outln!("Scenario:    {}", scenario.name);
+    outln!("Instruction: {instruction}");
     let mut emit = |e: &Event| print_event(e, flags.show_replies);
     let result = super::runtime()?.block_on(session::interpret::interpret_in_scenario(
         scenario,
@@ -134,11 +135,12 @@ fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -
     print_usage(&llm.model);
     let reading = result?;
     if let Some(why) = &reading.doubt {
-        println!("note: kept with a doubt: {why}");
+        outln!("note: kept with a doubt: {why}");
     }
-    println!(
+    outln!(
         "{} call(s), {} feedback round(s)",
-        reading.calls, reading.feedback_rounds
+        reading.calls,
+        reading.feedback_rounds
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -161,15 +163,25 @@ fn resolve(
     flags: &LlmFlags,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
+    // Where the work will be kept, checked before any of it is done.
+    let default_save = default_policy_path(args.scenario_path);
+    let save_to = args.save.unwrap_or(&default_save);
+    betr::store::check_writable(save_to)
+        .with_context(|| format!("the tree is to be saved to {}", save_to.display()))?;
+    if let Some(dir) = args.learn
+        && let Some(path) = dir.knowledge_path()
+    {
+        betr::store::check_writable(&path).context("--learn")?;
+    }
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
-    println!("Scenario:    {}", scenario.name);
+    outln!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
-        println!("Instruction: {i}");
+        outln!("Instruction: {i}");
         if let Some(v) = viz.as_mut() {
             v.instruction(i);
         }
@@ -208,31 +220,41 @@ fn resolve(
             return Err(e.into());
         }
     };
-    println!();
-    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
-        println!("{line}");
+    // A recording asked for and not made is a failed command, not a note.
+    if let Some(why) = record.as_ref().and_then(SessionRecorder::stopped) {
+        print_usage(&llm.model);
+        anyhow::bail!("--record: {why}");
     }
     let success = matches!(resolved.ending, Ending::Success { .. });
-    let save = match args.save {
+    // Saved before anything is printed: the tree is kept whatever happens to the output.
+    let saved = match args.save {
         Some(p) => Some(p.to_path_buf()),
-        None if success => Some(default_policy_path(args.scenario_path)),
+        None if success => Some(default_save.clone()),
         None => None,
-    };
-    match save {
-        Some(path) if success || resolved.repairs > 0 => {
-            betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
-                .with_context(|| format!("saving the tree to {}", path.display()))?;
-            let note = if success { "" } else { " (it still fails)" };
-            println!("\nSaved the tree to {}{note}", path.display());
-        }
-        _ => println!("\nNothing saved: no change was kept."),
     }
-    println!(
+    .filter(|_| success || resolved.repairs > 0);
+    if let Some(path) = &saved {
+        betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
+            .with_context(|| format!("saving the tree to {}", path.display()))?;
+    }
+    outln!();
+    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
+        outln!("{line}");
+    }
+    match &saved {
+        Some(path) => {
+            let note = if success { "" } else { " (it still fails)" };
+            outln!("\nSaved the tree to {}{note}", path.display());
+        }
+        None => outln!("\nNothing saved: no change was kept."),
+    }
+    outln!(
         "{} question(s) about failures, {} change(s) kept",
-        resolved.rounds, resolved.repairs
+        resolved.rounds,
+        resolved.repairs
     );
     if let Some(dir) = args.learn.filter(|_| success) {
-        println!();
+        outln!();
         super::knowledge_cmd::offer(scenario, args.scenario_path, &resolved.kept, dir, args.yes)?;
     }
     print_usage(&llm.model);
@@ -252,15 +274,15 @@ fn default_policy_path(scenario: &Path) -> PathBuf {
 
 fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {
     if yes {
-        println!("Approve? yes (--yes)");
+        outln!("Approve? yes (--yes)");
         return true;
     }
-    print!("Approve: {proposal}? [y/N] ");
-    let _ = std::io::stdout().flush();
+    out!("Approve: {proposal}? [y/N] ");
+    super::out::flush();
     let mut line = String::new();
     match std::io::stdin().lock().read_line(&mut line) {
         Ok(0) | Err(_) => {
-            println!("(no answer: not approved)");
+            outln!("(no answer: not approved)");
             false
         }
         Ok(_) => matches!(line.trim().to_ascii_lowercase().as_str(), "y" | "yes"),
@@ -271,7 +293,7 @@ fn print_event(event: &Event, show_replies: bool) {
     match event {
         Event::Replied { text, .. } if show_replies => {
             print_event_line(event);
-            println!("  ┌ reply text\n{}\n  └", indent(text));
+            outln!("  ┌ reply text\n{}\n  └", indent(text));
         }
         _ => print_event_line(event),
     }
@@ -286,22 +308,22 @@ fn indent(text: &str) -> String {
 
 fn print_event_line(event: &Event) {
     match event {
-        Event::Asking { what } => println!("\n→ asking for {what}"),
+        Event::Asking { what } => outln!("\n→ asking for {what}"),
         Event::Replied {
             attribution,
             prompt_tokens,
             completion_tokens,
             latency_ms,
             ..
-        } => println!(
+        } => outln!(
             "  reply from {attribution}: {prompt_tokens} prompt + {completion_tokens} completion tokens, {:.2} s",
             *latency_ms as f64 / 1000.0
         ),
-        Event::InvalidReply { error } => println!("  unusable reply: {error}"),
+        Event::InvalidReply { error } => outln!("  unusable reply: {error}"),
         Event::CandidateRejected {
             candidate, reason, ..
         } => {
-            println!("  set aside {candidate}: {reason}");
+            outln!("  set aside {candidate}: {reason}");
         }
         Event::Goal {
             goal,
@@ -310,17 +332,17 @@ fn print_event_line(event: &Event) {
             matches_expected,
         } => {
             if let Some(r) = reasoning {
-                println!("Reasoning: {r}");
+                outln!("Reasoning: {r}");
             }
             for s in substitutions {
-                println!("  note: {s}");
+                outln!("  note: {s}");
             }
             let check = match matches_expected {
                 Some(true) => "  (equivalent to the scenario's goal)",
                 Some(false) => "  (differs from the scenario's goal)",
                 None => "",
             };
-            println!("Goal: {goal}{check}");
+            outln!("Goal: {goal}{check}");
         }
         Event::ActionFailed {
             action,
@@ -328,7 +350,7 @@ fn print_event_line(event: &Event) {
             error,
             ..
         } => {
-            println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
+            outln!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
         }
         Event::Proposal {
             proposal,
@@ -337,32 +359,32 @@ fn print_event_line(event: &Event) {
             author,
         } => {
             if let Some(r) = reasoning {
-                println!("Reasoning: {r}");
+                outln!("Reasoning: {r}");
             }
             for s in substitutions {
-                println!("  note: {s}");
+                outln!("  note: {s}");
             }
-            println!("Proposal: {proposal} (by {author})");
+            outln!("Proposal: {proposal} (by {author})");
         }
         Event::Approved => {}
-        Event::Rejected => println!("Not approved; stopping."),
+        Event::Rejected => outln!("Not approved; stopping."),
         Event::Repaired {
             added_nodes,
             valued_nodes: 0,
-        } => println!("Repaired: {added_nodes} node(s) added"),
+        } => outln!("Repaired: {added_nodes} node(s) added"),
         Event::Repaired {
             added_nodes,
             valued_nodes,
         } => {
-            println!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
+            outln!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
         }
         Event::DidNotHelp { reason } => {
-            println!("The change did not help and was undone: {reason}")
+            outln!("The change did not help and was undone: {reason}")
         }
-        Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
-        Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        Event::Success { ticks } => outln!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
+        Event::GaveUp { reason } => outln!("\nGave up: {reason}"),
         Event::ChangeViolates { report } => {
-            println!(
+            outln!(
                 "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
             );
             let mut err = std::io::stderr();
@@ -391,7 +413,7 @@ fn print_event_line(event: &Event) {
         | Event::RuleRefused { .. }
         | Event::Knowledge { .. }
         | Event::Notice { .. } => {}
-        Event::Error { message } => println!("error: {message}"),
+        Event::Error { message } => outln!("error: {message}"),
         // Returned by the loop as its error, and printed once by `main`.
         Event::Failed { .. } => {}
     }
@@ -403,5 +425,5 @@ fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
         .log_path()
         .map(|p| format!("; logged to {}", p.display()))
         .unwrap_or_default();
-    println!("LLM usage: {}{log}", ledger.totals());
+    outln!("LLM usage: {}{log}", ledger.totals());
 }
