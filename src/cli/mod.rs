@@ -240,10 +240,9 @@ fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>> {
 /// A goal formula for `flag`, its text echoed in an error as an excerpt around the
 /// column the error is about.
 fn parse_formula(scenario: &Scenario, flag: &str, text: &str) -> Result<Formula> {
-    let at = Formula::parse(text).err().map(|e| e.at);
     scenario
         .parse_goal(text)
-        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", excerpt(text, at)))
+        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", excerpt(text, Some(e.at()))))
 }
 
 /// The goal to plan: `--goal`, else the scenario's.

@@ -12,6 +12,7 @@ use betr::llm::LanguageModel;
 use betr::llm::usage::Metered;
 use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
+use betr::session::submitted::{self, Submitted};
 use betr::session::{self, Ending, Event};
 
 use super::llm_cmds::{LlmFlags, setup};
@@ -120,6 +121,15 @@ fn interpret(scenario: &Scenario, instruction: Option<&str>, flags: &LlmFlags) -
         .map(str::to_string)
         .or_else(|| scenario.instruction.clone())
         .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
+    // Read before any model is asked: empty text and a formula the scene lacks are refused.
+    let instruction = match submitted::read(scenario, &instruction)? {
+        Submitted::Goal(goal) => {
+            outln!("Scenario:    {}", scenario.name);
+            outln!("Goal:        {goal} (a goal formula of the scene: no model asked)");
+            return Ok(ExitCode::SUCCESS);
+        }
+        Submitted::Instruction(text) => text,
+    };
     let llm = setup(flags)?;
     llm.model.set_purpose("interpret");
     outln!("Scenario:    {}", scenario.name);
@@ -163,6 +173,13 @@ fn resolve(
     flags: &LlmFlags,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
+    // The instruction read before any model is asked: empty text and a formula the scene
+    // lacks are refused.
+    if !args.stated_goal
+        && let Some(text) = args.instruction.or(scenario.instruction.as_deref())
+    {
+        submitted::read(scenario, text)?;
+    }
     // Where the work will be kept, checked before any of it is done.
     let default_save = default_policy_path(args.scenario_path);
     let save_to = args.save.unwrap_or(&default_save);
@@ -328,14 +345,10 @@ fn print_event_line(event: &Event) {
         Event::Goal {
             goal,
             reasoning,
-            substitutions,
             matches_expected,
         } => {
             if let Some(r) = reasoning {
                 outln!("Reasoning: {r}");
-            }
-            for s in substitutions {
-                outln!("  note: {s}");
             }
             let check = match matches_expected {
                 Some(true) => "  (equivalent to the scenario's goal)",
@@ -355,14 +368,10 @@ fn print_event_line(event: &Event) {
         Event::Proposal {
             proposal,
             reasoning,
-            substitutions,
             author,
         } => {
             if let Some(r) = reasoning {
                 outln!("Reasoning: {r}");
-            }
-            for s in substitutions {
-                outln!("  note: {s}");
             }
             outln!("Proposal: {proposal} (by {author})");
         }

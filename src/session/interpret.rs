@@ -300,7 +300,6 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
     emit(&Event::Goal {
         goal: answer.goal.clone(),
         reasoning: answer.reasoning.clone(),
-        substitutions: answer.substitutions.clone(),
         matches_expected,
     });
 }
@@ -327,6 +326,7 @@ fn feedback(messages: &mut Vec<Message>, candidates: &[Candidate]) {
             problems.push(line);
         }
     }
+    // The answer is echoed cut, so a prompt never grows with a reply's size.
     messages.push(Message {
         role: Role::Assistant,
         content: first.text.trim().to_string(),

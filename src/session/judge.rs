@@ -353,7 +353,6 @@ impl Judge<'_> {
                 read: Ok(GoalAnswer {
                     goal,
                     reasoning: None,
-                    substitutions: Vec::new(),
                 }),
                 problem,
                 first,

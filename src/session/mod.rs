@@ -20,6 +20,7 @@ pub mod resolve;
 pub mod screen;
 pub mod shortlist;
 pub mod side_by_side;
+pub mod submitted;
 pub mod types;
 pub mod value_bounds;
 mod value_levels;

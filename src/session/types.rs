@@ -8,7 +8,7 @@ use crate::domain::{ActionCall, Condition, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
 use crate::llm::prompt::{PromptError, Templates, Variant};
-use crate::llm::reply::{self, ReplyError, Substitution};
+use crate::llm::reply::{self, ReplyError};
 use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
 use crate::scenario::ScenarioError;
@@ -57,6 +57,8 @@ pub struct Options {
     pub shortlist: bool,
     pub temperature: f32,
     pub max_tokens: u32,
+    /// How alike a listed name must be to be offered ("did you mean …?") for a name of a
+    /// reply that the scene does not have; nothing is ever replaced by it.
     pub min_similarity: f64,
     pub variant: Variant,
     pub templates: Templates,
@@ -202,7 +204,6 @@ pub enum Event {
     Goal {
         goal: Formula,
         reasoning: Option<String>,
-        substitutions: Vec<Substitution>,
         matches_expected: Option<bool>,
     },
     /// An action failed in simulation.
@@ -217,7 +218,6 @@ pub enum Event {
     Proposal {
         proposal: Proposal,
         reasoning: Option<String>,
-        substitutions: Vec<Substitution>,
         author: String,
     },
     Approved,
