@@ -36,6 +36,7 @@ fn settings(base_url: String) -> OpenAiSettings {
         },
         structured: false,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     }
 }
 

@@ -140,6 +140,7 @@ fn the_library_loop_applies_the_expected_fixes() {
         retry: RetryPolicy::default(),
         structured: false,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     })
     .unwrap();
     let client: std::sync::Arc<dyn betr::llm::LanguageModel> = std::sync::Arc::new(client);

@@ -256,6 +256,11 @@ fn goal_of(scenario: &Scenario, goal: Option<&str>) -> Result<Formula> {
     }
 }
 
+/// A count flag refused by clap, with its range, outside `min..=max`.
+fn ranged(min: u64, max: u64) -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::<usize>::new().range(min..=max)
+}
+
 /// The async runtime of a one-shot command: one thread (the model and the server calls
 /// are awaited one at a time).
 fn runtime() -> Result<tokio::runtime::Runtime> {

@@ -32,7 +32,7 @@ pub struct ResolveFlags {
     #[arg(long, short = 'y')]
     pub yes: bool,
     /// Questions about failures before giving up.
-    #[arg(long, default_value_t = 5)]
+    #[arg(value_parser = super::ranged(0, 100), long, default_value_t = 5)]
     pub max_rounds: usize,
     /// Where to save the final tree (default: policies/<scenario>.bt on success).
     #[arg(long)]

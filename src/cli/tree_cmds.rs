@@ -30,7 +30,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub trace: bool,
     /// Give up after this many ticks.
-    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
+    #[arg(value_parser = clap::value_parser!(u64).range(1..=1_000_000_000), long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
     pub max_ticks: u64,
     /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
     #[arg(long)]

@@ -36,10 +36,10 @@ pub struct VerifyArgs {
     #[arg(long)]
     pub no_disturbances: bool,
     /// Stop exploring after this many states (the result is then "unknown").
-    #[arg(long, default_value_t = 200_000)]
+    #[arg(value_parser = super::ranged(1, 1_000_000_000), long, default_value_t = 200_000)]
     pub max_states: usize,
     /// Ticks within which the tree must succeed from every reachable state.
-    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
+    #[arg(value_parser = clap::value_parser!(u64).range(1..=1_000_000_000), long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
     pub max_ticks: u64,
     #[command(flatten)]
     pub knowledge: super::knowledge_cmd::KnowledgeFlags,

@@ -40,7 +40,7 @@ pub struct SttFlags {
     #[arg(long, value_name = "LANG")]
     pub language: Option<String>,
     /// Beam width of the embedded model (1: greedy, fastest; default 5).
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
     pub beam_size: Option<usize>,
 }
 

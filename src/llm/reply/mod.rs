@@ -20,6 +20,9 @@ use crate::goal::Formula;
 
 pub use crate::domain::names::{MIN_SIMILARITY, did_you_mean, similarity};
 
+/// Why a reply is not used. Every text of the reply a message echoes is cut to
+/// [`ECHOED`] characters, so an error (and a prompt that tells the model about it) never
+/// grows with the reply's size.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReplyError {
     #[error("the reply has no `{label}:` answer: {excerpt:?}")]
@@ -27,11 +30,16 @@ pub enum ReplyError {
         label: &'static str,
         excerpt: String,
     },
-    #[error("cannot read {text:?}: {reason}")]
+    #[error("cannot read {:?}: {}", echoed(text), echoed(reason))]
     Unreadable { text: String, reason: String },
-    #[error("{text:?} does not fit the scene: {reason}")]
+    #[error("{:?} does not fit the scene: {}", echoed(text), echoed(reason))]
     Invalid { text: String, reason: String },
-    #[error("{object:?} in {text} is not in the scene{}", did_you_mean(nearest))]
+    #[error(
+        "{:?} in {} is not in the scene{}",
+        echoed(object),
+        echoed(text),
+        did_you_mean(nearest)
+    )]
     UnknownObject {
         text: String,
         object: String,
@@ -40,8 +48,15 @@ pub enum ReplyError {
     },
     #[error("the reply proposes no condition")]
     NoConditions,
-    #[error("parameter value {text:?}: {reason}")]
+    #[error("parameter value {:?}: {}", echoed(text), echoed(reason))]
     BadValue { text: String, reason: String },
+}
+
+/// How many characters of a reply's text an error echoes.
+pub const ECHOED: usize = 200;
+
+fn echoed(text: &str) -> String {
+    crate::excerpt::shortened(text, ECHOED)
 }
 
 #[derive(Debug, Clone, PartialEq)]
