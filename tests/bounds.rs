@@ -9,7 +9,7 @@ mod support;
 use std::path::Path;
 use std::process::Output;
 
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{betr, openai_flags, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -23,19 +23,8 @@ fn cafe() -> String {
 /// `betr interpret` of the cafe scenario against `base`, with `extra` flags.
 fn interpret(dir: &Path, base: &str, extra: &[&str]) -> Output {
     let scenario = cafe();
-    let mut args = vec![
-        "interpret",
-        &scenario,
-        "Bring a coffee to the window table",
-        "--backend",
-        "openai",
-        "--base-url",
-        base,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-    ];
+    let mut args = vec!["interpret", &scenario, "Bring a coffee to the window table"];
+    args.extend(openai_flags(base));
     args.extend_from_slice(extra);
     betr(dir, &args)
 }

@@ -10,7 +10,7 @@ mod support;
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 
-use support::cli::{KEY_VAR, command, resolve_yes, text, tmp};
+use support::cli::{command, openai_flags, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -157,18 +157,7 @@ fn resolve_and_learn_keep_the_policy_and_the_rule_when_nobody_reads_the_output()
     for extra in [
         vec!["knowledge", "list", "--policy-dir", "pd"],
         vec!["knowledge", "show", "r1", "--policy-dir", "pd"],
-        vec![
-            "interpret",
-            &s,
-            "--backend",
-            "openai",
-            "--base-url",
-            &base,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
-        ],
+        [&["interpret", &s][..], &openai_flags(&base)].concat(),
     ] {
         let whole = read_whole(&read, &extra);
         let cut = closed_early(&closed, &extra);

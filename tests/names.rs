@@ -9,7 +9,7 @@ mod support;
 
 use std::process::Output;
 
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{betr, openai_flags, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -18,18 +18,7 @@ fn scenario(rel: &str) -> String {
 }
 
 fn model_flags(base: &str) -> Vec<String> {
-    [
-        "--backend",
-        "openai",
-        "--base-url",
-        base,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-    ]
-    .map(str::to_string)
-    .to_vec()
+    openai_flags(base).map(str::to_string).to_vec()
 }
 
 fn run(dir: &std::path::Path, args: &[String]) -> Output {

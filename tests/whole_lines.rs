@@ -11,7 +11,7 @@ use std::io::Write;
 use std::path::Path;
 use std::process::Output;
 
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{betr, openai_flags, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -24,8 +24,6 @@ fn interpret(dir: &Path, backend: &[&str], instruction: &str) -> Output {
         "interpret",
         &scenario,
         instruction,
-        "--model",
-        "fake-model",
         "--cassette",
         "c.jsonl",
         "--usage-log",
@@ -69,15 +67,8 @@ fn a_cut_last_line_is_left_out_on_replay_and_taken_off_before_the_next_entry() {
         Behavior::Reply("Goal: On_Coffee_WindowTable6".into()),
     );
     let base = server.base_url();
-    let live = [
-        "--backend",
-        "openai",
-        "--base-url",
-        &base,
-        "--api-key-env",
-        KEY_VAR,
-    ];
-    let replay = ["--backend", "replay"];
+    let live = openai_flags(&base);
+    let replay = ["--backend", "replay", "--model", "fake-model"];
     let dir = tmp("whole-lines");
     let first = "Bring a coffee to the window table";
     let out = interpret(&dir, &live, first);

@@ -218,6 +218,16 @@ pub mod limits {
     pub const CONTEXT: (u32, u32) = (512, 1_048_576);
 }
 
+/// `value` of the setting `what` when it lies in `range` (inclusive), else a
+/// configuration error saying the range.
+fn in_range<T: PartialOrd + std::fmt::Display>(
+    what: &str,
+    value: T,
+    (min, max): (T, T),
+) -> Result<T, LlmError> {
+    crate::bounds::within(what, value, min, max).map_err(|e| LlmError::Config(e.to_string()))
+}
+
 /// Threads for the local model when the load cannot decide (tests, which share the
 /// machine with other tests, use it too): one thread keeps generating at full speed when
 /// another process is busy, where two threads stall waiting for each other; see
@@ -242,60 +252,38 @@ impl Settings {
         };
         layer.merge(env);
         layer.merge(flags);
-        let range = |e: crate::bounds::OutOfRange| LlmError::Config(e.to_string());
         let secs = |v: Option<f64>, default: f64, what: &str| {
-            crate::bounds::seconds(what, v.unwrap_or(default)).map_err(range)
+            crate::bounds::seconds(what, v.unwrap_or(default))
+                .map_err(|e| LlmError::Config(e.to_string()))
         };
-        let temperature = crate::bounds::within(
+        let temperature = in_range(
             "temperature",
             layer.temperature.unwrap_or(0.0),
-            limits::TEMPERATURE.0,
-            limits::TEMPERATURE.1,
-        )
-        .map_err(range)?;
-        let max_tokens = crate::bounds::within(
+            limits::TEMPERATURE,
+        )?;
+        let max_tokens = in_range(
             "max_tokens",
             layer.max_tokens.unwrap_or(800),
-            limits::MAX_TOKENS.0,
-            limits::MAX_TOKENS.1,
-        )
-        .map_err(range)?;
-        let retries = crate::bounds::within(
+            limits::MAX_TOKENS,
+        )?;
+        let retries = in_range(
             "max_retries",
             layer.max_retries.unwrap_or(3),
-            limits::RETRIES.0,
-            limits::RETRIES.1,
-        )
-        .map_err(range)?;
+            limits::RETRIES,
+        )?;
         let backoff = |what: &str, v: Option<u64>, default: u64| {
-            crate::bounds::within(
-                what,
-                v.unwrap_or(default),
-                limits::BACKOFF_MS.0,
-                limits::BACKOFF_MS.1,
-            )
-            .map(Duration::from_millis)
-            .map_err(range)
+            in_range(what, v.unwrap_or(default), limits::BACKOFF_MS).map(Duration::from_millis)
         };
         let threads = layer
             .threads
-            .map(|t| crate::bounds::within("threads", t, limits::THREADS.0, limits::THREADS.1))
-            .transpose()
-            .map_err(range)?;
-        let context = crate::bounds::within(
-            "context",
-            layer.context.unwrap_or(4096),
-            limits::CONTEXT.0,
-            limits::CONTEXT.1,
-        )
-        .map_err(range)?;
-        let reply_bytes = crate::bounds::within(
+            .map(|t| in_range("threads", t, limits::THREADS))
+            .transpose()?;
+        let context = in_range("context", layer.context.unwrap_or(4096), limits::CONTEXT)?;
+        let reply_bytes = in_range(
             "max_reply_bytes",
             layer.max_reply_bytes.unwrap_or(limits::DEFAULT_REPLY_BYTES),
-            limits::REPLY_BYTES.0,
-            limits::REPLY_BYTES.1,
-        )
-        .map_err(range)?;
+            limits::REPLY_BYTES,
+        )?;
         Ok(Settings {
             // Offline by default: the embedded model needs no key and no network. A base
             // URL given without a backend can only mean an HTTP server.
@@ -530,71 +518,73 @@ mod tests {
                 .to_string();
             assert!(e.contains(said), "{e}");
         };
+        let d = Layer::default;
         for t in [1e20, 0.0, -5.0, f64::NAN, 3601.0] {
-            refused(
-                Layer {
-                    timeout_secs: Some(t),
-                    ..Layer::default()
-                },
-                "timeout_secs = ",
-            );
-            refused(
-                Layer {
-                    connect_timeout_secs: Some(t),
-                    ..Layer::default()
-                },
-                "connect_timeout_secs = ",
-            );
+            let timeout = Layer {
+                timeout_secs: Some(t),
+                ..d()
+            };
+            refused(timeout, "timeout_secs = ");
+            let connect = Layer {
+                connect_timeout_secs: Some(t),
+                ..d()
+            };
+            refused(connect, "connect_timeout_secs = ");
         }
-        refused(
-            Layer {
-                temperature: Some(f32::INFINITY),
-                ..Layer::default()
-            },
-            "temperature = inf is out of range",
-        );
-        refused(
-            Layer {
-                max_tokens: Some(0),
-                ..Layer::default()
-            },
-            "max_tokens = 0",
-        );
-        refused(
-            Layer {
-                max_retries: Some(4_000_000_000),
-                ..Layer::default()
-            },
-            "max_retries",
-        );
-        refused(
-            Layer {
-                max_backoff_ms: Some(u64::MAX),
-                ..Layer::default()
-            },
-            "max_backoff_ms",
-        );
-        refused(
-            Layer {
-                threads: Some(0),
-                ..Layer::default()
-            },
-            "threads = 0",
-        );
-        refused(
-            Layer {
-                context: Some(u32::MAX),
-                ..Layer::default()
-            },
-            "context = ",
-        );
-        refused(
-            Layer {
-                max_reply_bytes: Some(1 << 40),
-                ..Layer::default()
-            },
-            "max_reply_bytes = ",
-        );
+        let out_of_range = [
+            (
+                Layer {
+                    temperature: Some(f32::INFINITY),
+                    ..d()
+                },
+                "temperature = inf is out of range",
+            ),
+            (
+                Layer {
+                    max_tokens: Some(0),
+                    ..d()
+                },
+                "max_tokens = 0",
+            ),
+            (
+                Layer {
+                    max_retries: Some(4_000_000_000),
+                    ..d()
+                },
+                "max_retries",
+            ),
+            (
+                Layer {
+                    max_backoff_ms: Some(u64::MAX),
+                    ..d()
+                },
+                "max_backoff_ms",
+            ),
+            (
+                Layer {
+                    threads: Some(0),
+                    ..d()
+                },
+                "threads = 0",
+            ),
+            (
+                Layer {
+                    context: Some(u32::MAX),
+                    ..d()
+                },
+                "context = ",
+            ),
+            (
+                Layer {
+                    max_reply_bytes: Some(1 << 40),
+                    ..d()
+                },
+                "max_reply_bytes = ",
+            ),
+        ];
+        for (layer, said) in out_of_range {
+            refused(layer, said);
+        }
         let s = Settings::resolve(None, Layer::default(), Layer::default()).unwrap();
         assert_eq!(s.max_reply_bytes, 256 * 1024);
         assert_eq!(s.timeout, Duration::from_secs(60));
