@@ -210,7 +210,7 @@ pub fn offer(
             }
             rule
         };
-        let kept = knowledge.keep(KeptRule::new(
+        let (kept, new) = knowledge.keep(KeptRule::new(
             &rule,
             scenario,
             Provenance {
@@ -221,6 +221,15 @@ pub fn offer(
                 kept_by: if yes { "--yes --learn" } else { "a person" }.into(),
             },
         ))?;
+        if !new {
+            outln!(
+                "Already kept as rule {}: {} (in {})",
+                kept.id,
+                rule.describe(&scenario.domain),
+                knowledge.path.display()
+            );
+            continue;
+        }
         outln!(
             "Kept rule {}: {} (in {})",
             kept.id,
