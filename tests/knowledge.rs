@@ -639,3 +639,36 @@ fn the_same_rule_learned_by_two_processes_at_once_is_kept_once_and_said_so() {
         said.join("\n")
     );
 }
+
+#[test]
+fn resolve_keeps_its_policy_where_the_workbench_and_learn_look() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("knowledge-one-store");
+    let scenario = scenario_path("scenarios/cell/red_on_blue.toml");
+    let out = betr(&dir, &resolve_yes(&scenario, &server.base_url()));
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        !dir.join("policies").exists(),
+        "nothing in the working directory"
+    );
+    let store = betr::session::PolicyStore::new(dir.join("data/betr/policies"));
+    let s = scenario_of(&scenario);
+    let path = store.path_for(Path::new(&scenario), s.goal.as_ref().unwrap());
+    assert!(
+        log.contains(&format!("Saved the tree to {}", path.display())),
+        "{log}"
+    );
+    let saved = betr::session::policy::load(&path, &s.domain).unwrap();
+    assert_eq!(
+        saved.instruction.as_deref(),
+        Some("Put the blue cube on the green cube")
+    );
+    assert_eq!(saved.fixes.len(), 1, "the approved fix with its provenance");
+    assert!(!saved.fixes[0].nodes.is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn scenario_of(path: &str) -> betr::scenario::Scenario {
+    betr::scenario::Scenario::load(Path::new(path)).unwrap()
+}

@@ -311,5 +311,8 @@ fn resolve_yes_never_keeps_a_change_that_fails_verification() {
     assert!(stderr.contains("✕ never \"red cube\" grasped"), "{stderr}");
     assert!(stderr.contains("counterexample:"), "{stderr}");
     assert!(stderr.contains("grasp \"red cube\"!"), "{stderr}");
-    assert!(!dir.join("policies").exists(), "nothing may be saved");
+    assert!(
+        !dir.join("data/betr/policies").exists() && !dir.join("policies").exists(),
+        "nothing may be saved"
+    );
 }

@@ -24,12 +24,16 @@ pub struct PolicyDir {
 }
 
 impl PolicyDir {
-    /// The knowledge file, when a directory is given or a default one exists.
-    pub fn knowledge_path(&self) -> Option<PathBuf> {
+    /// The directory given, else the default one (the workbench's), if there is one.
+    pub fn dir(&self) -> Option<PathBuf> {
         self.policy_dir
             .clone()
             .or_else(|| PolicyStore::default_dir(&|k| std::env::var(k).ok()))
-            .map(|d| Knowledge::path_in(&d))
+    }
+
+    /// The knowledge file, when a directory is given or a default one exists.
+    pub fn knowledge_path(&self) -> Option<PathBuf> {
+        self.dir().map(|d| Knowledge::path_in(&d))
     }
 
     fn open(&self) -> Result<Knowledge> {

@@ -34,7 +34,8 @@ pub struct ResolveFlags {
     /// Questions about failures before giving up.
     #[arg(value_parser = super::ranged(0, 100), long, default_value_t = 5)]
     pub max_rounds: usize,
-    /// Where to save the final tree (default: policies/<scenario>.bt on success).
+    /// Where to save the final tree (default: on success, as a policy in the policy
+    /// directory, where the workbench finds it).
     #[arg(long)]
     pub save: Option<PathBuf>,
     /// Work on the scenario's stated goal instead of reading its instruction (no model
@@ -110,6 +111,7 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
             viz: &args.viz,
             stated_goal: args.stated_goal,
             learn: args.learn.then_some(&args.knowledge.dir),
+            policies: &args.knowledge.dir,
         },
         &args.llm,
         glyphs,
@@ -165,6 +167,8 @@ pub struct ResolveArgs<'a> {
     pub stated_goal: bool,
     /// Offer the kept fixes as rules, kept in this directory's knowledge file.
     pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
+    /// Where the tree that succeeds is kept as a policy unless `save` says otherwise.
+    pub policies: &'a super::knowledge_cmd::PolicyDir,
 }
 
 fn resolve(
@@ -180,10 +184,20 @@ fn resolve(
     {
         submitted::read(scenario, text)?;
     }
-    // Where the work will be kept, checked before any of it is done.
-    let default_save = default_policy_path(args.scenario_path);
-    let save_to = args.save.unwrap_or(&default_save);
-    betr::store::check_writable(save_to)
+    // Where the work will be kept, checked before any of it is done: --save, else the
+    // policy directory the workbench and --learn use.
+    let policy_dir = match args.save {
+        Some(_) => None,
+        None => Some(args.policies.dir().context(
+            "no policy directory to keep the tree in: pass --policy-dir or --save (neither XDG_DATA_HOME nor HOME is set)",
+        )?),
+    };
+    let save_to = match (args.save, &policy_dir) {
+        (Some(path), _) => path.to_path_buf(),
+        (None, Some(dir)) => dir.join(format!("{}.bt", stem(args.scenario_path))),
+        (None, None) => PathBuf::new(),
+    };
+    betr::store::check_writable(&save_to)
         .with_context(|| format!("the tree is to be saved to {}", save_to.display()))?;
     if let Some(dir) = args.learn
         && let Some(path) = dir.knowledge_path()
@@ -193,6 +207,7 @@ fn resolve(
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
+    llm.options.policy_dir = policy_dir;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
@@ -243,17 +258,17 @@ fn resolve(
         anyhow::bail!("--record: {why}");
     }
     let success = matches!(resolved.ending, Ending::Success { .. });
-    // Saved before anything is printed: the tree is kept whatever happens to the output.
+    // Saved before anything is printed (a policy by the loop itself, on success): the
+    // tree is kept whatever happens to the output.
     let saved = match args.save {
-        Some(p) => Some(p.to_path_buf()),
-        None if success => Some(default_save.clone()),
-        None => None,
-    }
-    .filter(|_| success || resolved.repairs > 0);
-    if let Some(path) = &saved {
-        betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
-            .with_context(|| format!("saving the tree to {}", path.display()))?;
-    }
+        Some(path) if success || resolved.repairs > 0 => {
+            betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
+                .with_context(|| format!("saving the tree to {}", path.display()))?;
+            Some(path.to_path_buf())
+        }
+        Some(_) => None,
+        None => resolved.saved.clone(),
+    };
     outln!();
     for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
         outln!("{line}");
@@ -282,11 +297,11 @@ fn resolve(
     })
 }
 
-fn default_policy_path(scenario: &Path) -> PathBuf {
-    let stem = scenario
+/// A scenario file's stem, as policies are named by it.
+fn stem(scenario: &Path) -> String {
+    scenario
         .file_stem()
-        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
-    Path::new("policies").join(format!("{stem}.bt"))
+        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned())
 }
 
 fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {

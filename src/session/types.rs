@@ -51,6 +51,9 @@ pub struct Options {
     /// (so the failure under study is reached whatever a model would read); the
     /// instruction still reaches the questions about failures.
     pub use_scenario_goal: bool,
+    /// The resolve loop saves the tree that succeeds as a policy in this directory, with
+    /// its provenance, where the workbench finds it (keyed by scenario and goal).
+    pub policy_dir: Option<std::path::PathBuf>,
     /// Before asking about a failure, try the conditions over the failing action's objects
     /// in simulation and let the model choose among those that fix it; off: the model
     /// names the condition out of the whole vocabulary.
@@ -81,6 +84,7 @@ impl Default for Options {
             read_by_parts: true,
             value_levels: true,
             use_scenario_goal: false,
+            policy_dir: None,
             shortlist: true,
             temperature: 0.0,
             max_tokens: 800,
@@ -390,6 +394,8 @@ pub struct Resolved {
     pub repairs: usize,
     /// The approved proposals kept in the tree, in order, with who wrote each.
     pub kept: Vec<(Proposal, String)>,
+    /// The policy file the tree was saved to (`Options::policy_dir`).
+    pub saved: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Clone, thiserror::Error)]
