@@ -50,6 +50,34 @@ pub fn server_message(body: &str, secret: Option<&str>) -> String {
     ))
 }
 
+/// Why a response's body was not read.
+#[derive(Debug)]
+pub enum BodyError {
+    /// It passed `limit` bytes (what came was dropped).
+    TooLarge {
+        limit: usize,
+    },
+    Transport(reqwest::Error),
+}
+
+/// A response's body as text, read a chunk at a time and given up as soon as it passes
+/// `limit` bytes, so a server that sends without end costs at most `limit` bytes of
+/// memory. Bytes that are not UTF-8 are replaced.
+pub async fn read_body(mut response: reqwest::Response, limit: usize) -> Result<String, BodyError> {
+    let declared = response.content_length().unwrap_or(0);
+    if usize::try_from(declared).map_or(true, |n| n > limit) {
+        return Err(BodyError::TooLarge { limit });
+    }
+    let mut body = Vec::new();
+    while let Some(chunk) = response.chunk().await.map_err(BodyError::Transport)? {
+        if body.len().saturating_add(chunk.len()) > limit {
+            return Err(BodyError::TooLarge { limit });
+        }
+        body.extend_from_slice(&chunk);
+    }
+    Ok(String::from_utf8_lossy(&body).into_owned())
+}
+
 /// `text` safe to show on a terminal: control characters other than newline and tab
 /// (escape sequences, carriage returns, bells) written out as `\u{1b}` instead of
 /// reaching the terminal raw.

@@ -45,7 +45,7 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            cli::out::stderr(format_args!("error: {e:#}\n"));
             ExitCode::from(2)
         }
     }

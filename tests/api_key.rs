@@ -24,7 +24,8 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
     let scenario_s = scenario.to_string_lossy().to_string();
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let base = server.base_url();
-    // Default paths: ./betr.toml is read, the usage log goes to $XDG_STATE_HOME, the tree to policies/.
+    // Default paths: ./betr.toml is read, the usage log goes to $XDG_STATE_HOME, the tree
+    // to the policy directory in $XDG_DATA_HOME.
     let out = betr(
         &dir,
         &[
@@ -100,13 +101,18 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
         "session.rrd",
         "replayed.rrd",
         "state/betr/usage.jsonl",
-        "policies/no_coffee.bt",
     ] {
         assert!(
             names.iter().any(|n| n == expected),
             "{expected} not written; files: {names:?}"
         );
     }
+    assert!(
+        names
+            .iter()
+            .any(|n| n.starts_with("data/betr/policies/no_coffee-") && n.ends_with(".bt")),
+        "no policy written; files: {names:?}"
+    );
     for file in &written {
         let bytes = std::fs::read(file).unwrap();
         let hay = String::from_utf8_lossy(&bytes);

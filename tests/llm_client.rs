@@ -36,6 +36,7 @@ fn settings(base_url: String) -> OpenAiSettings {
         },
         structured: false,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     }
 }
 
@@ -345,18 +346,25 @@ fn unknown_object_is_refused_and_the_tree_unchanged() {
 }
 
 #[test]
-fn a_near_miss_object_is_replaced_and_flagged() {
+fn a_near_miss_object_is_refused_with_the_nearest_name_never_replaced() {
     let (r, events) = resolve_with(Behavior::Reply(
         "Reasoning: make it.\nConditions: Exists_Cofee".into(),
     ));
     let r = r.unwrap();
-    assert!(matches!(r.ending, Ending::Success { .. }), "{:?}", r.ending);
-    let flagged = events.iter().find_map(|e| match e {
-        Event::Proposal { substitutions, .. } => substitutions.first().cloned(),
+    assert!(matches!(r.ending, Ending::GaveUp { .. }), "{:?}", r.ending);
+    assert_eq!(r.repairs, 0);
+    assert_eq!(bt::to_text(&r.tree), planned_tree(&no_coffee()));
+    assert!(
+        !events.iter().any(|e| matches!(e, Event::Proposal { .. })),
+        "nothing is proposed"
+    );
+    let said = events.iter().find_map(|e| match e {
+        Event::InvalidReply { error } => Some(error.clone()),
         _ => None,
     });
-    let s = flagged.expect("a flagged substitution");
-    assert_eq!((s.written.as_str(), s.used.as_str()), ("Cofee", "Coffee"));
+    let said = said.expect("the reply is refused");
+    assert!(said.contains("\"Cofee\""), "{said}");
+    assert!(said.contains("did you mean \"Coffee\""), "{said}");
 }
 
 #[test]

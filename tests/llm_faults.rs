@@ -232,9 +232,15 @@ fn a_reply_a_megabyte_long() {
     let server = FakeServer::start(vec![], Behavior::Reply("coffee ".repeat(150_000)));
     let out = case.resolve(&server.base_url(), &["--yes"]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
-    let line = told(&out, "no usable goal");
+    // Past the reply cap (256 KiB by default) the call fails; it is not read further.
+    let line = told(&out, "longer than 262144 bytes");
     assert!(line.len() < 2_000, "the message is {} bytes", line.len());
     assert!(out.stdout.len() + out.stderr.len() < 100_000);
+    assert_eq!(
+        chat_calls(&server),
+        1,
+        "a reply too long is not asked again"
+    );
     case.nothing_changed(&out);
 }
 
@@ -341,6 +347,7 @@ fn workbench_session(server: &FakeServer) -> support::engine::Session {
         },
         structured: false,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     })
     .unwrap();
     let model: std::sync::Arc<dyn betr::llm::LanguageModel> =

@@ -38,7 +38,6 @@ async fn interprets_scenario_1_exactly() {
         reading.answer.goal.to_string(),
         "\"blue cube\" on \"green cube\""
     );
-    assert!(reading.answer.substitutions.is_empty());
     assert!(reading.doubt.is_none());
 }
 
@@ -162,7 +161,7 @@ async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
             );
         }
         // Sampling may run a long conjunction past the token limit; a reply that ended
-        // on its own must parse, with no closest-object substitution (min_similarity 1.0).
+        // on its own must parse, naming only the scene's objects.
         if r.usage.completion_tokens >= u64::from(request.max_tokens) {
             continue;
         }
@@ -171,7 +170,6 @@ async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
         for atom in answer.goal.atoms() {
             vocabulary.check_atom(&atom).unwrap();
         }
-        assert!(answer.substitutions.is_empty(), "{}", r.text);
     }
 }
 

@@ -140,6 +140,7 @@ fn the_library_loop_applies_the_expected_fixes() {
         retry: RetryPolicy::default(),
         structured: false,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     })
     .unwrap();
     let client: std::sync::Arc<dyn betr::llm::LanguageModel> = std::sync::Arc::new(client);
@@ -310,5 +311,8 @@ fn resolve_yes_never_keeps_a_change_that_fails_verification() {
     assert!(stderr.contains("✕ never \"red cube\" grasped"), "{stderr}");
     assert!(stderr.contains("counterexample:"), "{stderr}");
     assert!(stderr.contains("grasp \"red cube\"!"), "{stderr}");
-    assert!(!dir.join("policies").exists(), "nothing may be saved");
+    assert!(
+        !dir.join("data/betr/policies").exists() && !dir.join("policies").exists(),
+        "nothing may be saved"
+    );
 }

@@ -182,7 +182,6 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
                     conditions: vec![fact(t)],
                 },
                 reasoning: Some("the benchmark's".into()),
-                substitutions: Vec::new(),
                 author: "the benchmark".into(),
             }),
             Step::Command("approve".into()),

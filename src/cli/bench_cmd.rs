@@ -87,7 +87,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     };
     let mut report = Report::new();
     for part in &parts {
-        eprintln!("bench: {}", format!("{part:?}").to_lowercase());
+        errln!("bench: {}", format!("{part:?}").to_lowercase());
         let rows = match part {
             Part::Ticks => ticks_part(args)?,
             Part::Scale => scale_part(args)?,
@@ -104,7 +104,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {
-            eprintln!(
+            errln!(
                 "  {} {}: {}",
                 row.part,
                 row.measure,
@@ -114,11 +114,11 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         report.rows.extend(rows);
     }
     report.machine.load_after = bench::load_average();
-    println!("{}", report.markdown());
+    outln!("{}", report.markdown());
     report
         .write_json(&args.json)
         .with_context(|| format!("cannot write {}", args.json.display()))?;
-    eprintln!("bench: written to {}", args.json.display());
+    errln!("bench: written to {}", args.json.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -271,7 +271,7 @@ fn llm(
         Some(p) => p.to_path_buf(),
         None => super::model_cmd::ensure(model)?,
     };
-    println!("model: {}", path.display());
+    outln!("model: {}", path.display());
     let prompt = cold::GoalPrompt::load(scenario)?;
     let instruction = prompt
         .scenario
@@ -287,13 +287,18 @@ fn llm(
         prompt_states: None,
     })?;
     let load = started.elapsed();
-    println!(
+    outln!(
         "model load: {:.2} s ({threads} thread(s))",
         load.as_secs_f64()
     );
-    println!(
+    outln!(
         "{:<34} {:>9} {:>8} {:>8} {:>11} {:>10}  answer",
-        "call", "latency", "prompt", "cached", "prompt t/s", "gen t/s"
+        "call",
+        "latency",
+        "prompt",
+        "cached",
+        "prompt t/s",
+        "gen t/s"
     );
     let cold = timed(&engine, prompt.generation(&instruction, true)?)?;
     report("cold (grammar)", &cold);
@@ -331,7 +336,7 @@ fn report(label: &str, (g, seconds): &(Generated, f64)) {
             0.0
         }
     };
-    println!(
+    outln!(
         "{:<34} {:>7.2} s {:>8} {:>8} {:>11.0} {:>10.1}  {}",
         label,
         seconds,

@@ -157,9 +157,9 @@ impl Driver {
         }
         if let Some(r) = self.record.as_mut() {
             r.event(&event);
+            // A recording asked for and not made is a failed command, not a note.
             if let Some(why) = r.stopped() {
-                eprintln!("note: {why}");
-                self.record = None;
+                bail!("--record: {why}");
             }
         }
         if let Event::TreeChanged { tree, .. } = &event {
@@ -214,7 +214,7 @@ impl Driver {
         loop {
             match self.next()? {
                 // Before the tree is loaded, notices are the file's notes.
-                Event::Notice { message } if !loaded => eprintln!("note: {message}"),
+                Event::Notice { message } if !loaded => errln!("note: {message}"),
                 Event::PolicyLoaded { .. } => loaded = true,
                 Event::Planned { summary: s } => summary = Some(s),
                 Event::TreeChanged { .. } => return Ok(summary),
@@ -265,7 +265,7 @@ impl Driver {
                 Event::ChangeViolates { report } => {
                     // A change written on the command line is the person's own: it is run
                     // with the finding in view rather than refused.
-                    eprintln!(
+                    errln!(
                         "note: the changed tree fails verification in the model; it runs as written"
                     );
                     let mut err = std::io::stderr();

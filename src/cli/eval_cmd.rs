@@ -184,10 +184,10 @@ fn write_all<T: serde::Serialize>(
     write(dir, "results.csv", csv.as_bytes())?;
     write(dir, "table.md", table.as_bytes())?;
     if let Err(e) = chart() {
-        eprintln!("warning: chart not drawn: {e}");
+        errln!("warning: chart not drawn: {e}");
     }
-    print!("{table}");
-    println!("\nresults: {}", dir.display());
+    out!("{table}");
+    outln!("\nresults: {}", dir.display());
     Ok(())
 }
 
@@ -412,8 +412,8 @@ fn sequence_experiment(
         serde_json::to_string_pretty(&results)?.as_bytes(),
     )?;
     write(&dir, "table.md", table.as_bytes())?;
-    print!("{table}");
-    println!("\nresults: {}", dir.display());
+    out!("{table}");
+    outln!("\nresults: {}", dir.display());
     Ok(ExitCode::SUCCESS)
 }
 

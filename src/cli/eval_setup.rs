@@ -45,14 +45,14 @@ pub struct RunFlags {
     #[arg(long, value_enum, default_value = "full")]
     pub prompt: PromptVariant,
     /// Requests in flight at once (default: 4 for HTTP backends, 1 for the local model).
-    #[arg(long, value_name = "K")]
+    #[arg(value_parser = super::ranged(1, 256), long, value_name = "K")]
     pub concurrency: Option<usize>,
     /// Where to write the results (default: a new directory under eval-results/). Pointing
     /// a run at an existing directory resumes it: cases already recorded are not asked again.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Stop after this many newly finished cases (for testing interruption).
-    #[arg(long, hide = true)]
+    #[arg(value_parser = super::ranged(1, 100_000_000), long, hide = true)]
     pub limit: Option<usize>,
     /// Leave out a detector of plain misreadings when goals are judged, to measure what it
     /// earns (repeatable; the names are listed in docs/ARCHITECTURE.md and in the error

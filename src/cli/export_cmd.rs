@@ -28,7 +28,7 @@ pub enum Format {
 pub fn load_tree(scenario: &Scenario, path: &Path) -> Result<(Tree, TreeFormat)> {
     let loaded = interop::load_tree_file(path, &scenario.domain)?;
     for note in &loaded.notes {
-        eprintln!("note: {}: {note}", path.display());
+        errln!("note: {}: {note}", path.display());
     }
     Ok((loaded.tree, loaded.format))
 }
@@ -103,9 +103,9 @@ pub fn export(
         Some(path) => {
             betr::store::write_atomic(path, text.as_bytes())
                 .with_context(|| format!("writing {}", path.display()))?;
-            eprintln!("Wrote {}", path.display());
+            errln!("Wrote {}", path.display());
         }
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     Ok(ExitCode::SUCCESS)
 }

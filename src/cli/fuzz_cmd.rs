@@ -139,7 +139,7 @@ fn worker(target: &str, args: &FuzzArgs) -> Result<ExitCode> {
     } else {
         fuzz::run(t.as_ref(), &options, &mut tell)?
     };
-    println!("report {}", serde_json::to_string(&report)?);
+    outln!("report {}", serde_json::to_string(&report)?);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -195,7 +195,7 @@ fn child(
         if let Some(i) = line.strip_prefix("at ") {
             end.last = i.parse().ok();
             if told.elapsed().as_secs() >= 60 {
-                eprintln!("{target}: input {i} of {}", args.start + args.inputs);
+                errln!("{target}: input {i} of {}", args.start + args.inputs);
                 told = Instant::now();
             }
         } else if let Some(json) = line.strip_prefix("failure ") {
@@ -229,7 +229,7 @@ fn supervise(target: &str, args: &FuzzArgs) -> Result<Report> {
         let begun = Instant::now();
         let again = child(target, args, from, count, Some(&pending))?;
         if let Some(r) = again.report {
-            eprintln!(
+            errln!(
                 "{target}: a child died ({}) after input {from}, but not again",
                 ended.status
             );
@@ -300,7 +300,7 @@ fn merge(mut a: Report, b: Report) -> Report {
 
 fn print_report(r: &Report, wall: f64) {
     let rate = r.inputs as f64 / r.seconds.max(1e-9);
-    println!(
+    outln!(
         "{}: {} inputs (seed {}, from {}) in {:.1} s ({:.0}/s; {:.1} s with setup), slowest {:.4} s (input {}), {} failing",
         r.target,
         r.inputs,
@@ -318,9 +318,11 @@ fn print_report(r: &Report, wall: f64) {
             .saved
             .as_ref()
             .map_or_else(String::new, |p| format!(" saved as {}", p.display()));
-        println!(
+        outln!(
             "  input {} ({} bytes){saved}: {}",
-            f.index, f.input_len, f.message
+            f.index,
+            f.input_len,
+            f.message
         );
     }
 }
@@ -335,10 +337,10 @@ fn replay(targets: &[&str], files: &[PathBuf]) -> Result<ExitCode> {
             let input =
                 std::fs::read(file).with_context(|| format!("reading {}", file.display()))?;
             match fuzz::check_caught(t.as_ref(), &input) {
-                Ok(()) => println!("{name}: {}: ok", file.display()),
+                Ok(()) => outln!("{name}: {}: ok", file.display()),
                 Err(v) => {
                     failed = true;
-                    println!("{name}: {}: {v}", file.display());
+                    outln!("{name}: {}: {v}", file.display());
                 }
             }
         }

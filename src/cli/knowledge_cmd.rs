@@ -2,7 +2,7 @@
 //! offer to keep an approved fix as a rule (`betr resolve --learn`), and
 //! `betr knowledge list|show|revoke`.
 
-use std::io::{BufRead, Write};
+use std::io::BufRead;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -24,12 +24,16 @@ pub struct PolicyDir {
 }
 
 impl PolicyDir {
-    /// The knowledge file, when a directory is given or a default one exists.
-    pub fn knowledge_path(&self) -> Option<PathBuf> {
+    /// The directory given, else the default one (the workbench's), if there is one.
+    pub fn dir(&self) -> Option<PathBuf> {
         self.policy_dir
             .clone()
             .or_else(|| PolicyStore::default_dir(&|k| std::env::var(k).ok()))
-            .map(|d| Knowledge::path_in(&d))
+    }
+
+    /// The knowledge file, when a directory is given or a default one exists.
+    pub fn knowledge_path(&self) -> Option<PathBuf> {
+        self.dir().map(|d| Knowledge::path_in(&d))
     }
 
     fn open(&self) -> Result<Knowledge> {
@@ -67,10 +71,10 @@ impl KnowledgeFlags {
         };
         let (applied, notes) = knowledge.apply(scenario);
         for note in &notes {
-            eprintln!("Knowledge: {note}");
+            errln!("Knowledge: {note}");
         }
         if !applied.is_empty() {
-            eprintln!(
+            errln!(
                 "Knowledge: {} learned rule(s) from {} ({}); --no-knowledge plans without them",
                 applied.len(),
                 knowledge.path.display(),
@@ -107,31 +111,31 @@ pub fn run(action: KnowledgeAction) -> Result<ExitCode> {
         KnowledgeAction::List { dir } => {
             let knowledge = dir.open()?;
             if knowledge.rules.is_empty() {
-                println!("No learned rules in {}", knowledge.path.display());
+                outln!("No learned rules in {}", knowledge.path.display());
             }
             for r in &knowledge.rules {
-                println!("{:<4} {:<6} {}", r.id, r.domain, words(r));
+                outln!("{:<4} {:<6} {}", r.id, r.domain, words(r));
             }
         }
         KnowledgeAction::Show { id, dir } => {
             let knowledge = dir.open()?;
             let r = knowledge.get(&id)?;
-            println!("Rule:        {} ({})", r.id, words(r));
-            println!("Domain:      {}", r.domain);
-            println!("Skill:       {}", r.skill);
-            println!("Requires:    {}", r.requires);
+            outln!("Rule:        {} ({})", r.id, words(r));
+            outln!("Domain:      {}", r.domain);
+            outln!("Skill:       {}", r.skill);
+            outln!("Requires:    {}", r.requires);
             if let Some(only) = &r.only {
-                println!("Only for:    {}", quoted(only));
+                outln!("Only for:    {}", quoted(only));
             }
-            println!("From:        {} in {}", r.scenario, r.kept_at);
-            println!("Fix:         {} before {}!", r.condition, r.action);
-            println!("Proposed by: {}", r.proposed_by);
-            println!("Kept by:     {}", r.kept_by);
+            outln!("From:        {} in {}", r.scenario, r.kept_at);
+            outln!("Fix:         {} before {}!", r.condition, r.action);
+            outln!("Proposed by: {}", r.proposed_by);
+            outln!("Kept by:     {}", r.kept_by);
         }
         KnowledgeAction::Revoke { id, dir } => {
             let mut knowledge = dir.open()?;
             let r = knowledge.revoke(&id)?;
-            println!(
+            outln!(
                 "Revoked {} ({}) from {}",
                 r.id,
                 words(&r),
@@ -187,12 +191,12 @@ pub fn offer(
         let rule = if yes {
             let (rule, refused) = rule_for_fix(action, condition, scenario, &knowledge);
             for (rule, why) in refused {
-                println!("Not kept: {} — {why}", rule.describe(&scenario.domain));
+                outln!("Not kept: {} — {why}", rule.describe(&scenario.domain));
             }
             let Some(rule) = rule else {
                 continue;
             };
-            println!(
+            outln!(
                 "Keep as a rule: {}? yes (--yes --learn)",
                 rule.describe(&scenario.domain)
             );
@@ -201,16 +205,16 @@ pub fn offer(
             let lifted = offered_rule(action, condition, false);
             let only = offered_rule(action, condition, true);
             let Some(rule) = ask(&lifted, &only, scenario) else {
-                println!("Not kept.");
+                outln!("Not kept.");
                 continue;
             };
             if let Err(refusal) = check_rule(&rule, scenario, &knowledge) {
-                println!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
+                outln!("Not kept: {} — {refusal}", rule.describe(&scenario.domain));
                 continue;
             }
             rule
         };
-        let kept = knowledge.keep(KeptRule::new(
+        let (kept, new) = knowledge.keep(KeptRule::new(
             &rule,
             scenario,
             Provenance {
@@ -221,7 +225,16 @@ pub fn offer(
                 kept_by: if yes { "--yes --learn" } else { "a person" }.into(),
             },
         ))?;
-        println!(
+        if !new {
+            outln!(
+                "Already kept as rule {}: {} (in {})",
+                kept.id,
+                rule.describe(&scenario.domain),
+                knowledge.path.display()
+            );
+            continue;
+        }
+        outln!(
             "Kept rule {}: {} (in {})",
             kept.id,
             rule.describe(&scenario.domain),
@@ -239,18 +252,18 @@ fn ask(
 ) -> Option<betr::domain::LearnedRule> {
     let general = lifted.only.is_none();
     if general {
-        print!(
+        out!(
             "Keep as a rule: {}? [y]es / [o]nly {} / [N]o ",
             lifted.describe(&scenario.domain),
             only.describe(&scenario.domain)
         );
     } else {
-        print!(
+        out!(
             "Keep as a rule: {}? [y/N] ",
             only.describe(&scenario.domain)
         );
     }
-    let _ = std::io::stdout().flush();
+    super::out::flush();
     let mut line = String::new();
     match std::io::stdin().lock().read_line(&mut line) {
         Ok(0) | Err(_) => None,

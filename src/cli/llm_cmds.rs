@@ -72,7 +72,7 @@ pub struct LlmFlags {
     pub examples: Option<PathBuf>,
     /// Worked examples per prompt, chosen from the scenario's pool as the most similar
     /// to the request (default 6; 0: none).
-    #[arg(long, value_name = "K")]
+    #[arg(value_parser = super::ranged(0, 100), long, value_name = "K")]
     pub examples_shown: Option<usize>,
     /// Show the pool's first K examples for every request instead of the most similar
     /// (ablation of retrieval).
@@ -80,7 +80,7 @@ pub struct LlmFlags {
     pub fixed_examples: bool,
     /// Candidates per question: drawn when a goal's first answer fails its checks, and
     /// for every failure, each tried in simulation before it is offered (default 4).
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
     pub candidates: Option<usize>,
     /// Local backend: a goal's first answer is the most likely whole answer of N beams
     /// searched under the grammar, the runners-up candidates too (default 4; 1: one
@@ -92,7 +92,7 @@ pub struct LlmFlags {
     #[arg(long)]
     pub no_checks: bool,
     /// Times the model is told why its goals were refused and asked again (default 2).
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::ranged(0, 10), long, value_name = "N")]
     pub feedback_rounds: Option<usize>,
     /// Read a request of several wishes whole, instead of one wish at a time with the
     /// goals joined as the request joins them.

@@ -1,5 +1,7 @@
 //! Command-line front end: parses arguments, drives the library, prints results.
 
+#[macro_use]
+pub mod out;
 mod bench_cmd;
 mod engine_driver;
 mod eval_cmd;
@@ -238,10 +240,9 @@ fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>> {
 /// A goal formula for `flag`, its text echoed in an error as an excerpt around the
 /// column the error is about.
 fn parse_formula(scenario: &Scenario, flag: &str, text: &str) -> Result<Formula> {
-    let at = Formula::parse(text).err().map(|e| e.at);
     scenario
         .parse_goal(text)
-        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", excerpt(text, at)))
+        .map_err(|e| anyhow::anyhow!("{flag} {}: {e}", excerpt(text, Some(e.at()))))
 }
 
 /// The goal to plan: `--goal`, else the scenario's.
@@ -253,6 +254,11 @@ fn goal_of(scenario: &Scenario, goal: Option<&str>) -> Result<Formula> {
             .clone()
             .with_context(|| format!("scenario {:?} has no goal; pass --goal", scenario.name)),
     }
+}
+
+/// A count flag refused by clap, with its range, outside `min..=max`.
+fn ranged(min: u64, max: u64) -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::<usize>::new().range(min..=max)
 }
 
 /// The async runtime of a one-shot command: one thread (the model and the server calls

@@ -91,7 +91,7 @@ pub fn ensure(name: Option<&str>) -> Result<std::path::PathBuf> {
     if spec.is_present() {
         return Ok(spec.path());
     }
-    eprintln!(
+    errln!(
         "Fetching {} ({:.0} MB) into {} — once only",
         spec.description,
         spec.size as f64 / 1e6,
@@ -122,7 +122,7 @@ pub fn ensure_stt(name: Option<&str>) -> Result<std::path::PathBuf> {
     if spec.is_present() {
         return Ok(spec.path());
     }
-    eprintln!(
+    errln!(
         "Fetching {} ({:.0} MB) into {} — once only",
         spec.description,
         spec.size() as f64 / 1e6,
@@ -140,14 +140,14 @@ pub fn fetch(name: Option<&str>, stt: bool) -> Result<ExitCode> {
     } else {
         ensure(name)?
     };
-    println!("{}", path.display());
+    outln!("{}", path.display());
     Ok(ExitCode::SUCCESS)
 }
 
 pub fn list() -> Result<ExitCode> {
-    println!("{:<22} {:>9}  {:<8} description", "name", "size", "present");
+    outln!("{:<22} {:>9}  {:<8} description", "name", "size", "present");
     for m in model::MODELS {
-        println!(
+        outln!(
             "{:<22} {:>6.0} MB  {:<8} {}",
             m.name,
             m.size as f64 / 1e6,
@@ -156,7 +156,7 @@ pub fn list() -> Result<ExitCode> {
         );
     }
     for m in model::STT_MODELS {
-        println!(
+        outln!(
             "{:<22} {:>6.0} MB  {:<8} {} [--stt]",
             m.name,
             m.size() as f64 / 1e6,
@@ -164,7 +164,7 @@ pub fn list() -> Result<ExitCode> {
             m.description
         );
     }
-    println!("\ncache: {}", model::cache_dir().display());
+    outln!("\ncache: {}", model::cache_dir().display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -183,10 +183,10 @@ pub fn verify(name: Option<&str>, stt: bool) -> Result<ExitCode> {
     }
     let digest = model::sha256_file(&path)?;
     if digest == spec.sha256 {
-        println!("{}: SHA-256 matches ({digest})", path.display());
+        outln!("{}: SHA-256 matches ({digest})", path.display());
         Ok(ExitCode::SUCCESS)
     } else {
-        println!(
+        outln!(
             "{}: SHA-256 is {digest}, expected {}; delete it and run `betr model fetch`",
             path.display(),
             spec.sha256
@@ -208,11 +208,11 @@ fn verify_stt(spec: &DirModelSpec) -> Result<ExitCode> {
     for check in spec.verify()? {
         match &check.found {
             Some(found) if check.matches() => {
-                println!("{}: SHA-256 matches ({found})", check.path.display());
+                outln!("{}: SHA-256 matches ({found})", check.path.display());
             }
             Some(found) => {
                 ok = false;
-                println!(
+                outln!(
                     "{}: SHA-256 is {found}, expected {}",
                     check.path.display(),
                     check.expected
@@ -220,14 +220,14 @@ fn verify_stt(spec: &DirModelSpec) -> Result<ExitCode> {
             }
             None => {
                 ok = false;
-                println!("{}: missing", check.path.display());
+                outln!("{}: missing", check.path.display());
             }
         }
     }
     if ok {
         Ok(ExitCode::SUCCESS)
     } else {
-        println!(
+        outln!(
             "run `betr model fetch --stt --model {}` to replace it",
             spec.name
         );

@@ -52,7 +52,7 @@ pub fn replay(args: &ReplayArgs, ascii: bool) -> Result<ExitCode> {
 /// Said when the recording's last entry was cut (the session did not end cleanly).
 fn cut_note(file: &Path, replay: &Replay) {
     if let Some(line) = replay.cut_at {
-        eprintln!(
+        errln!(
             "note: {}: {}",
             file.display(),
             betr::tui::strings::replay_cut(line)
@@ -120,22 +120,22 @@ fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
     }
     viz.flush();
     if let Some(tick) = cell.diverged {
-        eprintln!(
+        errln!(
             "note: re-simulating the cell gave other statuses from tick {tick} on (has the scenario changed since it was recorded?); the tree's statuses are the recorded ones"
         );
     }
-    eprintln!("Wrote {}", out.display());
+    errln!("Wrote {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
 /// One line per step; consecutive ticks of one run on one line.
 fn print_steps(replay: &Replay) {
-    println!(
+    outln!(
         "Recording: {} ({} steps)",
         replay.path.display(),
         replay.steps.len()
     );
-    println!(
+    outln!(
         "Scenario:  {} ({}), recorded {} with betr {}",
         replay.header.name,
         replay.header.scenario.display(),
@@ -146,9 +146,9 @@ fn print_steps(replay: &Replay) {
     let flush = |ticks: &mut Option<(u64, u64, u64)>| {
         if let Some((ms, first, last)) = ticks.take() {
             if first == last {
-                println!("{}  tick {first}", time(ms));
+                outln!("{}  tick {first}", time(ms));
             } else {
-                println!("{}  ticks {first}–{last}", time(ms));
+                outln!("{}  ticks {first}–{last}", time(ms));
             }
         }
     };
@@ -168,7 +168,7 @@ fn print_steps(replay: &Replay) {
         }
         if let Some(line) = betr::record::describe(step) {
             flush(&mut ticks);
-            println!("{}  {line}", time(*ms));
+            outln!("{}  {line}", time(*ms));
         }
     }
     flush(&mut ticks);

@@ -1,6 +1,6 @@
 //! `betr interpret` and `betr resolve`: the commands that ask a language model.
 
-use std::io::{BufRead, Write};
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -10,7 +10,9 @@ use anyhow::{Context as _, Result};
 use betr::bt::{self, Glyphs, TickRecord};
 use betr::llm::LanguageModel;
 use betr::llm::usage::Metered;
+use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
+use betr::session::submitted::{self, Submitted};
 use betr::session::{self, Ending, Event};
 
 use super::llm_cmds::{LlmFlags, setup};
@@ -30,9 +32,10 @@ pub struct ResolveFlags {
     #[arg(long, short = 'y')]
     pub yes: bool,
     /// Questions about failures before giving up.
-    #[arg(long, default_value_t = 5)]
+    #[arg(value_parser = super::ranged(0, 100), long, default_value_t = 5)]
     pub max_rounds: usize,
-    /// Where to save the final tree (default: policies/<scenario>.bt on success).
+    /// Where to save the final tree (default: on success, as a policy in the policy
+    /// directory, where the workbench finds it).
     #[arg(long)]
     pub save: Option<PathBuf>,
     /// Work on the scenario's stated goal instead of reading its instruction (no model
@@ -118,6 +121,7 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
             stated_goal: args.stated_goal,
             learn: args.learn.then_some(&args.knowledge.dir),
             reading: args.reading,
+            policies: &args.knowledge.dir,
         },
         &args.llm,
         glyphs,
@@ -130,14 +134,23 @@ fn interpret(
     chosen: Option<u16>,
     flags: &LlmFlags,
 ) -> Result<ExitCode> {
-    let llm = setup(flags)?;
     let instruction = instruction
         .map(str::to_string)
         .or_else(|| scenario.instruction.clone())
         .with_context(|| format!("scenario {:?} has no instruction; give one", scenario.name))?;
+    // Read before any model is asked: empty text and a formula the scene lacks are refused.
+    let instruction = match submitted::read(scenario, &instruction)? {
+        Submitted::Goal(goal) => {
+            outln!("Scenario:    {}", scenario.name);
+            outln!("Goal:        {goal} (a goal formula of the scene: no model asked)");
+            return Ok(ExitCode::SUCCESS);
+        }
+        Submitted::Instruction(text) => text,
+    };
+    let llm = setup(flags)?;
     llm.model.set_purpose("interpret");
-    println!("Scenario:    {}", scenario.name);
-    println!("Instruction: {instruction}");
+    outln!("Scenario:    {}", scenario.name);
+    outln!("Instruction: {instruction}");
     let mut emit = |e: &Event| print_event(e, flags.show_replies);
     let result = super::runtime()?.block_on(session::interpret::interpret_in_scenario(
         scenario,
@@ -149,19 +162,20 @@ fn interpret(
     print_usage(&llm.model);
     let reading = result?;
     if let Some(why) = &reading.doubt {
-        println!("note: kept with a doubt: {why}");
+        outln!("note: kept with a doubt: {why}");
     }
-    println!(
+    outln!(
         "{} call(s), {} feedback round(s)",
-        reading.calls, reading.feedback_rounds
+        reading.calls,
+        reading.feedback_rounds
     );
     let world = betr::world::load(scenario)?;
     let readings =
         session::readings::distinct_readings(scenario, world.as_ref(), &reading.readings);
     if readings.len() > 1 {
-        println!();
+        outln!();
         for line in readings_text(&readings) {
-            println!("{line}");
+            outln!("{line}");
         }
     }
     if let Some(n) = chosen {
@@ -175,7 +189,7 @@ fn interpret(
             let count = goals.len();
             anyhow::bail!("no reading {n}: the instruction has {count} (1 to {count})");
         };
-        println!("Goal (reading {n}): {goal}");
+        outln!("Goal (reading {n}): {goal}");
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -201,22 +215,22 @@ fn readings_text(readings: &[session::Reading]) -> Vec<String> {
 /// with `--yes` (a person must choose) or when the answer names none.
 fn choose_reading(readings: &[session::Reading], chosen: Option<u16>, yes: bool) -> Option<usize> {
     for line in readings_text(readings) {
-        println!("{line}");
+        outln!("{line}");
     }
     if let Some(n) = chosen {
         let index = usize::from(n) - 1;
         if index < readings.len() {
-            println!("Reading {n} (--reading)");
+            outln!("Reading {n} (--reading)");
             return Some(index);
         }
-        println!("no reading {n}: there are {}", readings.len());
+        outln!("no reading {n}: there are {}", readings.len());
         return None;
     }
     if yes {
         return None;
     }
-    print!("Choose a reading [1-{}]: ", readings.len());
-    let _ = std::io::stdout().flush();
+    out!("Choose a reading [1-{}]: ", readings.len());
+    super::out::flush();
     let mut line = String::new();
     match std::io::stdin().lock().read_line(&mut line) {
         Ok(0) | Err(_) => None,
@@ -241,6 +255,8 @@ pub struct ResolveArgs<'a> {
     pub learn: Option<&'a super::knowledge_cmd::PolicyDir>,
     /// The reading to work on when the instruction has several (from 1).
     pub reading: Option<u16>,
+    /// Where the tree that succeeds is kept as a policy unless `save` says otherwise.
+    pub policies: &'a super::knowledge_cmd::PolicyDir,
 }
 
 fn resolve(
@@ -249,16 +265,44 @@ fn resolve(
     flags: &LlmFlags,
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
+    // The instruction read before any model is asked: empty text and a formula the scene
+    // lacks are refused.
+    if !args.stated_goal
+        && let Some(text) = args.instruction.or(scenario.instruction.as_deref())
+    {
+        submitted::read(scenario, text)?;
+    }
+    // Where the work will be kept, checked before any of it is done: --save, else the
+    // policy directory the workbench and --learn use.
+    let policy_dir = match args.save {
+        Some(_) => None,
+        None => Some(args.policies.dir().context(
+            "no policy directory to keep the tree in: pass --policy-dir or --save (neither XDG_DATA_HOME nor HOME is set)",
+        )?),
+    };
+    let save_to = match (args.save, &policy_dir) {
+        (Some(path), _) => path.to_path_buf(),
+        (None, Some(dir)) => dir.join(format!("{}.bt", stem(args.scenario_path))),
+        (None, None) => PathBuf::new(),
+    };
+    betr::store::check_writable(&save_to)
+        .with_context(|| format!("the tree is to be saved to {}", save_to.display()))?;
+    if let Some(dir) = args.learn
+        && let Some(path) = dir.knowledge_path()
+    {
+        betr::store::check_writable(&path).context("--learn")?;
+    }
     let mut llm = setup(flags)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
     llm.options.choose_reading = true;
+    llm.options.policy_dir = policy_dir;
     llm.model.set_purpose("resolve");
     let mut viz = args.viz.open(false)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
-    println!("Scenario:    {}", scenario.name);
+    outln!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {
-        println!("Instruction: {i}");
+        outln!("Instruction: {i}");
         if let Some(v) = viz.as_mut() {
             v.instruction(i);
         }
@@ -303,31 +347,41 @@ fn resolve(
             return Err(e.into());
         }
     };
-    println!();
-    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
-        println!("{line}");
+    // A recording asked for and not made is a failed command, not a note.
+    if let Some(why) = record.as_ref().and_then(SessionRecorder::stopped) {
+        print_usage(&llm.model);
+        anyhow::bail!("--record: {why}");
     }
     let success = matches!(resolved.ending, Ending::Success { .. });
-    let save = match args.save {
-        Some(p) => Some(p.to_path_buf()),
-        None if success => Some(default_policy_path(args.scenario_path)),
-        None => None,
-    };
-    match save {
+    // Saved before anything is printed (a policy by the loop itself, on success): the
+    // tree is kept whatever happens to the output.
+    let saved = match args.save {
         Some(path) if success || resolved.repairs > 0 => {
-            betr::store::write_atomic(&path, bt::to_text(&resolved.tree).as_bytes())
+            betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
                 .with_context(|| format!("saving the tree to {}", path.display()))?;
-            let note = if success { "" } else { " (it still fails)" };
-            println!("\nSaved the tree to {}{note}", path.display());
+            Some(path.to_path_buf())
         }
-        _ => println!("\nNothing saved: no change was kept."),
+        Some(_) => None,
+        None => resolved.saved.clone(),
+    };
+    outln!();
+    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
+        outln!("{line}");
     }
-    println!(
+    match &saved {
+        Some(path) => {
+            let note = if success { "" } else { " (it still fails)" };
+            outln!("\nSaved the tree to {}{note}", path.display());
+        }
+        None => outln!("\nNothing saved: no change was kept."),
+    }
+    outln!(
         "{} question(s) about failures, {} change(s) kept",
-        resolved.rounds, resolved.repairs
+        resolved.rounds,
+        resolved.repairs
     );
     if let Some(dir) = args.learn.filter(|_| success) {
-        println!();
+        outln!();
         super::knowledge_cmd::offer(scenario, args.scenario_path, &resolved.kept, dir, args.yes)?;
     }
     print_usage(&llm.model);
@@ -338,24 +392,24 @@ fn resolve(
     })
 }
 
-fn default_policy_path(scenario: &Path) -> PathBuf {
-    let stem = scenario
+/// A scenario file's stem, as policies are named by it.
+fn stem(scenario: &Path) -> String {
+    scenario
         .file_stem()
-        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned());
-    Path::new("policies").join(format!("{stem}.bt"))
+        .map_or_else(|| "tree".into(), |s| s.to_string_lossy().into_owned())
 }
 
 fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {
     if yes {
-        println!("Approve? yes (--yes)");
+        outln!("Approve? yes (--yes)");
         return true;
     }
-    print!("Approve: {proposal}? [y/N] ");
-    let _ = std::io::stdout().flush();
+    out!("Approve: {proposal}? [y/N] ");
+    super::out::flush();
     let mut line = String::new();
     match std::io::stdin().lock().read_line(&mut line) {
         Ok(0) | Err(_) => {
-            println!("(no answer: not approved)");
+            outln!("(no answer: not approved)");
             false
         }
         Ok(_) => matches!(line.trim().to_ascii_lowercase().as_str(), "y" | "yes"),
@@ -366,7 +420,7 @@ fn print_event(event: &Event, show_replies: bool) {
     match event {
         Event::Replied { text, .. } if show_replies => {
             print_event_line(event);
-            println!("  ┌ reply text\n{}\n  └", indent(text));
+            outln!("  ┌ reply text\n{}\n  └", indent(text));
         }
         _ => print_event_line(event),
     }
@@ -381,41 +435,37 @@ fn indent(text: &str) -> String {
 
 fn print_event_line(event: &Event) {
     match event {
-        Event::Asking { what } => println!("\n→ asking for {what}"),
+        Event::Asking { what } => outln!("\n→ asking for {what}"),
         Event::Replied {
             attribution,
             prompt_tokens,
             completion_tokens,
             latency_ms,
             ..
-        } => println!(
+        } => outln!(
             "  reply from {attribution}: {prompt_tokens} prompt + {completion_tokens} completion tokens, {:.2} s",
             *latency_ms as f64 / 1000.0
         ),
-        Event::InvalidReply { error } => println!("  unusable reply: {error}"),
+        Event::InvalidReply { error } => outln!("  unusable reply: {error}"),
         Event::CandidateRejected {
             candidate, reason, ..
         } => {
-            println!("  set aside {candidate}: {reason}");
+            outln!("  set aside {candidate}: {reason}");
         }
         Event::Goal {
             goal,
             reasoning,
-            substitutions,
             matches_expected,
         } => {
             if let Some(r) = reasoning {
-                println!("Reasoning: {r}");
-            }
-            for s in substitutions {
-                println!("  note: {s}");
+                outln!("Reasoning: {r}");
             }
             let check = match matches_expected {
                 Some(true) => "  (equivalent to the scenario's goal)",
                 Some(false) => "  (differs from the scenario's goal)",
                 None => "",
             };
-            println!("Goal: {goal}{check}");
+            outln!("Goal: {goal}{check}");
         }
         Event::ActionFailed {
             action,
@@ -423,41 +473,37 @@ fn print_event_line(event: &Event) {
             error,
             ..
         } => {
-            println!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
+            outln!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
         }
         Event::Proposal {
             proposal,
             reasoning,
-            substitutions,
             author,
         } => {
             if let Some(r) = reasoning {
-                println!("Reasoning: {r}");
+                outln!("Reasoning: {r}");
             }
-            for s in substitutions {
-                println!("  note: {s}");
-            }
-            println!("Proposal: {proposal} (by {author})");
+            outln!("Proposal: {proposal} (by {author})");
         }
         Event::Approved => {}
-        Event::Rejected => println!("Not approved; stopping."),
+        Event::Rejected => outln!("Not approved; stopping."),
         Event::Repaired {
             added_nodes,
             valued_nodes: 0,
-        } => println!("Repaired: {added_nodes} node(s) added"),
+        } => outln!("Repaired: {added_nodes} node(s) added"),
         Event::Repaired {
             added_nodes,
             valued_nodes,
         } => {
-            println!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
+            outln!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
         }
         Event::DidNotHelp { reason } => {
-            println!("The change did not help and was undone: {reason}")
+            outln!("The change did not help and was undone: {reason}")
         }
-        Event::Success { ticks } => println!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
-        Event::GaveUp { reason } => println!("\nGave up: {reason}"),
+        Event::Success { ticks } => outln!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
+        Event::GaveUp { reason } => outln!("\nGave up: {reason}"),
         Event::ChangeViolates { report } => {
-            println!(
+            outln!(
                 "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
             );
             let mut err = std::io::stderr();
@@ -488,7 +534,7 @@ fn print_event_line(event: &Event) {
         | Event::Notice { .. }
         // Listed with the question that asks to choose among them.
         | Event::Readings { .. } => {}
-        Event::Error { message } => println!("error: {message}"),
+        Event::Error { message } => outln!("error: {message}"),
         // Returned by the loop as its error, and printed once by `main`.
         Event::Failed { .. } => {}
     }
@@ -500,5 +546,5 @@ fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
         .log_path()
         .map(|p| format!("; logged to {}", p.display()))
         .unwrap_or_default();
-    println!("LLM usage: {}{log}", ledger.totals());
+    outln!("LLM usage: {}{log}", ledger.totals());
 }

@@ -30,7 +30,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub trace: bool,
     /// Give up after this many ticks.
-    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
+    #[arg(value_parser = clap::value_parser!(u64).range(1..=1_000_000_000), long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
     pub max_ticks: u64,
     /// Run in the scenario's `[world.variants.NAME]` world (e.g. `clear`: without the obstacle).
     #[arg(long)]
@@ -90,6 +90,9 @@ pub fn run_command(args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode> {
 pub fn repair_command(args: &RepairArgs, glyphs: &Glyphs) -> Result<ExitCode> {
     let scenario_path = super::find_scenario(&args.scenario)?;
     let scenario = super::load_with(&scenario_path, &args.knowledge)?;
+    if let Some(path) = &args.save {
+        betr::store::check_writable(path).context("--save")?;
+    }
     let additions = args
         .add
         .iter()
@@ -127,17 +130,17 @@ pub fn repair_command(args: &RepairArgs, glyphs: &Glyphs) -> Result<ExitCode> {
 pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<ExitCode> {
     let goal_given = goal.is_some();
     let goal = super::goal_of(scenario, goal)?;
-    println!("Scenario: {}", scenario.name);
-    println!("Goal:     {goal}");
+    outln!("Scenario: {}", scenario.name);
+    outln!("Goal:     {goal}");
     if goal.to_dnf().is_false() {
-        println!(
+        outln!(
             "\nThe goal is contradictory: no state of the world satisfies it, so no tree can achieve it."
         );
         return Ok(ExitCode::from(WORLD_FAILED));
     }
     let mut session = Driver::start(Start::new(scenario))?;
     let summary = session.plan(goal_given.then_some(goal))?;
-    println!(
+    outln!(
         "Planned in {:.2} ms: {} expansion(s), {} reordering(s), {} simulated tick(s)\n",
         summary.elapsed.as_secs_f64() * 1e3,
         summary.expansions,
@@ -146,7 +149,7 @@ pub fn plan(scenario: &Scenario, goal: Option<&str>, glyphs: &Glyphs) -> Result<
     );
     let run = session.run(|_| {})?;
     print_tree(&*session.tree()?, run.last.as_deref(), glyphs);
-    println!("\n{}", summary.prediction);
+    outln!("\n{}", summary.prediction);
     Ok(if summary.prediction.is_success() {
         ExitCode::SUCCESS
     } else {
@@ -184,7 +187,7 @@ fn run(scenario: &Scenario, args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode>
         }
     })?;
     print_tree(&tree, run.last.as_deref(), glyphs);
-    println!("\n{}", run_end_text(&run, &tree));
+    outln!("\n{}", run_end_text(&run, &tree));
     Ok(match run.end {
         RunEnd::Success => ExitCode::SUCCESS,
         RunEnd::Break { .. } => ExitCode::from(STOPPED_AT_BREAKPOINT),
@@ -307,7 +310,7 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
     let mut before = session.run(|_| {})?;
     if !settings.is_empty() {
         if let RunEnd::ActionFailed { action, error, .. } = &before.end {
-            println!("{action}! failed in simulation: {error}");
+            outln!("{action}! failed in simulation: {error}");
         }
         for setting in settings {
             apply_setting(&mut session, setting)?;
@@ -319,23 +322,26 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
         add_conditions(&mut session, &before, conditions, at_action)?;
         before = session.run(|_| {})?;
     }
-    println!();
-    let tree = session.tree()?;
-    print_tree(&tree, before.last.as_deref(), glyphs);
-    println!("\n{}", bt::to_text(&tree));
+    // Saved before anything is printed: the tree is kept whatever happens to the output.
     if let Some(path) = save {
         session
             .save(path.to_path_buf())
             .with_context(|| format!("saving the repaired tree to {}", path.display()))?;
-        println!("Saved to {}", path.display());
+    }
+    outln!();
+    let tree = session.tree()?;
+    print_tree(&tree, before.last.as_deref(), glyphs);
+    outln!("\n{}", bt::to_text(&tree));
+    if let Some(path) = save {
+        outln!("Saved to {}", path.display());
     }
     match before.end {
         RunEnd::Success => {
-            println!("SUCCESS after {} tick(s)", before.ticks);
+            outln!("SUCCESS after {} tick(s)", before.ticks);
             Ok(ExitCode::SUCCESS)
         }
         _ => {
-            println!(
+            outln!(
                 "The repaired tree still fails: {}",
                 failure_text(&before.end)
             );
@@ -350,7 +356,7 @@ fn apply_setting(session: &mut Driver, setting: &Setting) -> Result<()> {
     let change = session
         .change(Command::SetValue(setting.clone()))
         .with_context(|| format!("--set {:?}", setting.text))?;
-    println!(
+    outln!(
         "Setting {} = {} for {:?} on {} action(s)",
         setting
             .targets
@@ -374,8 +380,8 @@ fn add_conditions(
 ) -> Result<()> {
     let names = joined(conditions);
     match (&before.end, at) {
-        (_, Some(action)) => println!("Inserting {names} before {action}!"),
-        (RunEnd::ActionFailed { action, error, .. }, None) => println!(
+        (_, Some(action)) => outln!("Inserting {names} before {action}!"),
+        (RunEnd::ActionFailed { action, error, .. }, None) => outln!(
             "{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)"
         ),
         (RunEnd::Success, None) => {
@@ -391,7 +397,7 @@ fn add_conditions(
         before: at.cloned(),
         author: "a person (betr repair)".into(),
     })?;
-    println!(
+    outln!(
         "  added {} node(s), {} expansion(s)",
         change.added_nodes,
         change.summary.map_or(0, |s| s.expansions)
@@ -410,7 +416,7 @@ fn joined(conditions: &[Condition]) -> String {
 
 fn print_tree(tree: &Tree, record: Option<&TickRecord>, glyphs: &Glyphs) {
     for line in bt::render(tree, record, glyphs) {
-        println!("{line}");
+        outln!("{line}");
     }
 }
 
@@ -426,7 +432,7 @@ fn print_trace(tree: &Tree, record: &TickRecord) {
     for node in &record.halted {
         line.push_str(&format!(", halted {}", leaf_text(tree, *node)));
     }
-    println!("{line}");
+    outln!("{line}");
 }
 
 fn leaf_text(tree: &Tree, node: bt::NodeId) -> String {

@@ -47,7 +47,7 @@ pub struct TuiArgs {
     #[arg(long, value_name = "FILE")]
     pub keys: Option<PathBuf>,
     /// Milliseconds between ticks when running.
-    #[arg(long, default_value_t = 150, value_name = "MS")]
+    #[arg(value_parser = clap::value_parser!(u64).range(1..=60_000), long, default_value_t = 150, value_name = "MS")]
     pub tick_ms: u64,
     #[command(flatten)]
     pub llm: LlmFlags,

@@ -36,10 +36,10 @@ pub struct VerifyArgs {
     #[arg(long)]
     pub no_disturbances: bool,
     /// Stop exploring after this many states (the result is then "unknown").
-    #[arg(long, default_value_t = 200_000)]
+    #[arg(value_parser = super::ranged(1, 1_000_000_000), long, default_value_t = 200_000)]
     pub max_states: usize,
     /// Ticks within which the tree must succeed from every reachable state.
-    #[arg(long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
+    #[arg(value_parser = clap::value_parser!(u64).range(1..=1_000_000_000), long, default_value_t = betr::session::RunLimits::DEFAULT.run_ticks)]
     pub max_ticks: u64,
     #[command(flatten)]
     pub knowledge: super::knowledge_cmd::KnowledgeFlags,
@@ -97,35 +97,37 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
     })?;
     let tree = session.tree()?;
 
-    println!("Scenario: {}", scenario.name);
-    println!("Tree:     {origin} ({} nodes)", scope.nodes);
+    outln!("Scenario: {}", scenario.name);
+    outln!("Tree:     {origin} ({} nodes)", scope.nodes);
     for c in &scope.added {
-        println!(
+        outln!(
             "Added:    {}? before {}! (property: {})",
-            c.condition, c.action, c.property
+            c.condition,
+            c.action,
+            c.property
         );
     }
     match &scope.planned {
         None | Some(Prediction::Success) => {}
         Some(Prediction::Unreachable { condition, .. }) => {
-            println!("Note:     {condition} cannot be achieved");
+            outln!("Note:     {condition} cannot be achieved");
         }
         Some(Prediction::ActionFails { action, error, .. }) => {
-            println!("Note:     {action}! failed in the model ({error})");
+            outln!("Note:     {action}! failed in the model ({error})");
         }
         Some(Prediction::Exhausted { reason }) => {
-            println!("Note:     planning stopped: {reason}");
+            outln!("Note:     planning stopped: {reason}");
         }
     }
     for learned in betr::session::knowledge::learned_in_tree(&scenario.domain, &tree) {
-        println!(
+        outln!(
             "Learned:  {}? before {}! (rule {})",
             learned.condition,
             learned.action,
             learned.rules.join(", ")
         );
     }
-    println!(
+    outln!(
         "Checking: action failures {}, {} disturbance(s){}\n",
         if scope.action_failures { "on" } else { "off" },
         scope.disturbances,
@@ -136,13 +138,13 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
         }
     );
     if let Some((file, claims)) = &scope.promela {
-        println!(
+        outln!(
             "Promela model written to {} (ltl claims: {})\n",
             file.display(),
             claims.join(", ")
         );
     }
-    write_report(&mut std::io::stdout(), &report, ascii)?;
+    write_report(&mut super::out::Stdout, &report, ascii)?;
     Ok(if report.holds() {
         ExitCode::SUCCESS
     } else {

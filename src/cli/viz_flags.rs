@@ -36,7 +36,7 @@ impl VizFlags {
             rrd: self.rrd.clone(),
         })?;
         if !quiet && let Some(note) = viz.as_ref().and_then(Viz::notice) {
-            eprintln!("{note}");
+            errln!("{note}");
         }
         Ok(viz)
     }

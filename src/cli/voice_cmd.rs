@@ -2,7 +2,7 @@
 //! from a file. A dictated instruction is always printed, and used only after `--yes` or a
 //! confirmation on the terminal (where it can also be corrected): never unseen.
 
-use std::io::{BufRead, Write};
+use std::io::BufRead;
 use std::path::Path;
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -40,7 +40,7 @@ pub struct SttFlags {
     #[arg(long, value_name = "LANG")]
     pub language: Option<String>,
     /// Beam width of the embedded model (1: greedy, fastest; default 5).
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
     pub beam_size: Option<usize>,
 }
 
@@ -175,8 +175,8 @@ pub fn transcribe(file: &Path, config: Option<&Path>, flags: &SttFlags) -> Resul
     let audio = read(file)?;
     let loaded = load(&settings(config, flags)?)?;
     let transcript = run_transcription(loaded.stt.as_ref(), &audio)?;
-    println!("{}", transcript.text);
-    eprintln!("{}", timings(&transcript, loaded.load_time));
+    outln!("{}", transcript.text);
+    errln!("{}", timings(&transcript, loaded.load_time));
     Ok(ExitCode::SUCCESS)
 }
 
@@ -202,14 +202,14 @@ fn dictate(audio: &Path, config: Option<&Path>, flags: &SttFlags, yes: bool) -> 
     let audio = read(audio)?;
     let loaded = load(&settings(config, flags)?)?;
     let transcript = run_transcription(loaded.stt.as_ref(), &audio)?;
-    println!("Dictated:    {}", transcript.text);
-    println!("             ({})", timings(&transcript, loaded.load_time));
+    outln!("Dictated:    {}", transcript.text);
+    outln!("             ({})", timings(&transcript, loaded.load_time));
     if yes {
-        println!("Using the transcript as the instruction (--yes).");
+        outln!("Using the transcript as the instruction (--yes).");
         return Ok(transcript.text);
     }
-    print!("Enter to use it, or type the corrected instruction (n to cancel): ");
-    let _ = std::io::stdout().flush();
+    out!("Enter to use it, or type the corrected instruction (n to cancel): ");
+    super::out::flush();
     let mut line = String::new();
     match std::io::stdin().lock().read_line(&mut line) {
         Ok(0) | Err(_) => bail!(

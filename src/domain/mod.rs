@@ -3,6 +3,7 @@
 pub mod action;
 pub mod condition;
 pub mod learned;
+pub mod names;
 
 pub use action::{ActionCall, Value};
 pub use condition::{ANY_OBJECT, Atom, Condition};

@@ -154,7 +154,7 @@ async fn run_step(
             let Some(rule) = rule else {
                 continue;
             };
-            let kept = knowledge
+            let (kept, _) = knowledge
                 .keep(KeptRule::new(
                     &rule,
                     scenario,

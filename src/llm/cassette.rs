@@ -1,10 +1,11 @@
 //! Record and replay. A cassette is a JSONL file; each line holds one request and its
 //! reply, keyed by (model, prompt hash), and names the model that produced the reply (or
-//! says the reply was hand-written). Recording wraps a live backend and appends; replay
-//! answers from the file and fails loudly on a miss, never calling a model.
+//! says the reply was hand-written). Recording wraps a live backend and appends each entry
+//! as one whole line (`store::append_line`); replay answers from the file and fails
+//! loudly on a miss, never calling a model. A cut last line (a recording killed midway)
+//! is left out and reported.
 
 use std::collections::HashMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -50,28 +51,33 @@ pub struct EntryError {
     pub detail: String,
 }
 
-/// The entries of a cassette's text, in order; blank lines are skipped.
-pub fn read_entries(text: &str) -> Result<Vec<Entry>, EntryError> {
-    let mut entries = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let entry: Entry = serde_json::from_str(line).map_err(|e| EntryError {
-            line: i + 1,
-            detail: e.to_string(),
-        })?;
+/// A cassette's entries read back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entries {
+    /// In order.
+    pub entries: Vec<Entry>,
+    /// The number of a cut last line that was left out.
+    pub cut_at: Option<usize>,
+}
+
+/// The entries of a cassette's text, in order; blank lines are skipped, and a last line
+/// without its newline that does not read (a recording killed midway) is left out and
+/// reported in `cut_at`. Any other line that is not an entry is an error naming it.
+pub fn read_entries(text: &str) -> Result<Entries, EntryError> {
+    let read = crate::store::read_lines(text, 1, |line| {
+        let entry: Entry = serde_json::from_str(line).map_err(|e| e.to_string())?;
         // A number beyond f32 reads as an infinite temperature, which JSON cannot hold:
         // the entry could not be written again, nor its request hashed as recorded.
         if !entry.request.temperature.is_finite() {
-            return Err(EntryError {
-                line: i + 1,
-                detail: "the request's temperature is not a finite number".into(),
-            });
+            return Err("the request's temperature is not a finite number".to_string());
         }
-        entries.push(entry);
-    }
-    Ok(entries)
+        Ok(entry)
+    })
+    .map_err(|(line, detail)| EntryError { line, detail })?;
+    Ok(Entries {
+        entries: read.items.into_iter().map(|(_, e)| e).collect(),
+        cut_at: read.cut_at,
+    })
 }
 
 /// Wraps a backend and appends every successful exchange to a cassette.
@@ -115,15 +121,7 @@ impl<M: LanguageModel> Recorder<M> {
         };
         let line = serde_json::to_string(entry).map_err(|e| err(e.to_string()))?;
         let _guard = self.lock.lock().map_err(|_| err("lock poisoned".into()))?;
-        if let Some(dir) = self.path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
-        }
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&self.path)
-            .map_err(|e| err(e.to_string()))?;
-        writeln!(f, "{line}").map_err(|e| err(e.to_string()))
+        crate::store::append_line(&self.path, &line).map_err(|e| err(e.to_string()))
     }
 }
 
@@ -161,8 +159,16 @@ impl Replay {
             path: path.display().to_string(),
             detail,
         };
+        let read = read_entries(text).map_err(|e| err(e.to_string()))?;
+        if let Some(line) = read.cut_at {
+            tracing::warn!(
+                path = %path.display(),
+                line,
+                "the cassette's last line was cut (a recording stopped midway); it is left out"
+            );
+        }
         let mut entries = HashMap::new();
-        for entry in read_entries(text).map_err(|e| err(e.to_string()))? {
+        for entry in read.entries {
             entries.insert((entry.model.clone(), entry.prompt_hash.clone()), entry);
         }
         let mut models: Vec<&str> = entries.keys().map(|(m, _)| m.as_str()).collect();
@@ -315,7 +321,11 @@ mod tests {
             recorded_unix: 0,
         };
         let line = serde_json::to_string(&entry).unwrap();
-        assert_eq!(read_entries(&line).unwrap(), vec![entry]);
+        let read = read_entries(&format!("{line}\n")).unwrap();
+        assert_eq!((read.entries, read.cut_at), (vec![entry.clone()], None));
+        // The same line without its newline, cut short: left out and reported.
+        let cut = read_entries(&format!("{line}\n{}", &line[..30])).unwrap();
+        assert_eq!((cut.entries, cut.cut_at), (vec![entry], Some(2)));
         let hot = line.replace("\"temperature\":0.0", "\"temperature\":1e39");
         assert_ne!(hot, line);
         let e = read_entries(&format!("{line}\n\n{hot}\n")).unwrap_err();

@@ -89,6 +89,8 @@ pub struct Layer {
     pub grammar: Option<bool>,
     /// Local backend: context length in tokens.
     pub context: Option<u32>,
+    /// The most bytes a server's reply may have; a longer one fails the call.
+    pub max_reply_bytes: Option<u64>,
     /// Refused: keys belong in the environment.
     pub api_key: Option<toml::Value>,
 }
@@ -122,6 +124,7 @@ impl Layer {
             threads,
             grammar,
             context,
+            max_reply_bytes,
             api_key
         );
     }
@@ -197,6 +200,32 @@ pub struct Settings {
     pub threads: Option<u32>,
     pub grammar: bool,
     pub context: u32,
+    /// The most bytes a server's reply may have.
+    pub max_reply_bytes: usize,
+}
+
+/// The ranges of the numbers settings take (inclusive).
+pub mod limits {
+    /// A server's reply: 256 KiB by default (a goal or a fix is a few hundred bytes).
+    pub const DEFAULT_REPLY_BYTES: u64 = 256 * 1024;
+    pub const REPLY_BYTES: (u64, u64) = (1024, 64 * 1024 * 1024);
+    pub const TEMPERATURE: (f32, f32) = (0.0, 2.0);
+    pub const MAX_TOKENS: (u32, u32) = (1, 131_072);
+    pub const RETRIES: (u32, u32) = (0, 20);
+    /// Backoff between retries, in milliseconds (an hour at most).
+    pub const BACKOFF_MS: (u64, u64) = (0, 3_600_000);
+    pub const THREADS: (u32, u32) = (1, 1024);
+    pub const CONTEXT: (u32, u32) = (512, 1_048_576);
+}
+
+/// `value` of the setting `what` when it lies in `range` (inclusive), else a
+/// configuration error saying the range.
+fn in_range<T: PartialOrd + std::fmt::Display>(
+    what: &str,
+    value: T,
+    (min, max): (T, T),
+) -> Result<T, LlmError> {
+    crate::bounds::within(what, value, min, max).map_err(|e| LlmError::Config(e.to_string()))
 }
 
 /// Threads for the local model when the load cannot decide (tests, which share the
@@ -224,15 +253,37 @@ impl Settings {
         layer.merge(env);
         layer.merge(flags);
         let secs = |v: Option<f64>, default: f64, what: &str| {
-            let s = v.unwrap_or(default);
-            if s.is_finite() && s > 0.0 {
-                Ok(Duration::from_secs_f64(s))
-            } else {
-                Err(LlmError::Config(format!(
-                    "{what} must be a positive number of seconds"
-                )))
-            }
+            crate::bounds::seconds(what, v.unwrap_or(default))
+                .map_err(|e| LlmError::Config(e.to_string()))
         };
+        let temperature = in_range(
+            "temperature",
+            layer.temperature.unwrap_or(0.0),
+            limits::TEMPERATURE,
+        )?;
+        let max_tokens = in_range(
+            "max_tokens",
+            layer.max_tokens.unwrap_or(800),
+            limits::MAX_TOKENS,
+        )?;
+        let retries = in_range(
+            "max_retries",
+            layer.max_retries.unwrap_or(3),
+            limits::RETRIES,
+        )?;
+        let backoff = |what: &str, v: Option<u64>, default: u64| {
+            in_range(what, v.unwrap_or(default), limits::BACKOFF_MS).map(Duration::from_millis)
+        };
+        let threads = layer
+            .threads
+            .map(|t| in_range("threads", t, limits::THREADS))
+            .transpose()?;
+        let context = in_range("context", layer.context.unwrap_or(4096), limits::CONTEXT)?;
+        let reply_bytes = in_range(
+            "max_reply_bytes",
+            layer.max_reply_bytes.unwrap_or(limits::DEFAULT_REPLY_BYTES),
+            limits::REPLY_BYTES,
+        )?;
         Ok(Settings {
             // Offline by default: the embedded model needs no key and no network. A base
             // URL given without a backend can only mean an HTTP server.
@@ -252,26 +303,27 @@ impl Settings {
             },
             auth_header: layer.auth_header.unwrap_or(AuthHeader::Bearer),
             structured: layer.structured.unwrap_or(false),
-            temperature: layer.temperature.unwrap_or(0.0),
-            max_tokens: layer.max_tokens.unwrap_or(800),
+            temperature,
+            max_tokens,
             max_tokens_field: layer
                 .max_tokens_field
                 .unwrap_or_else(|| "max_tokens".into()),
             timeout: secs(layer.timeout_secs, 60.0, "timeout_secs")?,
             connect_timeout: secs(layer.connect_timeout_secs, 10.0, "connect_timeout_secs")?,
             retry: RetryPolicy {
-                max_retries: layer.max_retries.unwrap_or(3),
-                initial_backoff: Duration::from_millis(layer.initial_backoff_ms.unwrap_or(500)),
-                max_backoff: Duration::from_millis(layer.max_backoff_ms.unwrap_or(20_000)),
+                max_retries: retries,
+                initial_backoff: backoff("initial_backoff_ms", layer.initial_backoff_ms, 500)?,
+                max_backoff: backoff("max_backoff_ms", layer.max_backoff_ms, 20_000)?,
             },
             cassette: layer.cassette,
             usage_log: layer.usage_log.or_else(super::usage::default_log_path),
             prices,
             file: path,
             model_path: layer.model_path,
-            threads: layer.threads.map(|t| t.max(1)),
+            threads,
             grammar: layer.grammar.unwrap_or(true),
-            context: layer.context.unwrap_or(4096).max(512),
+            context,
+            max_reply_bytes: usize::try_from(reply_bytes).unwrap_or(usize::MAX),
         })
     }
 
@@ -363,6 +415,7 @@ impl Settings {
                     retry: self.retry,
                     structured: self.structured,
                     max_tokens_field: self.max_tokens_field.clone(),
+                    max_reply_bytes: self.max_reply_bytes,
                 })?;
                 match &self.cassette {
                     Some(path) => Box::new(Recorder::new(client, path)),
@@ -455,5 +508,85 @@ mod tests {
                 .to_string()
                 .contains("unknown local model \"gpt-9\"")
         );
+    }
+
+    #[test]
+    fn every_number_is_checked_against_its_range() {
+        let refused = |layer: Layer, said: &str| {
+            let e = Settings::resolve(None, Layer::default(), layer)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(said), "{e}");
+        };
+        let d = Layer::default;
+        for t in [1e20, 0.0, -5.0, f64::NAN, 3601.0] {
+            let timeout = Layer {
+                timeout_secs: Some(t),
+                ..d()
+            };
+            refused(timeout, "timeout_secs = ");
+            let connect = Layer {
+                connect_timeout_secs: Some(t),
+                ..d()
+            };
+            refused(connect, "connect_timeout_secs = ");
+        }
+        let out_of_range = [
+            (
+                Layer {
+                    temperature: Some(f32::INFINITY),
+                    ..d()
+                },
+                "temperature = inf is out of range",
+            ),
+            (
+                Layer {
+                    max_tokens: Some(0),
+                    ..d()
+                },
+                "max_tokens = 0",
+            ),
+            (
+                Layer {
+                    max_retries: Some(4_000_000_000),
+                    ..d()
+                },
+                "max_retries",
+            ),
+            (
+                Layer {
+                    max_backoff_ms: Some(u64::MAX),
+                    ..d()
+                },
+                "max_backoff_ms",
+            ),
+            (
+                Layer {
+                    threads: Some(0),
+                    ..d()
+                },
+                "threads = 0",
+            ),
+            (
+                Layer {
+                    context: Some(u32::MAX),
+                    ..d()
+                },
+                "context = ",
+            ),
+            (
+                Layer {
+                    max_reply_bytes: Some(1 << 40),
+                    ..d()
+                },
+                "max_reply_bytes = ",
+            ),
+        ];
+        for (layer, said) in out_of_range {
+            refused(layer, said);
+        }
+        let s = Settings::resolve(None, Layer::default(), Layer::default()).unwrap();
+        assert_eq!(s.max_reply_bytes, 256 * 1024);
+        assert_eq!(s.timeout, Duration::from_secs(60));
     }
 }

@@ -198,6 +198,10 @@ pub enum LlmError {
     #[error("{url} sent a chat completion with no choices")]
     EmptyChoices { url: String },
     #[error(
+        "{url} sent a reply longer than {limit} bytes, the most `max_reply_bytes` under [llm] allows; it was not read further"
+    )]
+    ReplyTooLarge { url: String, limit: usize },
+    #[error(
         "cassette {path} has no reply for model {model:?} and prompt {hash} (replay never calls a model; record it first with a live backend and --cassette)"
     )]
     CassetteMiss {

@@ -45,6 +45,9 @@ pub struct OpenAiSettings {
     pub structured: bool,
     /// `max_tokens` for most servers; newer OpenAI models want `max_completion_tokens`.
     pub max_tokens_field: String,
+    /// The most bytes a reply's body may have: it is read in chunks and the call fails
+    /// as soon as it passes them.
+    pub max_reply_bytes: usize,
 }
 
 pub struct OpenAiClient {
@@ -121,10 +124,15 @@ impl OpenAiClient {
             let status = response.status().as_u16();
             let wait = crate::http_retry::retry_after(response.headers());
             let fixture = fixture_note(response.headers());
-            let text = response
-                .text()
+            let text = crate::http_text::read_body(response, self.settings.max_reply_bytes)
                 .await
-                .map_err(|e| self.transport_error(&e))?;
+                .map_err(|e| match e {
+                    crate::http_text::BodyError::TooLarge { limit } => LlmError::ReplyTooLarge {
+                        url: self.url.clone(),
+                        limit,
+                    },
+                    crate::http_text::BodyError::Transport(e) => self.transport_error(&e),
+                })?;
             match status {
                 200..=299 => {
                     let mut reply = self.parse_reply(&text, started.elapsed())?;

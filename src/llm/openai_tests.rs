@@ -13,6 +13,7 @@ fn client(structured: bool) -> OpenAiClient {
         retry: RetryPolicy::default(),
         structured,
         max_tokens_field: "max_tokens".into(),
+        max_reply_bytes: 256 * 1024,
     })
     .unwrap()
 }

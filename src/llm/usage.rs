@@ -3,7 +3,6 @@
 //! `~/.local/state/betr/usage.jsonl`).
 
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
@@ -158,16 +157,10 @@ pub fn totals(records: &[UsageRecord]) -> UsageTotals {
     t
 }
 
+/// One record as one whole line (`store::append_line`).
 fn append_line(path: &Path, record: &UsageRecord) -> std::io::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)?;
-    }
     let line = serde_json::to_string(record).map_err(std::io::Error::other)?;
-    let mut f = std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(path)?;
-    writeln!(f, "{line}")
+    crate::store::append_line(path, &line)
 }
 
 /// Wraps a model and accounts each call in a ledger.

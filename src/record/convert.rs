@@ -408,7 +408,6 @@ impl Decoder {
                     .parse_goal(goal)
                     .map_err(|e| bad(format!("the goal {goal:?}: {e}")))?,
                 reasoning: reasoning.clone(),
-                substitutions: Vec::new(),
                 matches_expected: *matches_expected,
             },
             Recorded::ActionFailed {
@@ -430,7 +429,6 @@ impl Decoder {
             } => Event::Proposal {
                 proposal: self.proposal(proposal, line)?,
                 reasoning: reasoning.clone(),
-                substitutions: Vec::new(),
                 author: author.clone(),
             },
             Recorded::Approved => Event::Approved,

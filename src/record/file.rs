@@ -102,12 +102,11 @@ pub fn read(path: &Path) -> Result<Recording, RecordError> {
 
 /// A recording from its text, as if read from `path` (which names it in errors).
 pub fn parse(path: &Path, text: &str) -> Result<Recording, RecordError> {
-    // Each line with whether it ended in a newline (only the last one can lack it).
-    let lines: Vec<(&str, bool)> = text
+    let Some(first) = text
         .split_inclusive('\n')
-        .map(|line| (line.trim_end_matches(['\n', '\r']), line.ends_with('\n')))
-        .collect();
-    let Some((first, _)) = lines.first() else {
+        .next()
+        .map(|line| line.trim_end_matches(['\n', '\r']))
+    else {
         return Err(RecordError::Empty {
             path: path.to_path_buf(),
         });
@@ -128,31 +127,18 @@ pub fn parse(path: &Path, text: &str) -> Result<Recording, RecordError> {
             found: header.version,
         });
     }
-    let mut entries = Vec::new();
-    let mut cut_at = None;
-    let last = lines.len();
-    for (i, (line, whole)) in lines.iter().enumerate().skip(1) {
-        let number = i + 1;
-        if line.trim().is_empty() {
-            continue;
-        }
-        match serde_json::from_str::<Entry>(line) {
-            Ok(entry) => entries.push((number, entry)),
-            Err(_) if !whole && number == last => cut_at = Some(number),
-            Err(e) => {
-                return Err(RecordError::Line {
-                    path: path.to_path_buf(),
-                    line: number,
-                    reason: e.to_string(),
-                });
-            }
-        }
-    }
+    let read = crate::store::read_lines(text, 2, |l| serde_json::from_str::<Entry>(l)).map_err(
+        |(line, e)| RecordError::Line {
+            path: path.to_path_buf(),
+            line,
+            reason: e.to_string(),
+        },
+    )?;
     Ok(Recording {
         path: path.to_path_buf(),
         header,
-        entries,
-        cut_at,
+        entries: read.items,
+        cut_at: read.cut_at,
     })
 }
 

@@ -1,6 +1,7 @@
 //! A session followed into a recording: every event the engine reports and every command a
-//! front end sends. A write that fails stops the recording (what was written stays
-//! readable) and is told once; the session goes on.
+//! front end sends. A write that fails (a full disk) stops the recording, and what was
+//! written stays readable; `stopped` says why, and the one-shot commands end with it as
+//! an error, while the workbench shows it.
 
 use std::path::Path;
 

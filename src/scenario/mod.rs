@@ -15,6 +15,8 @@ use toml::Spanned;
 mod build;
 mod file;
 
+use crate::domain::Atom;
+use crate::domain::names::{MIN_SIMILARITY, did_you_mean, nearest};
 use crate::domain::skill::{AtomTemplate, Domain, LiteralTemplate, Term};
 use crate::domain::vocabulary::{Vocabulary, VocabularyError};
 use crate::goal::{Formula, GoalError};
@@ -93,9 +95,15 @@ pub enum GoalTextError {
     /// The text is not a goal formula.
     #[error(transparent)]
     Syntax(#[from] GoalError),
-    /// An atom of the formula does not fit the vocabulary.
-    #[error(transparent)]
-    Vocabulary(#[from] VocabularyError),
+    /// An atom of the formula does not fit the vocabulary: where it stands (`at`, a byte
+    /// offset, and its column) and the atoms of the vocabulary most like it.
+    #[error("column {column}: {error}{}", did_you_mean(nearest))]
+    Vocabulary {
+        error: VocabularyError,
+        at: usize,
+        column: usize,
+        nearest: Vec<String>,
+    },
 }
 
 impl GoalTextError {
@@ -103,7 +111,7 @@ impl GoalTextError {
     pub fn at(&self) -> usize {
         match self {
             GoalTextError::Syntax(e) => e.at,
-            GoalTextError::Vocabulary(_) => 0,
+            GoalTextError::Vocabulary { at, .. } => *at,
         }
     }
 }
@@ -230,13 +238,79 @@ impl Scenario {
     }
 }
 
-/// A goal formula whose every atom fits `vocabulary`.
+/// A goal formula whose every atom fits `vocabulary`; the first that does not is refused
+/// with where it stands and the atoms of the vocabulary most like it.
 fn goal_in(text: &str, vocabulary: &Vocabulary) -> Result<Formula, GoalTextError> {
     let f = Formula::parse(text)?;
     for atom in f.atoms() {
-        vocabulary.check_atom(&atom)?;
+        if let Err(error) = vocabulary.check_atom(&atom) {
+            let at = where_in(text, &atom, &error);
+            return Err(GoalTextError::Vocabulary {
+                nearest: atoms_like(vocabulary, &atom, &error),
+                at,
+                column: crate::goal::column_of(text, at),
+                error,
+            });
+        }
     }
     Ok(f)
+}
+
+/// The byte offset of `atom` in the goal text it was read from: as it prints, else the
+/// name the error is about, else the start.
+fn where_in(text: &str, atom: &Atom, error: &VocabularyError) -> usize {
+    let name = match error {
+        VocabularyError::UnknownObject { object, .. } => object.as_str(),
+        _ => atom.predicate.as_str(),
+    };
+    text.find(&atom.to_string())
+        .or_else(|| text.find(&format!("\"{name}\"")))
+        .or_else(|| text.find(name))
+        .unwrap_or(0)
+}
+
+/// The atoms of the vocabulary most like `atom` where it names a predicate or an object
+/// the vocabulary lacks: the same atom with the most similar name in that place.
+fn atoms_like(vocabulary: &Vocabulary, atom: &Atom, error: &VocabularyError) -> Vec<String> {
+    let min = MIN_SIMILARITY;
+    match error {
+        VocabularyError::UnknownPredicate { predicate, .. } => {
+            let same_arity = vocabulary
+                .predicates
+                .iter()
+                .filter(|p| p.arg_types.len() == atom.args.len())
+                .map(|p| p.name.as_str());
+            nearest(predicate, same_arity, min)
+                .into_iter()
+                .map(|predicate| {
+                    Atom {
+                        predicate,
+                        args: atom.args.clone(),
+                    }
+                    .to_string()
+                })
+                .collect()
+        }
+        VocabularyError::UnknownObject { object, .. } => {
+            let Some(position) = atom.args.iter().position(|a| a == object) else {
+                return Vec::new();
+            };
+            let types = vocabulary
+                .predicate(&atom.predicate)
+                .and_then(|p| p.arg_types.get(position))
+                .cloned()
+                .unwrap_or_default();
+            nearest(object, vocabulary.objects_fitting(&types), min)
+                .into_iter()
+                .map(|name| {
+                    let mut like = atom.clone();
+                    like.args[position] = name;
+                    like.to_string()
+                })
+                .collect()
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// `place|item` → [place, item]; `item except makable` keeps the exclusion for `Param`.

@@ -7,7 +7,7 @@
 use crate::bt::NodeId;
 use crate::domain::{ActionCall, Condition, ValueParam};
 use crate::llm::prompt::{self, Context};
-use crate::llm::reply::{self, ReplyError, Substitution};
+use crate::llm::reply::{self, ReplyError};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
@@ -81,8 +81,8 @@ pub fn missing_value<'a>(
 /// What a question about a failure produced.
 pub(crate) struct Asked {
     /// The first candidate that fixed the failure in simulation, with the model's
-    /// reasoning and the names it corrected; `None` when no candidate did.
-    pub chosen: Option<(Proposal, Option<String>, Vec<Substitution>)>,
+    /// reasoning; `None` when no candidate did.
+    pub chosen: Option<(Proposal, Option<String>)>,
     /// Candidates that did not fix it, each with what happened in simulation.
     pub rejected: Vec<(Proposal, String)>,
     /// Replies that could not be read at all.
@@ -123,9 +123,8 @@ pub(crate) struct FailedAction<'a> {
 /// be worth trying.
 const SAMPLE_TEMPERATURE: f32 = 0.8;
 
-/// Reads one reply into a proposal, the reasoning shown with it and the values it sets.
-type ReadProposal<'a> =
-    dyn Fn(&str) -> Result<(Proposal, Option<String>, Vec<Substitution>), ReplyError> + Sync + 'a;
+/// Reads one reply into a proposal and the reasoning shown with it.
+type ReadProposal<'a> = dyn Fn(&str) -> Result<(Proposal, Option<String>), ReplyError> + Sync + 'a;
 
 /// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
 /// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
@@ -169,7 +168,7 @@ async fn draw_and_screen(
             emit,
         )
         .await?;
-        let (proposal, reasoning, substitutions) = match read(&r.text) {
+        let (proposal, reasoning) = match read(&r.text) {
             Ok(x) => x,
             Err(e) => {
                 emit(&Event::InvalidReply {
@@ -200,7 +199,7 @@ async fn draw_and_screen(
         }
         match screen_one(screen, bounds, (&proposal, None), emit) {
             Ok(()) => {
-                asked.chosen = Some((proposal, reasoning, substitutions));
+                asked.chosen = Some((proposal, reasoning));
                 return Ok(asked);
             }
             Err(why) => asked.rejected.push((proposal, why.to_string())),
@@ -337,7 +336,6 @@ pub(crate) async fn ask_conditions(
                     conditions: without_implied(a.conditions),
                 },
                 a.reasoning,
-                a.substitutions,
             )
         })
     };
@@ -407,7 +405,7 @@ pub(crate) async fn ask_value(
     let read = |text: &str| {
         let Some(levelled) = &levels else {
             let a = reply::value(text, param, options.min_similarity)?;
-            return Ok((proposal(a.value), a.reasoning, a.substitutions));
+            return Ok((proposal(a.value), a.reasoning));
         };
         // A model that answers a level question with a number (a server without the
         // grammar) is taken at its number.
@@ -415,7 +413,7 @@ pub(crate) async fn ask_value(
             Ok(a) => a,
             Err(e) => {
                 return reply::value(text, param, options.min_similarity)
-                    .map(|a| (proposal(a.value), a.reasoning, a.substitutions))
+                    .map(|a| (proposal(a.value), a.reasoning))
                     .map_err(|_| e);
             }
         };
@@ -429,7 +427,7 @@ pub(crate) async fn ask_value(
             Some(r) => format!("{said} {r}"),
             None => said,
         };
-        Ok((proposal(number), Some(reasoning), answer.substitutions))
+        Ok((proposal(number), Some(reasoning)))
     };
     let mut asked = draw_and_screen(
         model,
@@ -461,7 +459,7 @@ pub(crate) async fn ask_value(
         let midway = proposal(value);
         match screen_one(screen, &mut bounds, (&midway, Some(MIDWAY)), emit) {
             Ok(()) => {
-                asked.chosen = Some((midway, Some(between), Vec::new()));
+                asked.chosen = Some((midway, Some(between)));
                 asked.author = Some(MIDWAY.to_string());
             }
             Err(why) => asked.rejected.push((midway, why.to_string())),

@@ -348,10 +348,12 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
     emit(&Event::Goal {
         goal: answer.goal.clone(),
         reasoning: answer.reasoning.clone(),
-        substitutions: answer.substitutions.clone(),
         matches_expected,
     });
 }
+
+/// How many characters of a refused answer the next prompt repeats to the model.
+const ECHOED_ANSWER: usize = 2000;
 
 /// Continue the conversation: the first candidate as the model's answer, and what was
 /// wrong with each distinct candidate.
@@ -363,7 +365,10 @@ fn feedback(messages: &mut Vec<Message>, candidates: &[Candidate]) {
     for c in candidates {
         let shown = match &c.read {
             Ok(a) => a.goal.to_string(),
-            Err(_) => c.text.trim().lines().last().unwrap_or("").to_string(),
+            Err(_) => crate::excerpt::shortened(
+                c.text.trim().lines().last().unwrap_or(""),
+                crate::llm::reply::ECHOED,
+            ),
         };
         let line = format!(
             "- {shown}: {}",
@@ -375,9 +380,10 @@ fn feedback(messages: &mut Vec<Message>, candidates: &[Candidate]) {
             problems.push(line);
         }
     }
+    // The answer is echoed cut, so a prompt never grows with a reply's size.
     messages.push(Message {
         role: Role::Assistant,
-        content: first.text.trim().to_string(),
+        content: crate::excerpt::shortened(first.text.trim(), ECHOED_ANSWER),
     });
     messages.push(Message::user(format!(
         "That cannot be the goal the person means:\n{}\nRead the request again and write a goal that fixes this, in the same answer format.",

@@ -115,10 +115,6 @@ pub(super) async fn read_parts(
         answer: GoalAnswer {
             goal,
             reasoning: (!reasoning.is_empty()).then(|| reasoning.join("\n")),
-            substitutions: read
-                .iter()
-                .flat_map(|r| r.answer.substitutions.clone())
-                .collect(),
         },
         first,
         calls,

@@ -10,7 +10,6 @@ fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {
             Some(g) => Ok(GoalAnswer {
                 goal: Formula::parse(g).expect("parses"),
                 reasoning: None,
-                substitutions: Vec::new(),
             }),
             None => Err(ReplyError::NoConditions),
         },

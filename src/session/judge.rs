@@ -228,7 +228,6 @@ impl Judge<'_> {
                 read: Ok(GoalAnswer {
                     goal,
                     reasoning: None,
-                    substitutions: Vec::new(),
                 }),
                 problem,
                 first,

@@ -17,6 +17,7 @@ pub mod readings;
 pub mod resolve;
 pub mod screen;
 pub mod shortlist;
+pub mod submitted;
 pub mod types;
 pub mod value_bounds;
 mod value_levels;

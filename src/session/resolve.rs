@@ -16,6 +16,7 @@ use crate::llm::LanguageModel;
 use crate::scenario::Scenario;
 
 use super::engine::{Command, Engine, Setup};
+use super::policy::PolicyStore;
 use super::readings::Reading;
 use super::types::{Ending, Event, Options, Proposal, Resolved, SessionError};
 
@@ -68,7 +69,7 @@ pub async fn resolve_with_scenes(
         .last()
         .map(|f| f.path.clone())
         .unwrap_or_default();
-    let mut setup = Setup::new(Arc::new(scenario.clone()), path, Ok(model));
+    let mut setup = Setup::new(Arc::new(scenario.clone()), path.clone(), Ok(model));
     setup.options = options.clone();
     setup.scenes = scenes;
     let (engine, mut events) = Engine::spawn(setup)?;
@@ -153,6 +154,20 @@ pub async fn resolve_with_scenes(
             _ => {}
         }
     };
+    let saved = match (&ending, &options.policy_dir, &goal) {
+        (Ending::Success { .. }, Some(dir), Some(goal)) => {
+            let to = PolicyStore::new(dir).path_for(&path, goal);
+            engine.send(Command::SavePolicyTo(to));
+            match saved_policy(&mut events, emit).await {
+                Ok(saved) => Some(saved),
+                Err(e) => {
+                    engine.send(Command::Shutdown);
+                    return Err(e);
+                }
+            }
+        }
+        _ => None,
+    };
     engine.send(Command::Shutdown);
     let (Some(goal), Some(tree)) = (goal, tree) else {
         return Err(SessionError::Stopped);
@@ -164,5 +179,22 @@ pub async fn resolve_with_scenes(
         rounds,
         repairs,
         kept,
+        saved,
     })
+}
+
+/// The file the engine saved the policy to, once it says so.
+async fn saved_policy(
+    events: &mut tokio::sync::mpsc::UnboundedReceiver<Event>,
+    emit: &mut dyn FnMut(&Event),
+) -> Result<std::path::PathBuf, SessionError> {
+    loop {
+        let event = events.recv().await.ok_or(SessionError::Stopped)?;
+        emit(&event);
+        match event {
+            Event::PolicySaved { path, .. } => return Ok(path),
+            Event::Failed { error } => return Err(error),
+            _ => {}
+        }
+    }
 }

@@ -8,7 +8,7 @@ use crate::domain::{ActionCall, Condition, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
 use crate::llm::prompt::{PromptError, Templates, Variant};
-use crate::llm::reply::{self, ReplyError, Substitution};
+use crate::llm::reply::{self, ReplyError};
 use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
 use crate::scenario::ScenarioError;
@@ -51,12 +51,17 @@ pub struct Options {
     /// (so the failure under study is reached whatever a model would read); the
     /// instruction still reaches the questions about failures.
     pub use_scenario_goal: bool,
+    /// The resolve loop saves the tree that succeeds as a policy in this directory, with
+    /// its provenance, where the workbench finds it (keyed by scenario and goal).
+    pub policy_dir: Option<std::path::PathBuf>,
     /// Before asking about a failure, try the conditions over the failing action's objects
     /// in simulation and let the model choose among those that fix it; off: the model
     /// names the condition out of the whole vocabulary.
     pub shortlist: bool,
     pub temperature: f32,
     pub max_tokens: u32,
+    /// How alike a listed name must be to be offered ("did you mean …?") for a name of a
+    /// reply that the scene does not have; nothing is ever replaced by it.
     pub min_similarity: f64,
     pub variant: Variant,
     pub templates: Templates,
@@ -93,6 +98,7 @@ impl Default for Options {
             read_by_parts: true,
             value_levels: true,
             use_scenario_goal: false,
+            policy_dir: None,
             shortlist: true,
             temperature: 0.0,
             max_tokens: 800,
@@ -219,7 +225,6 @@ pub enum Event {
     Goal {
         goal: Formula,
         reasoning: Option<String>,
-        substitutions: Vec<Substitution>,
         matches_expected: Option<bool>,
     },
     /// The instruction has more than one reading that would make the robot do different
@@ -240,7 +245,6 @@ pub enum Event {
     Proposal {
         proposal: Proposal,
         reasoning: Option<String>,
-        substitutions: Vec<Substitution>,
         author: String,
     },
     Approved,
@@ -413,6 +417,8 @@ pub struct Resolved {
     pub repairs: usize,
     /// The approved proposals kept in the tree, in order, with who wrote each.
     pub kept: Vec<(Proposal, String)>,
+    /// The policy file the tree was saved to (`Options::policy_dir`).
+    pub saved: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Clone, thiserror::Error)]

@@ -122,6 +122,9 @@ pub struct SttSettings {
     pub max_retries: u32,
 }
 
+/// The widest beam search a transcription may ask for.
+const MAX_BEAM: usize = 64;
+
 impl SttSettings {
     /// Defaults, then `file`, then `env`, then `flags`.
     pub fn resolve(
@@ -141,13 +144,20 @@ impl SttSettings {
         layer.merge(env);
         layer.merge(flags);
         let backend = layer.backend.unwrap_or(SttBackend::Local);
-        let timeout = layer.timeout_secs.unwrap_or(120.0);
-        if !(timeout.is_finite() && timeout > 0.0) {
-            return Err(VoiceError::Config(
-                "timeout_secs must be a positive number of seconds".into(),
-            ));
-        }
+        let range = |e: crate::bounds::OutOfRange| VoiceError::Config(e.to_string());
+        let timeout = crate::bounds::seconds("timeout_secs", layer.timeout_secs.unwrap_or(120.0))
+            .map_err(range)?;
         let defaults = LocalSettings::default();
+        let beam_size = crate::bounds::within(
+            "beam_size",
+            layer.beam_size.unwrap_or(defaults.beam_size).max(1),
+            1,
+            MAX_BEAM,
+        )
+        .map_err(range)?;
+        let max_retries =
+            crate::bounds::within("max_retries", layer.max_retries.unwrap_or(3), 0, 20)
+                .map_err(range)?;
         Ok(SttSettings {
             backend,
             model: layer.model.unwrap_or_else(|| {
@@ -170,10 +180,15 @@ impl SttSettings {
                 Some(l) => Some(l.to_ascii_lowercase()),
                 None => Some("en".into()),
             },
-            beam_size: layer.beam_size.unwrap_or(defaults.beam_size).max(1),
-            threads: layer.threads.unwrap_or(defaults.threads),
-            timeout: Duration::from_secs_f64(timeout),
-            max_retries: layer.max_retries.unwrap_or(3),
+            beam_size,
+            threads: layer
+                .threads
+                .map(|t| crate::bounds::within("threads", t, 1, 1024))
+                .transpose()
+                .map_err(range)?
+                .unwrap_or(defaults.threads),
+            timeout,
+            max_retries,
         })
     }
 

@@ -9,6 +9,9 @@
 
 use std::time::{Duration, Instant};
 
+/// The most bytes a transcription reply may have (a transcript is a few kilobytes).
+const MAX_REPLY_BYTES: usize = 1024 * 1024;
+
 use reqwest::multipart::{Form, Part};
 use serde_json::Value as Json;
 
@@ -98,10 +101,17 @@ impl OpenAiStt {
             let response = request.send().await.map_err(|e| self.transport_error(&e))?;
             let status = response.status().as_u16();
             let wait = crate::http_retry::retry_after(response.headers());
-            let body = response
-                .text()
+            let body = crate::http_text::read_body(response, MAX_REPLY_BYTES)
                 .await
-                .map_err(|e| self.transport_error(&e))?;
+                .map_err(|e| match e {
+                    crate::http_text::BodyError::TooLarge { limit } => VoiceError::MalformedReply {
+                        url: self.url.clone(),
+                        detail: format!(
+                            "the reply is longer than {limit} bytes; it was not read further"
+                        ),
+                    },
+                    crate::http_text::BodyError::Transport(e) => self.transport_error(&e),
+                })?;
             match status {
                 200..=299 => {
                     let text = self.parse(&body)?;

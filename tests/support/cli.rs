@@ -86,13 +86,10 @@ pub fn relative_to(p: &Path, base: &Path) -> String {
         .replace('\\', "/")
 }
 
-/// `betr resolve SCENARIO --yes` against an OpenAI-compatible server at `base` (the fake
-/// server of the tests), with the key in [`KEY_VAR`].
-pub fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
-    vec![
-        "resolve",
-        scenario,
-        "--yes",
+/// The flags that ask the model `fake-model` of an OpenAI-compatible server at `base`
+/// (the fake server of the tests), with the key in [`KEY_VAR`].
+pub fn openai_flags(base: &str) -> [&str; 8] {
+    [
         "--backend",
         "openai",
         "--base-url",
@@ -102,4 +99,11 @@ pub fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
         "--api-key-env",
         KEY_VAR,
     ]
+}
+
+/// `betr resolve SCENARIO --yes` against the server at `base` ([`openai_flags`]).
+pub fn resolve_yes<'a>(scenario: &'a str, base: &'a str) -> Vec<&'a str> {
+    let mut args = vec!["resolve", scenario, "--yes"];
+    args.extend(openai_flags(base));
+    args
 }

@@ -43,6 +43,8 @@ pub enum Behavior {
     EmptyChoices,
     /// 200 with the first fixture whose `when` strings all occur in the prompt.
     Fixtures(Vec<FixtureReply>),
+    /// 200 with a chunked body that never ends (64 KiB chunks until the client goes).
+    Endless,
 }
 
 /// What the server received.
@@ -222,6 +224,15 @@ async fn serve(mut stream: TcpStream, state: Arc<Mutex<State>>) {
             ),
             Behavior::ServerError => (500, vec![], json!({"error": {"message": "internal error"}}).to_string()),
             Behavior::Unavailable => (503, vec![], json!({"error": {"message": "overloaded"}}).to_string()),
+            Behavior::Endless => {
+                let head = "HTTP/1.1 200 OK\r\ncontent-type: application/json\r\ntransfer-encoding: chunked\r\nconnection: close\r\n\r\n";
+                if stream.write_all(head.as_bytes()).await.is_err() {
+                    return;
+                }
+                let piece = format!("{:x}\r\n{}\r\n", 65_536, "x".repeat(65_536));
+                while stream.write_all(piece.as_bytes()).await.is_ok() {}
+                return;
+            }
             Behavior::CutBody => {
                 let whole = ok("Goal: On_Coffee_Table1");
                 let head = format!(

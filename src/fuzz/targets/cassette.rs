@@ -175,7 +175,7 @@ impl Target for CassetteTarget {
     fn check(&self, input: &[u8]) -> Result<(), Violation> {
         let text = text_of(input);
         let entries = match read_entries(&text) {
-            Ok(entries) => entries,
+            Ok(read) => read.entries,
             Err(e) => {
                 let lines = text.lines().count();
                 return ensure(

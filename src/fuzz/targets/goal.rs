@@ -123,11 +123,16 @@ impl GoalTarget {
                         || format!("{text:?}: {e} against {plain:?}"),
                     )?;
                 }
-                Err(GoalTextError::Vocabulary(e)) => {
+                Err(e @ GoalTextError::Vocabulary { at, .. }) => {
                     ensure(
                         plain.is_ok(),
                         "a vocabulary error is about a goal that parses",
                         || format!("{text:?}: {e}"),
+                    )?;
+                    ensure(
+                        text.is_char_boundary(at) && at <= text.len(),
+                        "a vocabulary error points inside the goal, on a character",
+                        || format!("{text:?}: {e} at byte {at}"),
                     )?;
                 }
             }

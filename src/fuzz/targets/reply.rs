@@ -6,15 +6,15 @@
 //! that reads as the same goal; accepted conditions are at least one, distinct, of the
 //! vocabulary, and each prints and reads back the same; an accepted number is finite,
 //! not negative and in the parameter's unit, an accepted category one of the parameter's;
-//! a substitution names an object of the scene at least as similar as asked; every error
-//! says something.
+//! an unknown object is refused, the names it offers instead all objects of the scene;
+//! every error says something.
 
 use super::{Rng, Target, Violation, atoms_of, ensure, random_formula, strings, text_of};
 use crate::domain::{Atom, Condition, Value, ValueParam, Vocabulary};
 use crate::fuzz::Corpus;
 use crate::fuzz::Material;
 use crate::goal::Formula;
-use crate::llm::reply::{self, MIN_SIMILARITY, Substitution};
+use crate::llm::reply::{self, MIN_SIMILARITY, ReplyError};
 
 pub struct ReplyTarget {
     material: Material,
@@ -105,13 +105,7 @@ impl ReplyTarget {
     fn goal(&self, text: &str, v: &Vocabulary) -> Result<(), Violation> {
         let answer = match reply::goal(text, v, MIN_SIMILARITY) {
             Ok(a) => a,
-            Err(e) => {
-                return ensure(
-                    !e.to_string().is_empty(),
-                    "a reply error says something",
-                    || text.to_string(),
-                );
-            }
+            Err(e) => return refusal(&e, v, text),
         };
         for atom in answer.goal.atoms() {
             ensure(
@@ -126,20 +120,13 @@ impl ReplyTarget {
             back.as_ref() == Ok(&answer.goal.flatten()),
             "a goal read from a reply prints back to the same goal",
             || format!("{text:?} gave {printed:?}, read back as {back:?}"),
-        )?;
-        substitutions(&answer.substitutions, v, text)
+        )
     }
 
     fn conditions(&self, text: &str, v: &Vocabulary) -> Result<(), Violation> {
         let answer = match reply::conditions(text, v, MIN_SIMILARITY) {
             Ok(a) => a,
-            Err(e) => {
-                return ensure(
-                    !e.to_string().is_empty(),
-                    "a reply error says something",
-                    || text.to_string(),
-                );
-            }
+            Err(e) => return refusal(&e, v, text),
         };
         let cs = &answer.conditions;
         ensure(
@@ -165,7 +152,7 @@ impl ReplyTarget {
                 || format!("{c} read back as {back:?}"),
             )?;
         }
-        substitutions(&answer.substitutions, v, text)
+        Ok(())
     }
 
     fn value(&self, text: &str, param: &ValueParam) -> Result<(), Violation> {
@@ -194,12 +181,22 @@ impl ReplyTarget {
     }
 }
 
-fn substitutions(subs: &[Substitution], v: &Vocabulary, text: &str) -> Result<(), Violation> {
-    for s in subs {
+/// A refused reply says something, and an unknown object is offered only names the scene
+/// has.
+fn refusal(e: &ReplyError, v: &Vocabulary, text: &str) -> Result<(), Violation> {
+    ensure(
+        !e.to_string().is_empty(),
+        "a reply error says something",
+        || text.to_string(),
+    )?;
+    if let ReplyError::UnknownObject {
+        object, nearest, ..
+    } = e
+    {
         ensure(
-            s.similarity >= MIN_SIMILARITY && v.object(&s.used).is_some(),
-            "a substitution uses a listed object similar enough",
-            || format!("{s} in {text:?}"),
+            v.object(object).is_none() && nearest.iter().all(|n| v.object(n).is_some()),
+            "an unknown object is one the scene lacks, and the names offered are the scene's",
+            || format!("{e} in {text:?}"),
         )?;
     }
     Ok(())

@@ -18,31 +18,11 @@ use crate::domain::Value;
 use crate::domain::{Condition, ValueParam, Vocabulary};
 use crate::goal::Formula;
 
-pub use validate::similarity;
+pub use crate::domain::names::{MIN_SIMILARITY, did_you_mean, similarity};
 
-/// The default lower bound on the similarity of a replaced object name.
-pub const MIN_SIMILARITY: f64 = 0.6;
-
-/// An object name the reply used that is not in the scene, and the listed one used instead.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Substitution {
-    pub written: String,
-    pub used: String,
-    pub similarity: f64,
-    /// The condition (or value) it appeared in, as written.
-    pub in_text: String,
-}
-
-impl std::fmt::Display for Substitution {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{:?} is not in the scene; used {:?} instead (similarity {:.2}, in {})",
-            self.written, self.used, self.similarity, self.in_text
-        )
-    }
-}
-
+/// Why a reply is not used. Every text of the reply a message echoes is cut to
+/// [`ECHOED`] characters, so an error (and a prompt that tells the model about it) never
+/// grows with the reply's size.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ReplyError {
     #[error("the reply has no `{label}:` answer: {excerpt:?}")]
@@ -50,50 +30,51 @@ pub enum ReplyError {
         label: &'static str,
         excerpt: String,
     },
-    #[error("cannot read {text:?}: {reason}")]
+    #[error("cannot read {:?}: {}", echoed(text), echoed(reason))]
     Unreadable { text: String, reason: String },
-    #[error("{text:?} does not fit the scene: {reason}")]
+    #[error("{:?} does not fit the scene: {}", echoed(text), echoed(reason))]
     Invalid { text: String, reason: String },
-    #[error("unknown object {object:?} in {text}{}", closest_text(closest))]
+    #[error(
+        "{:?} in {} is not in the scene{}",
+        echoed(object),
+        echoed(text),
+        did_you_mean(nearest)
+    )]
     UnknownObject {
         text: String,
         object: String,
-        closest: Option<(String, f64)>,
+        /// The listed names most like it, most alike first.
+        nearest: Vec<String>,
     },
     #[error("the reply proposes no condition")]
     NoConditions,
-    #[error("parameter value {text:?}: {reason}")]
+    #[error("parameter value {:?}: {}", echoed(text), echoed(reason))]
     BadValue { text: String, reason: String },
 }
 
-fn closest_text(closest: &Option<(String, f64)>) -> String {
-    match closest {
-        Some((name, s)) => {
-            format!(" (the closest listed object, {name:?}, is too different: similarity {s:.2})")
-        }
-        None => " (no listed object fits that place)".into(),
-    }
+/// How many characters of a reply's text an error echoes.
+pub const ECHOED: usize = 200;
+
+fn echoed(text: &str) -> String {
+    crate::excerpt::shortened(text, ECHOED)
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct GoalAnswer {
     pub goal: Formula,
     pub reasoning: Option<String>,
-    pub substitutions: Vec<Substitution>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ConditionsAnswer {
     pub conditions: Vec<Condition>,
     pub reasoning: Option<String>,
-    pub substitutions: Vec<Substitution>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ValueAnswer {
     pub value: Value,
     pub reasoning: Option<String>,
-    pub substitutions: Vec<Substitution>,
 }
 
 const GOAL: &[&str] = &["goal", "final goal"];
@@ -107,7 +88,6 @@ pub fn goal(
     vocabulary: &Vocabulary,
     min_similarity: f64,
 ) -> Result<GoalAnswer, ReplyError> {
-    let mut substitutions = Vec::new();
     if let Some(obj) = json_object(text) {
         let reasoning = json_reasoning(&obj);
         let formula = match obj.get("goal") {
@@ -126,12 +106,8 @@ pub fn goal(
             }
             _ => return Err(missing("goal", text)),
         };
-        let goal = validate::formula(vocabulary, formula, min_similarity, &mut substitutions)?;
-        return Ok(GoalAnswer {
-            goal,
-            reasoning,
-            substitutions,
-        });
+        let goal = validate::formula(vocabulary, formula, min_similarity)?;
+        return Ok(GoalAnswer { goal, reasoning });
     }
     let lines = extract::lines(text);
     let candidates = answers(&lines, GOAL);
@@ -139,11 +115,10 @@ pub fn goal(
     for (i, answer) in candidates.iter().rev() {
         match read_formula(answer) {
             Ok(f) => {
-                let goal = validate::formula(vocabulary, f, min_similarity, &mut substitutions)?;
+                let goal = validate::formula(vocabulary, f, min_similarity)?;
                 return Ok(GoalAnswer {
                     goal,
                     reasoning: reasoning(&lines, *i),
-                    substitutions,
                 });
             }
             Err(e) => {
@@ -160,11 +135,10 @@ pub fn goal(
             .as_slice()
         && let Ok(f) = Formula::parse(extract::strip_item(only))
     {
-        let goal = validate::formula(vocabulary, f, min_similarity, &mut substitutions)?;
+        let goal = validate::formula(vocabulary, f, min_similarity)?;
         return Ok(GoalAnswer {
             goal,
             reasoning: None,
-            substitutions,
         });
     }
     Err(first_error.unwrap_or_else(|| missing("Goal", text)))
@@ -176,7 +150,6 @@ pub fn conditions(
     vocabulary: &Vocabulary,
     min_similarity: f64,
 ) -> Result<ConditionsAnswer, ReplyError> {
-    let mut substitutions = Vec::new();
     let (raw, reasoning) = match json_object(text) {
         Some(obj) => {
             let items = match obj.get("conditions") {
@@ -226,7 +199,7 @@ pub fn conditions(
     }
     let mut conditions: Vec<Condition> = Vec::new();
     for c in raw {
-        let c = validate::condition(vocabulary, c, min_similarity, &mut substitutions)?;
+        let c = validate::condition(vocabulary, c, min_similarity)?;
         if !conditions.contains(&c) {
             conditions.push(c);
         }
@@ -234,7 +207,6 @@ pub fn conditions(
     Ok(ConditionsAnswer {
         conditions,
         reasoning,
-        substitutions,
     })
 }
 
@@ -261,18 +233,8 @@ pub fn value(
             (rest, reasoning(&lines, i))
         }
     };
-    let mut substitutions = Vec::new();
-    let value = read_value(
-        extract::strip_ticks(&raw),
-        param,
-        min_similarity,
-        &mut substitutions,
-    )?;
-    Ok(ValueAnswer {
-        value,
-        reasoning,
-        substitutions,
-    })
+    let value = read_value(extract::strip_ticks(&raw), param, min_similarity)?;
+    Ok(ValueAnswer { value, reasoning })
 }
 
 fn missing(label: &'static str, text: &str) -> ReplyError {

@@ -1,15 +1,16 @@
 //! Reading a parameter value: a number in the parameter's unit (SI prefixes m, c, k are
-//! converted), or one of its categories (the one named first, else the most similar).
+//! converted), or one of its categories (the one named first; a word that names none is
+//! an error offering the most similar, never replaced by it).
 
 use crate::domain::{Value, ValueParam, action::parse_value};
 
-use super::{ReplyError, Substitution, extract, similarity};
+use super::{ReplyError, did_you_mean, extract};
+use crate::domain::names::nearest;
 
 pub(super) fn read_value(
     text: &str,
     param: &ValueParam,
     min_similarity: f64,
-    substitutions: &mut Vec<Substitution>,
 ) -> Result<Value, ReplyError> {
     let bad = |reason: String| ReplyError::BadValue {
         text: text.to_string(),
@@ -58,26 +59,16 @@ pub(super) fn read_value(
                 return Ok(Value::Category(c.clone()));
             }
             let word = extract::strip_ticks(text.trim_matches('"'));
-            let best = param
-                .categories
-                .iter()
-                .map(|c| (c, similarity(word, c)))
-                .max_by(|a, b| a.1.total_cmp(&b.1));
-            match best {
-                Some((c, s)) if s >= min_similarity => {
-                    substitutions.push(Substitution {
-                        written: word.to_string(),
-                        used: c.clone(),
-                        similarity: s,
-                        in_text: text.to_string(),
-                    });
-                    Ok(Value::Category(c.clone()))
-                }
-                _ => Err(bad(format!(
-                    "expected one of: {}",
-                    param.categories.join(", ")
-                ))),
-            }
+            let near = nearest(
+                word,
+                param.categories.iter().map(String::as_str),
+                min_similarity,
+            );
+            Err(bad(format!(
+                "{word:?} is none of: {}{}",
+                param.categories.join(", "),
+                did_you_mean(&near)
+            )))
         }
     }
 }

@@ -148,7 +148,6 @@ impl Engine {
                         "In simulation, the proposal works without {}: only the rest fixes the failure.",
                         dropped.join(" & ")
                     )),
-                    substitutions: Vec::new(),
                     author: author.clone(),
                 });
                 self.pending = Some(Pending {
@@ -185,7 +184,6 @@ impl Engine {
         self.emit(Event::Proposal {
             proposal: edited.clone(),
             reasoning: Some("written by a person".into()),
-            substitutions: Vec::new(),
             author: "a person".into(),
         });
         self.pending = Some(Pending {

@@ -13,6 +13,7 @@ use crate::world;
 use super::super::planned::PlanSummary;
 use super::super::policy;
 use super::super::readings::distinct_readings;
+use super::super::submitted::{self, Submitted};
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Task};
 
@@ -31,7 +32,6 @@ impl Engine {
         self.emit(Event::Goal {
             goal: goal.clone(),
             reasoning: None,
-            substitutions: Vec::new(),
             matches_expected,
         });
         self.task = Some(Task { goal, instruction });
@@ -40,14 +40,12 @@ impl Engine {
 
     pub(super) fn submit(&mut self, text: &str) {
         self.choosing = None;
-        let text = text.trim();
-        if text.is_empty() {
-            return self.error("nothing to submit: type an instruction or a goal");
-        }
-        let not_a_goal = match self.scenario.parse_goal(text) {
-            Ok(goal) => return self.start_task(goal, None),
-            Err(e) => e,
+        let text = match submitted::read(&self.scenario, text) {
+            Ok(Submitted::Goal(goal)) => return self.start_task(goal, None),
+            Ok(Submitted::Instruction(text)) => text,
+            Err(e) => return self.error(e.to_string()),
         };
+        let text = text.as_str();
         if let Some(goal) = self.goal_from_policy(text) {
             self.task = Some(Task {
                 goal,
@@ -57,10 +55,17 @@ impl Engine {
         }
         match self.model.clone() {
             Ok(model) => self.ask_goal(model, text),
-            Err(why) => self.error(format!(
-                "{} is not a goal formula ({not_a_goal}), and no language model can read it as an instruction: {why}",
-                crate::excerpt::excerpt(text, None)
-            )),
+            Err(why) => {
+                let not_a_goal = self
+                    .scenario
+                    .parse_goal(text)
+                    .err()
+                    .map_or_else(String::new, |e| e.to_string());
+                self.error(format!(
+                    "{} is not a goal formula ({not_a_goal}), and no language model can read it as an instruction: {why}",
+                    crate::excerpt::excerpt(text, None)
+                ))
+            }
         }
     }
 
@@ -121,7 +126,6 @@ impl Engine {
         self.emit(Event::Goal {
             goal: goal.clone(),
             reasoning: None,
-            substitutions: Vec::new(),
             matches_expected: None,
         });
         Some(goal)

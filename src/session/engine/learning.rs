@@ -101,7 +101,7 @@ impl Engine {
             },
         ));
         match kept {
-            Ok(kept) => {
+            Ok((kept, _)) => {
                 let mut learned = rule.clone();
                 learned.id = kept.id.clone();
                 // Checked above: the rule fits this domain.

@@ -260,7 +260,7 @@ impl Engine {
                         for (proposal, why) in asked.rejected {
                             self.tried.push((failure.clone(), Tried { proposal, why }));
                         }
-                        let Some((proposal, reasoning, substitutions)) = asked.chosen else {
+                        let Some((proposal, reasoning)) = asked.chosen else {
                             // No candidate fixed the failure: ask again while rounds remain.
                             return self.ask_about(failure);
                         };
@@ -277,7 +277,6 @@ impl Engine {
                                 Some(r) => format!("{r}\n{checked}"),
                                 None => checked.to_string(),
                             }),
-                            substitutions,
                             author: author.clone(),
                         });
                         self.pending = Some(Pending {

@@ -7,6 +7,8 @@
 //! contradict what the skill declares, and every goal of the domain must still plan.
 //!
 //! The file is written atomically (`store::write_atomic`): a crash never leaves half of it.
+//! A change is made under a lock (`knowledge.toml.lock` beside it) to the file as it is
+//! then, read again: sessions sharing a policy directory keep each other's rules.
 
 use std::path::{Path, PathBuf};
 
@@ -234,8 +236,19 @@ impl Knowledge {
         }
     }
 
-    /// Keep `rule` (its id is assigned here) and write the file.
-    pub fn keep(&mut self, mut rule: KeptRule) -> Result<KeptRule, KnowledgeError> {
+    /// Keep `rule` (its id is assigned here) and write the file; with whether it is
+    /// new. The rules kept meanwhile by another session are read again first and kept
+    /// too; a rule the file holds already, or holds for every object where this one is
+    /// for some, is not kept again (the one kept is returned, not new).
+    pub fn keep(&mut self, mut rule: KeptRule) -> Result<(KeptRule, bool), KnowledgeError> {
+        let _lock = self.lock()?;
+        self.reread()?;
+        if let Some(same) = self.rules.iter().find(|r| {
+            (&r.domain, &r.skill, &r.requires) == (&rule.domain, &rule.skill, &rule.requires)
+                && (r.only.is_none() || r.only == rule.only)
+        }) {
+            return Ok((same.clone(), false));
+        }
         let next = self
             .rules
             .iter()
@@ -249,11 +262,13 @@ impl Knowledge {
             self.rules.pop();
             return Err(e);
         }
-        Ok(rule)
+        Ok((rule, true))
     }
 
-    /// Take a rule out and write the file.
+    /// Take a rule out and write the file (as it is now, read again).
     pub fn revoke(&mut self, id: &str) -> Result<KeptRule, KnowledgeError> {
+        let _lock = self.lock()?;
+        self.reread()?;
         let Some(at) = self.rules.iter().position(|r| r.id == id) else {
             return Err(self.no_such_rule(id));
         };
@@ -263,6 +278,34 @@ impl Knowledge {
             return Err(e);
         }
         Ok(removed)
+    }
+
+    /// An exclusive lock of the knowledge file, held until the returned file is dropped.
+    /// The lock is on `knowledge.toml.lock` beside it, since the file itself is replaced
+    /// by each write.
+    fn lock(&self) -> Result<std::fs::File, KnowledgeError> {
+        let path = self.path.with_extension("toml.lock");
+        let failed = |source| KnowledgeError::Write {
+            path: path.clone(),
+            source,
+        };
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(failed)?;
+        }
+        let file = std::fs::File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(failed)?;
+        file.lock().map_err(failed)?;
+        Ok(file)
+    }
+
+    /// The rules as the file holds them now.
+    fn reread(&mut self) -> Result<(), KnowledgeError> {
+        self.rules = Knowledge::open(&self.path)?.rules;
+        Ok(())
     }
 
     fn write(&self) -> Result<(), KnowledgeError> {
