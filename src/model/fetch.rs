@@ -40,6 +40,8 @@ pub enum FetchError {
     },
     #[error("{path}: {message}")]
     Wheel { path: PathBuf, message: String },
+    #[error("{path}: {message}; nothing was installed")]
+    Archive { path: PathBuf, message: String },
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,
@@ -62,7 +64,7 @@ pub enum FetchError {
     },
 }
 
-fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
+pub(super) fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
     move |source| FetchError::Io {
         path: path.to_path_buf(),
         source,
@@ -70,7 +72,7 @@ fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
 }
 
 /// Removes the temporary fetch directory however the fetch ends.
-struct TempDir(PathBuf);
+pub(super) struct TempDir(pub(super) PathBuf);
 
 impl Drop for TempDir {
     fn drop(&mut self) {
@@ -162,7 +164,7 @@ pub fn fetch_dir(
     Ok(target)
 }
 
-fn sync_dir(dir: &Path) {
+pub(super) fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
@@ -225,7 +227,11 @@ fn members<'a>(
 /// fetches of one model (two commands, or two threads of one process) would otherwise
 /// share or remove each other's temporary directory. The operating system releases the
 /// lock of a killed process, so a killed fetch never blocks the next one.
-fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<File, FetchError> {
+pub(super) fn lock_fetch(
+    dir: &Path,
+    name: &str,
+    progress: &mut dyn Progress,
+) -> Result<File, FetchError> {
     let path = dir.join(format!(".fetch-{name}.lock"));
     let file = fs::OpenOptions::new()
         .create(true)
@@ -245,7 +251,7 @@ fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<Fil
 
 /// Leftovers of fetches that were killed (called with the fetch lock held, so no fetch
 /// of the model is in progress).
-fn remove_stale_fetches(dir: &Path, name: &str) {
+pub(super) fn remove_stale_fetches(dir: &Path, name: &str) {
     let prefix = format!(".fetch-{name}-");
     if let Ok(entries) = fs::read_dir(dir) {
         for e in entries.flatten() {
@@ -268,7 +274,20 @@ fn list_wheels(dir: &Path) -> Result<Vec<PathBuf>, FetchError> {
 }
 
 fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchError> {
-    let output = Command::new(python)
+    let output = pip_download(python, requirement, into)
+        .output()
+        .map_err(|source| no_pip(python, source))?;
+    pip_outcome(
+        requirement,
+        output.status,
+        &String::from_utf8_lossy(&output.stderr),
+    )
+}
+
+/// `python -m pip download --no-deps` of `requirement` into `into`, quietly.
+pub(super) fn pip_download(python: &str, requirement: &str, into: &Path) -> Command {
+    let mut command = Command::new(python);
+    command
         .args([
             "-m",
             "pip",
@@ -280,23 +299,30 @@ fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchErr
             "-d",
         ])
         .arg(into)
-        .arg(requirement)
-        .output()
-        .map_err(|source| FetchError::NoPip {
-            python: python.to_string(),
-            source,
-        })?;
-    if output.status.success() {
+        .arg(requirement);
+    command
+}
+
+pub(super) fn no_pip(python: &str, source: io::Error) -> FetchError {
+    FetchError::NoPip {
+        python: python.to_string(),
+        source,
+    }
+}
+
+/// Success, or pip's failure with the last lines it wrote on standard error.
+pub(super) fn pip_outcome(
+    requirement: &str,
+    status: std::process::ExitStatus,
+    stderr: &str,
+) -> Result<(), FetchError> {
+    if status.success() {
         return Ok(());
     }
-    let stderr = String::from_utf8_lossy(&output.stderr);
     let tail: Vec<&str> = stderr.lines().rev().take(6).collect();
     Err(FetchError::Pip {
         requirement: requirement.to_string(),
-        status: output
-            .status
-            .code()
-            .map_or("killed".into(), |c| c.to_string()),
+        status: status.code().map_or("killed".into(), |c| c.to_string()),
         stderr: tail.into_iter().rev().collect::<Vec<_>>().join("\n"),
     })
 }
@@ -335,7 +361,7 @@ fn assemble_counted(
     result
 }
 
-fn file_name(path: &Path) -> String {
+pub(super) fn file_name(path: &Path) -> String {
     path.file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
 }
