@@ -23,6 +23,7 @@ pub mod llm;
 pub mod model;
 pub mod planner;
 pub mod record;
+pub mod robot;
 pub mod scenario;
 pub mod session;
 pub mod store;
