@@ -1,16 +1,20 @@
 //! A robot from its published description: the URDF read into links and joints
 //! (`urdf.rs`), a serial chain from the root to each arm's tool flange with forward
-//! kinematics (`chain.rs`).
+//! kinematics (`chain.rs`), and inverse kinematics for tool poses (`ik.rs`).
 //!
 //! Lengths are metres and angles radians, in the robot's root frame (the cell places the
 //! root). Kinematics is in f64.
 
 mod chain;
+mod ik;
+mod rng;
 mod urdf;
 
 use std::path::{Path, PathBuf};
 
 pub use chain::{Carried, Chain, ChainJoint, arm_tips};
+pub use ik::{IkOptions, IkSolution, Unreachable, describe_pose, nearest_arm_solution, solve};
+pub use rng::SplitMix;
 pub use urdf::{Element, Geometry, Joint, JointKind, Link, Model, Package};
 
 use crate::model::DescriptionSpec;
@@ -31,6 +35,8 @@ pub enum RobotError {
         link: String,
         mesh: PathBuf,
     },
+    #[error(transparent)]
+    Unreachable(#[from] Unreachable),
     #[error("{0}")]
     Fetch(#[from] crate::model::FetchError),
 }

@@ -208,3 +208,110 @@ fn bad_descriptions_name_the_file_and_the_element() {
     assert!(err.contains("absent.urdf"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A pose where the flange points straight down (tool z along world -z).
+fn from_above(x: f64, y: f64, z: f64) -> nalgebra::Isometry3<f64> {
+    nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(x, y, z),
+        nalgebra::UnitQuaternion::from_euler_angles(std::f64::consts::PI, 0.0, 0.0),
+    )
+}
+
+fn middle(chain: &Chain) -> Vec<f64> {
+    chain
+        .joints
+        .iter()
+        .map(|j| (j.lower + j.upper) / 2.0)
+        .collect()
+}
+
+fn assert_reaches(chain: &Chain, q: &[f64], target: &nalgebra::Isometry3<f64>) {
+    assert!(chain.within_limits(q), "{q:?}");
+    let got = chain.fk(q);
+    let dp = (got.translation.vector - target.translation.vector).norm();
+    let da = got.rotation.angle_to(&target.rotation);
+    assert!(
+        dp < 1e-4 && da < 1e-3,
+        "{} off by {dp} m, {da} rad",
+        chain.tip
+    );
+}
+
+#[test]
+fn inverse_kinematics_reaches_poses_forward_kinematics_gives() {
+    let robot = yumi();
+    let options = IkOptions::default();
+    for (a, arm) in robot.arms.iter().enumerate() {
+        let mut rng = SplitMix::new(a as u64);
+        for _ in 0..8 {
+            let q: Vec<f64> = arm
+                .joints
+                .iter()
+                .map(|j| j.lower + (0.1 + 0.8 * rng.unit()) * (j.upper - j.lower))
+                .collect();
+            let target = arm.fk(&q);
+            let (solution, _, _) = solve(arm, &target, &middle(arm), &options)
+                .unwrap_or_else(|| panic!("{}: no solution for {q:?}", arm.tip));
+            assert_reaches(arm, &solution, &target);
+        }
+    }
+}
+
+#[test]
+fn a_grasp_from_above_goes_to_the_nearer_arm() {
+    let robot = yumi();
+    let starts: Vec<Vec<f64>> = robot.arms.iter().map(middle).collect();
+    let options = IkOptions::default();
+    for (y, tip) in [(0.2, "yumi_link_7_l"), (-0.2, "yumi_link_7_r")] {
+        let target = from_above(0.4, y, 0.15);
+        let found = nearest_arm_solution(&robot.arms, &target, &starts, &options).unwrap();
+        let arm = &robot.arms[found.arm];
+        assert_eq!(arm.tip, tip);
+        assert_reaches(arm, &found.q, &target);
+        // Same query, same answer.
+        assert_eq!(
+            nearest_arm_solution(&robot.arms, &target, &starts, &options).unwrap(),
+            found
+        );
+    }
+}
+
+#[test]
+fn the_spare_axis_keeps_the_arm_near_where_it_starts() {
+    let arm = &yumi().arms[0];
+    let options = IkOptions::default();
+    let start = vec![0.3, -1.2, -1.0, 0.4, 0.2, 0.8, 0.1];
+    let target = arm.fk(&start);
+    // Already there: nothing moves.
+    let (same, _, _) = solve(arm, &target, &start, &options).unwrap();
+    assert_eq!(same, start);
+    // The elbow turned away by 0.3 rad: the flange is elsewhere, and the solution from
+    // there stays near that elbow rather than jumping to another branch.
+    let mut turned = start.clone();
+    turned[2] += 0.3;
+    let (q, _, _) = solve(arm, &target, &turned, &options).unwrap();
+    assert_reaches(arm, &q, &target);
+    let moved: f64 = q
+        .iter()
+        .zip(&turned)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(moved < 0.6, "{q:?} from {turned:?}");
+}
+
+#[test]
+fn an_unreachable_pose_is_named() {
+    let robot = yumi();
+    let starts: Vec<Vec<f64>> = robot.arms.iter().map(middle).collect();
+    let options = IkOptions {
+        starts: 4,
+        ..IkOptions::default()
+    };
+    let err = nearest_arm_solution(&robot.arms, &from_above(2.0, 0.0, 0.3), &starts, &options)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("(2.000, 0.000, 0.300) m") && err.contains("yumi_link_7_r and yumi_link_7_l"),
+        "{err}"
+    );
+}
