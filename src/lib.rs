@@ -21,6 +21,7 @@ pub mod http_text;
 pub mod interop;
 pub mod llm;
 pub mod model;
+pub mod motion;
 pub mod planner;
 pub mod record;
 pub mod robot;

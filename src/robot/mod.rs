@@ -1,13 +1,15 @@
 //! A robot from its published description: the URDF read into links and joints
 //! (`urdf.rs`), a serial chain from the root to each arm's tool flange with forward
-//! kinematics (`chain.rs`), and inverse kinematics for tool poses (`ik.rs`).
+//! kinematics (`chain.rs`), inverse kinematics for tool poses (`ik.rs`), and the links'
+//! collision shapes (`shapes.rs`).
 //!
 //! Lengths are metres and angles radians, in the robot's root frame (the cell places the
-//! root). Kinematics is in f64.
+//! root). Kinematics is in f64; collision shapes are f32 like the rest of the cell.
 
 mod chain;
 mod ik;
 mod rng;
+mod shapes;
 mod urdf;
 
 use std::path::{Path, PathBuf};
@@ -15,6 +17,7 @@ use std::path::{Path, PathBuf};
 pub use chain::{Carried, Chain, ChainJoint, arm_tips};
 pub use ik::{IkOptions, IkSolution, Unreachable, describe_pose, nearest_arm_solution, solve};
 pub use rng::SplitMix;
+pub use shapes::{LinkShape, RobotShapes, read_stl};
 pub use urdf::{Element, Geometry, Joint, JointKind, Link, Model, Package};
 
 use crate::model::DescriptionSpec;
@@ -35,6 +38,8 @@ pub enum RobotError {
         link: String,
         mesh: PathBuf,
     },
+    #[error("{file}: not a readable STL mesh: {message}")]
+    Mesh { file: PathBuf, message: String },
     #[error(transparent)]
     Unreachable(#[from] Unreachable),
     #[error("{0}")]
@@ -82,4 +87,4 @@ impl Robot {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -315,3 +315,41 @@ fn an_unreachable_pose_is_named() {
         "{err}"
     );
 }
+
+#[test]
+fn each_link_hull_contains_its_mesh() {
+    let robot = yumi();
+    let shapes = RobotShapes::new(&robot.model, &robot.arms).unwrap();
+    assert_eq!(shapes.torso.len(), 1, "{:?}", shapes.torso);
+    assert_eq!(shapes.torso[0].name, "yumi_body");
+    let all = shapes
+        .torso
+        .iter()
+        .chain(shapes.arms.iter().flatten().flatten());
+    let mut count = 0;
+    for shape in all {
+        count += 1;
+        let link = &robot.model.links[shape.link];
+        for element in &link.collisions {
+            let Geometry::Mesh { path, .. } = &element.geometry else {
+                panic!("{}: the YuMi's links are meshes", link.name);
+            };
+            let vertices = read_stl(path).unwrap();
+            for v in &vertices {
+                let inside = element.origin.cast::<f32>() * v;
+                let local = shape.local.inverse() * inside;
+                let d = shape.shape.distance_to_local_point(&local, true);
+                // The coarse mesh's hull holds the coarse mesh exactly and the detailed
+                // mesh to within a millimetre.
+                assert!(
+                    d < 1e-3,
+                    "{}: {} is {d} m outside",
+                    link.name,
+                    path.display()
+                );
+                assert!((local - shape.center).norm() <= shape.radius + 1e-4);
+            }
+        }
+    }
+    assert_eq!(count, 1 + 2 * 10);
+}
