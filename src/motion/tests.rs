@@ -1,4 +1,6 @@
-//! The YuMi's arms in poses the collision test finds free, and in poses it does not.
+//! The YuMi's arms in poses the collision test finds free and in poses it does not, and
+//! the right arm's paths among solids: found in free space, the same for the same seed,
+//! refused when the target is enclosed.
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use parry3d::shape::SharedShape;
@@ -50,6 +52,28 @@ fn shapes(robot: &Robot) -> RobotShapes {
     RobotShapes::new(&robot.model, &robot.arms).unwrap()
 }
 
+/// Every point along the path, at the planner's resolution, is free.
+fn assert_free(check: &ArmCheck<'_>, path: &JointPath, resolution: f64) {
+    for w in path.waypoints.windows(2) {
+        let d: f64 = w[0]
+            .iter()
+            .zip(&w[1])
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        let steps = (d / resolution).ceil().max(1.0) as usize;
+        for s in 0..=steps {
+            let t = s as f64 / steps as f64;
+            let q: Vec<f64> = w[0]
+                .iter()
+                .zip(&w[1])
+                .map(|(a, b)| a + (b - a) * t)
+                .collect();
+            assert!(check.is_free(&q), "{q:?} hits {:?}", check.blocker(&q));
+        }
+    }
+}
+
 #[test]
 fn the_home_and_forward_poses_are_free() {
     let robot = yumi();
@@ -90,4 +114,57 @@ fn a_solid_at_the_hand_and_the_other_arm_are_named() {
             .is_some_and(|b| b.ends_with("_l") || b.contains("_l_")),
         "{blocker:?}"
     );
+}
+
+#[test]
+fn a_path_is_found_in_free_space() {
+    let robot = yumi();
+    let shapes = shapes(robot);
+    let q = home(robot);
+    let options = PlanOptions::default();
+    let free = ArmCheck::new(robot, &shapes, Isometry3::identity(), 0, &q, &[]).unwrap();
+    let path = plan(&free, &q[0], &forward(), &options).unwrap();
+    assert_eq!(path.waypoints.first(), Some(&q[0]));
+    assert_eq!(path.waypoints.last(), Some(&forward()));
+    assert_free(&free, &path, options.resolution);
+    // The same seed finds the same path.
+    assert_eq!(plan(&free, &q[0], &forward(), &options).unwrap(), path);
+}
+
+#[test]
+fn a_target_inside_a_closed_box_is_refused_naming_the_box() {
+    let robot = yumi();
+    let shapes = shapes(robot);
+    let q = home(robot);
+    let tool = robot.arms[0]
+        .fk(&forward())
+        .translation
+        .vector
+        .cast::<f32>();
+    // A closed box around the flange: four walls, a floor and a lid 8 cm from it.
+    let (x, y, z) = (tool.x, tool.y, tool.z);
+    let (h, t) = (0.08, 0.005);
+    let solids = vec![
+        cuboid("box lid", [x, y, z + h], [h, h, t]),
+        cuboid("box floor", [x, y, z - h], [h, h, t]),
+        cuboid("box front", [x + h, y, z], [t, h, h]),
+        cuboid("box back", [x - h, y, z], [t, h, h]),
+        cuboid("box left", [x, y + h, z], [h, t, h]),
+        cuboid("box right", [x, y - h, z], [h, t, h]),
+    ];
+    let check = ArmCheck::new(robot, &shapes, Isometry3::identity(), 0, &q, &solids).unwrap();
+    let err = plan(&check, &q[0], &forward(), &PlanOptions::default()).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.starts_with("No collision free path found for yumi_link_7_r"),
+        "{text}"
+    );
+    let MotionError::NoPath {
+        blocker: Some(blocker),
+        ..
+    } = err
+    else {
+        panic!("{text}");
+    };
+    assert!(blocker.starts_with("box "), "{text}");
 }

@@ -1,9 +1,12 @@
-//! The links' collision shapes: the convex hull (parry3d) of each collision mesh's
-//! vertices, in the link's frame, with the ball around it for a quick first test.
+//! The links' collision shapes: for each collision mesh, the capsule along the mesh's
+//! main axis that holds every vertex by construction (its segment spans the vertices
+//! along that axis, its radius is the farthest vertex's distance from the segment), in
+//! the link's frame, with the ball around it for a quick first test.
 //!
-//! A hull contains every vertex of its mesh, so a configuration whose hulls are apart is
-//! one whose meshes are apart; the hull is the conservative side of the mesh (a concave
-//! link is as large as its hull).
+//! A configuration whose capsules are apart is one whose meshes are apart. Capsules
+//! rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
+//! point and contact queries wrongly (a vertex of the mesh reported a centimetre outside
+//! its own hull), and a capsule's queries are exact. The price is a fatter arm.
 
 use std::path::Path;
 
@@ -90,7 +93,7 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
                 .into_iter()
                 .map(|p| Point3::from(p.coords.component_mul(&s)))
                 .collect();
-            mesh_shape(&points)
+            capsule_around(&points)
                 .ok_or_else(|| bad(format!("mesh {} has no vertices", path.display())))?
         }
         Geometry::Box { size } => SharedShape::cuboid(
@@ -117,34 +120,6 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
         center: aabb.center(),
         radius: aabb.half_extents().norm(),
     })
-}
-
-/// A convex shape holding every one of `points`: their convex hull, its border rounded
-/// by however far the hull computed in floating point left a point outside; when even
-/// that does not hold them all (parry's hull of a near-degenerate mesh can be wrong by
-/// centimetres), the capsule around their main axis that holds them by construction.
-fn mesh_shape(points: &[Point3<f32>]) -> Option<SharedShape> {
-    let holds_all = |shape: &SharedShape| {
-        points
-            .iter()
-            .all(|p| shape.distance_to_local_point(p, true) <= 1e-6)
-    };
-    if let Some(hull) = SharedShape::convex_hull(points) {
-        let outside = points
-            .iter()
-            .map(|p| hull.distance_to_local_point(p, true))
-            .fold(0.0f32, f32::max);
-        if outside == 0.0 {
-            return Some(hull);
-        }
-        if outside < 0.002
-            && let Some(round) = SharedShape::round_convex_hull(points, outside * 1.01)
-            && holds_all(&round)
-        {
-            return Some(round);
-        }
-    }
-    capsule_around(points)
 }
 
 /// The capsule along the points' principal axis whose segment spans their extent along

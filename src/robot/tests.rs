@@ -317,7 +317,7 @@ fn an_unreachable_pose_is_named() {
 }
 
 #[test]
-fn each_link_hull_contains_its_mesh() {
+fn each_link_shape_contains_its_mesh() {
     let robot = yumi();
     let shapes = RobotShapes::new(&robot.model, &robot.arms).unwrap();
     assert_eq!(shapes.torso.len(), 1, "{:?}", shapes.torso);
