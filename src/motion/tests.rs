@@ -1,6 +1,6 @@
 //! The YuMi's arms in poses the collision test finds free and in poses it does not, and
-//! the right arm's paths among solids: found in free space, the same for the same seed,
-//! refused when the target is enclosed.
+//! the right arm's paths among solids: found in free space and around a post in the way,
+//! the same for the same seed, refused when the target is enclosed.
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use parry3d::shape::SharedShape;
@@ -167,4 +167,40 @@ fn a_target_inside_a_closed_box_is_refused_naming_the_box() {
         panic!("{text}");
     };
     assert!(blocker.starts_with("box "), "{text}");
+}
+
+#[test]
+fn a_path_goes_around_a_post_on_the_straight_way() {
+    let robot = yumi();
+    let shapes = shapes(robot);
+    let q = home(robot);
+    let options = PlanOptions::default();
+    // The whole right arm swung outwards about its first joint, and a small post where
+    // the hand passes halfway.
+    let straight = |to: &[f64], t: f64| -> Vec<f64> {
+        q[0].iter().zip(to).map(|(a, b)| a + (b - a) * t).collect()
+    };
+    let mut swung = q[0].clone();
+    swung[0] += 1.2;
+    let hand = robot.arms[0]
+        .fk(&straight(&swung, 0.5))
+        .translation
+        .vector
+        .cast::<f32>();
+    let post = vec![cuboid("post", [hand.x, hand.y, hand.z], [0.02, 0.02, 0.02])];
+    let check = ArmCheck::new(robot, &shapes, Isometry3::identity(), 0, &q, &post).unwrap();
+    assert!(check.is_free(&q[0]) && check.is_free(&swung));
+    assert_eq!(
+        check.blocker(&straight(&swung, 0.5)).as_deref(),
+        Some("post")
+    );
+    let around = plan(&check, &q[0], &swung, &options).unwrap();
+    assert!(
+        around.samples > 0 && around.waypoints.len() > 2,
+        "{around:?}"
+    );
+    assert_eq!(around.waypoints.first(), Some(&q[0]));
+    assert_eq!(around.waypoints.last(), Some(&swung));
+    assert_free(&check, &around, options.resolution);
+    assert_eq!(plan(&check, &q[0], &swung, &options).unwrap(), around);
 }
