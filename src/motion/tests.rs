@@ -203,4 +203,14 @@ fn a_path_goes_around_a_post_on_the_straight_way() {
     assert_eq!(around.waypoints.last(), Some(&swung));
     assert_free(&check, &around, options.resolution);
     assert_eq!(plan(&check, &q[0], &swung, &options).unwrap(), around);
+    // With too small a budget the search gives up and names what stopped it.
+    let hurried = PlanOptions {
+        samples: 2,
+        ..options
+    };
+    let err = plan(&check, &q[0], &swung, &hurried).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "No collision free path found for yumi_link_7_r: 2 samples tried, most often blocked by post"
+    );
 }
