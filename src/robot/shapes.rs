@@ -1,0 +1,183 @@
+//! The links' collision shapes: for each collision mesh, the capsule along the mesh's
+//! main axis that holds every vertex by construction (its segment spans the vertices
+//! along that axis, its radius is the farthest vertex's distance from the segment), in
+//! the link's frame, with the ball around it for a quick first test.
+//!
+//! A configuration whose capsules are apart is one whose meshes are apart. Capsules
+//! rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
+//! point and contact queries wrongly (a vertex of the mesh reported a centimetre outside
+//! its own hull), and a capsule's queries are exact. The price is a fatter arm.
+
+use std::path::Path;
+
+use std::f32::consts::FRAC_PI_2;
+
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
+use parry3d::shape::SharedShape;
+
+use super::RobotError;
+use super::chain::Chain;
+use super::urdf::{Element, Geometry, Model};
+
+/// One link's collision shape, in the link's frame.
+#[derive(Clone)]
+pub struct LinkShape {
+    /// Index into [`Model::links`].
+    pub link: usize,
+    pub name: String,
+    /// The shape's placement in the link's frame.
+    pub local: Isometry3<f32>,
+    pub shape: SharedShape,
+    /// A ball around the shape (in the shape's frame, `local`) for the first test.
+    pub center: Point3<f32>,
+    pub radius: f32,
+}
+
+impl std::fmt::Debug for LinkShape {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LinkShape")
+            .field("name", &self.name)
+            .field("radius", &self.radius)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The collision shapes of a robot: those fixed to the root (the torso) and, per arm, those
+/// each link of [`Chain::carried`] has (`arms[a][i]` belongs to `carried[i]` of arm `a`).
+#[derive(Debug, Clone)]
+pub struct RobotShapes {
+    pub torso: Vec<LinkShape>,
+    /// Per arm, per carried link, its shapes.
+    pub arms: Vec<Vec<Vec<LinkShape>>>,
+}
+
+impl RobotShapes {
+    /// The collision elements of every link, made convex.
+    pub fn new(model: &Model, arms: &[Chain]) -> Result<RobotShapes, RobotError> {
+        let shapes_of = |link: usize| -> Result<Vec<LinkShape>, RobotError> {
+            model.links[link]
+                .collisions
+                .iter()
+                .map(|e| link_shape(model, link, e))
+                .collect()
+        };
+        let carried: Vec<usize> = arms
+            .iter()
+            .flat_map(|a| a.carried.iter().map(|c| c.link))
+            .collect();
+        let mut torso = Vec::new();
+        for link in 0..model.links.len() {
+            if !carried.contains(&link) {
+                torso.extend(shapes_of(link)?);
+            }
+        }
+        let arms = arms
+            .iter()
+            .map(|a| a.carried.iter().map(|c| shapes_of(c.link)).collect())
+            .collect::<Result<_, _>>()?;
+        Ok(RobotShapes { torso, arms })
+    }
+}
+
+fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape, RobotError> {
+    let name = model.links[link].name.clone();
+    let bad = |message: String| RobotError::Urdf {
+        file: model.file.clone(),
+        message: format!("link \"{name}\": {message}"),
+    };
+    let mut local = element.origin.cast::<f32>();
+    let shape = match &element.geometry {
+        Geometry::Mesh { path, scale } => {
+            let s = scale.cast::<f32>();
+            let points: Vec<Point3<f32>> = read_stl(path)?
+                .into_iter()
+                .map(|p| Point3::from(p.coords.component_mul(&s)))
+                .collect();
+            capsule_around(&points)
+                .ok_or_else(|| bad(format!("mesh {} has no vertices", path.display())))?
+        }
+        Geometry::Box { size } => SharedShape::cuboid(
+            size.x as f32 / 2.0,
+            size.y as f32 / 2.0,
+            size.z as f32 / 2.0,
+        ),
+        Geometry::Sphere { radius } => SharedShape::ball(*radius as f32),
+        Geometry::Cylinder { radius, length } => {
+            // parry's cylinder stands along y, URDF's along z.
+            local *= UnitQuaternion::from_axis_angle(&Vector3::x_axis(), FRAC_PI_2);
+            SharedShape::cylinder(*length as f32 / 2.0, *radius as f32)
+        }
+        Geometry::Capsule { radius, length } => {
+            SharedShape::capsule_z(*length as f32 / 2.0, *radius as f32)
+        }
+    };
+    let aabb = shape.compute_local_aabb();
+    Ok(LinkShape {
+        link,
+        name,
+        local,
+        shape,
+        center: aabb.center(),
+        radius: aabb.half_extents().norm(),
+    })
+}
+
+/// The capsule along the points' principal axis whose segment spans their extent along
+/// it and whose radius is the farthest point's distance from that segment.
+fn capsule_around(points: &[Point3<f32>]) -> Option<SharedShape> {
+    let n = points.len() as f32;
+    let mean = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n.max(1.0);
+    let covariance = points.iter().fold(nalgebra::Matrix3::zeros(), |a, p| {
+        let d = p.coords - mean;
+        a + d * d.transpose()
+    });
+    let eigen = covariance.symmetric_eigen();
+    let axis = eigen
+        .eigenvectors
+        .column(eigen.eigenvalues.imax())
+        .normalize();
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for p in points {
+        let t = (p.coords - mean).dot(&axis);
+        lo = lo.min(t);
+        hi = hi.max(t);
+    }
+    if !lo.is_finite() || !hi.is_finite() {
+        return None;
+    }
+    let (a, b) = (
+        Point3::from(mean + axis * lo),
+        Point3::from(mean + axis * hi),
+    );
+    let segment = parry3d::shape::Segment::new(a, b);
+    let radius = points
+        .iter()
+        .map(|p| parry3d::query::PointQuery::distance_to_local_point(&segment, p, true))
+        .fold(0.0f32, f32::max);
+    // A hair more, so that rounding in the distance query never leaves a vertex out.
+    Some(SharedShape::capsule(a, b, radius * 1.0001 + 1e-6))
+}
+
+/// The vertices of an STL mesh (binary or ASCII), in the mesh's units.
+pub fn read_stl(path: &Path) -> Result<Vec<Point3<f32>>, RobotError> {
+    let file = std::fs::File::open(path).map_err(|source| RobotError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut reader = std::io::BufReader::new(file);
+    let mesh = stl_io::read_stl(&mut reader).map_err(|e| RobotError::Mesh {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    if mesh.vertices.is_empty() {
+        return Err(RobotError::Mesh {
+            file: path.to_path_buf(),
+            message: "no triangles".into(),
+        });
+    }
+    Ok(mesh
+        .vertices
+        .iter()
+        .map(|v| Point3::new(v[0], v[1], v[2]))
+        .collect())
+}
