@@ -178,7 +178,11 @@ impl Layer {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Settings {
     pub backend: Backend,
+    /// Without the credentials a URL may carry (they are `url_key`).
     pub base_url: String,
+    /// A key given inside the base URL (`http://user:KEY@host/v1`), taken out of it: sent
+    /// and redacted like a key from the environment, which wins when both are given.
+    pub url_key: Option<ApiKey>,
     pub model: Option<String>,
     pub api_key_env: Option<String>,
     pub auth_header: AuthHeader,
@@ -284,6 +288,12 @@ impl Settings {
             layer.max_reply_bytes.unwrap_or(limits::DEFAULT_REPLY_BYTES),
             limits::REPLY_BYTES,
         )?;
+        let (base_url, url_key) = crate::http_text::split_credentials(
+            layer
+                .base_url
+                .as_deref()
+                .unwrap_or("https://api.openai.com/v1"),
+        );
         Ok(Settings {
             // Offline by default: the embedded model needs no key and no network. A base
             // URL given without a backend can only mean an HTTP server.
@@ -292,9 +302,8 @@ impl Settings {
             } else {
                 Backend::Local
             }),
-            base_url: layer
-                .base_url
-                .unwrap_or_else(|| "https://api.openai.com/v1".into()),
+            base_url,
+            url_key,
             model: layer.model,
             api_key_env: match layer.api_key_env {
                 Some(v) if v.is_empty() => None,
@@ -400,10 +409,14 @@ impl Settings {
                     .and_then(var)
                     .filter(|k| !k.is_empty())
                     .map(ApiKey::new);
-                let api_key_env = self.api_key_env.as_ref().map(|n| match api_key {
-                    Some(_) => n.clone(),
-                    None => format!("{n}, which is not set"),
-                });
+                let api_key_env = match (&api_key, &self.url_key) {
+                    (None, Some(_)) => Some("the base URL".to_string()),
+                    _ => self.api_key_env.as_ref().map(|n| match api_key {
+                        Some(_) => n.clone(),
+                        None => format!("{n}, which is not set"),
+                    }),
+                };
+                let api_key = api_key.or_else(|| self.url_key.clone());
                 let client = OpenAiClient::new(OpenAiSettings {
                     base_url: self.base_url.clone(),
                     model,
