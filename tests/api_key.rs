@@ -136,28 +136,16 @@ fn a_key_inside_the_base_url_or_repeated_by_a_reply_appears_in_nothing_written()
         )),
     );
     let base = format!("http://user:{KEY}@{}/v1", server.addr);
-    let out = support::cli::betr_with(
-        &dir,
-        &[
-            "resolve",
-            &scenario,
-            "--yes",
-            "--backend",
-            "openai",
-            "--base-url",
-            &base,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            "BETR_TEST_NO_SUCH_KEY",
-            "--cassette",
-            "c.jsonl",
-            "--record",
-            "r.jsonl",
-            "--show-replies",
-        ],
-        &[("BETR_LOG", "betr=debug")],
-    );
+    let mut args = support::cli::resolve_yes(&scenario, &base);
+    args.extend([
+        "--cassette",
+        "c.jsonl",
+        "--record",
+        "r.jsonl",
+        "--show-replies",
+    ]);
+    // The variable the key is configured in is empty: only the URL holds the key.
+    let out = support::cli::betr_with(&dir, &args, &[(KEY_VAR, ""), ("BETR_LOG", "betr=debug")]);
     let sent = server.received();
     assert!(!sent.is_empty(), "{}", text(&out));
     assert!(
