@@ -9,7 +9,7 @@ mod support;
 
 use std::path::Path;
 
-use betr::domain::{ActionCall, Condition, LearnedRule};
+use betr::domain::{ActionCall, Condition};
 use betr::session::knowledge::{Knowledge, Refusal, check_rule, learned_in_tree, offered_rule};
 use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
@@ -165,21 +165,12 @@ fn knowledge_is_listed_shown_and_revoked() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-use support::repo::scenario;
+use support::repo::{rule, scenario};
 
 fn empty_knowledge() -> Knowledge {
     Knowledge {
         path: "unused.toml".into(),
         rules: Vec::new(),
-    }
-}
-
-fn rule(skill: &str, requires: &str) -> LearnedRule {
-    LearnedRule {
-        id: String::new(),
-        skill: skill.into(),
-        requires: requires.into(),
-        only: None,
     }
 }
 

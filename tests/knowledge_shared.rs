@@ -9,24 +9,15 @@ mod support;
 
 use std::path::Path;
 
-use betr::domain::{ActionCall, Condition, LearnedRule};
+use betr::domain::{ActionCall, Condition};
 use betr::session::knowledge::{KeptRule, Knowledge, Provenance};
 use support::cli::{betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
-use support::repo::scenario;
+use support::repo::{rule, scenario};
 
 fn scenario_path(rel: &str) -> String {
     fixtures::root().join(rel).to_string_lossy().into_owned()
-}
-
-fn rule(skill: &str, requires: &str) -> LearnedRule {
-    LearnedRule {
-        id: String::new(),
-        skill: skill.into(),
-        requires: requires.into(),
-        only: None,
-    }
 }
 
 /// A kept rule of `skill` as one made in scenario 1.
