@@ -20,6 +20,61 @@ impl Secret {
     }
 }
 
+impl PartialEq for Secret {
+    fn eq(&self, other: &Secret) -> bool {
+        self.0 == other.0
+    }
+}
+
+/// A URL with the credentials it carries (`http://user:KEY@host/v1`) taken out: the URL
+/// without them, and the password (else the user name) as a secret, to be sent and
+/// redacted as a key is. A URL without credentials, or one that does not parse, is
+/// given back as it is.
+pub fn split_credentials(url: &str) -> (String, Option<Secret>) {
+    let Ok(mut parsed) = reqwest::Url::parse(url) else {
+        return (url.to_string(), None);
+    };
+    let secret = match (parsed.username(), parsed.password()) {
+        (_, Some(password)) if !password.is_empty() => password.to_string(),
+        (user, _) if !user.is_empty() => user.to_string(),
+        _ => return (url.to_string(), None),
+    };
+    let secret = percent_decoded(&secret);
+    if parsed.set_username("").is_err() || parsed.set_password(None).is_err() {
+        return (url.to_string(), None);
+    }
+    let mut clean = parsed.to_string();
+    // `Url` writes a root path as `/`; a base URL given without one keeps its form.
+    if !url.trim_end().ends_with('/') && clean.ends_with('/') {
+        clean.pop();
+    }
+    (clean, Some(Secret::new(secret)))
+}
+
+/// `%XX` escapes of a URL's user information turned back into bytes.
+fn percent_decoded(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(b)) => {
+                out.push(b);
+                i += 3;
+            }
+            (b, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
 impl std::fmt::Debug for Secret {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("Secret(<redacted>)")
@@ -115,6 +170,20 @@ pub fn excerpt(text: &str) -> String {
 #[cfg(test)]
 mod printable_tests {
     use super::*;
+
+    #[test]
+    fn credentials_in_a_url_are_taken_out_as_a_secret() {
+        let (url, key) = split_credentials("http://user:sk-KEY%21@127.0.0.1:8080/v1");
+        assert_eq!(url, "http://127.0.0.1:8080/v1");
+        assert_eq!(key.map(|k| k.expose().to_string()), Some("sk-KEY!".into()));
+        let (url, key) = split_credentials("https://sk-only@api.example.com/v1");
+        assert_eq!(url, "https://api.example.com/v1");
+        assert_eq!(key.map(|k| k.expose().to_string()), Some("sk-only".into()));
+        let (url, key) = split_credentials("http://127.0.0.1:8080/v1");
+        assert_eq!((url.as_str(), key), ("http://127.0.0.1:8080/v1", None));
+        let (url, key) = split_credentials("not a url");
+        assert_eq!((url.as_str(), key), ("not a url", None));
+    }
 
     #[test]
     fn escape_sequences_and_carriage_returns_are_written_out() {

@@ -120,3 +120,50 @@ fn the_api_key_appears_in_no_file_the_run_wrote() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_key_inside_the_base_url_or_repeated_by_a_reply_appears_in_nothing_written() {
+    let dir = tmp("key-in-url");
+    let scenario = fixtures::root()
+        .join("scenarios/cafe/no_coffee.toml")
+        .to_string_lossy()
+        .into_owned();
+    // A reply that repeats the key it was sent with.
+    let server = FakeServer::start(
+        vec![],
+        Behavior::Reply(format!(
+            "Reasoning: the key is {KEY}.\nGoal: On_Coffee_WindowTable6"
+        )),
+    );
+    let base = format!("http://user:{KEY}@{}/v1", server.addr);
+    let mut args = support::cli::resolve_yes(&scenario, &base);
+    args.extend([
+        "--cassette",
+        "c.jsonl",
+        "--record",
+        "r.jsonl",
+        "--show-replies",
+    ]);
+    // The variable the key is configured in is empty: only the URL holds the key.
+    let out = support::cli::betr_with(&dir, &args, &[(KEY_VAR, ""), ("BETR_LOG", "betr=debug")]);
+    let sent = server.received();
+    assert!(!sent.is_empty(), "{}", text(&out));
+    assert!(
+        sent.iter()
+            .all(|r| r.header("authorization") == Some(format!("Bearer {KEY}").as_str())),
+        "the key from the URL is sent as the key"
+    );
+    assert!(
+        !text(&out).contains(KEY),
+        "the key on the terminal:\n{}",
+        text(&out)
+    );
+    let written = files_under(&dir);
+    assert!(written.iter().any(|p| p.ends_with("c.jsonl")));
+    assert!(written.iter().any(|p| p.ends_with("r.jsonl")));
+    for file in &written {
+        let hay = String::from_utf8_lossy(&std::fs::read(file).unwrap()).into_owned();
+        assert!(!hay.contains(KEY), "the key is in {}", file.display());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -118,3 +118,23 @@ fn an_empty_instruction_is_refused_before_any_model_call() {
     assert_eq!(server.received().len(), 0, "no model call");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_world_rule_on_an_object_the_scene_lacks_is_refused_where_it_stands() {
+    let dir = tmp("names-world-rule");
+    let cafe = fixtures::root().join("scenarios/cafe/cafe.toml");
+    let file = format!(
+        "extends = {cafe:?}\n\n[scenario]\nname = \"Typo\"\ngoal = \"On_Coffee_WindowTable6\"\n\n[[world.rules]]\naction = 'MoveTo \"Cofee\"'\nrequires = \"Exists_Coffee\"\nerror = \"Coffee not found\"\n"
+    );
+    std::fs::write(dir.join("typo.toml"), file).unwrap();
+    let out = betr(&dir, &["run", "typo.toml"]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("typo.toml:8:19"),
+        "file, line and column: {log}"
+    );
+    assert!(log.contains("no object named \"Cofee\""), "{log}");
+    assert!(log.contains("did you mean \"Coffee\""), "{log}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -5,7 +5,7 @@
 //! long as the server's `Retry-After` (or `retry-after-ms`) asks, capped by the policy.
 //! Timeouts are not retried: a model too slow once is usually too slow again. The API key
 //! is read from an environment variable whose name is configured; it is sent only in the
-//! authorization header and removed from every error text.
+//! authorization header and removed from every error text and every reply.
 
 use std::time::{Duration, Instant};
 
@@ -207,7 +207,9 @@ impl OpenAiClient {
         let count = |k: &str| json.pointer(&format!("/usage/{k}")).and_then(Json::as_u64);
         Ok(ChatReply {
             ranked: Vec::new(),
-            text: content.to_string(),
+            // A reply that repeats the key never carries it further (logs, cassettes,
+            // recordings).
+            text: self.redact(content),
             model: json
                 .get("model")
                 .and_then(Json::as_str)

@@ -25,6 +25,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::{Snapshot, Step, World, WorldError};
+use crate::domain::names::{MIN_SIMILARITY, did_you_mean, nearest};
 use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain};
 use crate::goal::Formula;
 use crate::scenario::{Scenario, ScenarioError};
@@ -164,6 +165,25 @@ impl SymbolicWorld {
                         &r.action.span(),
                         0,
                         format!("no skill named {:?} in this scenario", action.skill),
+                    ));
+                }
+                // A rule on an object the scene lacks would never fire.
+                if let Some(missing) = action.args.iter().find(|a| vocabulary.object(a).is_none()) {
+                    let text = r.action.get_ref();
+                    let at = text
+                        .find(&format!("\"{missing}\""))
+                        .map(|i| i + 1)
+                        .or_else(|| text.find(missing.as_str()))
+                        .unwrap_or(0);
+                    let listed = vocabulary.objects.iter().map(|o| o.name.as_str());
+                    let near = nearest(missing, listed, MIN_SIMILARITY);
+                    return Err(file.error_in_string(
+                        &r.action.span(),
+                        at,
+                        format!(
+                            "no object named {missing:?} in this scenario{}",
+                            did_you_mean(&near)
+                        ),
                     ));
                 }
                 let requires = scenario

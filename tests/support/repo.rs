@@ -15,6 +15,16 @@ pub fn path(rel: &str) -> PathBuf {
     root().join(rel)
 }
 
+/// A rule learned for every object of `skill`: it needs `requires`.
+pub fn rule(skill: &str, requires: &str) -> betr::domain::LearnedRule {
+    betr::domain::LearnedRule {
+        id: String::new(),
+        skill: skill.into(),
+        requires: requires.into(),
+        only: None,
+    }
+}
+
 /// A scenario by its path relative to the repository (a failure names the file).
 pub fn scenario(rel: &str) -> Scenario {
     Scenario::load(&path(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
