@@ -138,3 +138,36 @@ fn a_world_rule_on_an_object_the_scene_lacks_is_refused_where_it_stands() {
     assert!(log.contains("did you mean \"Coffee\""), "{log}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A reply that relates the request's objects the other way round is a misreading: the
+/// goal worked on is the one the request says, and the reversed one never runs.
+#[test]
+fn a_goal_with_its_objects_the_other_way_round_is_turned_round_before_it_runs() {
+    let server = FakeServer::start(
+        vec![],
+        Behavior::Reply("Goal: \"green cube\" on \"blue cube\"".into()),
+    );
+    let dir = tmp("names-reversed");
+    let mut args: Vec<String> = [
+        "resolve",
+        &scenario("scenarios/cell/red_on_blue.toml"),
+        "--instruction",
+        "Put the blue cube on the green cube",
+        "--yes",
+    ]
+    .map(str::to_string)
+    .to_vec();
+    args.extend(["--save".into(), "kept.bt".into()]);
+    args.extend(model_flags(&server.base_url()));
+    let out = run(&dir, &args);
+    let log = text(&out);
+    assert!(
+        log.contains("Goal: \"blue cube\" on \"green cube\""),
+        "{log}"
+    );
+    assert!(
+        !log.contains("Goal: \"green cube\" on \"blue cube\""),
+        "the reversed goal is never worked on:\n{log}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

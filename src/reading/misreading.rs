@@ -8,6 +8,7 @@
 //! | name | finds | undoes it by |
 //! |---|---|---|
 //! | `place-number` | a place number the request says that no condition is about ("table six" read as `Table1`) | renaming the numbered place to the one of its kind with that number |
+//! | `reversed-relation` | a relation with its objects the other way round from the request ("the blue cube on the green cube" read as green on blue) | turning it round |
 //! | `swapped-object` | an object no word names in the place of one a word names alone ("fries" read as coffee) | putting the named object back, when the request names one of that kind |
 //! | `turned-around` | a condition the other way round from the request's words ("do not open the curtain" read as open) | turning it back |
 //! | `left-unanswered` | a condition the request asks for in its own words, left out where the request offers no choice | putting it beside the goal |
@@ -23,6 +24,7 @@ use crate::scenario::Scenario;
 
 use super::lexicon::Lexicon;
 use super::names::{renumbered, swapped_back, swapped_object, unanswered_names};
+use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::relation_words::{convention_followed, relation_as_said};
@@ -81,6 +83,7 @@ pub trait Misreading: Sync {
 /// Every detector, in the order their findings are told and their undoing tried.
 pub const MISREADINGS: &[&dyn Misreading] = &[
     &PlaceNumber,
+    &ReversedRelation,
     &SwappedObject,
     &TurnedAround,
     &LeftUnanswered,
@@ -141,6 +144,28 @@ impl Misreading for PlaceNumber {
                 (
                     g,
                     format!("the request numbers a place the answer does not: {to} is the only one like {from} with that number"),
+                )
+            })
+            .into_iter()
+            .collect()
+    }
+}
+
+struct ReversedRelation;
+impl Misreading for ReversedRelation {
+    fn name(&self) -> &'static str {
+        "reversed-relation"
+    }
+    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
+        reversed(goal, request.text, request.vocabulary())
+            .map(|atom| format!("{goal} has {atom} the other way round from the request"))
+    }
+    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
+        turned_round(goal, request.text, request.vocabulary())
+            .map(|g| {
+                (
+                    g,
+                    format!("the request relates the objects of {goal} the other way round"),
                 )
             })
             .into_iter()

@@ -8,7 +8,7 @@
 //! about conditions ([`polarity`]), about items sent to places ([`placement`]), about
 //! things named side by side ([`side_by_side`]), about the relation said before a place
 //! and a scene's conventions ([`relation_words`]), and about a goal's objects and
-//! conjuncts ([`names`]).
+//! conjuncts ([`names`]), and about the order of a relation's objects ([`order`]).
 //!
 //! The session asks the model and judges its answers with what is here; formula rewrites
 //! that know nothing of words (rename, map atoms, flip) are [`crate::goal::rewrite`]'s.
@@ -17,6 +17,7 @@ pub mod english;
 pub mod lexicon;
 pub mod misreading;
 pub mod names;
+pub mod order;
 pub mod parts;
 pub mod placement;
 pub mod polarity;

@@ -80,3 +80,28 @@ fn what_was_undone_may_leave_a_part_nothing_asks_for_which_goes() {
         "{undone:?}"
     );
 }
+
+#[test]
+fn a_relation_the_other_way_round_is_a_misreading_undone() {
+    let cell = Scenario::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml"),
+    )
+    .expect("cell scenario");
+    let request = "Put the blue cube on the green cube";
+    let j = judge(&cell, request, false);
+    let reversed = cell
+        .parse_goal(r#""green cube" on "blue cube""#)
+        .expect("parses");
+    let why = j.misread(&reversed).expect("a misreading");
+    assert!(why.contains("other way round"), "{why}");
+    let as_said = cell
+        .parse_goal(r#""blue cube" on "green cube""#)
+        .expect("parses");
+    assert!(j.misread(&as_said).is_none());
+    assert!(
+        j.undone_in_turn(&reversed)
+            .iter()
+            .any(|(g, why)| *g == as_said && why.is_ok()),
+        "turned round as the request says"
+    );
+}
