@@ -25,28 +25,11 @@ use support::tmux::{Tmux, quote};
 /// The shell command that opens the workbench on scenario 1 in `dir`, with the model
 /// answered by `server`, then says how it exited.
 fn workbench_command(dir: &Path, server: &FakeServer, env: &str, extra: &str) -> String {
-    workbench_command_on("scenarios/cell/red_on_blue.toml", dir, server, (env, extra))
-}
-
-/// The same on `scenario` (relative to the crate root).
-fn workbench_command_on(
-    scenario: &str,
-    dir: &Path,
-    server: &FakeServer,
-    (env, extra): (&str, &str),
-) -> String {
-    let scenario = fixtures::root().join(scenario);
-    format!(
-        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
-         XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {env} {bin} tui {scenario} --backend openai \
-         --base-url {url} --model fake-model --api-key-env {KEY_VAR} --policy-dir {policies} \
-         --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
-         sleep 60",
-        dir = quote(dir),
-        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
-        scenario = quote(&scenario),
-        url = server.base_url(),
-        policies = quote(&dir.join("policies")),
+    support::tmux::workbench_command_on(
+        "scenarios/cell/red_on_blue.toml",
+        dir,
+        server,
+        (env, extra),
     )
 }
 
@@ -569,46 +552,4 @@ fn replay_position(screen: &str) -> (usize, usize) {
     let field = screen[at..].split_whitespace().next().unwrap();
     let (p, n) = field.split_once('/').unwrap();
     (p.parse().unwrap(), n.parse().unwrap())
-}
-
-/// A request that names no object of the scene ("something sweet") read two ways by the
-/// model's candidates, a dessert and a chocolate: the workbench offers both, and the
-/// person takes the second.
-#[test]
-fn a_person_chooses_the_second_reading_of_an_instruction() {
-    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
-    let dir = tmp("tmux-readings");
-    let tmux = Tmux::start(&workbench_command_on(
-        "scenarios/cafe/cafe.toml",
-        &dir,
-        &server,
-        ("", ""),
-    ));
-    tmux.wait_for(&["Behavior tree", "press i to type an instruction"], 20);
-    tmux.keys(&["i"]);
-    tmux.wait_for(&["Instruction or goal"], 10);
-    tmux.text("Bring something sweet to table 3.");
-    tmux.keys(&["Enter"]);
-    let screen = tmux.wait_for(&["Readings of the instruction", "goal: ", "first: "], 30);
-    let first = screen
-        .lines()
-        .position(|l| l.contains("goal: On_Dessert_Table3"));
-    let second = screen
-        .lines()
-        .position(|l| l.contains("goal: On_Chocolate_Table3"));
-    assert!(
-        matches!((first, second), (Some(a), Some(b)) if a < b),
-        "the dessert (two votes) first, the chocolate second:\n{screen}"
-    );
-    // Other keys leave the choice open; the number chooses.
-    tmux.keys(&["Space"]);
-    tmux.wait_for(&["Readings of the instruction"], 5);
-    tmux.keys(&["2"]);
-    let screen = tmux.wait_for(&["Goal: On_Chocolate_Table3", "PickUp \"Chocolate\"!"], 20);
-    assert!(
-        !screen.contains("Readings of the instruction")
-            && !screen.contains("On_Dessert_Table3?")
-            && !screen.contains("PickUp \"Dessert\"!"),
-        "the tree is the second reading's:\n{screen}"
-    );
 }

@@ -116,3 +116,28 @@ impl Drop for Tmux {
 pub fn quote(p: &Path) -> String {
     format!("'{}'", p.display())
 }
+
+/// The shell command that opens the workbench on `scenario` (relative to the crate root)
+/// in `dir`, with the model answered by `server`, then says how it exited.
+pub fn workbench_command_on(
+    scenario: &str,
+    dir: &Path,
+    server: &super::fake_openai::FakeServer,
+    (env, extra): (&str, &str),
+) -> String {
+    let scenario = super::fixtures::root().join(scenario);
+    format!(
+        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data {key_var}={key} {env} {bin} tui {scenario} --backend openai \
+         --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies} \
+         --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
+         sleep 60",
+        dir = quote(dir),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+        scenario = quote(&scenario),
+        url = server.base_url(),
+        policies = quote(&dir.join("policies")),
+        key_var = super::cli::KEY_VAR,
+        key = super::cli::KEY,
+    )
+}
