@@ -111,9 +111,9 @@ fn the_trees_of_every_scenario_round_trip_through_btcpp_xml() {
         }
         checked += 1;
     }
-    // 10 failure scenarios, 7 parameter scenarios, the cafe of the dataset, and the 7 new
-    // tasks of cell/tasks.
-    assert_eq!(checked, 25, "{files:?}");
+    // 10 failure scenarios, 7 parameter scenarios, the cafe of the dataset, the 7 new
+    // tasks of cell/tasks, and the greenhouse.
+    assert_eq!(checked, 26, "{files:?}");
     assert_eq!(with_value_ports, 7);
 }
 
