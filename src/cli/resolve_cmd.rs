@@ -169,9 +169,8 @@ fn interpret(
         reading.calls,
         reading.feedback_rounds
     );
-    let world = betr::world::load(scenario)?;
     let readings =
-        session::readings::distinct_readings(scenario, world.as_ref(), &reading.readings);
+        session::readings::distinct_readings_in_scenario(scenario, &reading.readings)?;
     if readings.len() > 1 {
         outln!();
         for line in readings_text(&readings) {

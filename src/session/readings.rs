@@ -85,6 +85,15 @@ pub fn distinct_readings(
     out
 }
 
+/// [`distinct_readings`] from the scenario's first state.
+pub fn distinct_readings_in_scenario(
+    scenario: &Scenario,
+    goals: &[Formula],
+) -> Result<Vec<Reading>, crate::scenario::ScenarioError> {
+    let world = crate::world::load(scenario)?;
+    Ok(distinct_readings(scenario, world.as_ref(), goals))
+}
+
 /// `goal` in words: each condition by its predicate's description with the objects put
 /// in for the words of their types ("the item is at the place" → "Chips is at Table3"),
 /// joined by "and", "or" and "not".
