@@ -169,8 +169,7 @@ fn interpret(
         reading.calls,
         reading.feedback_rounds
     );
-    let readings =
-        session::readings::distinct_readings_in_scenario(scenario, &reading.readings)?;
+    let readings = session::readings::distinct_readings_in_scenario(scenario, &reading.readings)?;
     if readings.len() > 1 {
         outln!();
         for line in readings_text(&readings) {
@@ -212,9 +211,26 @@ fn readings_text(readings: &[session::Reading]) -> Vec<String> {
 
 /// The reading to work on: the one `--reading` names, else asked on the terminal; none
 /// with `--yes` (a person must choose) or when the answer names none.
-fn choose_reading(readings: &[session::Reading], chosen: Option<u16>, yes: bool) -> Option<usize> {
-    for line in readings_text(readings) {
-        outln!("{line}");
+fn choose_reading(
+    readings: &[session::Reading],
+    doubt: Option<&str>,
+    chosen: Option<u16>,
+    yes: bool,
+) -> Option<usize> {
+    match doubt {
+        // One reading, doubted: approved by a person, or by --reading 1, never by --yes.
+        Some(why) => {
+            outln!("The goal read is doubtful: {why}");
+            if let Some(r) = readings.first() {
+                outln!("  1  {}", r.words);
+                outln!("     goal: {}", r.goal);
+            }
+        }
+        None => {
+            for line in readings_text(readings) {
+                outln!("{line}");
+            }
+        }
     }
     if let Some(n) = chosen {
         let index = usize::from(n) - 1;
@@ -324,7 +340,8 @@ fn resolve(
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
-    let mut choose = |r: &[session::Reading]| choose_reading(r, args.reading, yes);
+    let mut choose =
+        |r: &[session::Reading], doubt: Option<&str>| choose_reading(r, doubt, args.reading, yes);
     let result = super::runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,

@@ -215,9 +215,15 @@ impl Encoder {
             Event::Notice { message } => Recorded::Note {
                 message: message.clone(),
             },
-            Event::Readings { readings, .. } => Recorded::Note {
+            Event::Readings {
+                readings, doubt, ..
+            } => Recorded::Note {
                 message: format!(
-                    "readings to choose among: {}",
+                    "readings to choose among{}: {}",
+                    doubt
+                        .as_ref()
+                        .map(|why| format!(" (doubtful: {why})"))
+                        .unwrap_or_default(),
                     readings
                         .iter()
                         .enumerate()

@@ -12,6 +12,7 @@ use crate::reading::Lexicon;
 use crate::reading::names::{
     copied_from_example, more_alternatives_than_asked, unasked, unnamed_object,
 };
+use crate::reading::words::terms;
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -159,7 +160,17 @@ pub(super) fn assess(
                     ))
                 })
             })
-            .or(checked.err()),
+            .or(checked.err())
+            .or_else(|| {
+                // Text that names nothing of the scene (an instruction to the tool rather
+                // than the robot, or a request in words the scene does not know) gets a
+                // goal only as a doubt a person settles.
+                lexicon.covered(goal, &terms(request)).is_empty().then(|| {
+                    doubt(format!(
+                        "no word of the request names anything {goal} is about"
+                    ))
+                })
+            }),
     }
 }
 

@@ -30,7 +30,7 @@ pub async fn resolve(
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
     // Only offered with `options.choose_reading`: the best reading, as without it.
-    let mut best = |_: &[Reading]| Some(0);
+    let mut best = |_: &[Reading], _: Option<&str>| Some(0);
     resolve_with_scenes(
         scenario,
         instruction,
@@ -46,7 +46,9 @@ pub async fn resolve(
 /// Says whether a proposal is approved.
 pub type Approver<'a> = &'a mut dyn FnMut(&Proposal) -> bool;
 /// Picks the reading to work on among those offered, or none to stop.
-pub type ReadingChooser<'a> = &'a mut dyn FnMut(&[Reading]) -> Option<usize>;
+/// Picks the reading to work on among those offered (with the doubt the checks raised
+/// about a single one), or none to stop.
+pub type ReadingChooser<'a> = &'a mut dyn FnMut(&[Reading], Option<&str>) -> Option<usize>;
 
 /// [`resolve`], and with `scenes` the engine also emits the cell's scene after every tick
 /// (`Event::Scene`, for a 3D view). `choose` picks among the readings of the instruction
@@ -102,7 +104,9 @@ pub async fn resolve_with_scenes(
         emit(&event);
         match event {
             Event::Goal { goal: g, .. } => goal = Some(g),
-            Event::Readings { readings, .. } => match choose(&readings) {
+            Event::Readings {
+                readings, doubt, ..
+            } => match choose(&readings, doubt.as_deref()) {
                 Some(index) if index < readings.len() => {
                     engine.send(Command::ChooseReading(index));
                 }
@@ -110,6 +114,7 @@ pub async fn resolve_with_scenes(
                     engine.send(Command::Shutdown);
                     return Err(SessionError::ReadingNotChosen {
                         count: readings.len(),
+                        doubt,
                     });
                 }
             },

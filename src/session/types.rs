@@ -228,10 +228,12 @@ pub enum Event {
         matches_expected: Option<bool>,
     },
     /// The instruction has more than one reading that would make the robot do different
-    /// things: the person chooses one (`Command::ChooseReading`), best first.
+    /// things, or one the checks doubt (`doubt`, why): the person chooses one
+    /// (`Command::ChooseReading`), best first, before anything runs.
     Readings {
         instruction: String,
         readings: Vec<super::readings::Reading>,
+        doubt: Option<String>,
     },
     /// An action failed in simulation.
     ActionFailed {
@@ -445,10 +447,20 @@ pub enum SessionError {
     TreeFile(Box<crate::interop::TreeFileError>),
     #[error("the session stopped before the loop ended")]
     Stopped,
-    #[error(
-        "the instruction has {count} readings that make the robot do different things, and none was chosen: choose one with --reading N"
-    )]
-    ReadingNotChosen { count: usize },
+    #[error("{}", not_chosen(*count, doubt.as_deref()))]
+    ReadingNotChosen { count: usize, doubt: Option<String> },
+}
+
+/// Why no reading was worked on: several to choose among, or one the checks doubt.
+fn not_chosen(count: usize, doubt: Option<&str>) -> String {
+    match doubt {
+        Some(why) => format!(
+            "the goal read from the instruction is doubtful ({why}) and was not approved: run without --yes to approve it, or say the instruction otherwise"
+        ),
+        None => format!(
+            "the instruction has {count} readings that make the robot do different things, and none was chosen: choose one with --reading N"
+        ),
+    }
 }
 
 impl From<crate::interop::TreeFileError> for SessionError {

@@ -64,7 +64,7 @@ pub enum Overlay {
     Help,
     Report(Vec<String>),
     /// The readings of an instruction, waiting for the person to choose one.
-    Readings(Vec<crate::session::Reading>),
+    Readings(Vec<crate::session::Reading>, Option<String>),
 }
 
 pub struct App {
@@ -225,7 +225,7 @@ impl App {
             self.dictation.idle();
             return;
         }
-        if let Some(Overlay::Readings(readings)) = &self.overlay {
+        if let Some(Overlay::Readings(readings, _)) = &self.overlay {
             return self.on_reading_key(&key, readings.len());
         }
         if self.overlay.take().is_some() {

@@ -16,6 +16,8 @@ pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
 pub const READINGS_TITLE: &str = " Readings of the instruction (press a number; Esc: none) ";
 pub const READINGS_INTRO: &str =
     "The instruction can be read in ways that make the robot do different things:";
+pub const READING_DOUBTED: &str =
+    "The goal read from the instruction is doubtful; press 1 to work on it anyway:";
 pub const NO_READING_CHOSEN: &str =
     "no reading chosen: type the instruction again (i), said otherwise";
 

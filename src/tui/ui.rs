@@ -59,7 +59,9 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     match &app.overlay {
         Some(Overlay::Help) => draw_help(frame, area, &app.keys, app.mode, &theme),
         Some(Overlay::Report(lines)) => draw_report(frame, area, lines, &theme),
-        Some(Overlay::Readings(readings)) => draw_readings(frame, area, readings, &theme),
+        Some(Overlay::Readings(readings, doubt)) => {
+            draw_readings(frame, area, readings, doubt.as_deref(), &theme);
+        }
         None => {}
     }
 }

@@ -76,13 +76,17 @@ impl Engine {
         read: super::super::interpret::Interpretation,
         instruction: String,
     ) {
-        if self.options.choose_reading && read.readings.len() > 1 {
+        if self.options.choose_reading {
             let readings =
                 distinct_readings(&self.scenario, self.planning.as_ref(), &read.readings);
-            if readings.len() > 1 {
+            // Several readings that do different things, or one the checks doubt: a
+            // person decides before anything runs.
+            let doubt = read.doubt.clone().filter(|_| readings.len() == 1);
+            if readings.len() > 1 || doubt.is_some() {
                 self.emit(Event::Readings {
                     instruction: instruction.clone(),
                     readings: readings.clone(),
+                    doubt,
                 });
                 self.choosing = Some((instruction, readings));
                 return;

@@ -78,13 +78,18 @@ impl App {
                 self.llm.goal = Some(goal.to_string());
                 self.llm.reasoning = reasoning;
             }
-            Event::Readings { readings, .. } => {
+            Event::Readings {
+                readings, doubt, ..
+            } => {
                 self.status.awaiting = None;
-                self.llm.log(format!(
-                    "the instruction reads {} ways that make the robot do different things: choose one",
-                    readings.len()
-                ));
-                self.overlay = Some(Overlay::Readings(readings));
+                self.llm.log(match &doubt {
+                    Some(why) => format!("the goal read is doubtful ({why}): approve it or not"),
+                    None => format!(
+                        "the instruction reads {} ways that make the robot do different things: choose one",
+                        readings.len()
+                    ),
+                });
+                self.overlay = Some(Overlay::Readings(readings, doubt));
             }
             Event::Usage { totals } => self.status.usage = totals,
             _ => {}

@@ -118,8 +118,11 @@ pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Them
 
 /// The readings of an instruction to choose among, each with its number, its words, its
 /// goal and the first actions of its plan.
-pub fn readings_lines(readings: &[crate::session::Reading]) -> Vec<String> {
-    let mut lines = vec![strings::READINGS_INTRO.to_string()];
+pub fn readings_lines(readings: &[crate::session::Reading], doubt: Option<&str>) -> Vec<String> {
+    let mut lines = vec![match doubt {
+        Some(why) => format!("{} {why}", strings::READING_DOUBTED),
+        None => strings::READINGS_INTRO.to_string(),
+    }];
     for (i, r) in readings.iter().enumerate() {
         lines.push(String::new());
         lines.push(format!("{}  {}", i + 1, r.words));
@@ -136,12 +139,13 @@ pub fn draw_readings(
     frame: &mut Frame,
     area: Rect,
     readings: &[crate::session::Reading],
+    doubt: Option<&str>,
     theme: &Theme,
 ) {
     draw_box(
         frame,
         area,
-        &readings_lines(readings),
+        &readings_lines(readings, doubt),
         theme,
         strings::READINGS_TITLE,
     );
