@@ -81,7 +81,15 @@ fn a_person_chooses_the_second_reading_of_an_instruction() {
     tmux.wait_for(&["Instruction or goal"], 10);
     tmux.text("Bring something sweet to table 3.");
     tmux.keys(&["Enter"]);
-    let screen = tmux.wait_for(&["Readings of the instruction", "goal: ", "first: "], 30);
+    // Drawn whole: both readings with their first actions.
+    let wanted = [
+        "Readings of the instruction",
+        "goal: On_Dessert_Table3",
+        "goal: On_Chocolate_Table3",
+    ];
+    let screen = tmux.wait_until(&wanted, 30, |s| {
+        wanted.iter().all(|w| s.contains(w)) && s.matches("first: ").count() == 2
+    });
     let first = screen
         .lines()
         .position(|l| l.contains("goal: On_Dessert_Table3"));
@@ -94,9 +102,18 @@ fn a_person_chooses_the_second_reading_of_an_instruction() {
     );
     // Other keys leave the choice open; the number chooses.
     tmux.keys(&["Space"]);
-    tmux.wait_for(&["Readings of the instruction"], 5);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    assert!(tmux.screen().contains("Readings of the instruction"));
     tmux.keys(&["2"]);
-    let screen = tmux.wait_for(&["Goal: On_Chocolate_Table3", "PickUp \"Chocolate\"!"], 20);
+    // The tree's last action (not among the first actions the overlay lists), and the
+    // overlay gone: the screen is read once it has been redrawn whole.
+    let wanted = [
+        "Goal: On_Chocolate_Table3",
+        "PutDown \"Chocolate\" \"Table3\"!",
+    ];
+    let screen = tmux.wait_until(&wanted, 20, |s| {
+        wanted.iter().all(|w| s.contains(w)) && !s.contains("Readings of the instruction")
+    });
     assert!(
         !screen.contains("Readings of the instruction")
             && !screen.contains("On_Dessert_Table3?")
