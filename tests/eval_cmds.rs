@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use betr::dataset::{self, Case};
 use betr::goal::{Formula, same_dnf};
 use serde_json::Value as Json;
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{KEY_VAR, betr, openai_flags, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures::{self, FixtureReply};
 
@@ -415,28 +415,13 @@ fn a_suite_puts_its_sets_side_by_side() {
     .unwrap();
     let url = server.base_url();
     let suite_arg = suite.display().to_string();
-    let o = betr(
-        &dir,
-        &[
-            "eval",
-            "goals",
-            "--suite",
-            &suite_arg,
-            "--out",
-            "out",
-            "--backend",
-            "openai",
-            "--base-url",
-            &url,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
-            "--whole-request",
-            "--concurrency",
-            "4",
-        ],
-    );
+    let suite_run = |extra: &[&str]| {
+        let mut args = vec!["eval", "goals", "--suite", &suite_arg];
+        args.extend(openai_flags(&url));
+        args.extend_from_slice(extra);
+        betr(&dir, &args)
+    };
+    let o = suite_run(&["--out", "out", "--whole-request", "--concurrency", "4"]);
     assert!(o.status.success(), "{}", text(&o));
     let table = std::fs::read_to_string(dir.join("out/suite.md")).unwrap();
     // The cafe's first answers as in the single run.
@@ -457,23 +442,7 @@ fn a_suite_puts_its_sets_side_by_side() {
     }
     // A set with neither a dataset nor scenario files is refused, naming it.
     std::fs::write(&suite, "[[set]]\nname = \"x\"\nscenario = \"a.toml\"\n").unwrap();
-    let o = betr(
-        &dir,
-        &[
-            "eval",
-            "goals",
-            "--suite",
-            &suite_arg,
-            "--backend",
-            "openai",
-            "--base-url",
-            &url,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
-        ],
-    );
+    let o = suite_run(&[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("set \"x\" needs either"), "{}", text(&o));
 }
