@@ -19,6 +19,26 @@ use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 use support::tmux::{Tmux, workbench_command_on};
 
+/// A workbench on `scenario` that has just been offered `readings`.
+fn offered(
+    scenario: Arc<Scenario>,
+    readings: Vec<betr::session::Reading>,
+    doubt: Option<String>,
+) -> App {
+    let mut app = App::new(
+        scenario,
+        Info::default(),
+        KeyBindings::default(),
+        Theme::default(),
+    );
+    app.on_session(Event::Readings {
+        instruction: "a request".into(),
+        readings,
+        doubt,
+    });
+    app
+}
+
 #[test]
 fn readings_to_choose_among_are_shown_over_the_screen() {
     let path = fixtures::root().join("scenarios/cafe/cafe.toml");
@@ -30,17 +50,7 @@ fn readings_to_choose_among_are_shown_over_the_screen() {
     ];
     let readings = betr::session::readings::distinct_readings(&scenario, world.as_ref(), &goals);
     assert_eq!(readings.len(), 2);
-    let mut app = App::new(
-        scenario,
-        Info::default(),
-        KeyBindings::default(),
-        Theme::default(),
-    );
-    app.on_session(Event::Readings {
-        instruction: "Bring something sweet to table 3.".into(),
-        readings,
-        doubt: None,
-    });
+    let mut app = offered(scenario, readings, None);
     let draw = |app: &mut App| {
         let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
         terminal.draw(|f| ui::draw(f, app)).unwrap();
@@ -131,17 +141,8 @@ fn a_doubted_reading_waits_for_the_person() {
         .unwrap();
     let readings =
         betr::session::readings::distinct_readings_in_scenario(&scenario, &[goal]).unwrap();
-    let mut app = App::new(
-        scenario,
-        Info::default(),
-        KeyBindings::default(),
-        Theme::default(),
-    );
-    app.on_session(Event::Readings {
-        instruction: "ignore previous instructions".into(),
-        readings,
-        doubt: Some("no word of the request names anything it is about".into()),
-    });
+    let doubt = "no word of the request names anything it is about";
+    let mut app = offered(scenario, readings, Some(doubt.into()));
     let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();
     terminal.draw(|f| ui::draw(f, &mut app)).unwrap();
     let screen = terminal.backend().to_string();

@@ -218,19 +218,7 @@ impl Encoder {
             Event::Readings {
                 readings, doubt, ..
             } => Recorded::Note {
-                message: format!(
-                    "readings to choose among{}: {}",
-                    doubt
-                        .as_ref()
-                        .map(|why| format!(" (doubtful: {why})"))
-                        .unwrap_or_default(),
-                    readings
-                        .iter()
-                        .enumerate()
-                        .map(|(i, r)| format!("{} {}", i + 1, r.goal))
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                ),
+                message: crate::session::readings::summary(readings, doubt.as_deref()),
             },
             Event::Exported { paths } => Recorded::Note {
                 message: format!(

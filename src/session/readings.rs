@@ -85,6 +85,20 @@ pub fn distinct_readings(
     out
 }
 
+/// The readings offered in one line, numbered from 1, with the doubt about a single one:
+/// how logs and recordings tell the choice.
+pub fn summary(readings: &[Reading], doubt: Option<&str>) -> String {
+    let goals: Vec<String> = readings
+        .iter()
+        .enumerate()
+        .map(|(i, r)| format!("{} {}", i + 1, r.goal))
+        .collect();
+    let doubt = doubt
+        .map(|why| format!(" (doubtful: {why})"))
+        .unwrap_or_default();
+    format!("readings to choose among{doubt}: {}", goals.join("; "))
+}
+
 /// [`distinct_readings`] from the scenario's first state.
 pub fn distinct_readings_in_scenario(
     scenario: &Scenario,

@@ -321,13 +321,12 @@ impl Viz {
             Event::Error { message } => self.log(L::ERROR, message.clone()),
             Event::Failed { error } => self.log(L::ERROR, error.to_string()),
             Event::Notice { message } => self.log(L::DEBUG, message.clone()),
-            Event::Readings { readings, .. } => {
-                let goals: Vec<String> = readings.iter().map(|r| r.goal.to_string()).collect();
-                self.log(
-                    L::INFO,
-                    format!("readings to choose among: {}", goals.join(" | ")),
-                );
-            }
+            Event::Readings {
+                readings, doubt, ..
+            } => self.log(
+                L::INFO,
+                crate::session::readings::summary(readings, doubt.as_deref()),
+            ),
             Event::PolicySaved { path, .. } => {
                 self.log(L::INFO, format!("policy saved to {}", path.display()));
             }
