@@ -41,6 +41,11 @@ pub struct LlmFlags {
     /// [env: BETR_CASSETTE].
     #[arg(long, value_name = "FILE")]
     pub cassette: Option<PathBuf>,
+    /// With a live backend and --cassette: answer what the cassette already holds for the
+    /// model from it, ask the model only the rest and record that (a run repeated with
+    /// one setting changed asks only the questions that changed).
+    #[arg(long, requires = "cassette")]
+    pub reuse_cassette: bool,
     /// Constrain replies to the vocabulary with a JSON schema (servers with response_format)
     /// [env: BETR_STRUCTURED].
     #[arg(long)]
@@ -176,6 +181,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         timeout_secs: flags.timeout,
         max_retries: flags.max_retries,
         cassette: flags.cassette.clone(),
+        reuse_cassette: flags.reuse_cassette.then_some(true),
         usage_log: flags.usage_log.clone(),
         model_path: flags.model_path.clone(),
         threads: flags.threads,
