@@ -157,6 +157,9 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     );
     settings.insert("shortlist".into(), options.shortlist.to_string());
     settings.insert("read_by_parts".into(), options.read_by_parts.to_string());
+    if options.small_steps {
+        settings.insert("small_steps".into(), "true".into());
+    }
     settings.insert("value_levels".into(), options.value_levels.to_string());
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
     if !options.without_misreadings.is_empty() {
@@ -202,10 +205,11 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
                     "checked ({} candidates, {} feedback rounds{})",
                     llm.options.candidates,
                     llm.options.goal_feedback_rounds,
-                    if llm.options.read_by_parts {
-                        ", a wish at a time"
-                    } else {
-                        ", whole request"
+                    match (llm.options.read_by_parts, llm.options.small_steps) {
+                        (true, false) => ", a wish at a time",
+                        (false, false) => ", whole request",
+                        (true, true) => ", a wish at a time, the objects named first",
+                        (false, true) => ", whole request, the objects named first",
                     }
                 )
             } else {

@@ -103,6 +103,11 @@ pub struct LlmFlags {
     /// goals joined as the request joins them.
     #[arg(long)]
     pub whole_request: bool,
+    /// Ask first which of the scene's objects and places the request names, and type the
+    /// goal's first answer over those only (the embedded model, or any model held to a
+    /// grammar).
+    #[arg(long)]
+    pub small_steps: bool,
     /// Ask a numeric parameter's first value as a number, instead of as a level (very low
     /// … very high) of the range the robot can do that betr turns into a number.
     #[arg(long)]
@@ -223,6 +228,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         beams: flags.beams.unwrap_or(betr::session::types::DEFAULT_BEAMS),
         goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
         read_by_parts: !flags.whole_request,
+        small_steps: flags.small_steps,
         value_levels: !flags.value_as_number,
         shortlist: !flags.no_shortlist,
         ..Options::default()

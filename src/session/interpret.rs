@@ -158,6 +158,18 @@ pub(super) async fn read_goal(
     let cot = options.variant.chain_of_thought;
     let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
     let mut calls = 0;
+    // The small step first: the objects the request names type the first answer.
+    let mut narrowed: Option<crate::domain::Vocabulary> = None;
+    if options.small_steps && !cot && options.grammar && model.supports_grammar() {
+        calls += 1;
+        if let Some(named) = super::named_first::named_objects(&ctx, model, options, emit).await? {
+            narrowed = super::named_first::narrowed(vocabulary, &named);
+        }
+    }
+    let narrowed_grammar = || match &narrowed {
+        Some(v) => grammar::goal_grammar(v, true, cot),
+        None => goal_grammar(),
+    };
     let mut first: Option<Option<Formula>> = None;
     let rounds = if options.check_goals {
         options.goal_feedback_rounds + 1
@@ -191,10 +203,15 @@ pub(super) async fn read_goal(
             } else {
                 None
             };
+            let typed_by: &(dyn Fn() -> String + Sync) = if round == 0 && draw == 0 {
+                &narrowed_grammar
+            } else {
+                &goal_grammar
+            };
             let r = ask(
                 model,
                 messages.clone(),
-                (constraint.clone(), &goal_grammar),
+                (constraint.clone(), typed_by),
                 &opts,
                 seed,
                 emit,

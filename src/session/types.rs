@@ -44,6 +44,10 @@ pub struct Options {
     /// With checks on, read a request of several wishes one wish at a time and join the
     /// goals as the request joins them; off: the request is read whole.
     pub read_by_parts: bool,
+    /// Before a goal's first answer, ask the model which of the scene's objects and places
+    /// the request names, and type the first answer over those only
+    /// (`session::named_first`); off: the first answer is typed over the whole scene.
+    pub small_steps: bool,
     /// Ask the first value of a numeric parameter as a level of the robot's declared
     /// range (very low … very high), turned into a number by betr; off: as a number.
     pub value_levels: bool,
@@ -96,6 +100,7 @@ impl Default for Options {
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,
             read_by_parts: true,
+            small_steps: false,
             value_levels: true,
             use_scenario_goal: false,
             policy_dir: None,
