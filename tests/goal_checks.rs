@@ -22,6 +22,7 @@ use betr::llm::{
     ChatFuture, ChatReply, ChatRequest, LanguageModel, OutputConstraint, ReplySource, TokenUsage,
 };
 use betr::scenario::Scenario;
+use betr::session::types::Ablations;
 use betr::session::{self, Event, Options, Proposal};
 use betr::world;
 
@@ -494,7 +495,10 @@ async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() 
         seen: Mutex::default(),
     };
     let options = Options {
-        small_steps: true,
+        ablations: Ablations {
+            small_steps: true,
+            ..Ablations::default()
+        },
         ..Options::default()
     };
     let reading = session::interpret::interpret(
