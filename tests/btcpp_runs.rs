@@ -17,7 +17,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use betr::bt::{self, ActionStep, Leaves, NodeId, Outcome, Status, Ticker, Tree};
+use betr::bt::{
+    self, ActionStep, Leaves, NodeId, NodeKind, Outcome, Status, TickRecord, Ticker, Tree,
+};
 use betr::domain::{ActionCall, Condition, Domain, Value};
 use betr::interop;
 use betr::planner::{Planner, RunLimits, WorldLeaves};
@@ -86,9 +88,10 @@ fn action_key(domain: &Domain, action: &ActionCall) -> String {
     format!("{}({})", action.skill, ports.join(", "))
 }
 
-/// The world's leaves, with every answer and halt written down for the script.
+/// Leaves with every answer and halt written down for the script.
 struct Recording<'a> {
-    leaves: WorldLeaves<'a>,
+    leaves: &'a mut dyn Leaves,
+    domain: &'a Domain,
     answers: Vec<Json>,
     halted: Vec<String>,
 }
@@ -99,7 +102,7 @@ impl Leaves for Recording<'_> {
         // The script holds the predicate's truth; BT.CPP's <Inverter> turns it.
         let atom = holds != condition.negated;
         self.answers.push(json!({
-            "node": condition_key(self.leaves.domain, condition),
+            "node": condition_key(self.domain, condition),
             "result": if atom { "SUCCESS" } else { "FAILURE" },
         }));
         holds
@@ -113,7 +116,7 @@ impl Leaves for Recording<'_> {
             ActionStep::Failure(_) => "FAILURE",
         };
         self.answers.push(json!({
-            "node": action_key(self.leaves.domain, action),
+            "node": action_key(self.domain, action),
             "result": result,
             "started": started,
         }));
@@ -121,8 +124,34 @@ impl Leaves for Recording<'_> {
     }
 
     fn halt(&mut self, node: NodeId, action: &ActionCall) {
-        self.halted.push(action_key(self.leaves.domain, action));
+        self.halted.push(action_key(self.domain, action));
         self.leaves.halt(node, action);
+    }
+}
+
+/// The world's leaves, with one condition answered the other way in one tick (a
+/// disturbance: a guard that stops holding while an action runs).
+struct Disturbed<'a> {
+    world: WorldLeaves<'a>,
+    tick: u64,
+    flip: Option<(u64, Condition)>,
+}
+
+impl Leaves for Disturbed<'_> {
+    fn check(&mut self, condition: &Condition) -> bool {
+        let holds = self.world.check(condition);
+        match &self.flip {
+            Some((tick, c)) if *tick == self.tick && c == condition => !holds,
+            _ => holds,
+        }
+    }
+
+    fn step(&mut self, node: NodeId, action: &ActionCall, started: bool) -> ActionStep {
+        self.world.step(node, action, started)
+    }
+
+    fn halt(&mut self, node: NodeId, action: &ActionCall) {
+        self.world.halt(node, action);
     }
 }
 
@@ -151,24 +180,40 @@ fn outcome_name(outcome: Outcome) -> &'static str {
 type Statuses = BTreeMap<String, String>;
 
 fn betr_run(s: &Scenario, tree: &Tree) -> (Json, Vec<(String, Statuses)>) {
+    let (script, expected, _) = betr_run_disturbed(s, tree, None);
+    (script, expected)
+}
+
+/// [`betr_run`] with `flip`'s condition answered the other way in its tick; also the
+/// ticker's records.
+fn betr_run_disturbed(
+    s: &Scenario,
+    tree: &Tree,
+    flip: Option<(u64, Condition)>,
+) -> (Json, Vec<(String, Statuses)>, Vec<TickRecord>) {
     let mut world = world::load(s).unwrap();
-    let mut leaves = Recording {
-        leaves: WorldLeaves {
+    let mut disturbed = Disturbed {
+        world: WorldLeaves {
             world: world.as_mut(),
             domain: &s.domain,
         },
-        answers: Vec::new(),
-        halted: Vec::new(),
+        tick: 0,
+        flip,
     };
     let mut ticker = Ticker::new();
     let mut ticks = Vec::new();
     let mut expected = Vec::new();
-    for _ in 0..RunLimits::DEFAULT.run_ticks {
+    let mut records = Vec::new();
+    for n in 1..=RunLimits::DEFAULT.run_ticks {
+        disturbed.tick = n;
+        let mut leaves = Recording {
+            leaves: &mut disturbed,
+            domain: &s.domain,
+            answers: Vec::new(),
+            halted: Vec::new(),
+        };
         let record = ticker.tick(tree, &mut leaves);
-        ticks.push(json!({
-            "leaves": std::mem::take(&mut leaves.answers),
-            "halted": std::mem::take(&mut leaves.halted),
-        }));
+        ticks.push(json!({ "leaves": leaves.answers, "halted": leaves.halted }));
         let statuses: Statuses = tree
             .preorder()
             .into_iter()
@@ -178,13 +223,17 @@ fn betr_run(s: &Scenario, tree: &Tree) -> (Json, Vec<(String, Statuses)>) {
             })
             .collect();
         expected.push((outcome_name(record.root).to_string(), statuses));
-        match record.root {
-            Outcome::Running => {}
-            Outcome::Success if !record.completed.is_empty() => {}
-            Outcome::Success | Outcome::Failure => break,
+        let end = match record.root {
+            Outcome::Running => false,
+            Outcome::Success => record.completed.is_empty(),
+            Outcome::Failure => true,
+        };
+        records.push(record);
+        if end {
+            break;
         }
     }
-    (json!({ "ticks": ticks }), expected)
+    (json!({ "ticks": ticks }), expected, records)
 }
 
 /// Runs `xml` in BT.CPP against `script`; the driver's report.
@@ -336,5 +385,53 @@ fn a_leaf_the_script_does_not_answer_is_a_problem_the_driver_reports() {
             .any(|p| p.as_str().unwrap().contains(node)
                 && p.as_str().unwrap().contains("not answered")),
         "{problems:?}"
+    );
+}
+
+#[test]
+fn a_guard_that_stops_holding_halts_the_running_action_in_btcpp_as_in_betr() {
+    let python = btcpp_python();
+    let dir = tmp("btcpp-halt");
+    let s = Scenario::load(&root().join("scenarios/cafe/cafe.toml")).unwrap();
+    let world = world::load(&s).unwrap();
+    let tree = Planner::new(&s.domain)
+        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
+        .unwrap()
+        .tree;
+    // The first tick with an action running whose sequence checks a condition before it:
+    // that condition stops holding in the next tick.
+    let (_, _, records) = betr_run_disturbed(&s, &tree, None);
+    let (tick, guard) = records
+        .iter()
+        .find_map(|r| {
+            let action = r.running_action()?;
+            let parent = tree.parent(action).ok().flatten()?;
+            if !matches!(tree.kind(parent), Ok(NodeKind::Sequence)) {
+                return None;
+            }
+            let siblings = tree.children(parent).ok()?;
+            let at = siblings.iter().position(|&c| c == action)?;
+            siblings[..at]
+                .iter()
+                .rev()
+                .find_map(|&c| match tree.kind(c) {
+                    Ok(NodeKind::Condition(c)) => Some((r.tick + 1, c.clone())),
+                    _ => None,
+                })
+        })
+        .expect("a running action guarded by a condition");
+    let (script, expected, records) = betr_run_disturbed(&s, &tree, Some((tick, guard)));
+    let halted = &records[usize::try_from(tick).unwrap() - 1].halted;
+    assert_eq!(halted.len(), 1, "betr halts the running action");
+    let xml = interop::to_btcpp(&tree, &s.domain, "Main").unwrap();
+    let report = btcpp_run(&python, &dir, "cafe-halted", &xml, &script);
+    assert_eq!(
+        compare("cafe, halted", &report, &expected, &xml),
+        expected.len()
+    );
+    let path = bt::path_text(&tree.path(halted[0]).unwrap());
+    assert_eq!(
+        report["ticks"][usize::try_from(tick).unwrap() - 1]["statuses"][&path],
+        "HALTED"
     );
 }

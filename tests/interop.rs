@@ -7,7 +7,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 mod support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use betr::bt::{self, NodeKind, Tree};
