@@ -211,3 +211,65 @@ fn a_session_killed_while_waiting_leaves_an_rrd_the_viewer_reads() {
     assert!(ok, "{said}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The recording carries the viewer's layout (the blueprint: the cell, the tree graph
+/// with its forces off, the tree's text and the log, the time panel on the session's
+/// steps), the graph's node positions, and both timelines, as the viewer's CLI reads them.
+#[test]
+fn the_recording_holds_the_blueprint_the_tree_positions_and_the_step_timeline() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd_blueprint");
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("scenario1.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let rrd_arg = rrd.to_string_lossy();
+    let out = support::repo::betr(&[
+        "repair",
+        "scenarios/cell/red_on_blue.toml",
+        "--add",
+        "~\"any object\" on \"blue cube\"",
+        "--rrd",
+        &rrd_arg,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let print = rerun_rrd(&["print".as_ref(), rrd.as_os_str()]);
+    let listing = String::from_utf8_lossy(&print.stdout);
+    for what in [
+        "Blueprint,",
+        "/viewport - data columns: [ViewportBlueprint:auto_views ViewportBlueprint:root_container]",
+        "ContainerBlueprint:col_shares",
+        "ContainerBlueprint:row_shares",
+        "TimePanelBlueprint:timeline",
+        "ForceLink:enabled",
+        "ForceManyBody:enabled",
+        "ForceCenter:enabled",
+        "/tree/graph - data columns: [GraphNodes:colors GraphNodes:labels GraphNodes:node_ids GraphNodes:positions]",
+    ] {
+        assert!(
+            listing.contains(what),
+            "{what} not in `rerun rrd print`:\n{listing}"
+        );
+    }
+    assert_eq!(
+        listing.matches("ViewBlueprint:class_identifier").count(),
+        4,
+        "four views: the cell, the tree graph, the tree's text and the log\n{listing}"
+    );
+
+    let headers = rerun_rrd(&["print".as_ref(), "-vv".as_ref(), rrd.as_os_str()]);
+    let headers = String::from_utf8_lossy(&headers.stdout);
+    assert!(headers.contains("index_name: step"), "{headers}");
+    assert!(headers.contains("index_name: tick"), "{headers}");
+    // The time panel opens on the step timeline.
+    let data = rerun_rrd(&["print".as_ref(), "-vvv".as_ref(), rrd.as_os_str()]);
+    let data = String::from_utf8_lossy(&data.stdout);
+    let time_panel = data
+        .split("Chunk(")
+        .find(|c| c.contains("/time_panel"))
+        .unwrap_or_default();
+    assert!(time_panel.contains("step"), "{time_panel}");
+}
