@@ -100,9 +100,8 @@ fn place(
         at
     } else {
         let placed: Vec<f32> = children
-            .to_vec()
-            .into_iter()
-            .map(|c| place(tree, c, cursor, x))
+            .iter()
+            .map(|&c| place(tree, c, cursor, x))
             .collect();
         let first = placed.first().copied().unwrap_or(*cursor);
         let last = placed.last().copied().unwrap_or(*cursor);
