@@ -16,29 +16,45 @@ const GRPC_PORT: u16 = 9876;
 /// How long a started `rerun` may take to listen.
 const START_TIMEOUT: Duration = Duration::from_secs(20);
 
-/// What to say when the `rerun` program is not on PATH.
-const NOT_INSTALLED: &str =
-    "the `rerun` program is not installed (`pip install rerun-sdk==0.36.*` puts it on PATH)";
+/// Why a viewer could not be started.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    #[error(
+        "no display for the native viewer (DISPLAY and WAYLAND_DISPLAY are unset); `--viewer web` serves it to a browser, `--rrd FILE` saves the recording for `rerun FILE`"
+    )]
+    NoDisplay,
+    #[error(
+        "the `rerun` program is not installed (`pip install rerun-sdk==0.36.*` puts it on PATH)"
+    )]
+    NotInstalled,
+    #[error("cannot start `{program}`: {reason}")]
+    CannotStart { program: String, reason: String },
+    #[error("`rerun --serve-web` stopped ({status}); is port {GRPC_PORT} or {WEB_PORT} taken?")]
+    Stopped { status: std::process::ExitStatus },
+    #[error(
+        "`rerun --serve-web` did not listen on ports {GRPC_PORT} and {WEB_PORT} within {seconds} s"
+    )]
+    NotListening { seconds: u64 },
+}
 
 /// The native viewer started, streaming to it at the returned URL; why not otherwise.
-pub(super) fn spawn_native() -> Result<String, String> {
+pub(super) fn spawn_native() -> Result<String, ViewerError> {
     let display = ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|d| !d.is_empty()));
     if cfg!(target_os = "linux") && !display {
-        return Err(
-            "no display for the native viewer (DISPLAY and WAYLAND_DISPLAY are unset); `--viewer web` serves it to a browser, `--rrd FILE` saves the recording for `rerun FILE`"
-                .into(),
-        );
+        return Err(ViewerError::NoDisplay);
     }
     let opts = rerun::SpawnOptions::default();
     match rerun::spawn(&opts) {
         Ok(_) => Ok(format!("rerun+http://{}/proxy", opts.connect_addr())),
-        Err(rerun::SpawnError::ExecutableNotFoundInPath { .. }) => Err(NOT_INSTALLED.into()),
+        Err(rerun::SpawnError::ExecutableNotFoundInPath { .. }) => Err(ViewerError::NotInstalled),
         Err(e) => {
             let e = e.to_string();
-            let first = e.lines().next().unwrap_or_default().trim().to_string();
-            Err(format!("cannot start `rerun`: {first}"))
+            Err(ViewerError::CannotStart {
+                program: "rerun".into(),
+                reason: e.lines().next().unwrap_or_default().trim().to_string(),
+            })
         }
     }
 }
@@ -64,7 +80,7 @@ pub fn web_page(grpc: &str) -> String {
 }
 
 /// `rerun --serve-web` started (or found listening already) and listening.
-pub(super) fn start_web() -> Result<WebViewer, String> {
+pub(super) fn start_web() -> Result<WebViewer, ViewerError> {
     let grpc = DEFAULT_URL.to_string();
     let page = format!("http://127.0.0.1:{WEB_PORT}/");
     let viewer = WebViewer {
@@ -84,23 +100,23 @@ pub(super) fn start_web() -> Result<WebViewer, String> {
         .stderr(Stdio::null())
         .spawn()
         .map_err(|e| match e.kind() {
-            ErrorKind::NotFound => NOT_INSTALLED.to_string(),
-            _ => format!("cannot start `rerun --serve-web`: {e}"),
+            ErrorKind::NotFound => ViewerError::NotInstalled,
+            _ => ViewerError::CannotStart {
+                program: "rerun --serve-web".into(),
+                reason: e.to_string(),
+            },
         })?;
     let started = Instant::now();
     while !(listening(&viewer.grpc) && listening(&page)) {
         if let Ok(Some(status)) = child.try_wait() {
-            return Err(format!(
-                "`rerun --serve-web` stopped ({status}); is port {GRPC_PORT} or {WEB_PORT} taken?"
-            ));
+            return Err(ViewerError::Stopped { status });
         }
         if started.elapsed() > START_TIMEOUT {
             let _ = child.kill();
             let _ = child.wait();
-            return Err(format!(
-                "`rerun --serve-web` did not listen on ports {GRPC_PORT} and {WEB_PORT} within {} s",
-                START_TIMEOUT.as_secs()
-            ));
+            return Err(ViewerError::NotListening {
+                seconds: START_TIMEOUT.as_secs(),
+            });
         }
         std::thread::sleep(Duration::from_millis(100));
     }
