@@ -13,7 +13,10 @@ venv="${1:-${CARGO_TARGET_DIR:-target}/btcpp-venv}"
 python="$venv/bin/python"
 check="import behaviortreepy, importlib.metadata as m; assert m.version('behaviortreepy') == '$version'"
 
-mkdir -p "$(dirname "$venv")"
+if ! mkdir -p "$(dirname "$venv")" 2>/dev/null; then
+  echo "error: cannot create the folder of $venv" >&2
+  exit 1
+fi
 exec 9>"$venv.lock"
 flock 9
 if ! "$python" -c "$check" >/dev/null 2>&1; then
