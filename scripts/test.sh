@@ -15,7 +15,9 @@ fi
 bash scripts/setup.sh --test
 
 # The 3D view's end-to-end test (tests/viz_rrd.rs) checks a recording with the viewer's
-# own CLI, pip-installed once into a virtual environment under target/.
+# own CLI, and tests/btcpp_runs.rs ticks the exported trees in BehaviorTree.CPP's Python
+# bindings (scripts/btcpp-venv.sh), each pip-installed once into a virtual environment
+# under target/.
 if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
   echo "python3-venv is missing: installing the Debian package" >&2
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi

@@ -7,7 +7,7 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 mod support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use betr::bt::{self, NodeKind, Tree};
@@ -19,7 +19,7 @@ use betr::planner::Planner;
 use betr::scenario::Scenario;
 use betr::world;
 use support::cli::{betr, text, tmp};
-use support::verify::{repaired, root};
+use support::verify::{repaired, root, scenario_files};
 
 /// The tree survives BT.CPP XML and back, node for node.
 fn assert_round_trip(tree: &Tree, scenario: &Scenario, what: &str) {
@@ -29,26 +29,6 @@ fn assert_round_trip(tree: &Tree, scenario: &Scenario, what: &str) {
         .unwrap_or_else(|e| panic!("{what}: import: {e}\n{xml}"));
     assert_eq!(bt::to_text(&back.tree), bt::to_text(tree), "{what}:\n{xml}");
     assert!(back.notes.is_empty(), "{what}: {:?}", back.notes);
-}
-
-fn scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            scenario_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "toml")
-            // Example pools, and the cell's base file, which scenarios extend.
-            && !path
-                .file_name()
-                .is_some_and(|n| n == "examples.toml" || n == "cell.toml")
-        {
-            out.push(path);
-        }
-    }
 }
 
 /// Every action with value parameters gets a value of the right kind (a number in its
@@ -86,8 +66,7 @@ fn with_values(mut tree: Tree, scenario: &Scenario) -> Tree {
 
 #[test]
 fn the_trees_of_every_scenario_round_trip_through_btcpp_xml() {
-    let mut files = Vec::new();
-    scenario_files(&root().join("scenarios"), &mut files);
+    let files = scenario_files(&root().join("scenarios"));
     let mut checked = 0;
     let mut with_value_ports = 0;
     for file in &files {

@@ -1,4 +1,4 @@
-//! `--viewer connect[=URL]|spawn`, `--rrd FILE` and `--record FILE`: where a session
+//! `--viewer connect[=URL]|spawn|web`, `--rrd FILE` and `--record FILE`: where a session
 //! streams besides the screen: the 3D view, and the session's recording.
 
 use std::path::{Path, PathBuf};
@@ -13,9 +13,11 @@ use betr::viz::{Sinks, Viewer, Viz};
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct VizFlags {
     /// Stream the cell, the tree and the events to the rerun viewer: `connect` (a running
-    /// viewer at rerun+http://127.0.0.1:9876/proxy), `connect=URL`, or `spawn` (start the
-    /// `rerun` program if it is installed).
-    #[arg(long, value_name = "connect[=URL]|spawn")]
+    /// viewer at rerun+http://127.0.0.1:9876/proxy), `connect=URL`, `spawn` (start the
+    /// `rerun` program's native viewer; needs a display), or `web` (start `rerun
+    /// --serve-web` and print the address to open in a browser). `rerun` comes with
+    /// `pip install rerun-sdk==0.36.*`.
+    #[arg(long, value_name = "connect[=URL]|spawn|web")]
     pub viewer: Option<Viewer>,
     /// Save a rerun recording of the session to FILE (.rrd).
     #[arg(long, value_name = "FILE")]
@@ -29,12 +31,16 @@ pub struct VizFlags {
 
 impl VizFlags {
     /// The viz the flags ask for; a viewer that is not there is said once on stderr
-    /// (`quiet`: not said, the caller shows `Viz::notice` itself).
+    /// (`quiet`: not said, the caller shows `Viz::notice` itself). A web viewer's address
+    /// is always printed, before any workbench takes the screen.
     pub fn open(&self, quiet: bool) -> Result<Option<Viz>> {
         let viz = Viz::open(&Sinks {
             viewer: self.viewer.clone(),
             rrd: self.rrd.clone(),
         })?;
+        if let Some(url) = viz.as_ref().and_then(Viz::web_url) {
+            errln!("3D view: open {url}");
+        }
         if !quiet && let Some(note) = viz.as_ref().and_then(Viz::notice) {
             errln!("{note}");
         }

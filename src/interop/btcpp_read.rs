@@ -10,7 +10,7 @@
 
 use roxmltree::{Document, Node};
 
-use super::{condition_id, condition_port, predicate_for_id, skills_for_id};
+use super::{condition_id, condition_ports, positional_port, predicate_for_id, skills_for_id};
 use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::action::parse_value;
 use crate::domain::{ActionCall, Atom, Condition, Domain, Value};
@@ -323,6 +323,18 @@ impl<'a, 'i> Reader<'a, 'i> {
         Ok(value)
     }
 
+    /// A condition's argument: its named port or its positional one, not both.
+    fn slot(&self, node: Node<'a, 'i>, name: &str, position: &str) -> Result<&'a str, XmlError> {
+        match (node.attribute(name), node.attribute(position)) {
+            (Some(_), Some(_)) if name != position => Err(self.error(
+                node,
+                &format!("ports {name} and {position} name the same argument; write one"),
+            )),
+            (None, Some(_)) => self.port(node, position),
+            (_, None) | (Some(_), Some(_)) => self.port(node, name),
+        }
+    }
+
     /// A condition or an action: `id` names a predicate or a skill of the scenario.
     fn leaf(
         &self,
@@ -340,11 +352,14 @@ impl<'a, 'i> Reader<'a, 'i> {
             skills.is_empty() || declared == Some("Condition"),
         ) {
             (Some(p), _) => {
-                let ports: Vec<String> = (0..p.arg_types.len()).map(condition_port).collect();
-                self.no_ports(node, &ports)?;
-                let args = ports
+                let named = condition_ports(p);
+                let positional: Vec<String> = (0..p.arg_types.len()).map(positional_port).collect();
+                let accepted: Vec<String> = named.iter().chain(&positional).cloned().collect();
+                self.no_ports(node, &accepted)?;
+                let args = named
                     .iter()
-                    .map(|port| self.port(node, port).map(str::to_string))
+                    .zip(&positional)
+                    .map(|(name, position)| self.slot(node, name, position).map(str::to_string))
                     .collect::<Result<Vec<_>, _>>()?;
                 let condition = Condition::pos(Atom::new(p.name.clone(), args));
                 self.domain

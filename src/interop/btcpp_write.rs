@@ -1,11 +1,13 @@
-//! Writing a tree as BehaviorTree.CPP v4 XML, with a `<TreeNodesModel>` that declares
-//! every condition and action of the scenario and their ports, so Groot2 opens the file
-//! without the robot's plugins.
+//! Writing a tree as BehaviorTree.CPP v4 XML, leaves in the compact form (`<grasp x=…/>`,
+//! which BT.CPP 4.x loads once the node types are registered; its parser refuses an
+//! `<Action>` element), with a `<TreeNodesModel>` that declares every condition and action
+//! of the scenario and their ports, so Groot2 opens the file without the robot's plugins
+//! and a robot's code knows what to register.
 
 use quick_xml::Writer;
 use quick_xml::events::{BytesDecl, BytesText, Event};
 
-use super::{condition_id, condition_port, slot_types};
+use super::{condition_id, condition_ports, slot_types};
 use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::{Domain, Value};
 
@@ -14,6 +16,8 @@ use crate::domain::{Domain, Value};
 pub enum ExportError {
     #[error("{action}! names no skill of the scenario that accepts its objects")]
     UnknownSkill { action: String },
+    #[error("{condition}? names no predicate of the scenario")]
+    UnknownPredicate { condition: String },
     #[error(
         "the predicates {first:?} and {second:?} would both be the node ID {id:?}; BT.CPP needs one ID per node type"
     )]
@@ -28,10 +32,9 @@ pub enum ExportError {
 
 type Out = Writer<Vec<u8>>;
 
-/// An element to write: its tag, its `ID` (leaves), its ports and its children.
+/// An element to write: its tag (a leaf's node ID), its ports and its children.
 struct Element {
-    tag: &'static str,
-    id: Option<String>,
+    tag: String,
     ports: Vec<(String, String)>,
     children: Vec<Element>,
 }
@@ -78,9 +81,8 @@ impl From<std::io::Error> for ExportError {
 
 fn element(tree: &Tree, domain: &Domain, id: NodeId) -> Result<Element, ExportError> {
     let kind = tree.kind(id).map_err(|e| ExportError::Xml(e.to_string()))?;
-    let leaf = |tag, id: &str, ports| Element {
-        tag,
-        id: Some(id.to_string()),
+    let leaf = |id: &str, ports| Element {
+        tag: id.to_string(),
         ports,
         children: Vec::new(),
     };
@@ -90,8 +92,8 @@ fn element(tree: &Tree, domain: &Domain, id: NodeId) -> Result<Element, ExportEr
                 "ReactiveSequence"
             } else {
                 "ReactiveFallback"
-            },
-            id: None,
+            }
+            .to_string(),
             ports: Vec::new(),
             children: tree
                 .children(id)
@@ -101,18 +103,23 @@ fn element(tree: &Tree, domain: &Domain, id: NodeId) -> Result<Element, ExportEr
                 .collect::<Result<_, _>>()?,
         },
         NodeKind::Condition(c) => {
-            let ports = c
-                .atom
-                .args
+            let predicate = domain
+                .vocabulary
+                .predicates
                 .iter()
-                .enumerate()
-                .map(|(i, a)| (condition_port(i), a.clone()))
+                .find(|p| p.name == c.atom.predicate)
+                .ok_or_else(|| ExportError::UnknownPredicate {
+                    condition: c.to_string(),
+                })?;
+            let ports = condition_ports(predicate)
+                .into_iter()
+                .zip(&c.atom.args)
+                .map(|(port, a)| (port, a.clone()))
                 .collect();
-            let condition = leaf("Condition", &condition_id(domain, &c.atom.predicate), ports);
+            let condition = leaf(&condition_id(domain, &c.atom.predicate), ports);
             if c.negated {
                 Element {
-                    tag: "Inverter",
-                    id: None,
+                    tag: "Inverter".to_string(),
                     ports: Vec::new(),
                     children: vec![condition],
                 }
@@ -133,15 +140,14 @@ fn element(tree: &Tree, domain: &Domain, id: NodeId) -> Result<Element, ExportEr
                 .map(|(p, arg)| (p.name.clone(), arg.clone()))
                 .collect();
             ports.extend(a.values.iter().map(|(n, v)| (n.clone(), value_text(v))));
-            leaf("Action", &a.skill, ports)
+            leaf(&a.skill, ports)
         }
     })
 }
 
 fn write_element(w: &mut Out, e: &Element) -> std::io::Result<()> {
     let start = w
-        .create_element(e.tag)
-        .with_attributes(e.id.iter().map(|id| ("ID", id.as_str())))
+        .create_element(e.tag.as_str())
         .with_attributes(e.ports.iter().map(|(k, v)| (k.as_str(), v.as_str())));
     if e.children.is_empty() {
         start.write_empty()?;
@@ -169,16 +175,10 @@ fn value_text(value: &Value) -> String {
 /// parameter names.
 fn write_model(w: &mut Out, domain: &Domain) -> std::io::Result<()> {
     for p in &domain.vocabulary.predicates {
-        let ports: Vec<(String, String)> = p
-            .arg_types
-            .iter()
-            .enumerate()
-            .map(|(i, types)| {
-                (
-                    condition_port(i),
-                    format!("{}, or any object", slot_types(types)),
-                )
-            })
+        let ports: Vec<(String, String)> = condition_ports(p)
+            .into_iter()
+            .zip(&p.arg_types)
+            .map(|(port, types)| (port, format!("{}, or any object", slot_types(types))))
             .collect();
         model_entry(w, "Condition", &condition_id(domain, &p.name), &ports)?;
     }

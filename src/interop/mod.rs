@@ -8,14 +8,18 @@
 //! |---|---|
 //! | `sequence` | `<ReactiveSequence>` (a memory `<Sequence>` is read when memory changes nothing) |
 //! | `fallback` | `<ReactiveFallback>` (likewise `<Fallback>`) |
-//! | `"blue cube" on "green cube"?` | `<Condition ID="on" arg1="blue cube" arg2="green cube"/>` |
-//! | `~On_Coffee_Table1?` | `<Inverter><Condition ID="On" arg1="Coffee" arg2="Table1"/></Inverter>` |
-//! | `grasp "egg" {force = 5 N}!` | `<Action ID="grasp" x="egg" force="5 N"/>` |
+//! | `"blue cube" on "green cube"?` | `<on item="blue cube" item_or_fixture="green cube"/>` |
+//! | `~On_Coffee_Table1?` | `<Inverter><On item="Coffee" place="Table1"/></Inverter>` |
+//! | `grasp "egg" {force = 5 N}!` | `<grasp x="egg" force="5 N"/>` |
 //!
-//! A condition's ID is its predicate with `_` for spaces (`near robot` → `near_robot`),
-//! prefixed with `is_` when a skill has the same name (`open` → `is_open`), and its ports
-//! are its arguments by position; an action's ID is its skill and its ports are
-//! the skill's parameter names, then its value parameters.
+//! Leaves are written in BT.CPP's compact form (the node ID as the element's name), which
+//! every 4.x release loads; the explicit `<Condition ID=…>` and `<Action ID=…>` are read
+//! too. A condition's ID is its predicate with `_` for spaces (`near robot` →
+//! `near_robot`), prefixed with `is_` when a skill has the same name (`open` → `is_open`),
+//! and its ports are named after its argument slots' types (`item`, `item_or_fixture`; a
+//! repeated name numbered, `item_2`); the positional `arg1`, `arg2` are read as well. An
+//! action's ID is its skill and its ports are the skill's parameter names, then its value
+//! parameters.
 
 mod btcpp_read;
 mod btcpp_write;
@@ -48,8 +52,38 @@ pub fn condition_id(domain: &Domain, predicate: &str) -> String {
     id
 }
 
-/// The port holding argument `index` (0-based) of a condition.
-pub fn condition_port(index: usize) -> String {
+/// The ports of a predicate's condition, one per argument slot, named after the slot's
+/// types (`item|fixture` → `item_or_fixture`), a name already taken numbered (`item_2`).
+/// A name BT.CPP would refuse as a port (`name`, `ID`, not starting with a letter) is
+/// the positional one instead.
+pub fn condition_ports(predicate: &Predicate) -> Vec<String> {
+    let mut ports: Vec<String> = Vec::new();
+    for (index, types) in predicate.arg_types.iter().enumerate() {
+        let base: String = types
+            .join("_or_")
+            .chars()
+            .map(|c| if c.is_alphanumeric() { c } else { '_' })
+            .collect();
+        let allowed =
+            base.starts_with(|c: char| c.is_ascii_alphabetic()) && base != "name" && base != "ID";
+        let mut name = if allowed {
+            base.clone()
+        } else {
+            positional_port(index)
+        };
+        let mut n = 2;
+        while ports.contains(&name) {
+            name = format!("{base}_{n}");
+            n += 1;
+        }
+        ports.push(name);
+    }
+    ports
+}
+
+/// The positional port of argument `index` (0-based) of a condition: `arg1`, `arg2`;
+/// read besides the named ones, for files written by hand.
+pub fn positional_port(index: usize) -> String {
     format!("arg{}", index + 1)
 }
 

@@ -109,7 +109,13 @@ fn structure_errors_are_located() {
         "{e}"
     );
     let e = import(r#"<Condition ID="grasped"/>"#, &s).unwrap_err();
-    assert!(e.reason.contains("port arg1 is missing"), "{e}");
+    assert!(e.reason.contains("port item is missing"), "{e}");
+    let e = import(r#"<grasped item="red cube" arg1="blue cube"/>"#, &s).unwrap_err();
+    assert!(
+        e.reason
+            .contains("ports item and arg1 name the same argument"),
+        "{e}"
+    );
     let e = import(r#"<Condition ID="grasped" arg1="moon"/>"#, &s).unwrap_err();
     assert!(e.reason.contains("unknown object \"moon\""), "{e}");
     let e = from_btcpp(
@@ -136,5 +142,76 @@ fn a_tree_file_is_told_apart_by_name_or_first_character() {
     assert_eq!(
         TreeFormat::of(Path::new("t.bt"), "# betr policy\n"),
         TreeFormat::Text
+    );
+}
+
+#[test]
+fn condition_ports_are_named_after_their_slots_and_read_by_name_or_position() {
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let on = s
+        .domain
+        .vocabulary
+        .predicates
+        .iter()
+        .find(|p| p.name == "on")
+        .expect("on");
+    assert_eq!(condition_ports(on), ["item", "item_or_fixture"]);
+    let twin = crate::domain::vocabulary::Predicate {
+        name: "beside".into(),
+        arg_types: vec![
+            vec!["item".into()],
+            vec!["item".into()],
+            vec!["name".into()],
+        ],
+        description: String::new(),
+        words: Default::default(),
+    };
+    assert_eq!(condition_ports(&twin), ["item", "item_2", "arg3"]);
+
+    let expected = "\"blue cube\" on \"green cube\"?\n";
+    for xml in [
+        r#"<on item="blue cube" item_or_fixture="green cube"/>"#,
+        r#"<on arg1="blue cube" arg2="green cube"/>"#,
+        r#"<Condition ID="on" item_or_fixture="green cube" item="blue cube"/>"#,
+        r#"<Condition ID="on" arg1="blue cube" item_or_fixture="green cube"/>"#,
+    ] {
+        let read = import(xml, &s).unwrap_or_else(|e| panic!("{xml}: {e}"));
+        assert_eq!(bt::to_text(&read.tree), expected, "{xml}");
+    }
+    for xml in [
+        r#"<grasp x="blue cube"/>"#,
+        r#"<Action ID="grasp" x="blue cube"/>"#,
+    ] {
+        let read = import(xml, &s).unwrap_or_else(|e| panic!("{xml}: {e}"));
+        assert_eq!(bt::to_text(&read.tree), "grasp \"blue cube\"!\n", "{xml}");
+    }
+}
+
+#[test]
+fn the_export_writes_compact_leaves_with_named_ports() {
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let read = import(
+        r#"<ReactiveSequence><Inverter><grasped arg1="any object"/></Inverter><grasp x="blue cube"/></ReactiveSequence>"#,
+        &s,
+    )
+    .expect("tree");
+    let xml = to_btcpp(&read.tree, &s.domain, "Main").expect("export");
+    assert!(
+        xml.contains(
+            r#"<Inverter>
+        <grasped item="any object"/>
+      </Inverter>
+      <grasp x="blue cube"/>"#
+        ),
+        "{xml}"
+    );
+    assert!(!xml.contains("<Action ID=\"grasp\" x="), "{xml}");
+    assert!(!xml.contains("<Condition ID=\"grasped\" arg"), "{xml}");
+    assert!(
+        xml.contains(
+            r#"<Condition ID="grasped">
+      <input_port name="item" type="std::string">item, or any object</input_port>"#
+        ),
+        "{xml}"
     );
 }

@@ -1,19 +1,23 @@
 //! The 3D view: streams the simulated cell, the behavior tree and the session's events to
-//! the rerun viewer (gRPC to a running viewer, a viewer it starts, an `.rrd` file, or
-//! several at once).
+//! the rerun viewer (gRPC to a running viewer, a native or web viewer it starts, an `.rrd`
+//! file, or several at once), with a default layout (`blueprint.rs`).
 //!
 //! A front-end module: it reads `bt` trees and tick records, the cell's
 //! [`SceneSnapshot`](crate::world::cell::snapshot::SceneSnapshot) and session
-//! [`Event`]s; nothing below the front ends knows it exists. On the `tick` timeline each
-//! tick logs the tree's statuses and the scene after that tick. The timeline counts every
-//! tick logged (a run after a repair continues it), so a recording shows the whole
-//! session in order. Logging never stops a session: a failed log call is traced and
+//! [`Event`]s; nothing below the front ends knows it exists. Two timelines: `step` orders
+//! the whole session, one step per tick and one for each moment of the resolve loop (the
+//! failure, the question to the model, the proposal, the approval and repair, a new
+//! tree), so each has its own frame; `tick` is the tick number the workbench shows (a run
+//! after a repair starts again at 1). Each tick logs the tree's statuses and the scene
+//! after that tick. Logging never stops a session: a failed log call is traced and
 //! ignored, and a viewer that is not listening is reported once in [`Viz::notice`].
 
+pub mod blueprint;
 pub mod scene;
 #[cfg(test)]
 mod tests;
 pub mod tree;
+mod viewer;
 
 use std::net::{TcpStream, ToSocketAddrs};
 use std::path::PathBuf;
@@ -30,8 +34,10 @@ use crate::world::{CellWorld, World};
 
 /// The application id recordings are made under.
 pub const APP_ID: &str = "betr";
-/// The timeline every tick is logged on.
+/// The timeline of the workbench's tick numbers.
 pub const TIMELINE: &str = "tick";
+/// The timeline of the session's steps: every tick and every moment of the resolve loop.
+pub const STEPS: &str = "step";
 /// Entity path of the event log.
 pub const EVENTS: &str = "events";
 /// What the session says when no viewer listens.
@@ -44,8 +50,11 @@ pub const DEFAULT_URL: &str = "rerun+http://127.0.0.1:9876/proxy";
 pub enum Viewer {
     /// A running viewer at this URL (none: the default).
     Connect(Option<String>),
-    /// Start the `rerun` program, then stream to it.
+    /// Start the `rerun` program's native viewer, then stream to it.
     Spawn,
+    /// Start the `rerun` program as a web viewer (`rerun --serve-web`), stream to it, and
+    /// say the address to open in a browser.
+    Web,
 }
 
 impl std::str::FromStr for Viewer {
@@ -54,6 +63,7 @@ impl std::str::FromStr for Viewer {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.split_once('=') {
             None if s == "spawn" => Ok(Viewer::Spawn),
+            None if s == "web" => Ok(Viewer::Web),
             None if s == "connect" => Ok(Viewer::Connect(None)),
             Some(("connect", url)) if !url.is_empty() => Ok(Viewer::Connect(Some(url.into()))),
             _ => Err(VizError::BadViewer(s.to_string())),
@@ -76,7 +86,7 @@ impl Sinks {
 
 #[derive(Debug, thiserror::Error)]
 pub enum VizError {
-    #[error("--viewer {0:?}: expected `connect`, `connect=URL` or `spawn`")]
+    #[error("--viewer {0:?}: expected `connect`, `connect=URL`, `spawn` or `web`")]
     BadViewer(String),
     #[error("cannot write the recording {path}: {message}")]
     Rrd { path: PathBuf, message: String },
@@ -108,8 +118,15 @@ const FLUSH_TIMEOUT: Duration = Duration::from_secs(2);
 pub struct Viz {
     rec: RecordingStream,
     tree: Option<Arc<Tree>>,
+    /// The session's step (the `step` timeline).
     step: i64,
+    /// Ticks logged so far.
+    ticks: i64,
+    /// An approval opened the current step: the repair and its new tree join it.
+    repairing: bool,
     notice: Option<String>,
+    /// What to open in a browser, when a web viewer was asked for.
+    web_url: Option<String>,
     /// An `.rrd` file is written: flushed whenever the session comes to rest, so a
     /// session killed while it waits (for the model, for a person) leaves a file that
     /// holds everything up to there.
@@ -145,20 +162,26 @@ impl Viz {
             })?;
             out.push(Box::new(sink));
         }
+        let mut web_url = None;
         let url = match &sinks.viewer {
             Some(Viewer::Connect(url)) => Some(url.clone().unwrap_or_else(|| DEFAULT_URL.into())),
-            Some(Viewer::Spawn) => {
-                let opts = rerun::SpawnOptions::default();
-                match rerun::spawn(&opts) {
-                    Ok(_) => Some(format!("rerun+http://{}/proxy", opts.connect_addr())),
-                    Err(e) => {
-                        let e = e.to_string();
-                        let first = e.lines().next().unwrap_or_default().trim();
-                        notice = Some(format!("{NOT_CONNECTED} (cannot start `rerun`: {first})"));
-                        None
-                    }
+            Some(Viewer::Spawn) => match viewer::spawn_native() {
+                Ok(url) => Some(url),
+                Err(why) => {
+                    notice = Some(format!("{NOT_CONNECTED}: {why}"));
+                    None
                 }
-            }
+            },
+            Some(Viewer::Web) => match viewer::start_web() {
+                Ok(web) => {
+                    web_url = Some(web.open);
+                    Some(web.grpc)
+                }
+                Err(why) => {
+                    notice = Some(format!("{NOT_CONNECTED}: {why}"));
+                    None
+                }
+            },
             None => None,
         };
         if let Some(url) = url {
@@ -168,7 +191,8 @@ impl Viz {
                 Err(e) => notice = Some(format!("{NOT_CONNECTED} ({url}: {e})")),
             }
         }
-        let builder = RecordingStreamBuilder::new(APP_ID);
+        let builder =
+            RecordingStreamBuilder::new(APP_ID).with_blueprint(blueprint::default_blueprint());
         let rec = if out.is_empty() {
             RecordingStream::disabled()
         } else {
@@ -176,6 +200,7 @@ impl Viz {
         };
         let mut viz = Viz::with_stream(rec);
         viz.notice = notice;
+        viz.web_url = web_url;
         viz.file = sinks.rrd.is_some();
         Ok(Some(viz))
     }
@@ -183,14 +208,36 @@ impl Viz {
     /// A viz over a stream made elsewhere (tests use an in-memory one).
     pub fn with_stream(rec: RecordingStream) -> Viz {
         if rec.is_enabled() {
+            rec.set_time_sequence(STEPS, 0);
             rec.set_time_sequence(TIMELINE, 0);
         }
         Viz {
             rec,
             tree: None,
             step: 0,
+            ticks: 0,
+            repairing: false,
             notice: None,
+            web_url: None,
             file: false,
+        }
+    }
+
+    /// The address to open in a browser, when a web viewer was asked for and is there.
+    pub fn web_url(&self) -> Option<&str> {
+        self.web_url.as_deref()
+    }
+
+    /// Steps on the `step` timeline so far.
+    pub fn steps(&self) -> i64 {
+        self.step
+    }
+
+    /// The next step of the session.
+    fn next_step(&mut self) {
+        self.step += 1;
+        if self.rec.is_enabled() {
+            self.rec.set_time_sequence(STEPS, self.step);
         }
     }
 
@@ -201,7 +248,7 @@ impl Viz {
 
     /// Ticks logged so far.
     pub fn ticks(&self) -> i64 {
-        self.step
+        self.ticks
     }
 
     pub fn stream(&self) -> &RecordingStream {
@@ -223,14 +270,16 @@ impl Viz {
         self.tree = Some(tree);
     }
 
-    /// One tick: the next step on the timeline, the tree's statuses, and the scene after
-    /// it (when the world is a cell).
+    /// One tick: the next step, at the tick's own number, with the tree's statuses and
+    /// the scene after it (when the world is a cell).
     pub fn tick(&mut self, record: &TickRecord, scene: Option<&SceneSnapshot>) {
-        self.step += 1;
+        self.ticks += 1;
+        self.next_step();
         if !self.rec.is_enabled() {
             return;
         }
-        self.rec.set_time_sequence(TIMELINE, self.step);
+        self.rec
+            .set_time_sequence(TIMELINE, i64::try_from(record.tick).unwrap_or(i64::MAX));
         if let Some(tree) = &self.tree {
             Self::warn(tree::log_tree(&self.rec, tree, Some(record), false));
         }
@@ -265,9 +314,33 @@ impl Viz {
         self.log(rerun::TextLogLevel::INFO, format!("instruction: {text}"));
     }
 
+    /// Whether `event` opens a step of its own: the failure, the question, the proposal,
+    /// the approval (or rejection) with the repair it makes, and a tree that comes from
+    /// anything else (a plan, an undo, a load).
+    fn opens_step(&mut self, event: &Event) -> bool {
+        let opens = match event {
+            Event::ActionFailed { .. }
+            | Event::Asking { .. }
+            | Event::Proposal { .. }
+            | Event::Approved
+            | Event::Rejected => true,
+            Event::TreeChanged { .. } => !self.repairing,
+            _ => false,
+        };
+        self.repairing = match event {
+            Event::Approved => true,
+            Event::TreeChanged { .. } | Event::Ticked { .. } | Event::Rejected => false,
+            _ => self.repairing,
+        };
+        opens
+    }
+
     /// Follow a session: its tree, ticks, scenes and the steps of the resolve loop.
     pub fn on_event(&mut self, event: &Event) {
         use rerun::TextLogLevel as L;
+        if self.opens_step(event) {
+            self.next_step();
+        }
         match event {
             Event::TreeChanged { tree, why, .. } => {
                 self.set_tree(tree.clone());

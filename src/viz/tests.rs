@@ -24,12 +24,13 @@ fn scenario1() -> Scenario {
     Scenario::load(&path).unwrap()
 }
 
-/// Every entity path logged, with its component identifiers and the `tick` values it
-/// was logged at.
+/// Every entity path logged, with its component identifiers and the `tick` and `step`
+/// values it was logged at.
 #[derive(Default)]
 struct Logged {
     components: BTreeMap<String, BTreeSet<String>>,
     ticks: BTreeMap<String, BTreeSet<i64>>,
+    steps: BTreeMap<String, BTreeSet<i64>>,
 }
 
 fn decode(msgs: Vec<LogMsg>) -> Logged {
@@ -47,6 +48,12 @@ fn decode(msgs: Vec<LogMsg>) -> Logged {
         }
         if let Some(column) = chunk.timelines().get(&TIMELINE.into()) {
             out.ticks
+                .entry(path.clone())
+                .or_default()
+                .extend(column.times_raw().iter().copied());
+        }
+        if let Some(column) = chunk.timelines().get(&STEPS.into()) {
+            out.steps
                 .entry(path)
                 .or_default()
                 .extend(column.times_raw().iter().copied());
@@ -125,11 +132,12 @@ fn scenario1_before_and_after_repair_streams_scene_tree_and_ticks() {
     assert!(has(EVENTS, "TextLog:text"));
     assert!(has(EVENTS, "TextLog:level"));
 
-    // One step per tick on the timeline, before and after the repair, for the tree's
-    // statuses and for the scene (step 0 holds the scene before the first tick).
+    // One step per tick, before and after the repair, for the tree's statuses and for
+    // the scene (step 0 holds the scene before the first tick); on the `tick` timeline
+    // each run counts its ticks from 1, as the workbench does.
     let steps = |path: &str| {
         logged
-            .ticks
+            .steps
             .get(path)
             .map(|t| t.iter().filter(|t| **t > 0).count())
             .unwrap_or_default()
@@ -138,8 +146,11 @@ fn scenario1_before_and_after_repair_streams_scene_tree_and_ticks() {
     assert_eq!(steps(tree::TREE_TEXT), total);
     assert_eq!(steps("world/solids/blue_cube"), total);
     assert_eq!(steps(scene::ROBOT_ARMS), total);
-    let last = logged.ticks[tree::TREE_TEXT].iter().max().copied();
-    assert_eq!(last, Some(total as i64));
+    assert_eq!(viz.steps(), total as i64);
+    let ticks: Vec<i64> = logged.ticks[tree::TREE_TEXT].iter().copied().collect();
+    let longest = before.ticks.max(after.ticks) as i64;
+    assert_eq!(ticks, (0..=longest).collect::<Vec<_>>());
+    assert!(has(tree::TREE_GRAPH, "GraphNodes:positions"));
 }
 
 fn snapshot_segments() -> usize {
@@ -179,6 +190,8 @@ fn session_events_stream_the_tree_ticks_and_the_log() {
     viz.on_event(&Event::Approved);
     viz.stream().flush_blocking().unwrap();
     assert_eq!(viz.ticks(), 3);
+    // The plan's tree, three ticks and the approval: a step each.
+    assert_eq!(viz.steps(), 5);
     let logged = decode(storage.take());
     assert_eq!(
         logged.ticks[tree::TREE_TEXT].len(),
@@ -206,6 +219,11 @@ fn colours_come_from_the_names_and_shapes_from_the_parts() {
 #[test]
 fn viewer_flags_parse() {
     assert_eq!("spawn".parse::<Viewer>().unwrap(), Viewer::Spawn);
+    assert_eq!("web".parse::<Viewer>().unwrap(), Viewer::Web);
+    assert_eq!(
+        viewer::web_page(DEFAULT_URL),
+        "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
+    );
     assert_eq!("connect".parse::<Viewer>().unwrap(), Viewer::Connect(None));
     assert_eq!(
         "connect=rerun+http://127.0.0.1:9999/proxy"
@@ -234,4 +252,136 @@ fn a_viewer_that_is_not_there_is_said_once_and_the_session_goes_on() {
     assert!(viz.notice().unwrap().starts_with(NOT_CONNECTED));
     let mut viz = viz;
     viz.log(rerun::TextLogLevel::INFO, "still works");
+}
+
+/// The failure, the question, the proposal and the approval with its repair each take a
+/// step of their own after the failing tick, so the failing tick's frame stays visible.
+#[test]
+fn the_resolve_loop_takes_its_own_steps_after_the_failing_tick() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let plan = Planner::new(&scenario.domain)
+        .plan(&scenario.goal.clone().unwrap().to_dnf(), world.as_ref())
+        .unwrap();
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    let mut viz = Viz::with_stream(rec);
+    let tree = Arc::new(plan.tree);
+    let changed = |tree: &Arc<Tree>, why: &str| Event::TreeChanged {
+        tree: tree.clone(),
+        new_nodes: Vec::new(),
+        learned: Vec::new(),
+        why: why.into(),
+    };
+    viz.on_event(&changed(&tree, "planned"));
+    let mut exec = world.fork();
+    let mut ticker = crate::bt::Ticker::new();
+    let mut leaves = crate::planner::WorldLeaves {
+        world: exec.as_mut(),
+        domain: &scenario.domain,
+    };
+    let record = Arc::new(ticker.tick(&tree, &mut leaves));
+    assert!(
+        !record.failures.is_empty(),
+        "scenario 1 fails at its first tick"
+    );
+    viz.on_event(&Event::Ticked {
+        record: record.clone(),
+    });
+    assert_eq!(viz.steps(), 2);
+    let failing = viz.steps();
+    viz.on_event(&Event::ActionFailed {
+        node: record.failures[0].0,
+        node_path: "1.0.1.1".into(),
+        action: crate::domain::ActionCall::new("grasp", ["blue cube"]),
+        error: record.failures[0].1.clone(),
+    });
+    viz.on_event(&Event::Asking {
+        what: "a missing precondition".into(),
+    });
+    viz.on_event(&Event::Approved);
+    viz.on_event(&Event::Repaired {
+        added_nodes: 9,
+        valued_nodes: 0,
+    });
+    viz.on_event(&changed(&tree, "repaired"));
+    // failure, question, approval (with the repair and its tree): three more steps.
+    assert_eq!(viz.steps(), failing + 3);
+    viz.stream().flush_blocking().unwrap();
+    let logged = decode(storage.take());
+    // The failing tick's statuses stay at their step; the repaired tree is logged later.
+    let tree_steps = &logged.steps[tree::TREE_TEXT];
+    assert!(tree_steps.contains(&failing), "{tree_steps:?}");
+    assert!(tree_steps.contains(&(failing + 3)), "{tree_steps:?}");
+    assert!(!tree_steps.contains(&(failing + 1)), "{tree_steps:?}");
+    let event_steps = &logged.steps[EVENTS];
+    for step in failing..=failing + 3 {
+        assert!(event_steps.contains(&step), "{step}: {event_steps:?}");
+    }
+}
+
+#[test]
+fn the_tidy_layout_puts_parents_over_their_children_and_leaves_apart() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let tree = Planner::new(&scenario.domain)
+        .plan(&scenario.goal.clone().unwrap().to_dnf(), world.as_ref())
+        .unwrap()
+        .tree;
+    let order = tree.preorder();
+    let positions = tree::tidy_positions(&tree, &order);
+    let at = |id| positions[order.iter().position(|n| *n == id).unwrap()];
+    for &id in &order {
+        let children = tree.children(id).unwrap();
+        let (x, y) = at(id);
+        for &c in children {
+            assert!(at(c).1 > y, "a child lies below its parent");
+        }
+        if let (Some(&first), Some(&last)) = (children.first(), children.last()) {
+            assert!((x - (at(first).0 + at(last).0) / 2.0).abs() < 1e-3);
+        }
+    }
+    let mut leaves: Vec<f32> = order
+        .iter()
+        .filter(|n| tree.children(**n).unwrap().is_empty())
+        .map(|n| at(*n).0)
+        .collect();
+    let unsorted = leaves.clone();
+    leaves.sort_by(f32::total_cmp);
+    assert_eq!(leaves, unsorted, "leaves left to right in tree order");
+    assert!(leaves.windows(2).all(|w| w[1] - w[0] >= 90.0));
+}
+
+#[test]
+fn the_viewer_marks_are_ones_its_fonts_have() {
+    assert_eq!(tree::VIEWER_GLYPHS.failure, "×");
+    assert!(
+        [
+            tree::VIEWER_GLYPHS.idle,
+            tree::VIEWER_GLYPHS.running,
+            tree::VIEWER_GLYPHS.success,
+            tree::VIEWER_GLYPHS.failure,
+            tree::VIEWER_GLYPHS.halted,
+        ]
+        .iter()
+        .all(|g| !g.contains('✕'))
+    );
+}
+
+#[test]
+fn spawning_without_a_display_says_so() {
+    if std::env::var_os("DISPLAY").is_some() || std::env::var_os("WAYLAND_DISPLAY").is_some() {
+        return;
+    }
+    let viz = Viz::open(&Sinks {
+        viewer: Some(Viewer::Spawn),
+        rrd: None,
+    })
+    .unwrap()
+    .unwrap();
+    let notice = viz.notice().unwrap();
+    assert!(
+        notice.contains("no display for the native viewer"),
+        "{notice}"
+    );
+    assert!(notice.contains("--viewer web"), "{notice}");
 }

@@ -1,12 +1,32 @@
-//! Logging the behavior tree: a graph whose node colours follow the tick's statuses, and
-//! the same tree as a text document (`bt::render`).
+//! Logging the behavior tree: a graph laid out as a tidy tree (node positions logged, so
+//! the viewer does not push the nodes around), its colours and status marks following the
+//! tick's statuses, and the same tree as a text document (`bt::render`).
 
-use rerun::{Color, GraphEdges, GraphNodes, RecordingStream, RecordingStreamResult, TextDocument};
+use rerun::{
+    Color, GraphEdges, GraphNodes, Position2D, RecordingStream, RecordingStreamResult, TextDocument,
+};
 
-use crate::bt::{self, NodeKind, Status, TickRecord, Tree};
+use crate::bt::{self, Glyphs, NodeId, NodeKind, Status, TickRecord, Tree};
 
 pub const TREE_GRAPH: &str = "tree/graph";
 pub const TREE_TEXT: &str = "tree/text";
+
+/// The marks the viewer's fonts have: `bt::UNICODE` but for failure (`✕` is missing from
+/// them and shows as an empty box; the multiplication sign `×` is in every text font) and
+/// halted (`=`, as in ASCII).
+pub const VIEWER_GLYPHS: Glyphs = Glyphs {
+    failure: "×",
+    halted: "=",
+    ..bt::UNICODE
+};
+
+/// Vertical distance between the levels of the graph, in the graph view's units.
+const LEVEL: f32 = 90.0;
+/// Horizontal room a leaf takes: its label's characters at this width each, with a gap,
+/// and never less than `MIN_SLOT`.
+const CHAR_WIDTH: f32 = 7.5;
+const GAP: f32 = 30.0;
+const MIN_SLOT: f32 = 90.0;
 
 /// The colour of a node that showed `status`.
 pub fn status_colour(status: Status) -> [u8; 3] {
@@ -28,8 +48,71 @@ fn label(kind: &NodeKind) -> String {
     }
 }
 
-/// Log the nodes (with colours from `record`, grey without) and, when `edges` is true,
-/// the edges, plus the text rendering.
+/// A node's label in the graph: its status mark first once the tick reached it.
+fn graph_label(kind: &NodeKind, status: Status) -> String {
+    match status {
+        Status::Idle => label(kind),
+        shown => format!("{} {}", VIEWER_GLYPHS.status(shown), label(kind)),
+    }
+}
+
+/// Positions of the nodes of `order` (the tree's preorder) as a tidy tree: each leaf in
+/// its own slot, left to right, as wide as its label; each parent centred over its first
+/// and last child; one level per depth, the root on top (the graph view's y grows
+/// downwards).
+pub fn tidy_positions(tree: &Tree, order: &[NodeId]) -> Vec<(f32, f32)> {
+    let mut x = std::collections::HashMap::new();
+    let mut cursor = 0.0_f32;
+    place(tree, tree.root(), &mut cursor, &mut x);
+    let depth = |id: NodeId| {
+        let mut d = 0;
+        let mut at = id;
+        while let Ok(Some(parent)) = tree.parent(at) {
+            d += 1;
+            at = parent;
+        }
+        d
+    };
+    order
+        .iter()
+        .map(|&id| {
+            (
+                x.get(&id).copied().unwrap_or_default(),
+                depth(id) as f32 * LEVEL,
+            )
+        })
+        .collect()
+}
+
+/// Places `id`'s subtree from `cursor` on, returning `id`'s x.
+fn place(
+    tree: &Tree,
+    id: NodeId,
+    cursor: &mut f32,
+    x: &mut std::collections::HashMap<NodeId, f32>,
+) -> f32 {
+    let children = tree.children(id).unwrap_or_default();
+    let at = if children.is_empty() {
+        let chars = tree.kind(id).map(|k| label(k).chars().count() + 2);
+        let width = (chars.unwrap_or_default() as f32 * CHAR_WIDTH + GAP).max(MIN_SLOT);
+        let at = *cursor + width / 2.0;
+        *cursor += width;
+        at
+    } else {
+        let placed: Vec<f32> = children
+            .iter()
+            .map(|&c| place(tree, c, cursor, x))
+            .collect();
+        let first = placed.first().copied().unwrap_or(*cursor);
+        let last = placed.last().copied().unwrap_or(*cursor);
+        (first + last) / 2.0
+    };
+    x.insert(id, at);
+    at
+}
+
+/// Log the nodes (with colours and marks from `record`, grey without) at their tidy
+/// positions and, when `edges` is true, the edges, plus the text rendering.
 pub fn log_tree(
     rec: &RecordingStream,
     tree: &Tree,
@@ -37,23 +120,33 @@ pub fn log_tree(
     edges: bool,
 ) -> RecordingStreamResult<()> {
     let order = tree.preorder();
+    let status = |n: NodeId| record.map_or(Status::Idle, |r| r.status(n));
     let ids: Vec<String> = order.iter().map(|n| n.0.to_string()).collect();
     let labels: Vec<String> = order
         .iter()
-        .map(|n| tree.kind(*n).map(label).unwrap_or_default())
+        .map(|n| {
+            tree.kind(*n)
+                .map(|k| graph_label(k, status(*n)))
+                .unwrap_or_default()
+        })
         .collect();
     let colours: Vec<Color> = order
         .iter()
         .map(|n| {
-            let [r, g, b] = status_colour(record.map_or(Status::Idle, |r| r.status(*n)));
+            let [r, g, b] = status_colour(status(*n));
             Color::from_rgb(r, g, b)
         })
+        .collect();
+    let positions: Vec<Position2D> = tidy_positions(tree, &order)
+        .into_iter()
+        .map(|(x, y)| Position2D::new(x, y))
         .collect();
     rec.log(
         TREE_GRAPH,
         &GraphNodes::new(ids)
             .with_labels(labels)
-            .with_colors(colours),
+            .with_colors(colours)
+            .with_positions(positions),
     )?;
     if edges {
         let pairs: Vec<(String, String)> = order
@@ -68,7 +161,7 @@ pub fn log_tree(
             .collect();
         rec.log(TREE_GRAPH, &GraphEdges::new(pairs).with_directed_edges())?;
     }
-    let text = bt::render(tree, record, &bt::UNICODE).join("\n");
+    let text = bt::render(tree, record, &VIEWER_GLYPHS).join("\n");
     rec.log(TREE_TEXT, &TextDocument::new(text))?;
     Ok(())
 }

@@ -24,6 +24,34 @@ pub fn load(rel: &str) -> Scenario {
     Scenario::load(&root().join(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"))
 }
 
+/// The scenario files under `dir`, sorted, without example pools and the cell's base file
+/// (which scenarios extend).
+pub fn scenario_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    collect_scenario_files(dir, &mut out);
+    out
+}
+
+fn collect_scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            collect_scenario_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "toml")
+            // Example pools, and the cell's base file, which scenarios extend.
+            && !path
+                .file_name()
+                .is_some_and(|n| n == "examples.toml" || n == "cell.toml")
+        {
+            out.push(path);
+        }
+    }
+}
+
 /// The scenario's goal planned, then repaired with its `expected_fix`, one fix per
 /// failure in order (scenario 2 needs two), each at the action that fails.
 pub fn repaired(s: &Scenario) -> Tree {
