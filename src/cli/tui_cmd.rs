@@ -19,12 +19,10 @@ use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
 use super::llm_cmds::{self, LlmFlags};
 
-/// The scenario the workbench opens when none is given (scenario 1).
-pub const DEFAULT_SCENARIO: &str = "scenarios/cell/red_on_blue.toml";
-
 #[derive(Args, Debug, Clone, Default)]
 pub struct TuiArgs {
-    /// Scenario file (default: scenarios/cell/red_on_blue.toml, the red cube on the blue cube).
+    /// Scenario file or name (default: cell/red_on_blue, the red cube on the blue cube),
+    /// looked for as given, under ./scenarios, then under $XDG_DATA_HOME/betr/scenarios.
     pub scenario: Option<PathBuf>,
     /// Apply every proposal of the model without asking (shown in the status bar).
     #[arg(long)]
@@ -67,7 +65,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let arg = args
         .scenario
         .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_SCENARIO));
+        .unwrap_or_else(|| PathBuf::from(betr::scenario::catalog::DEFAULT_SCENARIO));
     let path = super::find_scenario(&arg)?;
     let microphone: Arc<dyn Microphone> = match &args.audio {
         Some(file) => {
