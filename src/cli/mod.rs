@@ -2,6 +2,7 @@
 
 #[macro_use]
 pub mod out;
+mod background_fetch;
 mod bench_cmd;
 mod engine_driver;
 mod eval_cmd;

