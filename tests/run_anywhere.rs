@@ -107,3 +107,27 @@ fn a_missing_scenario_names_each_place_looked_in_once_and_lists_the_known_ones()
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_goal_dataset_beside_the_repository_is_asked_for_clearly_elsewhere() {
+    let dir = tmp("anywhere-dataset");
+    let out = support::cli::betr(
+        &dir,
+        &[
+            "eval",
+            "goals",
+            "--backend",
+            "replay",
+            "--cassette",
+            "x.jsonl",
+        ],
+    );
+    let text = support::cli::text(&out);
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(
+        text.contains("the goal dataset ../shared/datasets/llm-obtea is not there")
+            && text.contains("--dataset DIR"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
