@@ -22,6 +22,7 @@ use betr::llm::{
     ChatFuture, ChatReply, ChatRequest, LanguageModel, OutputConstraint, ReplySource, TokenUsage,
 };
 use betr::scenario::Scenario;
+use betr::session::types::Ablations;
 use betr::session::{self, Event, Options, Proposal};
 use betr::world;
 
@@ -451,4 +452,115 @@ async fn a_misreading_that_can_be_undone_gives_the_undone_goal_as_a_candidate() 
     let model = ByDraw::new("Goal: Closed_Curtain", &[]);
     let (goal, _) = read(&cafe, &model, "Do not open the curtain, please.").await;
     assert_eq!(goal.to_string(), "Closed_Curtain");
+}
+
+/// Answers the question of the objects named with `named`, any goal question with `goal`.
+struct NamesFirst {
+    named: String,
+    goal: String,
+    seen: Mutex<Vec<ChatRequest>>,
+}
+
+impl LanguageModel for NamesFirst {
+    fn model(&self) -> &str {
+        "scripted"
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            let asks_names = matches!(
+                &request.constraint,
+                Some(OutputConstraint::Grammar { gbnf, .. }) if gbnf.starts_with("root ::= \"Named: \"")
+            );
+            Ok(scripted(if asks_names {
+                self.named.clone()
+            } else {
+                self.goal.clone()
+            }))
+        })
+    }
+}
+
+#[tokio::test]
+async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let model = NamesFirst {
+        named: "Named: Table1, Coffee".into(),
+        goal: "Goal: On_Coffee_Table1".into(),
+        seen: Mutex::default(),
+    };
+    let options = Options {
+        ablations: Ablations {
+            small_steps: true,
+            ..Ablations::default()
+        },
+        ..Options::default()
+    };
+    let reading = session::interpret::interpret(
+        &cafe,
+        world::load(&cafe).unwrap(),
+        "Bring a coffee to the first table.",
+        &model,
+        &options,
+        &mut |_| {},
+    )
+    .await
+    .unwrap();
+    assert_eq!(reading.answer.goal.to_string(), "On_Coffee_Table1");
+    assert_eq!(reading.calls, 2);
+    let seen = model.seen.lock().unwrap();
+    let grammar = |r: &ChatRequest| match &r.constraint {
+        Some(OutputConstraint::Grammar { gbnf, .. }) => gbnf.clone(),
+        other => panic!("not a grammar: {other:?}"),
+    };
+    // The first question offers every object of the scene and asks for no goal.
+    let names = grammar(&seen[0]);
+    assert!(
+        names.contains("\"Table2\"") && names.contains("\"Coffee\""),
+        "{names}"
+    );
+    assert!(
+        seen[0]
+            .messages
+            .iter()
+            .any(|m| m.content.contains("Named: <name>"))
+    );
+    // The goal is typed over the named objects only.
+    let goal = grammar(&seen[1]);
+    assert!(goal.starts_with("root ::= \"Goal: \""), "{goal}");
+    assert!(
+        goal.contains("\"Table1\"") && goal.contains("\"Coffee\""),
+        "{goal}"
+    );
+    assert!(
+        !goal.contains("\"Table2\"") && !goal.contains("\"Tea\""),
+        "{goal}"
+    );
+
+    // Off (the default): one call, typed over the whole scene.
+    let model = NamesFirst {
+        named: "Named: Table1".into(),
+        goal: "Goal: On_Coffee_Table1".into(),
+        seen: Mutex::default(),
+    };
+    let (goal, calls) = {
+        let r = session::interpret::interpret(
+            &cafe,
+            world::load(&cafe).unwrap(),
+            "Bring a coffee to the first table.",
+            &model,
+            &Options::default(),
+            &mut |_| {},
+        )
+        .await
+        .unwrap();
+        (r.answer.goal, r.calls)
+    };
+    assert_eq!((goal.to_string().as_str(), calls), ("On_Coffee_Table1", 1));
+    assert!(grammar(&model.seen.lock().unwrap()[0]).contains("\"Table2\""));
 }

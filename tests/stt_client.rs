@@ -245,3 +245,33 @@ fn the_cli_transcribes_and_dictates_through_a_server() {
     assert!(t.contains("(equivalent to the scenario's goal)"), "{t}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_key_inside_the_transcription_url_is_sent_as_the_key_and_printed_nowhere() {
+    let dir = tmp("stt-url-key");
+    let wav = dir.join("speech.wav");
+    std::fs::write(&wav, tone().to_wav_bytes()).unwrap();
+    let server = FakeServer::start(vec![], Behavior::Reply("Put the cup away.".into()));
+    let with_key = server
+        .base_url()
+        .replacen("http://", "http://user:sk-IN-URL-123@", 1);
+    let out = betr(
+        &dir,
+        &[
+            "transcribe",
+            &wav.to_string_lossy(),
+            "--stt",
+            "openai",
+            "--stt-base-url",
+            &with_key,
+            "--stt-api-key-env",
+            "BETR_TEST_NO_SUCH_KEY",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(!text(&out).contains("sk-IN-URL-123"), "{}", text(&out));
+    let got = server.received();
+    assert_eq!(got.len(), 1);
+    assert_eq!(got[0].header("authorization"), Some("Bearer sk-IN-URL-123"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -127,7 +127,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     }
     let mut llm = llm_cmds::setup(&llm_flags)?;
     betr::reading::misreadings_without(&flags.without_misreading)?;
-    llm.options.without_misreadings = flags.without_misreading.clone();
+    llm.options.ablations.without_misreadings = flags.without_misreading.clone();
     let backend = format!("{:?}", llm.settings.backend).to_lowercase();
     let model = llm.model.model().to_string();
     let mut settings: BTreeMap<String, String> = BTreeMap::new();
@@ -148,21 +148,30 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         "fixed_examples".into(),
         options.variant.fixed_examples.to_string(),
     );
-    settings.insert("checks".into(), options.check_goals.to_string());
+    settings.insert("checks".into(), options.ablations.check_goals.to_string());
     settings.insert("candidates".into(), options.candidates.to_string());
     settings.insert("beams".into(), options.beams.to_string());
     settings.insert(
         "feedback_rounds".into(),
         options.goal_feedback_rounds.to_string(),
     );
-    settings.insert("shortlist".into(), options.shortlist.to_string());
-    settings.insert("read_by_parts".into(), options.read_by_parts.to_string());
-    settings.insert("value_levels".into(), options.value_levels.to_string());
+    settings.insert("shortlist".into(), options.ablations.shortlist.to_string());
+    settings.insert(
+        "read_by_parts".into(),
+        options.ablations.read_by_parts.to_string(),
+    );
+    if options.ablations.small_steps {
+        settings.insert("small_steps".into(), "true".into());
+    }
+    settings.insert(
+        "value_levels".into(),
+        options.ablations.value_levels.to_string(),
+    );
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
-    if !options.without_misreadings.is_empty() {
+    if !options.ablations.without_misreadings.is_empty() {
         settings.insert(
             "without_misreadings".into(),
-            options.without_misreadings.join(" "),
+            options.ablations.without_misreadings.join(" "),
         );
     }
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
@@ -197,15 +206,19 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
                 (Some(k), true) => format!("{k} fixed examples"),
                 (Some(k), false) => format!("{k} retrieved examples"),
             },
-            if llm.options.check_goals {
+            if llm.options.ablations.check_goals {
                 format!(
                     "checked ({} candidates, {} feedback rounds{})",
                     llm.options.candidates,
                     llm.options.goal_feedback_rounds,
-                    if llm.options.read_by_parts {
-                        ", a wish at a time"
-                    } else {
-                        ", whole request"
+                    match (
+                        llm.options.ablations.read_by_parts,
+                        llm.options.ablations.small_steps
+                    ) {
+                        (true, false) => ", a wish at a time",
+                        (false, false) => ", whole request",
+                        (true, true) => ", a wish at a time, the objects named first",
+                        (false, true) => ", whole request, the objects named first",
                     }
                 )
             } else {

@@ -14,7 +14,11 @@ use betr::llm::prompt::{DEFAULT_EXAMPLES_SHOWN, Templates, Variant};
 use betr::llm::usage::{Ledger, Metered};
 use betr::scenario::Example;
 use betr::session::Options;
-use betr::session::types::DEFAULT_CANDIDATES;
+use betr::session::types::{Ablations, DEFAULT_CANDIDATES};
+
+/// The help heading of the flags an evaluation turns parts off with
+/// (`session::types::Ablations`).
+const ABLATIONS: &str = "Ablations (what an evaluation turns off to measure each part)";
 
 /// Flags shared by every command that asks a language model. Each overrides the
 /// matching `BETR_*` variable, which overrides `betr.toml`.
@@ -41,6 +45,11 @@ pub struct LlmFlags {
     /// [env: BETR_CASSETTE].
     #[arg(long, value_name = "FILE")]
     pub cassette: Option<PathBuf>,
+    /// With a live backend and --cassette: answer what the cassette already holds for the
+    /// model from it, ask the model only the rest and record that (a run repeated with
+    /// one setting changed asks only the questions that changed).
+    #[arg(long, requires = "cassette")]
+    pub reuse_cassette: bool,
     /// Constrain replies to the vocabulary with a JSON schema (servers with response_format)
     /// [env: BETR_STRUCTURED].
     #[arg(long)]
@@ -58,17 +67,17 @@ pub struct LlmFlags {
     #[arg(long)]
     pub temperature: Option<f32>,
     /// Ablation: leave the condition descriptions out of the prompt.
-    #[arg(long)]
+    #[arg(help_heading = ABLATIONS, long)]
     pub no_descriptions: bool,
     /// Ablation: leave out the rule that only listed objects may be used.
-    #[arg(long)]
+    #[arg(help_heading = ABLATIONS, long)]
     pub no_object_rule: bool,
     /// Ablation: ask for reasoning before the goal (chain of thought).
-    #[arg(long)]
+    #[arg(help_heading = ABLATIONS, long)]
     pub cot: bool,
     /// Ablation: examples from this TOML file ([[examples]] instruction, goal) instead of
     /// the scenario's, e.g. the original prompt's examples.
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = ABLATIONS, long, value_name = "FILE")]
     pub examples: Option<PathBuf>,
     /// Worked examples per prompt, chosen from the scenario's pool as the most similar
     /// to the request (default 6; 0: none).
@@ -89,23 +98,28 @@ pub struct LlmFlags {
     pub beams: Option<u32>,
     /// Take the first usable goal as it is: no checks, no vote, no feedback (the paper's
     /// single call).
-    #[arg(long)]
+    #[arg(long, help_heading = ABLATIONS)]
     pub no_checks: bool,
     /// Times the model is told why its goals were refused and asked again (default 2).
     #[arg(value_parser = super::ranged(0, 10), long, value_name = "N")]
     pub feedback_rounds: Option<usize>,
     /// Read a request of several wishes whole, instead of one wish at a time with the
     /// goals joined as the request joins them.
-    #[arg(long)]
+    #[arg(long, help_heading = ABLATIONS)]
     pub whole_request: bool,
+    /// Ask first which of the scene's objects and places the request names, and type the
+    /// goal's first answer over those only (the embedded model, or any model held to a
+    /// grammar).
+    #[arg(long, help_heading = ABLATIONS)]
+    pub small_steps: bool,
     /// Ask a numeric parameter's first value as a number, instead of as a level (very low
     /// … very high) of the range the robot can do that betr turns into a number.
-    #[arg(long)]
+    #[arg(long, help_heading = ABLATIONS)]
     pub value_as_number: bool,
     /// Let the model name a failure's missing condition out of the whole vocabulary,
     /// instead of choosing among the conditions over the action's objects that fix the
     /// failure when tried in simulation.
-    #[arg(long)]
+    #[arg(long, help_heading = ABLATIONS)]
     pub no_shortlist: bool,
     /// Read goal.md, resolve.md and value.md from this directory instead of the built-in prompts.
     #[arg(long, value_name = "DIR")]
@@ -189,6 +203,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         timeout_secs: flags.timeout,
         max_retries: flags.max_retries,
         cassette: flags.cassette.clone(),
+        reuse_cassette: flags.reuse_cassette.then_some(true),
         usage_log: flags.usage_log.clone(),
         model_path: flags.model_path.clone(),
         threads: flags.threads,
@@ -225,13 +240,17 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
             fixed_examples: flags.fixed_examples,
             examples,
         },
-        check_goals: !flags.no_checks,
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
         beams: flags.beams.unwrap_or(betr::session::types::DEFAULT_BEAMS),
         goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
-        read_by_parts: !flags.whole_request,
-        value_levels: !flags.value_as_number,
-        shortlist: !flags.no_shortlist,
+        ablations: Ablations {
+            check_goals: !flags.no_checks,
+            read_by_parts: !flags.whole_request,
+            small_steps: flags.small_steps,
+            value_levels: !flags.value_as_number,
+            shortlist: !flags.no_shortlist,
+            without_misreadings: Vec::new(),
+        },
         ..Options::default()
     };
     Ok((settings, options))

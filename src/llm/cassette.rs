@@ -1,7 +1,9 @@
 //! Record and replay. A cassette is a JSONL file; each line holds one request and its
 //! reply, keyed by (model, prompt hash), and names the model that produced the reply (or
 //! says the reply was hand-written). Recording wraps a live backend and appends each entry
-//! as one whole line (`store::append_line`); replay answers from the file and fails
+//! as one whole line (`store::append_line`), or, reusing, first answers from the file what
+//! it already holds for that model (an evaluation re-run with one rule changed asks the
+//! model only the questions that changed); replay answers from the file and fails
 //! loudly on a miss, never calling a model. A cut last line (a recording killed midway)
 //! is left out and reported.
 
@@ -85,6 +87,9 @@ pub struct Recorder<M> {
     inner: M,
     path: PathBuf,
     lock: std::sync::Mutex<()>,
+    /// The exchanges already in the cassette for this model, by prompt hash, answered
+    /// without asking it (empty unless reusing).
+    known: HashMap<String, Entry>,
 }
 
 impl<M: LanguageModel> Recorder<M> {
@@ -93,10 +98,42 @@ impl<M: LanguageModel> Recorder<M> {
             inner,
             path: path.into(),
             lock: std::sync::Mutex::new(()),
+            known: HashMap::new(),
         }
     }
 
+    /// A recorder that answers what the cassette already holds for `inner`'s model from
+    /// it (as recorded replies) and asks `inner` the rest, appending those. A cassette
+    /// that does not exist yet is empty; one that does not read is an error naming the
+    /// line.
+    pub fn reusing(inner: M, path: impl Into<PathBuf>) -> Result<Self, LlmError> {
+        let path = path.into();
+        let err = |detail: String| LlmError::Cassette {
+            path: path.display().to_string(),
+            detail,
+        };
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            Err(e) => return Err(err(e.to_string())),
+        };
+        let read = read_entries(&text).map_err(|e| err(e.to_string()))?;
+        let model = inner.model().to_string();
+        let known = read
+            .entries
+            .into_iter()
+            .filter(|e| e.model == model)
+            .map(|e| (e.prompt_hash.clone(), e))
+            .collect();
+        let mut recorder = Recorder::new(inner, path);
+        recorder.known = known;
+        Ok(recorder)
+    }
+
     async fn call(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
+        if let Some(entry) = self.known.get(&prompt_hash(request)) {
+            return Ok(recorded_reply(entry, Instant::now()));
+        }
         let reply = self.inner.chat(request).await?;
         let entry = Entry {
             model: self.inner.model().to_string(),
@@ -213,22 +250,27 @@ impl Replay {
                 hash,
             });
         };
-        let source = match &entry.source {
-            ReplySource::Model | ReplySource::Recorded => ReplySource::Recorded,
-            hand @ ReplySource::HandWritten { .. } => hand.clone(),
-        };
-        Ok(ChatReply {
-            text: entry.reply.clone(),
-            model: if entry.reply_model.is_empty() {
-                entry.model.clone()
-            } else {
-                entry.reply_model.clone()
-            },
-            usage: entry.usage,
-            latency: started.elapsed(),
-            source,
-            ranked: entry.ranked.clone(),
-        })
+        Ok(recorded_reply(entry, started))
+    }
+}
+
+/// The reply a cassette's entry gives back: marked as recorded (or hand-written).
+fn recorded_reply(entry: &Entry, started: Instant) -> ChatReply {
+    let source = match &entry.source {
+        ReplySource::Model | ReplySource::Recorded => ReplySource::Recorded,
+        hand @ ReplySource::HandWritten { .. } => hand.clone(),
+    };
+    ChatReply {
+        text: entry.reply.clone(),
+        model: if entry.reply_model.is_empty() {
+            entry.model.clone()
+        } else {
+            entry.reply_model.clone()
+        },
+        usage: entry.usage,
+        latency: started.elapsed(),
+        source,
+        ranked: entry.ranked.clone(),
     }
 }
 
@@ -302,6 +344,53 @@ mod tests {
         assert!(matches!(miss, LlmError::CassetteMiss { .. }), "{miss}");
         let other = Replay::open(&path, Some("gpt-x"), false).unwrap();
         assert!(block(other.chat(&a)).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Counts the calls that reach it.
+    struct Counting(std::sync::atomic::AtomicUsize);
+    impl LanguageModel for Counting {
+        fn model(&self) -> &str {
+            "echo-1"
+        }
+        fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+            self.0.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            Echo.chat(request)
+        }
+    }
+
+    #[test]
+    fn reusing_asks_only_what_the_cassette_lacks_and_records_it() {
+        let dir = std::env::temp_dir().join(format!("betr-cassette-reuse-{}", std::process::id()));
+        let path = dir.join("c.jsonl");
+        let _ = std::fs::remove_file(&path);
+        let a = ChatRequest::new(vec![Message::user("goal please")]);
+        let b = ChatRequest::new(vec![Message::user("other")]);
+        block(Recorder::new(Echo, &path).chat(&a)).unwrap();
+        let live = Recorder::reusing(Counting(Default::default()), &path).unwrap();
+        let reused = block(live.chat(&a)).unwrap();
+        assert_eq!(
+            (reused.text.as_str(), &reused.source),
+            ("GOAL PLEASE", &ReplySource::Recorded)
+        );
+        assert_eq!(live.inner.0.load(std::sync::atomic::Ordering::SeqCst), 0);
+        assert_eq!(block(live.chat(&b)).unwrap().text, "OTHER");
+        assert_eq!(live.inner.0.load(std::sync::atomic::Ordering::SeqCst), 1);
+        // The new exchange was appended; the reused one was not written twice.
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(read_entries(&text).unwrap().entries.len(), 2);
+        // Another model's entries are not reused.
+        std::fs::write(
+            &path,
+            text.replace("\"model\":\"echo-1\"", "\"model\":\"other-2\""),
+        )
+        .unwrap();
+        let fresh = Recorder::reusing(Counting(Default::default()), &path).unwrap();
+        block(fresh.chat(&a)).unwrap();
+        assert_eq!(fresh.inner.0.load(std::sync::atomic::Ordering::SeqCst), 1);
+        std::fs::write(&path, "not json\n").unwrap();
+        let bad = Recorder::reusing(Echo, &path).err().unwrap();
+        assert!(bad.to_string().contains("line 1"), "{bad}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -80,6 +80,8 @@ pub struct Layer {
     pub initial_backoff_ms: Option<u64>,
     pub max_backoff_ms: Option<u64>,
     pub cassette: Option<PathBuf>,
+    /// A live backend answers what the cassette already holds from it and records the rest.
+    pub reuse_cassette: Option<bool>,
     pub usage_log: Option<PathBuf>,
     /// Local backend: a GGUF file to use instead of a fetched model.
     pub model_path: Option<PathBuf>,
@@ -119,6 +121,7 @@ impl Layer {
             initial_backoff_ms,
             max_backoff_ms,
             cassette,
+            reuse_cassette,
             usage_log,
             model_path,
             threads,
@@ -194,6 +197,8 @@ pub struct Settings {
     pub connect_timeout: Duration,
     pub retry: RetryPolicy,
     pub cassette: Option<PathBuf>,
+    /// A live backend answers what the cassette already holds from it and records the rest.
+    pub reuse_cassette: bool,
     pub usage_log: Option<PathBuf>,
     pub prices: PriceTable,
     /// The file the settings came from, if any.
@@ -325,6 +330,7 @@ impl Settings {
                 max_backoff: backoff("max_backoff_ms", layer.max_backoff_ms, 20_000)?,
             },
             cassette: layer.cassette,
+            reuse_cassette: layer.reuse_cassette.unwrap_or(false),
             usage_log: layer.usage_log.or_else(super::usage::default_log_path),
             prices,
             file: path,
@@ -359,6 +365,19 @@ impl Settings {
         Ok((spec.name.to_string(), spec.path()))
     }
 
+    /// A live backend as configured: recording to the cassette when one is set, and
+    /// answering from it what it holds when reusing.
+    fn recording<M: LanguageModel + 'static>(
+        &self,
+        live: M,
+    ) -> Result<Box<dyn LanguageModel>, LlmError> {
+        Ok(match &self.cassette {
+            Some(path) if self.reuse_cassette => Box::new(Recorder::reusing(live, path)?),
+            Some(path) => Box::new(Recorder::new(live, path)),
+            None => Box::new(live),
+        })
+    }
+
     /// Build the configured model, metered into `ledger`: a live backend records to the
     /// cassette when one is set; replay answers only from it.
     pub fn build(
@@ -380,10 +399,7 @@ impl Settings {
                         prompt_states: Some(crate::model::cache_dir().join("prompt-state")),
                     },
                 )?;
-                match &self.cassette {
-                    Some(path) => Box::new(Recorder::new(local, path)),
-                    None => Box::new(local),
-                }
+                self.recording(local)?
             }
             Backend::Replay => {
                 let Some(cassette) = &self.cassette else {
@@ -430,10 +446,7 @@ impl Settings {
                     max_tokens_field: self.max_tokens_field.clone(),
                     max_reply_bytes: self.max_reply_bytes,
                 })?;
-                match &self.cassette {
-                    Some(path) => Box::new(Recorder::new(client, path)),
-                    None => Box::new(client),
-                }
+                self.recording(client)?
             }
         };
         // Every reply is made printable before anything shows or reads it.

@@ -118,6 +118,24 @@ pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) ->
     g
 }
 
+/// `Named: ` and one to `most` of `names`, separated by commas: the objects and places a
+/// request names, each once at most by the model's choice (repeats are read as one).
+pub fn names_grammar(names: &[&str], most: usize) -> String {
+    let mut sorted: Vec<&str> = names.to_vec();
+    // Longest first: GBNF alternatives are tried as written by some engines.
+    sorted.sort_by(|a, b| b.len().cmp(&a.len()).then(a.cmp(b)));
+    sorted.dedup();
+    let alternatives: Vec<String> = sorted.iter().map(|n| lit(n)).collect();
+    let mut g = String::new();
+    let _ = writeln!(
+        g,
+        "root ::= \"Named: \" name ( \", \" name ){{0,{}}}",
+        most.saturating_sub(1)
+    );
+    let _ = writeln!(g, "name ::= {}", alternatives.join(" | "));
+    g
+}
+
 /// One line of free text (the model's reasoning), bounded so it cannot run away.
 const REASONING_RULE: &str = "reasoning ::= [^\\n]{1,600}\n";
 
@@ -226,5 +244,14 @@ mod tests {
         );
         let v = value_grammar(None, &["shovel".into(), "spoon".into()]);
         assert!(v.contains("value ::= \"shovel\" | \"spoon\""), "{v}");
+        let n = names_grammar(&["Table1", "Coffee", "Table10", "Coffee"], 4);
+        assert!(
+            n.starts_with("root ::= \"Named: \" name ( \", \" name ){0,3}"),
+            "{n}"
+        );
+        assert!(
+            n.contains("name ::= \"Table10\" | \"Coffee\" | \"Table1\"\n"),
+            "{n}"
+        );
     }
 }

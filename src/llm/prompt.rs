@@ -167,6 +167,19 @@ impl Context<'_> {
         Ok(messages(fill("goal.md", &templates.goal, &values)?))
     }
 
+    /// The goal prompt asking first for the objects and places the request names, by
+    /// their names in the scene (`Named: a, b`), not yet for the goal: the same prompt
+    /// up to its answer format, so a model that keeps a prompt's state reuses it.
+    pub fn names(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
+        let mut values = self.common();
+        values.push(("conventions", self.conventions_text()));
+        values.push((
+            "answer_format",
+            "Do not write the goal yet. First name the objects and places of this scene that the request names or means (a kind of thing means every object of that kind), by their names in the list of objects, exactly like this:\nNamed: <name>, <name>".into(),
+        ));
+        Ok(messages(fill("goal.md", &templates.goal, &values)?))
+    }
+
     /// The failure-resolution request for `action`, which failed with `error`.
     /// `tried`: proposals for this same failure that did not fix it (reflective feedback,
     /// so a repeated question does not get the same answer). `shortlist`: conditions that

@@ -55,7 +55,7 @@ impl Scenario {
                 .iter()
                 .map(|f| f.get_ref().clone())
                 .collect(),
-            examples: examples(&raws),
+            examples: examples(&files, &raws, &vocabulary)?,
             conventions: conventions(&files, &raws, &vocabulary)?,
             domain: Domain { vocabulary, skills },
             world_kind: world_kind(&raws),
@@ -256,21 +256,36 @@ fn located_goal(
     goal_in(text.get_ref(), vocabulary).map_err(|e| file.error_in_string(&text.span(), e.at(), e))
 }
 
-/// The worked examples of the last file that has any.
-fn examples(raws: &[RawFile]) -> Vec<Example> {
-    raws.iter()
-        .rev()
-        .find(|r| !r.examples.is_empty())
-        .map(|r| {
-            r.examples
-                .iter()
-                .map(|e| Example {
-                    instruction: e.instruction.clone(),
-                    goal: e.goal.clone(),
-                })
-                .collect()
+/// The worked examples of the last file that has any (its own, then its pool's), each
+/// goal checked against the vocabulary: a predicate the domain lacks, or given the wrong
+/// number of arguments, is refused with its file, line and column, as a mistyped example
+/// would teach the model a condition that cannot be planned. Objects are not checked: a
+/// pool's examples come from other situations of the domain, with their own objects.
+fn examples(
+    files: &[SourceFile],
+    raws: &[RawFile],
+    vocabulary: &Vocabulary,
+) -> Result<Vec<Example>, ScenarioError> {
+    let Some((file, raw)) = files.iter().zip(raws).rev().find(|(_, r)| {
+        !r.examples.is_empty() || r.pooled.as_ref().is_some_and(|(_, p)| !p.is_empty())
+    }) else {
+        return Ok(Vec::new());
+    };
+    let own = raw.examples.iter().map(|e| (file, e));
+    let pooled = raw
+        .pooled
+        .iter()
+        .flat_map(|(pool, examples)| examples.iter().map(move |e| (pool, e)));
+    own.chain(pooled)
+        .map(|(file, e)| {
+            super::goal_with_objects(e.goal.get_ref(), vocabulary, false)
+                .map_err(|err| file.error_in_string(&e.goal.span(), err.at(), err))?;
+            Ok(Example {
+                instruction: e.instruction.clone(),
+                goal: e.goal.get_ref().clone(),
+            })
         })
-        .unwrap_or_default()
+        .collect()
 }
 
 /// The conventions of every file, base file first. A convention's `puts` names a
@@ -491,5 +506,42 @@ mod tests {
         let e = Scenario::from_text(Path::new("t.toml"), text).unwrap_err();
         assert_eq!((e.line, e.column), (13, 21), "{e}");
         assert!(e.message.contains("commas"), "{e}");
+    }
+
+    #[test]
+    fn an_example_goal_is_checked_for_its_predicates_but_not_its_objects() {
+        // Another situation's object passes; the predicate must be the domain's.
+        let ok =
+            format!("{BASE}[[examples]]\ninstruction = \"hold the tea\"\ngoal = \"Holding_Tea\"\n");
+        let s = Scenario::from_text(Path::new("t.toml"), ok).unwrap();
+        assert_eq!(s.examples[0].goal, "Holding_Tea");
+        let typo = format!(
+            "{BASE}[[examples]]\ninstruction = \"hold the cup\"\ngoal = \"Holding_Chips & Holdin_Cup\"\n"
+        );
+        let e = Scenario::from_text(Path::new("t.toml"), typo).unwrap_err();
+        assert_eq!((e.line, e.column), (14, 25), "{e}");
+        assert!(
+            e.message.contains("Holdin") && e.message.contains("Holding"),
+            "{e}"
+        );
+
+        // In a pool file, the error names the pool's file and line.
+        let dir = std::env::temp_dir().join(format!("betr-pool-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("pool.toml"),
+            "[[examples]]\ninstruction = \"a\"\ngoal = \"Holding_Cup\"\n\n[[examples]]\ninstruction = \"b\"\ngoal = \"Holding_Cup_Chips\"\n",
+        )
+        .unwrap();
+        let with_pool = BASE.replace("name = \"t\"\n", "name = \"t\"\n").replacen(
+            "[scenario]",
+            "example_pool = \"pool.toml\"\n\n[scenario]",
+            1,
+        );
+        let e = Scenario::from_text(&dir.join("t.toml"), with_pool).unwrap_err();
+        assert!(e.file.ends_with("pool.toml"), "{e}");
+        assert_eq!(e.line, 7, "{e}");
+        assert!(e.message.contains("argument"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

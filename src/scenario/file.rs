@@ -21,6 +21,9 @@ pub(super) struct RawFile {
     pub(super) skills: Vec<RawSkill>,
     #[serde(default)]
     pub(super) examples: Vec<RawExample>,
+    /// The examples read from `example_pool`, with the file they are located in.
+    #[serde(skip)]
+    pub(super) pooled: Option<(super::SourceFile, Vec<RawExample>)>,
     /// A file of `[[examples]]` beside this one: the domain's pool of worked examples,
     /// from which prompts choose the ones most like each request.
     pub(super) example_pool: Option<Spanned<String>>,
@@ -130,7 +133,7 @@ pub(super) struct RawPuts {
 #[serde(deny_unknown_fields)]
 pub(super) struct RawExample {
     pub(super) instruction: String,
-    pub(super) goal: String,
+    pub(super) goal: Spanned<String>,
 }
 
 pub(super) fn default_cost() -> f64 {

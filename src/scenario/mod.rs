@@ -212,8 +212,9 @@ impl Scenario {
                         format!("the example pool {} does not exist", pool_path.display()),
                     ));
                 }
-                let pooled: RawPool = SourceFile::read(&pool_path)?.parse()?;
-                raw.examples.extend(pooled.examples);
+                let pool_file = SourceFile::read(&pool_path)?;
+                let pooled: RawPool = pool_file.parse()?;
+                raw.pooled = Some((pool_file, pooled.examples));
             }
             if let Some(base) = &raw.extends {
                 let base_path = p.parent().unwrap_or(Path::new(".")).join(base.get_ref());
@@ -243,9 +244,27 @@ impl Scenario {
 /// A goal formula whose every atom fits `vocabulary`; the first that does not is refused
 /// with where it stands and the atoms of the vocabulary most like it.
 fn goal_in(text: &str, vocabulary: &Vocabulary) -> Result<Formula, GoalTextError> {
+    goal_with_objects(text, vocabulary, true)
+}
+
+/// As [`goal_in`]; without `objects_checked`, atoms over objects this scene lacks (a
+/// worked example from another situation of the domain) pass when their predicate and
+/// its number of arguments fit.
+pub(super) fn goal_with_objects(
+    text: &str,
+    vocabulary: &Vocabulary,
+    objects_checked: bool,
+) -> Result<Formula, GoalTextError> {
     let f = Formula::parse(text)?;
     for atom in f.atoms() {
         if let Err(error) = vocabulary.check_atom(&atom) {
+            let about_objects = matches!(
+                error,
+                VocabularyError::UnknownObject { .. } | VocabularyError::WrongType(_)
+            );
+            if about_objects && !objects_checked {
+                continue;
+            }
             let at = where_in(text, &atom, &error);
             return Err(GoalTextError::Vocabulary {
                 nearest: atoms_like(vocabulary, &atom, &error),

@@ -300,7 +300,7 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let choices = if options.shortlist {
+    let choices = if options.ablations.shortlist {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a
@@ -382,7 +382,7 @@ pub(crate) async fn ask_value(
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
     // The first question about a number asks for a level of the robot's range; once the
     // world has answered, the next ones ask for numbers.
-    let levels = if tried.is_empty() && options.value_levels {
+    let levels = if tried.is_empty() && options.ablations.value_levels {
         as_levels(param)
     } else {
         None

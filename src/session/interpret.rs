@@ -68,9 +68,9 @@ pub async fn interpret_in_scenario(
 }
 
 /// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
-/// as the module says (`options.check_goals` off: the first usable answer, as the paper's
+/// as the module says (`options.ablations.check_goals` off: the first usable answer, as the paper's
 /// single call). A request of several wishes is read a wish at a time
-/// (`options.read_by_parts`, see [`super::interpret_parts`]) when checks are on.
+/// (`options.ablations.read_by_parts`, see [`super::interpret_parts`]) when checks are on.
 pub async fn interpret(
     scenario: &Scenario,
     world: Box<dyn World>,
@@ -80,7 +80,7 @@ pub async fn interpret(
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Interpretation, SessionError> {
     let mut earlier_calls = 0;
-    if options.check_goals && options.read_by_parts {
+    if options.ablations.check_goals && options.ablations.read_by_parts {
         let lexicon = Lexicon::new(&scenario.domain.vocabulary, example_pool(scenario, options));
         let parts = split(instruction, &lexicon);
         if parts.len() > 1 {
@@ -150,7 +150,7 @@ pub(super) async fn read_goal(
         instruction,
         shown: options.variant.choose(pool, instruction),
         lexicon,
-        misreadings: crate::reading::misreadings_without(&options.without_misreadings)?,
+        misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
         one_of_several,
     };
     let vocabulary = &scenario.domain.vocabulary;
@@ -158,8 +158,20 @@ pub(super) async fn read_goal(
     let cot = options.variant.chain_of_thought;
     let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
     let mut calls = 0;
+    // The small step first: the objects the request names type the first answer.
+    let mut narrowed: Option<crate::domain::Vocabulary> = None;
+    if options.ablations.small_steps && !cot && options.grammar && model.supports_grammar() {
+        calls += 1;
+        if let Some(named) = super::named_first::named_objects(&ctx, model, options, emit).await? {
+            narrowed = super::named_first::narrowed(vocabulary, &named);
+        }
+    }
+    let narrowed_grammar = || match &narrowed {
+        Some(v) => grammar::goal_grammar(v, true, cot),
+        None => goal_grammar(),
+    };
     let mut first: Option<Option<Formula>> = None;
-    let rounds = if options.check_goals {
+    let rounds = if options.ablations.check_goals {
         options.goal_feedback_rounds + 1
     } else {
         1
@@ -171,7 +183,7 @@ pub(super) async fn read_goal(
     let mut runners_up: Vec<Candidate> = Vec::new();
     for round in 0..rounds {
         let mut candidates: Vec<Candidate> = Vec::new();
-        let draws = if options.check_goals {
+        let draws = if options.ablations.check_goals {
             options.candidates.max(1)
         } else {
             1
@@ -191,17 +203,22 @@ pub(super) async fn read_goal(
             } else {
                 None
             };
+            let typed_by: &(dyn Fn() -> String + Sync) = if round == 0 && draw == 0 {
+                &narrowed_grammar
+            } else {
+                &goal_grammar
+            };
             let r = ask(
                 model,
                 messages.clone(),
-                (constraint.clone(), &goal_grammar),
+                (constraint.clone(), typed_by),
                 &opts,
                 seed,
                 emit,
             )
             .await?;
             calls += 1;
-            if round == 0 && draw == 0 && options.check_goals {
+            if round == 0 && draw == 0 && options.ablations.check_goals {
                 runners_up = r
                     .ranked
                     .iter()
@@ -224,7 +241,7 @@ pub(super) async fn read_goal(
             let read = reply::goal(&r.text, vocabulary, options.min_similarity);
             let problem = match &read {
                 Err(e) => Some(GoalProblem::wrong(e.to_string())),
-                Ok(_) if !options.check_goals => None,
+                Ok(_) if !options.ablations.check_goals => None,
                 Ok(a) => judge.assess(&a.goal),
             };
             if first.is_none() {
@@ -249,7 +266,7 @@ pub(super) async fn read_goal(
             let derived = judge.derived(
                 &read,
                 problem.as_ref(),
-                options.check_goals,
+                options.ablations.check_goals,
                 first_draw,
                 emit,
             );
@@ -275,7 +292,7 @@ pub(super) async fn read_goal(
                 continue;
             }
             let settled = match &misread {
-                Some(_) if options.check_goals => {
+                Some(_) if options.ablations.check_goals => {
                     candidates.iter().any(|c| judge.answers_request(c))
                 }
                 _ => candidates.iter().any(|c| c.clean() || c.doubtful()),
@@ -294,7 +311,7 @@ pub(super) async fn read_goal(
                 }
             }
             if let Some(why) = misread
-                && options.check_goals
+                && options.ablations.check_goals
             {
                 emit(&Event::Notice {
                     message: format!("{why}: drawing more candidates"),
@@ -307,7 +324,7 @@ pub(super) async fn read_goal(
         let last_round = round + 1 == rounds;
         let chosen = judge.choose(&candidates, &set_aside, last_round);
         if let Some((mut answer, doubt)) = chosen {
-            if options.check_goals {
+            if options.ablations.check_goals {
                 let ordered = in_request_order(&judge.lexicon, &answer.goal, &terms(instruction));
                 if ordered != answer.goal {
                     emit(&Event::Notice {

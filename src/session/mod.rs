@@ -11,6 +11,7 @@ pub mod interpret;
 mod interpret_parts;
 mod judge;
 pub mod knowledge;
+mod named_first;
 pub mod planned;
 pub mod policy;
 pub mod readings;

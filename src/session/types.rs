@@ -32,21 +32,11 @@ pub enum NoModel {
 pub struct Options {
     /// Questions about failures (each reply, valid or not, is one round).
     pub max_rounds: usize,
-    /// Check every goal read from an instruction (parses, not contradictory, not true
-    /// already, plannable) and draw more candidates when the first fails; off: the
-    /// first usable answer is taken, as the paper's single call.
-    pub check_goals: bool,
     /// Candidates drawn per question when the first answer fails its checks (goals), or
     /// always (proposals for a failure, each tried in simulation before it is offered).
     pub candidates: usize,
     /// Times the model is told why its candidate goals were refused and asked again.
     pub goal_feedback_rounds: usize,
-    /// With checks on, read a request of several wishes one wish at a time and join the
-    /// goals as the request joins them; off: the request is read whole.
-    pub read_by_parts: bool,
-    /// Ask the first value of a numeric parameter as a level of the robot's declared
-    /// range (very low … very high), turned into a number by betr; off: as a number.
-    pub value_levels: bool,
     /// `resolve`: work on the scenario's stated goal instead of reading the instruction
     /// (so the failure under study is reached whatever a model would read); the
     /// instruction still reaches the questions about failures.
@@ -54,10 +44,6 @@ pub struct Options {
     /// The resolve loop saves the tree that succeeds as a policy in this directory, with
     /// its provenance, where the workbench finds it (keyed by scenario and goal).
     pub policy_dir: Option<std::path::PathBuf>,
-    /// Before asking about a failure, try the conditions over the failing action's objects
-    /// in simulation and let the model choose among those that fix it; off: the model
-    /// names the condition out of the whole vocabulary.
-    pub shortlist: bool,
     pub temperature: f32,
     pub max_tokens: u32,
     /// How alike a listed name must be to be offered ("did you mean …?") for a name of a
@@ -77,9 +63,50 @@ pub struct Options {
     /// different things, offer them for the person to choose (`Event::Readings`); off:
     /// the best one is taken.
     pub choose_reading: bool,
+    /// What an evaluation turns off (or on) to measure what each part earns.
+    pub ablations: Ablations,
+}
+
+/// The parts of reading and asking an evaluation turns off (or on) to measure what each
+/// earns (`betr eval`, and the same flags of the one-shot commands for diagnosis). The
+/// workbench and `betr resolve` run with the defaults, which are what the measurements
+/// chose.
+#[derive(Debug, Clone)]
+pub struct Ablations {
+    /// Check every goal read from an instruction (parses, not contradictory, not true
+    /// already, plannable) and draw more candidates when the first fails; off: the
+    /// first usable answer is taken, as the paper's single call.
+    pub check_goals: bool,
+    /// With checks on, read a request of several wishes one wish at a time and join the
+    /// goals as the request joins them; off: the request is read whole.
+    pub read_by_parts: bool,
+    /// Before a goal's first answer, ask the model which of the scene's objects and places
+    /// the request names, and type the first answer over those only
+    /// (`session::named_first`); off: the first answer is typed over the whole scene.
+    pub small_steps: bool,
+    /// Ask the first value of a numeric parameter as a level of the robot's declared
+    /// range (very low … very high), turned into a number by betr; off: as a number.
+    pub value_levels: bool,
+    /// Before asking about a failure, try the conditions over the failing action's objects
+    /// in simulation and let the model choose among those that fix it; off: the model
+    /// names the condition out of the whole vocabulary.
+    pub shortlist: bool,
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
     /// evaluation's way to measure what each earns; empty in use.
     pub without_misreadings: Vec<String>,
+}
+
+impl Default for Ablations {
+    fn default() -> Self {
+        Ablations {
+            check_goals: true,
+            read_by_parts: true,
+            small_steps: false,
+            value_levels: true,
+            shortlist: true,
+            without_misreadings: Vec::new(),
+        }
+    }
 }
 
 /// Candidates per question: the first answer and three sampled ones.
@@ -92,14 +119,10 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             max_rounds: 5,
-            check_goals: true,
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,
-            read_by_parts: true,
-            value_levels: true,
             use_scenario_goal: false,
             policy_dir: None,
-            shortlist: true,
             temperature: 0.0,
             max_tokens: 800,
             min_similarity: reply::MIN_SIMILARITY,
@@ -109,7 +132,7 @@ impl Default for Options {
             grammar: true,
             beams: DEFAULT_BEAMS,
             choose_reading: false,
-            without_misreadings: Vec::new(),
+            ablations: Ablations::default(),
         }
     }
 }

@@ -113,7 +113,11 @@ impl SttLayer {
 pub struct SttSettings {
     pub backend: SttBackend,
     pub model: String,
+    /// Without the credentials a URL may carry (they are `url_key`).
     pub base_url: String,
+    /// A key given inside the base URL (`http://user:KEY@host/v1`), taken out of it: sent
+    /// and redacted like a key from the environment, which wins when both are given.
+    pub url_key: Option<SttKey>,
     pub api_key_env: Option<String>,
     pub language: Option<String>,
     pub beam_size: usize,
@@ -158,8 +162,15 @@ impl SttSettings {
         let max_retries =
             crate::bounds::within("max_retries", layer.max_retries.unwrap_or(3), 0, 20)
                 .map_err(range)?;
+        let (base_url, url_key) = crate::http_text::split_credentials(
+            &layer
+                .base_url
+                .unwrap_or_else(|| "https://api.openai.com/v1".into()),
+        );
         Ok(SttSettings {
             backend,
+            base_url,
+            url_key,
             model: layer.model.unwrap_or_else(|| {
                 match backend {
                     SttBackend::Local => DEFAULT_LOCAL_MODEL,
@@ -167,9 +178,6 @@ impl SttSettings {
                 }
                 .to_string()
             }),
-            base_url: layer
-                .base_url
-                .unwrap_or_else(|| "https://api.openai.com/v1".into()),
             api_key_env: match layer.api_key_env {
                 Some(v) if v.is_empty() => None,
                 Some(v) => Some(v),
@@ -212,10 +220,14 @@ impl SttSettings {
             .and_then(var)
             .filter(|k| !k.is_empty())
             .map(SttKey::new);
-        let api_key_env = self.api_key_env.as_ref().map(|n| match api_key {
-            Some(_) => n.clone(),
-            None => format!("{n}, which is not set"),
-        });
+        let api_key_env = match (&api_key, &self.url_key) {
+            (None, Some(_)) => Some("the base URL".to_string()),
+            _ => self.api_key_env.as_ref().map(|n| match api_key {
+                Some(_) => n.clone(),
+                None => format!("{n}, which is not set"),
+            }),
+        };
+        let api_key = api_key.or_else(|| self.url_key.clone());
         OpenAiStt::new(OpenAiSttSettings {
             base_url: self.base_url.clone(),
             model: self.model.clone(),
@@ -268,6 +280,32 @@ mod tests {
         assert_eq!(s.model, DEFAULT_LOCAL_MODEL);
         assert_eq!(s.language, None);
         assert_eq!(s.api_key_env.as_deref(), Some("OPENAI_API_KEY"));
+    }
+
+    #[test]
+    fn a_key_inside_the_base_url_is_taken_out_and_used_as_the_key() {
+        let env = SttLayer::from_env(&|k| {
+            (k == "BETR_STT_BASE_URL").then(|| "http://user:sk-URLKEY@127.0.0.1:9/v1".to_string())
+        })
+        .unwrap();
+        let s = SttSettings::resolve(None, env, SttLayer::default()).unwrap();
+        assert!(!s.base_url.contains("sk-URLKEY"), "{}", s.base_url);
+        assert!(
+            s.base_url.starts_with("http://127.0.0.1:9/v1"),
+            "{}",
+            s.base_url
+        );
+        assert_eq!(s.url_key.as_ref().map(SttKey::expose), Some("sk-URLKEY"));
+        assert!(!format!("{s:?}").contains("sk-URLKEY"));
+        // No key in the environment: the URL's is sent, and named as where it came from.
+        let client = s.remote(&|_| None).unwrap();
+        assert!(!format!("{}", client.describe()).contains("sk-URLKEY"));
+        // One in the environment wins.
+        let s2 = s.clone();
+        assert!(
+            s2.remote(&|k| (k == "OPENAI_API_KEY").then(|| "sk-ENV".into()))
+                .is_ok()
+        );
     }
 
     #[test]
