@@ -513,34 +513,36 @@ async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() 
     .unwrap();
     assert_eq!(reading.answer.goal.to_string(), "On_Coffee_Table1");
     assert_eq!(reading.calls, 2);
-    let seen = model.seen.lock().unwrap();
     let grammar = |r: &ChatRequest| match &r.constraint {
         Some(OutputConstraint::Grammar { gbnf, .. }) => gbnf.clone(),
         other => panic!("not a grammar: {other:?}"),
     };
-    // The first question offers every object of the scene and asks for no goal.
-    let names = grammar(&seen[0]);
-    assert!(
-        names.contains("\"Table2\"") && names.contains("\"Coffee\""),
-        "{names}"
-    );
-    assert!(
-        seen[0]
-            .messages
-            .iter()
-            .any(|m| m.content.contains("Named: <name>"))
-    );
-    // The goal is typed over the named objects only.
-    let goal = grammar(&seen[1]);
-    assert!(goal.starts_with("root ::= \"Goal: \""), "{goal}");
-    assert!(
-        goal.contains("\"Table1\"") && goal.contains("\"Coffee\""),
-        "{goal}"
-    );
-    assert!(
-        !goal.contains("\"Table2\"") && !goal.contains("\"Tea\""),
-        "{goal}"
-    );
+    {
+        let seen = model.seen.lock().unwrap();
+        // The first question offers every object of the scene and asks for no goal.
+        let names = grammar(&seen[0]);
+        assert!(
+            names.contains("\"Table2\"") && names.contains("\"Coffee\""),
+            "{names}"
+        );
+        assert!(
+            seen[0]
+                .messages
+                .iter()
+                .any(|m| m.content.contains("Named: <name>"))
+        );
+        // The goal is typed over the named objects only.
+        let goal = grammar(&seen[1]);
+        assert!(goal.starts_with("root ::= \"Goal: \""), "{goal}");
+        assert!(
+            goal.contains("\"Table1\"") && goal.contains("\"Coffee\""),
+            "{goal}"
+        );
+        assert!(
+            !goal.contains("\"Table2\"") && !goal.contains("\"Tea\""),
+            "{goal}"
+        );
+    }
 
     // Off (the default): one call, typed over the whole scene.
     let model = NamesFirst {

@@ -205,7 +205,7 @@ pub fn goals_from_answers(
     scenario: &Path,
     out: Option<&Path>,
 ) -> Result<ExitCode> {
-    let cases = dataset::load(dataset_dir)?;
+    let cases = load_dataset(dataset_dir)?;
     let scenario = Scenario::load(scenario)?;
     let lines = goals::read_answers(answers, cases.len())?;
     let scored: Vec<goals::CaseResult> = cases
@@ -242,7 +242,7 @@ pub fn goals_with_model(
     runs: usize,
     flags: &RunFlags,
 ) -> Result<ExitCode> {
-    let cases = dataset::load(dataset_dir)?;
+    let cases = load_dataset(dataset_dir)?;
     let scenario = Scenario::load(scenario_path)?;
     let p = prepare(flags, &[("dataset", dataset_dir.display().to_string())])?;
     let dir =
@@ -542,4 +542,18 @@ pub fn session_experiment(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The goal dataset's cases; a dataset directory that is not there is said with where it
+/// was looked for (it is not shipped with betr: the default is beside the repository).
+fn load_dataset(dir: &Path) -> Result<Vec<dataset::Case>> {
+    if !dir.is_dir() {
+        bail!(
+            "the goal dataset {} is not there (it is not shipped with betr; the default is \
+             ../shared/datasets/llm-obtea beside the repository, so run from the repository's \
+             root or pass --dataset DIR)",
+            dir.display()
+        );
+    }
+    Ok(dataset::load(dir)?)
 }

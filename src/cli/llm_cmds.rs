@@ -168,6 +168,19 @@ pub fn ensure_local_model(settings: &Settings) -> Result<()> {
     Ok(())
 }
 
+/// The embedded model the settings ask for when it is not in the cache yet (none for a
+/// server, a model file given by path, or a model name betr does not know).
+pub fn local_model_to_fetch(settings: &Settings) -> Option<&'static betr::model::ModelSpec> {
+    if settings.backend != Backend::Local || settings.model_path.is_some() {
+        return None;
+    }
+    let spec = match settings.model.as_deref() {
+        None => betr::model::DEFAULT_MODEL,
+        Some(name) => betr::model::find(name)?,
+    };
+    (!spec.is_present()).then_some(spec)
+}
+
 /// The resolved settings and the session options the flags ask for (no model built yet).
 pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
     let var = |k: &str| std::env::var(k).ok();

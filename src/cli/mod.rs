@@ -2,6 +2,7 @@
 
 #[macro_use]
 pub mod out;
+mod background_fetch;
 mod bench_cmd;
 mod engine_driver;
 mod eval_cmd;
@@ -203,25 +204,12 @@ fn load_with(arg: &Path, knowledge: &knowledge_cmd::KnowledgeFlags) -> Result<Sc
     Ok(scenario)
 }
 
-/// The file a scenario argument names.
+/// The file a scenario argument names: a path as given, else a name under `scenarios/`
+/// of the working directory or the data directory, where the shipped scenarios are
+/// written on first use (`betr::scenario::catalog`).
 fn find_scenario(arg: &Path) -> Result<PathBuf> {
-    let candidates = [
-        arg.to_path_buf(),
-        Path::new("scenarios").join(arg),
-        Path::new("scenarios").join(arg).with_extension("toml"),
-    ];
-    let Some(path) = candidates.iter().find(|p| p.is_file()) else {
-        bail!(
-            "scenario {} not found (tried {})",
-            arg.display(),
-            candidates
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    };
-    Ok(path.clone())
+    let var = |k: &str| std::env::var(k).ok();
+    Ok(betr::scenario::catalog::Catalog::standard(&var).find(arg)?)
 }
 
 /// `A & ~B` → the literals, checked against the scenario's vocabulary.

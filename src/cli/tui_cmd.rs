@@ -1,7 +1,9 @@
 //! `betr` and `betr tui [SCENARIO]`: the workbench on a scenario (scenario 1 by default)
 //! with the configured model. A model that cannot be set up (no model name for a server,
 //! an embedded model file that cannot be fetched or loaded) is shown in the LLM pane; the
-//! rest of the workbench works.
+//! rest of the workbench works. An embedded model not in the cache yet is fetched while
+//! the workbench is open (`background_fetch`): its progress is in the status bar, it
+//! answers once it is loaded, and quitting cancels the fetch.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -12,6 +14,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use betr::llm::LanguageModel;
+use betr::llm::arriving::ArrivingModel;
 use betr::llm::usage::Ledger;
 use betr::session::{NoModel, PolicyStore, Setup};
 use betr::tui::dictation::{DefaultMicrophone, Microphone, WavMicrophone};
@@ -19,12 +22,10 @@ use betr::tui::{Info, KeyBindings, Theme, Workbench};
 
 use super::llm_cmds::{self, LlmFlags};
 
-/// The scenario the workbench opens when none is given (scenario 1).
-pub const DEFAULT_SCENARIO: &str = "scenarios/cell/red_on_blue.toml";
-
 #[derive(Args, Debug, Clone, Default)]
 pub struct TuiArgs {
-    /// Scenario file (default: scenarios/cell/red_on_blue.toml, the red cube on the blue cube).
+    /// Scenario file or name (default: cell/red_on_blue, the red cube on the blue cube),
+    /// looked for as given, under ./scenarios, then under $XDG_DATA_HOME/betr/scenarios.
     pub scenario: Option<PathBuf>,
     /// Apply every proposal of the model without asking (shown in the status bar).
     #[arg(long)]
@@ -67,7 +68,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let arg = args
         .scenario
         .clone()
-        .unwrap_or_else(|| PathBuf::from(DEFAULT_SCENARIO));
+        .unwrap_or_else(|| PathBuf::from(betr::scenario::catalog::DEFAULT_SCENARIO));
     let path = super::find_scenario(&arg)?;
     let microphone: Arc<dyn Microphone> = match &args.audio {
         Some(file) => {
@@ -94,19 +95,29 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
-    // First use fetches the local model with a progress bar, before the screen switches;
-    // a failed fetch leaves the workbench usable without a model and says why.
-    let model = llm_cmds::ensure_local_model(&settings)
-        .map_err(|e| NoModel::Unavailable(format!("{e:#}")))
-        .and_then(|()| {
-            settings
-                .build(ledger.clone(), &var)
-                .map_err(|e| NoModel::Unavailable(e.to_string()))
-        })
-        .map(|m| {
-            m.set_purpose("workbench");
-            Arc::new(m) as Arc<dyn LanguageModel>
-        });
+    // An embedded model not fetched yet arrives while the workbench is open; a failed
+    // fetch or load leaves the workbench usable without a model and says why.
+    let (arrival_report, arrivals) = tokio::sync::mpsc::unbounded_channel();
+    let mut background = None;
+    let model = match llm_cmds::local_model_to_fetch(&settings) {
+        Some(spec) => {
+            let arriving = Arc::new(ArrivingModel::new(
+                spec.name,
+                true,
+                false,
+                &format!("the model {} is not fetched yet", spec.name),
+            ));
+            background = Some(super::background_fetch::start(
+                spec,
+                settings.clone(),
+                ledger.clone(),
+                arriving.clone(),
+                arrival_report,
+            )?);
+            Ok(arriving as Arc<dyn LanguageModel>)
+        }
+        None => ready_model(&settings, &ledger, &var),
+    };
     let model_name = match settings.backend {
         betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
         _ => settings.model.clone(),
@@ -188,13 +199,39 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         stt: loader,
         stderr_to: log_path(),
         tree: args.tree.clone(),
+        model_arrival: background.is_some().then_some(arrivals),
     };
-    runtime.block_on(betr::tui::run(
+    let ran = runtime.block_on(betr::tui::run(
         setup,
         workbench,
         (!tap.is_empty()).then_some(&mut tap as &mut dyn betr::tui::Tap),
-    ))?;
+    ));
+    // Quitting while the model is fetched stops the fetch and removes what it wrote.
+    if let Some(fetch) = background {
+        fetch.cancel();
+    }
+    ran?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The configured model when nothing needs fetching: a server's client, or the embedded
+/// model loaded from its file.
+fn ready_model(
+    settings: &betr::llm::config::Settings,
+    ledger: &Ledger,
+    var: &dyn Fn(&str) -> Option<String>,
+) -> Result<Arc<dyn LanguageModel>, NoModel> {
+    llm_cmds::ensure_local_model(settings)
+        .map_err(|e| NoModel::Unavailable(format!("{e:#}")))
+        .and_then(|()| {
+            settings
+                .build(ledger.clone(), var)
+                .map_err(|e| NoModel::Unavailable(e.to_string()))
+        })
+        .map(|m| {
+            m.set_purpose("workbench");
+            Arc::new(m) as Arc<dyn LanguageModel>
+        })
 }
 
 /// Where the key bindings file is looked for when none is given.

@@ -7,6 +7,7 @@
 //! wrapped by a [`cassette::Recorder`], and anything by a [`usage::Metered`] model that
 //! accounts every call.
 
+pub mod arriving;
 pub mod cassette;
 pub mod config;
 pub mod examples;
@@ -213,6 +214,10 @@ pub enum LlmError {
     Cassette { path: String, detail: String },
     #[error("local model: {0}")]
     Local(String),
+    /// The model is not there yet (still being fetched or loaded), or will not come: what
+    /// it waits for or why.
+    #[error("{0}")]
+    NotReady(String),
     /// The prompt and the reply it may take are longer than the model's context window:
     /// this question cannot be asked as it is, others can.
     #[error(

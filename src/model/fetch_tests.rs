@@ -262,3 +262,65 @@ fn fetch_dir_with_a_wrong_hash_installs_nothing() {
     assert!(leftovers(&cache).is_empty(), "{:?}", leftovers(&cache));
     fs::remove_dir_all(&root).unwrap();
 }
+
+/// Progress that reports its downloaded bytes and gives up once `give_up_at` bytes of the
+/// download are seen.
+struct GivesUp {
+    give_up_at: u64,
+    seen: u64,
+}
+
+impl Progress for GivesUp {
+    fn stage(&mut self, _: &str) {}
+    fn bytes(&mut self, done: u64, _: u64) {
+        self.seen = self.seen.max(done);
+    }
+    fn cancelled(&self) -> bool {
+        self.seen >= self.give_up_at
+    }
+}
+
+#[test]
+fn a_cancelled_fetch_stops_pip_and_installs_nothing() {
+    let root = scratch("cancel");
+    let (spec, _) = setup(&root, None);
+    // A pip that writes part of a download into its temporary directory, then hangs; it
+    // runs as the child of the `python3` started, as behind a version manager's shim.
+    let python = root.join("slow-python3");
+    let pid_file = root.join("pip.pid");
+    fs::write(
+        &python,
+        format!(
+            "#!/bin/sh\nsleep 60 &\necho $! > {}\nprintf 'half a wheel' > \"$TMPDIR/partial.whl\"\nwait\n",
+            pid_file.display()
+        ),
+    )
+    .unwrap();
+    fs::set_permissions(&python, fs::Permissions::from_mode(0o755)).unwrap();
+    let cache = root.join("cache");
+    let started = std::time::Instant::now();
+    let mut progress = GivesUp {
+        give_up_at: 1,
+        seen: 0,
+    };
+    let err = fetch(&spec, &cache, python.to_str().unwrap(), &mut progress).unwrap_err();
+    assert!(matches!(err, FetchError::Cancelled), "{err}");
+    // The download's bytes were seen as they grew, and pip did not run its minute.
+    assert_eq!(progress.seen, "half a wheel".len() as u64);
+    assert!(started.elapsed() < Duration::from_secs(20));
+    assert!(leftovers(&cache).is_empty(), "{:?}", leftovers(&cache));
+    // The "pip" under the shim is gone too (or a zombie waiting for its reaper).
+    let stat = Path::new("/proc")
+        .join(fs::read_to_string(&pid_file).unwrap().trim())
+        .join("stat");
+    let deadline = std::time::Instant::now() + Duration::from_secs(5);
+    while fs::read_to_string(&stat).is_ok_and(|s| !s.contains(") Z ")) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "{} still runs",
+            stat.display()
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    fs::remove_dir_all(&root).unwrap();
+}

@@ -533,7 +533,7 @@ mod tests {
             "[[examples]]\ninstruction = \"a\"\ngoal = \"Holding_Cup\"\n\n[[examples]]\ninstruction = \"b\"\ngoal = \"Holding_Cup_Chips\"\n",
         )
         .unwrap();
-        let with_pool = BASE.replace("name = \"t\"\n", "name = \"t\"\n").replacen(
+        let with_pool = BASE.replacen(
             "[scenario]",
             "example_pool = \"pool.toml\"\n\n[scenario]",
             1,

@@ -13,7 +13,9 @@ use serde::Deserialize;
 use toml::Spanned;
 
 mod build;
+pub mod catalog;
 mod file;
+mod shipped;
 
 use crate::domain::Atom;
 use crate::domain::names::{MIN_SIMILARITY, did_you_mean, nearest};

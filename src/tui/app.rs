@@ -41,6 +41,17 @@ pub struct Info {
     pub keys_error: Option<String>,
 }
 
+/// How a model fetched or loaded while the workbench is open comes along.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ModelArrival {
+    /// Where the fetch stands, in a few words for the status bar.
+    Progress(String),
+    /// The model is there and answers from now on.
+    Ready,
+    /// It will not come: why.
+    Failed(String),
+}
+
 /// What a component asks of the app (the event queue between them).
 #[derive(Debug, Clone, PartialEq)]
 pub enum AppEvent {
@@ -375,6 +386,20 @@ impl App {
     }
 
     /// What the push-to-talk service reports.
+    pub fn on_model(&mut self, arrival: ModelArrival) {
+        match arrival {
+            ModelArrival::Progress(text) => self.status.fetching = Some(text),
+            ModelArrival::Ready => {
+                self.status.fetching = None;
+                self.llm.log(strings::MODEL_READY);
+            }
+            ModelArrival::Failed(why) => {
+                self.status.fetching = None;
+                self.llm.error = Some(strings::no_model(&why));
+            }
+        }
+    }
+
     pub fn on_dictation(&mut self, event: DictationEvent) {
         match event {
             DictationEvent::Recording { device } => {

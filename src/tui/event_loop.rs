@@ -16,7 +16,7 @@ use tokio::task::JoinHandle;
 
 use crate::session::{Command, EngineHandle, Event};
 
-use super::app::{App, Request};
+use super::app::{App, ModelArrival, Request};
 use super::dictation::{DictationEvent, DictationService, DictationSink};
 use super::ui;
 
@@ -36,6 +36,8 @@ pub enum QueueEvent {
     SessionEnded,
     /// From the push-to-talk service.
     Dictation(DictationEvent),
+    /// From a model fetched or loaded while the workbench is open.
+    Model(ModelArrival),
     /// Time to move animations on; sent only while something animates.
     Tick,
 }
@@ -107,6 +109,20 @@ fn read_input(queue: &UnboundedSender<QueueEvent>, stop: &AtomicBool) -> bool {
         }
     }
     true
+}
+
+/// Pass a model's arrival into the queue until it has arrived or failed.
+pub fn forward_model(
+    mut arrivals: UnboundedReceiver<ModelArrival>,
+    queue: UnboundedSender<QueueEvent>,
+) -> JoinHandle<()> {
+    tokio::spawn(async move {
+        while let Some(a) = arrivals.recv().await {
+            if queue.send(QueueEvent::Model(a)).is_err() {
+                return;
+            }
+        }
+    })
 }
 
 /// Pass the session's events into the queue, then say that the session ended.
@@ -219,6 +235,7 @@ fn dispatch(app: &mut App, event: QueueEvent, out: &mut Outlets, animated: &mut 
             app.on_session(e);
         }
         QueueEvent::Dictation(e) => app.on_dictation(e),
+        QueueEvent::Model(m) => app.on_model(m),
         QueueEvent::Tick => {
             // The ticker may not know yet that the animation stopped.
             if !*animated && app.animating() {

@@ -42,7 +42,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationService, Microphone, SttLoader};
 
-pub use app::{App, Info, Request};
+pub use app::{App, Info, ModelArrival, Request};
 pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
@@ -113,6 +113,9 @@ pub struct Workbench {
     pub stderr_to: Option<PathBuf>,
     /// A tree file to open instead of planning (betr text, a policy, BT.CPP XML).
     pub tree: Option<PathBuf>,
+    /// How a model fetched or loaded while the workbench is open comes along (shown in the
+    /// status bar); the model itself reaches the session by the setup's model.
+    pub model_arrival: Option<tokio::sync::mpsc::UnboundedReceiver<app::ModelArrival>>,
 }
 
 /// Open the workbench on `setup` until the person quits.
@@ -129,6 +132,7 @@ pub async fn run(
         stt,
         stderr_to,
         tree,
+        model_arrival,
     } = workbench;
     let scenario = setup.scenario.clone();
     let (engine, events) = Engine::spawn(setup)?;
@@ -142,6 +146,7 @@ pub async fn run(
     let mut dictation = DictationService::reporting_to(microphone, stt, queue.dictation_sink());
     let stop = Arc::new(AtomicBool::new(false));
     event_loop::spawn_input_reader(queue.sender(), stop.clone());
+    let arrivals = model_arrival.map(|a| event_loop::forward_model(a, queue.sender()));
     event_loop::run(
         &mut terminal,
         &mut app,
@@ -153,6 +158,9 @@ pub async fn run(
     )
     .await;
     stop.store(true, Ordering::Relaxed);
+    if let Some(a) = arrivals {
+        a.abort();
+    }
     // A recording still open is discarded with the service, before the screen goes.
     drop(dictation);
     Ok(())

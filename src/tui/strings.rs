@@ -191,6 +191,9 @@ pub fn success(ticks: u64) -> String {
     format!("SUCCESS after {ticks} tick(s)")
 }
 
+/// Said in the LLM pane's log when a model fetched while the workbench was open is there.
+pub const MODEL_READY: &str = "The model is fetched and loaded: instructions are read from now on.";
+
 pub fn no_model(why: &str) -> String {
     format!(
         "No language model: {why}. You can still type goal formulas, plan, tick, and type conditions with e."

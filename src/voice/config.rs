@@ -299,7 +299,7 @@ mod tests {
         assert!(!format!("{s:?}").contains("sk-URLKEY"));
         // No key in the environment: the URL's is sent, and named as where it came from.
         let client = s.remote(&|_| None).unwrap();
-        assert!(!format!("{}", client.describe()).contains("sk-URLKEY"));
+        assert!(!client.describe().to_string().contains("sk-URLKEY"));
         // One in the environment wins.
         let s2 = s.clone();
         assert!(

@@ -35,11 +35,17 @@ pub fn dataset_dir() -> PathBuf {
     root().join("../shared/datasets/llm-obtea")
 }
 
-/// The binary run from the repository's root.
+/// The binary run from the repository's root, its data directory (where it would write
+/// the shipped scenarios and policies) a scratch one under the target directory rather
+/// than the home directory of whoever runs the tests.
 pub fn betr(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_betr"))
         .args(args)
         .current_dir(root())
+        .env(
+            "XDG_DATA_HOME",
+            Path::new(env!("CARGO_TARGET_TMPDIR")).join("repo-data"),
+        )
         .output()
         .expect("the betr binary runs")
 }

@@ -1,4 +1,4 @@
-//! The status bar: scenario, backend and model, calls, tokens and cost so far, tick
+//! The status bar: scenario, backend and model (and its fetch's progress), calls, tokens and cost so far, tick
 //! count, run/pause state, the last outcome, and the auto-approve warning. In a replay,
 //! the timeline instead: the step it stands on of how many, the tick, the step's time and
 //! what the step was.
@@ -54,6 +54,8 @@ pub struct StatusBar {
     pub break_on_failure: bool,
     /// What a failure waits for (the model's proposal, a person's approval).
     pub awaiting: Option<&'static strings::Awaiting>,
+    /// Where the model's fetch stands while the workbench is open without it.
+    pub fetching: Option<String>,
     /// Said once when a 3D viewer was asked for and is not there.
     pub viewer: Option<String>,
     /// Takes the bar's middle while it is there.
@@ -113,6 +115,15 @@ impl StatusBar {
             sep.clone(),
             Span::styled(who, theme.status_bar),
             sep.clone(),
+        ];
+        if let Some(fetching) = &self.fetching {
+            spans.push(Span::styled(
+                fetching.clone(),
+                theme.status_bar.patch(theme.running),
+            ));
+            spans.push(sep.clone());
+        }
+        spans.extend([
             Span::styled(
                 strings::calls(
                     self.usage.calls,
@@ -134,7 +145,7 @@ impl StatusBar {
                 ),
                 (false, None) => Span::styled(strings::PAUSED, theme.status_bar),
             },
-        ];
+        ]);
         match self.ending {
             Some(Ending::Success) => {
                 spans.push(sep.clone());

