@@ -15,7 +15,7 @@ use crate::goal::Formula;
 use crate::scenario::Example;
 
 use super::english::is_generic;
-use super::words::{is_number, same_word, terms};
+use super::words::{same_word, terms};
 
 /// How many examples must use a word with an object before it is taken as the object's
 /// word: one example's "sitting" is not a soft drink's word because the example asked a
@@ -32,8 +32,6 @@ pub struct Lexicon {
     words: HashMap<String, Vec<String>>,
     /// The words of the objects' own names (table, 6, coffee, station, ...).
     object_words: Vec<String>,
-    /// Each object's own name words, for the objects whose name has a number.
-    numbered: Vec<Vec<String>>,
     /// Words that name an object by themselves: a one-word name (`Chips`) or a one-word
     /// thing it is called ("fries"), not a part of a longer name ("area" of `LoungeArea`).
     whole_names: Vec<String>,
@@ -79,13 +77,6 @@ impl Lexicon {
             .collect();
         object_words.sort_unstable();
         object_words.dedup();
-        let numbered: Vec<Vec<String>> = vocabulary
-            .objects
-            .iter()
-            .filter_map(|o| words.get(&o.name))
-            .filter(|own| own.iter().any(|w| is_number(w)))
-            .cloned()
-            .collect();
         // How many examples use each word, and each word together with each symbol.
         let mut uses: HashMap<String, usize> = HashMap::new();
         let mut together: HashMap<(String, String), usize> = HashMap::new();
@@ -148,7 +139,6 @@ impl Lexicon {
         Lexicon {
             words,
             object_words,
-            numbered,
             whole_names,
         }
     }
@@ -162,30 +152,6 @@ impl Lexicon {
     /// longer name ("area", "table").
     pub fn names_an_object_alone(&self, word: &str) -> bool {
         self.whole_names.iter().any(|w| same_word(w, word))
-    }
-
-    /// The numbers of `request` (as [`terms`] gives them) that number a place: a word
-    /// next to the number, or one word further, is in the name of an object with that
-    /// number ("table six", "the third table", "quiet table number eight"), where "one of
-    /// the paper cups" numbers nothing.
-    pub fn place_numbers(&self, request: &[String]) -> Vec<String> {
-        let mut out: Vec<String> = Vec::new();
-        for (i, n) in request.iter().enumerate() {
-            if !is_number(n) || out.contains(n) {
-                continue;
-            }
-            let near = &request[i.saturating_sub(2)..(i + 3).min(request.len())];
-            let numbers_a_place = self.numbered.iter().any(|own| {
-                own.contains(n)
-                    && near
-                        .iter()
-                        .any(|w| w != n && own.iter().any(|o| same_word(o, w)))
-            });
-            if numbers_a_place {
-                out.push(n.clone());
-            }
-        }
-        out
     }
 
     /// The words `symbol` answers to (none for a name the scene does not have).
@@ -294,17 +260,6 @@ mod tests {
             instruction: instruction.into(),
             goal: goal.into(),
         }
-    }
-
-    #[test]
-    fn only_a_number_beside_a_numbered_name_numbers_a_place() {
-        let lexicon = Lexicon::new(&vocabulary(), &[]);
-        let numbers = |request: &str| lexicon.place_numbers(&terms(request));
-        assert_eq!(numbers("Bring coffee to table six"), ["6"]);
-        assert_eq!(numbers("I'm at the sixth table by the window"), ["6"]);
-        assert!(numbers("Give me one of the coffees").is_empty());
-        // Six is a number here, but no place of this scene is numbered 2.
-        assert!(numbers("Bring coffee to table two").is_empty());
     }
 
     #[test]

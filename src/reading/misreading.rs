@@ -7,7 +7,6 @@
 //!
 //! | name | finds | undoes it by |
 //! |---|---|---|
-//! | `place-number` | a place number the request says that no condition is about ("table six" read as `Table1`) | renaming the numbered place to the one of its kind with that number |
 //! | `reversed-relation` | a relation with its objects the other way round from the request ("the blue cube on the green cube" read as green on blue) | turning it round |
 //! | `swapped-object` | an object no word names in the place of one a word names alone ("fries" read as coffee) | putting the named object back, when the request names one of that kind |
 //! | `turned-around` | a condition the other way round from the request's words ("do not open the curtain" read as open) | turning it back |
@@ -15,20 +14,17 @@
 //! | `relation-as-said` | a relation other than the one the request says before the place ("in the crib" read as on) | the relation said |
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
-//! | `left-out` | one of two things named side by side left out ("fries or a dessert" read as the dessert) | the one left out put beside the other |
-//! | `measure-for-content` | a measure in the place of what it holds ("a glass of water" read as the glass) | what it holds |
 
 use crate::domain::Vocabulary;
 use crate::goal::Formula;
 use crate::scenario::Scenario;
 
 use super::lexicon::Lexicon;
-use super::names::{renumbered, swapped_back, swapped_object, unanswered_names};
+use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::relation_words::{convention_followed, relation_as_said};
-use super::side_by_side::{left_out, measure_for_content, with_content, with_left_out};
 use super::words::terms;
 
 /// A request read once, with the scene it is read in: what every detector looks at.
@@ -37,8 +33,6 @@ pub struct Request<'a> {
     pub text: &'a str,
     /// Its words as [`terms`] gives them.
     pub terms: Vec<String>,
-    /// The place numbers it says (`6` of "table six", when a place of the scene has it).
-    pub place_numbers: Vec<String>,
     pub scenario: &'a Scenario,
     pub lexicon: &'a Lexicon,
 }
@@ -48,7 +42,6 @@ impl<'a> Request<'a> {
     pub fn new(text: &'a str, scenario: &'a Scenario, lexicon: &'a Lexicon) -> Self {
         let terms = terms(text);
         Request {
-            place_numbers: lexicon.place_numbers(&terms),
             terms,
             text,
             scenario,
@@ -58,14 +51,6 @@ impl<'a> Request<'a> {
 
     pub fn vocabulary(&self) -> &'a Vocabulary {
         &self.scenario.domain.vocabulary
-    }
-
-    /// The place numbers the request says that no condition of `goal` is about.
-    pub fn missing_numbers(&self, goal: &Formula) -> Vec<String> {
-        unanswered_names(goal, self.text, self.lexicon)
-            .into_iter()
-            .filter(|w| self.place_numbers.contains(w))
-            .collect()
     }
 }
 
@@ -82,7 +67,6 @@ pub trait Misreading: Sync {
 
 /// Every detector, in the order their findings are told and their undoing tried.
 pub const MISREADINGS: &[&dyn Misreading] = &[
-    &PlaceNumber,
     &ReversedRelation,
     &SwappedObject,
     &TurnedAround,
@@ -90,8 +74,6 @@ pub const MISREADINGS: &[&dyn Misreading] = &[
     &RelationAsSaid,
     &Convention,
     &NotPut,
-    &LeftOut,
-    &MeasureForContent,
 ];
 
 /// A misreading named that no detector has.
@@ -122,33 +104,6 @@ pub fn misreadings_without(
         .copied()
         .filter(|m| !without.iter().any(|n| n == m.name()))
         .collect())
-}
-
-struct PlaceNumber;
-impl Misreading for PlaceNumber {
-    fn name(&self) -> &'static str {
-        "place-number"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        let numbers = request.missing_numbers(goal);
-        (!numbers.is_empty()).then(|| {
-            format!(
-                "the request says {}, and no condition of {goal} is about it",
-                numbers.join(", ")
-            )
-        })
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        renumbered(goal, &request.missing_numbers(goal), request.vocabulary())
-            .map(|(g, from, to)| {
-                (
-                    g,
-                    format!("the request numbers a place the answer does not: {to} is the only one like {from} with that number"),
-                )
-            })
-            .into_iter()
-            .collect()
-    }
 }
 
 struct ReversedRelation;
@@ -328,59 +283,6 @@ impl Misreading for NotPut {
     }
 }
 
-struct LeftOut;
-impl Misreading for LeftOut {
-    fn name(&self) -> &'static str {
-        "left-out"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        left_out(goal, request.text, request.vocabulary()).map(|gap| {
-            format!(
-                "the request names {} beside {}, and {goal} leaves {} out",
-                gap.left_out, gap.kept, gap.left_out
-            )
-        })
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        with_left_out(goal, request.text, request.vocabulary())
-            .map(|g| {
-                (
-                    g,
-                    format!("the request names things side by side that {goal} has only one of"),
-                )
-            })
-            .into_iter()
-            .collect()
-    }
-}
-
-struct MeasureForContent;
-impl Misreading for MeasureForContent {
-    fn name(&self) -> &'static str {
-        "measure-for-content"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        measure_for_content(goal, request.text, request.vocabulary()).map(|(measure, content)| {
-            format!(
-                "the request asks for {content} by the {measure}, and {goal} has the {measure} in its place"
-            )
-        })
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        with_content(goal, request.text, request.vocabulary())
-            .map(|g| {
-                (
-                    g,
-                    format!(
-                        "the request names a measure of something that {goal} has in its place"
-                    ),
-                )
-            })
-            .into_iter()
-            .collect()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -411,8 +313,8 @@ mod tests {
             err.contains("\"polarity\"") && err.contains("turned-around"),
             "{err}"
         );
-        let kept = misreadings_without(&["left-out".into()]).expect("a known name");
+        let kept = misreadings_without(&["convention".into()]).expect("a known name");
         assert_eq!(kept.len(), MISREADINGS.len() - 1);
-        assert!(!kept.iter().any(|m| m.name() == "left-out"));
+        assert!(!kept.iter().any(|m| m.name() == "convention"));
     }
 }

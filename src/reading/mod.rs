@@ -6,7 +6,7 @@
 //! wishes it is made of ([`parts`]); and the plain misreadings of a request, each a
 //! detector registered in one list ([`misreading`]), built on what a request's words say
 //! about conditions ([`polarity`]), about items sent to places ([`placement`]), about
-//! things named side by side ([`side_by_side`]), about the relation said before a place
+//! the relation said before a place
 //! and a scene's conventions ([`relation_words`]), and about a goal's objects and
 //! conjuncts ([`names`]), and about the order of a relation's objects ([`order`]).
 //!
@@ -22,7 +22,6 @@ pub mod parts;
 pub mod placement;
 pub mod polarity;
 pub mod relation_words;
-pub mod side_by_side;
 pub mod words;
 
 pub use lexicon::Lexicon;
