@@ -425,7 +425,10 @@ fn small_terminal_stays_usable() {
         let mut b = Bench::start();
         b.step_to_failure().await;
         let screen = b.screen(80, 24);
-        assert!(screen.contains("Proposal for"), "{screen}");
+        // The proposal and its keys stay on the pane's border; its findings lead inside.
+        assert!(screen.contains("proposed: ~\"any object\" on"), "{screen}");
+        assert!(screen.contains("a approve · x reject"), "{screen}");
+        assert!(screen.contains("Found by betr:"), "{screen}");
         assert!(screen.contains("tick"), "{screen}");
         insta::assert_snapshot!("small_terminal_80x24", screen);
         // Even tinier terminals draw without panicking.

@@ -11,7 +11,7 @@ use crate::llm::reply::{self, ReplyError};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
-use super::screen::{NotHelped, Screen};
+use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
 use super::value_bounds::Bounds;
@@ -89,6 +89,10 @@ pub(crate) struct Asked {
     pub unusable: usize,
     /// Who wrote the chosen proposal when it was not the model's reply.
     pub author: Option<String>,
+    /// The conditions tried in simulation before the model was asked, when they were.
+    pub shortlist: Option<Shortlist>,
+    /// What the chosen proposal did in simulation.
+    pub verdict: Option<Verdict>,
 }
 
 /// Who proposes a value midway between values the world refused on either side.
@@ -146,6 +150,8 @@ async fn draw_and_screen(
         rejected: Vec::new(),
         unusable: 0,
         author: None,
+        shortlist: None,
+        verdict: None,
     };
     let draws = options.candidates.max(1);
     for draw in 0..draws {
@@ -198,7 +204,8 @@ async fn draw_and_screen(
             continue;
         }
         match screen_one(screen, bounds, (&proposal, None), emit) {
-            Ok(()) => {
+            Ok(verdict) => {
+                asked.verdict = Some(verdict);
                 asked.chosen = Some((proposal, reasoning));
                 return Ok(asked);
             }
@@ -208,16 +215,17 @@ async fn draw_and_screen(
     Ok(asked)
 }
 
-/// Try `proposal` (by `author`, `None`: the model) in `screen`: Ok when it fixes the
+/// Try `proposal` (by `author`, `None`: the model) in `screen`: how it fixes the
 /// failure, else what happened (reported, and learned into `bounds` for a value).
 fn screen_one(
     screen: &Screen,
     bounds: &mut Bounds,
     (proposal, author): (&Proposal, Option<&str>),
     emit: &mut (dyn FnMut(&Event) + Send),
-) -> Result<(), NotHelped> {
-    let Err(why) = screen.check(proposal) else {
-        return Ok(());
+) -> Result<Verdict, NotHelped> {
+    let why = match screen.try_change(proposal) {
+        Ok(verdict) => return Ok(verdict),
+        Err(why) => why,
     };
     let told = why.to_string();
     emit(&Event::CandidateRejected {
@@ -300,7 +308,7 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let choices = if options.shortlist {
+    let list = if options.shortlist {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a
@@ -310,10 +318,11 @@ pub(crate) async fn ask_conditions(
         emit(&Event::Notice {
             message: shortlist_notice(&list, before - list.fixes.len()),
         });
-        list.fixes
+        Some(list)
     } else {
-        Vec::new()
+        None
     };
+    let choices = list.as_ref().map(|l| l.fixes.clone()).unwrap_or_default();
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
@@ -339,7 +348,7 @@ pub(crate) async fn ask_conditions(
             )
         })
     };
-    draw_and_screen(
+    let mut asked = draw_and_screen(
         model,
         messages,
         (schema::conditions(vocabulary), &conditions_grammar),
@@ -349,7 +358,9 @@ pub(crate) async fn ask_conditions(
         &read,
         emit,
     )
-    .await
+    .await?;
+    asked.shortlist = list;
+    Ok(asked)
 }
 
 pub(crate) async fn ask_value(
@@ -458,7 +469,8 @@ pub(crate) async fn ask_value(
         });
         let midway = proposal(value);
         match screen_one(screen, &mut bounds, (&midway, Some(MIDWAY)), emit) {
-            Ok(()) => {
+            Ok(verdict) => {
+                asked.verdict = Some(verdict);
                 asked.chosen = Some((midway, Some(between)));
                 asked.author = Some(MIDWAY.to_string());
             }

@@ -226,6 +226,9 @@ pub enum Event {
         goal: Formula,
         reasoning: Option<String>,
         matches_expected: Option<bool>,
+        /// Where the goal came from: `model` (the reply's attribution says which), a
+        /// person, a policy file, the scenario file.
+        author: String,
     },
     /// The instruction has more than one reading that would make the robot do different
     /// things, or one the checks doubt (`doubt`, why): the person chooses one
@@ -246,8 +249,12 @@ pub enum Event {
     /// narrowed it, a person, betr's midway value).
     Proposal {
         proposal: Proposal,
+        /// The author's own reasoning (a model's is checked against the evidence).
         reasoning: Option<String>,
         author: String,
+        /// What betr itself found about the failure and the change, shown first; `None`
+        /// when the change was not asked of a model (a person's edit).
+        evidence: Option<super::evidence::Evidence>,
     },
     Approved,
     Rejected,

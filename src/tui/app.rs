@@ -62,7 +62,11 @@ pub enum Request {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
     Help,
-    Report(Vec<String>),
+    /// Lines in a box, under a title that says what they are.
+    Report {
+        title: &'static str,
+        lines: Vec<String>,
+    },
     /// The readings of an instruction, waiting for the person to choose one.
     Readings(Vec<crate::session::Reading>, Option<String>),
 }
@@ -317,6 +321,7 @@ impl App {
                 self.overlay = Some(Overlay::Help);
                 return;
             }
+            Action::Details => return self.show_details(),
             Action::LogUp => return self.llm.scroll_log_up(),
             Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
@@ -362,6 +367,17 @@ impl App {
             }
         };
         self.queue.push(AppEvent::Dictation(request));
+    }
+
+    /// Everything the panes may cut: the pending proposal whole (betr's findings, the
+    /// proposal, its author's reasoning), else the selected node's whole label.
+    fn show_details(&mut self) {
+        let (title, lines) = match (&self.llm.proposal, self.tree.selected_details(&self.theme)) {
+            (Some(p), _) => (strings::PROPOSAL_DETAILS_TITLE, p.details()),
+            (None, Some(lines)) => (strings::NODE_DETAILS_TITLE, lines),
+            (None, None) => return self.message(strings::NOTHING_TO_DETAIL.to_string(), true),
+        };
+        self.overlay = Some(Overlay::Report { title, lines });
     }
 
     fn message(&mut self, text: String, error: bool) {

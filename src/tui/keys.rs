@@ -37,6 +37,8 @@ pub enum Action {
     Breakpoint,
     Force,
     BreakOnFailure,
+    /// The pending proposal, or the selected node, whole in an overlay.
+    Details,
     LogUp,
     LogDown,
     Help,
@@ -307,6 +309,7 @@ bindings! {
     previous_model_call: PreviousModelCall = Key::plain('M'), Replay;
     start: Start = Key::plain('g'), Replay;
     end: End = Key::plain('G'), Replay;
+    details: Details = Key::plain('D'), Both;
     log_up: LogUp = Key::plain('['), Both;
     log_down: LogDown = Key::plain(']'), Both;
     help: Help = Key::plain('?'), Both;
@@ -421,7 +424,7 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "b", "f", "B", "[", "]", "?", "q"
+                "g", "w", "b", "f", "B", "D", "[", "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -477,7 +480,7 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "[", "]", "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "[", "]", "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

@@ -13,6 +13,12 @@ pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, 
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";
 pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
+pub const VIOLATION_TITLE: &str = " The change fails verification (any key closes) ";
+pub const RULES_TITLE: &str = " Rules learned from approved fixes (any key closes) ";
+pub const PROPOSAL_DETAILS_TITLE: &str = " The proposal, whole (any key closes) ";
+pub const NODE_DETAILS_TITLE: &str = " The selected node, whole (any key closes) ";
+pub const NOTHING_TO_DETAIL: &str =
+    "nothing to show whole: no proposal is pending and no node is selected (↑ ↓)";
 pub const READINGS_TITLE: &str = " Readings of the instruction (press a number; Esc: none) ";
 pub const READINGS_INTRO: &str =
     "The instruction can be read in ways that make the robot do different things:";
@@ -45,12 +51,43 @@ pub const AWAITING_VIOLATION: Awaiting = Awaiting {
     short: "violates",
 };
 pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, reject it (x: undone, and the model is asked again knowing why), or undo it (u).";
-pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
 pub const ASKING: &str = "asking the model for";
-pub const REPLY_FROM: &str = "reply from";
-pub const GOAL: &str = "Goal:";
+/// Above what betr itself established about a failure.
+pub const FOUND_BY_BETR: &str = "Found by betr:";
+pub const GOAL: &str = "Goal";
+
+/// The LLM pane's border while a proposal waits.
+pub fn proposed_title(proposal: &str) -> String {
+    format!(" proposed: {proposal} ")
+}
+
+/// Who a proposal is by.
+pub fn proposal_by(target: &str, author: &str) -> String {
+    format!("{PROPOSAL_FOR} {target} (by {author}):")
+}
+
+/// Above an author's own reasoning: labelled as theirs, and as doubtful when the
+/// evidence does not bear it out.
+pub fn reasoning_of(author: &str, doubt: Option<&str>) -> String {
+    match doubt {
+        Some(why) => format!(
+            "Reasoning of {author}, DOUBTFUL ({why}); not the reason, betr's findings above are:"
+        ),
+        None => format!("Reasoning of {author} (its words; the findings above are betr's):"),
+    }
+}
+
+/// Under the goal: who wrote it.
+pub fn goal_by(author: &str) -> String {
+    format!("  from {author}")
+}
+
+/// Who answered the last model call.
+pub fn last_reply(who: &str) -> String {
+    format!("last reply from {who}")
+}
 pub const LOG: &str = "Log";
 
 /// The marker under a log scrolled up: how many rows are below.
@@ -70,6 +107,7 @@ pub const SUCCESS: &str = "SUCCESS";
 pub const FAILED: &str = "FAILED";
 pub const HELP_WORD: &str = "help";
 pub const NEW_MARK: &str = "+";
+pub const ADDED_BY_LAST_CHANGE: &str = "+ added by the last change";
 pub const FAILED_MARK: &str = "◀ failed";
 /// After a node with a breakpoint.
 pub const BREAKPOINT_MARK: &str = "● break";
@@ -124,6 +162,7 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Breakpoint => "set / clear a breakpoint on the selected node",
         Force => "force the selected node: failure, success, running, off",
         BreakOnFailure => "break on failure: stop running when a node fails",
+        Details => "show whole what a pane cuts: the proposal, else the selected node",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",
@@ -177,6 +216,11 @@ pub fn verified_tree(origin: &str) -> String {
 
 pub fn exported(paths: &[String]) -> String {
     format!("tree written to {}", paths.join(" and "))
+}
+
+/// An approved proposal in the log, with who proposed it.
+pub fn approved(change: &str, target: &str, author: &str) -> String {
+    format!("approved {change} for {target} (proposed by {author})")
 }
 
 pub fn repaired(added: usize, valued: usize) -> String {

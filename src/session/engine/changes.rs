@@ -9,6 +9,7 @@ use crate::planner::Planner;
 
 use super::super::ask::{Tried, missing_value};
 use super::super::edit::Edit;
+use super::super::evidence::Evidence;
 use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
@@ -142,13 +143,27 @@ impl Engine {
             Some((proposal, dropped)) => {
                 let dropped: Vec<String> = dropped.iter().map(ToString::to_string).collect();
                 let author = format!("simulation, narrowed from {}", pending.author);
+                let mut findings: Vec<String> = before
+                    .map(|f| format!("{}! failed: {}", f.action, f.error))
+                    .into_iter()
+                    .collect();
+                findings.push(format!(
+                    "{} was approved and did not fix the failure in the execution world",
+                    pending.proposal
+                ));
+                findings.push(format!(
+                    "in simulation, it works without {}: only the rest fixes the failure",
+                    dropped.join(" & ")
+                ));
                 self.emit(Event::Proposal {
                     proposal: proposal.clone(),
-                    reasoning: Some(format!(
-                        "In simulation, the proposal works without {}: only the rest fixes the failure.",
-                        dropped.join(" & ")
-                    )),
+                    reasoning: None,
                     author: author.clone(),
+                    evidence: Some(Evidence {
+                        findings,
+                        objects: before.map(|f| f.action.args.clone()).unwrap_or_default(),
+                        doubt: None,
+                    }),
                 });
                 self.pending = Some(Pending {
                     proposal,
@@ -183,8 +198,9 @@ impl Engine {
         };
         self.emit(Event::Proposal {
             proposal: edited.clone(),
-            reasoning: Some("written by a person".into()),
+            reasoning: None,
             author: "a person".into(),
+            evidence: None,
         });
         self.pending = Some(Pending {
             proposal: edited,

@@ -72,11 +72,20 @@ impl App {
                 self.llm.log(format!("set aside {candidate}: {reason}"));
             }
             Event::Goal {
-                goal, reasoning, ..
+                goal,
+                reasoning,
+                author,
+                ..
             } => {
                 self.status.awaiting = None;
                 self.llm.goal = Some(goal.to_string());
-                self.llm.reasoning = reasoning;
+                // A model's goal names the model that answered.
+                let by = match (author.as_str(), &self.llm.replied_by) {
+                    ("model", Some(who)) => who.clone(),
+                    _ => author,
+                };
+                self.llm.goal_by = Some(by);
+                self.llm.goal_reasoning = reasoning;
             }
             Event::Readings {
                 readings, doubt, ..
@@ -141,17 +150,21 @@ impl App {
             Event::Proposal {
                 proposal,
                 reasoning,
-                ..
+                author,
+                evidence,
             } => {
                 self.llm.asking = None;
-                self.llm.reasoning = reasoning;
-                self.llm.proposal = Some(ProposalView::of(&proposal));
+                self.llm.proposal = Some(ProposalView::of(&proposal, &author, reasoning, evidence));
                 self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
             }
             Event::Approved => {
                 self.status.awaiting = None;
-                self.llm.proposal = None;
-                self.llm.log("approved");
+                // The log keeps who proposed what was approved.
+                let line = match self.llm.proposal.take() {
+                    Some(p) => strings::approved(&p.lines.join(" & "), &p.target, &p.author),
+                    None => "approved".to_string(),
+                };
+                self.llm.log(line);
             }
             Event::Rejected => {
                 self.status.awaiting = None;
@@ -213,7 +226,10 @@ impl App {
                 let holds = report.holds();
                 let mut lines = vec![strings::verified_tree(&origin)];
                 lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::VERIFY_TITLE,
+                    lines,
+                });
                 self.llm
                     .log(if holds { "verified" } else { "NOT verified" });
             }
@@ -221,7 +237,10 @@ impl App {
                 self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
                 let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
                 lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::VIOLATION_TITLE,
+                    lines,
+                });
                 self.llm.log(strings::CHANGE_VIOLATES);
             }
             Event::PolicySaved { path, fixes } => {
@@ -279,7 +298,10 @@ impl App {
                     lines.push(strings::NO_RULES.to_string());
                 }
                 lines.extend(rules);
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::RULES_TITLE,
+                    lines,
+                });
             }
             _ => {}
         }

@@ -1,4 +1,5 @@
-//! Overlays: the help (generated from the key bindings) and a verification report.
+//! Overlays: the help (generated from the key bindings), and lines in a titled box (a
+//! verification report, the rules kept, the details of a proposal or a node, readings).
 
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Flex, Layout, Rect};
@@ -111,9 +112,9 @@ pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
     lines
 }
 
-/// The verification report in a box over the screen.
-pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme) {
-    draw_box(frame, area, lines, theme, strings::VERIFY_TITLE);
+/// Lines (a verification report, the rules kept, details) in a box over the screen.
+pub fn draw_report(frame: &mut Frame, area: Rect, title: &str, lines: &[String], theme: &Theme) {
+    draw_box(frame, area, lines, theme, title);
 }
 
 /// The readings of an instruction to choose among, each with its number, its words, its

@@ -112,6 +112,42 @@ impl TreePane {
         self.tree.as_ref()?.contains(node).then_some(node)
     }
 
+    /// The selected node whole: its label, where it is, its status and its marks.
+    pub fn selected_details(&self, theme: &Theme) -> Option<Vec<String>> {
+        let node = self.selected()?;
+        let tree = self.tree.as_ref()?;
+        let status = self
+            .record
+            .as_ref()
+            .map_or(Status::Idle, |r| r.status(node));
+        let mut lines = vec![
+            node_label(tree, node, theme),
+            format!(
+                "node {}",
+                tree.path(node)
+                    .map(|p| crate::bt::path_text(&p))
+                    .unwrap_or_default()
+            ),
+            format!("status: {}", strings::status_word(status)),
+        ];
+        if self.marks.new_nodes.contains(&node) {
+            lines.push(strings::ADDED_BY_LAST_CHANGE.to_string());
+        }
+        if self.marks.failing == Some(node) {
+            lines.push(strings::FAILED_MARK.to_string());
+        }
+        if let Some((_, rules)) = self.marks.learned.iter().find(|(n, _)| *n == node) {
+            lines.push(strings::learned_mark(rules).trim().to_string());
+        }
+        if self.marks.breakpoints.contains(&node) {
+            lines.push(strings::BREAKPOINT_MARK.to_string());
+        }
+        if let Some((_, forced)) = self.marks.forced.iter().find(|(n, _)| *n == node) {
+            lines.push(strings::forced_mark(*forced).trim().to_string());
+        }
+        Some(lines)
+    }
+
     /// The nodes with a breakpoint.
     pub fn breakpoints(&self) -> &[NodeId] {
         &self.marks.breakpoints
