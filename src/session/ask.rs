@@ -133,14 +133,16 @@ type ReadProposal<'a> = dyn Fn(&str) -> Result<(Proposal, Option<String>), Reply
 /// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
 /// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
 /// first that fixes the failure. A value that `bounds` rules out is turned away without
-/// a try, and what the world says of each value tried tightens `bounds`.
+/// a try, and what the world says of each value tried tightens `bounds`. A proposal tried
+/// before for this failure (`before`: refused by the simulation, verification or a
+/// person) is not offered again.
 #[allow(clippy::too_many_arguments)]
 async fn draw_and_screen(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
     constraint: (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
-    screen: &mut Screen,
+    (screen, before): (&mut Screen, &[Tried]),
     bounds: &mut Bounds,
     read: &ReadProposal<'_>,
     emit: &mut (dyn FnMut(&Event) + Send),
@@ -189,6 +191,18 @@ async fn draw_and_screen(
             .iter()
             .any(|(p, _)| same_proposal(p, &proposal))
         {
+            continue;
+        }
+        if let Some(t) = before
+            .iter()
+            .find(|t| same_proposal(&t.proposal, &proposal))
+        {
+            emit(&Event::CandidateRejected {
+                candidate: proposal.to_string(),
+                proposal: Some(proposal.clone()),
+                reason: format!("tried before: {}", t.why),
+                author: None,
+            });
             continue;
         }
         if let Some(Err(why)) = value_of(&proposal).map(|v| bounds.admits(v)) {
@@ -326,8 +340,8 @@ pub(crate) async fn ask_conditions(
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
-    let tried: Vec<String> = tried.iter().map(ToString::to_string).collect();
-    let messages = ctx.resolve(&options.templates, action, error, &tried, &choices)?;
+    let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
+    let messages = ctx.resolve(&options.templates, action, error, &tried_lines, &choices)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
     let conditions_grammar = || {
         if choices.is_empty() {
@@ -353,7 +367,7 @@ pub(crate) async fn ask_conditions(
         messages,
         (schema::conditions(vocabulary), &conditions_grammar),
         options,
-        screen,
+        (screen, tried),
         &mut Bounds::default(),
         &read,
         emit,
@@ -445,7 +459,7 @@ pub(crate) async fn ask_value(
         messages,
         (schema::value(param), &value_grammar),
         options,
-        screen,
+        (screen, tried),
         &mut bounds,
         &read,
         emit,

@@ -32,6 +32,9 @@ pub enum NoModel {
 pub struct Options {
     /// Questions about failures (each reply, valid or not, is one round).
     pub max_rounds: usize,
+    /// Proposals a person may reject for one failure, each followed by the model asked
+    /// again with the rejected fix left out; past it, the person types the fix.
+    pub max_rejections: usize,
     /// Check every goal read from an instruction (parses, not contradictory, not true
     /// already, plannable) and draw more candidates when the first fails; off: the
     /// first usable answer is taken, as the paper's single call.
@@ -92,6 +95,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             max_rounds: 5,
+            max_rejections: 3,
             check_goals: true,
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,

@@ -48,6 +48,9 @@ enum Unfit {
     Conform(#[from] super::super::values::ConformError),
 }
 
+/// What the model is told of a proposal a person rejected.
+pub(super) const REJECTED: &str = "rejected by a person";
+
 impl Engine {
     pub(super) fn approve(&mut self) {
         if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
@@ -63,10 +66,35 @@ impl Engine {
         if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
             return self.reject_violation();
         }
-        if self.pending.take().is_none() {
+        let Some(pending) = self.pending.take() else {
             return self.error("no proposal to reject");
-        }
+        };
         self.emit(Event::Rejected);
+        let Some(failure) = pending.failure else {
+            return;
+        };
+        // The model is asked again with what the person rejected told to it as tried (and
+        // left out of the conditions it may choose from), a few times; then the person
+        // types the fix.
+        self.tried.push((
+            failure.clone(),
+            Tried {
+                proposal: pending.proposal,
+                why: REJECTED.to_string(),
+            },
+        ));
+        let rejected = self
+            .tried
+            .iter()
+            .filter(|(f, t)| *f == failure && t.why == REJECTED)
+            .count();
+        if rejected > self.options.max_rejections || self.model.is_err() {
+            return self.notice(format!(
+                "{rejected} proposal(s) for {}! rejected: type the missing condition(s) or value yourself (e)",
+                failure.action
+            ));
+        }
+        self.ask_about(failure);
     }
 
     /// Apply the pending proposal; keep it only if it helps.
