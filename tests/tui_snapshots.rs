@@ -249,6 +249,9 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
         b.step_to_failure().await;
         b.key(KeyCode::Char('x'));
         b.until(|e| matches!(e, Event::Rejected)).await;
+        // The model is asked again without the rejected fix; every answer of these
+        // fixtures names it again, so the questions end with the rounds.
+        b.until(|e| matches!(e, Event::GaveUp { .. })).await;
         b.key(KeyCode::Char('e'));
         b.type_text("\"purple cube\" on \"blue cube\"");
         b.key(KeyCode::Enter);
@@ -263,6 +266,14 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
             b.app.llm.log_lines().last(),
             Some(&format!("error: {shown}"))
         );
+        // The line stays as typed, the error under it, for the person to correct.
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("> \"purple cube\" on \"blue cube\""),
+            "{screen}"
+        );
+        insta::assert_snapshot!("a_mistyped_edit_kept_with_its_error", screen);
+        b.key(KeyCode::Esc);
 
         b.key(KeyCode::Char('e'));
         b.type_text("5 N");

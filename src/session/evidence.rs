@@ -72,7 +72,7 @@ impl Evidence {
             findings.push(shortlist_finding(list));
         }
         for t in found.tried {
-            findings.push(format!("tried before, did not fix it: {t}"));
+            findings.push(format!("proposed before and turned down: {t}"));
         }
         if let Proposal::Conditions { conditions, .. } = found.proposal {
             for c in conditions {

@@ -26,7 +26,7 @@ pub mod values;
 
 pub use crate::planner::RunLimits;
 pub use ask::missing_value;
-pub use edit::{Edit, EditError, parse_edit};
+pub use edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use engine::{Command, Engine, EngineHandle, Setup};
 pub use evidence::Evidence;
 pub use goal_checks::check_goal;

@@ -87,6 +87,8 @@ pub struct App {
     pub mode: KeyMode,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
+    /// The scene's conditions the edit line completes from (built when first edited).
+    vocabulary: Option<Vec<String>>,
     quit: bool,
 }
 
@@ -121,6 +123,7 @@ impl App {
             overlay: None,
             mode: KeyMode::Workbench,
             queue: Vec::new(),
+            vocabulary: None,
             quit: false,
         }
     }
@@ -214,8 +217,12 @@ impl App {
                     self.llm.error = None;
                     match parse_edit(&self.scenario, &text) {
                         Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
-                        // Shown as the engine's errors are; nothing reaches the session.
-                        Err(e) => self.show_error(e.to_string()),
+                        // Shown as the engine's errors are, and the line stays as typed
+                        // with the error under it; nothing reaches the session.
+                        Err(e) => {
+                            self.show_error(e.to_string());
+                            self.input.reopen_with_error(&text, e.to_string());
+                        }
                     }
                 }
                 None => {}
@@ -315,6 +322,11 @@ impl App {
                     .as_ref()
                     .map(|p| p.edit_text.clone())
                     .unwrap_or_default();
+                if self.vocabulary.is_none() {
+                    self.vocabulary = Some(crate::session::vocabulary_words(&self.scenario));
+                }
+                self.input
+                    .set_vocabulary(self.vocabulary.clone().unwrap_or_default());
                 return self.input.open(Mode::Edit, &text);
             }
             Action::Help => {

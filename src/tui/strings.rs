@@ -9,6 +9,17 @@ pub const WORLD_TITLE: &str = " World ";
 pub const INPUT_TITLE_IDLE: &str = " Input ";
 pub const INPUT_TITLE_INSTRUCTION: &str = " Instruction or goal (Enter submits, Esc cancels) ";
 pub const INPUT_TITLE_EDIT: &str = " Edit the proposal (Enter applies, Esc cancels) ";
+/// Under the edit line while nothing else is said there.
+pub const TAB_COMPLETES: &str = " Tab completes a condition of this scene ";
+pub const NO_COMPLETION: &str = "no condition of this scene begins so";
+
+/// The completions left under the edit line: a few, and how many.
+pub fn completions(listed: &[&str], count: usize) -> String {
+    let more = if count > listed.len() { ", …" } else { "" };
+    format!("{count} match: {}{more}", listed.join(", "))
+}
+
+pub const REJECTED: &str = "rejected: the tree is unchanged; the model is asked again without it (e: type the fix yourself)";
 pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, ? for help";
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";

@@ -224,6 +224,9 @@ impl Engine {
             Ok(p) => p,
             Err(e) => return self.error(e.to_string()),
         };
+        // What the person wrote answers the failure: a question still out about it is
+        // dropped.
+        self.cancel_request();
         self.emit(Event::Proposal {
             proposal: edited.clone(),
             reasoning: None,

@@ -169,8 +169,7 @@ impl App {
             Event::Rejected => {
                 self.status.awaiting = None;
                 self.llm.proposal = None;
-                self.llm
-                    .log("rejected: the tree is unchanged (e to type conditions)");
+                self.llm.log(strings::REJECTED);
             }
             Event::DidNotHelp { reason } => {
                 self.status.awaiting = None;
