@@ -231,6 +231,13 @@ fn failure_with_a_pending_proposal_then_approval() {
             "{screen}"
         );
         insta::assert_snapshot!("after_approval", screen);
+        // Quitting now would lose the approved fix: q asks first, another key stays.
+        b.key(KeyCode::Char('q'));
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("not saved as a policy"), "{screen}");
+        insta::assert_snapshot!("quit_asks_when_a_fix_is_unsaved", screen);
+        b.key(KeyCode::Esc);
+        assert!(!b.app.should_quit());
 
         b.key(KeyCode::Char('r'));
         b.until(|e| matches!(e, Event::Success { .. })).await;

@@ -109,4 +109,16 @@ fn reject_then_the_model_is_asked_again_and_a_mistyped_edit_is_kept() {
     tmux.keys(&["Escape"]);
     tmux.keys(&["a"]);
     tmux.wait_for(&["+[-] ~\"red cube\" on \"blue cube\"?"], 20);
+
+    // Quitting with the fix unsaved asks first; quitting again says what was not saved.
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["Quit?", "not saved as a policy"], 10);
+    tmux.keys(&["q"]);
+    tmux.wait_for(
+        &[
+            "not saved: 1 approved fix(es) of the last tree",
+            "betr exited with status 0",
+        ],
+        10,
+    );
 }

@@ -189,11 +189,30 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         stderr_to: log_path(),
         tree: args.tree.clone(),
     };
-    runtime.block_on(betr::tui::run(
+    let summary = runtime.block_on(betr::tui::run(
         setup,
         workbench,
         (!tap.is_empty()).then_some(&mut tap as &mut dyn betr::tui::Tap),
     ))?;
+    // Where what the session made went, now the terminal is the shell's again.
+    for path in &summary.policies {
+        outln!("policy saved: {}", path.display());
+    }
+    if summary.unsaved_fixes > 0 {
+        outln!(
+            "not saved: {} approved fix(es) of the last tree",
+            summary.unsaved_fixes
+        );
+    }
+    for path in &summary.exported {
+        outln!("tree exported: {}", path.display());
+    }
+    if let Some(path) = &args.viz.record {
+        outln!("session recording: {}", path.display());
+    }
+    if let Some(path) = &args.viz.rrd {
+        outln!("3D view (.rrd): {}", path.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -69,6 +69,20 @@ pub enum Overlay {
     },
     /// The readings of an instruction, waiting for the person to choose one.
     Readings(Vec<crate::session::Reading>, Option<String>),
+    /// Quitting would lose what these lines say: the quit key again quits, any other
+    /// key stays.
+    ConfirmQuit(Vec<String>),
+}
+
+/// What a session of the workbench left behind, for the lines printed after it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Policies saved, in order.
+    pub policies: Vec<std::path::PathBuf>,
+    /// Files the tree was exported to.
+    pub exported: Vec<std::path::PathBuf>,
+    /// Approved fixes in the tree that no saved policy holds.
+    pub unsaved_fixes: usize,
 }
 
 pub struct App {
@@ -89,6 +103,8 @@ pub struct App {
     queue: Vec<AppEvent>,
     /// The scene's conditions the edit line completes from (built when first edited).
     vocabulary: Option<Vec<String>>,
+    /// What was saved, exported, and is not saved yet.
+    pub summary: Summary,
     quit: bool,
 }
 
@@ -124,6 +140,7 @@ impl App {
             mode: KeyMode::Workbench,
             queue: Vec::new(),
             vocabulary: None,
+            summary: Summary::default(),
             quit: false,
         }
     }
@@ -239,6 +256,13 @@ impl App {
         if let Some(Overlay::Readings(readings, _)) = &self.overlay {
             return self.on_reading_key(&key, readings.len());
         }
+        if let Some(Overlay::ConfirmQuit(_)) = &self.overlay {
+            self.overlay = None;
+            if self.keys.action_in(self.mode, &key) == Some(Action::Quit) {
+                self.queue.push(AppEvent::Quit);
+            }
+            return;
+        }
         if self.overlay.take().is_some() {
             return;
         }
@@ -282,6 +306,7 @@ impl App {
             Action::Reject => Command::Reject,
             Action::Undo => {
                 self.llm.offer = None;
+                self.summary.unsaved_fixes = self.summary.unsaved_fixes.saturating_sub(1);
                 Command::Undo
             }
             Action::Verify => Command::Verify,
@@ -337,7 +362,12 @@ impl App {
             Action::LogUp => return self.llm.scroll_log_up(),
             Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
-                self.queue.push(AppEvent::Quit);
+                let lost = self.would_be_lost();
+                if lost.is_empty() {
+                    self.queue.push(AppEvent::Quit);
+                } else {
+                    self.overlay = Some(Overlay::ConfirmQuit(lost));
+                }
                 return;
             }
             // Bound in a replay only: moves in the recording.
@@ -379,6 +409,29 @@ impl App {
             }
         };
         self.queue.push(AppEvent::Dictation(request));
+    }
+
+    /// What quitting now would lose, one line each (nothing in a replay).
+    fn would_be_lost(&self) -> Vec<String> {
+        if self.mode == KeyMode::Replay {
+            return Vec::new();
+        }
+        let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+        let mut lost = Vec::new();
+        if self.summary.unsaved_fixes > 0 {
+            lost.push(strings::unsaved_fixes(
+                self.summary.unsaved_fixes,
+                &key(Action::Save),
+            ));
+        }
+        if let Some(p) = &self.llm.proposal {
+            lost.push(strings::pending_lost(&p.target));
+        }
+        if !lost.is_empty() {
+            lost.push(String::new());
+            lost.push(strings::confirm_quit(&key(Action::Quit)));
+        }
+        lost
     }
 
     /// Everything the panes may cut: the pending proposal whole (betr's findings, the

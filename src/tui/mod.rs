@@ -42,7 +42,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationService, Microphone, SttLoader};
 
-pub use app::{App, Info, Request};
+pub use app::{App, Info, Request, Summary};
 pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
@@ -115,12 +115,13 @@ pub struct Workbench {
     pub tree: Option<PathBuf>,
 }
 
-/// Open the workbench on `setup` until the person quits.
+/// Open the workbench on `setup` until the person quits; what the session saved and left
+/// unsaved.
 pub async fn run(
     setup: Setup,
     workbench: Workbench,
     mut tap: Option<&mut dyn Tap>,
-) -> Result<(), TuiError> {
+) -> Result<app::Summary, TuiError> {
     let Workbench {
         info,
         keys,
@@ -155,5 +156,5 @@ pub async fn run(
     stop.store(true, Ordering::Relaxed);
     // A recording still open is discarded with the service, before the screen goes.
     drop(dictation);
-    Ok(())
+    Ok(app.summary)
 }

@@ -20,6 +20,29 @@ pub fn completions(listed: &[&str], count: usize) -> String {
 }
 
 pub const REJECTED: &str = "rejected: the tree is unchanged; the model is asked again without it (e: type the fix yourself)";
+pub const CONFIRM_QUIT_TITLE: &str = " Quit? ";
+
+/// Approved fixes no saved policy holds, in the quit question.
+pub fn unsaved_fixes(count: usize, save_key: &str) -> String {
+    format!(
+        "{count} approved fix(es) in the tree are not saved as a policy ({save_key} saves them)."
+    )
+}
+
+/// A proposal waiting, in the quit question.
+pub fn pending_lost(target: &str) -> String {
+    format!("The proposal for {target} waits for approval.")
+}
+
+pub fn confirm_quit(quit_key: &str) -> String {
+    format!("Press {quit_key} again to quit; any other key stays.")
+}
+
+/// Where a goal loaded with a policy came from.
+pub fn from_policy(path: &str) -> String {
+    format!("policy {path}")
+}
+
 pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, ? for help";
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";

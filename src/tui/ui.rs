@@ -60,6 +60,9 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     match &app.overlay {
         Some(Overlay::Help) => draw_help(frame, area, &app.keys, app.mode, &theme),
         Some(Overlay::Report { title, lines }) => draw_report(frame, area, title, lines, &theme),
+        Some(Overlay::ConfirmQuit(lines)) => {
+            draw_report(frame, area, strings::CONFIRM_QUIT_TITLE, lines, &theme);
+        }
         Some(Overlay::Readings(readings, doubt)) => {
             draw_readings(frame, area, readings, doubt.as_deref(), &theme);
         }

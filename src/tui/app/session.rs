@@ -126,7 +126,10 @@ impl App {
             Event::Repaired {
                 added_nodes,
                 valued_nodes,
-            } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
+            } => {
+                self.summary.unsaved_fixes += 1;
+                self.llm.log(strings::repaired(added_nodes, valued_nodes));
+            }
             _ => {}
         }
     }
@@ -245,14 +248,19 @@ impl App {
             Event::PolicySaved { path, fixes } => {
                 self.llm
                     .log(strings::policy_saved(&path.display().to_string(), fixes));
+                self.summary.unsaved_fixes = 0;
+                self.summary.policies.push(path);
             }
             Event::Exported { paths } => {
                 let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
                 self.llm.log(strings::exported(&names));
+                self.summary.exported.extend(paths);
             }
             Event::PolicyLoaded { path, fixes } => {
                 self.llm
                     .log(strings::policy_loaded(&path.display().to_string(), fixes));
+                self.summary.unsaved_fixes = 0;
+                self.llm.goal_by = Some(strings::from_policy(&path.display().to_string()));
             }
             _ => {}
         }
