@@ -66,6 +66,30 @@ fn an_undone_fix_is_a_candidate_again() {
 }
 
 #[test]
+fn a_rejected_fix_applied_by_hand_then_undone_is_a_candidate_again() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        s.send(Command::Reject);
+        s.until("rejected", |e| matches!(e, Event::Rejected)).await;
+        s.send(support::engine::edit(support::engine::FIX).unwrap());
+        s.until("edited", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Undo);
+        s.until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.seen.clear();
+        let again = s.run_to_proposal().await;
+        let notice = shortlist_notice(&again).unwrap();
+        assert!(!notice.contains("refused before"), "{notice}");
+        assert_eq!(
+            proposed(&again).as_deref(),
+            Some("~\"any object\" on \"blue cube\"")
+        );
+    });
+}
+
+#[test]
 fn a_rejection_asks_again_without_the_rejected_fix_then_leaves_it_to_the_person() {
     rt().block_on(async {
         let mut s = Session::start(one_rejection());

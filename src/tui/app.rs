@@ -242,6 +242,10 @@ impl App {
                         }
                     }
                 }
+                Some(Submitted::Search(text)) => {
+                    self.tree.query = (!text.is_empty()).then(|| text.clone());
+                    self.search(true);
+                }
                 None => {}
             }
             return;
@@ -359,6 +363,23 @@ impl App {
                 return;
             }
             Action::Details => return self.show_details(),
+            Action::Follow => {
+                self.tree.follow = !self.tree.follow;
+                if self.tree.follow {
+                    self.tree.show_running(false);
+                }
+                return self.message(strings::follow(self.tree.follow).to_string(), false);
+            }
+            Action::Search => return self.input.open(Mode::Search, ""),
+            Action::SearchNext => return self.search(true),
+            Action::SearchPrevious => return self.search(false),
+            Action::CollapseAll => return self.tree.collapse_all(),
+            Action::ExpandToRunning => {
+                if !self.tree.show_running(true) {
+                    self.message(strings::NOTHING_RUNNING.to_string(), true);
+                }
+                return;
+            }
             Action::LogUp => return self.llm.scroll_log_up(),
             Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
@@ -409,6 +430,23 @@ impl App {
             }
         };
         self.queue.push(AppEvent::Dictation(request));
+    }
+
+    /// The next (or previous) match of the tree search, said in the status bar.
+    fn search(&mut self, forward: bool) {
+        let Some(query) = self.tree.query.clone() else {
+            return;
+        };
+        let text = match self.tree.search(&query, forward, &self.theme) {
+            Some(found) => strings::found(&query, found.at, found.of),
+            None => strings::not_found(&query),
+        };
+        self.message(text, false);
+    }
+
+    /// A mouse event: on the tree pane it selects or scrolls.
+    pub fn on_mouse(&mut self, event: crossterm::event::MouseEvent) {
+        self.tree.mouse(&event);
     }
 
     /// What quitting now would lose, one line each (nothing in a replay).

@@ -39,6 +39,15 @@ pub enum Action {
     BreakOnFailure,
     /// The pending proposal, or the selected node, whole in an overlay.
     Details,
+    /// Select the running node after every tick (toggle).
+    Follow,
+    /// Search the tree's labels; next and previous match.
+    Search,
+    SearchNext,
+    SearchPrevious,
+    /// Close every node; open the way to the running node only.
+    CollapseAll,
+    ExpandToRunning,
     LogUp,
     LogDown,
     Help,
@@ -310,6 +319,12 @@ bindings! {
     start: Start = Key::plain('g'), Replay;
     end: End = Key::plain('G'), Replay;
     details: Details = Key::plain('D'), Both;
+    follow: Follow = Key::plain('F'), Both;
+    search: Search = Key::plain('/'), Workbench;
+    search_next: SearchNext = Key::plain('>'), Workbench;
+    search_previous: SearchPrevious = Key::plain('<'), Workbench;
+    collapse_all: CollapseAll = Key::plain('C'), Both;
+    expand_to_running: ExpandToRunning = Key::plain('E'), Both;
     log_up: LogUp = Key::plain('['), Both;
     log_down: LogDown = Key::plain(']'), Both;
     help: Help = Key::plain('?'), Both;
@@ -424,7 +439,7 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "b", "f", "B", "D", "[", "]", "?", "q"
+                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "[", "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -480,7 +495,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "[", "]", "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "[", "]",
+                "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

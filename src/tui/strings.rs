@@ -3,6 +3,32 @@
 use crate::bt::Status;
 
 pub const TREE_TITLE: &str = " Behavior tree ";
+pub const FOLLOWING: &str = " following the running node ";
+pub const SEARCH_TITLE: &str = " Search the tree (Enter finds, Esc cancels) ";
+
+/// Under the tree while a search is on.
+pub fn searching(query: &str) -> String {
+    format!(" /{query} ")
+}
+
+/// Where a search stands, in the status bar.
+pub fn found(query: &str, at: usize, of: usize) -> String {
+    format!("/{query}: match {at} of {of}")
+}
+
+pub fn not_found(query: &str) -> String {
+    format!("/{query}: no node's label holds it")
+}
+
+pub fn follow(on: bool) -> &'static str {
+    if on {
+        "following the running node after every tick"
+    } else {
+        "not following the running node"
+    }
+}
+
+pub const NOTHING_RUNNING: &str = "no node is running or has failed yet";
 pub const TREE_EMPTY: &str = "No tree yet. Press i to type an instruction (or a goal formula), or p to plan the scenario's goal.";
 pub const LLM_TITLE: &str = " LLM ";
 pub const WORLD_TITLE: &str = " World ";
@@ -197,6 +223,12 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Force => "force the selected node: failure, success, running, off",
         BreakOnFailure => "break on failure: stop running when a node fails",
         Details => "show whole what a pane cuts: the proposal, else the selected node",
+        Follow => "follow the running node after every tick (on / off)",
+        Search => "search the tree's labels",
+        SearchNext => "the next match of the search",
+        SearchPrevious => "the previous match of the search",
+        CollapseAll => "collapse every node",
+        ExpandToRunning => "collapse all but the way to the running node",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",

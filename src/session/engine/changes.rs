@@ -123,6 +123,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: Some(pending.proposal.clone()),
         });
         let change = pending.proposal.to_string();
         self.last_change = Some((before.clone(), pending.proposal.clone()));
@@ -369,6 +370,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: None,
         });
         let change = format!("set {} ({valued} action(s))", setting.text);
         self.fixes.push(AppliedFix {
@@ -443,6 +445,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: None,
         });
         self.fixes.push(AppliedFix {
             change: change.clone(),

@@ -378,6 +378,10 @@ impl Engine {
         self.drop_offers();
         let undone = self.fixes.len().saturating_sub(entry.fixes);
         self.fixes.truncate(entry.fixes);
+        // Undoing is not rejecting: the undone change may be proposed again.
+        if let Some(proposal) = &entry.proposal {
+            self.tried.retain(|(_, t)| &t.proposal != proposal);
+        }
         let why = format!("undid the last change ({undone} fix(es) removed)");
         self.replace_tree(entry.tree, Vec::new(), why);
     }

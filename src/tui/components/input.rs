@@ -16,6 +16,8 @@ use super::super::theme::Theme;
 pub enum Mode {
     Instruction,
     Edit,
+    /// Text to find in the tree's labels.
+    Search,
 }
 
 /// What the input line produced.
@@ -23,6 +25,7 @@ pub enum Mode {
 pub enum Submitted {
     Instruction(String),
     Edit(String),
+    Search(String),
 }
 
 #[derive(Default)]
@@ -168,6 +171,7 @@ impl InputLine {
                 return Some(match mode {
                     Mode::Instruction => Submitted::Instruction(text),
                     Mode::Edit => Submitted::Edit(text),
+                    Mode::Search => Submitted::Search(text),
                 });
             }
             KeyCode::Esc => {
@@ -222,6 +226,7 @@ impl InputLine {
                 match mode {
                     Mode::Instruction => strings::INPUT_TITLE_INSTRUCTION,
                     Mode::Edit => strings::INPUT_TITLE_EDIT,
+                    Mode::Search => strings::SEARCH_TITLE,
                 },
                 Line::from(vec![
                     Span::styled("> ", theme.key),
