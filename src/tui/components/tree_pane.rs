@@ -568,6 +568,10 @@ mod tests {
         terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
         let label = pane.label(pane.selected().unwrap(), &theme);
         assert!(terminal.backend().to_string().contains(&label));
+        pane.query = Some("thing 1".into());
+        pane.follow = true;
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        insta::assert_snapshot!("searched_300_nodes_80x24", terminal.backend().to_string());
     }
 
     #[test]
