@@ -123,10 +123,7 @@ impl App {
             theme,
             tree: TreePane::default(),
             llm,
-            world: WorldPane {
-                objects: info.objects.clone(),
-                ..WorldPane::default()
-            },
+            world: WorldPane::of(info.objects.clone()),
             input: InputLine::default(),
             status: StatusBar {
                 scenario: info.scenario,
@@ -150,6 +147,7 @@ impl App {
     pub fn replaying(scenario: Arc<Scenario>, info: Info, keys: KeyBindings, theme: Theme) -> App {
         let mut app = App::new(scenario, info, keys, theme);
         app.mode = KeyMode::Replay;
+        app.world.unmarked = true;
         let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
         let pair = |a: Action, b: Action| format!("{} {}", key(a), key(b));
         let hint = strings::replay_hint(&[
@@ -242,6 +240,7 @@ impl App {
                         }
                     }
                 }
+                Some(Submitted::Filter(text)) => self.world.set_filter(Some(text)),
                 Some(Submitted::Search(text)) => {
                     self.tree.query = (!text.is_empty()).then(|| text.clone());
                     self.search(true);
@@ -374,6 +373,12 @@ impl App {
             Action::SearchNext => return self.search(true),
             Action::SearchPrevious => return self.search(false),
             Action::CollapseAll => return self.tree.collapse_all(),
+            Action::WorldUp => return self.world.scroll_up(),
+            Action::WorldDown => return self.world.scroll_down(),
+            Action::WorldFilter => {
+                let now = self.world.filter.clone().unwrap_or_default();
+                return self.input.open(Mode::Filter, &now);
+            }
             Action::ExpandToRunning => {
                 if !self.tree.show_running(true) {
                     self.message(strings::NOTHING_RUNNING.to_string(), true);

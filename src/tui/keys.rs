@@ -48,6 +48,10 @@ pub enum Action {
     /// Close every node; open the way to the running node only.
     CollapseAll,
     ExpandToRunning,
+    /// The world's fact table: scroll, and narrow to facts holding a text.
+    WorldUp,
+    WorldDown,
+    WorldFilter,
     LogUp,
     LogDown,
     Help,
@@ -325,6 +329,9 @@ bindings! {
     search_previous: SearchPrevious = Key::plain('<'), Workbench;
     collapse_all: CollapseAll = Key::plain('C'), Both;
     expand_to_running: ExpandToRunning = Key::plain('E'), Both;
+    world_up: WorldUp = Key::plain('{'), Both;
+    world_down: WorldDown = Key::plain('}'), Both;
+    world_filter: WorldFilter = Key::plain('W'), Workbench;
     log_up: LogUp = Key::plain('['), Both;
     log_down: LogDown = Key::plain(']'), Both;
     help: Help = Key::plain('?'), Both;
@@ -439,7 +446,8 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "[", "]", "?", "q"
+                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "{", "}", "W", "[",
+                "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -495,8 +503,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "[", "]",
-                "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "{", "}",
+                "[", "]", "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

@@ -88,6 +88,29 @@ pub const NO_READING_CHOSEN: &str =
     "no reading chosen: type the instruction again (i), said otherwise";
 
 pub const NOW_TRUE: &str = "True now:";
+/// Before a fact the last tick made true, and one it made false.
+pub const MADE_TRUE: &str = "+ ";
+pub const MADE_FALSE: &str = "- ";
+pub const VALUE_SET: &str = "value set:";
+pub const FILTER_TITLE: &str = " Show the facts holding (Enter filters, empty: all) ";
+
+/// The objects when their names do not fit on a line.
+pub fn objects_counted(count: usize) -> String {
+    format!("{OBJECTS} {count} (too many to name here)")
+}
+
+/// Above the fact table: how many are listed, of how many, and the filter.
+pub fn facts_heading(shown: usize, total: usize, filter: Option<&str>) -> String {
+    match filter {
+        Some(q) => format!("True now: {shown} of {total} holding \"{q}\""),
+        None => format!("True now: {total} (+ made true, - made false by the last tick)"),
+    }
+}
+
+/// Over the fact table scrolled down.
+pub fn rows_above(rows: usize) -> String {
+    format!("↑ {rows} row(s) above")
+}
 pub const NOTHING_TRUE: &str = "  (nothing)";
 pub const OBJECTS: &str = "Objects:";
 pub const LAST_ERROR: &str = "Last error:";
@@ -224,6 +247,9 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         BreakOnFailure => "break on failure: stop running when a node fails",
         Details => "show whole what a pane cuts: the proposal, else the selected node",
         Follow => "follow the running node after every tick (on / off)",
+        WorldUp => "scroll the world's facts up",
+        WorldDown => "scroll the world's facts down",
+        WorldFilter => "show only the world's facts holding a text",
         Search => "search the tree's labels",
         SearchNext => "the next match of the search",
         SearchPrevious => "the previous match of the search",

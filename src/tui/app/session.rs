@@ -115,6 +115,7 @@ impl App {
                 why,
             } => {
                 let added = new_nodes.len();
+                self.world.values = values_set(&tree);
                 self.tree.set_tree(tree, new_nodes, learned);
                 self.status.ending = None;
                 self.llm.log(if added > 0 {
@@ -201,7 +202,7 @@ impl App {
                 let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
                 // Relations between objects first: they change; "near robot" rarely does.
                 facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
-                self.world.facts = facts;
+                self.world.set_facts(facts, reset);
                 if reset {
                     self.status.ticks = 0;
                     self.status.ending = None;
@@ -370,4 +371,21 @@ impl App {
             _ => {}
         }
     }
+}
+
+/// The values parameters set on `tree`'s actions, one line each, each action once.
+fn values_set(tree: &crate::bt::Tree) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for node in tree.preorder() {
+        if let Ok(crate::bt::NodeKind::Action(a)) = tree.kind(node) {
+            for (name, value) in &a.values {
+                let objects: Vec<String> = a.args.iter().map(|o| format!("\"{o}\"")).collect();
+                let line = format!("{} {}: {name} = {value}", a.skill, objects.join(" "));
+                if !lines.contains(&line) {
+                    lines.push(line);
+                }
+            }
+        }
+    }
+    lines
 }

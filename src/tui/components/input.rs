@@ -18,6 +18,8 @@ pub enum Mode {
     Edit,
     /// Text to find in the tree's labels.
     Search,
+    /// Text the world's facts listed must hold.
+    Filter,
 }
 
 /// What the input line produced.
@@ -26,6 +28,7 @@ pub enum Submitted {
     Instruction(String),
     Edit(String),
     Search(String),
+    Filter(String),
 }
 
 #[derive(Default)]
@@ -172,6 +175,7 @@ impl InputLine {
                     Mode::Instruction => Submitted::Instruction(text),
                     Mode::Edit => Submitted::Edit(text),
                     Mode::Search => Submitted::Search(text),
+                    Mode::Filter => Submitted::Filter(text),
                 });
             }
             KeyCode::Esc => {
@@ -227,6 +231,7 @@ impl InputLine {
                     Mode::Instruction => strings::INPUT_TITLE_INSTRUCTION,
                     Mode::Edit => strings::INPUT_TITLE_EDIT,
                     Mode::Search => strings::SEARCH_TITLE,
+                    Mode::Filter => strings::FILTER_TITLE,
                 },
                 Line::from(vec![
                     Span::styled("> ", theme.key),
