@@ -258,7 +258,7 @@ pub enum Event {
         author: String,
         /// What betr itself found about the failure and the change, shown first; `None`
         /// when the change was not asked of a model (a person's edit).
-        evidence: Option<super::evidence::Evidence>,
+        evidence: Option<Box<super::evidence::Evidence>>,
     },
     Approved,
     Rejected,

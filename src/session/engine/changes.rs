@@ -188,11 +188,11 @@ impl Engine {
                     proposal: proposal.clone(),
                     reasoning: None,
                     author: author.clone(),
-                    evidence: Some(Evidence {
+                    evidence: Some(Box::new(Evidence {
                         findings,
                         objects: before.map(|f| f.action.args.clone()).unwrap_or_default(),
                         doubt: None,
-                    }),
+                    })),
                 });
                 self.pending = Some(Pending {
                     proposal,

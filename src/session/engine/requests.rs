@@ -30,7 +30,7 @@ pub(crate) enum Internal {
         failure: Failure,
         result: Result<Asked, SessionError>,
         /// What betr found, for the chosen proposal.
-        evidence: Option<Evidence>,
+        evidence: Option<Box<Evidence>>,
         replies: Vec<Reply>,
     },
     Verified {
@@ -223,11 +223,11 @@ impl Engine {
                     proposal,
                     verdict: asked.verdict,
                 };
-                Some(Evidence::of(
+                Some(Box::new(Evidence::of(
                     &found,
                     reasoning.as_deref(),
                     &scenario.domain.vocabulary.objects,
-                ))
+                )))
             });
             let _ = tx.send(Internal::Proposal {
                 id,

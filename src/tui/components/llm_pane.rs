@@ -47,7 +47,7 @@ impl ProposalView {
         proposal: &Proposal,
         author: &str,
         reasoning: Option<String>,
-        evidence: Option<Evidence>,
+        evidence: Option<Box<Evidence>>,
     ) -> ProposalView {
         let (findings, doubt) = evidence.map(|e| (e.findings, e.doubt)).unwrap_or_default();
         let (target, lines, edit_text) = ProposalView::parts(proposal);
@@ -388,7 +388,7 @@ mod tests {
                 &proposal,
                 "model qwen",
                 Some(reasoning.to_string()),
-                Some(evidence),
+                Some(Box::new(evidence)),
             )),
             ..LlmPane::default()
         }
