@@ -231,6 +231,13 @@ fn failure_with_a_pending_proposal_then_approval() {
             "{screen}"
         );
         insta::assert_snapshot!("after_approval", screen);
+        // Quitting now would lose the approved fix: q asks first, another key stays.
+        b.key(KeyCode::Char('q'));
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("not saved as a policy"), "{screen}");
+        insta::assert_snapshot!("quit_asks_when_a_fix_is_unsaved", screen);
+        b.key(KeyCode::Esc);
+        assert!(!b.app.should_quit());
 
         b.key(KeyCode::Char('r'));
         b.until(|e| matches!(e, Event::Success { .. })).await;
@@ -249,6 +256,9 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
         b.step_to_failure().await;
         b.key(KeyCode::Char('x'));
         b.until(|e| matches!(e, Event::Rejected)).await;
+        // The model is asked again without the rejected fix; every answer of these
+        // fixtures names it again, so the questions end with the rounds.
+        b.until(|e| matches!(e, Event::GaveUp { .. })).await;
         b.key(KeyCode::Char('e'));
         b.type_text("\"purple cube\" on \"blue cube\"");
         b.key(KeyCode::Enter);
@@ -263,6 +273,14 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
             b.app.llm.log_lines().last(),
             Some(&format!("error: {shown}"))
         );
+        // The line stays as typed, the error under it, for the person to correct.
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("> \"purple cube\" on \"blue cube\""),
+            "{screen}"
+        );
+        insta::assert_snapshot!("a_mistyped_edit_kept_with_its_error", screen);
+        b.key(KeyCode::Esc);
 
         b.key(KeyCode::Char('e'));
         b.type_text("5 N");
@@ -407,7 +425,8 @@ fn help_overlay_lists_every_binding() {
     rt().block_on(async {
         let mut b = Bench::start();
         b.key(KeyCode::Char('?'));
-        let screen = b.screen(120, 40);
+        // Too many keys for one column in 40 rows: two columns.
+        let screen = b.screen(160, 40);
         for (key, what) in KeyBindings::default().help_lines(KeyMode::Workbench) {
             assert!(screen.contains(&key), "{key} missing:\n{screen}");
             assert!(screen.contains(what), "{what} missing:\n{screen}");
@@ -425,7 +444,10 @@ fn small_terminal_stays_usable() {
         let mut b = Bench::start();
         b.step_to_failure().await;
         let screen = b.screen(80, 24);
-        assert!(screen.contains("Proposal for"), "{screen}");
+        // The proposal and its keys stay on the pane's border; its findings lead inside.
+        assert!(screen.contains("proposed: ~\"any object\" on"), "{screen}");
+        assert!(screen.contains("a approve · x reject"), "{screen}");
+        assert!(screen.contains("Found by betr:"), "{screen}");
         assert!(screen.contains("tick"), "{screen}");
         insta::assert_snapshot!("small_terminal_80x24", screen);
         // Even tinier terminals draw without panicking.

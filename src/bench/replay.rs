@@ -183,6 +183,7 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
                 },
                 reasoning: Some("the benchmark's".into()),
                 author: "the benchmark".into(),
+                evidence: None,
             }),
             Step::Command("approve".into()),
             event(Event::Approved),

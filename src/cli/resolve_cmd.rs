@@ -472,6 +472,7 @@ fn print_event_line(event: &Event) {
             goal,
             reasoning,
             matches_expected,
+            ..
         } => {
             if let Some(r) = reasoning {
                 outln!("Reasoning: {r}");
@@ -495,9 +496,18 @@ fn print_event_line(event: &Event) {
             proposal,
             reasoning,
             author,
+            evidence,
         } => {
+            // What betr found comes first; the author's reasoning is labelled as theirs.
+            let doubt = evidence.as_ref().and_then(|e| e.doubt.as_deref());
+            for finding in evidence.iter().flat_map(|e| &e.findings) {
+                outln!("Found: {finding}");
+            }
             if let Some(r) = reasoning {
-                outln!("Reasoning: {r}");
+                match doubt {
+                    Some(why) => outln!("Reasoning of {author}, doubtful ({why}): {r}"),
+                    None => outln!("Reasoning of {author}: {r}"),
+                }
             }
             outln!("Proposal: {proposal} (by {author})");
         }

@@ -210,7 +210,26 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     if let Some(fetch) = background {
         fetch.cancel();
     }
-    ran?;
+    let summary = ran?;
+    // Where what the session made went, now the terminal is the shell's again.
+    for path in &summary.policies {
+        outln!("policy saved: {}", path.display());
+    }
+    if summary.unsaved_fixes > 0 {
+        outln!(
+            "not saved: {} approved fix(es) of the last tree",
+            summary.unsaved_fixes
+        );
+    }
+    for path in &summary.exported {
+        outln!("tree exported: {}", path.display());
+    }
+    if let Some(path) = &args.viz.record {
+        outln!("session recording: {}", path.display());
+    }
+    if let Some(path) = &args.viz.rrd {
+        outln!("3D view (.rrd): {}", path.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 

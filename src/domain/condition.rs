@@ -193,14 +193,14 @@ pub fn parse_atom_prefix(text: &str, start: usize) -> Result<(Atom, usize), Atom
             if args.iter().any(String::is_empty) {
                 return Err(AtomError {
                     at: begin,
-                    expected: "an atom like On_Coffee_Table1 (no empty part between underscores)",
+                    expected: "an atom of parts joined by underscores, none of them empty",
                     found: format!("{word:?}"),
                 });
             }
             if is_word_predicate(&predicate) && !args.is_empty() {
                 return Err(AtomError {
                     at: begin,
-                    expected: "a predicate starting with an upper-case letter (On_Coffee_Table1) or a quoted object (\"blue cube\" on \"green cube\")",
+                    expected: "a predicate starting with an upper-case letter, or a quoted object followed by a predicate word",
                     found: format!("{word:?}"),
                 });
             }
@@ -208,7 +208,7 @@ pub fn parse_atom_prefix(text: &str, start: usize) -> Result<(Atom, usize), Atom
         }
         Some(_) => Err(AtomError {
             at: i,
-            expected: "a condition such as On_Coffee_Table1 or \"blue cube\" on \"green cube\"",
+            expected: "a condition: a predicate atom, or a quoted object followed by a predicate word",
             found: found_at(text, i),
         }),
         None => Err(AtomError {

@@ -8,7 +8,8 @@ use crate::domain::condition::parse_atom_prefix;
 /// the stack.
 const MAX_DEPTH: usize = 256;
 
-const EXAMPLE: &str = "a condition such as On_Coffee_Table1 or \"blue cube\" on \"green cube\"";
+const EXAMPLE: &str =
+    "a condition: a predicate atom, or a quoted object followed by a predicate word";
 
 /// What came just before the operand being read, for the error message.
 #[derive(Clone, Copy)]
@@ -246,7 +247,7 @@ pub(super) mod tests {
         let e = err("A & \"blue cube\" & B");
         assert_eq!(e.column, 17);
         assert!(e.expected.contains("predicate"));
-        assert!(err("A & lowercase").expected.contains("On_Coffee_Table1"));
+        assert!(err("A & lowercase").expected.contains("predicate atom"));
         assert!(err("A B").expected.contains("end of goal"));
     }
 

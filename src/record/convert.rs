@@ -134,11 +134,12 @@ impl Encoder {
                 goal,
                 reasoning,
                 matches_expected,
-                ..
+                author,
             } => Recorded::Goal {
                 goal: goal.to_string(),
                 reasoning: reasoning.clone(),
                 matches_expected: *matches_expected,
+                author: author.clone(),
             },
             Event::ActionFailed {
                 action,
@@ -155,11 +156,12 @@ impl Encoder {
                 proposal,
                 reasoning,
                 author,
-                ..
+                evidence,
             } => Recorded::Proposal {
                 proposal: self.proposal(proposal),
                 reasoning: reasoning.clone(),
                 author: author.clone(),
+                evidence: evidence.as_deref().cloned(),
             },
             Event::Approved => Recorded::Approved,
             Event::Rejected => Recorded::Rejected,
@@ -396,7 +398,9 @@ impl Decoder {
                 goal,
                 reasoning,
                 matches_expected,
+                author,
             } => Event::Goal {
+                author: author.clone(),
                 goal: self
                     .scenario
                     .parse_goal(goal)
@@ -420,10 +424,12 @@ impl Decoder {
                 proposal,
                 reasoning,
                 author,
+                evidence,
             } => Event::Proposal {
                 proposal: self.proposal(proposal, line)?,
                 reasoning: reasoning.clone(),
                 author: author.clone(),
+                evidence: evidence.clone().map(Box::new),
             },
             Recorded::Approved => Event::Approved,
             Recorded::Rejected => Event::Rejected,

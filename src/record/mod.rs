@@ -114,6 +114,9 @@ pub enum Recorded {
         goal: String,
         reasoning: Option<String>,
         matches_expected: Option<bool>,
+        /// Where the goal came from (absent in older recordings: the model).
+        #[serde(default = "model_author")]
+        author: String,
     },
     ActionFailed {
         action: String,
@@ -125,6 +128,9 @@ pub enum Recorded {
         proposal: RecordedProposal,
         reasoning: Option<String>,
         author: String,
+        /// What betr found about the failure and the change (absent in older recordings).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        evidence: Option<crate::session::Evidence>,
     },
     Approved,
     Rejected,
@@ -229,4 +235,9 @@ pub enum RecordError {
     },
     #[error("line {line}: {reason}")]
     Decode { line: usize, reason: String },
+}
+
+/// Who wrote a goal of a recording older than goals' authors: the model.
+fn model_author() -> String {
+    "model".into()
 }

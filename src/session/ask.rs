@@ -11,7 +11,7 @@ use crate::llm::reply::{self, ReplyError};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
-use super::screen::{NotHelped, Screen};
+use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::types::{Event, Options, Proposal, SessionError};
 use super::value_bounds::Bounds;
@@ -89,6 +89,10 @@ pub(crate) struct Asked {
     pub unusable: usize,
     /// Who wrote the chosen proposal when it was not the model's reply.
     pub author: Option<String>,
+    /// The conditions tried in simulation before the model was asked, when they were.
+    pub shortlist: Option<Shortlist>,
+    /// What the chosen proposal did in simulation.
+    pub verdict: Option<Verdict>,
 }
 
 /// Who proposes a value midway between values the world refused on either side.
@@ -129,14 +133,16 @@ type ReadProposal<'a> = dyn Fn(&str) -> Result<(Proposal, Option<String>), Reply
 /// Draw up to `options.candidates` replies to `messages` (the first greedy, the rest
 /// sampled), read each with `read`, and try each new proposal in `screen`; stop at the
 /// first that fixes the failure. A value that `bounds` rules out is turned away without
-/// a try, and what the world says of each value tried tightens `bounds`.
+/// a try, and what the world says of each value tried tightens `bounds`. A proposal tried
+/// before for this failure (`before`: refused by the simulation, verification or a
+/// person) is not offered again.
 #[allow(clippy::too_many_arguments)]
 async fn draw_and_screen(
     model: &dyn LanguageModel,
     messages: Vec<Message>,
     constraint: (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
-    screen: &mut Screen,
+    (screen, before): (&mut Screen, &[Tried]),
     bounds: &mut Bounds,
     read: &ReadProposal<'_>,
     emit: &mut (dyn FnMut(&Event) + Send),
@@ -146,6 +152,8 @@ async fn draw_and_screen(
         rejected: Vec::new(),
         unusable: 0,
         author: None,
+        shortlist: None,
+        verdict: None,
     };
     let draws = options.candidates.max(1);
     for draw in 0..draws {
@@ -185,6 +193,18 @@ async fn draw_and_screen(
         {
             continue;
         }
+        if let Some(t) = before
+            .iter()
+            .find(|t| same_proposal(&t.proposal, &proposal))
+        {
+            emit(&Event::CandidateRejected {
+                candidate: proposal.to_string(),
+                proposal: Some(proposal.clone()),
+                reason: format!("tried before: {}", t.why),
+                author: None,
+            });
+            continue;
+        }
         if let Some(Err(why)) = value_of(&proposal).map(|v| bounds.admits(v)) {
             let why = format!("{NOT_TRIED}{why}");
             emit(&Event::CandidateRejected {
@@ -198,7 +218,8 @@ async fn draw_and_screen(
             continue;
         }
         match screen_one(screen, bounds, (&proposal, None), emit) {
-            Ok(()) => {
+            Ok(verdict) => {
+                asked.verdict = Some(verdict);
                 asked.chosen = Some((proposal, reasoning));
                 return Ok(asked);
             }
@@ -208,16 +229,17 @@ async fn draw_and_screen(
     Ok(asked)
 }
 
-/// Try `proposal` (by `author`, `None`: the model) in `screen`: Ok when it fixes the
+/// Try `proposal` (by `author`, `None`: the model) in `screen`: how it fixes the
 /// failure, else what happened (reported, and learned into `bounds` for a value).
 fn screen_one(
     screen: &Screen,
     bounds: &mut Bounds,
     (proposal, author): (&Proposal, Option<&str>),
     emit: &mut (dyn FnMut(&Event) + Send),
-) -> Result<(), NotHelped> {
-    let Err(why) = screen.check(proposal) else {
-        return Ok(());
+) -> Result<Verdict, NotHelped> {
+    let why = match screen.try_change(proposal) {
+        Ok(verdict) => return Ok(verdict),
+        Err(why) => why,
     };
     let told = why.to_string();
     emit(&Event::CandidateRejected {
@@ -300,7 +322,7 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let choices = if options.ablations.shortlist {
+    let list = if options.ablations.shortlist {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a
@@ -310,15 +332,16 @@ pub(crate) async fn ask_conditions(
         emit(&Event::Notice {
             message: shortlist_notice(&list, before - list.fixes.len()),
         });
-        list.fixes
+        Some(list)
     } else {
-        Vec::new()
+        None
     };
+    let choices = list.as_ref().map(|l| l.fixes.clone()).unwrap_or_default();
     emit(&Event::Asking {
         what: format!("missing preconditions of {action}!"),
     });
-    let tried: Vec<String> = tried.iter().map(ToString::to_string).collect();
-    let messages = ctx.resolve(&options.templates, action, error, &tried, &choices)?;
+    let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
+    let messages = ctx.resolve(&options.templates, action, error, &tried_lines, &choices)?;
     let vocabulary = &ctx.scenario.domain.vocabulary;
     let conditions_grammar = || {
         if choices.is_empty() {
@@ -339,17 +362,19 @@ pub(crate) async fn ask_conditions(
             )
         })
     };
-    draw_and_screen(
+    let mut asked = draw_and_screen(
         model,
         messages,
         (schema::conditions(vocabulary), &conditions_grammar),
         options,
-        screen,
+        (screen, tried),
         &mut Bounds::default(),
         &read,
         emit,
     )
-    .await
+    .await?;
+    asked.shortlist = list;
+    Ok(asked)
 }
 
 pub(crate) async fn ask_value(
@@ -434,7 +459,7 @@ pub(crate) async fn ask_value(
         messages,
         (schema::value(param), &value_grammar),
         options,
-        screen,
+        (screen, tried),
         &mut bounds,
         &read,
         emit,
@@ -458,7 +483,8 @@ pub(crate) async fn ask_value(
         });
         let midway = proposal(value);
         match screen_one(screen, &mut bounds, (&midway, Some(MIDWAY)), emit) {
-            Ok(()) => {
+            Ok(verdict) => {
+                asked.verdict = Some(verdict);
                 asked.chosen = Some((midway, Some(between)));
                 asked.author = Some(MIDWAY.to_string());
             }

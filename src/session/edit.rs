@@ -47,8 +47,13 @@ impl fmt::Display for Edit {
 /// byte of a value that is not one.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum EditError {
-    #[error("'{text}': {error}")]
-    Syntax { text: String, error: GoalError },
+    #[error("'{text}': {error}; a condition of this scene reads like {example}")]
+    Syntax {
+        text: String,
+        error: GoalError,
+        /// A condition of the scenario in use, in its own words.
+        example: String,
+    },
     #[error("'{text}': {error}")]
     Vocabulary {
         text: String,
@@ -88,6 +93,7 @@ fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>, E
     let formula = Formula::parse(text).map_err(|error| EditError::Syntax {
         text: text.to_string(),
         error,
+        example: example(scenario),
     })?;
     for atom in formula.atoms() {
         scenario
@@ -106,6 +112,48 @@ fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>, E
             formula: formula.to_string(),
         }),
     }
+}
+
+/// A condition of `scenario` for messages: the negation of its first atom relating two
+/// objects (else of its first atom), in the scene's own words.
+pub fn example(scenario: &Scenario) -> String {
+    let atoms = scenario.domain.vocabulary.ground_atoms();
+    atoms
+        .iter()
+        .find(|a| a.args.len() == 2)
+        .or_else(|| atoms.first())
+        .map_or_else(String::new, |a| Condition::neg(a.clone()).to_string())
+}
+
+/// How many conditions of a scene the edit line completes from, at most.
+const MAX_COMPLETIONS: usize = 20_000;
+
+/// Every condition of `scenario`'s vocabulary as written (`"red cube" on "blue cube"`,
+/// `On_Coffee_Table1`), with the `"any object"` forms of relations: what the edit line
+/// completes from.
+pub fn vocabulary_words(scenario: &Scenario) -> Vec<String> {
+    let mut words: Vec<String> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    for atom in scenario.domain.vocabulary.ground_atoms() {
+        if atom.is_quoted_form() && atom.args.len() == 2 {
+            for slot in 0..2 {
+                let mut args = atom.args.clone();
+                args[slot] = crate::domain::ANY_OBJECT.to_string();
+                let any = crate::domain::Atom::new(atom.predicate.clone(), args).to_string();
+                if seen.insert(any.clone()) {
+                    words.push(any);
+                }
+            }
+        }
+        let text = atom.to_string();
+        if seen.insert(text.clone()) {
+            words.push(text);
+        }
+        if words.len() >= MAX_COMPLETIONS {
+            break;
+        }
+    }
+    words
 }
 
 /// Whether a skill of the domain takes a value given by category (such as a tool).
@@ -179,6 +227,10 @@ mod tests {
         let e = parse_edit(&s, "~\"blue cube\" on \"blue cube\" | ").unwrap_err();
         assert!(matches!(e, EditError::Syntax { .. }), "{e:?}");
         assert!(e.to_string().contains("column"), "{e}");
+        // The example is the scene's own, never another scene's.
+        let e = parse_edit(&s, "on_ blue").unwrap_err();
+        assert!(e.to_string().contains("reads like ~\""), "{e}");
+        assert!(!e.to_string().contains("Coffee"), "{e}");
         let e = parse_edit(
             &s,
             "\"red cube\" on \"blue cube\" | \"red cube\" on \"green cube\"",

@@ -366,6 +366,7 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
         goal: answer.goal.clone(),
         reasoning: answer.reasoning.clone(),
         matches_expected,
+        author: "model".into(),
     });
 }
 

@@ -6,6 +6,7 @@
 pub mod ask;
 pub mod edit;
 pub mod engine;
+pub mod evidence;
 pub mod goal_checks;
 pub mod interpret;
 mod interpret_parts;
@@ -26,8 +27,9 @@ pub mod values;
 
 pub use crate::planner::RunLimits;
 pub use ask::missing_value;
-pub use edit::{Edit, EditError, parse_edit};
+pub use edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use engine::{Command, Engine, EngineHandle, Setup};
+pub use evidence::Evidence;
 pub use goal_checks::check_goal;
 pub use interpret::{Interpretation, interpret};
 pub use knowledge::{KeptRule, Knowledge, KnowledgeError, Refusal};

@@ -32,6 +32,9 @@ pub enum NoModel {
 pub struct Options {
     /// Questions about failures (each reply, valid or not, is one round).
     pub max_rounds: usize,
+    /// Proposals a person may reject for one failure, each followed by the model asked
+    /// again with the rejected fix left out; past it, the person types the fix.
+    pub max_rejections: usize,
     /// Candidates drawn per question when the first answer fails its checks (goals), or
     /// always (proposals for a failure, each tried in simulation before it is offered).
     pub candidates: usize,
@@ -119,6 +122,7 @@ impl Default for Options {
     fn default() -> Self {
         Options {
             max_rounds: 5,
+            max_rejections: 3,
             candidates: DEFAULT_CANDIDATES,
             goal_feedback_rounds: 2,
             use_scenario_goal: false,
@@ -249,6 +253,9 @@ pub enum Event {
         goal: Formula,
         reasoning: Option<String>,
         matches_expected: Option<bool>,
+        /// Where the goal came from: `model` (the reply's attribution says which), a
+        /// person, a policy file, the scenario file.
+        author: String,
     },
     /// The instruction has more than one reading that would make the robot do different
     /// things, or one the checks doubt (`doubt`, why): the person chooses one
@@ -269,8 +276,12 @@ pub enum Event {
     /// narrowed it, a person, betr's midway value).
     Proposal {
         proposal: Proposal,
+        /// The author's own reasoning (a model's is checked against the evidence).
         reasoning: Option<String>,
         author: String,
+        /// What betr itself found about the failure and the change, shown first; `None`
+        /// when the change was not asked of a model (a person's edit).
+        evidence: Option<Box<super::evidence::Evidence>>,
     },
     Approved,
     Rejected,

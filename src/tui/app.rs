@@ -73,9 +73,27 @@ pub enum Request {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
     Help,
-    Report(Vec<String>),
+    /// Lines in a box, under a title that says what they are.
+    Report {
+        title: &'static str,
+        lines: Vec<String>,
+    },
     /// The readings of an instruction, waiting for the person to choose one.
     Readings(Vec<crate::session::Reading>, Option<String>),
+    /// Quitting would lose what these lines say: the quit key again quits, any other
+    /// key stays.
+    ConfirmQuit(Vec<String>),
+}
+
+/// What a session of the workbench left behind, for the lines printed after it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Summary {
+    /// Policies saved, in order.
+    pub policies: Vec<std::path::PathBuf>,
+    /// Files the tree was exported to.
+    pub exported: Vec<std::path::PathBuf>,
+    /// Approved fixes in the tree that no saved policy holds.
+    pub unsaved_fixes: usize,
 }
 
 pub struct App {
@@ -94,6 +112,10 @@ pub struct App {
     pub mode: KeyMode,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
+    /// The scene's conditions the edit line completes from (built when first edited).
+    vocabulary: Option<Vec<String>>,
+    /// What was saved, exported, and is not saved yet.
+    pub summary: Summary,
     quit: bool,
 }
 
@@ -112,10 +134,7 @@ impl App {
             theme,
             tree: TreePane::default(),
             llm,
-            world: WorldPane {
-                objects: info.objects.clone(),
-                ..WorldPane::default()
-            },
+            world: WorldPane::of(info.objects.clone()),
             input: InputLine::default(),
             status: StatusBar {
                 scenario: info.scenario,
@@ -128,6 +147,8 @@ impl App {
             overlay: None,
             mode: KeyMode::Workbench,
             queue: Vec::new(),
+            vocabulary: None,
+            summary: Summary::default(),
             quit: false,
         }
     }
@@ -137,6 +158,7 @@ impl App {
     pub fn replaying(scenario: Arc<Scenario>, info: Info, keys: KeyBindings, theme: Theme) -> App {
         let mut app = App::new(scenario, info, keys, theme);
         app.mode = KeyMode::Replay;
+        app.world.unmarked = true;
         let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
         let pair = |a: Action, b: Action| format!("{} {}", key(a), key(b));
         let hint = strings::replay_hint(&[
@@ -221,9 +243,18 @@ impl App {
                     self.llm.error = None;
                     match parse_edit(&self.scenario, &text) {
                         Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
-                        // Shown as the engine's errors are; nothing reaches the session.
-                        Err(e) => self.show_error(e.to_string()),
+                        // Shown as the engine's errors are, and the line stays as typed
+                        // with the error under it; nothing reaches the session.
+                        Err(e) => {
+                            self.show_error(e.to_string());
+                            self.input.reopen_with_error(&text, e.to_string());
+                        }
                     }
+                }
+                Some(Submitted::Filter(text)) => self.world.set_filter(Some(text)),
+                Some(Submitted::Search(text)) => {
+                    self.tree.query = (!text.is_empty()).then(|| text.clone());
+                    self.search(true);
                 }
                 None => {}
             }
@@ -238,6 +269,13 @@ impl App {
         }
         if let Some(Overlay::Readings(readings, _)) = &self.overlay {
             return self.on_reading_key(&key, readings.len());
+        }
+        if let Some(Overlay::ConfirmQuit(_)) = &self.overlay {
+            self.overlay = None;
+            if self.keys.action_in(self.mode, &key) == Some(Action::Quit) {
+                self.queue.push(AppEvent::Quit);
+            }
+            return;
         }
         if self.overlay.take().is_some() {
             return;
@@ -282,6 +320,7 @@ impl App {
             Action::Reject => Command::Reject,
             Action::Undo => {
                 self.llm.offer = None;
+                self.summary.unsaved_fixes = self.summary.unsaved_fixes.saturating_sub(1);
                 Command::Undo
             }
             Action::Verify => Command::Verify,
@@ -322,16 +361,50 @@ impl App {
                     .as_ref()
                     .map(|p| p.edit_text.clone())
                     .unwrap_or_default();
+                if self.vocabulary.is_none() {
+                    self.vocabulary = Some(crate::session::vocabulary_words(&self.scenario));
+                }
+                self.input
+                    .set_vocabulary(self.vocabulary.clone().unwrap_or_default());
                 return self.input.open(Mode::Edit, &text);
             }
             Action::Help => {
                 self.overlay = Some(Overlay::Help);
                 return;
             }
+            Action::Details => return self.show_details(),
+            Action::Follow => {
+                self.tree.follow = !self.tree.follow;
+                if self.tree.follow {
+                    self.tree.show_running(false);
+                }
+                return self.message(strings::follow(self.tree.follow).to_string(), false);
+            }
+            Action::Search => return self.input.open(Mode::Search, ""),
+            Action::SearchNext => return self.search(true),
+            Action::SearchPrevious => return self.search(false),
+            Action::CollapseAll => return self.tree.collapse_all(),
+            Action::WorldUp => return self.world.scroll_up(),
+            Action::WorldDown => return self.world.scroll_down(),
+            Action::WorldFilter => {
+                let now = self.world.filter.clone().unwrap_or_default();
+                return self.input.open(Mode::Filter, &now);
+            }
+            Action::ExpandToRunning => {
+                if !self.tree.show_running(true) {
+                    self.message(strings::NOTHING_RUNNING.to_string(), true);
+                }
+                return;
+            }
             Action::LogUp => return self.llm.scroll_log_up(),
             Action::LogDown => return self.llm.scroll_log_down(),
             Action::Quit => {
-                self.queue.push(AppEvent::Quit);
+                let lost = self.would_be_lost();
+                if lost.is_empty() {
+                    self.queue.push(AppEvent::Quit);
+                } else {
+                    self.overlay = Some(Overlay::ConfirmQuit(lost));
+                }
                 return;
             }
             // Bound in a replay only: moves in the recording.
@@ -373,6 +446,57 @@ impl App {
             }
         };
         self.queue.push(AppEvent::Dictation(request));
+    }
+
+    /// The next (or previous) match of the tree search, said in the status bar.
+    fn search(&mut self, forward: bool) {
+        let Some(query) = self.tree.query.clone() else {
+            return;
+        };
+        let text = match self.tree.search(&query, forward, &self.theme) {
+            Some(found) => strings::found(&query, found.at, found.of),
+            None => strings::not_found(&query),
+        };
+        self.message(text, false);
+    }
+
+    /// A mouse event: on the tree pane it selects or scrolls.
+    pub fn on_mouse(&mut self, event: crossterm::event::MouseEvent) {
+        self.tree.mouse(&event);
+    }
+
+    /// What quitting now would lose, one line each (nothing in a replay).
+    fn would_be_lost(&self) -> Vec<String> {
+        if self.mode == KeyMode::Replay {
+            return Vec::new();
+        }
+        let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+        let mut lost = Vec::new();
+        if self.summary.unsaved_fixes > 0 {
+            lost.push(strings::unsaved_fixes(
+                self.summary.unsaved_fixes,
+                &key(Action::Save),
+            ));
+        }
+        if let Some(p) = &self.llm.proposal {
+            lost.push(strings::pending_lost(&p.target));
+        }
+        if !lost.is_empty() {
+            lost.push(String::new());
+            lost.push(strings::confirm_quit(&key(Action::Quit)));
+        }
+        lost
+    }
+
+    /// Everything the panes may cut: the pending proposal whole (betr's findings, the
+    /// proposal, its author's reasoning), else the selected node's whole label.
+    fn show_details(&mut self) {
+        let (title, lines) = match (&self.llm.proposal, self.tree.selected_details(&self.theme)) {
+            (Some(p), _) => (strings::PROPOSAL_DETAILS_TITLE, p.details()),
+            (None, Some(lines)) => (strings::NODE_DETAILS_TITLE, lines),
+            (None, None) => return self.message(strings::NOTHING_TO_DETAIL.to_string(), true),
+        };
+        self.overlay = Some(Overlay::Report { title, lines });
     }
 
     fn message(&mut self, text: String, error: bool) {

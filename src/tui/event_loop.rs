@@ -225,6 +225,7 @@ pub async fn run<B: Backend>(
 fn dispatch(app: &mut App, event: QueueEvent, out: &mut Outlets, animated: &mut bool) -> bool {
     match event {
         QueueEvent::Input(TermEvent::Key(key)) => app.on_key(key),
+        QueueEvent::Input(TermEvent::Mouse(mouse)) => app.on_mouse(mouse),
         // A resize is drawn at the next draw.
         QueueEvent::Input(_) => {}
         QueueEvent::InputEnded | QueueEvent::SessionEnded => return false,

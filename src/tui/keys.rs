@@ -37,6 +37,21 @@ pub enum Action {
     Breakpoint,
     Force,
     BreakOnFailure,
+    /// The pending proposal, or the selected node, whole in an overlay.
+    Details,
+    /// Select the running node after every tick (toggle).
+    Follow,
+    /// Search the tree's labels; next and previous match.
+    Search,
+    SearchNext,
+    SearchPrevious,
+    /// Close every node; open the way to the running node only.
+    CollapseAll,
+    ExpandToRunning,
+    /// The world's fact table: scroll, and narrow to facts holding a text.
+    WorldUp,
+    WorldDown,
+    WorldFilter,
     LogUp,
     LogDown,
     Help,
@@ -307,6 +322,16 @@ bindings! {
     previous_model_call: PreviousModelCall = Key::plain('M'), Replay;
     start: Start = Key::plain('g'), Replay;
     end: End = Key::plain('G'), Replay;
+    details: Details = Key::plain('D'), Both;
+    follow: Follow = Key::plain('F'), Both;
+    search: Search = Key::plain('/'), Workbench;
+    search_next: SearchNext = Key::plain('>'), Workbench;
+    search_previous: SearchPrevious = Key::plain('<'), Workbench;
+    collapse_all: CollapseAll = Key::plain('C'), Both;
+    expand_to_running: ExpandToRunning = Key::plain('E'), Both;
+    world_up: WorldUp = Key::plain('{'), Both;
+    world_down: WorldDown = Key::plain('}'), Both;
+    world_filter: WorldFilter = Key::plain('W'), Workbench;
     log_up: LogUp = Key::plain('['), Both;
     log_down: LogDown = Key::plain(']'), Both;
     help: Help = Key::plain('?'), Both;
@@ -421,7 +446,8 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "b", "f", "B", "[", "]", "?", "q"
+                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "{", "}", "W", "[",
+                "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -477,7 +503,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "[", "]", "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "{", "}",
+                "[", "]", "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

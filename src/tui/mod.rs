@@ -31,6 +31,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crossterm::cursor::{Hide, Show};
+use crossterm::event::{DisableMouseCapture, EnableMouseCapture};
 use crossterm::execute;
 use crossterm::terminal::{
     EnterAlternateScreen, LeaveAlternateScreen, disable_raw_mode, enable_raw_mode,
@@ -42,7 +43,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationService, Microphone, SttLoader};
 
-pub use app::{App, Info, ModelArrival, Request};
+pub use app::{App, Info, ModelArrival, Request, Summary};
 pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
@@ -67,7 +68,7 @@ impl TerminalGuard {
         install_panic_hook();
         let guard = TerminalGuard;
         enable_raw_mode()?;
-        execute!(stdout(), EnterAlternateScreen, Hide)?;
+        execute!(stdout(), EnterAlternateScreen, Hide, EnableMouseCapture)?;
         if let Some(file) = stderr_to
             && let Err(e) = stderr::redirect(file)
         {
@@ -89,7 +90,7 @@ impl Drop for TerminalGuard {
 pub fn restore() {
     stderr::restore();
     let _ = disable_raw_mode();
-    let _ = execute!(stdout(), LeaveAlternateScreen, Show);
+    let _ = execute!(stdout(), DisableMouseCapture, LeaveAlternateScreen, Show);
 }
 
 fn install_panic_hook() {
@@ -118,12 +119,13 @@ pub struct Workbench {
     pub model_arrival: Option<tokio::sync::mpsc::UnboundedReceiver<app::ModelArrival>>,
 }
 
-/// Open the workbench on `setup` until the person quits.
+/// Open the workbench on `setup` until the person quits; what the session saved and left
+/// unsaved.
 pub async fn run(
     setup: Setup,
     workbench: Workbench,
     mut tap: Option<&mut dyn Tap>,
-) -> Result<(), TuiError> {
+) -> Result<app::Summary, TuiError> {
     let Workbench {
         info,
         keys,
@@ -163,5 +165,5 @@ pub async fn run(
     }
     // A recording still open is discarded with the service, before the screen goes.
     drop(dictation);
-    Ok(())
+    Ok(app.summary)
 }

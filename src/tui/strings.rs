@@ -3,16 +3,82 @@
 use crate::bt::Status;
 
 pub const TREE_TITLE: &str = " Behavior tree ";
+pub const FOLLOWING: &str = " following the running node ";
+pub const SEARCH_TITLE: &str = " Search the tree (Enter finds, Esc cancels) ";
+
+/// Under the tree while a search is on.
+pub fn searching(query: &str) -> String {
+    format!(" /{query} ")
+}
+
+/// Where a search stands, in the status bar.
+pub fn found(query: &str, at: usize, of: usize) -> String {
+    format!("/{query}: match {at} of {of}")
+}
+
+pub fn not_found(query: &str) -> String {
+    format!("/{query}: no node's label holds it")
+}
+
+pub fn follow(on: bool) -> &'static str {
+    if on {
+        "following the running node after every tick"
+    } else {
+        "not following the running node"
+    }
+}
+
+pub const NOTHING_RUNNING: &str = "no node is running or has failed yet";
 pub const TREE_EMPTY: &str = "No tree yet. Press i to type an instruction (or a goal formula), or p to plan the scenario's goal.";
 pub const LLM_TITLE: &str = " LLM ";
 pub const WORLD_TITLE: &str = " World ";
 pub const INPUT_TITLE_IDLE: &str = " Input ";
 pub const INPUT_TITLE_INSTRUCTION: &str = " Instruction or goal (Enter submits, Esc cancels) ";
 pub const INPUT_TITLE_EDIT: &str = " Edit the proposal (Enter applies, Esc cancels) ";
+/// Under the edit line while nothing else is said there.
+pub const TAB_COMPLETES: &str = " Tab completes a condition of this scene ";
+pub const NO_COMPLETION: &str = "no condition of this scene begins so";
+
+/// The completions left under the edit line: a few, and how many.
+pub fn completions(listed: &[&str], count: usize) -> String {
+    let more = if count > listed.len() { ", …" } else { "" };
+    format!("{count} match: {}{more}", listed.join(", "))
+}
+
+pub const REJECTED: &str = "rejected: the tree is unchanged; the model is asked again without it (e: type the fix yourself)";
+pub const CONFIRM_QUIT_TITLE: &str = " Quit? ";
+
+/// Approved fixes no saved policy holds, in the quit question.
+pub fn unsaved_fixes(count: usize, save_key: &str) -> String {
+    format!(
+        "{count} approved fix(es) in the tree are not saved as a policy ({save_key} saves them)."
+    )
+}
+
+/// A proposal waiting, in the quit question.
+pub fn pending_lost(target: &str) -> String {
+    format!("The proposal for {target} waits for approval.")
+}
+
+pub fn confirm_quit(quit_key: &str) -> String {
+    format!("Press {quit_key} again to quit; any other key stays.")
+}
+
+/// Where a goal loaded with a policy came from.
+pub fn from_policy(path: &str) -> String {
+    format!("policy {path}")
+}
+
 pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, ? for help";
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";
 pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
+pub const VIOLATION_TITLE: &str = " The change fails verification (any key closes) ";
+pub const RULES_TITLE: &str = " Rules learned from approved fixes (any key closes) ";
+pub const PROPOSAL_DETAILS_TITLE: &str = " The proposal, whole (any key closes) ";
+pub const NODE_DETAILS_TITLE: &str = " The selected node, whole (any key closes) ";
+pub const NOTHING_TO_DETAIL: &str =
+    "nothing to show whole: no proposal is pending and no node is selected (↑ ↓)";
 pub const READINGS_TITLE: &str = " Readings of the instruction (press a number; Esc: none) ";
 pub const READINGS_INTRO: &str =
     "The instruction can be read in ways that make the robot do different things:";
@@ -22,6 +88,29 @@ pub const NO_READING_CHOSEN: &str =
     "no reading chosen: type the instruction again (i), said otherwise";
 
 pub const NOW_TRUE: &str = "True now:";
+/// Before a fact the last tick made true, and one it made false.
+pub const MADE_TRUE: &str = "+ ";
+pub const MADE_FALSE: &str = "- ";
+pub const VALUE_SET: &str = "value set:";
+pub const FILTER_TITLE: &str = " Show the facts holding (Enter filters, empty: all) ";
+
+/// The objects when their names do not fit on a line.
+pub fn objects_counted(count: usize) -> String {
+    format!("{OBJECTS} {count} (too many to name here)")
+}
+
+/// Above the fact table: how many are listed, of how many, and the filter.
+pub fn facts_heading(shown: usize, total: usize, filter: Option<&str>) -> String {
+    match filter {
+        Some(q) => format!("True now: {shown} of {total} holding \"{q}\""),
+        None => format!("True now: {total} (+ made true, - made false by the last tick)"),
+    }
+}
+
+/// Over the fact table scrolled down.
+pub fn rows_above(rows: usize) -> String {
+    format!("↑ {rows} row(s) above")
+}
 pub const NOTHING_TRUE: &str = "  (nothing)";
 pub const OBJECTS: &str = "Objects:";
 pub const LAST_ERROR: &str = "Last error:";
@@ -45,12 +134,43 @@ pub const AWAITING_VIOLATION: Awaiting = Awaiting {
     short: "violates",
 };
 pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, reject it (x: undone, and the model is asked again knowing why), or undo it (u).";
-pub const REASONING: &str = "Reasoning:";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
 pub const ASKING: &str = "asking the model for";
-pub const REPLY_FROM: &str = "reply from";
-pub const GOAL: &str = "Goal:";
+/// Above what betr itself established about a failure.
+pub const FOUND_BY_BETR: &str = "Found by betr:";
+pub const GOAL: &str = "Goal";
+
+/// The LLM pane's border while a proposal waits.
+pub fn proposed_title(proposal: &str) -> String {
+    format!(" proposed: {proposal} ")
+}
+
+/// Who a proposal is by.
+pub fn proposal_by(target: &str, author: &str) -> String {
+    format!("{PROPOSAL_FOR} {target} (by {author}):")
+}
+
+/// Above an author's own reasoning: labelled as theirs, and as doubtful when the
+/// evidence does not bear it out.
+pub fn reasoning_of(author: &str, doubt: Option<&str>) -> String {
+    match doubt {
+        Some(why) => format!(
+            "Reasoning of {author}, DOUBTFUL ({why}); not the reason, betr's findings above are:"
+        ),
+        None => format!("Reasoning of {author} (its words; the findings above are betr's):"),
+    }
+}
+
+/// Under the goal: who wrote it.
+pub fn goal_by(author: &str) -> String {
+    format!("  from {author}")
+}
+
+/// Who answered the last model call.
+pub fn last_reply(who: &str) -> String {
+    format!("last reply from {who}")
+}
 pub const LOG: &str = "Log";
 
 /// The marker under a log scrolled up: how many rows are below.
@@ -70,6 +190,7 @@ pub const SUCCESS: &str = "SUCCESS";
 pub const FAILED: &str = "FAILED";
 pub const HELP_WORD: &str = "help";
 pub const NEW_MARK: &str = "+";
+pub const ADDED_BY_LAST_CHANGE: &str = "+ added by the last change";
 pub const FAILED_MARK: &str = "◀ failed";
 /// After a node with a breakpoint.
 pub const BREAKPOINT_MARK: &str = "● break";
@@ -124,6 +245,16 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Breakpoint => "set / clear a breakpoint on the selected node",
         Force => "force the selected node: failure, success, running, off",
         BreakOnFailure => "break on failure: stop running when a node fails",
+        Details => "show whole what a pane cuts: the proposal, else the selected node",
+        Follow => "follow the running node after every tick (on / off)",
+        WorldUp => "scroll the world's facts up",
+        WorldDown => "scroll the world's facts down",
+        WorldFilter => "show only the world's facts holding a text",
+        Search => "search the tree's labels",
+        SearchNext => "the next match of the search",
+        SearchPrevious => "the previous match of the search",
+        CollapseAll => "collapse every node",
+        ExpandToRunning => "collapse all but the way to the running node",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",
@@ -177,6 +308,11 @@ pub fn verified_tree(origin: &str) -> String {
 
 pub fn exported(paths: &[String]) -> String {
     format!("tree written to {}", paths.join(" and "))
+}
+
+/// An approved proposal in the log, with who proposed it.
+pub fn approved(change: &str, target: &str, author: &str) -> String {
+    format!("approved {change} for {target} (proposed by {author})")
 }
 
 pub fn repaired(added: usize, valued: usize) -> String {

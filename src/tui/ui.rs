@@ -38,10 +38,11 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
     let hint = match app.mode {
         KeyMode::Workbench => format!(
-            "{} approve · {} reject · {} edit",
+            "{} approve · {} reject · {} edit · {} whole",
             key(Action::Approve),
             key(Action::Reject),
-            key(Action::Edit)
+            key(Action::Edit),
+            key(Action::Details)
         ),
         KeyMode::Replay => strings::REPLAY_PROPOSAL_HINT.to_string(),
     };
@@ -58,7 +59,10 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     app.status.draw(frame, status, &theme, &help_key);
     match &app.overlay {
         Some(Overlay::Help) => draw_help(frame, area, &app.keys, app.mode, &theme),
-        Some(Overlay::Report(lines)) => draw_report(frame, area, lines, &theme),
+        Some(Overlay::Report { title, lines }) => draw_report(frame, area, title, lines, &theme),
+        Some(Overlay::ConfirmQuit(lines)) => {
+            draw_report(frame, area, strings::CONFIRM_QUIT_TITLE, lines, &theme);
+        }
         Some(Overlay::Readings(readings, doubt)) => {
             draw_readings(frame, area, readings, doubt.as_deref(), &theme);
         }

@@ -98,3 +98,13 @@ pub fn replies(path: &Path, file: &FixtureFile) -> Vec<FixtureReply> {
 pub fn every_reply() -> Vec<FixtureReply> {
     all().iter().flat_map(|(p, f)| replies(p, f)).collect()
 }
+
+/// The replies of the fixture file `name` alone (`red_on_blue.toml`): for a session whose
+/// replies must come from that file when another file's would match the prompt too.
+pub fn replies_of(name: &str) -> Vec<FixtureReply> {
+    all()
+        .iter()
+        .filter(|(p, _)| p.file_name().is_some_and(|n| n == name))
+        .flat_map(|(p, f)| replies(p, f))
+        .collect()
+}

@@ -177,6 +177,7 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
             goal: goal.clone(),
             reasoning: Some("because".into()),
             matches_expected: Some(true),
+            author: "model".into(),
         },
     ];
     for _ in 0..1 + rng.small(6) {
@@ -209,6 +210,7 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
                 },
                 reasoning: None,
                 author: "model".into(),
+                evidence: None,
             },
             5 => Recorded::Proposal {
                 proposal: RecordedProposal::Value {
@@ -219,6 +221,11 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
                 },
                 reasoning: Some((0..rng.small(20)).map(|_| random_char(rng)).collect()),
                 author: "model".into(),
+                evidence: Some(crate::session::Evidence {
+                    findings: vec![(0..rng.small(20)).map(|_| random_char(rng)).collect()],
+                    objects: vec!["egg".into()],
+                    doubt: None,
+                }),
             },
             6 => Recorded::WorldChanged {
                 facts: vec![goal.clone()],

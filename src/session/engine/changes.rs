@@ -9,6 +9,7 @@ use crate::planner::Planner;
 
 use super::super::ask::{Tried, missing_value};
 use super::super::edit::Edit;
+use super::super::evidence::Evidence;
 use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
@@ -47,6 +48,9 @@ enum Unfit {
     Conform(#[from] super::super::values::ConformError),
 }
 
+/// What the model is told of a proposal a person rejected.
+pub(super) const REJECTED: &str = "rejected by a person";
+
 impl Engine {
     pub(super) fn approve(&mut self) {
         if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
@@ -62,10 +66,35 @@ impl Engine {
         if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
             return self.reject_violation();
         }
-        if self.pending.take().is_none() {
+        let Some(pending) = self.pending.take() else {
             return self.error("no proposal to reject");
-        }
+        };
         self.emit(Event::Rejected);
+        let Some(failure) = pending.failure else {
+            return;
+        };
+        // The model is asked again with what the person rejected told to it as tried (and
+        // left out of the conditions it may choose from), a few times; then the person
+        // types the fix.
+        self.tried.push((
+            failure.clone(),
+            Tried {
+                proposal: pending.proposal,
+                why: REJECTED.to_string(),
+            },
+        ));
+        let rejected = self
+            .tried
+            .iter()
+            .filter(|(f, t)| *f == failure && t.why == REJECTED)
+            .count();
+        if rejected > self.options.max_rejections || self.model.is_err() {
+            return self.notice(format!(
+                "{rejected} proposal(s) for {}! rejected: type the missing condition(s) or value yourself (e)",
+                failure.action
+            ));
+        }
+        self.ask_about(failure);
     }
 
     /// Apply the pending proposal; keep it only if it helps.
@@ -94,6 +123,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: Some(pending.proposal.clone()),
         });
         let change = pending.proposal.to_string();
         self.last_change = Some((before.clone(), pending.proposal.clone()));
@@ -142,13 +172,27 @@ impl Engine {
             Some((proposal, dropped)) => {
                 let dropped: Vec<String> = dropped.iter().map(ToString::to_string).collect();
                 let author = format!("simulation, narrowed from {}", pending.author);
+                let mut findings: Vec<String> = before
+                    .map(|f| format!("{}! failed: {}", f.action, f.error))
+                    .into_iter()
+                    .collect();
+                findings.push(format!(
+                    "{} was approved and did not fix the failure in the execution world",
+                    pending.proposal
+                ));
+                findings.push(format!(
+                    "in simulation, it works without {}: only the rest fixes the failure",
+                    dropped.join(" & ")
+                ));
                 self.emit(Event::Proposal {
                     proposal: proposal.clone(),
-                    reasoning: Some(format!(
-                        "In simulation, the proposal works without {}: only the rest fixes the failure.",
-                        dropped.join(" & ")
-                    )),
+                    reasoning: None,
                     author: author.clone(),
+                    evidence: Some(Box::new(Evidence {
+                        findings,
+                        objects: before.map(|f| f.action.args.clone()).unwrap_or_default(),
+                        doubt: None,
+                    })),
                 });
                 self.pending = Some(Pending {
                     proposal,
@@ -181,10 +225,14 @@ impl Engine {
             Ok(p) => p,
             Err(e) => return self.error(e.to_string()),
         };
+        // What the person wrote answers the failure: a question still out about it is
+        // dropped.
+        self.cancel_request();
         self.emit(Event::Proposal {
             proposal: edited.clone(),
-            reasoning: Some("written by a person".into()),
+            reasoning: None,
             author: "a person".into(),
+            evidence: None,
         });
         self.pending = Some(Pending {
             proposal: edited,
@@ -322,6 +370,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: None,
         });
         let change = format!("set {} ({valued} action(s))", setting.text);
         self.fixes.push(AppliedFix {
@@ -396,6 +445,7 @@ impl Engine {
         self.undo.push(UndoEntry {
             tree,
             fixes: self.fixes.len(),
+            proposal: None,
         });
         self.fixes.push(AppliedFix {
             change: change.clone(),

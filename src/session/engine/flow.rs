@@ -17,13 +17,25 @@ use super::super::submitted::{self, Submitted};
 use super::super::types::{Event, SessionError};
 use super::{Engine, Failure, Task};
 
+/// Who wrote a goal a person typed as a formula.
+const TYPED: &str = "a person, typed as a goal";
+/// Who wrote a goal a person chose among the model's readings.
+const CHOSEN: &str = "a person, chosen among the model's readings";
+/// Who wrote a goal the caller gave with the instruction.
+const GIVEN: &str = "given with the instruction";
+
 impl Engine {
     pub(super) fn submit_goal(&mut self, goal: crate::goal::Formula, instruction: String) {
-        self.start_task(goal, Some(instruction));
+        self.start_task(goal, Some(instruction), GIVEN);
     }
 
-    /// Plan `goal`, reporting how it compares with the scenario's goal.
-    fn start_task(&mut self, goal: crate::goal::Formula, instruction: Option<String>) {
+    /// Plan `goal` (from `author`), reporting how it compares with the scenario's goal.
+    fn start_task(
+        &mut self,
+        goal: crate::goal::Formula,
+        instruction: Option<String>,
+        author: &str,
+    ) {
         let matches_expected = self
             .scenario
             .goal
@@ -33,6 +45,7 @@ impl Engine {
             goal: goal.clone(),
             reasoning: None,
             matches_expected,
+            author: author.to_string(),
         });
         self.task = Some(Task { goal, instruction });
         self.plan();
@@ -41,7 +54,7 @@ impl Engine {
     pub(super) fn submit(&mut self, text: &str) {
         self.choosing = None;
         let text = match submitted::read(&self.scenario, text) {
-            Ok(Submitted::Goal(goal)) => return self.start_task(goal, None),
+            Ok(Submitted::Goal(goal)) => return self.start_task(goal, None, TYPED),
             Ok(Submitted::Instruction(text)) => text,
             Err(e) => return self.error(e.to_string()),
         };
@@ -114,7 +127,7 @@ impl Engine {
         };
         let goal = reading.goal.clone();
         self.notice(format!("reading {} chosen: {goal}", index + 1));
-        self.start_task(goal, Some(instruction));
+        self.start_task(goal, Some(instruction), CHOSEN);
     }
 
     /// The goal a saved policy recorded for this instruction (no model call needed).
@@ -131,6 +144,7 @@ impl Engine {
             goal: goal.clone(),
             reasoning: None,
             matches_expected: None,
+            author: format!("policy {}", path.display()),
         });
         Some(goal)
     }
@@ -364,6 +378,10 @@ impl Engine {
         self.drop_offers();
         let undone = self.fixes.len().saturating_sub(entry.fixes);
         self.fixes.truncate(entry.fixes);
+        // Undoing is not rejecting: the undone change may be proposed again.
+        if let Some(proposal) = &entry.proposal {
+            self.tried.retain(|(_, t)| &t.proposal != proposal);
+        }
         let why = format!("undid the last change ({undone} fix(es) removed)");
         self.replace_tree(entry.tree, Vec::new(), why);
     }

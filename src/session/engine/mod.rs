@@ -216,6 +216,9 @@ struct AppliedFix {
 struct UndoEntry {
     tree: Tree,
     fixes: usize,
+    /// The change this entry undoes, when it was a proposal: undone, it is a candidate
+    /// for its failure again, whatever was said of it before.
+    proposal: Option<Proposal>,
 }
 
 /// A model call under way.

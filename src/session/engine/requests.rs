@@ -10,6 +10,7 @@ use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
 use super::super::ask::{Asked, FailedAction, Tried, ask_conditions, ask_value, missing_value};
+use super::super::evidence::{Evidence, Found};
 use super::super::interpret::{Interpretation, interpret};
 use super::super::policy::Approval;
 use super::super::screen::Screen;
@@ -28,6 +29,8 @@ pub(crate) enum Internal {
         id: u64,
         failure: Failure,
         result: Result<Asked, SessionError>,
+        /// What betr found, for the chosen proposal.
+        evidence: Option<Box<Evidence>>,
         replies: Vec<Reply>,
     },
     Verified {
@@ -210,10 +213,27 @@ impl Engine {
                     }
                 }
             };
+            let evidence = result.as_ref().ok().and_then(|asked| {
+                let (proposal, reasoning) = asked.chosen.as_ref()?;
+                let found = Found {
+                    failure: &failure,
+                    facts: &facts,
+                    shortlist: asked.shortlist.as_ref(),
+                    tried: &tried,
+                    proposal,
+                    verdict: asked.verdict,
+                };
+                Some(Box::new(Evidence::of(
+                    &found,
+                    reasoning.as_deref(),
+                    &scenario.domain.vocabulary.objects,
+                )))
+            });
             let _ = tx.send(Internal::Proposal {
                 id,
                 failure,
                 result,
+                evidence,
                 replies,
             });
         });
@@ -247,6 +267,7 @@ impl Engine {
                 id,
                 failure,
                 result,
+                evidence,
                 replies,
             } => {
                 self.count(&replies);
@@ -269,15 +290,11 @@ impl Engine {
                                 .last()
                                 .map_or_else(|| "unknown".into(), |r| r.attribution.clone())
                         });
-                        let checked =
-                            "Tried in simulation before it was offered: it fixes the failure.";
                         self.emit(Event::Proposal {
                             proposal: proposal.clone(),
-                            reasoning: Some(match reasoning {
-                                Some(r) => format!("{r}\n{checked}"),
-                                None => checked.to_string(),
-                            }),
+                            reasoning,
                             author: author.clone(),
+                            evidence,
                         });
                         self.pending = Some(Pending {
                             proposal,

@@ -72,11 +72,20 @@ impl App {
                 self.llm.log(format!("set aside {candidate}: {reason}"));
             }
             Event::Goal {
-                goal, reasoning, ..
+                goal,
+                reasoning,
+                author,
+                ..
             } => {
                 self.status.awaiting = None;
                 self.llm.goal = Some(goal.to_string());
-                self.llm.reasoning = reasoning;
+                // A model's goal names the model that answered.
+                let by = match (author.as_str(), &self.llm.replied_by) {
+                    ("model", Some(who)) => who.clone(),
+                    _ => author,
+                };
+                self.llm.goal_by = Some(by);
+                self.llm.goal_reasoning = reasoning;
             }
             Event::Readings {
                 readings, doubt, ..
@@ -106,6 +115,7 @@ impl App {
                 why,
             } => {
                 let added = new_nodes.len();
+                self.world.values = values_set(&tree);
                 self.tree.set_tree(tree, new_nodes, learned);
                 self.status.ending = None;
                 self.llm.log(if added > 0 {
@@ -117,7 +127,10 @@ impl App {
             Event::Repaired {
                 added_nodes,
                 valued_nodes,
-            } => self.llm.log(strings::repaired(added_nodes, valued_nodes)),
+            } => {
+                self.summary.unsaved_fixes += 1;
+                self.llm.log(strings::repaired(added_nodes, valued_nodes));
+            }
             _ => {}
         }
     }
@@ -141,23 +154,26 @@ impl App {
             Event::Proposal {
                 proposal,
                 reasoning,
-                ..
+                author,
+                evidence,
             } => {
                 self.llm.asking = None;
-                self.llm.reasoning = reasoning;
-                self.llm.proposal = Some(ProposalView::of(&proposal));
+                self.llm.proposal = Some(ProposalView::of(&proposal, &author, reasoning, evidence));
                 self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
             }
             Event::Approved => {
                 self.status.awaiting = None;
-                self.llm.proposal = None;
-                self.llm.log("approved");
+                // The log keeps who proposed what was approved.
+                let line = match self.llm.proposal.take() {
+                    Some(p) => strings::approved(&p.lines.join(" & "), &p.target, &p.author),
+                    None => "approved".to_string(),
+                };
+                self.llm.log(line);
             }
             Event::Rejected => {
                 self.status.awaiting = None;
                 self.llm.proposal = None;
-                self.llm
-                    .log("rejected: the tree is unchanged (e to type conditions)");
+                self.llm.log(strings::REJECTED);
             }
             Event::DidNotHelp { reason } => {
                 self.status.awaiting = None;
@@ -186,7 +202,7 @@ impl App {
                 let mut facts: Vec<String> = facts.iter().map(ToString::to_string).collect();
                 // Relations between objects first: they change; "near robot" rarely does.
                 facts.sort_by_key(|f| std::cmp::Reverse(f.matches('"').count()));
-                self.world.facts = facts;
+                self.world.set_facts(facts, reset);
                 if reset {
                     self.status.ticks = 0;
                     self.status.ending = None;
@@ -213,7 +229,10 @@ impl App {
                 let holds = report.holds();
                 let mut lines = vec![strings::verified_tree(&origin)];
                 lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::VERIFY_TITLE,
+                    lines,
+                });
                 self.llm
                     .log(if holds { "verified" } else { "NOT verified" });
             }
@@ -221,20 +240,28 @@ impl App {
                 self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
                 let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
                 lines.extend(report_lines(&report, &self.theme));
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::VIOLATION_TITLE,
+                    lines,
+                });
                 self.llm.log(strings::CHANGE_VIOLATES);
             }
             Event::PolicySaved { path, fixes } => {
                 self.llm
                     .log(strings::policy_saved(&path.display().to_string(), fixes));
+                self.summary.unsaved_fixes = 0;
+                self.summary.policies.push(path);
             }
             Event::Exported { paths } => {
                 let names: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
                 self.llm.log(strings::exported(&names));
+                self.summary.exported.extend(paths);
             }
             Event::PolicyLoaded { path, fixes } => {
                 self.llm
                     .log(strings::policy_loaded(&path.display().to_string(), fixes));
+                self.summary.unsaved_fixes = 0;
+                self.llm.goal_by = Some(strings::from_policy(&path.display().to_string()));
             }
             _ => {}
         }
@@ -279,7 +306,10 @@ impl App {
                     lines.push(strings::NO_RULES.to_string());
                 }
                 lines.extend(rules);
-                self.overlay = Some(Overlay::Report(lines));
+                self.overlay = Some(Overlay::Report {
+                    title: strings::RULES_TITLE,
+                    lines,
+                });
             }
             _ => {}
         }
@@ -341,4 +371,21 @@ impl App {
             _ => {}
         }
     }
+}
+
+/// The values parameters set on `tree`'s actions, one line each, each action once.
+fn values_set(tree: &crate::bt::Tree) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for node in tree.preorder() {
+        if let Ok(crate::bt::NodeKind::Action(a)) = tree.kind(node) {
+            for (name, value) in &a.values {
+                let objects: Vec<String> = a.args.iter().map(|o| format!("\"{o}\"")).collect();
+                let line = format!("{} {}: {name} = {value}", a.skill, objects.join(" "));
+                if !lines.contains(&line) {
+                    lines.push(line);
+                }
+            }
+        }
+    }
+    lines
 }

@@ -1,4 +1,5 @@
-//! Overlays: the help (generated from the key bindings) and a verification report.
+//! Overlays: the help (generated from the key bindings), and lines in a titled box (a
+//! verification report, the rules kept, the details of a proposal or a node, readings).
 
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Flex, Layout, Rect};
@@ -24,18 +25,41 @@ fn centered(area: Rect, width: u16, height: u16) -> Rect {
 
 pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, mode: KeyMode, theme: &Theme) {
     let entries = keys.help_lines(mode);
-    let key_width = entries
+    // Two columns, each with its own key width, when one does not fit the height.
+    let rows = if entries.len() + 4 > usize::from(area.height) {
+        entries.len().div_ceil(2)
+    } else {
+        entries.len()
+    };
+    let (left, right) = entries.split_at(rows.min(entries.len()));
+    let width_of = |column: &[(String, &'static str)]| {
+        column
+            .iter()
+            .map(|(k, _)| k.chars().count())
+            .max()
+            .unwrap_or(0)
+    };
+    let (left_keys, right_keys) = (width_of(left), width_of(right));
+    let left_width = left
         .iter()
-        .map(|(k, _)| k.chars().count())
+        .map(|(_, what)| left_keys + 3 + what.chars().count())
         .max()
         .unwrap_or(0);
-    let mut lines: Vec<Line> = entries
+    let mut lines: Vec<Line> = left
         .iter()
-        .map(|(k, what)| {
-            Line::from(vec![
-                Span::styled(format!(" {k:>key_width$}  "), theme.key),
+        .enumerate()
+        .map(|(i, (k, what))| {
+            let mut spans = vec![
+                Span::styled(format!(" {k:>left_keys$}  "), theme.key),
                 Span::raw(*what),
-            ])
+            ];
+            if let Some((rk, rwhat)) = right.get(i) {
+                let used = left_keys + 3 + what.chars().count();
+                spans.push(Span::raw(" ".repeat(left_width - used + 2)));
+                spans.push(Span::styled(format!("{rk:>right_keys$}  "), theme.key));
+                spans.push(Span::raw(*rwhat));
+            }
+            Line::from(spans)
         })
         .collect();
     lines.push(Line::from(""));
@@ -111,9 +135,9 @@ pub fn report_lines(report: &Report, theme: &Theme) -> Vec<String> {
     lines
 }
 
-/// The verification report in a box over the screen.
-pub fn draw_report(frame: &mut Frame, area: Rect, lines: &[String], theme: &Theme) {
-    draw_box(frame, area, lines, theme, strings::VERIFY_TITLE);
+/// Lines (a verification report, the rules kept, details) in a box over the screen.
+pub fn draw_report(frame: &mut Frame, area: Rect, title: &str, lines: &[String], theme: &Theme) {
+    draw_box(frame, area, lines, theme, title);
 }
 
 /// The readings of an instruction to choose among, each with its number, its words, its

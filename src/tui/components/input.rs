@@ -1,5 +1,7 @@
 //! The input line: an instruction (or a goal formula) to submit, or a proposal to edit.
-//! Enter submits, Esc cancels; while it is open it takes every key.
+//! Enter submits, Esc cancels; while it is open it takes every key. Editing, Tab completes
+//! the condition under the cursor from the scene's vocabulary (the choices left are listed
+//! under the line), and a line that could not be read stays open with the error under it.
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Frame;
@@ -14,6 +16,10 @@ use super::super::theme::Theme;
 pub enum Mode {
     Instruction,
     Edit,
+    /// Text to find in the tree's labels.
+    Search,
+    /// Text the world's facts listed must hold.
+    Filter,
 }
 
 /// What the input line produced.
@@ -21,6 +27,8 @@ pub enum Mode {
 pub enum Submitted {
     Instruction(String),
     Edit(String),
+    Search(String),
+    Filter(String),
 }
 
 #[derive(Default)]
@@ -31,7 +39,21 @@ pub struct InputLine {
     cursor: usize,
     /// The title and text while closed, when not the workbench's (a replay's keys).
     idle: Option<(&'static str, String)>,
+    /// The conditions Tab completes from while editing.
+    vocabulary: Vec<String>,
+    /// Under the line: why it could not be read, or the completions left.
+    note: Option<Note>,
 }
+
+/// What the line's lower border says.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Note {
+    Error(String),
+    Choices(String),
+}
+
+/// Completions listed under the line at most.
+const LISTED: usize = 4;
 
 impl InputLine {
     /// What the line says while closed.
@@ -43,6 +65,71 @@ impl InputLine {
         self.mode = Some(mode);
         self.text = text.to_string();
         self.cursor = self.text.chars().count();
+        self.note = None;
+    }
+
+    /// Open the edit line again on `text` that could not be read, with why under it.
+    pub fn reopen_with_error(&mut self, text: &str, error: String) {
+        self.open(Mode::Edit, text);
+        self.note = Some(Note::Error(error));
+    }
+
+    /// The conditions Tab completes from.
+    pub fn set_vocabulary(&mut self, words: Vec<String>) {
+        self.vocabulary = words;
+    }
+
+    /// What is under the line, if anything.
+    pub fn note(&self) -> Option<&Note> {
+        self.note.as_ref()
+    }
+
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Complete the condition before the cursor: to the one condition it begins, or as
+    /// far as all it begins agree, listing them under the line.
+    fn complete(&mut self) {
+        let at = self.byte_at(self.cursor);
+        // The condition under the cursor starts after the last operator before it.
+        let start = self.text[..at]
+            .rfind(['&', '|', '(', '~'])
+            .map_or(0, |i| i + 1);
+        let typed = self.text[start..at].trim_start();
+        let start = at - typed.len();
+        let lower = typed.to_lowercase();
+        let matching: Vec<&String> = self
+            .vocabulary
+            .iter()
+            .filter(|w| w.to_lowercase().starts_with(&lower))
+            .collect();
+        let Some(first) = matching.first() else {
+            self.note = Some(Note::Choices(strings::NO_COMPLETION.to_string()));
+            return;
+        };
+        let common = matching.iter().fold(first.as_str(), |acc, w| {
+            let same = acc
+                .char_indices()
+                .zip(w.chars())
+                .take_while(|((_, a), b)| a.eq_ignore_ascii_case(b))
+                .last()
+                .map_or(0, |((i, a), _)| i + a.len_utf8());
+            &acc[..same]
+        });
+        let replacement = if common.len() >= typed.len() {
+            common.to_string()
+        } else {
+            typed.to_string()
+        };
+        self.text.replace_range(start..at, &replacement);
+        self.cursor = self.text[..start + replacement.len()].chars().count();
+        self.note = if matching.len() == 1 {
+            None
+        } else {
+            let listed: Vec<&str> = matching.iter().take(LISTED).map(|w| w.as_str()).collect();
+            Some(Note::Choices(strings::completions(&listed, matching.len())))
+        };
     }
 
     pub fn is_open(&self) -> bool {
@@ -74,7 +161,12 @@ impl InputLine {
     /// Handle a key while open: `Some` when Enter submitted the text.
     pub fn event(&mut self, key: &KeyEvent) -> Option<Submitted> {
         let mode = self.mode?;
+        if key.code != KeyCode::Tab {
+            // A key that changes the line makes what was said under it stale.
+            self.note = None;
+        }
         match key.code {
+            KeyCode::Tab if mode == Mode::Edit => self.complete(),
             KeyCode::Enter => {
                 let text = std::mem::take(&mut self.text);
                 self.mode = None;
@@ -82,6 +174,8 @@ impl InputLine {
                 return Some(match mode {
                     Mode::Instruction => Submitted::Instruction(text),
                     Mode::Edit => Submitted::Edit(text),
+                    Mode::Search => Submitted::Search(text),
+                    Mode::Filter => Submitted::Filter(text),
                 });
             }
             KeyCode::Esc => {
@@ -136,6 +230,8 @@ impl InputLine {
                 match mode {
                     Mode::Instruction => strings::INPUT_TITLE_INSTRUCTION,
                     Mode::Edit => strings::INPUT_TITLE_EDIT,
+                    Mode::Search => strings::SEARCH_TITLE,
+                    Mode::Filter => strings::FILTER_TITLE,
                 },
                 Line::from(vec![
                     Span::styled("> ", theme.key),
@@ -150,6 +246,18 @@ impl InputLine {
             .borders(Borders::ALL)
             .border_style(theme.border)
             .title(Span::styled(title, theme.title));
+        let block = match (&self.note, self.mode) {
+            (Some(Note::Error(e)), Some(_)) => {
+                block.title_bottom(Span::styled(format!(" {e} "), theme.error))
+            }
+            (Some(Note::Choices(c)), Some(_)) => {
+                block.title_bottom(Span::styled(format!(" {c} "), theme.dim))
+            }
+            (None, Some(Mode::Edit)) if !self.vocabulary.is_empty() => {
+                block.title_bottom(Span::styled(strings::TAB_COMPLETES, theme.dim))
+            }
+            _ => block,
+        };
         let scroll = u16::try_from(scroll).unwrap_or(u16::MAX);
         frame.render_widget(Paragraph::new(line).block(block).scroll((0, scroll)), area);
         if self.mode.is_some() {
@@ -195,6 +303,42 @@ mod tests {
         assert!(!input.insert_dictation("put the cup"));
         input.event(&key(KeyCode::Esc));
         assert!(!input.is_open());
+    }
+
+    #[test]
+    fn tab_completes_a_condition_from_the_vocabulary() {
+        let mut input = InputLine::default();
+        input.set_vocabulary(vec![
+            "\"any object\" on \"blue cube\"".into(),
+            "\"red cube\" on \"blue cube\"".into(),
+            "\"red cube\" on \"green cube\"".into(),
+        ]);
+        input.open(Mode::Edit, "~\"re");
+        input.event(&key(KeyCode::Tab));
+        // Both conditions it begins agree up to the object's name: completed that far,
+        // the two listed.
+        assert_eq!(input.text(), "~\"red cube\" on \"");
+        assert!(
+            matches!(input.note(), Some(Note::Choices(c)) if c.contains("2 match")),
+            "{:?}",
+            input.note()
+        );
+        input.event(&key(KeyCode::Char('b')));
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(input.text(), "~\"red cube\" on \"blue cube\"");
+        assert_eq!(input.note(), None);
+        // After an operator the next condition completes alone.
+        for c in " & \"AN".chars() {
+            input.event(&key(KeyCode::Char(c)));
+        }
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(
+            input.text(),
+            "~\"red cube\" on \"blue cube\" & \"any object\" on \"blue cube\""
+        );
+        input.event(&key(KeyCode::Char('x')));
+        input.event(&key(KeyCode::Tab));
+        assert!(matches!(input.note(), Some(Note::Choices(c)) if c == strings::NO_COMPLETION));
     }
 
     #[test]

@@ -1,6 +1,9 @@
-//! The LLM pane: the call under way, the pending proposal (which action, what conditions
-//! or value) with its keys first, so small terminals show it; then the goal, who
-//! answered, the reasoning of the last call (why), and a log of what happened below them.
+//! The LLM pane: the call under way; for a pending proposal, what betr itself found about
+//! the failure first (the failure, what stood in the way, the conditions tried in
+//! simulation and which fixed it, what the change did there), then the proposal with who
+//! wrote it and its keys, then the author's own reasoning labelled as theirs (marked
+//! doubtful when the findings do not bear it out); then the goal with where it came from,
+//! and a log of what happened below them.
 //!
 //! The log follows its newest line unless the person scrolled it up (then a marker says
 //! how many rows are below); a line said again right after itself is counted, not
@@ -11,7 +14,7 @@ use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 
-use crate::session::Proposal;
+use crate::session::{Evidence, Proposal};
 
 use super::super::strings;
 use super::super::theme::Theme;
@@ -28,31 +31,72 @@ pub struct ProposalView {
     pub lines: Vec<String>,
     /// The text the edit line starts with.
     pub edit_text: String,
+    /// Who wrote it (a model, a person, the simulation that narrowed it, betr's midway).
+    pub author: String,
+    /// What betr found, one finding a line (empty when nothing was looked into).
+    pub findings: Vec<String>,
+    /// The author's own reasoning.
+    pub reasoning: Option<String>,
+    /// Why that reasoning is doubtful, when it is.
+    pub doubt: Option<String>,
 }
 
 impl ProposalView {
-    pub fn of(proposal: &Proposal) -> ProposalView {
+    /// `proposal` by `author`, with their `reasoning` and what betr found.
+    pub fn of(
+        proposal: &Proposal,
+        author: &str,
+        reasoning: Option<String>,
+        evidence: Option<Box<Evidence>>,
+    ) -> ProposalView {
+        let (findings, doubt) = evidence.map(|e| (e.findings, e.doubt)).unwrap_or_default();
+        let (target, lines, edit_text) = ProposalView::parts(proposal);
+        ProposalView {
+            target,
+            lines,
+            edit_text,
+            author: author.to_string(),
+            findings,
+            reasoning,
+            doubt,
+        }
+    }
+
+    /// The proposal whole, as lines: betr's findings, the proposal, the reasoning.
+    pub fn details(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if !self.findings.is_empty() {
+            lines.push(strings::FOUND_BY_BETR.to_string());
+            lines.extend(self.findings.iter().map(|f| format!("  {f}")));
+        }
+        lines.push(strings::proposal_by(&self.target, &self.author));
+        lines.extend(self.lines.iter().map(|l| format!("  {l}")));
+        if let Some(r) = &self.reasoning {
+            lines.push(strings::reasoning_of(&self.author, self.doubt.as_deref()));
+            lines.push(format!("  {r}"));
+        }
+        lines
+    }
+
+    /// What the proposal is for, its lines, and the edit line's text.
+    fn parts(proposal: &Proposal) -> (String, Vec<String>, String) {
         match proposal {
             Proposal::Conditions {
                 action, conditions, ..
             } => {
                 let lines: Vec<String> = conditions.iter().map(ToString::to_string).collect();
-                ProposalView {
-                    target: format!("{action}!"),
-                    edit_text: lines.join(" & "),
-                    lines,
-                }
+                (format!("{action}!"), lines.clone(), lines.join(" & "))
             }
             Proposal::Value {
                 skill,
                 object,
                 param,
                 value,
-            } => ProposalView {
-                target: format!("{skill} \"{object}\""),
-                lines: vec![format!("{param} = {value}")],
-                edit_text: value.to_string(),
-            },
+            } => (
+                format!("{skill} \"{object}\""),
+                vec![format!("{param} = {value}")],
+                value.to_string(),
+            ),
         }
     }
 }
@@ -60,9 +104,13 @@ impl ProposalView {
 #[derive(Default)]
 pub struct LlmPane {
     pub asking: Option<String>,
+    /// Who answered the last model call (`model qwen…`, a fixture).
     pub replied_by: Option<String>,
     pub goal: Option<String>,
-    pub reasoning: Option<String>,
+    /// Where the goal came from (a model, a person, a policy file, the scenario file).
+    pub goal_by: Option<String>,
+    /// The model's reasoning for the goal, when a model read it.
+    pub goal_reasoning: Option<String>,
     pub proposal: Option<ProposalView>,
     /// An approved fix offered as a rule, with the keys that answer it.
     pub offer: Option<String>,
@@ -139,38 +187,41 @@ impl LlmPane {
             )));
         }
         match &self.proposal {
-            Some(p) => {
-                lines.push(Line::from(Span::styled(
-                    format!("{} {}:", strings::PROPOSAL_FOR, p.target),
-                    theme.proposal,
-                )));
-                for l in &p.lines {
-                    lines.push(Line::from(Span::styled(format!("  {l}"), theme.proposal)));
-                }
-                lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
-            }
+            Some(p) => proposal_lines(p, theme, keys_hint, &mut lines),
             None => match &self.offer {
                 Some(offer) => lines.push(Line::from(Span::styled(offer.clone(), theme.proposal))),
                 None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
             },
         }
         if let Some(goal) = &self.goal {
+            let by = self.goal_by.as_deref().unwrap_or("the scenario file");
             lines.push(Line::from(vec![
-                Span::styled(format!("{} ", strings::GOAL), theme.title),
+                Span::styled(format!("{}: ", strings::GOAL), theme.title),
                 Span::raw(goal.clone()),
             ]));
+            lines.push(Line::from(Span::styled(strings::goal_by(by), theme.dim)));
+            // The goal's reasoning only while no proposal's is shown: one reasoning at a
+            // time, each under what it is about.
+            if let (Some(r), None) = (&self.goal_reasoning, &self.proposal) {
+                lines.push(Line::from(Span::styled(
+                    format!(
+                        "  {} {}",
+                        strings::reasoning_of(by, None),
+                        r.replace('\n', " ")
+                    ),
+                    theme.dim,
+                )));
+            }
         }
-        if let Some(who) = &self.replied_by {
+        // The last model reply, when no pane above says who wrote it already.
+        if let Some(who) = &self.replied_by
+            && self.proposal.is_none()
+            && self.goal_by.as_ref() != Some(who)
+        {
             lines.push(Line::from(Span::styled(
-                format!("{} {who}", strings::REPLY_FROM),
+                strings::last_reply(who),
                 theme.dim,
             )));
-        }
-        if let Some(r) = &self.reasoning {
-            lines.push(Line::from(vec![
-                Span::styled(format!("{} ", strings::REASONING), theme.title),
-                Span::raw(r.replace('\n', " ")),
-            ]));
         }
         if let Some(e) = &self.error {
             lines.push(Line::from(Span::styled(e.clone(), theme.error)));
@@ -179,10 +230,20 @@ impl LlmPane {
             format!("── {} ──", strings::LOG),
             theme.dim,
         )));
-        let block = Block::default()
+        let mut block = Block::default()
             .borders(Borders::ALL)
             .border_style(theme.border)
             .title(Span::styled(strings::LLM_TITLE, theme.title));
+        // What is proposed and the keys that answer it stay on the border, so a pane too
+        // small for the findings still shows them (D shows the whole proposal).
+        if let Some(p) = &self.proposal {
+            block = block
+                .title(Span::styled(
+                    strings::proposed_title(&p.lines.join(" & ")),
+                    theme.proposal,
+                ))
+                .title_bottom(Span::styled(format!(" {keys_hint} "), theme.key));
+        }
         let inner = block.inner(area);
         frame.render_widget(block, area);
         // The parts above the log take the rows they wrap to; the log gets the rest.
@@ -193,7 +254,51 @@ impl LlmPane {
         frame.render_widget(head, head_area);
         self.draw_log(frame, log_area, theme);
     }
+}
 
+/// A pending proposal: betr's findings, the proposal with its author and keys, then the
+/// author's reasoning labelled as theirs.
+fn proposal_lines<'a>(
+    p: &'a ProposalView,
+    theme: &Theme,
+    keys_hint: &str,
+    lines: &mut Vec<Line<'a>>,
+) {
+    if !p.findings.is_empty() {
+        lines.push(Line::from(Span::styled(
+            strings::FOUND_BY_BETR,
+            theme.title,
+        )));
+        for f in &p.findings {
+            lines.push(Line::from(format!("  {f}")));
+        }
+    }
+    lines.push(Line::from(Span::styled(
+        strings::proposal_by(&p.target, &p.author),
+        theme.proposal,
+    )));
+    for l in &p.lines {
+        lines.push(Line::from(Span::styled(format!("  {l}"), theme.proposal)));
+    }
+    lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
+    if let Some(r) = &p.reasoning {
+        let style = if p.doubt.is_some() {
+            theme.error
+        } else {
+            theme.dim
+        };
+        lines.push(Line::from(Span::styled(
+            strings::reasoning_of(&p.author, p.doubt.as_deref()),
+            style,
+        )));
+        lines.push(Line::from(Span::styled(
+            format!("  {}", r.replace('\n', " ")),
+            theme.dim,
+        )));
+    }
+}
+
+impl LlmPane {
     /// The log's rows that fit in `area`: the newest, or those the person scrolled to,
     /// with a marker of the rows below them.
     fn draw_log(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
@@ -244,6 +349,103 @@ mod tests {
             .draw(|f| pane.draw(f, f.area(), &Theme::default(), ""))
             .unwrap();
         terminal.backend().to_string()
+    }
+
+    /// Scenario 1's proposal with the reasoning a small model gave for it, which blames
+    /// the green cube while the simulation found the red cube in the way.
+    fn scenario_1_pane(reasoning: &str) -> LlmPane {
+        use crate::domain::{ActionCall, Condition, Object};
+        let object = |name: &str| Object {
+            name: name.into(),
+            types: vec!["cube".into()],
+            called: Vec::new(),
+        };
+        let scene: Vec<Object> = ["table", "blue cube", "green cube", "red cube"]
+            .into_iter()
+            .map(object)
+            .collect();
+        let objects = vec!["blue cube".to_string(), "red cube".to_string()];
+        let evidence = Evidence {
+            findings: vec![
+                "grasp \"blue cube\"! failed: No collision free path found".into(),
+                "in the way: \"red cube\" on \"blue cube\" (true now)".into(),
+            ],
+            doubt: crate::session::evidence::doubt(
+                reasoning,
+                &objects,
+                &["red cube".to_string()],
+                &scene,
+            ),
+            objects,
+        };
+        let proposal = Proposal::Conditions {
+            action: ActionCall::parse("grasp \"blue cube\"").unwrap(),
+            node: crate::bt::NodeId(7),
+            conditions: vec![Condition::parse("~\"any object\" on \"blue cube\"").unwrap()],
+        };
+        LlmPane {
+            proposal: Some(ProposalView::of(
+                &proposal,
+                "model qwen",
+                Some(reasoning.to_string()),
+                Some(Box::new(evidence)),
+            )),
+            ..LlmPane::default()
+        }
+    }
+
+    fn screen_of(pane: &LlmPane, width: u16, height: u16) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
+        terminal
+            .draw(|f| pane.draw(f, f.area(), &Theme::default(), "a approve"))
+            .unwrap();
+        terminal.backend().to_string()
+    }
+
+    #[test]
+    fn the_first_lines_are_betrs_evidence_and_a_misplaced_reasoning_is_doubtful() {
+        let pane = scenario_1_pane(
+            "The blue cube was resting on the table, and the green cube was also resting on the table, which blocked the path.",
+        );
+        let screen = screen_of(&pane, 70, 16);
+        let rows: Vec<&str> = screen.lines().collect();
+        assert!(rows[1].contains("Found by betr:"), "{screen}");
+        assert!(rows[2].contains("grasp \"blue cube\"! failed"), "{screen}");
+        let reasoning_at = rows
+            .iter()
+            .position(|r| r.contains("Reasoning of model qwen"));
+        let proposal_at = rows.iter().position(|r| r.contains("Proposal for"));
+        assert!(
+            proposal_at > Some(2) && reasoning_at > proposal_at,
+            "{screen}"
+        );
+        assert!(screen.contains("DOUBTFUL"), "{screen}");
+        insta::assert_snapshot!("doubtful_reasoning_after_the_evidence", screen);
+
+        // A reasoning that names none of the failure's objects is doubtful too.
+        let pane = scenario_1_pane("The gripper needs more room.");
+        let p = pane.proposal.as_ref().unwrap();
+        assert_eq!(
+            p.doubt.as_deref(),
+            Some("it names none of the failure's objects (\"blue cube\", \"red cube\")")
+        );
+        // One naming what was in the way is shown as the model's, not doubted.
+        let pane = scenario_1_pane("The red cube sits on the blue cube.");
+        let screen = screen_of(&pane, 70, 16);
+        assert!(!screen.contains("DOUBTFUL"), "{screen}");
+        assert!(
+            screen.contains("Reasoning of model qwen (its words"),
+            "{screen}"
+        );
+    }
+
+    #[test]
+    fn no_reasoning_is_left_under_no_proposal_pending() {
+        let mut pane = scenario_1_pane("The red cube sits on the blue cube.");
+        pane.proposal = None;
+        let screen = screen_of(&pane, 70, 16);
+        assert!(screen.contains("No proposal pending."), "{screen}");
+        assert!(!screen.contains("red cube"), "{screen}");
     }
 
     #[test]

@@ -28,6 +28,17 @@ pub struct TreePane {
     items: Vec<TreeItem<'static, u32>>,
     state: TreeState<u32>,
     dirty: bool,
+    /// Select the running node after every tick.
+    pub follow: bool,
+    /// The last search, for next and previous.
+    pub query: Option<String>,
+}
+
+/// Where a search stands: the match selected (from 1) of how many.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Found {
+    pub at: usize,
+    pub of: usize,
 }
 
 /// What the pane marks on nodes besides their status.
@@ -73,6 +84,113 @@ impl TreePane {
         self.record = Some(record);
         self.marks.stopped = None;
         self.dirty = true;
+        if self.follow {
+            self.show_running(false);
+        }
+    }
+
+    /// The node the last tick is at: the deepest running node, else the last failing
+    /// action.
+    pub fn running(&self) -> Option<NodeId> {
+        let tree = self.tree.as_ref()?;
+        let record = self.record.as_ref()?;
+        tree.preorder()
+            .into_iter()
+            .rev()
+            .find(|n| record.status(*n) == Status::Running)
+            .or(self.marks.failing)
+    }
+
+    /// Open the way to the running node and select it; `alone`: close everything else.
+    pub fn show_running(&mut self, alone: bool) -> bool {
+        let Some(node) = self.running() else {
+            return false;
+        };
+        if alone {
+            self.state.close_all();
+        }
+        self.open_to(node);
+        self.select(node);
+        true
+    }
+
+    /// Close every node but the root, and select it.
+    pub fn collapse_all(&mut self) {
+        self.state.close_all();
+        if let Some(tree) = &self.tree {
+            let root = tree.root();
+            self.state.open(vec![root.0]);
+            self.select(root);
+        }
+    }
+
+    /// Select the next (or previous) node whose label holds `query` (any case), after
+    /// the selected one in the tree's order, wrapping; its ancestors are opened.
+    pub fn search(&mut self, query: &str, forward: bool, theme: &Theme) -> Option<Found> {
+        let tree = self.tree.clone()?;
+        let query = query.to_lowercase();
+        let order = tree.preorder();
+        let matches: Vec<NodeId> = order
+            .iter()
+            .copied()
+            .filter(|n| node_label(&tree, *n, theme).to_lowercase().contains(&query))
+            .collect();
+        if matches.is_empty() {
+            return None;
+        }
+        let position = |n: NodeId| order.iter().position(|m| *m == n).unwrap_or(0);
+        let here = self.selected().map(position);
+        let next = match (here, forward) {
+            (None, true) => 0,
+            (None, false) => matches.len() - 1,
+            (Some(h), true) => matches.iter().position(|m| position(*m) > h).unwrap_or(0),
+            (Some(h), false) => matches
+                .iter()
+                .rposition(|m| position(*m) < h)
+                .unwrap_or(matches.len() - 1),
+        };
+        let node = matches[next];
+        self.open_to(node);
+        self.select(node);
+        Some(Found {
+            at: next + 1,
+            of: matches.len(),
+        })
+    }
+
+    /// Open every ancestor of `node`.
+    fn open_to(&mut self, node: NodeId) {
+        let Some(tree) = &self.tree else {
+            return;
+        };
+        let mut path: Vec<u32> = Vec::new();
+        let mut at = tree.parent(node).ok().flatten();
+        while let Some(n) = at {
+            path.push(n.0);
+            at = tree.parent(n).ok().flatten();
+        }
+        path.reverse();
+        for depth in 1..=path.len() {
+            self.state.open(path[..depth].to_vec());
+        }
+    }
+
+    /// A mouse click on the pane selects (and toggles) the row; the wheel scrolls.
+    pub fn mouse(&mut self, event: &crossterm::event::MouseEvent) {
+        use crossterm::event::{MouseButton, MouseEventKind};
+        let at = ratatui::layout::Position::new(event.column, event.row);
+        match event.kind {
+            MouseEventKind::Down(MouseButton::Left) => {
+                self.state.click_at(at);
+            }
+            MouseEventKind::ScrollDown => {
+                self.state.scroll_down(3);
+            }
+            MouseEventKind::ScrollUp => {
+                self.state.scroll_up(3);
+            }
+            _ => {}
+        }
     }
 
     /// Statuses back to "not ticked" (the world was reset).
@@ -110,6 +228,42 @@ impl TreePane {
     pub fn selected(&self) -> Option<NodeId> {
         let node = NodeId(*self.state.selected().last()?);
         self.tree.as_ref()?.contains(node).then_some(node)
+    }
+
+    /// The selected node whole: its label, where it is, its status and its marks.
+    pub fn selected_details(&self, theme: &Theme) -> Option<Vec<String>> {
+        let node = self.selected()?;
+        let tree = self.tree.as_ref()?;
+        let status = self
+            .record
+            .as_ref()
+            .map_or(Status::Idle, |r| r.status(node));
+        let mut lines = vec![
+            node_label(tree, node, theme),
+            format!(
+                "node {}",
+                tree.path(node)
+                    .map(|p| crate::bt::path_text(&p))
+                    .unwrap_or_default()
+            ),
+            format!("status: {}", strings::status_word(status)),
+        ];
+        if self.marks.new_nodes.contains(&node) {
+            lines.push(strings::ADDED_BY_LAST_CHANGE.to_string());
+        }
+        if self.marks.failing == Some(node) {
+            lines.push(strings::FAILED_MARK.to_string());
+        }
+        if let Some((_, rules)) = self.marks.learned.iter().find(|(n, _)| *n == node) {
+            lines.push(strings::learned_mark(rules).trim().to_string());
+        }
+        if self.marks.breakpoints.contains(&node) {
+            lines.push(strings::BREAKPOINT_MARK.to_string());
+        }
+        if let Some((_, forced)) = self.marks.forced.iter().find(|(n, _)| *n == node) {
+            lines.push(strings::forced_mark(*forced).trim().to_string());
+        }
+        Some(lines)
     }
 
     /// The nodes with a breakpoint.
@@ -199,10 +353,16 @@ impl TreePane {
 
     pub fn draw(&mut self, frame: &mut Frame, area: Rect, theme: &Theme) {
         self.rebuild(theme);
-        let block = Block::default()
+        let mut block = Block::default()
             .borders(Borders::ALL)
             .border_style(theme.border)
             .title(Span::styled(strings::TREE_TITLE, theme.title));
+        if self.follow {
+            block = block.title(Span::styled(strings::FOLLOWING, theme.key));
+        }
+        if let Some(q) = &self.query {
+            block = block.title_bottom(Span::styled(strings::searching(q), theme.dim));
+        }
         if self.items.is_empty() {
             let text = Paragraph::new(self.empty_text.unwrap_or(strings::TREE_EMPTY))
                 .style(theme.dim)
@@ -376,6 +536,42 @@ mod tests {
             }
         }
         t
+    }
+
+    #[test]
+    fn search_finds_next_and_previous_and_opens_the_way() {
+        let tree = Arc::new(big(300));
+        let theme = Theme::default();
+        let mut pane = TreePane::default();
+        pane.set_tree(tree.clone(), Vec::new(), Vec::new());
+        pane.collapse_all();
+        let found = pane.search("thing 1", true, &theme).unwrap();
+        // The actions are numbered 1, 4, 7, …: those whose number starts with a 1.
+        let expected = (1..300)
+            .step_by(3)
+            .filter(|n: &usize| n.to_string().starts_with('1'))
+            .count();
+        assert_eq!(found.of, expected);
+        let first = pane.selected().unwrap();
+        assert!(pane.label(first, &theme).contains("\"thing 1\""));
+        let second = pane.search("thing 1", true, &theme).unwrap();
+        assert_eq!(second.at, 2);
+        let back = pane.search("thing 1", false, &theme).unwrap();
+        assert_eq!(back.at, 1);
+        assert_eq!(pane.selected(), Some(first));
+        // Previous from the first wraps to the last.
+        let last = pane.search("thing 1", false, &theme).unwrap();
+        assert_eq!(last.at, last.of);
+        assert!(pane.search("no such node", true, &theme).is_none());
+        // The match is drawn: its ancestors were opened.
+        let mut terminal = Terminal::new(TestBackend::new(80, 24)).unwrap();
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        let label = pane.label(pane.selected().unwrap(), &theme);
+        assert!(terminal.backend().to_string().contains(&label));
+        pane.query = Some("thing 1".into());
+        pane.follow = true;
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        insta::assert_snapshot!("searched_300_nodes_80x24", terminal.backend().to_string());
     }
 
     #[test]

@@ -1,8 +1,14 @@
-//! The world pane: the conditions true now in the execution world, the objects, and the
-//! last error text.
+//! The world pane as a blackboard: the last error, the values parameters set on the tree's
+//! actions, and a table of the facts true now in the execution world, each marked when
+//! the last tick made it true, with the facts it made false listed (struck) above the
+//! rest. The table scrolls and can be narrowed to the facts holding a text; the objects
+//! are named when they fit on one line, else counted (D shows a node whole).
+
+use std::collections::HashSet;
 
 use ratatui::Frame;
 use ratatui::layout::Rect;
+use ratatui::style::Modifier;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 
@@ -11,14 +17,101 @@ use super::super::theme::Theme;
 
 #[derive(Default)]
 pub struct WorldPane {
+    /// The facts true now, in the order shown.
     pub facts: Vec<String>,
+    /// Facts the last change of the world made true.
+    pub became_true: HashSet<String>,
+    /// Facts the last change of the world made false.
+    pub became_false: Vec<String>,
     pub objects: Vec<String>,
     pub last_error: Option<String>,
     /// The tree has succeeded since the last error.
     pub error_resolved: bool,
+    /// Values parameters set on the tree's actions (`grasp "egg": force = 5 N`).
+    pub values: Vec<String>,
+    /// Only facts holding this text (any case) are listed.
+    pub filter: Option<String>,
+    /// Rows of the fact table scrolled past.
+    scroll: usize,
+    /// Do not mark what changed: a replay seeks past the worlds in between, so the
+    /// world before the last one is not known there.
+    pub unmarked: bool,
 }
 
+/// Rows one scroll key moves the fact table.
+const SCROLL_ROWS: usize = 5;
+
 impl WorldPane {
+    /// The pane of a scene with these objects.
+    pub fn of(objects: Vec<String>) -> WorldPane {
+        WorldPane {
+            objects,
+            ..WorldPane::default()
+        }
+    }
+
+    /// The world after a tick (`reset`: afresh): what changed is marked, unless it was
+    /// reset.
+    pub fn set_facts(&mut self, facts: Vec<String>, reset: bool) {
+        if reset || self.unmarked {
+            self.became_true.clear();
+            self.became_false.clear();
+        } else {
+            let now: HashSet<&String> = facts.iter().collect();
+            let before: HashSet<&String> = self.facts.iter().collect();
+            self.became_true = facts
+                .iter()
+                .filter(|f| !before.contains(f))
+                .cloned()
+                .collect();
+            self.became_false = self
+                .facts
+                .iter()
+                .filter(|f| !now.contains(f))
+                .cloned()
+                .collect();
+        }
+        self.facts = facts;
+    }
+
+    pub fn scroll_down(&mut self) {
+        self.scroll = (self.scroll + SCROLL_ROWS).min(self.rows().len().saturating_sub(1));
+    }
+
+    pub fn scroll_up(&mut self) {
+        self.scroll = self.scroll.saturating_sub(SCROLL_ROWS);
+    }
+
+    pub fn set_filter(&mut self, filter: Option<String>) {
+        self.filter = filter.filter(|f| !f.is_empty());
+        self.scroll = 0;
+    }
+
+    /// The fact table's rows: those the last tick made false, then those it made true,
+    /// then the rest; each with its mark, narrowed by the filter.
+    fn rows(&self) -> Vec<(&'static str, &String, Mark)> {
+        let keep = |f: &String| {
+            self.filter
+                .as_ref()
+                .is_none_or(|q| f.to_lowercase().contains(&q.to_lowercase()))
+        };
+        let mut rows: Vec<(&'static str, &String, Mark)> = Vec::new();
+        for f in self.became_false.iter().filter(|f| keep(f)) {
+            rows.push((strings::MADE_FALSE, f, Mark::False));
+        }
+        for f in self.facts.iter().filter(|f| keep(f)) {
+            if self.became_true.contains(f) {
+                rows.push((strings::MADE_TRUE, f, Mark::True));
+            }
+        }
+        for f in self.facts.iter().filter(|f| keep(f)) {
+            if !self.became_true.contains(f) {
+                rows.push(("  ", f, Mark::Same));
+            }
+        }
+        rows
+    }
+
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
         let mut lines: Vec<Line> = Vec::new();
         if let Some(e) = &self.last_error {
@@ -33,16 +126,48 @@ impl WorldPane {
                 lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
             }
         }
+        for v in &self.values {
+            lines.push(Line::from(Span::styled(
+                format!("{} {v}", strings::VALUE_SET),
+                theme.proposal,
+            )));
+        }
+        let names = format!("{} {}", strings::OBJECTS, self.objects.join(", "));
+        let width = usize::from(area.width.saturating_sub(2));
         lines.push(Line::from(Span::styled(
-            format!("{} {}", strings::OBJECTS, self.objects.join(", ")),
+            if names.chars().count() <= width {
+                names
+            } else {
+                strings::objects_counted(self.objects.len())
+            },
             theme.dim,
         )));
-        lines.push(Line::from(Span::styled(strings::NOW_TRUE, theme.title)));
-        if self.facts.is_empty() {
+        let rows = self.rows();
+        let shown = rows.iter().filter(|(_, _, m)| *m != Mark::False).count();
+        lines.push(Line::from(Span::styled(
+            strings::facts_heading(shown, self.facts.len(), self.filter.as_deref()),
+            theme.title,
+        )));
+        if rows.is_empty() {
             lines.push(Line::from(strings::NOTHING_TRUE));
         }
-        for f in &self.facts {
-            lines.push(Line::from(format!("  {f}")));
+        let scroll = self.scroll.min(rows.len().saturating_sub(1));
+        if scroll > 0 {
+            lines.push(Line::from(Span::styled(
+                strings::rows_above(scroll),
+                theme.key,
+            )));
+        }
+        for (mark, fact, kind) in rows.into_iter().skip(scroll) {
+            let style = match kind {
+                Mark::True => theme.new_node,
+                Mark::False => theme.dim.add_modifier(Modifier::CROSSED_OUT),
+                Mark::Same => ratatui::style::Style::default(),
+            };
+            lines.push(Line::from(vec![
+                Span::styled(mark, style),
+                Span::styled(fact.clone(), style),
+            ]));
         }
         let block = Block::default()
             .borders(Borders::ALL)
@@ -54,5 +179,68 @@ impl WorldPane {
                 .block(block),
             area,
         );
+    }
+}
+
+/// How the last tick changed a fact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mark {
+    True,
+    False,
+    Same,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    fn screen(pane: &WorldPane) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(50, 14)).unwrap();
+        terminal
+            .draw(|f| pane.draw(f, f.area(), &Theme::default()))
+            .unwrap();
+        terminal.backend().to_string()
+    }
+
+    #[test]
+    fn a_tick_marks_what_it_made_true_and_false_and_the_table_filters_and_scrolls() {
+        let mut pane = WorldPane::of((1..=100).map(|n| format!("Cup{n}")).collect());
+        pane.values = vec!["grasp \"egg\": force = 5 N".into()];
+        let facts = |list: &[&str]| list.iter().map(|f| f.to_string()).collect::<Vec<_>>();
+        pane.set_facts(
+            facts(&[
+                "\"red cube\" on \"blue cube\"",
+                "hand empty",
+                "Cup1 on table",
+            ]),
+            true,
+        );
+        pane.set_facts(
+            facts(&[
+                "\"red cube\" grasped",
+                "Cup1 on table",
+                "\"blue cube\" clear",
+            ]),
+            false,
+        );
+        let s = screen(&pane);
+        assert!(s.contains("Objects: 100"), "{s}");
+        assert!(s.contains("value set: grasp \"egg\": force = 5 N"), "{s}");
+        assert!(s.contains("- \"red cube\" on \"blue cube\""), "{s}");
+        assert!(s.contains("+ \"red cube\" grasped"), "{s}");
+        assert!(s.contains("  Cup1 on table"), "{s}");
+        insta::assert_snapshot!("blackboard_after_a_tick", s);
+
+        pane.set_filter(Some("CUBE".into()));
+        let s = screen(&pane);
+        assert!(!s.contains("Cup1 on table"), "{s}");
+        assert!(s.contains("True now: 2 of 3 holding \"CUBE\""), "{s}");
+
+        pane.set_filter(None);
+        pane.scroll_down();
+        let s = screen(&pane);
+        assert!(s.contains("↑ 4 row(s) above"), "{s}");
     }
 }

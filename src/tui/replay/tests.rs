@@ -183,7 +183,7 @@ fn keys_move_to_the_failure_the_proposal_and_back_to_the_end() {
     }
     let proposal = screen(&mut s.app);
     assert!(
-        proposal.contains("Proposal for grasp \"blue cube\"!:"),
+        proposal.contains("Proposal for grasp \"blue cube\"!"),
         "{proposal}"
     );
     assert!(

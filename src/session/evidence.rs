@@ -1,0 +1,347 @@
+//! What betr itself established about a failure before a change for it is offered: the
+//! failure, what stood in the way, the conditions tried in simulation and which fixed it,
+//! what the changes tried before did, and what the offered change did in simulation. A
+//! person approves on this evidence; the model's reasoning comes after it, labelled as the
+//! model's, and is checked against it: a reasoning that names none of the failure's
+//! objects, or blames objects while the simulation found others in the way, is doubtful
+//! and never shown as the reason.
+
+use serde::{Deserialize, Serialize};
+
+use crate::domain::{ANY_OBJECT, Atom, Condition, Object};
+
+use super::ask::Tried;
+use super::screen::{FailureAt, Verdict};
+use super::shortlist::Shortlist;
+use super::types::Proposal;
+
+/// The evidence shown with a proposal, before the model's reasoning.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Evidence {
+    /// What betr found, one finding a line, the failure first.
+    pub findings: Vec<String>,
+    /// The objects the failure involves: the action's, those its error names, those
+    /// whose facts stood in the way, and those the change names.
+    pub objects: Vec<String>,
+    /// Why the model's reasoning is not to be taken as the reason, when it is not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub doubt: Option<String>,
+}
+
+/// What went into a question about a failure and what came out of it.
+pub struct Found<'a> {
+    pub failure: &'a FailureAt,
+    /// The execution world's facts when the action failed.
+    pub facts: &'a [Condition],
+    /// The conditions tried in simulation before the model was asked, if they were.
+    pub shortlist: Option<&'a Shortlist>,
+    /// Changes tried for this failure before, that did not fix it.
+    pub tried: &'a [Tried],
+    pub proposal: &'a Proposal,
+    /// What the offered change did in simulation, when it was tried there.
+    pub verdict: Option<Verdict>,
+}
+
+impl Evidence {
+    /// The evidence of `found`, with `reasoning` (the model's, if any) checked against it.
+    pub fn of(found: &Found<'_>, reasoning: Option<&str>, scene: &[Object]) -> Evidence {
+        let failure = found.failure;
+        let mut findings = vec![format!("{}! failed: {}", failure.action, failure.error)];
+        let mut objects: Vec<String> = failure.action.args.clone();
+        let error = failure.error.to_lowercase();
+        for o in scene {
+            if names(&error, o) {
+                push_new(&mut objects, &o.name);
+            }
+        }
+        let in_the_way = in_the_way(found);
+        let mut blockers: Vec<String> = Vec::new();
+        if !in_the_way.is_empty() {
+            let facts: Vec<String> = in_the_way.iter().map(ToString::to_string).collect();
+            findings.push(format!("in the way: {} (true now)", facts.join(", ")));
+            for atom in &in_the_way {
+                for a in &atom.args {
+                    if !failure.action.args.contains(a) {
+                        push_new(&mut blockers, a);
+                    }
+                    push_new(&mut objects, a);
+                }
+            }
+        }
+        if let Some(list) = found.shortlist {
+            findings.push(shortlist_finding(list));
+        }
+        for t in found.tried {
+            findings.push(format!("proposed before and turned down: {t}"));
+        }
+        if let Proposal::Conditions { conditions, .. } = found.proposal {
+            for c in conditions {
+                for a in &c.atom.args {
+                    if a != ANY_OBJECT {
+                        push_new(&mut objects, a);
+                    }
+                }
+            }
+        }
+        findings.push(match found.verdict {
+            Some(v) => format!("this change, tried in simulation: {}", verdict_text(v)),
+            None => "this change was not tried in simulation before it was offered".into(),
+        });
+        let doubt = reasoning.and_then(|r| doubt(r, &objects, &blockers, scene));
+        Evidence {
+            findings,
+            objects,
+            doubt,
+        }
+    }
+}
+
+/// What a verdict says, in words.
+fn verdict_text(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Succeeds => "the whole task then succeeds",
+        Verdict::MovesOn => {
+            "the failure is gone; the tree then stops at a later action it had before"
+        }
+        Verdict::FailsItself => "the failure is gone; an action the change brings in then fails",
+    }
+}
+
+fn shortlist_finding(list: &Shortlist) -> String {
+    let about: Vec<String> = list.objects.iter().map(|o| format!("\"{o}\"")).collect();
+    let about = about.join(", ");
+    if list.fixes.is_empty() {
+        return format!(
+            "tried {} condition(s) about {about} in simulation: none fixes the failure alone",
+            list.tried
+        );
+    }
+    let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
+    format!(
+        "tried {} condition(s) about {about} in simulation: {} fix the failure ({})",
+        list.tried,
+        list.fixes.len(),
+        fixes.join(", ")
+    )
+}
+
+/// The facts true at the failure that a fix found in simulation makes false: a negated
+/// condition of the shortlist or of the change, with "any object" standing for any.
+fn in_the_way(found: &Found<'_>) -> Vec<Atom> {
+    let mut negations: Vec<&Condition> = Vec::new();
+    if let Some(list) = found.shortlist {
+        negations.extend(list.fixes.iter().filter(|c| c.negated));
+    }
+    if let Proposal::Conditions { conditions, .. } = found.proposal {
+        negations.extend(conditions.iter().filter(|c| c.negated));
+    }
+    let mut atoms: Vec<Atom> = Vec::new();
+    for fact in found.facts.iter().filter(|f| !f.negated) {
+        if negations.iter().any(|n| covers(&n.atom, &fact.atom)) && !atoms.contains(&fact.atom) {
+            atoms.push(fact.atom.clone());
+        }
+    }
+    atoms
+}
+
+/// Whether `pattern` (which may say "any object") stands for `atom`.
+fn covers(pattern: &Atom, atom: &Atom) -> bool {
+    pattern.predicate == atom.predicate
+        && pattern.args.len() == atom.args.len()
+        && pattern
+            .args
+            .iter()
+            .zip(&atom.args)
+            .all(|(p, a)| p == ANY_OBJECT || p == a)
+}
+
+/// Why `reasoning` is not to be taken as the reason: it names none of `objects` (the
+/// failure's); or the simulation found `blockers` in the way and the reasoning names none
+/// of them but blames other objects of the scene; or it stops mid-sentence.
+pub fn doubt(
+    reasoning: &str,
+    objects: &[String],
+    blockers: &[String],
+    scene: &[Object],
+) -> Option<String> {
+    let text = reasoning.to_lowercase();
+    let named: Vec<&Object> = scene.iter().filter(|o| names(&text, o)).collect();
+    let quoted = |list: &[&str]| {
+        list.iter()
+            .map(|o| format!("\"{o}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if !named.iter().any(|o| objects.contains(&o.name)) {
+        let objects: Vec<&str> = objects.iter().map(String::as_str).collect();
+        return Some(format!(
+            "it names none of the failure's objects ({})",
+            quoted(&objects)
+        ));
+    }
+    let others: Vec<&str> = named
+        .iter()
+        .filter(|o| !objects.contains(&o.name))
+        .map(|o| o.name.as_str())
+        .collect();
+    if !blockers.is_empty() && !named.iter().any(|o| blockers.contains(&o.name)) {
+        let blockers: Vec<&str> = blockers.iter().map(String::as_str).collect();
+        if !others.is_empty() {
+            return Some(format!(
+                "it blames {}, while the simulation found {} in the way",
+                quoted(&others),
+                quoted(&blockers)
+            ));
+        }
+    }
+    let trimmed = reasoning.trim_end();
+    if !trimmed.is_empty() && !trimmed.ends_with(['.', '!', '?', ')', '"']) {
+        return Some("it stops mid-sentence".into());
+    }
+    None
+}
+
+/// Whether lower-cased `text` names `object` (its name or what it is called), as whole
+/// words (a plural's `s` allowed).
+fn names(text: &str, object: &Object) -> bool {
+    std::iter::once(&object.name)
+        .chain(&object.called)
+        .any(|n| has_words(text, &n.to_lowercase()))
+}
+
+fn has_words(text: &str, words: &str) -> bool {
+    if words.is_empty() {
+        return false;
+    }
+    let boundary = |c: Option<char>| c.is_none_or(|c| !c.is_alphanumeric());
+    text.match_indices(words).any(|(at, _)| {
+        let before = text[..at].chars().next_back();
+        let rest = &text[at + words.len()..];
+        let mut after = rest.chars();
+        let next = after.next();
+        boundary(before) && (boundary(next) || (next == Some('s') && boundary(after.next())))
+    })
+}
+
+fn push_new(list: &mut Vec<String>, name: &str) {
+    if !list.iter().any(|n| n == name) {
+        list.push(name.to_string());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bt::NodeId;
+    use crate::domain::ActionCall;
+
+    fn object(name: &str) -> Object {
+        Object {
+            name: name.into(),
+            types: vec!["cube".into()],
+            called: Vec::new(),
+        }
+    }
+
+    fn scene() -> Vec<Object> {
+        ["table", "blue cube", "green cube", "red cube"]
+            .into_iter()
+            .map(object)
+            .collect()
+    }
+
+    fn condition(text: &str) -> Condition {
+        Condition::parse(text).unwrap()
+    }
+
+    /// Scenario 1's failure: the grasp of the blue cube, with the red cube on it.
+    fn evidence_of(reasoning: &str) -> Evidence {
+        let failure = FailureAt {
+            node: NodeId(7),
+            action: ActionCall::parse("grasp \"blue cube\"").unwrap(),
+            error: "No collision free path found".into(),
+        };
+        let facts = [
+            condition("\"blue cube\" on \"table\""),
+            condition("\"green cube\" on \"table\""),
+            condition("\"red cube\" on \"blue cube\""),
+        ];
+        let fixes = vec![
+            condition("~\"any object\" on \"blue cube\""),
+            condition("~\"red cube\" on \"blue cube\""),
+        ];
+        let list = Shortlist {
+            fixes: fixes.clone(),
+            tried: 19,
+            objects: vec!["blue cube".into()],
+        };
+        let proposal = Proposal::Conditions {
+            action: failure.action.clone(),
+            node: failure.node,
+            conditions: vec![fixes[0].clone()],
+        };
+        let found = Found {
+            failure: &failure,
+            facts: &facts,
+            shortlist: Some(&list),
+            tried: &[],
+            proposal: &proposal,
+            verdict: Some(Verdict::Succeeds),
+        };
+        Evidence::of(&found, Some(reasoning), &scene())
+    }
+
+    #[test]
+    fn the_findings_start_with_the_failure_and_say_what_was_in_the_way() {
+        let e = evidence_of("Something lies on top of the blue cube.");
+        assert_eq!(
+            e.findings,
+            [
+                "grasp \"blue cube\"! failed: No collision free path found",
+                "in the way: \"red cube\" on \"blue cube\" (true now)",
+                "tried 19 condition(s) about \"blue cube\" in simulation: 2 fix the failure (~\"any object\" on \"blue cube\", ~\"red cube\" on \"blue cube\")",
+                "this change, tried in simulation: the whole task then succeeds",
+            ]
+        );
+        assert_eq!(e.objects, ["blue cube", "red cube"]);
+        assert_eq!(e.doubt, None);
+    }
+
+    #[test]
+    fn a_reasoning_naming_none_of_the_failures_objects_is_doubtful() {
+        let e = evidence_of("The gripper needs room to close.");
+        assert_eq!(
+            e.doubt.as_deref(),
+            Some("it names none of the failure's objects (\"blue cube\", \"red cube\")")
+        );
+    }
+
+    #[test]
+    fn a_reasoning_blaming_another_object_than_the_one_in_the_way_is_doubtful() {
+        let e = evidence_of(
+            "The blue cube was resting on the table, and the green cube was also resting on the table, which blocked the path.",
+        );
+        assert_eq!(
+            e.doubt.as_deref(),
+            Some(
+                "it blames \"table\", \"green cube\", while the simulation found \"red cube\" in the way"
+            )
+        );
+        // Naming what the simulation found in the way is not doubtful.
+        let e = evidence_of("The red cube on the blue cubes blocks the gripper.");
+        assert_eq!(e.doubt, None);
+    }
+
+    #[test]
+    fn a_reasoning_cut_mid_sentence_is_doubtful() {
+        let e = evidence_of("The red cube is on the blue cube and the");
+        assert_eq!(e.doubt.as_deref(), Some("it stops mid-sentence"));
+    }
+
+    #[test]
+    fn names_are_matched_as_whole_words() {
+        assert!(has_words("the red cubes are", "red cube"));
+        assert!(!has_words("the red cubed", "red cube"));
+        assert!(!has_words("hired cube", "red cube"));
+    }
+}
