@@ -324,6 +324,9 @@ impl Engine {
             node_path,
             error: failure.error.clone(),
         });
+        if failure.error.contains(world::DISAGREEMENT_NOTE) {
+            self.plan_with_arms();
+        }
         let known = self.failure.as_ref() == Some(&failure)
             && (self.pending.is_some() || self.request.is_some());
         self.failure = Some(failure.clone());
@@ -332,11 +335,27 @@ impl Engine {
         }
     }
 
+    /// The planning world predicted a motion the arm cannot make: from now on the planning
+    /// world moves the real arms too, so that proposals are tried against the real reason.
+    fn plan_with_arms(&mut self) {
+        match world::load_execution(&self.scenario, self.variant.as_deref()) {
+            Ok(e) if e.notice.is_none() => {
+                self.planning = e.world;
+                self.notice(
+                    "planning and execution disagree: the planning world found the way clear and \
+                     the arm found no path; the planning world now moves the arms too",
+                );
+            }
+            Ok(_) => {}
+            Err(e) => self.error(format!("cannot plan with the arms: {e}")),
+        }
+    }
+
     /// A fresh execution world and ticker (the tree stays).
     pub(super) fn reset_world(&mut self, announce: bool) {
         self.set_running(false);
-        match world::load_variant(&self.scenario, self.variant.as_deref()) {
-            Ok(w) => self.exec = w,
+        match world::load_execution(&self.scenario, self.variant.as_deref()) {
+            Ok(e) => self.exec = e.world,
             Err(e) => return self.error(format!("cannot reset the world: {e}")),
         }
         self.ticker = crate::bt::Ticker::new();

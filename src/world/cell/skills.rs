@@ -23,6 +23,13 @@ use crate::domain::{ActionCall, Value};
 pub enum SkillFailure {
     #[error("No collision free path found")]
     NoPath,
+    /// The real arm found no path: the motion's own message, and whether the planning
+    /// world's gripper sweep had found the way clear.
+    #[error("{message}{}", if *predicted { DISAGREEMENT_NOTE } else { "" })]
+    ArmNoPath { message: String, predicted: bool },
+    /// No real arm reaches the pose; the inverse kinematics' message.
+    #[error("Position out of reach: {0}")]
+    ArmOutOfReach(String),
     #[error("Position out of reach")]
     OutOfReach,
     #[error("Torque limit exceeded")]
@@ -63,6 +70,21 @@ pub enum SkillFailure {
     #[error("{0:?} cannot be put in itself")]
     InItself(String),
 }
+/// Said after an arm's message when the planning world found the way clear.
+pub const DISAGREEMENT_NOTE: &str =
+    " (the planning world predicted success: planning and execution disagree)";
+
+/// A motion the real arm makes for a skill: the tool from above `above` straight down to
+/// `at`, with `exclude` left out of the obstacles (what is grasped) and what the hand holds.
+struct Motion<'h> {
+    above: Point3<f32>,
+    at: Point3<f32>,
+    exclude: Vec<usize>,
+    carried: Option<&'h Held>,
+}
+
+/// How many free spots on a large support the real arm tries before giving up.
+const ARM_SPOTS: usize = 12;
 /// How many free spots on a large support are tried before giving up.
 const MAX_SPOTS: usize = 24;
 /// Clearance beyond which a spot is as good as any other.
@@ -181,6 +203,152 @@ impl CellWorld {
         !collided
     }
 
+    /// Coming down onto `id` from above: the gripper sweep's verdict (after `reach`, the
+    /// reach spheres'), and with real arms the arm's, which decides.
+    fn from_above(&self, id: usize, reach: Result<(), SkillFailure>) -> Result<(), SkillFailure> {
+        let predicted = reach.and_then(|()| {
+            if self.approach_is_clear(id) {
+                Ok(())
+            } else {
+                Err(SkillFailure::NoPath)
+            }
+        });
+        if self.arms.is_none() {
+            return predicted;
+        }
+        let (end, _) = self.grip_pose(id);
+        let at = Point3::from(end.translation.vector);
+        let above = at + Vector3::z() * self.scene.robot.gripper.approach;
+        self.arm_moves(
+            &Motion {
+                above,
+                at,
+                exclude: vec![id],
+                carried: None,
+            },
+            predicted.is_ok(),
+        )
+    }
+
+    /// Move a real arm for `motion`; on success the move is kept for the action's end.
+    /// `predicted`: whether the planning world's abstraction found the way clear.
+    fn arm_moves(&self, motion: &Motion<'_>, predicted: bool) -> Result<(), SkillFailure> {
+        let Some(arms) = &self.arms else {
+            return Ok(());
+        };
+        let carried: Vec<crate::motion::Solid> = motion
+            .carried
+            .map(|held| {
+                self.scene.solids[held.id]
+                    .body
+                    .parts
+                    .iter()
+                    .map(|p| crate::motion::Solid {
+                        name: self.name(held.id).to_string(),
+                        pose: held.grip * p.local,
+                        shape: p.shape.clone(),
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let mut exclude = motion.exclude.clone();
+        if let Some(h) = motion.carried {
+            exclude.push(h.id);
+        }
+        let solids = self.arm_solids(&exclude);
+        let base = nalgebra::Isometry3::translation(
+            f64::from(self.state.base.x),
+            f64::from(self.state.base.y),
+            0.0,
+        );
+        let reach = super::arms::Reach {
+            base,
+            configs: &self.state.arms,
+            solids: &solids,
+            carried: &carried,
+            above: super::arms::from_above(&motion.above),
+            at: super::arms::from_above(&motion.at),
+            only: motion.carried.and_then(|h| h.arm),
+            lets_go: motion.carried.is_some(),
+        };
+        match arms.reach(&reach) {
+            Ok(m) => {
+                self.planned.replace(Some(m));
+                Ok(())
+            }
+            Err(super::arms::Refusal::OutOfReach(why)) => Err(SkillFailure::ArmOutOfReach(why)),
+            Err(super::arms::Refusal::NoPath { message, .. }) => {
+                Err(SkillFailure::ArmNoPath { message, predicted })
+            }
+        }
+    }
+
+    /// Every solid (and lid) but `exclude`, part by part, as the arms' obstacles.
+    fn arm_solids(&self, exclude: &[usize]) -> Vec<crate::motion::Solid> {
+        let mut out = Vec::new();
+        for (i, s) in self.scene.solids.iter().enumerate() {
+            let pose = self.state.poses[i];
+            if let Some(lid) = &s.lid {
+                let rel = if self.state.lid_open[i] {
+                    lid.open
+                } else {
+                    lid.closed
+                };
+                for p in lid.body.parts.iter() {
+                    out.push(crate::motion::Solid {
+                        name: format!("{} lid", s.name),
+                        pose: pose * rel * p.local,
+                        shape: p.shape.clone(),
+                    });
+                }
+            }
+            if exclude.contains(&i) || self.is_held(i) {
+                continue;
+            }
+            for p in s.body.parts.iter() {
+                out.push(crate::motion::Solid {
+                    name: s.name.clone(),
+                    pose: pose * p.local,
+                    shape: p.shape.clone(),
+                });
+            }
+        }
+        out
+    }
+
+    /// Letting the held object go at `pose`, come in along `direction` over `travel`: the
+    /// gripper sweep's verdict, and with real arms the arm's, which decides.
+    /// The arm lets go `drop` metres short of `pose` along the way in (into a container
+    /// through its top, the object just inside the rim).
+    fn release(
+        &self,
+        held: &Held,
+        pose: &Pose,
+        direction: Vector3<f32>,
+        travel: f32,
+        drop: f32,
+    ) -> Result<(), SkillFailure> {
+        let clear = self.release_path_clear(held, pose, direction, travel);
+        if self.arms.is_none() {
+            return if clear {
+                Ok(())
+            } else {
+                Err(SkillFailure::NoPath)
+            };
+        }
+        let end = Pose::translation(0.0, 0.0, CONTACT_GAP) * pose * held.grip.inverse();
+        let at = Point3::from(end.translation.vector) + direction * drop.clamp(0.0, travel);
+        self.arm_moves(
+            &Motion {
+                above: Point3::from(end.translation.vector) + direction * travel,
+                at,
+                exclude: Vec::new(),
+                carried: Some(held),
+            },
+            clear,
+        )
+    }
+
     fn grasp(&self, x: usize) -> Result<Effect, SkillFailure> {
         let solid = &self.scene.solids[x];
         if solid.fixed {
@@ -190,7 +358,10 @@ impl CellWorld {
             });
         }
         self.free_hand("grasp", x)?;
-        self.reachable(x)?;
+        let reach = self.reachable(x);
+        if self.arms.is_none() {
+            reach.clone()?;
+        }
         if solid.mass > self.scene.robot.payload {
             return Err(SkillFailure::Payload {
                 object: solid.name.clone(),
@@ -198,15 +369,14 @@ impl CellWorld {
                 payload: self.scene.robot.payload,
             });
         }
-        if !self.approach_is_clear(x) {
-            return Err(SkillFailure::NoPath);
-        }
+        self.from_above(x, reach)?;
         let (tool, half_width) = self.grip_pose(x);
         Ok(Effect::Grasp(Held {
             id: x,
             grip: tool.inverse() * self.state.poses[x],
             half_width,
             from: self.aabb(x).center(),
+            arm: self.planned.borrow().as_ref().map(|m| m.arm),
         }))
     }
 
@@ -218,10 +388,11 @@ impl CellWorld {
             });
         }
         self.free_hand("flip", x)?;
-        self.reachable(x)?;
-        if !self.approach_is_clear(x) {
-            return Err(SkillFailure::NoPath);
+        let reach = self.reachable(x);
+        if self.arms.is_none() {
+            reach.clone()?;
         }
+        self.from_above(x, reach)?;
         let pose = self.state.poses[x];
         let b = self.aabb(x);
         let c = b.center();
@@ -307,13 +478,22 @@ impl CellWorld {
             return Err(SkillFailure::OutOfReach);
         }
         let approach = self.scene.robot.gripper.approach;
-        for (px, py) in spots.into_iter().take(MAX_SPOTS) {
+        let tries = if self.arms.is_some() {
+            ARM_SPOTS
+        } else {
+            MAX_SPOTS
+        };
+        let mut first_refusal = None;
+        for (px, py) in spots.into_iter().take(tries) {
             let pose = body.resting(rotation, px, py, top.maxs.z);
-            if self.release_path_clear(&held, &pose, Vector3::z(), approach) {
-                return Ok(Effect::Release { id: x, pose });
+            match self.release(&held, &pose, Vector3::z(), approach, 0.0) {
+                Ok(()) => return Ok(Effect::Release { id: x, pose }),
+                Err(e) => {
+                    first_refusal.get_or_insert(e);
+                }
             }
         }
-        Err(SkillFailure::NoPath)
+        Err(first_refusal.unwrap_or(SkillFailure::NoPath))
     }
 
     /// Reachable spots on the top of `s` for a footprint of half size `hx` × `hy`, best
@@ -396,10 +576,15 @@ impl CellWorld {
         }
         self.reachable(c)?;
         let (pose, direction, travel) = self.cavity_rest(x, c)?;
-        if self.release_path_clear(&held, &pose, direction, travel) {
-            Ok(Effect::Release { id: x, pose })
+        // Through a top opening that is open (nothing over it, not turned down) the hand
+        // lets go with the object's bottom at the rim; otherwise it must go all the way in.
+        let drop = if direction == Vector3::z() && self.open(c) {
+            let bottom = self.scene.solids[x].body.aabb(&pose).mins.z;
+            self.aabb(c).maxs.z - bottom
         } else {
-            Err(SkillFailure::NoPath)
-        }
+            0.0
+        };
+        self.release(&held, &pose, direction, travel, drop)?;
+        Ok(Effect::Release { id: x, pose })
     }
 }
