@@ -170,3 +170,69 @@ fn failure_scenarios_fail_for_the_arms_reason_and_succeed_after_their_fix() {
         assert!(cell.last_motion().is_some(), "{rel}: an arm moved");
     }
 }
+
+/// Scenarios whose failure only the real arms produce: the planning world's gripper sweep
+/// finds the way clear, the arm does not, and the failure says both.
+const ARMS_ONLY: &[(&str, &str, &str)] = &[(
+    "shelf_over.toml",
+    "grasp \"blue cube\"",
+    "collides with shelf",
+)];
+
+#[test]
+fn real_arm_scenarios_fail_only_with_the_arms_and_succeed_after_their_fix() {
+    for (rel, action, reason) in ARMS_ONLY {
+        let scenario = load(rel);
+        let exec = arms_world(&scenario, None);
+        let planning = world::load(&scenario).unwrap();
+        let goal = scenario.goal.clone().unwrap();
+        // The planning world predicts success.
+        let plan = Planner::new(&scenario.domain)
+            .plan(&goal.to_dnf(), planning.as_ref())
+            .expect("a plan");
+        assert_eq!(plan.outcome, betr::planner::Outcome::Success, "{rel}");
+        let (end, _) = run(&plan.tree, &scenario, exec.as_ref());
+        let RunEnd::Failure {
+            action: Some((node, error)),
+        } = end
+        else {
+            panic!("{rel}: expected {action} to fail, got {end:?}");
+        };
+        let failed = plan
+            .tree
+            .kind(node)
+            .unwrap()
+            .as_action()
+            .unwrap()
+            .to_string();
+        assert_eq!(failed, *action, "{rel}: {error}");
+        assert!(
+            error.starts_with("No collision free path found for yumi_link_7_"),
+            "{rel}: {error}"
+        );
+        assert!(error.contains(reason), "{rel}: {error}");
+        assert!(error.ends_with(world::DISAGREEMENT_NOTE), "{rel}: {error}");
+        // Repaired in a planning world that moves the arms too, as the engine does once
+        // planning and execution disagree.
+        let fix = Condition::parse(&scenario.expected_fix[0]).unwrap();
+        let repaired = Planner::new(&scenario.domain)
+            .repair(plan.tree.clone(), node, &[fix], exec.as_ref())
+            .expect("a repair");
+        assert_eq!(repaired.outcome, betr::planner::Outcome::Success, "{rel}");
+        let (end, after) = run(&repaired.tree, &scenario, exec.as_ref());
+        assert_eq!(
+            end,
+            RunEnd::Success,
+            "{rel}:\n{}",
+            bt::to_text(&repaired.tree)
+        );
+        assert!(
+            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
+            "{rel}"
+        );
+        // Without the obstacle the first tree already runs with the arms.
+        let clear = arms_world(&scenario, Some("clear"));
+        let (end, _) = run(&plan.tree, &scenario, clear.as_ref());
+        assert_eq!(end, RunEnd::Success, "{rel}: the clear variant");
+    }
+}

@@ -277,6 +277,20 @@ impl CellWorld {
             && (y.mins.y..=y.maxs.y).contains(&c.y)
     }
 
+    /// `a` over `b`: a is higher than b's top and their footprints overlap (a shelf over
+    /// a cube, a cube lying on it).
+    fn over(&self, a: usize, b: usize) -> bool {
+        if a == b || self.is_held(a) || self.is_held(b) {
+            return false;
+        }
+        let (x, y) = (self.aabb(a), self.aabb(b));
+        x.mins.z >= y.maxs.z - REST_TOLERANCE
+            && x.mins.x < y.maxs.x
+            && y.mins.x < x.maxs.x
+            && x.mins.y < y.maxs.y
+            && y.mins.y < x.maxs.y
+    }
+
     fn inside(&self, a: usize, b: usize) -> bool {
         a != b
             && !self.is_held(a)
@@ -306,6 +320,7 @@ impl CellWorld {
         match (predicate, args) {
             ("on", [a, b]) => self.on(*a, *b),
             ("in", [a, b]) => self.inside(*a, *b),
+            ("over", [a, b]) => self.over(*a, *b),
             ("grasped", [a]) => self.is_held(*a),
             ("open", [a]) => self.open(*a),
             ("unlocked", [a]) => !self.state.locked[*a],
@@ -451,7 +466,7 @@ impl World for CellWorld {
         let n = self.scene.solids.len();
         let mut out = Vec::new();
         let known = |p: &str| self.domain.vocabulary.predicate(p).is_some();
-        for p in ["on", "in"].into_iter().filter(|p| known(p)) {
+        for p in ["on", "in", "over"].into_iter().filter(|p| known(p)) {
             for a in 0..n {
                 for b in 0..n {
                     if self.holds(p, &[a, b]) {

@@ -83,6 +83,8 @@ struct Motion<'h> {
     carried: Option<&'h Held>,
 }
 
+/// Room left between a slid object and what was over it (the wrist's width).
+const SLIDE_MARGIN: f32 = 0.08;
 /// How many free spots on a large support the real arm tries before giving up.
 const ARM_SPOTS: usize = 12;
 /// How many free spots on a large support are tried before giving up.
@@ -147,6 +149,7 @@ impl CellWorld {
                 let pose = self.cavity_rest(*x, *c)?.0;
                 Ok(Effect::Move { id: *x, pose })
             }
+            ("slide", [x]) => self.slide(*x),
             ("wipe", [x]) => {
                 self.free_hand("wipe", *x)?;
                 self.reachable(*x)?;
@@ -567,6 +570,75 @@ impl CellWorld {
                 (pose, flat, 2.0 * half.x + approach)
             }
         })
+    }
+
+    /// Push `x` along the table (towards the robot or sideways, the middle of the robot
+    /// first) until nothing is over it, leaving `SLIDE_MARGIN` between it and what was over it; the
+    /// spot must be free and within reach.
+    fn slide(&self, x: usize) -> Result<Effect, SkillFailure> {
+        let solid = &self.scene.solids[x];
+        if solid.fixed {
+            return Err(SkillFailure::Fixed {
+                object: solid.name.clone(),
+                done: "slid",
+            });
+        }
+        self.free_hand("slide", x)?;
+        self.reachable(x)?;
+        let covers: Vec<usize> = (0..self.scene.solids.len())
+            .filter(|o| self.over(*o, x))
+            .collect();
+        let b = self.aabb(x);
+        let c = b.center();
+        if covers.is_empty() {
+            return Ok(Effect::Move {
+                id: x,
+                pose: self.state.poses[x],
+            });
+        }
+        let (lo_x, lo_y, hi_y) = covers.iter().fold(
+            (f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY),
+            |(lx, ly, hy), o| {
+                let a = self.aabb(*o);
+                (lx.min(a.mins.x), ly.min(a.mins.y), hy.max(a.maxs.y))
+            },
+        );
+        let (hx, hy) = ((b.maxs.x - b.mins.x) / 2.0, (b.maxs.y - b.mins.y) / 2.0);
+        let mut moves = [
+            (lo_x - hx - SLIDE_MARGIN - c.x, 0.0),
+            (0.0, lo_y - hy - SLIDE_MARGIN - c.y),
+            (0.0, hi_y + hy + SLIDE_MARGIN - c.y),
+        ];
+        // Towards the middle of the robot first (both arms reach there, neither under what
+        // was over it), then the shortest.
+        let middle = self.state.base.y;
+        moves.sort_by(|a, b| {
+            (c.y + a.1 - middle)
+                .abs()
+                .total_cmp(&(c.y + b.1 - middle).abs())
+                .then((a.0.abs() + a.1.abs()).total_cmp(&(b.0.abs() + b.1.abs())))
+        });
+        let rotation = self.state.poses[x].rotation;
+        let table_top = b.mins.z;
+        let others = self.obstacles(&[x]);
+        for (dx, dy) in moves {
+            let pose = solid.body.resting(rotation, c.x + dx, c.y + dy, table_top);
+            let point = Point3::new(c.x + dx, c.y + dy, b.maxs.z);
+            if !self.scene.robot.reaches(self.state.base, &point) {
+                continue;
+            }
+            let free = solid.body.parts.iter().all(|p| {
+                let part = Part {
+                    local: Pose::translation(0.0, 0.0, CONTACT_GAP) * pose * p.local,
+                    shape: p.shape.clone(),
+                };
+                !super::geometry::overlaps_any(&part, &others, &self.counter)
+            });
+            if free {
+                return Ok(Effect::Move { id: x, pose });
+            }
+        }
+        Err(SkillFailure::NoPath)
     }
 
     fn put_in(&self, x: usize, c: usize) -> Result<Effect, SkillFailure> {

@@ -70,6 +70,7 @@ pub const SKILLS: &[&str] = &[
     "move_base",
     "scoop",
     "wipe",
+    "slide",
 ];
 
 #[derive(Deserialize)]
