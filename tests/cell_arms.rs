@@ -173,11 +173,18 @@ fn failure_scenarios_fail_for_the_arms_reason_and_succeed_after_their_fix() {
 
 /// Scenarios whose failure only the real arms produce: the planning world's gripper sweep
 /// finds the way clear, the arm does not, and the failure says both.
-const ARMS_ONLY: &[(&str, &str, &str)] = &[(
-    "shelf_over.toml",
-    "grasp \"blue cube\"",
-    "collides with shelf",
-)];
+const ARMS_ONLY: &[(&str, &str, &str)] = &[
+    (
+        "shelf_over.toml",
+        "grasp \"blue cube\"",
+        "collides with shelf",
+    ),
+    (
+        "vase_beside.toml",
+        "place \"blue cube\" \"green cube\"",
+        "collides with vase",
+    ),
+];
 
 #[test]
 fn real_arm_scenarios_fail_only_with_the_arms_and_succeed_after_their_fix() {

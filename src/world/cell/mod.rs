@@ -36,6 +36,9 @@ use crate::scenario::{Scenario, ScenarioError};
 use geometry::{Counter, Obstacle, Pose, REST_TOLERANCE, is_upright, overlaps_any};
 use scene::Scene;
 
+/// Footprints nearer than this (metres) stand beside each other.
+const BESIDE_GAP: f32 = 0.05;
+
 /// What the gripper holds: the object and where it sits relative to the tool centre point.
 #[derive(Debug, Clone, PartialEq)]
 struct Held {
@@ -291,6 +294,18 @@ impl CellWorld {
             && y.mins.y < x.maxs.y
     }
 
+    /// `a` beside `b`: side by side at the same height, their footprints less than
+    /// `BESIDE_GAP` apart (a tall vase next to a cube), neither over the other.
+    fn beside(&self, a: usize, b: usize) -> bool {
+        if a == b || self.is_held(a) || self.is_held(b) || self.over(a, b) || self.over(b, a) {
+            return false;
+        }
+        let (x, y) = (self.aabb(a), self.aabb(b));
+        let gap_x = (x.mins.x - y.maxs.x).max(y.mins.x - x.maxs.x);
+        let gap_y = (x.mins.y - y.maxs.y).max(y.mins.y - x.maxs.y);
+        x.mins.z < y.maxs.z && y.mins.z < x.maxs.z && gap_x.max(gap_y) < BESIDE_GAP
+    }
+
     fn inside(&self, a: usize, b: usize) -> bool {
         a != b
             && !self.is_held(a)
@@ -321,6 +336,7 @@ impl CellWorld {
             ("on", [a, b]) => self.on(*a, *b),
             ("in", [a, b]) => self.inside(*a, *b),
             ("over", [a, b]) => self.over(*a, *b),
+            ("beside", [a, b]) => self.beside(*a, *b),
             ("grasped", [a]) => self.is_held(*a),
             ("open", [a]) => self.open(*a),
             ("unlocked", [a]) => !self.state.locked[*a],
@@ -466,7 +482,10 @@ impl World for CellWorld {
         let n = self.scene.solids.len();
         let mut out = Vec::new();
         let known = |p: &str| self.domain.vocabulary.predicate(p).is_some();
-        for p in ["on", "in", "over"].into_iter().filter(|p| known(p)) {
+        for p in ["on", "in", "over", "beside"]
+            .into_iter()
+            .filter(|p| known(p))
+        {
             for a in 0..n {
                 for b in 0..n {
                     if self.holds(p, &[a, b]) {

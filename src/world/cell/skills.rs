@@ -11,6 +11,7 @@
 //! is swept along that line against every other solid.
 
 use nalgebra::{Point3, UnitQuaternion, Vector3};
+use parry3d::bounding_volume::BoundingVolume;
 
 use super::geometry::{CONTACT_GAP, Footprints, Opening, Part, Pose, path_collides};
 use super::values::judge;
@@ -573,7 +574,7 @@ impl CellWorld {
     }
 
     /// Push `x` along the table (towards the robot or sideways, the middle of the robot
-    /// first) until nothing is over it, leaving `SLIDE_MARGIN` between it and what was over it; the
+    /// first, never through what is in the way) until nothing is over it or beside it, leaving `SLIDE_MARGIN` between it and what was over it; the
     /// spot must be free and within reach.
     fn slide(&self, x: usize) -> Result<Effect, SkillFailure> {
         let solid = &self.scene.solids[x];
@@ -586,7 +587,7 @@ impl CellWorld {
         self.free_hand("slide", x)?;
         self.reachable(x)?;
         let covers: Vec<usize> = (0..self.scene.solids.len())
-            .filter(|o| self.over(*o, x))
+            .filter(|o| self.over(*o, x) || self.beside(*o, x))
             .collect();
         let b = self.aabb(x);
         let c = b.center();
@@ -596,19 +597,32 @@ impl CellWorld {
                 pose: self.state.poses[x],
             });
         }
-        let (lo_x, lo_y, hi_y) = covers.iter().fold(
-            (f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY),
-            |(lx, ly, hy), o| {
-                let a = self.aabb(*o);
-                (lx.min(a.mins.x), ly.min(a.mins.y), hy.max(a.maxs.y))
-            },
-        );
+        let mut around = self.aabb(covers[0]);
+        for o in &covers[1..] {
+            around.merge(&self.aabb(*o));
+        }
         let (hx, hy) = ((b.maxs.x - b.mins.x) / 2.0, (b.maxs.y - b.mins.y) / 2.0);
-        let mut moves = [
-            (lo_x - hx - SLIDE_MARGIN - c.x, 0.0),
-            (0.0, lo_y - hy - SLIDE_MARGIN - c.y),
-            (0.0, hi_y + hy + SLIDE_MARGIN - c.y),
-        ];
+        let across_x = b.mins.x < around.maxs.x && around.mins.x < b.maxs.x;
+        let across_y = b.mins.y < around.maxs.y && around.mins.y < b.maxs.y;
+        // A push never goes through what is in the way: only the ways that lead off it.
+        let mut moves: Vec<(f32, f32)> = [
+            (around.mins.x - hx - SLIDE_MARGIN - c.x, 0.0),
+            (0.0, around.mins.y - hy - SLIDE_MARGIN - c.y),
+            (0.0, around.maxs.y + hy + SLIDE_MARGIN - c.y),
+        ]
+        .into_iter()
+        .filter(|&(dx, dy)| {
+            if dx < 0.0 {
+                !(across_y && b.mins.x >= around.maxs.x)
+            } else if dy < 0.0 {
+                !(across_x && b.mins.y >= around.maxs.y)
+            } else if dy > 0.0 {
+                !(across_x && b.maxs.y <= around.mins.y)
+            } else {
+                false
+            }
+        })
+        .collect();
         // Towards the middle of the robot first (both arms reach there, neither under what
         // was over it), then the shortest.
         let middle = self.state.base.y;
