@@ -46,6 +46,9 @@ impl std::fmt::Debug for Arms {
     }
 }
 
+/// The descriptions read so far in this process, by name (or why one could not be read).
+type ReadRobots = HashMap<&'static str, Result<Arc<Robot>, String>>;
+
 /// Whether a cell's execution world moves real arms.
 #[derive(Debug, Clone)]
 pub enum ArmsAvailability {
@@ -101,8 +104,7 @@ pub enum Refusal {
 impl Arms {
     /// The arms of `spec`'s description when it is in the cache, read once per process.
     pub fn available(spec: &ArmsSpec) -> ArmsAvailability {
-        static READ: OnceLock<Mutex<HashMap<&'static str, Result<Arc<Robot>, String>>>> =
-            OnceLock::new();
+        static READ: OnceLock<Mutex<ReadRobots>> = OnceLock::new();
         let description = spec.description;
         let dir = description.path();
         if !description.urdf_in(&dir).is_file() {

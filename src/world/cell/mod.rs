@@ -15,6 +15,7 @@
 
 pub mod arms;
 pub mod geometry;
+mod motions;
 pub mod robot;
 pub mod scene;
 pub mod skills;
