@@ -243,3 +243,57 @@ fn real_arm_scenarios_fail_only_with_the_arms_and_succeed_after_their_fix() {
         assert_eq!(end, RunEnd::Success, "{rel}: the clear variant");
     }
 }
+
+/// In the workbench's engine: the arm's failure says planning and execution disagree, the
+/// engine says so, asks the model, and the approved fix runs to success with the arms.
+#[test]
+fn the_engine_reports_the_disagreement_and_repairs_it_through_the_usual_loop() {
+    use betr::session::{Command, Event, Setup};
+    use std::sync::Arc;
+    description();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/shelf_over.toml");
+    let scenario = Arc::new(Scenario::load(&path).unwrap());
+    let model = support::engine::model(std::time::Duration::ZERO);
+    let setup = Setup::new(scenario, path, Ok(Arc::new(model)));
+    support::repo::runtime().block_on(async {
+        let mut s = support::engine::Session::start(setup);
+        s.send(Command::Submit("\"blue cube\" on \"green cube\"".into()));
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        s.until("a proposal", |e| matches!(e, Event::Proposal { .. }))
+            .await;
+        let error = s
+            .seen
+            .iter()
+            .find_map(|e| match e {
+                Event::ActionFailed { error, .. } => Some(error.clone()),
+                _ => None,
+            })
+            .expect("an action failed");
+        assert!(error.contains("collides with shelf"), "{error}");
+        assert!(error.ends_with(world::DISAGREEMENT_NOTE), "{error}");
+        assert!(s.seen.iter().any(|e| matches!(
+            e,
+            Event::Notice { message } if message.starts_with("planning and execution disagree")
+        )));
+        let proposed = s.seen.iter().find_map(|e| match e {
+            Event::Proposal { proposal, .. } => Some(proposal.to_string()),
+            _ => None,
+        });
+        assert!(
+            proposed
+                .as_deref()
+                .is_some_and(|p| p.starts_with("insert ~\"any object\" over \"blue cube\"")),
+            "{proposed:?}"
+        );
+        s.send(Command::Approve);
+        s.until("the repaired tree", |e| {
+            matches!(e, Event::TreeChanged { .. })
+        })
+        .await;
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+    });
+}
