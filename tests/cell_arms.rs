@@ -4,7 +4,8 @@
 //! expected fix planned in the planning world, and the repaired tree then runs to success
 //! with the arms, the same way on every run.
 //!
-//! Three are not among them yet. The locked cupboard (scenario 5): it fails and is repaired as the
+//! Three are not among them yet, and their scenario files do not name the robot's
+//! description (their execution world keeps the reach spheres and the gripper sweep). The locked cupboard (scenario 5): it fails and is repaired as the
 //! paper says ("Torque limit exceeded" on opening it), but the plate, gripped from above,
 //! then cannot go in through the cupboard's front opening — the wrist meets the
 //! cupboard's top — so with real arms its repaired tree does not succeed. The unknown

@@ -155,7 +155,7 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
             "{seconds} s each on 1000 random configurations; Pinocchio computes every joint and the two flange frames"
         ),
     }];
-    // The rest values the cell's arms start from (cell.toml).
+    // The rest values the cell's arms start from (the cell scenarios' `[world.robot] rest`).
     let rest: Vec<Vec<f64>> = [
         [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
         [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
