@@ -28,12 +28,14 @@ fn submit_plan_fail_propose_approve_run_to_success() {
             Event::ActionFailed { action, error, .. } => Some((action.to_string(), error.clone())),
             _ => None,
         });
-        assert_eq!(
-            failed,
-            Some((
-                "grasp \"blue cube\"".to_string(),
-                "No collision free path found".to_string()
-            ))
+        let (action, error) = failed.expect("an action failed");
+        assert_eq!(action, "grasp \"blue cube\"");
+        // The arm's reason when the robot's description is in the cache, else the sweep's.
+        assert!(
+            error == "No collision free path found"
+                || (error.starts_with("No collision free path found for yumi_link_7_")
+                    && error.ends_with("collides with red cube")),
+            "{error}"
         );
         // Nothing proposed changes the tree before approval.
         assert!(!got.iter().any(|e| matches!(e, Event::TreeChanged { .. })));

@@ -6,10 +6,13 @@
 //! embedded model's prompt and generation speed against llama.cpp's own `llama-bench`
 //! built from the same source with the same settings (`model`); the first answer of a
 //! one-shot command against a warm one (`cold`); and seeking in a long recording through
-//! the replay workbench's own seek (`replay`). Nothing here is timed inside tests.
+//! the replay workbench's own seek (`replay`); the YuMi's forward kinematics against
+//! Pinocchio and its collision-free paths against OMPL with PyBullet (`motion`, not in the
+//! default set: it needs the robot's description in the cache). Nothing here is timed inside tests.
 
 pub mod cold;
 pub mod model;
+pub mod motion;
 pub mod replay;
 pub mod scale;
 pub mod ticks;

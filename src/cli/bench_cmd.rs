@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, Result};
 use clap::{Args, ValueEnum};
 
-use betr::bench::{self, Report, cold, model, replay, scale, ticks};
+use betr::bench::{self, Report, cold, model, motion, replay, scale, ticks};
 use betr::llm::local::{Engine, EngineOptions, Generated, Generation};
 
 /// A part of `betr bench`.
@@ -25,6 +25,10 @@ pub enum Part {
     /// Seeking to random steps of a 10,000-tick recording on a 500-node tree, as the replay
     /// workbench seeks.
     Replay,
+    /// The YuMi's forward kinematics against Pinocchio, and collision-free paths to 200
+    /// random reachable targets in a cluttered cell against OMPL's RRTConnect with
+    /// PyBullet's collision checks (same URDF, same boxes); not part of the default set.
+    Motion,
     /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
     /// not part of the default set.
     Llm,
@@ -101,6 +105,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                     replay::Sizes::FULL
                 },
             )?),
+            Part::Motion => motion_part(args)?,
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {
@@ -120,6 +125,68 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         .with_context(|| format!("cannot write {}", args.json.display()))?;
     errln!("bench: written to {}", args.json.display());
     Ok(ExitCode::SUCCESS)
+}
+
+fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
+    let spec = &betr::model::YUMI_DESCRIPTION;
+    let dir = spec.path();
+    if !spec.urdf_in(&dir).is_file() {
+        anyhow::bail!(
+            "the YuMi's description is not in the cache ({}): the motion part needs it",
+            dir.display()
+        );
+    }
+    let robot = betr::robot::Robot::read(spec, &dir)?;
+    let shapes = betr::robot::RobotShapes::new(&robot.model, &robot.arms)?;
+    let python = motion::anchor_python(Path::new("target/motion-bench-venv"))?;
+    let script = Path::new("scripts/bench_motion.py");
+    let seconds = if args.quick { 0.3 } else { args.seconds };
+    let betr_fk = motion::betr_fk_rate(&robot, seconds);
+    let pin_fk = motion::pin_fk_rate(&python, script, &spec.urdf_in(&dir), &dir, &robot, seconds)?;
+    let mut rows = vec![bench::Row {
+        part: "motion".into(),
+        measure: "forward kinematics of both arms' flanges".into(),
+        unit: "configurations/s".into(),
+        better: bench::Better::Higher,
+        betr: betr_fk,
+        anchor: Some(("Pinocchio 4.1.0".into(), pin_fk)),
+        target: Some(bench::Target::RatioAtLeast(1.0)),
+        note: format!(
+            "{seconds} s each on 1000 random configurations; Pinocchio computes every joint and the two flange frames"
+        ),
+    }];
+    // The rest values the cell's arms start from (the cell scenarios' `[world.robot] rest`).
+    let rest: Vec<Vec<f64>> = [
+        [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
+        [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
+    ]
+    .iter()
+    .map(|a| a.iter().map(|d: &f64| d.to_radians()).collect())
+    .collect();
+    let count = if args.quick { 10 } else { 200 };
+    let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
+    let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
+    let betr_times = motion::betr_plan(&robot, &shapes, &rest, &boxes, &queries)?;
+    let ompl_times = motion::ompl_plan(
+        &python,
+        script,
+        spec,
+        &dir,
+        &robot,
+        &rest,
+        &boxes,
+        &queries,
+        2.0,
+        Path::new("target"),
+    )?;
+    rows.extend(motion::plan_rows(
+        &format!("{count} random reachable targets among 12 boxes"),
+        &betr_times,
+        &ompl_times,
+        "from each arm's rest values; betr: 4000 samples at most, 0.03 rad segment checks, \
+         shortcutting; OMPL: 2 s at most, the same resolution, simplified",
+    ));
+    Ok(rows)
 }
 
 fn ticks_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {

@@ -55,6 +55,9 @@ pub struct ArmCheck<'a> {
     still: Vec<Still>,
     /// Pairs of carried links (indices) that are tested against each other.
     self_pairs: Vec<(usize, usize)>,
+    /// What the hand holds, in the flange's frame: it moves with the arm and is tested
+    /// against everything that stays still.
+    carried: Vec<Solid>,
     frames: RefCell<Vec<Isometry3<f64>>>,
 }
 
@@ -124,8 +127,15 @@ impl<'a> ArmCheck<'a> {
             base,
             still,
             self_pairs,
+            carried: Vec::new(),
             frames: RefCell::new(Vec::with_capacity(chain.dof())),
         })
+    }
+
+    /// The same check with `parts` (poses in the flange's frame) held in the hand.
+    pub fn carrying(mut self, parts: Vec<Solid>) -> Self {
+        self.carried = parts;
+        self
     }
 
     pub fn chain(&self) -> &Chain {
@@ -148,6 +158,23 @@ impl<'a> ArmCheck<'a> {
                         continue;
                     }
                     if intersects(&pose, &shape.shape, &s.pose, &s.shape) {
+                        return Some(s.name.clone());
+                    }
+                }
+            }
+        }
+        if !self.carried.is_empty() {
+            let last = self.chain.dof().saturating_sub(1);
+            let flange = (self.base * frames[last] * self.chain.flange).cast::<f32>();
+            for part in &self.carried {
+                let pose = flange * part.pose;
+                let aabb = part.shape.compute_local_aabb();
+                let (center, radius) = (pose * aabb.center(), aabb.half_extents().norm());
+                for s in &self.still {
+                    if (center - s.center).norm() > radius + s.radius {
+                        continue;
+                    }
+                    if intersects(&pose, &part.shape, &s.pose, &s.shape) {
                         return Some(s.name.clone());
                     }
                 }

@@ -1,12 +1,11 @@
-//! The links' collision shapes: for each collision mesh, the capsule along the mesh's
-//! main axis that holds every vertex by construction (its segment spans the vertices
-//! along that axis, its radius is the farthest vertex's distance from the segment), in
-//! the link's frame, with the ball around it for a quick first test.
+//! The links' collision shapes: for each collision mesh, the tighter of the capsule along
+//! the mesh's main axis and the box on its principal axes, each holding every vertex by
+//! construction, in the link's frame, with the ball around it for a quick first test.
 //!
-//! A configuration whose capsules are apart is one whose meshes are apart. Capsules
-//! rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
+//! A configuration whose shapes are apart is one whose meshes are apart. Capsules and
+//! boxes rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
 //! point and contact queries wrongly (a vertex of the mesh reported a centimetre outside
-//! its own hull), and a capsule's queries are exact. The price is a fatter arm.
+//! its own hull), and a capsule's or a box's queries are exact. The price is a fatter arm.
 
 use std::path::Path;
 
@@ -93,8 +92,10 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
                 .into_iter()
                 .map(|p| Point3::from(p.coords.component_mul(&s)))
                 .collect();
-            capsule_around(&points)
-                .ok_or_else(|| bad(format!("mesh {} has no vertices", path.display())))?
+            let (placed, shape) = hull_around(&points)
+                .ok_or_else(|| bad(format!("mesh {} has no vertices", path.display())))?;
+            local *= placed;
+            shape
         }
         Geometry::Box { size } => SharedShape::cuboid(
             size.x as f32 / 2.0,
@@ -122,9 +123,8 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
     })
 }
 
-/// The capsule along the points' principal axis whose segment spans their extent along
-/// it and whose radius is the farthest point's distance from that segment.
-fn capsule_around(points: &[Point3<f32>]) -> Option<SharedShape> {
+/// The points' principal axes (columns, right-handed) and their mean.
+fn principal_axes(points: &[Point3<f32>]) -> (nalgebra::Matrix3<f32>, Vector3<f32>) {
     let n = points.len() as f32;
     let mean = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / n.max(1.0);
     let covariance = points.iter().fold(nalgebra::Matrix3::zeros(), |a, p| {
@@ -132,30 +132,62 @@ fn capsule_around(points: &[Point3<f32>]) -> Option<SharedShape> {
         a + d * d.transpose()
     });
     let eigen = covariance.symmetric_eigen();
-    let axis = eigen
-        .eigenvectors
-        .column(eigen.eigenvalues.imax())
-        .normalize();
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for p in points {
-        let t = (p.coords - mean).dot(&axis);
-        lo = lo.min(t);
-        hi = hi.max(t);
-    }
-    if !lo.is_finite() || !hi.is_finite() {
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|a, b| eigen.eigenvalues[*b].total_cmp(&eigen.eigenvalues[*a]));
+    let x = eigen.eigenvectors.column(order[0]).normalize();
+    let y = eigen.eigenvectors.column(order[1]).normalize();
+    let z = x.cross(&y);
+    (nalgebra::Matrix3::from_columns(&[x, y, z]), mean)
+}
+
+/// The tighter (by volume) of two shapes that hold every point by construction, with its
+/// placement in the points' frame: the capsule along the principal axis whose segment
+/// spans the points along it and whose radius is the farthest point's distance from that
+/// segment, and the box on the principal axes around them. A gripper's squat base is far
+/// tighter in a box; a forearm in a capsule.
+fn hull_around(points: &[Point3<f32>]) -> Option<(Isometry3<f32>, SharedShape)> {
+    if points.is_empty() {
         return None;
     }
+    let (axes, mean) = principal_axes(points);
+    let (mut lo, mut hi) = (
+        Vector3::repeat(f32::INFINITY),
+        Vector3::repeat(f32::NEG_INFINITY),
+    );
+    for p in points {
+        let t = axes.transpose() * (p.coords - mean);
+        lo = lo.inf(&t);
+        hi = hi.sup(&t);
+    }
+    if !lo.iter().chain(hi.iter()).all(|v| v.is_finite()) {
+        return None;
+    }
+    let axis = axes.column(0).into_owned();
     let (a, b) = (
-        Point3::from(mean + axis * lo),
-        Point3::from(mean + axis * hi),
+        Point3::from(mean + axis * lo.x),
+        Point3::from(mean + axis * hi.x),
     );
     let segment = parry3d::shape::Segment::new(a, b);
     let radius = points
         .iter()
         .map(|p| parry3d::query::PointQuery::distance_to_local_point(&segment, p, true))
         .fold(0.0f32, f32::max);
-    // A hair more, so that rounding in the distance query never leaves a vertex out.
-    Some(SharedShape::capsule(a, b, radius * 1.0001 + 1e-6))
+    // A hair more, so that rounding in the distance queries never leaves a vertex out.
+    let radius = radius * 1.0001 + 1e-6;
+    let half = (hi - lo) / 2.0 * 1.0001 + Vector3::repeat(1e-6);
+    let capsule_volume =
+        std::f32::consts::PI * radius * radius * ((hi.x - lo.x) + 4.0 * radius / 3.0);
+    let box_volume = 8.0 * half.x * half.y * half.z;
+    if capsule_volume <= box_volume {
+        return Some((Isometry3::identity(), SharedShape::capsule(a, b, radius)));
+    }
+    let centre = mean + axes * ((lo + hi) / 2.0);
+    let rotation =
+        UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(axes));
+    Some((
+        Isometry3::from_parts(centre.into(), rotation),
+        SharedShape::cuboid(half.x, half.y, half.z),
+    ))
 }
 
 /// The vertices of an STL mesh (binary or ASCII), in the mesh's units.

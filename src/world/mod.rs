@@ -14,6 +14,7 @@ use crate::domain::{ActionCall, Condition};
 use crate::scenario::{Scenario, ScenarioError};
 
 pub use cell::CellWorld;
+pub use cell::skills::DISAGREEMENT_NOTE;
 pub use symbolic::SymbolicWorld;
 
 /// The result of advancing an action by one tick.
@@ -71,6 +72,47 @@ pub trait World: Send {
 /// Build the world a scenario describes.
 pub fn load(scenario: &Scenario) -> Result<Box<dyn World>, ScenarioError> {
     load_variant(scenario, None)
+}
+
+/// The world a tree runs in (the one a person steps), and what to tell them about it once.
+pub struct Execution {
+    pub world: Box<dyn World>,
+    /// Why the cell moves its abstraction instead of the robot's real arms, when it does.
+    pub notice: Option<String>,
+}
+
+/// Build the world a scenario's tree runs in: the cell moves its robot's real arms when
+/// the scenario names a robot description that is in the cache (planning worlds keep the
+/// reach spheres and the gripper sweep: [`load_variant`]); otherwise, with a notice, the
+/// same world as [`load_variant`].
+pub fn load_execution(
+    scenario: &Scenario,
+    variant: Option<&str>,
+) -> Result<Execution, ScenarioError> {
+    if scenario.world_kind != "cell" {
+        return Ok(Execution {
+            world: load_variant(scenario, variant)?,
+            notice: None,
+        });
+    }
+    let cell = CellWorld::from_scenario(scenario, variant)?;
+    Ok(match cell.arms_availability() {
+        cell::arms::ArmsAvailability::Real(arms) => Execution {
+            world: Box::new(cell.moving_arms(arms)),
+            notice: None,
+        },
+        cell::arms::ArmsAvailability::NotAsked => Execution {
+            world: Box::new(cell),
+            notice: None,
+        },
+        cell::arms::ArmsAvailability::Abstract(why) => {
+            tracing::warn!("{why}");
+            Execution {
+                world: Box::new(cell),
+                notice: Some(why),
+            }
+        }
+    })
 }
 
 /// Build the world a scenario describes, changed by its `[world.variants.NAME]` table when

@@ -96,7 +96,10 @@ pub fn replies(path: &Path, file: &FixtureFile) -> Vec<FixtureReply> {
 
 /// Every reply of every file (prompts of different scenarios differ in their instruction).
 pub fn every_reply() -> Vec<FixtureReply> {
-    all().iter().flat_map(|(p, f)| replies(p, f)).collect()
+    let mut all: Vec<FixtureReply> = all().iter().flat_map(|(p, f)| replies(p, f)).collect();
+    // The first reply that answers a prompt is given: the most specific first.
+    all.sort_by_key(|r| std::cmp::Reverse(r.when.len()));
+    all
 }
 
 /// The replies of the fixture file `name` alone (`red_on_blue.toml`): for a session whose

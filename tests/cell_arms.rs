@@ -1,0 +1,300 @@
+//! The tabletop cell with the YuMi's real arms in the execution world: every failure
+//! scenario of BETR-XP-LLM fails at the paper's action with the arm's own reason (the
+//! solid its motion collides with, the pose no joint values reach), is repaired by its
+//! expected fix planned in the planning world, and the repaired tree then runs to success
+//! with the arms, the same way on every run.
+//!
+//! Three are not among them yet, and their scenario files do not name the robot's
+//! description (their execution world keeps the reach spheres and the gripper sweep). The locked cupboard (scenario 5): it fails and is repaired as the
+//! paper says ("Torque limit exceeded" on opening it), but the plate, gripped from above,
+//! then cannot go in through the cupboard's front opening — the wrist meets the
+//! cupboard's top — so with real arms its repaired tree does not succeed. The unknown
+//! banana (scenario 6): once found and grasped, putting it on the tray near the body
+//! meets the torso's collision shape (the box around the whole body mesh). The banana out
+//! of reach (scenario 7) fails with the arm's "Position out of reach", but after driving
+//! towards it the tray is out of the arms' reach while the reach spheres still hold it.
+
+mod support;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use betr::bt::{self, Tree};
+use betr::domain::Condition;
+use betr::model::{Pip, Progress, YUMI_DESCRIPTION, cache_dir, ensure_description};
+use betr::planner::{Planner, RunEnd, run_tree};
+use betr::scenario::Scenario;
+use betr::world::{self, World};
+
+struct Quiet;
+impl Progress for Quiet {
+    fn stage(&mut self, _: &str) {}
+    fn bytes(&mut self, _: u64, _: u64) {}
+}
+
+/// The YuMi's description in the cache, fetched on first use like the robot's own tests.
+fn description() {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        ensure_description(&YUMI_DESCRIPTION, &cache_dir(), Pip::DEFAULT, &mut Quiet)
+            .unwrap_or_else(|e| panic!("fetching the YuMi's description: {e}"))
+    });
+}
+
+fn load(rel: &str) -> Scenario {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenarios/cell")
+        .join(rel);
+    Scenario::load(&path).unwrap_or_else(|e| panic!("{rel}: {e}"))
+}
+
+/// The execution world, which must move the real arms.
+fn arms_world(scenario: &Scenario, variant: Option<&str>) -> Box<dyn World> {
+    description();
+    let e = world::load_execution(scenario, variant).expect("the execution world");
+    assert_eq!(e.notice, None, "the arms are available");
+    let cell = e
+        .world
+        .as_any()
+        .and_then(|a| a.downcast_ref::<world::CellWorld>())
+        .expect("a cell");
+    assert!(cell.has_real_arms());
+    e.world
+}
+
+/// Run `tree` in a fresh copy of `world`; how it ended.
+fn run(tree: &Tree, scenario: &Scenario, world: &dyn World) -> (RunEnd, Box<dyn World>) {
+    let mut w = world.fork();
+    let report = run_tree(tree, w.as_mut(), &scenario.domain, 1000, |_, _| true);
+    (report.end, w)
+}
+
+/// One expected failure in the execution world: the action, how the error begins, and a
+/// part of it that says the arm's reason.
+type Expected = (&'static str, &'static str, &'static str);
+
+const FAILURES: &[(&str, &[Expected])] = &[
+    (
+        "red_on_blue.toml",
+        &[(
+            "grasp \"blue cube\"",
+            "No collision free path found for yumi_link_7_l",
+            "collides with red cube",
+        )],
+    ),
+    (
+        "blocked_both.toml",
+        &[
+            (
+                "grasp \"blue cube\"",
+                "No collision free path found for yumi_link_7_l",
+                "collides with red cube",
+            ),
+            (
+                "place \"blue cube\" \"green cube\"",
+                "No collision free path found for yumi_link_7_l",
+                "collides with yellow cube",
+            ),
+        ],
+    ),
+    (
+        "flip_cup.toml",
+        &[(
+            "put_in \"green cube\" \"red cup\"",
+            "No collision free path found for yumi_link_7_",
+            "collides with red cup",
+        )],
+    ),
+    (
+        "centrifuge.toml",
+        &[(
+            "put_in \"test tube\" \"centrifuge\"",
+            "No collision free path found for yumi_link_7_",
+            "collides with centrifuge lid",
+        )],
+    ),
+];
+
+#[test]
+fn failure_scenarios_fail_for_the_arms_reason_and_succeed_after_their_fix() {
+    for (rel, steps) in FAILURES {
+        let scenario = load(rel);
+        let exec = arms_world(&scenario, None);
+        let planning = world::load(&scenario).unwrap();
+        let planner = Planner::new(&scenario.domain);
+        let goal = scenario.goal.clone().unwrap();
+        let mut tree = planner
+            .plan(&goal.to_dnf(), planning.as_ref())
+            .expect("a plan")
+            .tree;
+        assert_eq!(scenario.expected_fix.len(), steps.len(), "{rel}");
+        for ((action, begins, reason), fix) in steps.iter().zip(&scenario.expected_fix) {
+            let (end, _) = run(&tree, &scenario, exec.as_ref());
+            let RunEnd::Failure {
+                action: Some((node, error)),
+            } = end
+            else {
+                panic!(
+                    "{rel}: expected {action} to fail, got {end:?}\n{}",
+                    bt::to_text(&tree)
+                );
+            };
+            let failed = tree.kind(node).unwrap().as_action().unwrap().to_string();
+            assert_eq!(failed, *action, "{rel}: the failing action ({error})");
+            assert!(error.starts_with(begins), "{rel}: {error}");
+            assert!(error.contains(reason), "{rel}: {error}");
+            // The planning world's sweep agrees here: no disagreement is reported.
+            assert!(!error.contains(world::DISAGREEMENT_NOTE), "{rel}: {error}");
+            let fix = Condition::parse(fix).unwrap();
+            tree = planner
+                .repair(tree, node, &[fix], planning.as_ref())
+                .expect("a repair")
+                .tree;
+        }
+        let (end, after) = run(&tree, &scenario, exec.as_ref());
+        assert_eq!(
+            end,
+            RunEnd::Success,
+            "{rel}: {end:?}\n{}",
+            bt::to_text(&tree)
+        );
+        assert!(
+            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
+            "{rel}: the goal holds"
+        );
+        // The same arms, the same run.
+        let (again, _) = run(&tree, &scenario, exec.as_ref());
+        assert_eq!(again, RunEnd::Success, "{rel}");
+        let cell = after
+            .as_any()
+            .and_then(|a| a.downcast_ref::<world::CellWorld>())
+            .unwrap();
+        assert!(cell.last_motion().is_some(), "{rel}: an arm moved");
+    }
+}
+
+/// Scenarios whose failure only the real arms produce: the planning world's gripper sweep
+/// finds the way clear, the arm does not, and the failure says both.
+const ARMS_ONLY: &[(&str, &str, &str)] = &[
+    (
+        "shelf_over.toml",
+        "grasp \"blue cube\"",
+        "collides with shelf",
+    ),
+    (
+        "vase_beside.toml",
+        "place \"blue cube\" \"green cube\"",
+        "collides with vase",
+    ),
+];
+
+#[test]
+fn real_arm_scenarios_fail_only_with_the_arms_and_succeed_after_their_fix() {
+    for (rel, action, reason) in ARMS_ONLY {
+        let scenario = load(rel);
+        let exec = arms_world(&scenario, None);
+        let planning = world::load(&scenario).unwrap();
+        let goal = scenario.goal.clone().unwrap();
+        // The planning world predicts success.
+        let plan = Planner::new(&scenario.domain)
+            .plan(&goal.to_dnf(), planning.as_ref())
+            .expect("a plan");
+        assert_eq!(plan.outcome, betr::planner::Outcome::Success, "{rel}");
+        let (end, _) = run(&plan.tree, &scenario, exec.as_ref());
+        let RunEnd::Failure {
+            action: Some((node, error)),
+        } = end
+        else {
+            panic!("{rel}: expected {action} to fail, got {end:?}");
+        };
+        let failed = plan
+            .tree
+            .kind(node)
+            .unwrap()
+            .as_action()
+            .unwrap()
+            .to_string();
+        assert_eq!(failed, *action, "{rel}: {error}");
+        assert!(
+            error.starts_with("No collision free path found for yumi_link_7_"),
+            "{rel}: {error}"
+        );
+        assert!(error.contains(reason), "{rel}: {error}");
+        assert!(error.ends_with(world::DISAGREEMENT_NOTE), "{rel}: {error}");
+        // Repaired in a planning world that moves the arms too, as the engine does once
+        // planning and execution disagree.
+        let fix = Condition::parse(&scenario.expected_fix[0]).unwrap();
+        let repaired = Planner::new(&scenario.domain)
+            .repair(plan.tree.clone(), node, &[fix], exec.as_ref())
+            .expect("a repair");
+        assert_eq!(repaired.outcome, betr::planner::Outcome::Success, "{rel}");
+        let (end, after) = run(&repaired.tree, &scenario, exec.as_ref());
+        assert_eq!(
+            end,
+            RunEnd::Success,
+            "{rel}:\n{}",
+            bt::to_text(&repaired.tree)
+        );
+        assert!(
+            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
+            "{rel}"
+        );
+        // Without the obstacle the first tree already runs with the arms.
+        let clear = arms_world(&scenario, Some("clear"));
+        let (end, _) = run(&plan.tree, &scenario, clear.as_ref());
+        assert_eq!(end, RunEnd::Success, "{rel}: the clear variant");
+    }
+}
+
+/// In the workbench's engine: the arm's failure says planning and execution disagree, the
+/// engine says so, asks the model, and the approved fix runs to success with the arms.
+#[test]
+fn the_engine_reports_the_disagreement_and_repairs_it_through_the_usual_loop() {
+    use betr::session::{Command, Event, Setup};
+    use std::sync::Arc;
+    description();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/shelf_over.toml");
+    let scenario = Arc::new(Scenario::load(&path).unwrap());
+    let model = support::engine::model(std::time::Duration::ZERO);
+    let setup = Setup::new(scenario, path, Ok(Arc::new(model)));
+    support::repo::runtime().block_on(async {
+        let mut s = support::engine::Session::start(setup);
+        s.send(Command::Submit("\"blue cube\" on \"green cube\"".into()));
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        s.until("a proposal", |e| matches!(e, Event::Proposal { .. }))
+            .await;
+        let error = s
+            .seen
+            .iter()
+            .find_map(|e| match e {
+                Event::ActionFailed { error, .. } => Some(error.clone()),
+                _ => None,
+            })
+            .expect("an action failed");
+        assert!(error.contains("collides with shelf"), "{error}");
+        assert!(error.ends_with(world::DISAGREEMENT_NOTE), "{error}");
+        assert!(s.seen.iter().any(|e| matches!(
+            e,
+            Event::Notice { message } if message.starts_with("planning and execution disagree")
+        )));
+        let proposed = s.seen.iter().find_map(|e| match e {
+            Event::Proposal { proposal, .. } => Some(proposal.to_string()),
+            _ => None,
+        });
+        assert!(
+            proposed
+                .as_deref()
+                .is_some_and(|p| p.starts_with("insert ~\"any object\" over \"blue cube\"")),
+            "{proposed:?}"
+        );
+        s.send(Command::Approve);
+        s.until("the repaired tree", |e| {
+            matches!(e, Event::TreeChanged { .. })
+        })
+        .await;
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+    });
+}
