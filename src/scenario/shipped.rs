@@ -89,6 +89,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../scenarios/cell/red_on_blue.toml"),
     ),
     (
+        "cell/shelf_over.toml",
+        include_str!("../../scenarios/cell/shelf_over.toml"),
+    ),
+    (
         "cell/tasks/apple_unknown.toml",
         include_str!("../../scenarios/cell/tasks/apple_unknown.toml"),
     ),
@@ -115,6 +119,10 @@ pub const SHIPPED: &[(&str, &str)] = &[
     (
         "cell/tasks/yellow_on_red.toml",
         include_str!("../../scenarios/cell/tasks/yellow_on_red.toml"),
+    ),
+    (
+        "cell/vase_beside.toml",
+        include_str!("../../scenarios/cell/vase_beside.toml"),
     ),
     (
         "greenhouse/examples.toml",
