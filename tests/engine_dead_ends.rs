@@ -57,7 +57,12 @@ fn an_undone_fix_is_a_candidate_again() {
         let again = s.run_to_proposal().await;
         let notice = shortlist_notice(&again).unwrap();
         assert!(!notice.contains("refused before"), "{notice}");
-        assert!(notice.contains("2 fix the failure"), "{notice}");
+        // The undone fix is among the choices again (how many others fix the failure
+        // depends on where the arm left things).
+        assert!(
+            notice.contains("chooses among: ~\"any object\" on \"blue cube\""),
+            "{notice}"
+        );
         assert_eq!(
             proposed(&again).as_deref(),
             Some("~\"any object\" on \"blue cube\"")
