@@ -118,8 +118,9 @@ fn an_unattended_loop_rejects_a_change_that_fails_its_check_and_asks_again() {
         )
         .await
         .unwrap();
-        // The fixture model proposes the same fix every time; each is refused by the check,
-        // undone, and told to the next question, until the rounds run out.
+        // The fixture model proposes the same fix every time: refused by the check once,
+        // undone and told to the next question, and never offered again, until the rounds
+        // run out.
         assert!(
             matches!(resolved.ending, betr::session::Ending::GaveUp { .. }),
             "{:?}",
@@ -131,7 +132,12 @@ fn an_unattended_loop_rejects_a_change_that_fails_its_check_and_asks_again() {
             .iter()
             .filter(|e| matches!(e, Event::ChangeViolates { .. }))
             .count();
-        assert!(refused >= 2, "asked again after the first refusal: {refused}");
+        assert_eq!(refused, 1, "a refused fix is not offered again");
+        let asked = events
+            .iter()
+            .filter(|e| matches!(e, Event::Asking { what } if what.contains("missing preconditions")))
+            .count();
+        assert!(asked >= 2, "asked again after the refusal: {asked}");
         assert!(events.iter().any(|e| matches!(e, Event::DidNotHelp { reason }
             if reason.contains("fails verification in the model: never \"red cube\" grasped is violated"))));
     });

@@ -289,17 +289,17 @@ impl Engine {
             "it fixes the failure in simulation, but the changed tree fails verification in the model: {}",
             self.violation.take().unwrap_or_default()
         );
-        if let Some((Some(failure), proposal)) = self.last_change.take() {
-            self.tried.push((
-                failure,
-                super::super::ask::Tried {
-                    proposal,
-                    why: why.clone(),
-                },
-            ));
-        }
-        self.emit(Event::DidNotHelp { reason: why });
+        let refused = self.last_change.take();
+        self.emit(Event::DidNotHelp {
+            reason: why.clone(),
+        });
+        // Undone first: undoing makes the undone change a candidate again, and this one is
+        // refused, so it is remembered as tried after.
         self.undo();
+        if let Some((Some(failure), proposal)) = refused {
+            self.tried
+                .push((failure, super::super::ask::Tried { proposal, why }));
+        }
     }
 
     /// A person approves a change that failed verification, having seen why.
