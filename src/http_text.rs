@@ -26,6 +26,28 @@ impl PartialEq for Secret {
     }
 }
 
+/// The key a client sends and where it came from, for its messages: the key in the
+/// variable `env_name` names (read through `var`), else the one the base URL carried.
+/// The source is `None` when no variable is named and the URL has no key.
+pub fn chosen_key(
+    env_name: Option<&str>,
+    var: &dyn Fn(&str) -> Option<String>,
+    url_key: Option<&Secret>,
+) -> (Option<Secret>, Option<String>) {
+    let from_env = env_name
+        .and_then(var)
+        .filter(|k| !k.is_empty())
+        .map(Secret::new);
+    let source = match (&from_env, url_key) {
+        (None, Some(_)) => Some("the base URL".to_string()),
+        _ => env_name.map(|n| match from_env {
+            Some(_) => n.to_string(),
+            None => format!("{n}, which is not set"),
+        }),
+    };
+    (from_env.or_else(|| url_key.cloned()), source)
+}
+
 /// A URL with the credentials it carries (`http://user:KEY@host/v1`) taken out: the URL
 /// without them, and the password (else the user name) as a secret, to be sent and
 /// redacted as a key is. A URL without credentials, or one that does not parse, is
@@ -170,6 +192,25 @@ pub fn excerpt(text: &str) -> String {
 #[cfg(test)]
 mod printable_tests {
     use super::*;
+
+    #[test]
+    fn the_environment_key_wins_over_the_url_and_the_source_is_named() {
+        let url = Secret::new("sk-URL");
+        let env = |k: &str| (k == "K").then(|| "sk-ENV".to_string());
+        let (key, from) = chosen_key(Some("K"), &env, Some(&url));
+        assert_eq!(
+            (key.as_ref().map(Secret::expose), from.as_deref()),
+            (Some("sk-ENV"), Some("K"))
+        );
+        let (key, from) = chosen_key(Some("UNSET"), &env, Some(&url));
+        assert_eq!(
+            (key.as_ref().map(Secret::expose), from.as_deref()),
+            (Some("sk-URL"), Some("the base URL"))
+        );
+        let (key, from) = chosen_key(Some("UNSET"), &env, None);
+        assert!(key.is_none());
+        assert_eq!(from.as_deref(), Some("UNSET, which is not set"));
+    }
 
     #[test]
     fn credentials_in_a_url_are_taken_out_as_a_secret() {

@@ -419,20 +419,11 @@ impl Settings {
                         "no model configured: pass --model NAME, set BETR_MODEL, or set `model` under [llm] in betr.toml".into(),
                     ));
                 };
-                let api_key = self
-                    .api_key_env
-                    .as_deref()
-                    .and_then(var)
-                    .filter(|k| !k.is_empty())
-                    .map(ApiKey::new);
-                let api_key_env = match (&api_key, &self.url_key) {
-                    (None, Some(_)) => Some("the base URL".to_string()),
-                    _ => self.api_key_env.as_ref().map(|n| match api_key {
-                        Some(_) => n.clone(),
-                        None => format!("{n}, which is not set"),
-                    }),
-                };
-                let api_key = api_key.or_else(|| self.url_key.clone());
+                let (api_key, api_key_env) = crate::http_text::chosen_key(
+                    self.api_key_env.as_deref(),
+                    var,
+                    self.url_key.as_ref(),
+                );
                 let client = OpenAiClient::new(OpenAiSettings {
                     base_url: self.base_url.clone(),
                     model,

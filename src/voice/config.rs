@@ -214,20 +214,8 @@ impl SttSettings {
 
     /// The OpenAI-compatible client, with the key read through `var`.
     pub fn remote(&self, var: &dyn Fn(&str) -> Option<String>) -> Result<OpenAiStt, VoiceError> {
-        let api_key = self
-            .api_key_env
-            .as_deref()
-            .and_then(var)
-            .filter(|k| !k.is_empty())
-            .map(SttKey::new);
-        let api_key_env = match (&api_key, &self.url_key) {
-            (None, Some(_)) => Some("the base URL".to_string()),
-            _ => self.api_key_env.as_ref().map(|n| match api_key {
-                Some(_) => n.clone(),
-                None => format!("{n}, which is not set"),
-            }),
-        };
-        let api_key = api_key.or_else(|| self.url_key.clone());
+        let (api_key, api_key_env) =
+            crate::http_text::chosen_key(self.api_key_env.as_deref(), var, self.url_key.as_ref());
         OpenAiStt::new(OpenAiSttSettings {
             base_url: self.base_url.clone(),
             model: self.model.clone(),
