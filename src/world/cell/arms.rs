@@ -47,7 +47,22 @@ impl std::fmt::Debug for Arms {
 }
 
 /// The descriptions read so far in this process, by name (or why one could not be read).
-type ReadRobots = HashMap<&'static str, Result<Arc<Robot>, String>>;
+type ReadRobots = HashMap<&'static str, Result<Arc<Robot>, ArmsError>>;
+
+/// Why a scenario's robot cannot move its real arms.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ArmsError {
+    /// The description did not read (kept as text: it is remembered for the process).
+    #[error("the robot description: {0}")]
+    Description(String),
+    /// The links' collision shapes could not be made from the meshes.
+    #[error("{0}")]
+    Shapes(String),
+    #[error("[world.robot] rest gives {given} arm(s), the description has {has}")]
+    RestCount { given: usize, has: usize },
+    #[error("[world.robot] rest: the values for {arm} are not within its joint limits")]
+    RestLimits { arm: String },
+}
 
 /// Whether a cell's execution world moves real arms.
 #[derive(Debug, Clone)]
@@ -124,35 +139,34 @@ impl Arms {
                 .or_insert_with(|| {
                     Robot::read(description, &dir)
                         .map(Arc::new)
-                        .map_err(|e| e.to_string())
+                        .map_err(|e| ArmsError::Description(e.to_string()))
                 })
                 .clone()
         };
         let robot = match robot {
             Ok(r) => r,
-            Err(e) => return ArmsAvailability::Abstract(format!("the robot description: {e}")),
+            Err(e) => return ArmsAvailability::Abstract(e.to_string()),
         };
         match Arms::new(robot.as_ref().clone(), spec) {
             Ok(arms) => ArmsAvailability::Real(Arc::new(arms)),
-            Err(e) => ArmsAvailability::Abstract(e),
+            Err(e) => ArmsAvailability::Abstract(e.to_string()),
         }
     }
 
-    fn new(robot: Robot, spec: &ArmsSpec) -> Result<Arms, String> {
-        let shapes = RobotShapes::new(&robot.model, &robot.arms).map_err(|e| e.to_string())?;
+    fn new(robot: Robot, spec: &ArmsSpec) -> Result<Arms, ArmsError> {
+        let shapes = RobotShapes::new(&robot.model, &robot.arms)
+            .map_err(|e| ArmsError::Shapes(e.to_string()))?;
         if spec.rest.len() != robot.arms.len() {
-            return Err(format!(
-                "[world.robot] rest gives {} arm(s), the description has {}",
-                spec.rest.len(),
-                robot.arms.len()
-            ));
+            return Err(ArmsError::RestCount {
+                given: spec.rest.len(),
+                has: robot.arms.len(),
+            });
         }
         for (q, arm) in spec.rest.iter().zip(&robot.arms) {
             if !arm.within_limits(q) {
-                return Err(format!(
-                    "[world.robot] rest: the values for {} are not within its joint limits",
-                    arm.tip
-                ));
+                return Err(ArmsError::RestLimits {
+                    arm: arm.tip.clone(),
+                });
             }
         }
         Ok(Arms {
