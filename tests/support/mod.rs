@@ -15,3 +15,4 @@ pub mod recorded;
 pub mod repo;
 pub mod tmux;
 pub mod verify;
+pub mod workbench;
