@@ -129,6 +129,10 @@ pub const BACK_REFERENCES: &[&str] = &["it", "them", "it's", "its", "they", "tho
 /// Words that send an item to the place named after them.
 pub const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
 
+/// Words that say where an item comes from, not where it goes ("bring the lettuce in
+/// from the cold frame to the bench").
+pub const SOURCES: &[&str] = &["from"];
+
 /// Words of courtesy and time that ask for nothing ("thanks", "right away").
 pub const COURTESY: &[&str] = &[
     "need", "have", "now", "too", "right", "away", "thank", "thanks", "kindly", "over",
@@ -315,6 +319,7 @@ mod tests {
             ("MODALS", plain(MODALS)),
             ("BACK_REFERENCES", plain(BACK_REFERENCES)),
             ("TOWARDS", plain(TOWARDS)),
+            ("SOURCES", plain(SOURCES)),
             ("COURTESY", plain(COURTESY)),
             ("FUNCTION_WORDS", plain(FUNCTION_WORDS)),
             ("ROBOT_WORDS", plain(ROBOT_WORDS)),

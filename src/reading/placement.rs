@@ -8,7 +8,7 @@ use crate::domain::{Atom, Object, Predicate, Vocabulary};
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
-use super::english::{MOVING_VERBS, TOWARDS};
+use super::english::{MOVING_VERBS, SOURCES, TOWARDS};
 use super::words::{every_term, same_word, terms};
 
 use super::polarity::{find_phrase, without_numbering};
@@ -73,7 +73,8 @@ pub(super) fn put_sent(
 
 /// `goal` with each item the request sends to a place moved there from a place the
 /// request never names ("bring yogurt to the bar" read as yogurt on the second bar):
-/// small models pick a place of the same kind, or one of an example.
+/// small models pick a place of the same kind, or one of an example; or from the place
+/// the request says it comes from ("the lettuce in from the cold frame to the bench").
 pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
     let relating = relating(vocabulary);
     let sent = sent(request, vocabulary, &relating);
@@ -82,10 +83,12 @@ pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Op
     }
     let objects: Vec<&Object> = vocabulary.objects.iter().collect();
     let named = named_in(request, &objects);
+    let sources = sources(request, &objects);
     let moved = map_atoms(goal, &|a| {
         let to = match a.args.as_slice() {
             [item, place]
-                if relating.iter().any(|p| p.name == a.predicate) && !named.contains(place) =>
+                if relating.iter().any(|p| p.name == a.predicate)
+                    && (!named.contains(place) || sources.contains(place)) =>
             {
                 // Only an item sent to one place is moved: "chips to table 1 and table 2"
                 // does not say which one the second bar was meant to be.
@@ -297,10 +300,18 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
             let place = place_spans
                 .iter()
                 .find(|(start, _, _)| *start > at && *start <= at + PLACE_WITHIN);
-            let Some((_, _, place)) = place else {
+            let Some((start, _, place)) = place else {
                 sent_unnamed = true;
                 continue;
             };
+            // "In from the cold frame": the place the item comes from; where it goes is
+            // said next.
+            if words[at + 1..*start]
+                .iter()
+                .any(|w| SOURCES.contains(&w.as_str()))
+            {
+                continue;
+            }
             for item in waiting.drain(..) {
                 if item != *place {
                     out.push(Sent {
@@ -308,6 +319,21 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
                         place: place.clone(),
                     });
                 }
+            }
+        }
+    }
+    out
+}
+
+/// The names of the `objects` the request says things come from ("from the cold frame").
+fn sources(request: &str, objects: &[&Object]) -> Vec<String> {
+    let mut out = Vec::new();
+    for clause in without_numbering(request).split(['.', ';', '!', '?', ',']) {
+        let words = every_term(clause);
+        for (start, _, name) in mentions(&words, objects, &[]) {
+            let before = &words[start.saturating_sub(PLACE_WITHIN)..start];
+            if before.iter().any(|w| SOURCES.contains(&w.as_str())) {
+                out.push(name);
             }
         }
     }

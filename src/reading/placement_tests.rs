@@ -277,6 +277,15 @@ fn an_item_at_a_place_the_request_never_names_is_moved_where_it_is_sent() {
         ),
         None
     );
+    // The place it comes from is not where it is sent, and an item left there is moved.
+    assert_eq!(
+        flagged("On_Cup_Table1", "Take the cup in from table 1 to the bar."),
+        Some(("Cup".into(), "Bar".into()))
+    );
+    assert_eq!(
+        moved("On_Cup_Table1", "Take the cup in from table 1 to the bar.").as_deref(),
+        Some("On_Cup_Bar")
+    );
 }
 
 #[test]

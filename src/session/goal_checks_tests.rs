@@ -3,7 +3,8 @@
 use super::*;
 use crate::goal::Formula;
 use crate::reading::names::{
-    factored, renumbered, swapped_back, swapped_object, without_copied, without_unasked,
+    factored, renumbered, swapped_back, swapped_object, understood_object, without_copied,
+    without_unasked,
 };
 use crate::reading::words::same_word;
 use std::path::Path;
@@ -165,6 +166,97 @@ fn a_swapped_object_is_put_back_when_the_word_names_one_thing_of_its_kind() {
         (to.as_str(), goal.to_string().as_str()),
         ("SpringWater", "Holding_SpringWater")
     );
+}
+
+#[test]
+fn an_object_left_to_be_understood_is_the_one_of_its_kind_the_request_names() {
+    let (scenario, _) = cafe();
+    let vocabulary = &scenario.domain.vocabulary;
+    let lexicon = Lexicon::new(vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "Some chips at the bar, or else a dessert.";
+    let (goal, from, to) = understood_object(
+        &g("On_Chips_Bar | On_Dessert_Table2"),
+        request,
+        &lexicon,
+        vocabulary,
+    )
+    .expect("the place the request names");
+    assert_eq!((from.as_str(), to.as_str()), ("Table2", "Bar"));
+    assert_eq!(goal.to_string(), "On_Chips_Bar | On_Dessert_Bar");
+    // Every object named: nothing to understand.
+    assert!(
+        understood_object(
+            &g("On_Chips_Bar | On_Dessert_Bar"),
+            request,
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
+    // Two places named: which one is meant is not plain.
+    assert!(
+        understood_object(
+            &g("On_Chips_Bar | On_Dessert_Table2"),
+            "Some chips at the bar or at table 3, or else a dessert.",
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
+    // A place named by a word its longer name shares with another ("the lounge" of the
+    // lounge area and of the VIP lounge) is named.
+    assert!(
+        understood_object(
+            &g("On_Watermelon_LoungeArea & On_Chips_Bar"),
+            "Put a watermelon at the lounge and chips at the bar.",
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
+    // Two things where the request names one: not one left understood.
+    assert!(
+        understood_object(
+            &g("Active_HallLight | Active_TubeLight"),
+            "Turn on the ceiling lamp or the hall light.",
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
+    // The named place is nowhere in the goal: a swap, not something left understood.
+    assert!(
+        understood_object(
+            &g("On_Dessert_Table2"),
+            "A dessert at the bar.",
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
+}
+
+#[test]
+fn the_empty_hand_is_no_object_a_request_must_name() {
+    let (scenario, world) = cafe();
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let g = |t: &str| Formula::parse(t).expect("parses");
+    let request = "Make sure you are not holding anything.";
+    assert_eq!(
+        unnamed_object(g("Holding_Nothing").atoms(), request, &lexicon),
+        None
+    );
+    // The hand is empty now: a doubt, not a goal refused for an object nobody named.
+    let problem = assess(
+        &scenario,
+        world.as_ref(),
+        &g("Holding_Nothing"),
+        (&[], &lexicon),
+        request,
+    )
+    .expect("it holds already");
+    assert!(problem.is_doubt(), "{problem:?}");
 }
 
 #[test]

@@ -16,6 +16,7 @@ use crate::world::World;
 
 use super::goal_checks::assess;
 use super::interpret::{Interpretation, example_pool, read_goal};
+use super::judge::Judge;
 use super::types::{Event, Options, SessionError};
 
 /// What reading a request part by part came to.
@@ -79,7 +80,6 @@ pub(super) async fn read_parts(
         }
     }
     let goal = joined(parts, read.iter().map(|r| r.answer.goal.clone()).collect());
-    let goal_read = goal.clone();
     let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
     let shown = options.variant.choose(pool, instruction);
@@ -102,6 +102,34 @@ pub(super) async fn read_parts(
         });
         return Ok(PartsRead::Whole { calls });
     }
+    // Each part was judged against its own words; what the whole request says about the
+    // joined goal ("bread at the reading corner, or failing that an apple": the apple's
+    // place is said only in the other part) is judged here.
+    let judge = Judge {
+        scenario,
+        world: world.fork(),
+        instruction,
+        shown,
+        lexicon,
+        misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
+        one_of_several: false,
+    };
+    let (goal, problem) = match undone_whole(&judge, &goal) {
+        Some((undone, why, problem)) => {
+            emit(&Event::CandidateRejected {
+                candidate: goal.to_string(),
+                proposal: None,
+                reason: judge.misread(&goal).unwrap_or_else(|| why.clone()),
+                author: Some("betr, joining the parts' goals".into()),
+            });
+            emit(&Event::Notice {
+                message: format!("read as {undone}: {why}"),
+            });
+            (undone, problem)
+        }
+        None => (goal, problem),
+    };
+    let goal_read = goal.clone();
     let first = read
         .iter()
         .map(|r| r.first.clone())
@@ -124,6 +152,25 @@ pub(super) async fn read_parts(
         doubt: problem.map(|p| p.reason),
         readings: vec![goal_read],
     }))
+}
+
+/// The joined `goal` with what it plainly misread in the whole request undone, when it
+/// has misread it and an undone goal passes every check but doubts and misreads nothing:
+/// that goal, what was undone, and its doubt.
+fn undone_whole(
+    judge: &Judge,
+    goal: &Formula,
+) -> Option<(Formula, String, Option<super::goal_checks::GoalProblem>)> {
+    judge.misread(goal)?;
+    judge
+        .undone_in_turn(goal)
+        .into_iter()
+        .filter_map(|(g, why)| Some((g, why.ok()?)))
+        .find_map(|(g, why)| {
+            let problem = judge.assess(&g);
+            let usable = problem.as_ref().is_none_or(|p| p.is_doubt());
+            (usable && judge.misread(&g).is_none()).then_some((g, why, problem))
+        })
 }
 
 /// The goals of `parts` joined as the parts are: alternatives grouped, the groups
