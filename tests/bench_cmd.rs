@@ -189,6 +189,7 @@ fn ask(engine: &Engine, question: &str) -> betr::llm::local::Generated {
             seed: 0,
             stop: vec!["\n".into()],
             grammar: None,
+            prefill: String::new(),
         })
         .unwrap()
 }

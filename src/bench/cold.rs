@@ -69,6 +69,7 @@ impl GoalPrompt {
             stop: vec!["\n".into()],
             grammar: grammar.then(|| self.gbnf.clone()),
             beams: 1,
+            prefill: String::new(),
         })
     }
 }

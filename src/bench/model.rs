@@ -140,6 +140,7 @@ pub fn betr_speeds(model: &Path, threads: u32, sizes: ModelSizes) -> Result<Spee
                 stop: Vec::new(),
                 grammar: None,
                 beams: 1,
+                prefill: String::new(),
             })
             .map_err(|e| BenchError::Setup(e.to_string()))?;
         let evaluated = g.prompt_tokens.saturating_sub(g.cached_tokens);

@@ -112,6 +112,11 @@ pub struct LlmFlags {
     /// grammar).
     #[arg(long, help_heading = ABLATIONS)]
     pub small_steps: bool,
+    /// With a grammar: write a goal answer's `Goal:` into the prompt for the model to
+    /// continue and let the grammar type only the formula, instead of the grammar typing
+    /// the whole answer.
+    #[arg(long, help_heading = ABLATIONS)]
+    pub goal_prefix_in_prompt: bool,
     /// Ask a numeric parameter's first value as a number, instead of as a level (very low
     /// … very high) of the range the robot can do that betr turns into a number.
     #[arg(long, help_heading = ABLATIONS)]
@@ -247,6 +252,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
             check_goals: !flags.no_checks,
             read_by_parts: !flags.whole_request,
             small_steps: flags.small_steps,
+            goal_prefix_in_prompt: flags.goal_prefix_in_prompt,
             value_levels: !flags.value_as_number,
             shortlist: !flags.no_shortlist,
             without_misreadings: Vec::new(),

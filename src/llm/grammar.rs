@@ -97,6 +97,9 @@ pub fn atom_rules(vocabulary: &Vocabulary, wildcard: bool) -> String {
     out
 }
 
+/// The words a goal's answer begins with.
+pub const GOAL_PREFIX: &str = "Goal:";
+
 /// `Goal: <formula>` with `&`, `|`, `~` and parentheses over the vocabulary's atoms;
 /// with `reasoning`, a free `Reasoning:` line comes first (the chain-of-thought prompt).
 pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) -> String {
@@ -107,6 +110,21 @@ pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) ->
     } else {
         g.push_str("root ::= \"Goal: \" formula\n");
     }
+    g.push_str(&formula_rules(vocabulary, wildcard));
+    g
+}
+
+/// The rest of a goal's answer after [`GOAL_PREFIX`], written for the model: a space and
+/// the formula, as [`goal_grammar`] types it.
+pub fn goal_grammar_after_prefix(vocabulary: &Vocabulary, wildcard: bool) -> String {
+    let mut g = String::from("root ::= \" \" formula\n");
+    g.push_str(&formula_rules(vocabulary, wildcard));
+    g
+}
+
+/// The formula's rules, below the root.
+fn formula_rules(vocabulary: &Vocabulary, wildcard: bool) -> String {
+    let mut g = String::new();
     // One operator per level: `A | B & C` cannot be written, only `A | (B & C)` or
     // `(A | B) & C`, so the model has to decide how the parts group (small models write
     // the first meaning the second) and the reader never needs precedence rules.
@@ -227,6 +245,13 @@ mod tests {
     fn answer_grammars_have_their_prefix() {
         let g = goal_grammar(&vocab(), false, false);
         assert!(g.starts_with("root ::= \"Goal: \" formula"));
+        // Continuing the prefix written for the model: the same formula after a space.
+        let after = goal_grammar_after_prefix(&vocab(), false);
+        assert!(after.starts_with("root ::= \" \" formula\n"), "{after}");
+        assert_eq!(
+            after.split_once('\n').map(|(_, rules)| rules),
+            g.split_once('\n').map(|(_, rules)| rules)
+        );
         // `&` and `|` never share a level: mixing them needs parentheses.
         assert!(
             g.contains("formula ::= factor ( ( \" & \" factor ){1,7} | ( \" | \" factor ){1,3} )?"),

@@ -99,6 +99,12 @@ pub struct ChatRequest {
     /// model); others answer once.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beams: Option<u32>,
+    /// The reply's first words, written by the caller: a backend that can continue an
+    /// answer begun for it (the embedded model) has them after the assistant's header,
+    /// goes on from there and returns them with the rest; others ignore them (the prompt
+    /// asks the model to begin that way).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prefill: Option<String>,
 }
 
 impl ChatRequest {
@@ -111,6 +117,7 @@ impl ChatRequest {
             constraint: None,
             seed: None,
             beams: None,
+            prefill: None,
         }
     }
 }

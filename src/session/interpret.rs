@@ -156,7 +156,14 @@ pub(super) async fn read_goal(
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
-    let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
+    // The answer's `Goal:` written into the prompt for the model to continue, the grammar
+    // typing only the formula (an ablation), or the grammar typing both.
+    let prefill = (options.ablations.goal_prefix_in_prompt && !cot).then_some(grammar::GOAL_PREFIX);
+    let typed = |v: &crate::domain::Vocabulary| match prefill {
+        Some(_) => grammar::goal_grammar_after_prefix(v, true),
+        None => grammar::goal_grammar(v, true, cot),
+    };
+    let goal_grammar = || typed(vocabulary);
     let mut calls = 0;
     // The small step first: the objects the request names type the first answer.
     let mut narrowed: Option<crate::domain::Vocabulary> = None;
@@ -167,7 +174,7 @@ pub(super) async fn read_goal(
         }
     }
     let narrowed_grammar = || match &narrowed {
-        Some(v) => grammar::goal_grammar(v, true, cot),
+        Some(v) => typed(v),
         None => goal_grammar(),
     };
     let mut first: Option<Option<Formula>> = None;
@@ -214,6 +221,7 @@ pub(super) async fn read_goal(
                 (constraint.clone(), typed_by),
                 &opts,
                 seed,
+                prefill,
                 emit,
             )
             .await?;

@@ -46,6 +46,7 @@ pub(super) async fn named_objects(
         (schema::goal(vocabulary), &names_grammar),
         &opts,
         None,
+        None,
         emit,
     )
     .await?;

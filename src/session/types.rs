@@ -97,6 +97,10 @@ pub struct Ablations {
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
     /// evaluation's way to measure what each earns; empty in use.
     pub without_misreadings: Vec<String>,
+    /// With a grammar, write a goal answer's `Goal:` into the prompt for the model to
+    /// continue and type only the formula; off: the grammar types the whole answer,
+    /// `Goal:` included.
+    pub goal_prefix_in_prompt: bool,
 }
 
 impl Default for Ablations {
@@ -108,6 +112,7 @@ impl Default for Ablations {
             value_levels: true,
             shortlist: true,
             without_misreadings: Vec::new(),
+            goal_prefix_in_prompt: false,
         }
     }
 }

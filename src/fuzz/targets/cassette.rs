@@ -94,6 +94,7 @@ fn entry(rng: &mut Rng) -> Entry {
         },
         constraint,
         seed: rng.chance(50).then(|| rng.next_u64()),
+        prefill: rng.chance(20).then(|| text(rng)),
     };
     let model = rng
         .pick(&["gpt-x", "qwen2.5-coder-1.5b", ""])

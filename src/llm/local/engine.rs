@@ -52,6 +52,9 @@ pub struct Generation {
     /// With a grammar and temperature 0: search this many beams for the answers the model
     /// finds most likely as a whole ([`super::beam`]); 0 or 1: one greedy answer.
     pub beams: u32,
+    /// The reply's first words, written after the assistant's header for the model to
+    /// continue; the reply's text (and every ranked answer) begins with them.
+    pub prefill: String,
 }
 
 /// What a generation produced, with its timings.
@@ -270,9 +273,10 @@ fn worker(
                 .map(|(role, content)| LlamaChatMessage::new(role.clone(), content.clone()))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| EngineError::Template(e.to_string()))?;
-            let prompt = model
+            let mut prompt = model
                 .apply_chat_template(&template, &chat, true)
                 .map_err(|e| EngineError::Template(e.to_string()))?;
+            prompt.push_str(&job.prefill);
             // The template already wrote the special tokens; parse them as such.
             let tokens = model.vocab().tokenize(prompt.as_bytes(), false, true);
             if cold && let Some(saved) = states.as_ref().and_then(|s| s.load(&mut ctx, &tokens)) {
@@ -280,7 +284,15 @@ fn worker(
                 cached = saved.tokens;
                 loaded = true;
             }
-            generate(&model, &mut ctx, &mut cached, &tokens, &job)
+            generate(&model, &mut ctx, &mut cached, &tokens, &job).map(|mut g| {
+                if !job.prefill.is_empty() {
+                    g.text.insert_str(0, &job.prefill);
+                    for (text, _) in &mut g.ranked {
+                        text.insert_str(0, &job.prefill);
+                    }
+                }
+                g
+            })
         })();
         let save = match &result {
             Ok(g) => {

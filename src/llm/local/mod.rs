@@ -71,6 +71,7 @@ impl LanguageModel for LocalModel {
                     1
                 },
                 grammar,
+                prefill: request.prefill.clone().unwrap_or_default(),
             };
             let started = Instant::now();
             let out = self
