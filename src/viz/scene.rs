@@ -6,7 +6,7 @@ use rerun::{
     Quaternion, RecordingStream, RecordingStreamResult,
 };
 
-use crate::world::cell::snapshot::{PartShape, PartView, SceneSnapshot};
+use crate::world::cell::snapshot::{PartShape, PartView, RobotView, SceneSnapshot};
 
 /// Entity paths of the scene (also used by the tests).
 pub const SOLIDS: &str = "world/solids";
@@ -154,43 +154,29 @@ fn log_parts(
     Ok(())
 }
 
-/// Log the whole scene at the current time.
+/// Whether a solid is what blocked the last motion (a lid blocks as "NAME lid").
+fn blocks(solid: &str, blocker: Option<&str>) -> bool {
+    blocker.is_some_and(|b| b == solid || b.strip_suffix(" lid") == Some(solid))
+}
+
+/// Log the whole scene at the current time. With real arms the robot is drawn from its
+/// description (`robot.rs`, by the caller) and the boxes stand aside; the solid that
+/// blocked a refused motion is drawn red and labelled so.
 pub fn log_scene(rec: &RecordingStream, scene: &SceneSnapshot) -> RecordingStreamResult<()> {
+    let blocker = scene.motion.as_ref().and_then(|m| m.blocker.as_deref());
     for s in &scene.solids {
         let path = format!("{SOLIDS}/{}", slug(&s.name));
-        log_parts(rec, &path, &s.parts, s.colour, Some(&s.name))?;
+        if blocks(&s.name, blocker) {
+            let label = format!("{} blocks the arm", s.name);
+            log_parts(rec, &path, &s.parts, COLLIDES, Some(&label))?;
+        } else {
+            log_parts(rec, &path, &s.parts, s.colour, Some(&s.name))?;
+        }
     }
     let r = &scene.robot;
-    rec.log(
-        ROBOT_TORSO,
-        &Boxes3D::from_centers_and_half_sizes([r.torso_center], [r.torso_half])
-            .with_colors([colour([200, 200, 205], 255)])
-            .with_fill_mode(FillMode::Solid)
-            .with_labels(["YuMi"]),
-    )?;
-    let strips: Vec<Vec<[f32; 3]>> = r
-        .arms
-        .iter()
-        .map(|a| vec![a.shoulder, a.elbow, a.hand])
-        .collect();
-    rec.log(
-        ROBOT_ARMS,
-        &LineStrips3D::new(strips)
-            .with_colors([colour([90, 90, 100], 255)])
-            .with_radii([0.02]),
-    )?;
-    let joints: Vec<[f32; 3]> = r
-        .arms
-        .iter()
-        .flat_map(|a| [a.shoulder, a.elbow, a.hand])
-        .collect();
-    rec.log(
-        ROBOT_JOINTS,
-        &Points3D::new(joints)
-            .with_colors([colour([60, 60, 70], 255)])
-            .with_radii([0.025]),
-    )?;
-    log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
+    if scene.arms.is_none() {
+        log_robot_boxes(rec, r)?;
+    }
     match &scene.approach {
         Some(a) => {
             let strips: Vec<Vec<[f32; 3]>> =
@@ -221,5 +207,40 @@ pub fn log_scene(rec: &RecordingStream, scene: &SceneSnapshot) -> RecordingStrea
                 .with_fill_mode(FillMode::MajorWireframe),
         )?;
     }
+    Ok(())
+}
+
+/// The robot as boxes and segments, for cells without real arms.
+fn log_robot_boxes(rec: &RecordingStream, r: &RobotView) -> RecordingStreamResult<()> {
+    rec.log(
+        ROBOT_TORSO,
+        &Boxes3D::from_centers_and_half_sizes([r.torso_center], [r.torso_half])
+            .with_colors([colour([200, 200, 205], 255)])
+            .with_fill_mode(FillMode::Solid)
+            .with_labels(["YuMi"]),
+    )?;
+    let strips: Vec<Vec<[f32; 3]>> = r
+        .arms
+        .iter()
+        .map(|a| vec![a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_ARMS,
+        &LineStrips3D::new(strips)
+            .with_colors([colour([90, 90, 100], 255)])
+            .with_radii([0.02]),
+    )?;
+    let joints: Vec<[f32; 3]> = r
+        .arms
+        .iter()
+        .flat_map(|a| [a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_JOINTS,
+        &Points3D::new(joints)
+            .with_colors([colour([60, 60, 70], 255)])
+            .with_radii([0.025]),
+    )?;
+    log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
     Ok(())
 }

@@ -108,8 +108,8 @@ pub struct CellWorld {
     arms: Option<Arc<arms::Arms>>,
     /// The arm motion of the action being started (taken into its progress).
     planned: RefCell<Option<arms::ArmMove>>,
-    /// The last arm motion made (for display only).
-    last_motion: RefCell<Option<arms::ArmMove>>,
+    /// The last arm motion made or refused (for display only).
+    last_motion: RefCell<Option<arms::LastMotion>>,
 }
 
 impl CellWorld {
@@ -175,11 +175,14 @@ impl CellWorld {
         &self.state.arms
     }
 
-    /// The last arm motion a skill made, and the arm's name.
+    /// The last arm motion a skill made (none when the last one was refused), and the
+    /// arm's name.
     pub fn last_motion(&self) -> Option<(String, arms::ArmMove)> {
         let arms = self.arms.as_ref()?;
-        let m = self.last_motion.borrow().clone()?;
-        Some((arms.arm_name(m.arm).to_string(), m))
+        match self.last_motion.borrow().clone()? {
+            arms::LastMotion::Made(m) => Some((arms.arm_name(m.arm).to_string(), m)),
+            arms::LastMotion::Refused { .. } => None,
+        }
     }
 
     /// Exact collision tests (of two convex parts) made so far by this world and all
@@ -449,7 +452,7 @@ impl World for CellWorld {
                 if let Some(q) = self.state.arms.get_mut(m.arm) {
                     q.clone_from(&m.q);
                 }
-                self.last_motion.replace(Some(m));
+                self.last_motion.replace(Some(arms::LastMotion::Made(m)));
             }
         }
         Step::Success

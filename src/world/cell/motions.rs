@@ -94,13 +94,22 @@ impl CellWorld {
             only: motion.carried.and_then(|h| h.arm),
             lets_go: motion.carried.is_some(),
         };
-        match arms.reach(&reach) {
+        let (made, effort) = arms.reach(&reach);
+        let refused = |blocker: Option<String>| {
+            self.last_motion
+                .replace(Some(super::arms::LastMotion::Refused { effort, blocker }));
+        };
+        match made {
             Ok(m) => {
                 self.planned.replace(Some(m));
                 Ok(())
             }
-            Err(super::arms::Refusal::OutOfReach(why)) => Err(SkillFailure::ArmOutOfReach(why)),
-            Err(super::arms::Refusal::NoPath { message, .. }) => {
+            Err(super::arms::Refusal::OutOfReach(why)) => {
+                refused(None);
+                Err(SkillFailure::ArmOutOfReach(why))
+            }
+            Err(super::arms::Refusal::NoPath { message, blocker }) => {
+                refused(blocker);
                 Err(SkillFailure::ArmNoPath { message, predicted })
             }
         }
