@@ -395,6 +395,29 @@ impl Viz {
             Event::Scene { scene } => self.scene(scene),
             Event::WorldChanged { reset: true, .. } => self.log(L::DEBUG, "world reset"),
             Event::WorldChanged { .. } => {}
+            Event::ArmMotion { motion } => {
+                let ms = motion.seconds * 1000.0;
+                match (motion.length, &motion.blocker) {
+                    (Some(length), _) => self.log(
+                        L::INFO,
+                        format!(
+                            "{} moved: joint path {length:.2} rad, planned in {ms:.1} ms, {} attempt(s)",
+                            motion.arm, motion.attempts
+                        ),
+                    ),
+                    (None, blocker) => self.log(
+                        L::WARN,
+                        format!(
+                            "{} found no path{}: {ms:.1} ms, {} attempt(s)",
+                            motion.arm,
+                            blocker
+                                .as_ref()
+                                .map_or(String::new(), |b| format!(", blocked by {b}")),
+                            motion.attempts
+                        ),
+                    ),
+                }
+            }
             Event::Asking { what } => self.log(L::DEBUG, format!("asking the model for {what}")),
             Event::Replied { attribution, .. } => {
                 self.log(L::DEBUG, format!("reply from {attribution}"));

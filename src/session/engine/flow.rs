@@ -288,6 +288,13 @@ impl Engine {
                 reset: false,
             });
         }
+        let motion = crate::world::CellWorld::motion_of(self.exec.as_ref());
+        if motion.is_some() && motion != self.motion {
+            self.motion.clone_from(&motion);
+            if let Some(motion) = motion {
+                self.emit(Event::ArmMotion { motion });
+            }
+        }
         match (record.root, failed) {
             (TickOutcome::Running, _) => {}
             (TickOutcome::Success, _) if !record.completed.is_empty() => {}
