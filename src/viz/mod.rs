@@ -338,6 +338,7 @@ impl Viz {
                 self.next_motion();
             }
             self.arms_drawn = robot::values_now(arms);
+            Self::warn(robot::log_base(&self.rec, arms));
             Self::warn(robot::log_joints(&self.rec, arms, &self.arms_drawn));
             Self::warn(robot::log_gripper_path(&self.rec, arms));
         }

@@ -125,19 +125,23 @@ pub fn log_description(rec: &RecordingStream, view: &ArmsView) -> RecordingStrea
     Ok(())
 }
 
-/// The robot's root in the world and the arms' joints at `values` (per arm, in the order
-/// of [`ArmsView::joints`]).
+/// The robot's root link in the world (hung from the frame of the view's origin).
+pub fn log_base(rec: &RecordingStream, view: &ArmsView) -> RecordingStreamResult<()> {
+    let model = view.model.as_ref();
+    let root = &model.links[model.root].name;
+    rec.log(
+        format!("{}/base", robot_path(model)),
+        &transform(&view.base.cast(), WORLD_FRAME, root),
+    )
+}
+
+/// The arms' joints at `values` (per arm, in the order of [`ArmsView::joints`]).
 pub fn log_joints(
     rec: &RecordingStream,
     view: &ArmsView,
     values: &[Vec<f64>],
 ) -> RecordingStreamResult<()> {
     let model = view.model.as_ref();
-    let root = &model.links[model.root].name;
-    rec.log(
-        format!("{}/base", robot_path(model)),
-        &transform(&view.base.cast(), WORLD_FRAME, root),
-    )?;
     let by_name: HashMap<&str, &crate::robot::Joint> =
         model.joints.iter().map(|j| (j.name.as_str(), j)).collect();
     for (arm, q) in view.joints.iter().zip(values) {

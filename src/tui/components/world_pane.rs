@@ -14,8 +14,8 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 
 use super::super::strings;
-use crate::world::cell::snapshot::MotionView;
 use super::super::theme::Theme;
+use crate::world::cell::snapshot::MotionView;
 
 #[derive(Default)]
 pub struct WorldPane {
