@@ -118,7 +118,7 @@ pub struct ArmMove {
 }
 
 /// What finding a motion took, made or refused.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Effort {
     /// The arm that made the motion, or whose refusal is reported.
     pub arm: usize,
@@ -476,10 +476,11 @@ fn densify(way: &[Vec<f64>], step: f64) -> Vec<Vec<f64>> {
             .map(|(x, y)| (y - x).abs())
             .fold(0.0, f64::max);
         let n = (widest / step).ceil().max(1.0) as usize;
-        for k in 1..=n {
+        for k in 1..n {
             let t = k as f64 / n as f64;
             out.push(a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect());
         }
+        out.push(b.clone());
     }
     out
 }

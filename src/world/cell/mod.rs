@@ -110,6 +110,8 @@ pub struct CellWorld {
     planned: RefCell<Option<arms::ArmMove>>,
     /// The last arm motion made or refused (for display only).
     last_motion: RefCell<Option<arms::LastMotion>>,
+    /// What the arm motions of the action being started took so far.
+    spent: RefCell<arms::Effort>,
 }
 
 impl CellWorld {
@@ -146,6 +148,7 @@ impl CellWorld {
             arms: None,
             planned: RefCell::new(None),
             last_motion: RefCell::new(None),
+            spent: RefCell::new(arms::Effort::default()),
         })
     }
 
@@ -419,8 +422,13 @@ impl World for CellWorld {
         let key = format!("{} {:?}", action.skill, action.args);
         if started || !self.state.progress.contains_key(&key) {
             self.planned.replace(None);
+            self.spent.replace(arms::Effort::default());
+            let before = self.last_motion.borrow().clone();
             match self.start(action) {
                 Ok(effect) => {
+                    // Spots refused on the way to the one the action takes are not its
+                    // motion: that is recorded when the action completes.
+                    self.last_motion.replace(before);
                     let arm = self.planned.take();
                     self.state.progress.insert(
                         key.clone(),

@@ -95,12 +95,21 @@ impl CellWorld {
             lets_go: motion.carried.is_some(),
         };
         let (made, effort) = arms.reach(&reach);
+        // A skill may try several spots: what it took is the sum over all of them.
+        let effort = {
+            let mut spent = self.spent.borrow_mut();
+            spent.arm = effort.arm;
+            spent.attempts += effort.attempts;
+            spent.seconds += effort.seconds;
+            *spent
+        };
         let refused = |blocker: Option<String>| {
             self.last_motion
                 .replace(Some(super::arms::LastMotion::Refused { effort, blocker }));
         };
         match made {
-            Ok(m) => {
+            Ok(mut m) => {
+                m.effort = effort;
                 self.planned.replace(Some(m));
                 Ok(())
             }
