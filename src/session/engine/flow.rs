@@ -377,6 +377,7 @@ impl Engine {
         self.debug.forget_stop();
         self.last = None;
         self.run_ticks = 0;
+        self.motion = None;
         self.facts = self.exec.facts();
         self.emit(Event::WorldChanged {
             facts: self.facts.clone(),

@@ -208,6 +208,7 @@ impl App {
                     self.status.ticks = 0;
                     self.status.ending = None;
                     self.world.last_error = None;
+                    self.world.motion = None;
                     self.tree.clear_statuses();
                 }
             }
