@@ -484,3 +484,38 @@ fn real_arms_are_drawn_from_the_description_and_move_between_ticks() {
             .contains_key("world/robot/yumi/joints/gripper_l_joint")
     );
 }
+
+/// With real arms a grasped solid is drawn in the hand: at the tool of the arm's joint
+/// values once the grasp completes (the arm back above where it grasped), not where it
+/// lay on the table.
+#[test]
+fn a_solid_grasped_by_a_real_arm_is_drawn_in_its_hand() {
+    use crate::domain::ActionCall;
+    use crate::world::Step;
+    crate::robot::tests::yumi_dir();
+    let scenario = scenario1();
+    let mut world = crate::world::load_execution(&scenario, None).unwrap().world;
+    let centre = |scene: &crate::world::cell::snapshot::SceneSnapshot| {
+        let red = scene.solids.iter().find(|s| s.name == "red cube").unwrap();
+        red.parts[0].pose.translation.vector
+    };
+    let lying = centre(&CellWorld::scene_of(world.as_ref()).unwrap());
+    let grasp = ActionCall::parse("grasp \"red cube\"").unwrap();
+    let mut started = true;
+    loop {
+        match world.step(&grasp, started) {
+            Step::Running => started = false,
+            Step::Success => break,
+            Step::Failure(e) => panic!("the grasp failed: {e}"),
+        }
+    }
+    let scene = CellWorld::scene_of(world.as_ref()).unwrap();
+    let held = centre(&scene);
+    let path = scene.arms.unwrap().path.unwrap();
+    let tool = nalgebra::Vector3::from(*path.tool.last().unwrap());
+    assert!(
+        (held - tool).norm() < 0.05,
+        "in the hand: {held:?}, tool at {tool:?}"
+    );
+    assert!(held.z > lying.z + 0.03, "lifted: {held:?} from {lying:?}");
+}

@@ -186,6 +186,26 @@ impl CellWorld {
         })
     }
 
+    /// Where a real arm holds solid `i` now: in the hand, at the tool of the arm's joint
+    /// values (the solid's own pose stays where it was grasped until it is let go).
+    fn held_by_arm(&self, i: usize) -> Option<Pose> {
+        let held = self.state.held.as_ref().filter(|h| h.id == i)?;
+        let arms = self.arms.as_ref()?;
+        let arm = held.arm?;
+        let (chain, q) = (arms.robot.arms.get(arm)?, self.state.arms.get(arm)?);
+        let base = nalgebra::Isometry3::translation(
+            f64::from(self.state.base.x),
+            f64::from(self.state.base.y),
+            0.0,
+        );
+        let tool = (base * chain.fk(q) * arms.tool)
+            .translation
+            .vector
+            .cast::<f32>();
+        let grasped_tool = self.state.poses[i] * held.grip.inverse();
+        Some(Pose::from_parts(Translation3::from(tool), grasped_tool.rotation) * held.grip)
+    }
+
     fn arms_view(&self) -> Option<ArmsView> {
         let arms = self.arms.as_ref()?;
         let joints = arms
@@ -239,7 +259,7 @@ impl CellWorld {
     pub fn scene(&self) -> SceneSnapshot {
         let mut solids = Vec::with_capacity(self.scene.solids.len());
         for (i, s) in self.scene.solids.iter().enumerate() {
-            let pose = self.state.poses[i];
+            let pose = self.held_by_arm(i).unwrap_or(self.state.poses[i]);
             let mut parts: Vec<PartView> = s.body.parts.iter().map(|p| view(&pose, p)).collect();
             if let Some(lid) = &s.lid {
                 let rel = if self.state.lid_open[i] {
