@@ -341,6 +341,8 @@ impl Viz {
             Self::warn(robot::log_base(&self.rec, arms));
             Self::warn(robot::log_joints(&self.rec, arms, &self.arms_drawn));
             Self::warn(robot::log_gripper_path(&self.rec, arms));
+            let blocker = scene.motion.as_ref().and_then(|m| m.blocker.as_deref());
+            Self::warn(robot::log_blocking_link(&self.rec, arms, blocker));
         }
         Self::warn(scene::log_scene(&self.rec, scene));
     }

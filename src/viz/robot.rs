@@ -14,7 +14,7 @@ use std::collections::HashMap;
 
 use nalgebra::{Isometry3, UnitQuaternion};
 use rerun::{
-    Asset3D, Clear, Color, CoordinateFrame, InstancePoses3D, LineStrips3D, Quaternion,
+    Asset3D, Clear, Color, CoordinateFrame, InstancePoses3D, LineStrips3D, Points3D, Quaternion,
     RecordingStream, RecordingStreamResult, Rgba32, Transform3D,
 };
 
@@ -218,5 +218,29 @@ pub fn log_gripper_path(rec: &RecordingStream, view: &ArmsView) -> RecordingStre
                 .with_radii([0.004]),
         ),
         None => rec.log(GRIPPER_PATH, &Clear::flat()),
+    }
+}
+
+/// A link of the robot that blocked the last motion (the arm met the torso or the other
+/// arm): a red mark with a label in the link's frame; nothing otherwise.
+pub fn log_blocking_link(
+    rec: &RecordingStream,
+    view: &ArmsView,
+    blocker: Option<&str>,
+) -> RecordingStreamResult<()> {
+    let model = view.model.as_ref();
+    let entity = format!("{}/blocked_by", robot_path(model));
+    match blocker.filter(|b| model.link(b).is_some()) {
+        Some(link) => {
+            rec.log(entity.as_str(), &CoordinateFrame::new(link))?;
+            rec.log(
+                entity.as_str(),
+                &Points3D::new([[0.0, 0.0, 0.0]])
+                    .with_radii([0.04])
+                    .with_colors([Color::from_unmultiplied_rgba(230, 40, 40, 255)])
+                    .with_labels([format!("{link} blocks the arm")]),
+            )
+        }
+        None => rec.log(entity.as_str(), &Clear::flat()),
     }
 }

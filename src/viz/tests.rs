@@ -519,3 +519,43 @@ fn a_solid_grasped_by_a_real_arm_is_drawn_in_its_hand() {
     );
     assert!(held.z > lying.z + 0.03, "lifted: {held:?} from {lying:?}");
 }
+
+/// A link of the robot that blocked a motion (the torso here) is marked in its own
+/// frame; a solid's name is not a link, and no blocker clears the mark.
+#[test]
+fn a_blocking_link_is_marked_in_its_frame() {
+    crate::robot::tests::yumi_dir();
+    let scenario = scenario1();
+    let world = crate::world::load_execution(&scenario, None).unwrap().world;
+    let mut scene = CellWorld::scene_of(world.as_ref()).unwrap();
+    let arms = scene.arms.clone().expect("real arms");
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    robot::log_blocking_link(&rec, &arms, Some("yumi_body")).unwrap();
+    rec.flush_blocking().unwrap();
+    let logged = decode(storage.take());
+    let mark = &logged.components["world/robot/yumi/blocked_by"];
+    assert!(mark.contains("Points3D:labels"), "{mark:?}");
+    assert!(mark.contains("CoordinateFrame:frame"), "{mark:?}");
+
+    scene.motion = Some(crate::world::cell::snapshot::MotionView {
+        arm: "yumi_link_7_l".into(),
+        length: None,
+        seconds: 0.1,
+        attempts: 2,
+        blocker: Some("red cube".into()),
+    });
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    let mut viz = Viz::with_stream(rec);
+    viz.scene(&scene);
+    viz.stream().flush_blocking().unwrap();
+    let logged = decode(storage.take());
+    let mark = &logged.components["world/robot/yumi/blocked_by"];
+    assert!(
+        !mark.contains("Points3D:labels"),
+        "a solid is no link: {mark:?}"
+    );
+    assert!(
+        logged.components["world/solids/red_cube"].contains("Boxes3D:labels"),
+        "the solid is marked instead"
+    );
+}
