@@ -226,6 +226,21 @@ fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
         );
         assert!(listing.contains(&mesh), "{mesh} not in:\n{listing}");
     }
+    // The URDF itself, as text (the CLI prints only its first lines).
+    let data = rerun_rrd(&["print".as_ref(), "-vvv".as_ref(), rrd.as_os_str()]);
+    let data = String::from_utf8_lossy(&data.stdout);
+    let urdf = data
+        .split("Chunk(")
+        .find(|c| {
+            c.lines()
+                .next()
+                .is_some_and(|h| h.contains(" - /robot_description - "))
+        })
+        .unwrap_or_default();
+    assert!(
+        urdf.contains("component: TextDocument:text") && urdf.contains("<?xml version=\"1.0\""),
+        "no URDF text: {urdf}"
+    );
     assert!(
         !listing.contains("/world/robot/torso"),
         "no boxes for a robot drawn from its meshes"

@@ -15,7 +15,7 @@ use std::collections::HashMap;
 use nalgebra::{Isometry3, UnitQuaternion};
 use rerun::{
     Asset3D, Clear, Color, CoordinateFrame, InstancePoses3D, LineStrips3D, Points3D, Quaternion,
-    RecordingStream, RecordingStreamResult, Rgba32, Transform3D,
+    RecordingStream, RecordingStreamResult, Rgba32, TextDocument, Transform3D,
 };
 
 use crate::robot::{Geometry, JointKind, Model};
@@ -25,6 +25,9 @@ use crate::world::cell::snapshot::ArmsView;
 pub const ROBOT_ROOT: &str = "world/robot";
 /// The tool's way through the last motion.
 pub const GRIPPER_PATH: &str = "world/robot/gripper_path";
+/// The URDF the robot was drawn from, as text (where ROS keeps it too); outside `world`,
+/// so the 3D view does not try to draw it.
+pub const ROBOT_DESCRIPTION: &str = "robot_description";
 /// The frame of the 3D view's origin entity (`world`), which the robot's root link
 /// hangs from.
 pub const WORLD_FRAME: &str = "tf#/world";
@@ -52,10 +55,16 @@ fn transform(pose: &Isometry3<f64>, parent: &str, child: &str) -> Transform3D {
     .with_child_frame(child)
 }
 
-/// The static part: the root's frame, every link's meshes in its frame, and the joints
-/// no arm moves (fixed ones, and the fingers at their resting value).
+/// The static part: the URDF's text, the root's frame, every link's meshes in its frame,
+/// and the joints no arm moves (fixed ones, and the fingers at their resting value).
 pub fn log_description(rec: &RecordingStream, view: &ArmsView) -> RecordingStreamResult<()> {
     let model = view.model.as_ref();
+    match std::fs::read_to_string(&model.file) {
+        Ok(urdf) => rec.log_static(ROBOT_DESCRIPTION, &TextDocument::new(urdf))?,
+        Err(e) => {
+            tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
+        }
+    }
     let root = &model.links[model.root].name;
     rec.log_static(robot_path(model), &CoordinateFrame::new(root.as_str()))?;
     for link in &model.links {
