@@ -134,6 +134,8 @@ pub struct Viz {
     robot_drawn: bool,
     /// The arms' joint values last drawn, per arm.
     arms_drawn: Vec<Vec<f64>>,
+    /// The solids last drawn (what a motion since picked up or let go is found in them).
+    solids_drawn: Vec<crate::world::cell::snapshot::SolidView>,
     /// An approval opened the current step: the repair and its new tree join it.
     repairing: bool,
     notice: Option<String>,
@@ -232,6 +234,7 @@ impl Viz {
             motion: 0,
             robot_drawn: false,
             arms_drawn: Vec::new(),
+            solids_drawn: Vec::new(),
             repairing: false,
             notice: None,
             web_url: None,
@@ -330,9 +333,13 @@ impl Viz {
             }
             let between = robot::sub_steps(arms, &self.arms_drawn);
             let moved = !between.is_empty();
-            for values in between {
+            let carried = scene::Carried::between(&self.solids_drawn, &scene.solids);
+            for (index, values) in between {
                 self.next_motion();
                 Self::warn(robot::log_joints(&self.rec, arms, &values));
+                if let (Some(c), Some(path)) = (&carried, &arms.path) {
+                    Self::warn(scene::log_carried(&self.rec, c, path, index));
+                }
             }
             if moved {
                 self.next_motion();
@@ -345,6 +352,9 @@ impl Viz {
             Self::warn(robot::log_blocking_link(&self.rec, arms, blocker));
         }
         Self::warn(scene::log_scene(&self.rec, scene));
+        if scene.arms.is_some() {
+            self.solids_drawn.clone_from(&scene.solids);
+        }
     }
 
     /// A line in the event log.

@@ -182,10 +182,10 @@ pub fn values_now(view: &ArmsView) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// The configurations to draw between `before` (the arms' values last drawn) and now:
-/// the last motion's way when it starts where the arm was and ends where it is now (the
-/// motion happened since), else none.
-pub fn sub_steps(view: &ArmsView, before: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
+/// The configurations to draw between `before` (the arms' values last drawn) and now,
+/// each with its index on the last motion's way: that way when it starts where the arm
+/// was and ends where it is now (the motion happened since), else none.
+pub fn sub_steps(view: &ArmsView, before: &[Vec<f64>]) -> Vec<(usize, Vec<Vec<f64>>)> {
     let Some(path) = &view.path else {
         return Vec::new();
     };
@@ -207,12 +207,13 @@ pub fn sub_steps(view: &ArmsView, before: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
     let every = path.joints.len().div_ceil(MOST_SUB_STEPS).max(1);
     path.joints
         .iter()
+        .enumerate()
         .step_by(every)
         .skip(1)
-        .map(|q| {
+        .map(|(index, q)| {
             let mut values = now.clone();
             values[path.arm].clone_from(q);
-            values
+            (index, values)
         })
         .collect()
 }

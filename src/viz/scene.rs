@@ -6,7 +6,9 @@ use rerun::{
     Quaternion, RecordingStream, RecordingStreamResult,
 };
 
-use crate::world::cell::snapshot::{PartShape, PartView, RobotView, SceneSnapshot};
+use crate::world::cell::snapshot::{
+    ArmPathView, PartShape, PartView, RobotView, SceneSnapshot, SolidView,
+};
 
 /// Entity paths of the scene (also used by the tests).
 pub const SOLIDS: &str = "world/solids";
@@ -243,4 +245,74 @@ fn log_robot_boxes(rec: &RecordingStream, r: &RobotView) -> RecordingStreamResul
     )?;
     log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
     Ok(())
+}
+
+/// A solid the last motion picked up or let go: as it was before the motion and as it is
+/// after it.
+pub struct Carried {
+    pub before: SolidView,
+    pub after: SolidView,
+    /// Picked up (held after the motion), else let go (held before it).
+    pub grasped: bool,
+}
+
+impl Carried {
+    /// The solid whose holding changed from `before` to `after`, if one did.
+    pub fn between(before: &[SolidView], after: &[SolidView]) -> Option<Carried> {
+        before
+            .iter()
+            .zip(after)
+            .find(|(b, a)| b.name == a.name && b.held != a.held)
+            .map(|(b, a)| Carried {
+                before: b.clone(),
+                after: a.clone(),
+                grasped: a.held,
+            })
+    }
+}
+
+/// `parts` moved by `by` (world).
+fn shifted(parts: &[PartView], by: &Vector3<f32>) -> Vec<PartView> {
+    parts
+        .iter()
+        .map(|p| {
+            let mut moved = p.clone();
+            moved.pose.translation.vector += by;
+            if let PartShape::Capsule { a, b, .. } = &mut moved.shape {
+                *a = (Vector3::from(*a) + by).into();
+                *b = (Vector3::from(*b) + by).into();
+            }
+            moved
+        })
+        .collect()
+}
+
+/// The carried solid at configuration `index` of the way the arm went: in the hand
+/// after the fingers close (at `path.acts_at`) for a grasp, up to where they open for a
+/// release, else where it lies.
+pub fn log_carried(
+    rec: &RecordingStream,
+    carried: &Carried,
+    path: &ArmPathView,
+    index: usize,
+) -> RecordingStreamResult<()> {
+    let tool = &path.tool;
+    let (Some(at), Some(first), Some(last)) = (tool.get(index), tool.first(), tool.last()) else {
+        return Ok(());
+    };
+    let at = Vector3::from(*at);
+    let parts = match (carried.grasped, index > path.acts_at) {
+        (true, true) => shifted(&carried.after.parts, &(at - Vector3::from(*last))),
+        (true, false) => carried.before.parts.clone(),
+        (false, false) => shifted(&carried.before.parts, &(at - Vector3::from(*first))),
+        (false, true) => carried.after.parts.clone(),
+    };
+    let s = &carried.after;
+    log_parts(
+        rec,
+        &format!("{SOLIDS}/{}", slug(&s.name)),
+        &parts,
+        s.colour,
+        Some(&s.name),
+    )
 }

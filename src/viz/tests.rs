@@ -477,6 +477,14 @@ fn real_arms_are_drawn_from_the_description_and_move_between_ticks() {
         motions > 5 * steps,
         "{motions} motion values for {steps} steps"
     );
+    // The red cube the arm picks up and puts on the table is drawn along the way too.
+    let cube = "world/solids/red_cube";
+    assert!(
+        logged.motions[cube].len() > 2 * logged.steps[cube].len(),
+        "{} motion values, {} steps",
+        logged.motions[cube].len(),
+        logged.steps[cube].len()
+    );
     // The fingers and fixed joints are static: not on any timeline.
     assert!(
         !logged

@@ -114,6 +114,8 @@ pub struct ArmMove {
     pub path: Vec<Vec<f64>>,
     /// The tool centre point (world) at each configuration of `path`.
     pub tool: Vec<[f32; 3]>,
+    /// Where on `path` the fingers close or open (the bottom of the approach).
+    pub acts_at: usize,
     pub effort: Effort,
 }
 
@@ -423,6 +425,7 @@ impl Arms {
             checks: path.checks,
             path: Vec::new(),
             tool: Vec::new(),
+            acts_at: 0,
             effort: Effort {
                 arm,
                 attempts: 0,
@@ -450,6 +453,12 @@ impl Arms {
             way.extend(back.waypoints.into_iter().skip(1));
         }
         done.path = densify(&way, DRAW_STEP);
+        // Densifying keeps every configuration of the way as it is: the bottom of the
+        // approach is found again exactly.
+        done.acts_at = line
+            .first()
+            .and_then(|bottom| done.path.iter().position(|q| q == bottom))
+            .unwrap_or_default();
         done.tool = done
             .path
             .iter()

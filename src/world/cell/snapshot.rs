@@ -119,6 +119,8 @@ pub struct ArmPathView {
     pub joints: Vec<Vec<f64>>,
     /// The tool centre point (world) at each of them.
     pub tool: Vec<[f32; 3]>,
+    /// Where on the way the fingers close or open.
+    pub acts_at: usize,
 }
 
 /// The last motion asked of the arms: which arm, what finding it took, and its length or
@@ -227,6 +229,7 @@ impl CellWorld {
                 arm: m.arm,
                 joints: m.path.clone(),
                 tool: m.tool.clone(),
+                acts_at: m.acts_at,
             }),
             _ => None,
         };
