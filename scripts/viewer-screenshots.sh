@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Screenshots of the 3D view for the README: rerun's web viewer (`rerun --serve-web`,
-# rerun-sdk 0.36.3 in target/viewer-venv) fed by the real `betr` through `--viewer web`,
+# Screenshots of the 3D view for the README: rerun's web viewer (`rerun --serve-web FILE`,
+# rerun-sdk 0.36.3 in target/viewer-venv) serving what the real `betr` recorded (`--rrd`),
 # rendered in headless Chromium (Debian's `chromium`, software WebGL) and captured through
 # the DevTools protocol (scripts/viewer_screenshot.py) into docs/images/:
 #   viewer-failure.png   scenario 1's planned tree run: the grasp of the blue cube fails,
-#                        its way down red where the red cube is in it
+#                        its way down red where the red cube is in it (with the YuMi's
+#                        description cached: the robot's meshes, the red cube that blocks
+#                        the arm drawn red)
 #   viewer-repaired.png  the same tree repaired with the fix, run to success
 # Usage: bash scripts/viewer-screenshots.sh   (installs chromium with apt when missing;
-#        BETR=path/to/betr uses that binary instead of building one)
+#        BETR=path/to/betr uses that binary instead of building one; the viewer listens
+#        on VIEWER_GRPC_PORT and VIEWER_PAGE_PORT, 9931 and 9932 unless set)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -49,9 +52,13 @@ stop_viewer() {
 }
 trap 'stop_viewer; rm -rf "$work"' EXIT
 
-for port in 9876 9090; do
+# The recording is served by a viewer of its own on ports no live session streams to
+# (betr's `--viewer web` uses 9876 and 9090, where another session's stream would mix in).
+grpc_port="${VIEWER_GRPC_PORT:-9931}"
+page_port="${VIEWER_PAGE_PORT:-9932}"
+for port in "$grpc_port" "$page_port"; do
   if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
-    echo "error: port $port is taken; betr's web viewer listens on 9876 (gRPC) and 9090 (page)" >&2
+    echo "error: port $port is taken; set VIEWER_GRPC_PORT and VIEWER_PAGE_PORT to free ones" >&2
     exit 2
   fi
 done
@@ -59,25 +66,26 @@ done
 scenario="$PWD/scenarios/cell/red_on_blue.toml"
 fix='~"any object" on "blue cube"'
 
-# One capture: a fresh web viewer (started here, so it is stopped here; betr finds it
-# listening and streams to it), the session, then the page once it has drawn.
+# One capture: the session recorded to an .rrd, a fresh web viewer serving it (started
+# here, so it is stopped here), then the page once it has drawn.
 capture() {
   local png="$1"
   shift
-  PATH="$venv/bin:$PATH" setsid rerun --serve-web --port 9876 --web-viewer-port 9090 >"$work/rerun.log" 2>&1 &
-  viewer=$!
-  for _ in $(seq 100); do
-    (exec 3<>/dev/tcp/127.0.0.1/9090) 2>/dev/null && break
-    sleep 0.2
-  done
-  (cd "$work" && PATH="$venv/bin:$PATH" "$betr" "$@" --viewer web >"$work/betr.out" 2>"$work/betr.err") || true
-  local url
-  url="$(sed -n 's/^3D view: open //p' "$work/betr.err")"
-  if [ -z "$url" ]; then
-    echo "error: betr printed no web viewer address:" >&2
+  local rrd="$work/${png%.png}.rrd"
+  (cd "$work" && "$betr" "$@" --rrd "$rrd" >"$work/betr.out" 2>"$work/betr.err") || true
+  if [ ! -s "$rrd" ]; then
+    echo "error: betr wrote no recording:" >&2
     cat "$work/betr.err" >&2
     exit 1
   fi
+  PATH="$venv/bin:$PATH" setsid rerun --serve-web "$rrd" --port "$grpc_port" \
+    --web-viewer-port "$page_port" >"$work/rerun.log" 2>&1 &
+  viewer=$!
+  for _ in $(seq 100); do
+    (exec 3<>"/dev/tcp/127.0.0.1/$page_port") 2>/dev/null && break
+    sleep 0.2
+  done
+  local url="http://127.0.0.1:$page_port/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A$grpc_port%2Fproxy"
   "$venv/bin/python" scripts/viewer_screenshot.py "$url" "$out/$png" --wait 30 --size 1920x1080
   stop_viewer
   echo "$out/$png" >&2

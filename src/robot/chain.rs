@@ -92,13 +92,7 @@ impl Chain {
         let mut stack = vec![(tip_index, pending)];
         while let Some((link, at)) = stack.pop() {
             for j in model.child_joints(link) {
-                let value = if j.kind == JointKind::Fixed {
-                    0.0
-                } else {
-                    j.lower.max(0.0).min(j.upper)
-                };
-                let offset =
-                    at * j.origin * joint_motion(&j.axis, j.kind != JointKind::Prismatic, value);
+                let offset = at * j.transform_at(j.resting_value());
                 carried.push(Carried {
                     link: j.child,
                     joint: Some(last),
@@ -162,7 +156,7 @@ impl Chain {
 }
 
 /// The motion of a joint at `value`: a rotation about `axis` or a translation along it.
-fn joint_motion(axis: &Unit<Vector3<f64>>, rotates: bool, value: f64) -> Isometry3<f64> {
+pub(super) fn joint_motion(axis: &Unit<Vector3<f64>>, rotates: bool, value: f64) -> Isometry3<f64> {
     if rotates {
         Isometry3::from_parts(
             Translation3::identity(),

@@ -63,6 +63,49 @@ fn the_yumi_has_two_seven_axis_arms_with_their_limits() {
     }
 }
 
+/// What a viewer composes from the joints' transforms (each joint's `transform_at` from
+/// its parent link's frame to its child's, root first) is where forward kinematics puts
+/// the flange; the links' colours come from their visual materials.
+#[test]
+fn joint_transforms_compose_to_the_flange_and_links_keep_their_colours() {
+    let robot = yumi();
+    let model = &robot.model;
+    for arm in &robot.arms {
+        let q: Vec<f64> = arm
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| j.lower + (j.upper - j.lower) * (0.2 + 0.08 * i as f64))
+            .collect();
+        let tip = model.link(&arm.tip).unwrap();
+        let mut at = nalgebra::Isometry3::identity();
+        for joint in model.path_to(tip) {
+            let value = arm
+                .joints
+                .iter()
+                .position(|j| j.name == joint.name)
+                .map_or(joint.resting_value(), |i| q[i]);
+            at *= joint.transform_at(value);
+        }
+        let fk = arm.fk(&q);
+        assert!(
+            (at.translation.vector - fk.translation.vector).norm() < 1e-9,
+            "{}: {at} vs {fk}",
+            arm.tip
+        );
+        assert!(at.rotation.angle_to(&fk.rotation) < 1e-9, "{}", arm.tip);
+    }
+    let colour = |link: &str| {
+        model.links[model.link(link).unwrap()]
+            .visuals
+            .first()
+            .and_then(|v| v.colour)
+    };
+    // Light_Grey and Grey, as yumi.urdf gives them.
+    assert_eq!(colour("yumi_body"), Some([0.8, 0.8, 0.8, 1.0]));
+    assert_eq!(colour("gripper_l_finger_r"), Some([0.5, 0.5, 0.5, 1.0]));
+}
+
 #[derive(serde::Deserialize)]
 struct Fixture {
     arms: Vec<FixtureArm>,

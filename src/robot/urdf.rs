@@ -36,6 +36,9 @@ pub enum Geometry {
 pub struct Element {
     pub origin: Isometry3<f64>,
     pub geometry: Geometry,
+    /// Linear RGBA from the element's material, its own or one the URDF defines by name
+    /// (visual elements only).
+    pub colour: Option<[f32; 4]>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -121,10 +124,13 @@ impl Model {
             if links.iter().any(|l: &Link| l.name == link.name) {
                 return Err(bad(format!("link \"{}\" is defined twice", link.name)));
             }
-            let element = |origin: &urdf_rs::Pose, geometry: &urdf_rs::Geometry| {
+            let element = |origin: &urdf_rs::Pose,
+                           geometry: &urdf_rs::Geometry,
+                           material: Option<&urdf_rs::Material>| {
                 Ok::<_, RobotError>(Element {
                     origin: pose(origin),
                     geometry: geometry_of(geometry, file, &link.name, packages)?,
+                    colour: material.and_then(|m| colour_of(m, &robot.materials)),
                 })
             };
             links.push(Link {
@@ -132,12 +138,12 @@ impl Model {
                 visuals: link
                     .visual
                     .iter()
-                    .map(|v| element(&v.origin, &v.geometry))
+                    .map(|v| element(&v.origin, &v.geometry, v.material.as_ref()))
                     .collect::<Result<_, _>>()?,
                 collisions: link
                     .collision
                     .iter()
-                    .map(|c| element(&c.origin, &c.geometry))
+                    .map(|c| element(&c.origin, &c.geometry, None))
                     .collect::<Result<_, _>>()?,
             });
         }
@@ -248,6 +254,41 @@ impl Model {
     pub fn child_joints(&self, link: usize) -> impl Iterator<Item = &Joint> {
         self.joints.iter().filter(move |j| j.parent == link)
     }
+}
+
+impl Joint {
+    /// The value a joint takes when nothing moves it: 0, or the nearest limit when 0 is
+    /// outside them.
+    pub fn resting_value(&self) -> f64 {
+        match self.kind {
+            JointKind::Fixed => 0.0,
+            _ => self.lower.max(0.0).min(self.upper),
+        }
+    }
+
+    /// The child link's frame in the parent's at joint value `value`.
+    pub fn transform_at(&self, value: f64) -> Isometry3<f64> {
+        match self.kind {
+            JointKind::Fixed => self.origin,
+            JointKind::Revolute | JointKind::Continuous => {
+                self.origin * super::chain::joint_motion(&self.axis, true, value)
+            }
+            JointKind::Prismatic => {
+                self.origin * super::chain::joint_motion(&self.axis, false, value)
+            }
+        }
+    }
+}
+
+/// A material's colour: its own, else that of the URDF's material of the same name.
+fn colour_of(material: &urdf_rs::Material, defined: &[urdf_rs::Material]) -> Option<[f32; 4]> {
+    let rgba = |m: &urdf_rs::Material| m.color.as_ref().map(|c| c.rgba.0.map(|v| v as f32));
+    rgba(material).or_else(|| {
+        defined
+            .iter()
+            .find(|d| d.name == material.name)
+            .and_then(rgba)
+    })
 }
 
 /// A URDF `<origin xyz rpy>` (roll about x, then pitch about y, then yaw about z, all

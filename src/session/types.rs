@@ -13,7 +13,7 @@ use crate::llm::usage::UsageTotals;
 use crate::planner::RepairError;
 use crate::scenario::ScenarioError;
 use crate::verify::Report;
-use crate::world::cell::snapshot::SceneSnapshot;
+use crate::world::cell::snapshot::{MotionView, SceneSnapshot};
 
 /// Why a session has no language model (it still plans, ticks and takes the conditions a
 /// person types).
@@ -353,6 +353,11 @@ pub enum Event {
     /// `Setup::scenes`, and only for cell worlds).
     Scene {
         scene: Arc<SceneSnapshot>,
+    },
+    /// A real arm of the execution cell moved, or found no way to: the last motion, after
+    /// the tick that asked for it.
+    ArmMotion {
+        motion: MotionView,
     },
     /// The execution world changed (a tick moved something, or it was reset).
     WorldChanged {

@@ -92,6 +92,31 @@ pub const NOW_TRUE: &str = "True now:";
 pub const MADE_TRUE: &str = "+ ";
 pub const MADE_FALSE: &str = "- ";
 pub const VALUE_SET: &str = "value set:";
+pub const LAST_MOTION: &str = "last motion:";
+
+/// The last motion of a real arm in one line: the arm, the joint path's length or what
+/// blocked it, how long finding it took and in how many attempts.
+pub fn last_motion(m: &crate::world::cell::snapshot::MotionView) -> String {
+    let attempts = match m.attempts {
+        1 => "1 attempt".to_string(),
+        n => format!("{n} attempts"),
+    };
+    let ms = m.seconds * 1000.0;
+    match (m.length, &m.blocker) {
+        (Some(length), _) => format!(
+            "{LAST_MOTION} {} moved, joint path {length:.2} rad, planned in {ms:.1} ms, {attempts}",
+            m.arm
+        ),
+        (None, Some(blocker)) => format!(
+            "{LAST_MOTION} {} found no path, blocked by {blocker}, {ms:.1} ms, {attempts}",
+            m.arm
+        ),
+        (None, None) => format!(
+            "{LAST_MOTION} {} found no path (out of reach), {ms:.1} ms, {attempts}",
+            m.arm
+        ),
+    }
+}
 pub const FILTER_TITLE: &str = " Show the facts holding (Enter filters, empty: all) ";
 
 /// The objects when their names do not fit on a line.

@@ -8,11 +8,14 @@
 //! the whole session, one step per tick and one for each moment of the resolve loop (the
 //! failure, the question to the model, the proposal, the approval and repair, a new
 //! tree), so each has its own frame; `tick` is the tick number the workbench shows (a run
-//! after a repair starts again at 1). Each tick logs the tree's statuses and the scene
-//! after that tick. Logging never stops a session: a failed log call is traced and
+//! after a repair starts again at 1); `motion` counts the steps and, between two, the
+//! configurations an arm of the robot went through, so scrubbing it shows the arm moving
+//! along its planned path. Each tick logs the tree's statuses and the scene after that
+//! tick; with real arms the robot is drawn from its description (`robot.rs`). Logging never stops a session: a failed log call is traced and
 //! ignored, and a viewer that is not listening is reported once in [`Viz::notice`].
 
 pub mod blueprint;
+pub mod robot;
 pub mod scene;
 #[cfg(test)]
 mod tests;
@@ -38,6 +41,9 @@ pub const APP_ID: &str = "betr";
 pub const TIMELINE: &str = "tick";
 /// The timeline of the session's steps: every tick and every moment of the resolve loop.
 pub const STEPS: &str = "step";
+/// The timeline of the steps and, between two, the configurations a moving arm goes
+/// through.
+pub const MOTION: &str = "motion";
 /// Entity path of the event log.
 pub const EVENTS: &str = "events";
 /// What the session says when no viewer listens.
@@ -122,6 +128,14 @@ pub struct Viz {
     step: i64,
     /// Ticks logged so far.
     ticks: i64,
+    /// The `motion` timeline's last value.
+    motion: i64,
+    /// The robot's description is in the recording.
+    robot_drawn: bool,
+    /// The arms' joint values last drawn, per arm.
+    arms_drawn: Vec<Vec<f64>>,
+    /// The solids last drawn (what a motion since picked up or let go is found in them).
+    solids_drawn: Vec<crate::world::cell::snapshot::SolidView>,
     /// An approval opened the current step: the repair and its new tree join it.
     repairing: bool,
     notice: Option<String>,
@@ -210,12 +224,17 @@ impl Viz {
         if rec.is_enabled() {
             rec.set_time_sequence(STEPS, 0);
             rec.set_time_sequence(TIMELINE, 0);
+            rec.set_time_sequence(MOTION, 0);
         }
         Viz {
             rec,
             tree: None,
             step: 0,
             ticks: 0,
+            motion: 0,
+            robot_drawn: false,
+            arms_drawn: Vec::new(),
+            solids_drawn: Vec::new(),
             repairing: false,
             notice: None,
             web_url: None,
@@ -238,6 +257,15 @@ impl Viz {
         self.step += 1;
         if self.rec.is_enabled() {
             self.rec.set_time_sequence(STEPS, self.step);
+        }
+        self.next_motion();
+    }
+
+    /// The next value of the `motion` timeline.
+    fn next_motion(&mut self) {
+        self.motion += 1;
+        if self.rec.is_enabled() {
+            self.rec.set_time_sequence(MOTION, self.motion);
         }
     }
 
@@ -291,12 +319,42 @@ impl Viz {
         }
     }
 
-    /// The scene at the current step.
+    /// The scene at the current step. With real arms: the robot's description the first
+    /// time, then the way an arm went since the last scene (each configuration a value of
+    /// the `motion` timeline) and the joints now.
     pub fn scene(&mut self, scene: &SceneSnapshot) {
         if !self.rec.is_enabled() {
             return;
         }
+        if let Some(arms) = &scene.arms {
+            if !self.robot_drawn {
+                Self::warn(robot::log_description(&self.rec, arms));
+                self.robot_drawn = true;
+            }
+            let between = robot::sub_steps(arms, &self.arms_drawn);
+            let moved = !between.is_empty();
+            let carried = scene::Carried::between(&self.solids_drawn, &scene.solids);
+            for (index, values) in between {
+                self.next_motion();
+                Self::warn(robot::log_joints(&self.rec, arms, &values));
+                if let (Some(c), Some(path)) = (&carried, &arms.path) {
+                    Self::warn(scene::log_carried(&self.rec, c, path, index));
+                }
+            }
+            if moved {
+                self.next_motion();
+            }
+            self.arms_drawn = robot::values_now(arms);
+            Self::warn(robot::log_base(&self.rec, arms));
+            Self::warn(robot::log_joints(&self.rec, arms, &self.arms_drawn));
+            Self::warn(robot::log_gripper_path(&self.rec, arms));
+            let blocker = scene.motion.as_ref().and_then(|m| m.blocker.as_deref());
+            Self::warn(robot::log_blocking_link(&self.rec, arms, blocker));
+        }
         Self::warn(scene::log_scene(&self.rec, scene));
+        if scene.arms.is_some() {
+            self.solids_drawn.clone_from(&scene.solids);
+        }
     }
 
     /// A line in the event log.
@@ -350,6 +408,29 @@ impl Viz {
             Event::Scene { scene } => self.scene(scene),
             Event::WorldChanged { reset: true, .. } => self.log(L::DEBUG, "world reset"),
             Event::WorldChanged { .. } => {}
+            Event::ArmMotion { motion } => {
+                let ms = motion.seconds * 1000.0;
+                match (motion.length, &motion.blocker) {
+                    (Some(length), _) => self.log(
+                        L::INFO,
+                        format!(
+                            "{} moved: joint path {length:.2} rad, planned in {ms:.1} ms, {} attempt(s)",
+                            motion.arm, motion.attempts
+                        ),
+                    ),
+                    (None, blocker) => self.log(
+                        L::WARN,
+                        format!(
+                            "{} found no path{}: {ms:.1} ms, {} attempt(s)",
+                            motion.arm,
+                            blocker
+                                .as_ref()
+                                .map_or(String::new(), |b| format!(", blocked by {b}")),
+                            motion.attempts
+                        ),
+                    ),
+                }
+            }
             Event::Asking { what } => self.log(L::DEBUG, format!("asking the model for {what}")),
             Event::Replied { attribution, .. } => {
                 self.log(L::DEBUG, format!("reply from {attribution}"));

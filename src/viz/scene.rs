@@ -6,7 +6,9 @@ use rerun::{
     Quaternion, RecordingStream, RecordingStreamResult,
 };
 
-use crate::world::cell::snapshot::{PartShape, PartView, SceneSnapshot};
+use crate::world::cell::snapshot::{
+    ArmPathView, PartShape, PartView, RobotView, SceneSnapshot, SolidView,
+};
 
 /// Entity paths of the scene (also used by the tests).
 pub const SOLIDS: &str = "world/solids";
@@ -154,43 +156,29 @@ fn log_parts(
     Ok(())
 }
 
-/// Log the whole scene at the current time.
+/// Whether a solid is what blocked the last motion (a lid blocks as "NAME lid").
+fn blocks(solid: &str, blocker: Option<&str>) -> bool {
+    blocker.is_some_and(|b| b == solid || b.strip_suffix(" lid") == Some(solid))
+}
+
+/// Log the whole scene at the current time. With real arms the robot is drawn from its
+/// description (`robot.rs`, by the caller) and the boxes stand aside; the solid that
+/// blocked a refused motion is drawn red and labelled so.
 pub fn log_scene(rec: &RecordingStream, scene: &SceneSnapshot) -> RecordingStreamResult<()> {
+    let blocker = scene.motion.as_ref().and_then(|m| m.blocker.as_deref());
     for s in &scene.solids {
         let path = format!("{SOLIDS}/{}", slug(&s.name));
-        log_parts(rec, &path, &s.parts, s.colour, Some(&s.name))?;
+        if blocks(&s.name, blocker) {
+            let label = format!("{} blocks the arm", s.name);
+            log_parts(rec, &path, &s.parts, COLLIDES, Some(&label))?;
+        } else {
+            log_parts(rec, &path, &s.parts, s.colour, Some(&s.name))?;
+        }
     }
     let r = &scene.robot;
-    rec.log(
-        ROBOT_TORSO,
-        &Boxes3D::from_centers_and_half_sizes([r.torso_center], [r.torso_half])
-            .with_colors([colour([200, 200, 205], 255)])
-            .with_fill_mode(FillMode::Solid)
-            .with_labels(["YuMi"]),
-    )?;
-    let strips: Vec<Vec<[f32; 3]>> = r
-        .arms
-        .iter()
-        .map(|a| vec![a.shoulder, a.elbow, a.hand])
-        .collect();
-    rec.log(
-        ROBOT_ARMS,
-        &LineStrips3D::new(strips)
-            .with_colors([colour([90, 90, 100], 255)])
-            .with_radii([0.02]),
-    )?;
-    let joints: Vec<[f32; 3]> = r
-        .arms
-        .iter()
-        .flat_map(|a| [a.shoulder, a.elbow, a.hand])
-        .collect();
-    rec.log(
-        ROBOT_JOINTS,
-        &Points3D::new(joints)
-            .with_colors([colour([60, 60, 70], 255)])
-            .with_radii([0.025]),
-    )?;
-    log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
+    if scene.arms.is_none() {
+        log_robot_boxes(rec, r)?;
+    }
     match &scene.approach {
         Some(a) => {
             let strips: Vec<Vec<[f32; 3]>> =
@@ -222,4 +210,109 @@ pub fn log_scene(rec: &RecordingStream, scene: &SceneSnapshot) -> RecordingStrea
         )?;
     }
     Ok(())
+}
+
+/// The robot as boxes and segments, for cells without real arms.
+fn log_robot_boxes(rec: &RecordingStream, r: &RobotView) -> RecordingStreamResult<()> {
+    rec.log(
+        ROBOT_TORSO,
+        &Boxes3D::from_centers_and_half_sizes([r.torso_center], [r.torso_half])
+            .with_colors([colour([200, 200, 205], 255)])
+            .with_fill_mode(FillMode::Solid)
+            .with_labels(["YuMi"]),
+    )?;
+    let strips: Vec<Vec<[f32; 3]>> = r
+        .arms
+        .iter()
+        .map(|a| vec![a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_ARMS,
+        &LineStrips3D::new(strips)
+            .with_colors([colour([90, 90, 100], 255)])
+            .with_radii([0.02]),
+    )?;
+    let joints: Vec<[f32; 3]> = r
+        .arms
+        .iter()
+        .flat_map(|a| [a.shoulder, a.elbow, a.hand])
+        .collect();
+    rec.log(
+        ROBOT_JOINTS,
+        &Points3D::new(joints)
+            .with_colors([colour([60, 60, 70], 255)])
+            .with_radii([0.025]),
+    )?;
+    log_parts(rec, ROBOT_GRIPPER, &r.gripper, [70, 70, 80], None)?;
+    Ok(())
+}
+
+/// A solid the last motion picked up or let go: as it was before the motion and as it is
+/// after it.
+pub struct Carried {
+    pub before: SolidView,
+    pub after: SolidView,
+    /// Picked up (held after the motion), else let go (held before it).
+    pub grasped: bool,
+}
+
+impl Carried {
+    /// The solid whose holding changed from `before` to `after`, if one did.
+    pub fn between(before: &[SolidView], after: &[SolidView]) -> Option<Carried> {
+        before
+            .iter()
+            .zip(after)
+            .find(|(b, a)| b.name == a.name && b.held != a.held)
+            .map(|(b, a)| Carried {
+                before: b.clone(),
+                after: a.clone(),
+                grasped: a.held,
+            })
+    }
+}
+
+/// `parts` moved by `by` (world).
+fn shifted(parts: &[PartView], by: &Vector3<f32>) -> Vec<PartView> {
+    parts
+        .iter()
+        .map(|p| {
+            let mut moved = p.clone();
+            moved.pose.translation.vector += by;
+            if let PartShape::Capsule { a, b, .. } = &mut moved.shape {
+                *a = (Vector3::from(*a) + by).into();
+                *b = (Vector3::from(*b) + by).into();
+            }
+            moved
+        })
+        .collect()
+}
+
+/// The carried solid at configuration `index` of the way the arm went: in the hand
+/// after the fingers close (at `path.acts_at`) for a grasp, up to where they open for a
+/// release, else where it lies.
+pub fn log_carried(
+    rec: &RecordingStream,
+    carried: &Carried,
+    path: &ArmPathView,
+    index: usize,
+) -> RecordingStreamResult<()> {
+    let tool = &path.tool;
+    let (Some(at), Some(first), Some(last)) = (tool.get(index), tool.first(), tool.last()) else {
+        return Ok(());
+    };
+    let at = Vector3::from(*at);
+    let parts = match (carried.grasped, index > path.acts_at) {
+        (true, true) => shifted(&carried.after.parts, &(at - Vector3::from(*last))),
+        (true, false) => carried.before.parts.clone(),
+        (false, false) => shifted(&carried.before.parts, &(at - Vector3::from(*first))),
+        (false, true) => carried.after.parts.clone(),
+    };
+    let s = &carried.after;
+    log_parts(
+        rec,
+        &format!("{SOLIDS}/{}", slug(&s.name)),
+        &parts,
+        s.colour,
+        Some(&s.name),
+    )
 }

@@ -288,6 +288,13 @@ impl Engine {
                 reset: false,
             });
         }
+        let motion = crate::world::CellWorld::motion_of(self.exec.as_ref());
+        if motion.is_some() && motion != self.motion {
+            self.motion.clone_from(&motion);
+            if let Some(motion) = motion {
+                self.emit(Event::ArmMotion { motion });
+            }
+        }
         match (record.root, failed) {
             (TickOutcome::Running, _) => {}
             (TickOutcome::Success, _) if !record.completed.is_empty() => {}
@@ -370,6 +377,7 @@ impl Engine {
         self.debug.forget_stop();
         self.last = None;
         self.run_ticks = 0;
+        self.motion = None;
         self.facts = self.exec.facts();
         self.emit(Event::WorldChanged {
             facts: self.facts.clone(),

@@ -251,6 +251,8 @@ pub struct Engine {
     /// Ticks since the last Run command (for the limit).
     run_ticks: u64,
     facts: Vec<Condition>,
+    /// The last arm motion told (`Event::ArmMotion`).
+    motion: Option<crate::world::cell::snapshot::MotionView>,
     task: Option<Task>,
     tree: Option<Tree>,
     last: Option<Arc<TickRecord>>,
@@ -328,6 +330,7 @@ impl Engine {
             ticker: Ticker::new(),
             debug: debug::Debugger::default(),
             run_ticks: 0,
+            motion: None,
             facts,
             task: None,
             tree: None,

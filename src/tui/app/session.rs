@@ -31,7 +31,8 @@ impl App {
             | Event::WorldChanged { .. }
             | Event::RunState { .. }
             | Event::Success { .. }
-            | Event::Scene { .. }) => self.on_world(e),
+            | Event::Scene { .. }
+            | Event::ArmMotion { .. }) => self.on_world(e),
             e @ (Event::Verified { .. }
             | Event::ChangeViolates { .. }
             | Event::PolicySaved { .. }
@@ -207,6 +208,7 @@ impl App {
                     self.status.ticks = 0;
                     self.status.ending = None;
                     self.world.last_error = None;
+                    self.world.motion = None;
                     self.tree.clear_statuses();
                 }
             }
@@ -216,6 +218,7 @@ impl App {
                 self.world.error_resolved = true;
                 self.llm.log(strings::success(ticks));
             }
+            Event::ArmMotion { motion } => self.world.motion = Some(motion),
             // For the 3D view; the world pane shows facts.
             Event::Scene { .. } => {}
             _ => {}

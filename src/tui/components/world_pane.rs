@@ -1,5 +1,6 @@
 //! The world pane as a blackboard: the last error, the values parameters set on the tree's
-//! actions, and a table of the facts true now in the execution world, each marked when
+//! actions, the last motion of a real arm (its arm, joint path length, planning time and
+//! attempts, or what blocked it), and a table of the facts true now in the execution world, each marked when
 //! the last tick made it true, with the facts it made false listed (struck) above the
 //! rest. The table scrolls and can be narrowed to the facts holding a text; the objects
 //! are named when they fit on one line, else counted (D shows a node whole).
@@ -14,6 +15,7 @@ use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 
 use super::super::strings;
 use super::super::theme::Theme;
+use crate::world::cell::snapshot::MotionView;
 
 #[derive(Default)]
 pub struct WorldPane {
@@ -29,6 +31,8 @@ pub struct WorldPane {
     pub error_resolved: bool,
     /// Values parameters set on the tree's actions (`grasp "egg": force = 5 N`).
     pub values: Vec<String>,
+    /// The last motion of a real arm, when the cell moves them.
+    pub motion: Option<MotionView>,
     /// Only facts holding this text (any case) are listed.
     pub filter: Option<String>,
     /// Rows of the fact table scrolled past.
@@ -132,6 +136,14 @@ impl WorldPane {
                 theme.proposal,
             )));
         }
+        if let Some(m) = &self.motion {
+            let style = if m.length.is_some() {
+                theme.dim
+            } else {
+                theme.error
+            };
+            lines.push(Line::from(Span::styled(strings::last_motion(m), style)));
+        }
         let names = format!("{} {}", strings::OBJECTS, self.objects.join(", "));
         let width = usize::from(area.width.saturating_sub(2));
         lines.push(Line::from(Span::styled(
@@ -197,7 +209,11 @@ mod tests {
     use ratatui::backend::TestBackend;
 
     fn screen(pane: &WorldPane) -> String {
-        let mut terminal = Terminal::new(TestBackend::new(50, 14)).unwrap();
+        screen_of(pane, 50, 14)
+    }
+
+    fn screen_of(pane: &WorldPane, width: u16, height: u16) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
         terminal
             .draw(|f| pane.draw(f, f.area(), &Theme::default()))
             .unwrap();
@@ -242,5 +258,41 @@ mod tests {
         pane.scroll_down();
         let s = screen(&pane);
         assert!(s.contains("↑ 4 row(s) above"), "{s}");
+    }
+
+    #[test]
+    fn the_last_motion_of_a_real_arm_is_one_line_made_or_blocked() {
+        let mut pane = WorldPane::of(vec!["red cube".into(), "blue cube".into()]);
+        pane.set_facts(vec!["\"red cube\" grasped".into()], true);
+        pane.motion = Some(MotionView {
+            arm: "yumi_link_7_l".into(),
+            length: Some(3.4178),
+            seconds: 0.01234,
+            attempts: 1,
+            blocker: None,
+        });
+        let s = screen_of(&pane, 90, 8);
+        assert!(
+            s.contains(
+                "last motion: yumi_link_7_l moved, joint path 3.42 rad, planned in 12.3 ms, 1 attempt"
+            ),
+            "{s}"
+        );
+        insta::assert_snapshot!("blackboard_with_the_last_motion", s);
+
+        pane.motion = Some(MotionView {
+            arm: "yumi_link_7_l".into(),
+            length: None,
+            seconds: 0.5,
+            attempts: 6,
+            blocker: Some("red cube".into()),
+        });
+        let s = screen_of(&pane, 90, 8);
+        assert!(
+            s.contains(
+                "last motion: yumi_link_7_l found no path, blocked by red cube, 500.0 ms, 6 attempts"
+            ),
+            "{s}"
+        );
     }
 }

@@ -12,12 +12,13 @@
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
 
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::robot::ArmsSpec;
 use crate::motion::{ArmCheck, MotionError, PlanOptions, Solid, plan};
-use crate::robot::{IkOptions, Robot, RobotShapes, describe_pose, solve};
+use crate::robot::{IkOptions, Model, Robot, RobotShapes, describe_pose, solve};
 
 /// Longest step (metres) between two poses followed along a straight approach.
 const APPROACH_STEP: f64 = 0.01;
@@ -26,10 +27,15 @@ const APPROACH_STEP: f64 = 0.01;
 const APPROACH_JUMP: f64 = 0.35;
 /// Inverse kinematics runs (from different starts) per arm and grip before giving up.
 const IK_ATTEMPTS: u64 = 3;
+/// Largest change of any joint (radians) between two configurations of the path kept
+/// for display: fine enough that the arm is seen to move, not jump.
+const DRAW_STEP: f64 = 0.05;
 
 /// The robot's arms with their collision shapes and where the tool sits on each flange.
 pub struct Arms {
     pub robot: Robot,
+    /// The description as read (shared with the scene snapshots that draw it).
+    pub model: Arc<Model>,
     pub shapes: RobotShapes,
     /// The tool centre point in each flange's frame.
     pub tool: Isometry3<f64>,
@@ -102,6 +108,37 @@ pub struct ArmMove {
     pub length: f64,
     pub samples: usize,
     pub checks: usize,
+    /// The whole way the arm goes, from where it was to `q`: the planned path to above
+    /// the target, down the approach and back up, and (after letting go) the path back
+    /// to rest; no joint changes by more than `DRAW_STEP` between two of them.
+    pub path: Vec<Vec<f64>>,
+    /// The tool centre point (world) at each configuration of `path`.
+    pub tool: Vec<[f32; 3]>,
+    /// Where on `path` the fingers close or open (the bottom of the approach).
+    pub acts_at: usize,
+    pub effort: Effort,
+}
+
+/// What finding a motion took, made or refused.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Effort {
+    /// The arm that made the motion, or whose refusal is reported.
+    pub arm: usize,
+    /// Arm, grip and inverse-kinematics start combinations tried.
+    pub attempts: usize,
+    /// Wall-clock seconds spent (inverse kinematics, collision tests, path search).
+    pub seconds: f64,
+}
+
+/// The last motion asked of the arms (for display): made, or refused with what blocked it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LastMotion {
+    Made(ArmMove),
+    Refused {
+        effort: Effort,
+        /// The solid or link the motion collided with, when known.
+        blocker: Option<String>,
+    },
 }
 
 /// Why no arm made a motion.
@@ -170,6 +207,7 @@ impl Arms {
             }
         }
         Ok(Arms {
+            model: Arc::new(robot.model.clone()),
             robot,
             shapes,
             tool: Isometry3::translation(0.0, 0.0, spec.tool),
@@ -185,8 +223,24 @@ impl Arms {
     }
 
     /// Move an arm to `reach.above` and along the straight line to `reach.at`: the nearer
-    /// arm first, each of the two grips that open across y; the first that gets there.
-    pub fn reach(&self, reach: &Reach<'_>) -> Result<ArmMove, Refusal> {
+    /// arm first, each of the two grips that open across y; the first that gets there,
+    /// else the refusal that tells the most, with what the search took either way.
+    pub fn reach(&self, reach: &Reach<'_>) -> (Result<ArmMove, Refusal>, Effort) {
+        let began = Instant::now();
+        let mut effort = Effort {
+            arm: 0,
+            attempts: 0,
+            seconds: 0.0,
+        };
+        let mut result = self.try_arms(reach, &mut effort);
+        effort.seconds = began.elapsed().as_secs_f64();
+        if let Ok(m) = &mut result {
+            m.effort = effort;
+        }
+        (result, effort)
+    }
+
+    fn try_arms(&self, reach: &Reach<'_>, effort: &mut Effort) -> Result<ArmMove, Refusal> {
         let target = reach.at.translation.vector;
         let mut order: Vec<(usize, f64)> = self
             .robot
@@ -216,11 +270,16 @@ impl Arms {
                 .flat_map(|t| (0..IK_ATTEMPTS).map(move |a| (t, a)))
             {
                 let spin = Isometry3::rotation(Vector3::z() * turn);
+                effort.attempts += 1;
                 match self.reach_with(arm, reach, spin, attempt) {
-                    Ok(m) => return Ok(m),
+                    Ok(m) => {
+                        effort.arm = arm;
+                        return Ok(m);
+                    }
                     Err(r) => {
                         if refused.as_ref().is_none_or(|old| rank(&r) > rank(old)) {
                             refused = Some(r);
+                            effort.arm = arm;
                         }
                     }
                 }
@@ -354,12 +413,24 @@ impl Arms {
             }
         }
         let path = plan(&check, &start, &above, &self.plan).map_err(|e| no_path(&e))?;
+        // There, down the approach (`line` runs up from the bottom) and back up.
+        let mut way = path.waypoints.clone();
+        way.extend(line.iter().rev().skip(1).cloned());
+        way.extend(line.iter().skip(1).cloned());
         let mut done = ArmMove {
             arm,
             q: above.clone(),
             length: path.length(),
             samples: path.samples,
             checks: path.checks,
+            path: Vec::new(),
+            tool: Vec::new(),
+            acts_at: 0,
+            effort: Effort {
+                arm,
+                attempts: 0,
+                seconds: 0.0,
+            },
         };
         if reach.lets_go {
             // Empty-handed, from above the object let go back to rest (the object below
@@ -379,9 +450,48 @@ impl Arms {
             done.length += back.length();
             done.samples += back.samples;
             done.checks += back.checks;
+            way.extend(back.waypoints.into_iter().skip(1));
         }
+        done.path = densify(&way, DRAW_STEP);
+        // Densifying keeps every configuration of the way as it is: the bottom of the
+        // approach is found again exactly.
+        done.acts_at = line
+            .first()
+            .and_then(|bottom| done.path.iter().position(|q| q == bottom))
+            .unwrap_or_default();
+        done.tool = done
+            .path
+            .iter()
+            .map(|q| {
+                // The grip's turn about the tool's axis does not move its centre.
+                let at = reach.base * chain.fk(q) * self.tool;
+                let p = at.translation.vector;
+                [p.x as f32, p.y as f32, p.z as f32]
+            })
+            .collect();
         Ok(done)
     }
+}
+
+/// `way` with configurations put in between so that no joint changes by more than `step`
+/// from one to the next.
+fn densify(way: &[Vec<f64>], step: f64) -> Vec<Vec<f64>> {
+    let mut out: Vec<Vec<f64>> = way.first().cloned().into_iter().collect();
+    for pair in way.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        let widest = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (y - x).abs())
+            .fold(0.0, f64::max);
+        let n = (widest / step).ceil().max(1.0) as usize;
+        for k in 1..n {
+            let t = k as f64 / n as f64;
+            out.push(a.iter().zip(b).map(|(x, y)| x + (y - x) * t).collect());
+        }
+        out.push(b.clone());
+    }
+    out
 }
 
 fn no_path(e: &MotionError) -> Refusal {

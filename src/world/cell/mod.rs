@@ -108,8 +108,10 @@ pub struct CellWorld {
     arms: Option<Arc<arms::Arms>>,
     /// The arm motion of the action being started (taken into its progress).
     planned: RefCell<Option<arms::ArmMove>>,
-    /// The last arm motion made (for display only).
-    last_motion: RefCell<Option<arms::ArmMove>>,
+    /// The last arm motion made or refused (for display only).
+    last_motion: RefCell<Option<arms::LastMotion>>,
+    /// What the arm motions of the action being started took so far.
+    spent: RefCell<arms::Effort>,
 }
 
 impl CellWorld {
@@ -146,6 +148,7 @@ impl CellWorld {
             arms: None,
             planned: RefCell::new(None),
             last_motion: RefCell::new(None),
+            spent: RefCell::new(arms::Effort::default()),
         })
     }
 
@@ -175,11 +178,14 @@ impl CellWorld {
         &self.state.arms
     }
 
-    /// The last arm motion a skill made, and the arm's name.
+    /// The last arm motion a skill made (none when the last one was refused), and the
+    /// arm's name.
     pub fn last_motion(&self) -> Option<(String, arms::ArmMove)> {
         let arms = self.arms.as_ref()?;
-        let m = self.last_motion.borrow().clone()?;
-        Some((arms.arm_name(m.arm).to_string(), m))
+        match self.last_motion.borrow().clone()? {
+            arms::LastMotion::Made(m) => Some((arms.arm_name(m.arm).to_string(), m)),
+            arms::LastMotion::Refused { .. } => None,
+        }
     }
 
     /// Exact collision tests (of two convex parts) made so far by this world and all
@@ -416,8 +422,13 @@ impl World for CellWorld {
         let key = format!("{} {:?}", action.skill, action.args);
         if started || !self.state.progress.contains_key(&key) {
             self.planned.replace(None);
+            self.spent.replace(arms::Effort::default());
+            let before = self.last_motion.borrow().clone();
             match self.start(action) {
                 Ok(effect) => {
+                    // Spots refused on the way to the one the action takes are not its
+                    // motion: that is recorded when the action completes.
+                    self.last_motion.replace(before);
                     let arm = self.planned.take();
                     self.state.progress.insert(
                         key.clone(),
@@ -449,7 +460,7 @@ impl World for CellWorld {
                 if let Some(q) = self.state.arms.get_mut(m.arm) {
                     q.clone_from(&m.q);
                 }
-                self.last_motion.replace(Some(m));
+                self.last_motion.replace(Some(arms::LastMotion::Made(m)));
             }
         }
         Step::Success

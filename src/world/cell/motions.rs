@@ -94,13 +94,31 @@ impl CellWorld {
             only: motion.carried.and_then(|h| h.arm),
             lets_go: motion.carried.is_some(),
         };
-        match arms.reach(&reach) {
-            Ok(m) => {
+        let (made, effort) = arms.reach(&reach);
+        // A skill may try several spots: what it took is the sum over all of them.
+        let effort = {
+            let mut spent = self.spent.borrow_mut();
+            spent.arm = effort.arm;
+            spent.attempts += effort.attempts;
+            spent.seconds += effort.seconds;
+            *spent
+        };
+        let refused = |blocker: Option<String>| {
+            self.last_motion
+                .replace(Some(super::arms::LastMotion::Refused { effort, blocker }));
+        };
+        match made {
+            Ok(mut m) => {
+                m.effort = effort;
                 self.planned.replace(Some(m));
                 Ok(())
             }
-            Err(super::arms::Refusal::OutOfReach(why)) => Err(SkillFailure::ArmOutOfReach(why)),
-            Err(super::arms::Refusal::NoPath { message, .. }) => {
+            Err(super::arms::Refusal::OutOfReach(why)) => {
+                refused(None);
+                Err(SkillFailure::ArmOutOfReach(why))
+            }
+            Err(super::arms::Refusal::NoPath { message, blocker }) => {
+                refused(blocker);
                 Err(SkillFailure::ArmNoPath { message, predicted })
             }
         }

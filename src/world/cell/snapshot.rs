@@ -1,14 +1,19 @@
 //! A read-only picture of the cell for display: every solid's convex parts at their world
 //! poses with a colour and a label, the robot (base, arms as link segments, gripper), the
 //! last approach path a skill swept with the segments where it collides, and the reach
-//! spheres with the objects outside them. Plain data: the 3D view draws it, nothing
-//! decides anything from it.
+//! spheres with the objects outside them; with real arms also the robot's description,
+//! its joint values, the way the last motion went and what it cost or what blocked it.
+//! Plain data: the 3D view draws it, nothing decides anything from it.
+
+use std::sync::Arc;
 
 use nalgebra::{Point3, Translation3, Vector3};
 use parry3d::shape::SharedShape;
 
 use super::CellWorld;
+use super::arms::LastMotion;
 use super::geometry::{Counter, Part, Pose, path_collides};
+use crate::robot::Model;
 use crate::world::World;
 
 /// Segments an approach path is cut into to show where it collides.
@@ -91,6 +96,47 @@ pub struct ApproachView {
     pub collided: Vec<bool>,
 }
 
+/// The robot's real arms, drawn from its description.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmsView {
+    /// The description: links with their meshes, joints with their frames.
+    pub model: Arc<Model>,
+    /// The robot's root link in the world.
+    pub base: Pose,
+    /// Every arm's moving joints, by name, with their values now.
+    pub joints: Vec<Vec<(String, f64)>>,
+    /// The last motion made, to draw the arm moving along it.
+    pub path: Option<ArmPathView>,
+}
+
+/// The way an arm went in its last motion.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmPathView {
+    /// Index into [`ArmsView::joints`].
+    pub arm: usize,
+    /// Joint values from where the arm was to where it ended, close enough together to
+    /// be drawn as a motion.
+    pub joints: Vec<Vec<f64>>,
+    /// The tool centre point (world) at each of them.
+    pub tool: Vec<[f32; 3]>,
+    /// Where on the way the fingers close or open.
+    pub acts_at: usize,
+}
+
+/// The last motion asked of the arms: which arm, what finding it took, and its length or
+/// what blocked it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionView {
+    pub arm: String,
+    /// Joint-space length (radians) of the path; none when the arm found no path.
+    pub length: Option<f64>,
+    pub seconds: f64,
+    /// Arm, grip and start combinations tried.
+    pub attempts: usize,
+    /// The solid (or link) the refused motion collided with, when known.
+    pub blocker: Option<String>,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneSnapshot {
     pub solids: Vec<SolidView>,
@@ -98,6 +144,10 @@ pub struct SceneSnapshot {
     pub approach: Option<ApproachView>,
     /// Movable objects the robot cannot reach from where it stands.
     pub out_of_reach: Vec<String>,
+    /// With real arms: the robot as its description draws it.
+    pub arms: Option<ArmsView>,
+    /// With real arms: the last motion asked of them.
+    pub motion: Option<MotionView>,
 }
 
 impl CellWorld {
@@ -107,6 +157,88 @@ impl CellWorld {
             .as_any()
             .and_then(|w| w.downcast_ref::<CellWorld>())
             .map(CellWorld::scene)
+    }
+
+    /// The last motion asked of a cell's real arms (`None` for other worlds, worlds
+    /// without real arms, and before the first motion).
+    pub fn motion_of(world: &dyn World) -> Option<MotionView> {
+        world
+            .as_any()
+            .and_then(|w| w.downcast_ref::<CellWorld>())
+            .and_then(CellWorld::motion_view)
+    }
+
+    fn motion_view(&self) -> Option<MotionView> {
+        let arms = self.arms.as_ref()?;
+        Some(match self.last_motion.borrow().as_ref()? {
+            LastMotion::Made(m) => MotionView {
+                arm: arms.arm_name(m.arm).to_string(),
+                length: Some(m.length),
+                seconds: m.effort.seconds,
+                attempts: m.effort.attempts,
+                blocker: None,
+            },
+            LastMotion::Refused { effort, blocker } => MotionView {
+                arm: arms.arm_name(effort.arm).to_string(),
+                length: None,
+                seconds: effort.seconds,
+                attempts: effort.attempts,
+                blocker: blocker.clone(),
+            },
+        })
+    }
+
+    /// Where a real arm holds solid `i` now: in the hand, at the tool of the arm's joint
+    /// values (the solid's own pose stays where it was grasped until it is let go).
+    fn held_by_arm(&self, i: usize) -> Option<Pose> {
+        let held = self.state.held.as_ref().filter(|h| h.id == i)?;
+        let arms = self.arms.as_ref()?;
+        let arm = held.arm?;
+        let (chain, q) = (arms.robot.arms.get(arm)?, self.state.arms.get(arm)?);
+        let base = nalgebra::Isometry3::translation(
+            f64::from(self.state.base.x),
+            f64::from(self.state.base.y),
+            0.0,
+        );
+        let tool = (base * chain.fk(q) * arms.tool)
+            .translation
+            .vector
+            .cast::<f32>();
+        let grasped_tool = self.state.poses[i] * held.grip.inverse();
+        Some(Pose::from_parts(Translation3::from(tool), grasped_tool.rotation) * held.grip)
+    }
+
+    fn arms_view(&self) -> Option<ArmsView> {
+        let arms = self.arms.as_ref()?;
+        let joints = arms
+            .robot
+            .arms
+            .iter()
+            .zip(&self.state.arms)
+            .map(|(chain, q)| {
+                chain
+                    .joints
+                    .iter()
+                    .zip(q)
+                    .map(|(j, v)| (j.name.clone(), *v))
+                    .collect()
+            })
+            .collect();
+        let path = match self.last_motion.borrow().as_ref() {
+            Some(LastMotion::Made(m)) => Some(ArmPathView {
+                arm: m.arm,
+                joints: m.path.clone(),
+                tool: m.tool.clone(),
+                acts_at: m.acts_at,
+            }),
+            _ => None,
+        };
+        Some(ArmsView {
+            model: arms.model.clone(),
+            base: Pose::translation(self.state.base.x, self.state.base.y, 0.0),
+            joints,
+            path,
+        })
     }
 
     pub(super) fn record_approach(
@@ -130,7 +262,7 @@ impl CellWorld {
     pub fn scene(&self) -> SceneSnapshot {
         let mut solids = Vec::with_capacity(self.scene.solids.len());
         for (i, s) in self.scene.solids.iter().enumerate() {
-            let pose = self.state.poses[i];
+            let pose = self.held_by_arm(i).unwrap_or(self.state.poses[i]);
             let mut parts: Vec<PartView> = s.body.parts.iter().map(|p| view(&pose, p)).collect();
             if let Some(lid) = &s.lid {
                 let rel = if self.state.lid_open[i] {
@@ -164,6 +296,8 @@ impl CellWorld {
             robot: self.robot_view(),
             approach: self.approach_view(),
             out_of_reach,
+            arms: self.arms_view(),
+            motion: self.motion_view(),
         }
     }
 
