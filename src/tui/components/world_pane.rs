@@ -36,6 +36,8 @@ pub struct WorldPane {
     /// Do not mark what changed: a replay seeks past the worlds in between, so the
     /// world before the last one is not known there.
     pub unmarked: bool,
+    /// Whether keys go to this pane (its border says so).
+    pub focused: bool,
 }
 
 /// Rows one scroll key moves the fact table.
@@ -75,11 +77,17 @@ impl WorldPane {
     }
 
     pub fn scroll_down(&mut self) {
-        self.scroll = (self.scroll + SCROLL_ROWS).min(self.rows().len().saturating_sub(1));
+        self.scroll(SCROLL_ROWS.cast_signed());
     }
 
     pub fn scroll_up(&mut self) {
-        self.scroll = self.scroll.saturating_sub(SCROLL_ROWS);
+        self.scroll(-SCROLL_ROWS.cast_signed());
+    }
+
+    /// Scroll the fact table by `rows` (negative: up), keeping its last row in view.
+    pub fn scroll(&mut self, rows: isize) {
+        let last = self.rows().len().saturating_sub(1);
+        self.scroll = self.scroll.saturating_add_signed(rows).min(last);
     }
 
     pub fn set_filter(&mut self, filter: Option<String>) {
@@ -171,7 +179,11 @@ impl WorldPane {
         }
         let block = Block::default()
             .borders(Borders::ALL)
-            .border_style(theme.border)
+            .border_style(if self.focused {
+                theme.focused
+            } else {
+                theme.border
+            })
             .title(Span::styled(strings::WORLD_TITLE, theme.title));
         frame.render_widget(
             Paragraph::new(lines)
