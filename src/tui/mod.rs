@@ -43,7 +43,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationService, Microphone, SttLoader};
 
-pub use app::{App, Info, ModelArrival, Request, Summary};
+pub use app::{App, Info, ModelArrival, Pane, Request, Summary};
 pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
