@@ -143,6 +143,9 @@ pub async fn run(
     }
     let mut app = App::new(scenario, info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
+    if let Some(page) = tap.as_ref().and_then(|t| t.viewer_page()) {
+        app.llm.log(strings::viewer_page(&page));
+    }
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let queue = event_loop::Queue::new();
     let mut dictation = DictationService::reporting_to(microphone, stt, queue.dictation_sink());

@@ -119,6 +119,11 @@ pub fn facts_heading(shown: usize, total: usize, filter: Option<&str>) -> String
 }
 
 /// Over the fact table scrolled down.
+/// The first line of the log when a web viewer shows the session.
+pub fn viewer_page(page: &str) -> String {
+    format!("3D view: open {page}")
+}
+
 /// Under a proposal cut to fit: which of its rows are shown.
 pub fn rows_of(first: usize, last: usize, total: usize) -> String {
     format!("↕ rows {first}–{last} of {total} · D whole")

@@ -221,7 +221,7 @@ fn viewer_flags_parse() {
     assert_eq!("spawn".parse::<Viewer>().unwrap(), Viewer::Spawn);
     assert_eq!("web".parse::<Viewer>().unwrap(), Viewer::Web);
     assert_eq!(
-        viewer::web_page(DEFAULT_URL),
+        viewer::web_page(DEFAULT_URL, WEB_PORT),
         "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
     );
     assert_eq!("connect".parse::<Viewer>().unwrap(), Viewer::Connect(None));
@@ -245,7 +245,7 @@ fn a_viewer_that_is_not_there_is_said_once_and_the_session_goes_on() {
         viewer: Some(Viewer::Connect(Some(
             "rerun+http://127.0.0.1:9/proxy".into(),
         ))),
-        rrd: None,
+        ..Sinks::default()
     })
     .unwrap()
     .unwrap();
@@ -374,7 +374,7 @@ fn spawning_without_a_display_says_so() {
     }
     let viz = Viz::open(&Sinks {
         viewer: Some(Viewer::Spawn),
-        rrd: None,
+        ..Sinks::default()
     })
     .unwrap()
     .unwrap();
