@@ -197,3 +197,61 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
     drop(second);
     assert_eq!(still_running(&second_viewers), Vec::<u32>::new());
 }
+
+/// A one-shot command's web viewer stays after the command, so what it was sent can be
+/// looked at, and the command says how to stop it (the test then does so).
+#[test]
+fn a_one_shot_commands_web_viewer_stays_and_says_how_to_stop_it() {
+    let path = format!(
+        "{}:{}",
+        support::rerun::bin_dir().display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let listening = |port: u16| std::net::TcpStream::connect(("127.0.0.1", port)).is_ok();
+    let usual_listening = listening(9876) && listening(9090);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_betr"))
+        .args(["run", "scenarios/cell/red_on_blue.toml", "--viewer", "web"])
+        .current_dir(support::repo::root())
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr).to_string();
+    let Some(stop) = said
+        .lines()
+        .find_map(|l| l.split_once("`kill -- -").map(|(_, rest)| rest))
+        .and_then(|rest| rest.split('`').next())
+    else {
+        // Only a viewer already on the usual ports (another session's) is used without
+        // starting one: then nothing is left to stop.
+        assert!(usual_listening, "no viewer started and none was there: {said}");
+        assert!(
+            said.contains("3D view: open http://127.0.0.1:9090/"),
+            "{said}"
+        );
+        return;
+    };
+    let group: i32 = stop.parse().unwrap();
+    let url = said
+        .lines()
+        .find_map(|l| l.strip_prefix("3D view: open "))
+        .unwrap();
+    let port: u16 = url
+        .trim_start_matches("http://127.0.0.1:")
+        .split('/')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let served = page_status(port);
+    let viewers: BTreeSet<Served> = web_viewers()
+        .into_iter()
+        .filter(|s| s.group == u32::try_from(group).unwrap())
+        .collect();
+    let _ = nix::sys::signal::killpg(
+        nix::unistd::Pid::from_raw(group),
+        nix::sys::signal::Signal::SIGTERM,
+    );
+    assert!(served.contains("200"), "{served}: {said}");
+    assert!(viewers.len() >= 2, "{viewers:?}");
+    assert_eq!(still_running(&viewers), Vec::<u32>::new());
+}

@@ -385,3 +385,48 @@ fn spawning_without_a_display_says_so() {
     );
     assert!(notice.contains("--viewer web"), "{notice}");
 }
+
+/// With the usual ports held by another program, the web viewer's ports are others the
+/// system gives, both free and different; held only while they are chosen.
+#[test]
+fn the_web_viewer_moves_off_ports_that_are_taken() {
+    // Hold the usual ports where this test can (another program may hold them already,
+    // which serves the test as well).
+    let _held: Vec<std::net::TcpListener> = [viewer::GRPC_PORT, viewer::WEB_PORT]
+        .iter()
+        .filter_map(|p| std::net::TcpListener::bind(("0.0.0.0", *p)).ok())
+        .collect();
+    let (grpc, web) = viewer::free_ports().unwrap();
+    assert_ne!(grpc, viewer::GRPC_PORT);
+    assert_ne!(web, viewer::WEB_PORT);
+    assert_ne!(grpc, web);
+    for port in [grpc, web] {
+        assert!(std::net::TcpListener::bind(("0.0.0.0", port)).is_ok(), "{port}");
+    }
+}
+
+/// A viewer program that stops at once is tried again on new ports, then refused with the
+/// ports tried and how to use a viewer started by hand; one that is not there is said.
+#[test]
+fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
+    let error = viewer::start_web(
+        std::ffi::OsStr::new("false"),
+        ViewerLife::StopsWithSession,
+    )
+    .err()
+    .unwrap();
+    let said = error.to_string();
+    assert!(
+        matches!(error, viewer::ViewerError::Stopped { attempts: 3, .. }),
+        "{said}"
+    );
+    assert!(said.contains("before listening on ports"), "{said}");
+    assert!(said.contains("--viewer connect=URL"), "{said}");
+    let missing = viewer::start_web(
+        std::ffi::OsStr::new("/nonexistent/rerun"),
+        ViewerLife::StopsWithSession,
+    )
+    .err()
+    .unwrap();
+    assert!(matches!(missing, viewer::ViewerError::NotInstalled), "{missing}");
+}

@@ -358,7 +358,7 @@ fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebSer
 
 /// A port for the stream and one for the page: the usual ones when nothing holds them,
 /// else ones the system gives. Both are held until both are chosen, so they differ.
-fn free_ports() -> Result<(u16, u16), ViewerError> {
+pub(super) fn free_ports() -> Result<(u16, u16), ViewerError> {
     let grpc = bind(GRPC_PORT)?;
     let web = bind(WEB_PORT)?;
     let port = |l: &TcpListener| {
