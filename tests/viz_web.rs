@@ -18,6 +18,10 @@ use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 use support::tmux::Tmux;
 
+/// One test at a time: two starting viewers at once may choose the same free ports (each
+/// start is tried again then, but the test would measure the race, not the workbench).
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// A running `--serve-web` process: its id, process group and page port.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 struct Served {
@@ -163,6 +167,7 @@ fn port_of(viewers: &BTreeSet<Served>) -> (u32, u16) {
 
 #[test]
 fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     support::rerun::rerun_cli();
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
 
@@ -202,6 +207,7 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
 /// looked at, and the command says how to stop it (the test then does so).
 #[test]
 fn a_one_shot_commands_web_viewer_stays_and_says_how_to_stop_it() {
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let path = format!(
         "{}:{}",
         support::rerun::bin_dir().display(),

@@ -30,6 +30,8 @@ pub const GRPC_PORT: u16 = 9876;
 const START_TIMEOUT: Duration = Duration::from_secs(20);
 /// How long a stopped viewer may take to go before it is killed.
 const STOP_TIMEOUT: Duration = Duration::from_secs(3);
+/// How long a viewer that listens must keep running to be taken as the one listening.
+const SETTLE: Duration = Duration::from_millis(300);
 /// Starts tried when the viewer stops at once: ports free when chosen can be taken by
 /// another program before the viewer binds them.
 const START_ATTEMPTS: usize = 3;
@@ -352,6 +354,18 @@ fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebSer
             });
         }
         std::thread::sleep(Duration::from_millis(100));
+    }
+    // Another program may have taken one of the ports between their choice and the
+    // viewer's start, answering in its place while the viewer stops: it must still run.
+    std::thread::sleep(SETTLE);
+    if let Ok(Some(status)) = server.child.try_wait() {
+        server.stop();
+        return Err(ViewerError::Stopped {
+            status,
+            grpc,
+            web,
+            attempts: 1,
+        });
     }
     Ok(server)
 }
