@@ -26,7 +26,11 @@ use support::workbench::Bench;
 fn deep_tree() -> Arc<betr::bt::Tree> {
     let mut text = String::new();
     for depth in 0..13 {
-        let kind = if depth % 2 == 0 { "fallback" } else { "sequence" };
+        let kind = if depth % 2 == 0 {
+            "fallback"
+        } else {
+            "sequence"
+        };
         text.push_str(&format!("{}{kind}\n", "  ".repeat(depth)));
         text.push_str(&format!(
             "{}\"red cube\" on \"blue cube\"?\n",
@@ -238,7 +242,10 @@ fn a_click_focuses_a_pane_and_the_wheel_scrolls_the_one_under_it() {
             KeyModifiers::NONE,
         ));
         let world_scrolled = b.screen(120, 40);
-        assert!(world_scrolled.contains("↑ 3 row(s) above"), "{world_scrolled}");
+        assert!(
+            world_scrolled.contains("↑ 3 row(s) above"),
+            "{world_scrolled}"
+        );
         // Keys scroll the focused pane: ↑ one row back.
         b.key(KeyCode::Up);
         assert!(b.screen(120, 40).contains("↑ 2 row(s) above"));
@@ -257,7 +264,10 @@ fn a_click_focuses_a_pane_and_the_wheel_scrolls_the_one_under_it() {
         ));
         assert_eq!(b.app.focus, Pane::World);
         let proposal_scrolled = b.screen(80, 24);
-        assert!(proposal_scrolled.contains("↕ rows 4–"), "{proposal_scrolled}");
+        assert!(
+            proposal_scrolled.contains("↕ rows 4–"),
+            "{proposal_scrolled}"
+        );
         insta::assert_snapshot!("proposal_scrolled_by_the_wheel_80x24", proposal_scrolled);
         b.app.on_mouse(mouse(
             MouseEventKind::Down(MouseButton::Left),

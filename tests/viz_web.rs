@@ -119,8 +119,11 @@ fn still_running(viewers: &BTreeSet<Served>) -> Vec<u32> {
             .iter()
             .map(|s| s.pid)
             .filter(|pid| {
-                std::fs::read_to_string(format!("/proc/{pid}/stat"))
-                    .is_ok_and(|stat| !stat.rsplit_once(')').is_some_and(|(_, r)| r.trim_start().starts_with('Z')))
+                std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+                    !stat
+                        .rsplit_once(')')
+                        .is_some_and(|(_, r)| r.trim_start().starts_with('Z'))
+                })
             })
             .collect();
         if running.is_empty() || started.elapsed() > Duration::from_secs(10) {
@@ -195,7 +198,10 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
     let after = first.wait_for(&["betr exited with status 0"], 30);
     assert!(after.contains("the web viewer was stopped"), "{after}");
     assert_eq!(still_running(&first_viewers), Vec::<u32>::new());
-    assert!(page_status(first_port).is_empty(), "{first_port} still serves");
+    assert!(
+        page_status(first_port).is_empty(),
+        "{first_port} still serves"
+    );
     assert!(page_status(second_port).contains("200"), "{second_port}");
 
     // The second's terminal closes: the hangup reaches its viewer with it.
@@ -229,7 +235,10 @@ fn a_one_shot_commands_web_viewer_stays_and_says_how_to_stop_it() {
     else {
         // Only a viewer already on the usual ports (another session's) is used without
         // starting one: then nothing is left to stop.
-        assert!(usual_listening, "no viewer started and none was there: {said}");
+        assert!(
+            usual_listening,
+            "no viewer started and none was there: {said}"
+        );
         assert!(
             said.contains("3D view: open http://127.0.0.1:9090/"),
             "{said}"

@@ -171,7 +171,9 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     };
     // The status bar says it when a viewer is not there or the recording stopped.
     let mut tap = super::viz_flags::SessionTap {
-        viz: args.viz.open(true, betr::viz::ViewerLife::StopsWithSession)?,
+        viz: args
+            .viz
+            .open(true, betr::viz::ViewerLife::StopsWithSession)?,
         record,
     };
     let theme = Theme::new(if ascii {

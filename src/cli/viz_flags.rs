@@ -51,7 +51,9 @@ impl VizFlags {
             && let Some(server) = viz.as_mut().and_then(Viz::take_web_server)
         {
             let pid = server.leave_running();
-            errln!("3D view: the web viewer keeps running after this command; `kill -- -{pid}` stops it");
+            errln!(
+                "3D view: the web viewer keeps running after this command; `kill -- -{pid}` stops it"
+            );
         }
         if !quiet && let Some(note) = viz.as_ref().and_then(Viz::notice) {
             errln!("{note}");

@@ -401,7 +401,10 @@ fn the_web_viewer_moves_off_ports_that_are_taken() {
     assert_ne!(web, viewer::WEB_PORT);
     assert_ne!(grpc, web);
     for port in [grpc, web] {
-        assert!(std::net::TcpListener::bind(("0.0.0.0", port)).is_ok(), "{port}");
+        assert!(
+            std::net::TcpListener::bind(("0.0.0.0", port)).is_ok(),
+            "{port}"
+        );
     }
 }
 
@@ -409,12 +412,9 @@ fn the_web_viewer_moves_off_ports_that_are_taken() {
 /// ports tried and how to use a viewer started by hand; one that is not there is said.
 #[test]
 fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
-    let error = viewer::start_web(
-        std::ffi::OsStr::new("false"),
-        ViewerLife::StopsWithSession,
-    )
-    .err()
-    .unwrap();
+    let error = viewer::start_web(std::ffi::OsStr::new("false"), ViewerLife::StopsWithSession)
+        .err()
+        .unwrap();
     let said = error.to_string();
     assert!(
         matches!(error, viewer::ViewerError::Stopped { attempts: 3, .. }),
@@ -428,5 +428,8 @@ fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
     )
     .err()
     .unwrap();
-    assert!(matches!(missing, viewer::ViewerError::NotInstalled), "{missing}");
+    assert!(
+        matches!(missing, viewer::ViewerError::NotInstalled),
+        "{missing}"
+    );
 }

@@ -186,7 +186,10 @@ fn stop_group(child: &mut Child, group: nix::unistd::Pid) {
         }
         std::thread::sleep(Duration::from_millis(50));
     }
-    tracing::warn!(group = group.as_raw(), "the web viewer did not stop when asked: killed");
+    tracing::warn!(
+        group = group.as_raw(),
+        "the web viewer did not stop when asked: killed"
+    );
     let _ = killpg(group, Signal::SIGKILL);
     let _ = child.wait();
 }
@@ -220,7 +223,12 @@ fn descendants(root: i32) -> Vec<i32> {
     let mut at = 0;
     while at < found.len() {
         let parent = found[at];
-        found.extend(parents.iter().filter(|(_, p)| *p == parent).map(|(c, _)| *c));
+        found.extend(
+            parents
+                .iter()
+                .filter(|(_, p)| *p == parent)
+                .map(|(c, _)| *c),
+        );
         at += 1;
     }
     found.remove(0);
@@ -317,15 +325,13 @@ fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebSer
     if own_group {
         command.process_group(0);
     }
-    let child = command
-        .spawn()
-        .map_err(|e| match e.kind() {
-            ErrorKind::NotFound => ViewerError::NotInstalled,
-            _ => ViewerError::CannotStart {
-                program: format!("{} --serve-web", program.to_string_lossy()),
-                reason: e.to_string(),
-            },
-        })?;
+    let child = command.spawn().map_err(|e| match e.kind() {
+        ErrorKind::NotFound => ViewerError::NotInstalled,
+        _ => ViewerError::CannotStart {
+            program: format!("{} --serve-web", program.to_string_lossy()),
+            reason: e.to_string(),
+        },
+    })?;
     // Owned from here: any way out of this function that does not return it stops it.
     let mut server = WebServer {
         child,

@@ -60,7 +60,6 @@ fn install_rerun_cli() -> PathBuf {
     rerun
 }
 
-
 /// The venv's `bin` directory, to put first on a command's PATH.
 pub fn bin_dir() -> PathBuf {
     rerun_cli().parent().unwrap().to_path_buf()

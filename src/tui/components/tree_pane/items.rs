@@ -173,4 +173,3 @@ pub(super) fn copy_columns(from: &Buffer, to: &mut Buffer, area: Rect, column: u
     // The cell right after a wide character is left blank by the widget; at the left
     // edge its character is out of view, so it shows as a blank.
 }
-

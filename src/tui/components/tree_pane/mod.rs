@@ -432,9 +432,7 @@ impl TreePane {
         self.extent = (self.widest_row(), usize::from(inner.width));
         self.column = self.column.min(self.max_column());
         if let Some(mark) = strings::sideways(self.column, self.column < self.max_column()) {
-            block = block.title(
-                Line::from(Span::styled(mark, theme.key)).right_aligned(),
-            );
+            block = block.title(Line::from(Span::styled(mark, theme.key)).right_aligned());
         }
         let widget = match TreeWidget::new(&self.items) {
             Ok(widget) => widget
