@@ -219,9 +219,9 @@ fn a_click_focuses_a_pane_and_the_wheel_scrolls_the_one_under_it() {
         assert_eq!(border_colour(&mut b, 0, 0), theme.focused.fg);
         assert_eq!(border_colour(&mut b, 44, 12), theme.border.fg);
 
-        // The world pane (at 120×40, where its facts have rows below the last error): a
+        // The world pane (its last error in one row at 80×24, so its facts have rows): a
         // click focuses it, the wheel scrolls its facts.
-        let world_before = b.screen(120, 40);
+        let world_before = b.screen(80, 24);
         let (world_x, world_row) = top_left_of(&world_before, "┌ World");
         let (world_x, world_row) = (world_x + 2, world_row + 2);
         b.app.on_mouse(mouse(
@@ -234,23 +234,24 @@ fn a_click_focuses_a_pane_and_the_wheel_scrolls_the_one_under_it() {
         b.screen(80, 24);
         assert_eq!(border_colour(&mut b, 44, 12), theme.focused.fg);
         assert_eq!(border_colour(&mut b, 0, 0), theme.border.fg);
-        b.screen(120, 40);
+        b.screen(80, 24);
         b.app.on_mouse(mouse(
             MouseEventKind::ScrollDown,
             world_x,
             world_row,
             KeyModifiers::NONE,
         ));
-        let world_scrolled = b.screen(120, 40);
+        let world_scrolled = b.screen(80, 24);
         assert!(
             world_scrolled.contains("↑ 3 row(s) above"),
             "{world_scrolled}"
         );
+        insta::assert_snapshot!("world_scrolled_by_the_wheel_80x24", world_scrolled);
         // Keys scroll the focused pane: ↑ one row back.
         b.key(KeyCode::Up);
-        assert!(b.screen(120, 40).contains("↑ 2 row(s) above"));
+        assert!(b.screen(80, 24).contains("↑ 2 row(s) above"));
         b.key(KeyCode::Home);
-        assert_eq!(b.screen(120, 40), world_before);
+        assert_eq!(b.screen(80, 24), world_before);
 
         // The proposal does not fit its pane at 80×24: it says which rows it shows, and the
         // wheel over it scrolls it without moving the focus.

@@ -2,7 +2,8 @@
 //! actions, and a table of the facts true now in the execution world, each marked when
 //! the last tick made it true, with the facts it made false listed (struck) above the
 //! rest. The table scrolls and can be narrowed to the facts holding a text; the objects
-//! are named when they fit on one line, else counted (D shows a node whole).
+//! are named when they fit on one line, else counted (D shows a node whole). A short pane
+//! shows the last error in one row, so the facts keep rows to scroll in.
 
 use std::collections::HashSet;
 
@@ -122,7 +123,21 @@ impl WorldPane {
 
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
         let mut lines: Vec<Line> = Vec::new();
-        if let Some(e) = &self.last_error {
+        let width = usize::from(area.width.saturating_sub(2));
+        // In a short pane the error takes one row, so the facts keep theirs (the LLM pane
+        // and D show it whole).
+        let short = area.height < SHORT_PANE;
+        if let (Some(e), true) = (&self.last_error, short) {
+            let style = if self.error_resolved {
+                theme.dim
+            } else {
+                theme.error
+            };
+            lines.push(Line::from(Span::styled(
+                cut_to(&format!("{} {e}", strings::LAST_ERROR), width),
+                style,
+            )));
+        } else if let Some(e) = &self.last_error {
             if self.error_resolved {
                 lines.push(Line::from(Span::styled(
                     strings::LAST_ERROR_RESOLVED,
@@ -141,7 +156,6 @@ impl WorldPane {
             )));
         }
         let names = format!("{} {}", strings::OBJECTS, self.objects.join(", "));
-        let width = usize::from(area.width.saturating_sub(2));
         lines.push(Line::from(Span::styled(
             if names.chars().count() <= width {
                 names
@@ -192,6 +206,19 @@ impl WorldPane {
             area,
         );
     }
+}
+
+/// Panes lower than this show the last error in one row.
+const SHORT_PANE: u16 = 12;
+
+/// `text` in at most `width` cells, ending in `…` when cut.
+fn cut_to(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        return text.to_string();
+    }
+    let mut cut: String = text.chars().take(width.saturating_sub(1)).collect();
+    cut.push('…');
+    cut
 }
 
 /// How the last tick changed a fact.
