@@ -5,58 +5,10 @@
 
 mod support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-const RERUN_SDK: &str = "rerun-sdk==0.36.3";
-
-/// The `rerun` program of the pinned Python package, installed on first use (once per
-/// test binary: two tests installing into one venv at once see each other's half-done
-/// install).
-fn rerun_cli() -> PathBuf {
-    static RERUN: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    RERUN.get_or_init(install_rerun_cli).clone()
-}
-
-fn install_rerun_cli() -> PathBuf {
-    let venv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("rerun-venv");
-    let rerun = venv.join("bin").join("rerun");
-    let version_ok = |rerun: &Path| {
-        Command::new(rerun)
-            .arg("--version")
-            .output()
-            .is_ok_and(|o| {
-                o.status.success() && String::from_utf8_lossy(&o.stdout).contains("0.36.3")
-            })
-    };
-    if version_ok(&rerun) {
-        return rerun;
-    }
-    if !venv.join("bin").join("pip").exists() {
-        let status = Command::new("python3")
-            .args(["-m", "venv"])
-            .arg(&venv)
-            .status()
-            .unwrap();
-        assert!(
-            status.success(),
-            "python3 -m venv failed (install python3-venv)"
-        );
-    }
-    let status = Command::new(venv.join("bin").join("pip"))
-        .args(["install", "--quiet", RERUN_SDK])
-        .status()
-        .unwrap();
-    assert!(status.success(), "pip install {RERUN_SDK} failed");
-    assert!(
-        version_ok(&rerun),
-        "{} is not rerun 0.36.3",
-        rerun.display()
-    );
-    // No usage data from test runs.
-    let _ = Command::new(&rerun).args(["analytics", "disable"]).output();
-    rerun
-}
+use support::rerun::rerun_cli;
 
 /// `rerun rrd ARGS…` with the pinned CLI.
 fn rerun_rrd(args: &[&std::ffi::OsStr]) -> std::process::Output {

@@ -98,8 +98,8 @@ fn workbench(replay: Replay, args: &ReplayArgs, ascii: bool) -> Result<ExitCode>
 
 fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
     let mut viz = Viz::open(&Sinks {
-        viewer: None,
         rrd: Some(out.to_path_buf()),
+        ..Sinks::default()
     })?
     .context("--to-rrd: no recording was opened")?;
     let mut cell = Resimulation::new(replay);

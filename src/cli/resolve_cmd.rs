@@ -313,7 +313,9 @@ fn resolve(
     llm.options.choose_reading = true;
     llm.options.policy_dir = policy_dir;
     llm.model.set_purpose("resolve");
-    let mut viz = args.viz.open(false)?;
+    let mut viz = args
+        .viz
+        .open(false, betr::viz::ViewerLife::OutlivesCommand)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
     outln!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {

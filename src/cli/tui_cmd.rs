@@ -171,7 +171,9 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     };
     // The status bar says it when a viewer is not there or the recording stopped.
     let mut tap = super::viz_flags::SessionTap {
-        viz: args.viz.open(true)?,
+        viz: args
+            .viz
+            .open(true, betr::viz::ViewerLife::StopsWithSession)?,
         record,
     };
     let theme = Theme::new(if ascii {
@@ -229,6 +231,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     }
     if let Some(path) = &args.viz.rrd {
         outln!("3D view (.rrd): {}", path.display());
+    }
+    // The web viewer started for the workbench goes with it.
+    if let Some(mut server) = tap.viz.as_mut().and_then(betr::viz::Viz::take_web_server) {
+        server.stop();
+        outln!("3D view: the web viewer was stopped");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -8,7 +8,7 @@ use anyhow::{Context as _, Result};
 use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
 use betr::session::{Command, Event};
-use betr::viz::{Sinks, Viewer, Viz};
+use betr::viz::{Sinks, Viewer, ViewerLife, Viz};
 
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct VizFlags {
@@ -32,14 +32,28 @@ pub struct VizFlags {
 impl VizFlags {
     /// The viz the flags ask for; a viewer that is not there is said once on stderr
     /// (`quiet`: not said, the caller shows `Viz::notice` itself). A web viewer's address
-    /// is always printed, before any workbench takes the screen.
-    pub fn open(&self, quiet: bool) -> Result<Option<Viz>> {
-        let viz = Viz::open(&Sinks {
+    /// is always printed, before any workbench takes the screen, with the ports it moved
+    /// to when the usual ones were taken; one that outlives the command is left running
+    /// and its process said.
+    pub fn open(&self, quiet: bool, web_viewer: ViewerLife) -> Result<Option<Viz>> {
+        let mut viz = Viz::open(&Sinks {
             viewer: self.viewer.clone(),
             rrd: self.rrd.clone(),
+            web_viewer,
         })?;
+        if let Some(moved) = viz.as_ref().and_then(Viz::web_moved) {
+            errln!("3D view: {moved}");
+        }
         if let Some(url) = viz.as_ref().and_then(Viz::web_url) {
             errln!("3D view: open {url}");
+        }
+        if web_viewer == ViewerLife::OutlivesCommand
+            && let Some(server) = viz.as_mut().and_then(Viz::take_web_server)
+        {
+            let pid = server.leave_running();
+            errln!(
+                "3D view: the web viewer keeps running after this command; `kill -- -{pid}` stops it"
+            );
         }
         if !quiet && let Some(note) = viz.as_ref().and_then(Viz::notice) {
             errln!("{note}");
@@ -96,6 +110,10 @@ impl betr::tui::Tap for SessionTap {
         if let Some(r) = self.record.as_mut() {
             r.command(command);
         }
+    }
+
+    fn viewer_page(&self) -> Option<String> {
+        self.viz.as_ref().and_then(Viz::web_url).map(str::to_string)
     }
 
     fn notice(&self) -> Option<String> {

@@ -4,7 +4,10 @@
 //! `session`. In a replay (`KeyMode::Replay`) the same state is built from a recording's
 //! events, and keys become moves in the recording instead of commands.
 
+mod panes;
 mod session;
+
+pub use panes::{Pane, PaneAreas};
 
 use std::sync::Arc;
 
@@ -110,6 +113,10 @@ pub struct App {
     pub overlay: Option<Overlay>,
     /// The live workbench, or a replay (whose keys move in the recording).
     pub mode: KeyMode,
+    /// The pane navigation keys go to.
+    pub focus: Pane,
+    /// Where the panes were drawn last (for the mouse).
+    areas: PaneAreas,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
     /// The scene's conditions the edit line completes from (built when first edited).
@@ -146,6 +153,8 @@ impl App {
             dictation: DictationPanel::default(),
             overlay: None,
             mode: KeyMode::Workbench,
+            focus: Pane::default(),
+            areas: PaneAreas::default(),
             queue: Vec::new(),
             vocabulary: None,
             summary: Summary::default(),
@@ -282,9 +291,7 @@ impl App {
         }
         match self.keys.action_in(self.mode, &key) {
             Some(action) => self.on_action(action),
-            None => {
-                self.tree.event(&key);
-            }
+            None => self.on_navigation(&key),
         }
     }
 
@@ -384,6 +391,12 @@ impl App {
             Action::SearchNext => return self.search(true),
             Action::SearchPrevious => return self.search(false),
             Action::CollapseAll => return self.tree.collapse_all(),
+            Action::ScrollLeft => return self.tree.scroll_left(),
+            Action::ScrollRight => return self.tree.scroll_right(),
+            Action::FocusNext => {
+                self.focus = self.focus.next();
+                return;
+            }
             Action::WorldUp => return self.world.scroll_up(),
             Action::WorldDown => return self.world.scroll_down(),
             Action::WorldFilter => {
@@ -458,11 +471,6 @@ impl App {
             None => strings::not_found(&query),
         };
         self.message(text, false);
-    }
-
-    /// A mouse event: on the tree pane it selects or scrolls.
-    pub fn on_mouse(&mut self, event: crossterm::event::MouseEvent) {
-        self.tree.mouse(&event);
     }
 
     /// What quitting now would lose, one line each (nothing in a replay).

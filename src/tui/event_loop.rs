@@ -164,6 +164,10 @@ pub trait Tap {
     fn command(&mut self, command: &Command);
     /// A line for the status bar (a viewer that is not connected).
     fn notice(&self) -> Option<String>;
+    /// The page of a web viewer showing the session, to open in a browser.
+    fn viewer_page(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Where the app's requests go.

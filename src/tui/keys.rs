@@ -48,6 +48,11 @@ pub enum Action {
     /// Close every node; open the way to the running node only.
     CollapseAll,
     ExpandToRunning,
+    /// Scroll the tree sideways, for long labels deep in it.
+    ScrollLeft,
+    ScrollRight,
+    /// Move the focus to the next pane (the arrows and PgUp PgDn scroll the focused one).
+    FocusNext,
     /// The world's fact table: scroll, and narrow to facts holding a text.
     WorldUp,
     WorldDown,
@@ -329,6 +334,9 @@ bindings! {
     search_previous: SearchPrevious = Key::plain('<'), Workbench;
     collapse_all: CollapseAll = Key::plain('C'), Both;
     expand_to_running: ExpandToRunning = Key::plain('E'), Both;
+    scroll_left: ScrollLeft = Key::plain('H'), Both;
+    scroll_right: ScrollRight = Key::plain('L'), Both;
+    focus_next: FocusNext = Key::code(KeyCode::Tab), Both;
     world_up: WorldUp = Key::plain('{'), Both;
     world_down: WorldDown = Key::plain('}'), Both;
     world_filter: WorldFilter = Key::plain('W'), Workbench;
@@ -446,8 +454,8 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "e", "u", "v", "s", "l", "o", "m", "M", "n",
-                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "{", "}", "W", "[",
-                "]", "?", "q"
+                "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "H", "L", "tab", "{",
+                "}", "W", "[", "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -503,8 +511,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "{", "}",
-                "[", "]", "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "H", "L",
+                "tab", "{", "}", "[", "]", "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

@@ -43,7 +43,7 @@ use crate::session::{Engine, SessionError, Setup};
 
 use dictation::{DictationService, Microphone, SttLoader};
 
-pub use app::{App, Info, ModelArrival, Request, Summary};
+pub use app::{App, Info, ModelArrival, Pane, Request, Summary};
 pub use keys::{KeyBindings, KeyMode};
 pub use theme::Theme;
 
@@ -143,6 +143,9 @@ pub async fn run(
     }
     let mut app = App::new(scenario, info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
+    if let Some(page) = tap.as_ref().and_then(|t| t.viewer_page()) {
+        app.llm.log(strings::viewer_page(&page));
+    }
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let queue = event_loop::Queue::new();
     let mut dictation = DictationService::reporting_to(microphone, stt, queue.dictation_sink());

@@ -6,6 +6,17 @@ pub const TREE_TITLE: &str = " Behavior tree ";
 pub const FOLLOWING: &str = " following the running node ";
 pub const SEARCH_TITLE: &str = " Search the tree (Enter finds, Esc cancels) ";
 
+/// On the tree's border when its rows are cut sideways: `«16` when 16 columns are
+/// scrolled past on the left, `»` when rows go on past the right edge.
+pub fn sideways(scrolled: usize, more_right: bool) -> Option<String> {
+    match (scrolled, more_right) {
+        (0, false) => None,
+        (0, true) => Some(" » ".to_string()),
+        (n, false) => Some(format!(" «{n} ")),
+        (n, true) => Some(format!(" «{n} » ")),
+    }
+}
+
 /// Under the tree while a search is on.
 pub fn searching(query: &str) -> String {
     format!(" /{query} ")
@@ -133,6 +144,16 @@ pub fn facts_heading(shown: usize, total: usize, filter: Option<&str>) -> String
 }
 
 /// Over the fact table scrolled down.
+/// The first line of the log when a web viewer shows the session.
+pub fn viewer_page(page: &str) -> String {
+    format!("3D view: open {page}")
+}
+
+/// Under a proposal cut to fit: which of its rows are shown.
+pub fn rows_of(first: usize, last: usize, total: usize) -> String {
+    format!("↕ rows {first}–{last} of {total} · D whole")
+}
+
 pub fn rows_above(rows: usize) -> String {
     format!("↑ {rows} row(s) above")
 }
@@ -229,19 +250,23 @@ pub const SELECT_A_NODE: &str = "select a node in the tree first (↑ ↓)";
 
 /// One line per navigation key (fixed, not rebindable).
 pub const NAVIGATION: &[(&str, &str)] = &[
-    ("↑ ↓ / k j", "move in the tree"),
+    ("↑ ↓ / k j", "move in the focused pane (the tree: select)"),
     ("← →", "collapse / expand a node"),
     ("Enter", "toggle a node"),
-    ("PgUp PgDn Home End", "scroll the tree"),
+    ("PgUp PgDn Home End", "scroll the focused pane"),
+    ("mouse", "click: focus a pane, select a node; wheel: scroll"),
+    ("shift-wheel", "scroll the tree sideways"),
     ("Ctrl-C", "quit"),
 ];
 
 /// The navigation keys of a replay: the arrows move in the recording, so a node is
 /// collapsed and expanded with Enter.
 pub const REPLAY_NAVIGATION: &[(&str, &str)] = &[
-    ("↑ ↓ / k j", "move in the tree"),
+    ("↑ ↓ / k j", "move in the focused pane (the tree: select)"),
     ("Enter", "collapse / expand a node"),
-    ("PgUp PgDn Home End", "scroll the tree"),
+    ("PgUp PgDn Home End", "scroll the focused pane"),
+    ("mouse", "click: focus a pane, select a node; wheel: scroll"),
+    ("shift-wheel", "scroll the tree sideways"),
     ("Ctrl-C", "quit"),
 ];
 
@@ -280,6 +305,9 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         SearchPrevious => "the previous match of the search",
         CollapseAll => "collapse every node",
         ExpandToRunning => "collapse all but the way to the running node",
+        ScrollLeft => "scroll the tree left (long labels)",
+        ScrollRight => "scroll the tree right (long labels)",
+        FocusNext => "focus the next pane: tree, proposal, log, world",
         LogUp => "scroll the log to older lines",
         LogDown => "scroll the log to newer lines",
         Help => "show / hide this help",

@@ -26,6 +26,8 @@ pub struct Theme {
     pub selected: Style,
     pub title: Style,
     pub border: Style,
+    /// The border of the pane keys go to.
+    pub focused: Style,
     pub status_bar: Style,
     pub proposal: Style,
     pub error: Style,
@@ -62,6 +64,7 @@ impl Theme {
             selected: Style::new().add_modifier(Modifier::REVERSED),
             title: Style::new().add_modifier(Modifier::BOLD),
             border: Style::new().fg(Color::DarkGray),
+            focused: Style::new().fg(Color::Yellow),
             status_bar: Style::new().fg(Color::Black).bg(Color::Cyan),
             proposal: Style::new().fg(Color::Cyan).add_modifier(Modifier::BOLD),
             error: Style::new().fg(Color::Red).add_modifier(Modifier::BOLD),

@@ -34,6 +34,11 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
         .areas(main);
         (tree, llm, world)
     };
+    app.place_panes(super::app::PaneAreas {
+        tree: tree_area,
+        llm: llm_area,
+        world: world_area,
+    });
     let theme = app.theme;
     let key = |a: Action| app.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
     let hint = match app.mode {

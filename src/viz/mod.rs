@@ -22,6 +22,9 @@ mod tests;
 pub mod tree;
 mod viewer;
 
+pub use viewer::{GRPC_PORT, ViewerLife, WEB_PORT, WebServer};
+
+use std::ffi::OsStr;
 use std::net::{TcpStream, ToSocketAddrs};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -82,6 +85,8 @@ impl std::str::FromStr for Viewer {
 pub struct Sinks {
     pub viewer: Option<Viewer>,
     pub rrd: Option<PathBuf>,
+    /// How long a web viewer started for the session lives.
+    pub web_viewer: ViewerLife,
 }
 
 impl Sinks {
@@ -141,10 +146,15 @@ pub struct Viz {
     notice: Option<String>,
     /// What to open in a browser, when a web viewer was asked for.
     web_url: Option<String>,
+    /// Why the web viewer is not on the usual ports, when it is not.
+    web_moved: Option<String>,
     /// An `.rrd` file is written: flushed whenever the session comes to rest, so a
     /// session killed while it waits (for the model, for a person) leaves a file that
     /// holds everything up to there.
     file: bool,
+    /// The web viewer started for this session alone; last, so the stream is closed
+    /// before the viewer stops.
+    web_server: Option<WebServer>,
 }
 
 impl Viz {
@@ -177,6 +187,8 @@ impl Viz {
             out.push(Box::new(sink));
         }
         let mut web_url = None;
+        let mut web_moved = None;
+        let mut web_server = None;
         let url = match &sinks.viewer {
             Some(Viewer::Connect(url)) => Some(url.clone().unwrap_or_else(|| DEFAULT_URL.into())),
             Some(Viewer::Spawn) => match viewer::spawn_native() {
@@ -186,9 +198,11 @@ impl Viz {
                     None
                 }
             },
-            Some(Viewer::Web) => match viewer::start_web() {
+            Some(Viewer::Web) => match viewer::start_web(OsStr::new("rerun"), sinks.web_viewer) {
                 Ok(web) => {
                     web_url = Some(web.open);
+                    web_moved = web.moved;
+                    web_server = web.server;
                     Some(web.grpc)
                 }
                 Err(why) => {
@@ -215,6 +229,8 @@ impl Viz {
         let mut viz = Viz::with_stream(rec);
         viz.notice = notice;
         viz.web_url = web_url;
+        viz.web_moved = web_moved;
+        viz.web_server = web_server;
         viz.file = sinks.rrd.is_some();
         Ok(Some(viz))
     }
@@ -238,13 +254,26 @@ impl Viz {
             repairing: false,
             notice: None,
             web_url: None,
+            web_moved: None,
             file: false,
+            web_server: None,
         }
     }
 
     /// The address to open in a browser, when a web viewer was asked for and is there.
     pub fn web_url(&self) -> Option<&str> {
         self.web_url.as_deref()
+    }
+
+    /// Why the web viewer is not on the usual ports, when it is not.
+    pub fn web_moved(&self) -> Option<&str> {
+        self.web_moved.as_deref()
+    }
+
+    /// The web viewer started for this session, to leave running or to stop; none when
+    /// none was started (or it was taken already).
+    pub fn take_web_server(&mut self) -> Option<WebServer> {
+        self.web_server.take()
     }
 
     /// Steps on the `step` timeline so far.

@@ -228,7 +228,7 @@ fn viewer_flags_parse() {
     assert_eq!("spawn".parse::<Viewer>().unwrap(), Viewer::Spawn);
     assert_eq!("web".parse::<Viewer>().unwrap(), Viewer::Web);
     assert_eq!(
-        viewer::web_page(DEFAULT_URL),
+        viewer::web_page(DEFAULT_URL, WEB_PORT),
         "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
     );
     assert_eq!("connect".parse::<Viewer>().unwrap(), Viewer::Connect(None));
@@ -252,7 +252,7 @@ fn a_viewer_that_is_not_there_is_said_once_and_the_session_goes_on() {
         viewer: Some(Viewer::Connect(Some(
             "rerun+http://127.0.0.1:9/proxy".into(),
         ))),
-        rrd: None,
+        ..Sinks::default()
     })
     .unwrap()
     .unwrap();
@@ -381,7 +381,7 @@ fn spawning_without_a_display_says_so() {
     }
     let viz = Viz::open(&Sinks {
         viewer: Some(Viewer::Spawn),
-        rrd: None,
+        ..Sinks::default()
     })
     .unwrap()
     .unwrap();
@@ -565,5 +565,53 @@ fn a_blocking_link_is_marked_in_its_frame() {
     assert!(
         logged.components["world/solids/red_cube"].contains("Boxes3D:labels"),
         "the solid is marked instead"
+    );
+}
+
+/// With the usual ports held by another program, the web viewer's ports are others the
+/// system gives, both free and different; held only while they are chosen.
+#[test]
+fn the_web_viewer_moves_off_ports_that_are_taken() {
+    // Hold the usual ports where this test can (another program may hold them already,
+    // which serves the test as well).
+    let _held: Vec<std::net::TcpListener> = [viewer::GRPC_PORT, viewer::WEB_PORT]
+        .iter()
+        .filter_map(|p| std::net::TcpListener::bind(("0.0.0.0", *p)).ok())
+        .collect();
+    let (grpc, web) = viewer::free_ports().unwrap();
+    assert_ne!(grpc, viewer::GRPC_PORT);
+    assert_ne!(web, viewer::WEB_PORT);
+    assert_ne!(grpc, web);
+    for port in [grpc, web] {
+        assert!(
+            std::net::TcpListener::bind(("0.0.0.0", port)).is_ok(),
+            "{port}"
+        );
+    }
+}
+
+/// A viewer program that stops at once is tried again on new ports, then refused with the
+/// ports tried and how to use a viewer started by hand; one that is not there is said.
+#[test]
+fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
+    let error = viewer::start_web(std::ffi::OsStr::new("false"), ViewerLife::StopsWithSession)
+        .err()
+        .unwrap();
+    let said = error.to_string();
+    assert!(
+        matches!(error, viewer::ViewerError::Stopped { attempts: 3, .. }),
+        "{said}"
+    );
+    assert!(said.contains("before listening on ports"), "{said}");
+    assert!(said.contains("--viewer connect=URL"), "{said}");
+    let missing = viewer::start_web(
+        std::ffi::OsStr::new("/nonexistent/rerun"),
+        ViewerLife::StopsWithSession,
+    )
+    .err()
+    .unwrap();
+    assert!(
+        matches!(missing, viewer::ViewerError::NotInstalled),
+        "{missing}"
     );
 }

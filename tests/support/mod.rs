@@ -13,6 +13,7 @@ pub mod microphone;
 pub mod multipart;
 pub mod recorded;
 pub mod repo;
+pub mod rerun;
 pub mod tmux;
 pub mod verify;
 pub mod workbench;

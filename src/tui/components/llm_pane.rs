@@ -122,6 +122,15 @@ pub struct LlmPane {
     /// Rows of the log above the view when it last followed its newest line: how far it
     /// can be scrolled.
     log_hidden: std::cell::Cell<usize>,
+    /// Rows of the proposal (and goal) above the log scrolled past, when they do not fit.
+    head_scroll: usize,
+    /// How far they can be scrolled at the last draw.
+    head_hidden: std::cell::Cell<usize>,
+    /// Where the log was drawn last (for the mouse).
+    log_area: std::cell::Cell<Rect>,
+    /// Whether keys go to this pane, and to its log.
+    pub focused: bool,
+    pub log_focused: bool,
     spin: usize,
 }
 
@@ -166,6 +175,27 @@ impl LlmPane {
     /// Scroll the log towards the newest line (following it again at the bottom).
     pub fn scroll_log_down(&mut self) {
         self.log_scroll = self.log_scroll.saturating_sub(SCROLL_ROWS);
+    }
+
+    /// Scroll the log `rows` towards older lines (negative: towards the newest).
+    pub fn scroll_log(&mut self, rows: isize) {
+        self.log_scroll = self
+            .log_scroll
+            .saturating_add_signed(rows)
+            .min(self.log_hidden.get());
+    }
+
+    /// Scroll the proposal above the log `rows` down (negative: up), when it does not fit.
+    pub fn scroll_head(&mut self, rows: isize) {
+        self.head_scroll = self
+            .head_scroll
+            .saturating_add_signed(rows)
+            .min(self.head_hidden.get());
+    }
+
+    /// Where the log was drawn last.
+    pub fn log_area(&self) -> Rect {
+        self.log_area.get()
     }
 
     /// Scroll the log as far up as `previous` was.
@@ -228,11 +258,19 @@ impl LlmPane {
         }
         lines.push(Line::from(Span::styled(
             format!("── {} ──", strings::LOG),
-            theme.dim,
+            if self.log_focused {
+                theme.focused
+            } else {
+                theme.dim
+            },
         )));
         let mut block = Block::default()
             .borders(Borders::ALL)
-            .border_style(theme.border)
+            .border_style(if self.focused {
+                theme.focused
+            } else {
+                theme.border
+            })
             .title(Span::styled(strings::LLM_TITLE, theme.title));
         // What is proposed and the keys that answer it stay on the border, so a pane too
         // small for the findings still shows them (D shows the whole proposal).
@@ -248,11 +286,50 @@ impl LlmPane {
         frame.render_widget(block, area);
         // The parts above the log take the rows they wrap to; the log gets the rest.
         let head = Paragraph::new(lines).wrap(Wrap { trim: false });
-        let head_rows = u16::try_from(head.line_count(inner.width)).unwrap_or(u16::MAX);
-        let [head_area, log_area] =
-            Layout::vertical([Constraint::Length(head_rows), Constraint::Fill(1)]).areas(inner);
-        frame.render_widget(head, head_area);
+        let head_rows = head.line_count(inner.width);
+        let [head_area, log_area] = Layout::vertical([
+            Constraint::Length(u16::try_from(head_rows).unwrap_or(u16::MAX)),
+            Constraint::Fill(1),
+        ])
+        .areas(inner);
+        self.draw_head(frame, head, head_rows, head_area, theme);
+        self.log_area.set(log_area);
         self.draw_log(frame, log_area, theme);
+    }
+
+    /// The proposal and the goal: whole when they fit, else the rows scrolled to with a
+    /// last row saying which rows these are.
+    fn draw_head(
+        &self,
+        frame: &mut Frame,
+        head: Paragraph,
+        rows: usize,
+        area: Rect,
+        theme: &Theme,
+    ) {
+        let height = usize::from(area.height);
+        if rows <= height || height < 2 {
+            self.head_hidden.set(0);
+            frame.render_widget(head, area);
+            return;
+        }
+        let shown = height - 1;
+        let hidden = rows - shown;
+        self.head_hidden.set(hidden);
+        let top = self.head_scroll.min(hidden);
+        let [text_area, marker_area] =
+            Layout::vertical([Constraint::Fill(1), Constraint::Length(1)]).areas(area);
+        frame.render_widget(
+            head.scroll((u16::try_from(top).unwrap_or(u16::MAX), 0)),
+            text_area,
+        );
+        frame.render_widget(
+            Paragraph::new(Span::styled(
+                strings::rows_of(top + 1, top + shown, rows),
+                theme.key,
+            )),
+            marker_area,
+        );
     }
 }
 

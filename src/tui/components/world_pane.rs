@@ -3,7 +3,8 @@
 //! attempts, or what blocked it), and a table of the facts true now in the execution world, each marked when
 //! the last tick made it true, with the facts it made false listed (struck) above the
 //! rest. The table scrolls and can be narrowed to the facts holding a text; the objects
-//! are named when they fit on one line, else counted (D shows a node whole).
+//! are named when they fit on one line, else counted (D shows a node whole). A short pane
+//! shows the last error in one row, so the facts keep rows to scroll in.
 
 use std::collections::HashSet;
 
@@ -40,6 +41,8 @@ pub struct WorldPane {
     /// Do not mark what changed: a replay seeks past the worlds in between, so the
     /// world before the last one is not known there.
     pub unmarked: bool,
+    /// Whether keys go to this pane (its border says so).
+    pub focused: bool,
 }
 
 /// Rows one scroll key moves the fact table.
@@ -79,11 +82,17 @@ impl WorldPane {
     }
 
     pub fn scroll_down(&mut self) {
-        self.scroll = (self.scroll + SCROLL_ROWS).min(self.rows().len().saturating_sub(1));
+        self.scroll(SCROLL_ROWS.cast_signed());
     }
 
     pub fn scroll_up(&mut self) {
-        self.scroll = self.scroll.saturating_sub(SCROLL_ROWS);
+        self.scroll(-SCROLL_ROWS.cast_signed());
+    }
+
+    /// Scroll the fact table by `rows` (negative: up), keeping its last row in view.
+    pub fn scroll(&mut self, rows: isize) {
+        let last = self.rows().len().saturating_sub(1);
+        self.scroll = self.scroll.saturating_add_signed(rows).min(last);
     }
 
     pub fn set_filter(&mut self, filter: Option<String>) {
@@ -118,7 +127,21 @@ impl WorldPane {
 
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme) {
         let mut lines: Vec<Line> = Vec::new();
-        if let Some(e) = &self.last_error {
+        let width = usize::from(area.width.saturating_sub(2));
+        // In a short pane the error takes one row, so the facts keep theirs (the LLM pane
+        // and D show it whole).
+        let short = area.height < SHORT_PANE;
+        if let (Some(e), true) = (&self.last_error, short) {
+            let style = if self.error_resolved {
+                theme.dim
+            } else {
+                theme.error
+            };
+            lines.push(Line::from(Span::styled(
+                cut_to(&format!("{} {e}", strings::LAST_ERROR), width),
+                style,
+            )));
+        } else if let Some(e) = &self.last_error {
             if self.error_resolved {
                 lines.push(Line::from(Span::styled(
                     strings::LAST_ERROR_RESOLVED,
@@ -145,7 +168,6 @@ impl WorldPane {
             lines.push(Line::from(Span::styled(strings::last_motion(m), style)));
         }
         let names = format!("{} {}", strings::OBJECTS, self.objects.join(", "));
-        let width = usize::from(area.width.saturating_sub(2));
         lines.push(Line::from(Span::styled(
             if names.chars().count() <= width {
                 names
@@ -183,7 +205,11 @@ impl WorldPane {
         }
         let block = Block::default()
             .borders(Borders::ALL)
-            .border_style(theme.border)
+            .border_style(if self.focused {
+                theme.focused
+            } else {
+                theme.border
+            })
             .title(Span::styled(strings::WORLD_TITLE, theme.title));
         frame.render_widget(
             Paragraph::new(lines)
@@ -192,6 +218,19 @@ impl WorldPane {
             area,
         );
     }
+}
+
+/// Panes lower than this show the last error in one row.
+const SHORT_PANE: u16 = 12;
+
+/// `text` in at most `width` cells, ending in `…` when cut.
+fn cut_to(text: &str, width: usize) -> String {
+    if text.chars().count() <= width {
+        return text.to_string();
+    }
+    let mut cut: String = text.chars().take(width.saturating_sub(1)).collect();
+    cut.push('…');
+    cut
 }
 
 /// How the last tick changed a fact.

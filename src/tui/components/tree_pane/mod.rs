@@ -3,17 +3,28 @@
 //! marked, and the debugger's marks: breakpoints, forced statuses and the node a run
 //! stopped at. Items are rebuilt only when the tree or the statuses change, iteratively (no
 //! recursion, so deep trees are fine); the widget draws only the visible rows.
+//!
+//! Long labels deep in a tree scroll sideways. tui-tree-widget 0.24 has no horizontal
+//! offset (its rows always start at the pane's left edge), so a scrolled pane draws the
+//! widget into a buffer as much wider as it is scrolled and copies the columns in view:
+//! indentation, fold symbols and highlight move together, and clicks still find their
+//! row (the widget matches them by row only).
 
 use std::sync::Arc;
 
 use crossterm::event::{KeyCode, KeyEvent};
 use ratatui::Frame;
-use ratatui::layout::Rect;
+use ratatui::buffer::Buffer;
+use ratatui::layout::{Position, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use tui_tree_widget::{Tree as TreeWidget, TreeItem, TreeState};
 
-use crate::bt::{Forced, NodeId, NodeKind, Status, TickRecord, Tree};
+use crate::bt::{Forced, NodeId, Status, TickRecord, Tree};
+
+mod items;
+
+use items::{build_items, composite_paths, copy_columns, node_label};
 
 use super::super::strings;
 use super::super::theme::Theme;
@@ -32,7 +43,19 @@ pub struct TreePane {
     pub follow: bool,
     /// The last search, for next and previous.
     pub query: Option<String>,
+    /// Whether keys go to this pane (its border says so).
+    pub focused: bool,
+    /// Columns scrolled past on the left.
+    column: usize,
+    /// Each node's label width in cells, by node index (rebuilt with the items).
+    widths: Vec<usize>,
+    /// The widest shown row and the pane's inner width at the last draw: how far the
+    /// pane can scroll sideways.
+    extent: (usize, usize),
 }
+
+/// Columns one sideways key or wheel notch moves the tree.
+const SIDEWAYS_STEP: usize = 8;
 
 /// Where a search stands: the match selected (from 1) of how many.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -175,14 +198,20 @@ impl TreePane {
         }
     }
 
-    /// A mouse click on the pane selects (and toggles) the row; the wheel scrolls.
+    /// A mouse click on the pane selects (and toggles) the row; the wheel scrolls, and
+    /// the horizontal wheel (or the wheel with Shift held) scrolls sideways.
     pub fn mouse(&mut self, event: &crossterm::event::MouseEvent) {
-        use crossterm::event::{MouseButton, MouseEventKind};
-        let at = ratatui::layout::Position::new(event.column, event.row);
+        use crossterm::event::{KeyModifiers, MouseButton, MouseEventKind};
+        let at = Position::new(event.column, event.row);
+        let shift = event.modifiers.contains(KeyModifiers::SHIFT);
         match event.kind {
             MouseEventKind::Down(MouseButton::Left) => {
                 self.state.click_at(at);
             }
+            MouseEventKind::ScrollLeft => self.scroll_left(),
+            MouseEventKind::ScrollRight => self.scroll_right(),
+            MouseEventKind::ScrollUp if shift => self.scroll_left(),
+            MouseEventKind::ScrollDown if shift => self.scroll_right(),
             MouseEventKind::ScrollDown => {
                 self.state.scroll_down(3);
             }
@@ -191,6 +220,26 @@ impl TreePane {
             }
             _ => {}
         }
+    }
+
+    /// Scroll towards the labels' starts.
+    pub fn scroll_left(&mut self) {
+        self.column = self.column.saturating_sub(SIDEWAYS_STEP);
+    }
+
+    /// Scroll towards the labels' ends, no further than the widest row shown needs.
+    pub fn scroll_right(&mut self) {
+        self.column = (self.column + SIDEWAYS_STEP).min(self.max_column());
+    }
+
+    /// Columns scrolled past on the left.
+    pub fn column(&self) -> usize {
+        self.column
+    }
+
+    fn max_column(&self) -> usize {
+        let (widest, width) = self.extent;
+        widest.saturating_sub(width)
     }
 
     /// Statuses back to "not ticked" (the world was reset).
@@ -340,12 +389,14 @@ impl TreePane {
             return;
         }
         self.dirty = false;
+        self.widths = vec![0; self.tree.as_ref().map_or(0, |t| t.capacity())];
         self.items = match &self.tree {
             Some(tree) => vec![build_items(
                 tree,
                 self.record.as_deref(),
                 &self.marks,
                 theme,
+                &mut self.widths,
             )],
             None => Vec::new(),
         };
@@ -353,9 +404,14 @@ impl TreePane {
 
     pub fn draw(&mut self, frame: &mut Frame, area: Rect, theme: &Theme) {
         self.rebuild(theme);
+        let border = if self.focused {
+            theme.focused
+        } else {
+            theme.border
+        };
         let mut block = Block::default()
             .borders(Borders::ALL)
-            .border_style(theme.border)
+            .border_style(border)
             .title(Span::styled(strings::TREE_TITLE, theme.title));
         if self.follow {
             block = block.title(Span::styled(strings::FOLLOWING, theme.key));
@@ -364,6 +420,7 @@ impl TreePane {
             block = block.title_bottom(Span::styled(strings::searching(q), theme.dim));
         }
         if self.items.is_empty() {
+            self.column = 0;
             let text = Paragraph::new(self.empty_text.unwrap_or(strings::TREE_EMPTY))
                 .style(theme.dim)
                 .wrap(Wrap { trim: true })
@@ -371,150 +428,63 @@ impl TreePane {
             frame.render_widget(text, area);
             return;
         }
-        match TreeWidget::new(&self.items) {
-            Ok(widget) => {
-                let widget = widget
-                    .block(block)
-                    .highlight_style(theme.selected)
-                    .node_closed_symbol("▸ ")
-                    .node_open_symbol("▾ ")
-                    .node_no_children_symbol("  ");
-                frame.render_stateful_widget(widget, area, &mut self.state);
-            }
+        let inner = block.inner(area);
+        self.extent = (self.widest_row(), usize::from(inner.width));
+        self.column = self.column.min(self.max_column());
+        if let Some(mark) = strings::sideways(self.column, self.column < self.max_column()) {
+            block = block.title(Line::from(Span::styled(mark, theme.key)).right_aligned());
+        }
+        let widget = match TreeWidget::new(&self.items) {
+            Ok(widget) => widget
+                .highlight_style(theme.selected)
+                .node_closed_symbol("▸ ")
+                .node_open_symbol("▾ ")
+                .node_no_children_symbol("  "),
             Err(e) => {
                 tracing::warn!(error = %e, "cannot draw the tree");
-            }
-        }
-    }
-}
-
-/// Identifier paths of every composite, to open them all.
-fn composite_paths(tree: &Tree) -> Vec<Vec<u32>> {
-    let mut out = Vec::new();
-    let mut stack: Vec<(NodeId, Vec<u32>)> = vec![(tree.root(), vec![tree.root().0])];
-    while let Some((node, path)) = stack.pop() {
-        let children = tree.children(node).unwrap_or_default();
-        if children.is_empty() {
-            continue;
-        }
-        for c in children {
-            let mut p = path.clone();
-            p.push(c.0);
-            stack.push((*c, p));
-        }
-        out.push(path);
-    }
-    out
-}
-
-/// The widget's items for `tree`, children before parents (no recursion).
-fn build_items(
-    tree: &Tree,
-    record: Option<&TickRecord>,
-    marks: &Marks,
-    theme: &Theme,
-) -> TreeItem<'static, u32> {
-    let mut built: Vec<Option<TreeItem<'static, u32>>> = vec![None; tree.capacity()];
-    let order = tree.preorder();
-    for &node in order.iter().rev() {
-        let status = record.map_or(Status::Idle, |r| r.status(node));
-        let mut line = node_line(tree, node, status, marks, theme);
-        if let Some((_, rules)) = marks.learned.iter().find(|(n, _)| *n == node) {
-            line.spans
-                .push(Span::styled(strings::learned_mark(rules), theme.dim));
-        }
-        if marks.breakpoints.contains(&node) {
-            line.spans.push(Span::styled(
-                format!(" {}", strings::BREAKPOINT_MARK),
-                theme.breakpoint,
-            ));
-        }
-        if let Some((_, forced)) = marks.forced.iter().find(|(n, _)| *n == node) {
-            line.spans
-                .push(Span::styled(strings::forced_mark(*forced), theme.forced));
-        }
-        if marks.stopped == Some(node) {
-            line.spans.push(Span::styled(
-                format!(" {}", strings::STOPPED_MARK),
-                theme.key,
-            ));
-        }
-        let children: Vec<TreeItem<'static, u32>> = tree
-            .children(node)
-            .unwrap_or_default()
-            .iter()
-            .filter_map(|c| built.get_mut(c.index()).and_then(Option::take))
-            .collect();
-        let item = if children.is_empty() {
-            TreeItem::new_leaf(node.0, line)
-        } else {
-            match TreeItem::new(node.0, line.clone(), children) {
-                Ok(item) => item,
-                Err(_) => TreeItem::new_leaf(node.0, line),
+                return;
             }
         };
-        if let Some(slot) = built.get_mut(node.index()) {
-            *slot = Some(item);
+        frame.render_widget(block, area);
+        if self.column == 0 {
+            frame.render_stateful_widget(widget, inner, &mut self.state);
+            return;
         }
+        // Drawn as wide as the scrolled-past columns plus the pane, then the part in view
+        // copied over.
+        let column = u16::try_from(self.column).unwrap_or(u16::MAX);
+        let wide = Rect {
+            width: inner.width.saturating_add(column),
+            ..inner
+        };
+        let mut drawn = Buffer::empty(wide);
+        ratatui::widgets::StatefulWidget::render(widget, wide, &mut drawn, &mut self.state);
+        copy_columns(&drawn, frame.buffer_mut(), inner, column);
     }
-    built
-        .get_mut(tree.root().index())
-        .and_then(Option::take)
-        .unwrap_or_else(|| TreeItem::new_leaf(tree.root().0, ""))
-}
 
-/// `[-] Sequence`, `grasp "blue cube"!`.
-fn node_label(tree: &Tree, node: NodeId, theme: &Theme) -> String {
-    let g = theme.glyphs;
-    match tree.kind(node) {
-        Ok(NodeKind::Sequence) => format!("{} {}", g.sequence, g.sequence_name),
-        Ok(NodeKind::Fallback) => format!("{} {}", g.fallback, g.fallback_name),
-        Ok(NodeKind::Condition(c)) => format!("{c}{}", g.condition_suffix),
-        Ok(NodeKind::Action(a)) => format!("{a}{}", g.action_suffix),
-        Err(_) => String::new(),
+    /// The widest row the widget shows now: indentation, fold symbol and label.
+    fn widest_row(&self) -> usize {
+        self.state
+            .flatten(&self.items)
+            .iter()
+            .map(|row| {
+                let label = row
+                    .identifier
+                    .last()
+                    .and_then(|id| self.widths.get(NodeId(*id).index()))
+                    .copied()
+                    .unwrap_or(0);
+                row.depth() * 2 + 2 + label
+            })
+            .max()
+            .unwrap_or(0)
     }
-}
-
-/// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
-fn node_line(
-    tree: &Tree,
-    node: NodeId,
-    status: Status,
-    marks: &Marks,
-    theme: &Theme,
-) -> Line<'static> {
-    let new = marks.new_nodes.contains(&node);
-    let failing = marks.failing == Some(node);
-    let label = node_label(tree, node, theme);
-    let mut spans = vec![
-        Span::styled(if new { strings::NEW_MARK } else { " " }, theme.new_node),
-        Span::styled(
-            format!("[{}] ", theme.glyphs.status(status)),
-            theme.status(status),
-        ),
-    ];
-    let style = if failing {
-        theme.failing
-    } else if marks.stopped == Some(node) {
-        theme.stopped
-    } else if new {
-        theme.new_node.patch(theme.status(status))
-    } else {
-        theme.status(status)
-    };
-    spans.push(Span::styled(label, style));
-    if failing {
-        spans.push(Span::styled(
-            format!(" {}", strings::FAILED_MARK),
-            theme.error,
-        ));
-    }
-    Line::from(spans)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bt::NodeKind;
     use crate::domain::{ActionCall, Condition};
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
