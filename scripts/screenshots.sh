@@ -5,11 +5,17 @@
 # docs/images/: the planned tree, the failure with the proposal awaiting approval, and
 # success after the repair. Run it again whenever the screens change.
 # Usage: bash scripts/screenshots.sh   (needs tmux and python3; fetches the model once)
+#        BETR=path/to/betr bash scripts/screenshots.sh   (a betr already built, e.g. the
+#        dev profile's target/debug/betr, instead of building the release one)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v tmux >/dev/null || { echo "error: tmux is needed (apt install tmux)" >&2; exit 2; }
-cargo build --release --locked
-betr="$PWD/target/release/betr"
+if [ -n "${BETR:-}" ]; then
+  betr="$(cd "$(dirname "$BETR")" && pwd)/$(basename "$BETR")"
+else
+  cargo build --release --locked
+  betr="$PWD/target/release/betr"
+fi
 out="docs/images"
 mkdir -p "$out"
 betr_dir="$(mktemp -d)"
