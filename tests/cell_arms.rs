@@ -112,6 +112,30 @@ const FAILURES: &[(&str, &[Expected])] = &[
             "collides with centrifuge lid",
         )],
     ),
+    (
+        "cupboard.toml",
+        &[(
+            "open \"cupboard\"",
+            "Torque limit exceeded",
+            "Torque limit exceeded",
+        )],
+    ),
+    (
+        "banana_unknown.toml",
+        &[(
+            "grasp \"banana\"",
+            "Object \"banana\" is not in the dictionary",
+            "not in the dictionary",
+        )],
+    ),
+    (
+        "banana_far.toml",
+        &[(
+            "grasp \"banana\"",
+            "Position out of reach: pose",
+            "is out of reach of yumi_link_7_",
+        )],
+    ),
 ];
 
 #[test]
