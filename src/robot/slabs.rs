@@ -136,11 +136,11 @@ fn merge(fine: &[Bounds]) -> Vec<Bounds> {
     }
     // span[i][j]: the box around fine slabs i..=j.
     let mut span = vec![vec![Bounds::empty(); n]; n];
-    for i in 0..n {
+    for (i, row) in span.iter_mut().enumerate() {
         let mut b = Bounds::empty();
-        for j in i..n {
-            b = b.merged(&fine[j]);
-            span[i][j] = b;
+        for (j, slab) in fine.iter().enumerate().skip(i) {
+            b = b.merged(slab);
+            row[j] = b;
         }
     }
     // cost[k][j]: least volume of the first j slabs in k groups; from[k][j]: where the
