@@ -178,3 +178,71 @@ fn merge(fine: &[Bounds]) -> Vec<Bounds> {
     boxes.reverse();
     boxes
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The twelve triangles of the box from `lo` to `hi`.
+    fn cuboid(lo: [f32; 3], hi: [f32; 3]) -> Vec<[Point3<f32>; 3]> {
+        let c = |i: usize| {
+            Point3::new(
+                if i & 1 == 0 { lo[0] } else { hi[0] },
+                if i & 2 == 0 { lo[1] } else { hi[1] },
+                if i & 4 == 0 { lo[2] } else { hi[2] },
+            )
+        };
+        let faces = [
+            [0, 1, 3, 2],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 3, 7, 5],
+        ];
+        faces
+            .iter()
+            .flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]])
+            .collect()
+    }
+
+    #[test]
+    fn a_wide_foot_under_a_thin_column_is_two_boxes_that_hold_every_triangle() {
+        // Long triangles across every slab: the column's sides span its whole height.
+        let mut mesh = cuboid([-0.3, -0.2, 0.0], [0.3, 0.2, 0.1]);
+        mesh.extend(cuboid([-0.05, -0.05, 0.1], [0.05, 0.05, 0.6]));
+        let boxes = stacked_boxes(&mesh);
+        assert_eq!(boxes.len(), 2, "{boxes:?}");
+        // The two solids' own volumes, and one slab's worth of the foot more at most.
+        let exact: f32 = 0.6 * 0.4 * 0.1 + 0.1 * 0.1 * 0.5;
+        let stacked: f32 = boxes.iter().map(Bounds::volume).sum();
+        assert!(
+            stacked >= exact - 1e-6 && stacked <= exact + 0.6 * 0.4 * 0.6 / 48.0,
+            "{stacked} against {exact}"
+        );
+        for t in &mesh {
+            for (a, b) in [
+                (0.0, 0.0),
+                (1.0, 0.0),
+                (0.0, 1.0),
+                (0.3, 0.3),
+                (0.5, 0.5),
+                (0.1, 0.8),
+            ] {
+                let p = t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b;
+                assert!(
+                    boxes
+                        .iter()
+                        .any(|b| (0..3)
+                            .all(|k| b.mins[k] - 1e-6 <= p[k] && p[k] <= b.maxs[k] + 1e-6)),
+                    "{p:?} outside {boxes:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn no_triangles_no_boxes() {
+        assert!(stacked_boxes(&[]).is_empty());
+    }
+}
