@@ -1,18 +1,13 @@
 //! The tabletop cell with the YuMi's real arms in the execution world: every failure
 //! scenario of BETR-XP-LLM fails at the paper's action with the arm's own reason (the
-//! solid its motion collides with, the pose no joint values reach), is repaired by its
-//! expected fix planned in the planning world, and the repaired tree then runs to success
-//! with the arms, the same way on every run.
-//!
-//! Three are not among them yet, and their scenario files do not name the robot's
-//! description (their execution world keeps the reach spheres and the gripper sweep). The locked cupboard (scenario 5): it fails and is repaired as the
-//! paper says ("Torque limit exceeded" on opening it), but the plate, gripped from above,
-//! then cannot go in through the cupboard's front opening — the wrist meets the
-//! cupboard's top — so with real arms its repaired tree does not succeed. The unknown
-//! banana (scenario 6): once found and grasped, putting it on the tray near the body
-//! meets the torso's collision shape (the box around the whole body mesh). The banana out
-//! of reach (scenario 7) fails with the arm's "Position out of reach", but after driving
-//! towards it the tray is out of the arms' reach while the reach spheres still hold it.
+//! solid its motion collides with, the pose no joint values reach) where the failure is a
+//! motion's, or with the paper's error where it is not (a locked door's torque, an object
+//! the robot has never seen), is repaired by its expected fix planned in the planning
+//! world, and the repaired tree then runs to success with every grasp, place and put-in
+//! made by an arm (through the cupboard's front opening the hand comes in level), the
+//! same way on every run. The parameter scenarios run with the arms too: the action that
+//! needs a value fails for want of it, and with a good value the tree succeeds. The
+//! planning world keeps the reach spheres and the gripper sweep.
 
 mod support;
 use std::path::{Path, PathBuf};
@@ -110,6 +105,30 @@ const FAILURES: &[(&str, &[Expected])] = &[
             "put_in \"test tube\" \"centrifuge\"",
             "No collision free path found for yumi_link_7_",
             "collides with centrifuge lid",
+        )],
+    ),
+    (
+        "cupboard.toml",
+        &[(
+            "open \"cupboard\"",
+            "Torque limit exceeded",
+            "Torque limit exceeded",
+        )],
+    ),
+    (
+        "banana_unknown.toml",
+        &[(
+            "grasp \"banana\"",
+            "Object \"banana\" is not in the dictionary",
+            "not in the dictionary",
+        )],
+    ),
+    (
+        "banana_far.toml",
+        &[(
+            "grasp \"banana\"",
+            "Position out of reach: pose",
+            "is out of reach of yumi_link_7_",
         )],
     ),
 ];
@@ -297,4 +316,109 @@ fn the_engine_reports_the_disagreement_and_repairs_it_through_the_usual_loop() {
         s.until("success", |e| matches!(e, Event::Success { .. }))
             .await;
     });
+}
+
+/// The parameter scenarios with the real arms: the action that needs a value fails at
+/// once for want of it, and with a good value the tree runs to success, its motions made
+/// by an arm (scooping and wiping move no arm).
+const VALUES: &[(&str, &str, &str, &str, f64, bool)] = &[
+    ("params/egg.toml", "grasp \"egg\"", "force", "N", 5.3, true),
+    (
+        "params/hammer.toml",
+        "grasp \"hammer\"",
+        "force",
+        "N",
+        37.2,
+        true,
+    ),
+    (
+        "params/pillow.toml",
+        "place \"pillow\" \"tray\"",
+        "speed",
+        "m/s",
+        0.6,
+        true,
+    ),
+    (
+        "params/first_aid.toml",
+        "place \"first aid kit\" \"tray\"",
+        "speed",
+        "m/s",
+        1.5,
+        true,
+    ),
+    (
+        "params/baby.toml",
+        "put_in \"baby doll\" \"crib\"",
+        "speed",
+        "m/s",
+        0.1,
+        true,
+    ),
+];
+
+/// The tool scenarios: the category a good answer names.
+const TOOLS: &[(&str, &str, &str)] = &[
+    ("params/sand.toml", "scoop \"sand\" \"bucket\"", "shovel"),
+    ("params/plate.toml", "wipe \"plate\"", "sponge"),
+];
+
+#[test]
+fn parameter_scenarios_run_with_the_arms_once_given_a_good_value() {
+    use betr::domain::{ActionCall, Value};
+    let cases = VALUES
+        .iter()
+        .map(|(file, action, name, unit, amount, moves)| {
+            let value = Value::Number {
+                value: *amount,
+                unit: (*unit).to_string(),
+            };
+            (*file, *action, *name, value, *moves)
+        })
+        .chain(TOOLS.iter().map(|(file, action, tool)| {
+            (
+                *file,
+                *action,
+                "tool",
+                Value::Category((*tool).into()),
+                false,
+            )
+        }));
+    for (rel, action, name, value, moves) in cases {
+        let scenario = load(rel);
+        let exec = arms_world(&scenario, None);
+        let planning = world::load(&scenario).unwrap();
+        let goal = scenario.goal.clone().unwrap();
+        let mut tree = Planner::new(&scenario.domain)
+            .plan(&goal.to_dnf(), planning.as_ref())
+            .expect("a plan")
+            .tree;
+        let (end, _) = run(&tree, &scenario, exec.as_ref());
+        let RunEnd::Failure {
+            action: Some((node, error)),
+        } = end
+        else {
+            panic!("{rel}: expected {action} to fail, got {end:?}");
+        };
+        let failed = tree.kind(node).unwrap().as_action().unwrap().to_string();
+        assert_eq!(failed, action, "{rel}: {error}");
+        assert!(error.contains("not defined"), "{rel}: {error}");
+        let target = ActionCall::parse(action).unwrap();
+        let changed =
+            betr::planner::set_value(&mut tree, &target.skill, &target.args[0], name, &value);
+        assert!(changed >= 1, "{rel}");
+        let (end, after) = run(&tree, &scenario, exec.as_ref());
+        assert_eq!(end, RunEnd::Success, "{rel}:\n{}", bt::to_text(&tree));
+        assert!(
+            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
+            "{rel}: the goal holds"
+        );
+        let (again, _) = run(&tree, &scenario, exec.as_ref());
+        assert_eq!(again, RunEnd::Success, "{rel}");
+        let cell = after
+            .as_any()
+            .and_then(|a| a.downcast_ref::<world::CellWorld>())
+            .unwrap();
+        assert_eq!(cell.last_motion().is_some(), moves, "{rel}: an arm moved");
+    }
 }

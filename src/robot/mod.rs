@@ -10,6 +10,7 @@ mod chain;
 mod ik;
 mod rng;
 mod shapes;
+mod slabs;
 mod urdf;
 
 use std::path::{Path, PathBuf};
@@ -17,7 +18,7 @@ use std::path::{Path, PathBuf};
 pub use chain::{Carried, Chain, ChainJoint, arm_tips};
 pub use ik::{IkOptions, IkSolution, Unreachable, describe_pose, nearest_arm_solution, solve};
 pub use rng::SplitMix;
-pub use shapes::{LinkShape, RobotShapes, read_stl};
+pub use shapes::{LinkShape, RobotShapes, read_stl, read_stl_triangles};
 pub use urdf::{Element, Geometry, Joint, JointKind, Link, Model, Package};
 
 use crate::model::DescriptionSpec;

@@ -1,6 +1,8 @@
-//! The links' collision shapes: for each collision mesh, the tighter of the capsule along
-//! the mesh's main axis and the box on its principal axes, each holding every vertex by
-//! construction, in the link's frame, with the ball around it for a quick first test.
+//! The links' collision shapes: for each collision mesh of an arm's link, the tighter of
+//! the capsule along the mesh's main axis and the box on its principal axes, each holding
+//! every vertex by construction, in the link's frame, with the ball around it for a quick
+//! first test; for each mesh of a link that stays with the root (the torso), a few boxes
+//! stacked along one of its axes that together hold the mesh (`slabs.rs`).
 //!
 //! A configuration whose shapes are apart is one whose meshes are apart. Capsules and
 //! boxes rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
@@ -16,6 +18,7 @@ use parry3d::shape::SharedShape;
 
 use super::RobotError;
 use super::chain::Chain;
+use super::slabs::stacked_boxes;
 use super::urdf::{Element, Geometry, Model};
 
 /// One link's collision shape, in the link's frame.
@@ -64,10 +67,15 @@ impl RobotShapes {
             .iter()
             .flat_map(|a| a.carried.iter().map(|c| c.link))
             .collect();
+        // What stays with the root is big and still: boxes stacked along it hold its
+        // mesh far more tightly than one shape around all of it.
         let mut torso = Vec::new();
         for link in 0..model.links.len() {
-            if !carried.contains(&link) {
-                torso.extend(shapes_of(link)?);
+            if carried.contains(&link) {
+                continue;
+            }
+            for element in &model.links[link].collisions {
+                torso.extend(still_link_shapes(model, link, element)?);
             }
         }
         let arms = arms
@@ -121,6 +129,53 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
         center: aabb.center(),
         radius: aabb.half_extents().norm(),
     })
+}
+
+/// The shapes of a link that does not move with an arm: a mesh as boxes stacked along one
+/// of its axes (`slabs.rs`), any other geometry as [`link_shape`] makes it.
+fn still_link_shapes(
+    model: &Model,
+    link: usize,
+    element: &Element,
+) -> Result<Vec<LinkShape>, RobotError> {
+    let Geometry::Mesh { path, scale } = &element.geometry else {
+        return Ok(vec![link_shape(model, link, element)?]);
+    };
+    let s = scale.cast::<f32>();
+    let triangles: Vec<[Point3<f32>; 3]> = read_stl_triangles(path)?
+        .into_iter()
+        .map(|t| t.map(|p| Point3::from(p.coords.component_mul(&s))))
+        .collect();
+    let name = model.links[link].name.clone();
+    let origin = element.origin.cast::<f32>();
+    let boxes = stacked_boxes(&triangles);
+    if boxes.is_empty() {
+        return Err(RobotError::Urdf {
+            file: model.file.clone(),
+            message: format!("link \"{name}\": mesh {} has no vertices", path.display()),
+        });
+    }
+    Ok(boxes
+        .iter()
+        .map(|b| {
+            // A hair more, so that rounding in the queries never leaves a vertex out.
+            let half = (b.maxs - b.mins) / 2.0 * 1.0001 + Vector3::repeat(1e-6);
+            let shape = SharedShape::cuboid(half.x, half.y, half.z);
+            LinkShape {
+                link,
+                name: name.clone(),
+                local: origin
+                    * Isometry3::translation(
+                        (b.mins.x + b.maxs.x) / 2.0,
+                        (b.mins.y + b.maxs.y) / 2.0,
+                        (b.mins.z + b.maxs.z) / 2.0,
+                    ),
+                shape,
+                center: Point3::origin(),
+                radius: half.norm(),
+            }
+        })
+        .collect())
 }
 
 /// The points' principal axes (columns, right-handed) and their mean.
@@ -192,6 +247,39 @@ fn hull_around(points: &[Point3<f32>]) -> Option<(Isometry3<f32>, SharedShape)> 
 
 /// The vertices of an STL mesh (binary or ASCII), in the mesh's units.
 pub fn read_stl(path: &Path) -> Result<Vec<Point3<f32>>, RobotError> {
+    let mesh = read_indexed(path)?;
+    Ok(mesh
+        .vertices
+        .iter()
+        .map(|v| Point3::new(v[0], v[1], v[2]))
+        .collect())
+}
+
+/// The triangles of an STL mesh (binary or ASCII), in the mesh's units.
+pub fn read_stl_triangles(path: &Path) -> Result<Vec<[Point3<f32>; 3]>, RobotError> {
+    let mesh = read_indexed(path)?;
+    let vertex = |i: usize| {
+        mesh.vertices
+            .get(i)
+            .map(|v| Point3::new(v[0], v[1], v[2]))
+            .ok_or_else(|| RobotError::Mesh {
+                file: path.to_path_buf(),
+                message: format!("a triangle names vertex {i}, which the mesh lacks"),
+            })
+    };
+    mesh.faces
+        .iter()
+        .map(|f| {
+            Ok([
+                vertex(f.vertices[0])?,
+                vertex(f.vertices[1])?,
+                vertex(f.vertices[2])?,
+            ])
+        })
+        .collect()
+}
+
+fn read_indexed(path: &Path) -> Result<stl_io::IndexedMesh, RobotError> {
     let file = std::fs::File::open(path).map_err(|source| RobotError::Io {
         path: path.to_path_buf(),
         source,
@@ -207,9 +295,5 @@ pub fn read_stl(path: &Path) -> Result<Vec<Point3<f32>>, RobotError> {
             message: "no triangles".into(),
         });
     }
-    Ok(mesh
-        .vertices
-        .iter()
-        .map(|v| Point3::new(v[0], v[1], v[2]))
-        .collect())
+    Ok(mesh)
 }

@@ -505,11 +505,14 @@ fn no_path(e: &MotionError) -> Refusal {
     }
 }
 
-/// The tool pose of a grip from above at `point`: pointing down, fingers opening across y.
-pub fn from_above(point: &Point3<f32>) -> Isometry3<f64> {
+/// The tool pose of a grip from above at `point` with the whole hand turned by `turn` (in
+/// the world's axes) about the tool centre point; unturned, pointing down with the fingers
+/// opening across y.
+pub fn turned_from_above(point: &Point3<f32>, turn: &UnitQuaternion<f32>) -> Isometry3<f64> {
     Isometry3::from_parts(
         Translation3::new(f64::from(point.x), f64::from(point.y), f64::from(point.z)),
         // Tool x along world y, tool z down.
-        UnitQuaternion::from_basis_unchecked(&[Vector3::y(), Vector3::x(), -Vector3::z()]),
+        turn.cast::<f64>()
+            * UnitQuaternion::from_basis_unchecked(&[Vector3::y(), Vector3::x(), -Vector3::z()]),
     )
 }

@@ -3,22 +3,27 @@
 //! sweep did not predict says that planning and execution disagree. Also the push along
 //! the table (`slide`), which moves an item out from under or away from what is in the way.
 
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 use parry3d::bounding_volume::BoundingVolume;
 
 use super::geometry::{CONTACT_GAP, Part, Pose};
 use super::skills::SkillFailure;
 use super::{CellWorld, Effect, Held};
 
-/// A motion the real arm makes for a skill: the tool from above `above` straight down to
-/// `at`, with `exclude` left out of the obstacles (what is grasped) and what the hand holds.
+/// A motion the real arm makes for a skill: the tool straight from `above` to `at`,
+/// pointing down turned by `turn`, with `exclude` left out of the obstacles (what is
+/// grasped) and what the hand holds (turned with the hand).
 struct Motion<'h> {
     above: Point3<f32>,
     at: Point3<f32>,
+    turn: UnitQuaternion<f32>,
     exclude: Vec<usize>,
     carried: Option<&'h Held>,
 }
 
+/// How far outside a front opening the object is when a level hand starts its straight
+/// way in.
+const LEVEL_CLEARANCE: f32 = 0.03;
 /// Room left between a slid object and what was over it (the wrist's width).
 const SLIDE_MARGIN: f32 = 0.08;
 impl CellWorld {
@@ -46,6 +51,7 @@ impl CellWorld {
             &Motion {
                 above,
                 at,
+                turn: UnitQuaternion::identity(),
                 exclude: vec![id],
                 carried: None,
             },
@@ -68,7 +74,7 @@ impl CellWorld {
                     .iter()
                     .map(|p| crate::motion::Solid {
                         name: self.name(held.id).to_string(),
-                        pose: held.grip * p.local,
+                        pose: motion.turn * held.grip * p.local,
                         shape: p.shape.clone(),
                     })
                     .collect()
@@ -89,8 +95,8 @@ impl CellWorld {
             configs: &self.state.arms,
             solids: &solids,
             carried: &carried,
-            above: super::arms::from_above(&motion.above),
-            at: super::arms::from_above(&motion.at),
+            above: super::arms::turned_from_above(&motion.above, &motion.turn),
+            at: super::arms::turned_from_above(&motion.at, &motion.turn),
             only: motion.carried.and_then(|h| h.arm),
             lets_go: motion.carried.is_some(),
         };
@@ -160,7 +166,12 @@ impl CellWorld {
     /// Letting the held object go at `pose`, come in along `direction` over `travel`: the
     /// gripper sweep's verdict, and with real arms the arm's, which decides.
     /// The arm lets go `drop` metres short of `pose` along the way in (into a container
-    /// through its top, the object just inside the rim).
+    /// through its top, the object just inside the rim). With real arms and `level`
+    /// (through a front opening, `pose` that far inside it), the hand comes in level, its
+    /// tool pointing along the way in rather than down, with the object it holds turned
+    /// with it, and sets it down just inside the opening: a hand pointing down would have
+    /// its wrist inside the container, and one reaching to the back its elbow. Where the
+    /// object comes to rest.
     pub(super) fn release(
         &self,
         held: &Held,
@@ -168,26 +179,50 @@ impl CellWorld {
         direction: Vector3<f32>,
         travel: f32,
         drop: f32,
-    ) -> Result<(), SkillFailure> {
+        level: Option<f32>,
+    ) -> Result<Pose, SkillFailure> {
         let clear = self.release_path_clear(held, pose, direction, travel);
         if self.arms.is_none() {
             return if clear {
-                Ok(())
+                Ok(*pose)
             } else {
                 Err(SkillFailure::NoPath)
             };
         }
-        let end = Pose::translation(0.0, 0.0, CONTACT_GAP) * pose * held.grip.inverse();
+        let body = &self.scene.solids[held.id].body;
+        let (turn, rest, travel) = match level {
+            Some(inside) => {
+                // The tool (down, -z, when it grasped) turned to point along the way in,
+                // the object turned with it, resting on the same floor.
+                let turn = UnitQuaternion::rotation_between(&-Vector3::z(), &-direction)
+                    .unwrap_or_else(UnitQuaternion::identity);
+                let flat = body.aabb(pose);
+                let c = flat.center();
+                let turned = body.resting(turn * pose.rotation, c.x, c.y, flat.mins.z);
+                let b = body.aabb(&turned);
+                let half = (b.maxs - b.mins).component_mul(&direction).abs().sum() / 2.0;
+                let back = (inside - half - CONTACT_GAP).max(0.0);
+                let rest = Pose::translation(direction.x * back, direction.y * back, 0.0) * turned;
+                // In a straight line only from just outside the opening: the way there is
+                // the arm's path.
+                (turn, rest, 2.0 * half + CONTACT_GAP + LEVEL_CLEARANCE)
+            }
+            None => (UnitQuaternion::identity(), *pose, travel),
+        };
+        let grip = Pose::from_parts(Default::default(), turn) * held.grip;
+        let end = Pose::translation(0.0, 0.0, CONTACT_GAP) * rest * grip.inverse();
         let at = Point3::from(end.translation.vector) + direction * drop.clamp(0.0, travel);
         self.arm_moves(
             &Motion {
                 above: Point3::from(end.translation.vector) + direction * travel,
                 at,
+                turn,
                 exclude: Vec::new(),
                 carried: Some(held),
             },
             clear,
-        )
+        )?;
+        Ok(rest)
     }
 
     /// Push `x` along the table (towards the robot or sideways, the middle of the robot

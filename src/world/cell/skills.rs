@@ -332,8 +332,8 @@ impl CellWorld {
         let mut first_refusal = None;
         for (px, py) in spots.into_iter().take(tries) {
             let pose = body.resting(rotation, px, py, top.maxs.z);
-            match self.release(&held, &pose, Vector3::z(), approach, 0.0) {
-                Ok(()) => return Ok(Effect::Release { id: x, pose }),
+            match self.release(&held, &pose, Vector3::z(), approach, 0.0, None) {
+                Ok(pose) => return Ok(Effect::Release { id: x, pose }),
                 Err(e) => {
                     first_refusal.get_or_insert(e);
                 }
@@ -380,9 +380,13 @@ impl CellWorld {
         scored.into_iter().map(|(_, _, x, y)| (x, y)).collect()
     }
 
-    /// Where `x` rests on the floor of `c`'s cavity, and the direction and length of the
-    /// way in.
-    fn cavity_rest(&self, x: usize, c: usize) -> Result<(Pose, Vector3<f32>, f32), SkillFailure> {
+    /// Where `x` rests on the floor of `c`'s cavity, the direction and length of the way
+    /// in, and how far that rest is from the opening.
+    fn cavity_rest(
+        &self,
+        x: usize,
+        c: usize,
+    ) -> Result<(Pose, Vector3<f32>, f32, f32), SkillFailure> {
         let Some((cavity, half, opening)) =
             self.scene.solids[c].body.cavity_at(&self.state.poses[c])
         else {
@@ -404,13 +408,13 @@ impl CellWorld {
         Ok(match opening {
             // Into a top opening the arm comes straight down, whichever way the container
             // is turned: an upside-down cup's bottom is then in the way.
-            Opening::Top => (pose, Vector3::z(), 2.0 * half.z + approach),
+            Opening::Top => (pose, Vector3::z(), 2.0 * half.z + approach, half.z),
             Opening::Front => {
                 let out = cavity.rotation * -Vector3::x();
                 let flat = Vector3::new(out.x, out.y, 0.0)
                     .try_normalize(1e-6)
                     .unwrap_or(-Vector3::x());
-                (pose, flat, 2.0 * half.x + approach)
+                (pose, flat, 2.0 * half.x + approach, half.x)
             }
         })
     }
@@ -421,7 +425,7 @@ impl CellWorld {
             return Err(SkillFailure::InItself(self.name(x).to_string()));
         }
         self.reachable(c)?;
-        let (pose, direction, travel) = self.cavity_rest(x, c)?;
+        let (pose, direction, travel, inside) = self.cavity_rest(x, c)?;
         // Through a top opening that is open (nothing over it, not turned down) the hand
         // lets go with the object's bottom at the rim; otherwise it must go all the way in.
         let drop = if direction == Vector3::z() && self.open(c) {
@@ -430,7 +434,9 @@ impl CellWorld {
         } else {
             0.0
         };
-        self.release(&held, &pose, direction, travel, drop)?;
+        // Through a front opening the hand comes in level.
+        let level = (direction.z.abs() < 0.5).then_some(inside);
+        let pose = self.release(&held, &pose, direction, travel, drop, level)?;
         Ok(Effect::Release { id: x, pose })
     }
 }
