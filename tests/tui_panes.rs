@@ -175,6 +175,42 @@ fn the_help_lists_the_sideways_and_focus_keys() {
     });
 }
 
+/// At 80×24 the key list does not fit: it shows in one column, says which rows show, and
+/// scrolls with the arrow and page keys down to its last key; another key closes it.
+#[test]
+fn the_help_scrolls_at_80x24() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.key(KeyCode::Char('?'));
+        let top = b.screen(80, 24);
+        assert!(top.contains("rows 1\u{2013}"), "{top}");
+        assert!(top.contains("any other key closes"), "{top}");
+        insta::assert_snapshot!("help_80x24_top", top);
+        // Every key of the list is reachable: the last one shows after scrolling down.
+        let last = b
+            .app
+            .keys
+            .help_lines(b.app.mode)
+            .last()
+            .map(|(_, what)| what.to_string())
+            .unwrap();
+        assert!(!top.contains(&last), "{top}");
+        for _ in 0..10 {
+            b.key(KeyCode::PageDown);
+        }
+        let bottom = b.screen(80, 24);
+        assert!(bottom.contains(&last), "{last} missing:\n{bottom}");
+        assert!(!bottom.contains("rows 1\u{2013}"), "{bottom}");
+        b.key(KeyCode::Up);
+        assert!(
+            b.app.overlay.is_some(),
+            "an arrow scrolls, it does not close"
+        );
+        b.key(KeyCode::Char('x'));
+        assert!(b.app.overlay.is_none(), "another key closes the list");
+    });
+}
+
 /// The column and row where `text` starts on a screen (its characters are one cell
 /// wide each).
 fn top_left_of(screen: &str, text: &str) -> (u16, u16) {

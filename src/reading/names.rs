@@ -124,12 +124,7 @@ pub fn swapped_back(
     vocabulary: &crate::domain::Vocabulary,
 ) -> Option<(Formula, String, String)> {
     let (from, _) = swapped_object(goal, request, lexicon)?;
-    let kinds = &vocabulary.objects.iter().find(|o| o.name == from)?.types;
-    let of_kind: Vec<&crate::domain::Object> = vocabulary
-        .objects
-        .iter()
-        .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
-        .collect();
+    let of_kind = of_a_kind_with(vocabulary, &from)?;
     let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
     let mut named: Vec<String> = named_in(request, &of_kind)
         .into_iter()
@@ -141,6 +136,22 @@ pub fn swapped_back(
         return None;
     };
     Some((rename(goal, &from, to), from, to.clone()))
+}
+
+/// The objects that share a kind with the object called `name` (it among them); `None`
+/// when the vocabulary has no such object.
+fn of_a_kind_with<'a>(
+    vocabulary: &'a crate::domain::Vocabulary,
+    name: &str,
+) -> Option<Vec<&'a crate::domain::Object>> {
+    let kinds = &vocabulary.objects.iter().find(|o| o.name == name)?.types;
+    Some(
+        vocabulary
+            .objects
+            .iter()
+            .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
+            .collect(),
+    )
 }
 
 /// The first object of `atoms` that no word of `request` names.
@@ -187,12 +198,18 @@ pub fn understood_object(
     let words = every_term(&without_numbering(request));
     let spans = mentions(&words, &every, &[]);
     let mentioned: Vec<&String> = spans.iter().map(|(_, _, name)| name).collect();
-    // Words that are part of another object's name as said ("plants" of "the strawberry
-    // plants") do not name this one, even where it answers to them (the pepper plants).
+    // Words that are part of another object's name of several words as said ("plants" of
+    // "the strawberry plants") do not name this one, even where it answers to them (the
+    // pepper plants). A name of one word names whatever answers to it ("coffee" of the
+    // coffee station too).
     let free: Vec<&String> = words
         .iter()
         .enumerate()
-        .filter(|(i, _)| !spans.iter().any(|(at, len, _)| (*at..at + len).contains(i)))
+        .filter(|(i, _)| {
+            !spans
+                .iter()
+                .any(|(at, len, _)| *len > 1 && (*at..at + len).contains(i))
+        })
         .map(|(_, w)| w)
         .collect();
     let named_apart = |object: &str| {
@@ -206,12 +223,8 @@ pub fn understood_object(
         .filter(|arg| !is_placeholder(arg) && !mentioned.contains(arg) && !named_apart(arg))
         .find_map(|from| {
             let from = from.clone();
-            let kinds = &vocabulary.objects.iter().find(|o| o.name == from)?.types;
-            let of_kind: Vec<&crate::domain::Object> = vocabulary
-                .objects
-                .iter()
-                .filter(|o| o.name != from && o.types.iter().any(|t| kinds.contains(t)))
-                .collect();
+            let mut of_kind = of_a_kind_with(vocabulary, &from)?;
+            of_kind.retain(|o| o.name != from);
             let mut named = named_in(request, &of_kind);
             named.sort();
             named.dedup();

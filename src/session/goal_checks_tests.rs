@@ -215,6 +215,17 @@ fn an_object_left_to_be_understood_is_the_one_of_its_kind_the_request_names() {
         )
         .is_none()
     );
+    // A word that is a whole name of one object names the others that answer to it:
+    // "coffee" of the coffee station.
+    assert!(
+        understood_object(
+            &g("On_Yogurt_Table1 & (RobotNear_WaterStation | RobotNear_CoffeeStation)"),
+            "Bring the yogurt to the first table, then go near the water or the coffee.",
+            &lexicon,
+            vocabulary
+        )
+        .is_none()
+    );
     // Two things where the request names one: not one left understood.
     assert!(
         understood_object(

@@ -73,9 +73,14 @@ pub enum Request {
     Replay(Move),
 }
 
+/// Rows of the key list a page key scrolls by.
+const HELP_PAGE: usize = 10;
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Overlay {
-    Help,
+    /// The keys, shown from this row of their list on (the list scrolls where the screen
+    /// is too small for it).
+    Help(usize),
     /// Lines in a box, under a title that says what they are.
     Report {
         title: &'static str,
@@ -286,6 +291,17 @@ impl App {
             }
             return;
         }
+        if let Some(Overlay::Help(first)) = self.overlay {
+            let last = self.keys.help_lines(self.mode).len().saturating_sub(1);
+            self.overlay = match key.code {
+                KeyCode::Down | KeyCode::Char('j') => Some(Overlay::Help((first + 1).min(last))),
+                KeyCode::Up | KeyCode::Char('k') => Some(Overlay::Help(first.saturating_sub(1))),
+                KeyCode::PageDown => Some(Overlay::Help((first + HELP_PAGE).min(last))),
+                KeyCode::PageUp => Some(Overlay::Help(first.saturating_sub(HELP_PAGE))),
+                _ => None,
+            };
+            return;
+        }
         if self.overlay.take().is_some() {
             return;
         }
@@ -376,7 +392,7 @@ impl App {
                 return self.input.open(Mode::Edit, &text);
             }
             Action::Help => {
-                self.overlay = Some(Overlay::Help);
+                self.overlay = Some(Overlay::Help(0));
                 return;
             }
             Action::Details => return self.show_details(),

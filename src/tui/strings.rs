@@ -83,6 +83,13 @@ pub fn from_policy(path: &str) -> String {
 pub const INPUT_HINT: &str = "press i to type an instruction, d to dictate one, ? for help";
 pub const HELP_TITLE: &str = " Keys ";
 pub const HELP_FOOTER: &str = "Press any key to close.";
+
+/// The footer of a key list that does not fit: which rows show and how to see the rest.
+pub fn help_rows(from: usize, to: usize, of: usize) -> String {
+    format!(
+        "rows {from}\u{2013}{to} of {of} \u{b7} \u{2191}\u{2193} PgUp PgDn scroll \u{b7} any other key closes"
+    )
+}
 pub const VERIFY_TITLE: &str = " Verification (any key closes) ";
 pub const VIOLATION_TITLE: &str = " The change fails verification (any key closes) ";
 pub const RULES_TITLE: &str = " Rules learned from approved fixes (any key closes) ";

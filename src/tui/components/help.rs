@@ -23,14 +23,73 @@ fn centered(area: Rect, width: u16, height: u16) -> Rect {
     h
 }
 
-pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, mode: KeyMode, theme: &Theme) {
+/// The keys in a box over the screen: in two columns when one does not fit the height and
+/// two fit the width, else in one; a list taller than the screen shows the rows from
+/// `first` on, and says which rows show and how to scroll.
+pub fn draw_help(
+    frame: &mut Frame,
+    area: Rect,
+    keys: &KeyBindings,
+    mode: KeyMode,
+    first: usize,
+    theme: &Theme,
+) {
     let entries = keys.help_lines(mode);
-    // Two columns, each with its own key width, when one does not fit the height.
-    let rows = if entries.len() + 4 > usize::from(area.height) {
-        entries.len().div_ceil(2)
+    // Borders, the blank line and the footer.
+    let fixed = 4;
+    let two = if entries.len() + fixed > usize::from(area.height) {
+        let columns = two_columns(&entries, theme);
+        let wide = columns.iter().map(Line::width).max().unwrap_or(0) + 3;
+        (wide <= usize::from(area.width)).then_some(columns)
     } else {
-        entries.len()
+        None
     };
+    let mut lines = two.unwrap_or_else(|| {
+        let key_width = entries
+            .iter()
+            .map(|(k, _)| k.chars().count())
+            .max()
+            .unwrap_or(0);
+        entries
+            .iter()
+            .map(|(k, what)| {
+                Line::from(vec![
+                    Span::styled(format!(" {k:>key_width$}  "), theme.key),
+                    Span::raw(*what),
+                ])
+            })
+            .collect()
+    });
+    let room = usize::from(area.height).saturating_sub(fixed).max(1);
+    let total = lines.len();
+    let footer = if total > room {
+        let from = first.min(total - room);
+        lines = lines.split_off(from);
+        lines.truncate(room);
+        strings::help_rows(from + 1, from + room, total)
+    } else {
+        strings::HELP_FOOTER.to_string()
+    };
+    lines.push(Line::from(""));
+    lines.push(Line::from(Span::styled(format!(" {footer}"), theme.dim)));
+    let width = lines.iter().map(Line::width).max().unwrap_or(20) + 3;
+    let height = lines.len() + 2;
+    let rect = centered(
+        area,
+        u16::try_from(width).unwrap_or(u16::MAX),
+        u16::try_from(height).unwrap_or(u16::MAX),
+    );
+    frame.render_widget(Clear, rect);
+    let block = Block::default()
+        .borders(Borders::ALL)
+        .border_style(theme.key)
+        .title(Span::styled(strings::HELP_TITLE, theme.title));
+    frame.render_widget(Paragraph::new(lines).block(block), rect);
+}
+
+/// The keys in two columns side by side, each with its own key width.
+fn two_columns(entries: &[(String, &'static str)], theme: &Theme) -> Vec<Line<'static>> {
+    let rows = entries.len().div_ceil(2);
     let (left, right) = entries.split_at(rows.min(entries.len()));
     let width_of = |column: &[(String, &'static str)]| {
         column
@@ -45,8 +104,7 @@ pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, mode: KeyMod
         .map(|(_, what)| left_keys + 3 + what.chars().count())
         .max()
         .unwrap_or(0);
-    let mut lines: Vec<Line> = left
-        .iter()
+    left.iter()
         .enumerate()
         .map(|(i, (k, what))| {
             let mut spans = vec![
@@ -61,25 +119,7 @@ pub fn draw_help(frame: &mut Frame, area: Rect, keys: &KeyBindings, mode: KeyMod
             }
             Line::from(spans)
         })
-        .collect();
-    lines.push(Line::from(""));
-    lines.push(Line::from(Span::styled(
-        format!(" {}", strings::HELP_FOOTER),
-        theme.dim,
-    )));
-    let width = lines.iter().map(Line::width).max().unwrap_or(20) + 3;
-    let height = lines.len() + 2;
-    let rect = centered(
-        area,
-        u16::try_from(width).unwrap_or(u16::MAX),
-        u16::try_from(height).unwrap_or(u16::MAX),
-    );
-    frame.render_widget(Clear, rect);
-    let block = Block::default()
-        .borders(Borders::ALL)
-        .border_style(theme.key)
-        .title(Span::styled(strings::HELP_TITLE, theme.title));
-    frame.render_widget(Paragraph::new(lines).block(block), rect);
+        .collect()
 }
 
 /// The report as lines, in the words of `betr verify`.

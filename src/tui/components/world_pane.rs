@@ -4,7 +4,8 @@
 //! the last tick made it true, with the facts it made false listed (struck) above the
 //! rest. The table scrolls and can be narrowed to the facts holding a text; the objects
 //! are named when they fit on one line, else counted (D shows a node whole). A short pane
-//! shows the last error in one row, so the facts keep rows to scroll in.
+//! shows the last error and the last motion in one row each, so the facts keep rows to
+//! scroll in.
 
 use std::collections::HashSet;
 
@@ -165,7 +166,14 @@ impl WorldPane {
             } else {
                 theme.error
             };
-            lines.push(Line::from(Span::styled(strings::last_motion(m), style)));
+            let motion = strings::last_motion(m);
+            // Cut to one row in a short pane too, for the same reason as the error.
+            let motion = if short {
+                cut_to(&motion, width)
+            } else {
+                motion
+            };
+            lines.push(Line::from(Span::styled(motion, style)));
         }
         let names = format!("{} {}", strings::OBJECTS, self.objects.join(", "));
         lines.push(Line::from(Span::styled(
@@ -220,7 +228,7 @@ impl WorldPane {
     }
 }
 
-/// Panes lower than this show the last error in one row.
+/// Panes lower than this show the last error and the last motion in one row each.
 const SHORT_PANE: u16 = 12;
 
 /// `text` in at most `width` cells, ending in `…` when cut.
