@@ -169,26 +169,33 @@ fn failure_scenarios_fail_for_the_arms_reason_and_succeed_after_their_fix() {
                 .expect("a repair")
                 .tree;
         }
-        let (end, after) = run(&tree, &scenario, exec.as_ref());
-        assert_eq!(
-            end,
-            RunEnd::Success,
-            "{rel}: {end:?}\n{}",
-            bt::to_text(&tree)
-        );
-        assert!(
-            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
-            "{rel}: the goal holds"
-        );
-        // The same arms, the same run.
-        let (again, _) = run(&tree, &scenario, exec.as_ref());
-        assert_eq!(again, RunEnd::Success, "{rel}");
-        let cell = after
-            .as_any()
-            .and_then(|a| a.downcast_ref::<world::CellWorld>())
-            .unwrap();
-        assert!(cell.last_motion().is_some(), "{rel}: an arm moved");
+        succeeds_twice(rel, &tree, &scenario, exec.as_ref(), true);
     }
+}
+
+/// `tree` runs to success in `exec` and the scenario's goal holds; a second run from the
+/// same world does the same; and an arm moved, or not, as `moves` says.
+fn succeeds_twice(rel: &str, tree: &Tree, scenario: &Scenario, exec: &dyn World, moves: bool) {
+    let goal = scenario.goal.clone().expect("the scenario's goal");
+    let (end, after) = run(tree, scenario, exec);
+    assert_eq!(
+        end,
+        RunEnd::Success,
+        "{rel}: {end:?}\n{}",
+        bt::to_text(tree)
+    );
+    assert!(
+        goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
+        "{rel}: the goal holds"
+    );
+    // The same arms, the same run.
+    let (again, _) = run(tree, scenario, exec);
+    assert_eq!(again, RunEnd::Success, "{rel}");
+    let cell = after
+        .as_any()
+        .and_then(|a| a.downcast_ref::<world::CellWorld>())
+        .expect("a cell");
+    assert_eq!(cell.last_motion().is_some(), moves, "{rel}: an arm moved");
 }
 
 /// Scenarios whose failure only the real arms produce: the planning world's gripper sweep
@@ -407,18 +414,6 @@ fn parameter_scenarios_run_with_the_arms_once_given_a_good_value() {
         let changed =
             betr::planner::set_value(&mut tree, &target.skill, &target.args[0], name, &value);
         assert!(changed >= 1, "{rel}");
-        let (end, after) = run(&tree, &scenario, exec.as_ref());
-        assert_eq!(end, RunEnd::Success, "{rel}:\n{}", bt::to_text(&tree));
-        assert!(
-            goal.eval(&|a| after.check(&Condition::pos(a.clone()))),
-            "{rel}: the goal holds"
-        );
-        let (again, _) = run(&tree, &scenario, exec.as_ref());
-        assert_eq!(again, RunEnd::Success, "{rel}");
-        let cell = after
-            .as_any()
-            .and_then(|a| a.downcast_ref::<world::CellWorld>())
-            .unwrap();
-        assert_eq!(cell.last_motion().is_some(), moves, "{rel}: an arm moved");
+        succeeds_twice(rel, &tree, &scenario, exec.as_ref(), moves);
     }
 }

@@ -30,11 +30,12 @@ fn verified(file: &Path) -> (bool, String) {
     (out.status.success(), said)
 }
 
-#[test]
-fn scenario1_recording_verifies_and_lists_the_entities() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd");
+/// `betr repair` of scenario 1 with its fix, recorded to `file` in the test folder `dir`
+/// (made afresh): the recording's path and what betr said on stderr, once it succeeded.
+fn repaired_scenario1(dir: &str, file: &str) -> (std::path::PathBuf, String) {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let rrd = dir.join("scenario1.rrd");
+    let rrd = dir.join(file);
     let _ = std::fs::remove_file(&rrd);
     let rrd_arg = rrd.to_string_lossy();
     let out = support::repo::betr(&[
@@ -46,12 +47,15 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
         &rrd_arg,
     ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(out.status.success(), "{stdout}\n{stderr}");
     assert!(stdout.contains("SUCCESS"), "{stdout}");
+    (rrd, stderr)
+}
+
+#[test]
+fn scenario1_recording_verifies_and_lists_the_entities() {
+    let (rrd, _) = repaired_scenario1("viz_rrd", "scenario1.rrd");
     assert!(rrd.metadata().unwrap().len() > 0);
 
     let (ok, said) = verified(&rrd);
@@ -138,23 +142,7 @@ fn rows_of(data: &str, entity: &str) -> Vec<std::collections::BTreeMap<String, S
 #[test]
 fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
     description();
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd_arms");
-    std::fs::create_dir_all(&dir).unwrap();
-    let rrd = dir.join("scenario1-arms.rrd");
-    let _ = std::fs::remove_file(&rrd);
-    let rrd_arg = rrd.to_string_lossy();
-    let out = support::repo::betr(&[
-        "repair",
-        "scenarios/cell/red_on_blue.toml",
-        "--add",
-        "~\"any object\" on \"blue cube\"",
-        "--rrd",
-        &rrd_arg,
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stdout}\n{stderr}");
-    assert!(stdout.contains("SUCCESS"), "{stdout}");
+    let (rrd, stderr) = repaired_scenario1("viz_rrd_arms", "scenario1-arms.rrd");
     assert!(
         !stderr.contains("reach spheres and gripper sweep instead"),
         "the arms move: {stderr}"
