@@ -342,15 +342,8 @@ fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebSer
     let page = format!("http://127.0.0.1:{web}/");
     let started = Instant::now();
     while !(listening(&url) && listening(&page)) {
-        if let Ok(Some(status)) = server.child.try_wait() {
-            // The launcher may have left the viewer's binary behind.
-            server.stop();
-            return Err(ViewerError::Stopped {
-                status,
-                grpc,
-                web,
-                attempts: 1,
-            });
+        if let Some(e) = exited(&mut server, grpc, web) {
+            return Err(e);
         }
         if started.elapsed() > START_TIMEOUT {
             return Err(ViewerError::NotListening {
@@ -364,16 +357,23 @@ fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebSer
     // Another program may have taken one of the ports between their choice and the
     // viewer's start, answering in its place while the viewer stops: it must still run.
     std::thread::sleep(SETTLE);
-    if let Ok(Some(status)) = server.child.try_wait() {
-        server.stop();
-        return Err(ViewerError::Stopped {
-            status,
-            grpc,
-            web,
-            attempts: 1,
-        });
+    match exited(&mut server, grpc, web) {
+        Some(e) => Err(e),
+        None => Ok(server),
     }
-    Ok(server)
+}
+
+/// When the viewer's launcher has exited: it stopped with whatever it left behind (the
+/// viewer's binary may outlive the launcher), said with its ports.
+fn exited(server: &mut WebServer, grpc: u16, web: u16) -> Option<ViewerError> {
+    let status = server.child.try_wait().ok().flatten()?;
+    server.stop();
+    Some(ViewerError::Stopped {
+        status,
+        grpc,
+        web,
+        attempts: 1,
+    })
 }
 
 /// A port for the stream and one for the page: the usual ones when nothing holds them,
