@@ -207,8 +207,14 @@ fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
     };
     let step_to_proposal = |tmux: &Tmux| {
         for _ in 0..10 {
+            let before = tmux.screen();
             tmux.keys(&["Space"]);
-            std::thread::sleep(Duration::from_millis(200));
+            // The next key only once the screen shows this tick: on a loaded machine a
+            // key sent before it caught up ticks past the failure.
+            let deadline = Instant::now() + Duration::from_secs(5);
+            while tmux.screen() == before && Instant::now() < deadline {
+                std::thread::sleep(Duration::from_millis(50));
+            }
             if tmux.screen().contains("◀ failed") {
                 break;
             }
