@@ -9,7 +9,6 @@
 //! |---|---|---|
 //! | `reversed-relation` | a relation with its objects the other way round from the request ("the blue cube on the green cube" read as green on blue) | turning it round |
 //! | `swapped-object` | an object no word names in the place of one a word names alone ("fries" read as coffee) | putting the named object back, when the request names one of that kind |
-//! | `understood-object` | an object no word names where the request names one of its kind and the goal has that one elsewhere ("bread at the reading corner, or failing that an apple" read as the apple at table 3) | putting the named object in its place |
 //! | `turned-around` | a condition the other way round from the request's words ("do not open the curtain" read as open) | turning it back |
 //! | `left-unanswered` | a condition the request asks for in its own words, left out where the request offers no choice | putting it beside the goal |
 //! | `relation-as-said` | a relation other than the one the request says before the place ("in the crib" read as on) | the relation said |
@@ -21,7 +20,7 @@ use crate::goal::Formula;
 use crate::scenario::Scenario;
 
 use super::lexicon::Lexicon;
-use super::names::{swapped_back, swapped_object, understood_object};
+use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
@@ -70,7 +69,6 @@ pub trait Misreading: Sync {
 pub const MISREADINGS: &[&dyn Misreading] = &[
     &ReversedRelation,
     &SwappedObject,
-    &UnderstoodObject,
     &TurnedAround,
     &LeftUnanswered,
     &RelationAsSaid,
@@ -151,36 +149,6 @@ impl Misreading for SwappedObject {
                     format!(
                         "the request names {to} where the answer has {from}, which it never names"
                     ),
-                )
-            })
-            .into_iter()
-            .collect()
-    }
-}
-
-struct UnderstoodObject;
-impl UnderstoodObject {
-    fn found(goal: &Formula, request: &Request) -> Option<(Formula, String, String)> {
-        understood_object(goal, request.text, request.lexicon, request.vocabulary())
-    }
-}
-impl Misreading for UnderstoodObject {
-    fn name(&self) -> &'static str {
-        "understood-object"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        Self::found(goal, request).map(|(_, from, to)| {
-            format!(
-                "{goal} has {from}, which the request never names, where the request names only {to} of its kind"
-            )
-        })
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        Self::found(goal, request)
-            .map(|(g, from, to)| {
-                (
-                    g,
-                    format!("the request leaves {to} to be understood where the answer has {from}"),
                 )
             })
             .into_iter()

@@ -8,9 +8,8 @@ use crate::goal::rewrite::rename;
 
 use super::english::{is_generic, is_phrasing, offers_choice};
 use super::lexicon::Lexicon;
-use super::placement::{mentions, named_in};
-use super::polarity::without_numbering;
-use super::words::{every_term, is_number, same_word, terms};
+use super::placement::named_in;
+use super::words::{is_number, same_word, terms};
 
 /// A condition of `goal` that one of the `shown` examples' goals holds and that shares no
 /// word with the request: pasted from the example rather than asked for (small models
@@ -178,65 +177,6 @@ pub fn unnamed_object(
 /// `Holding_Nothing` without the word).
 fn is_placeholder(object: &str) -> bool {
     object == crate::domain::ANY_OBJECT || is_generic(&object.to_lowercase())
-}
-
-/// `goal` with an object no word of the request names replaced by the one object of its
-/// kind the request does name, where the goal already has that one elsewhere: the request
-/// left the object to be understood from the one it names, and the answer filled it in
-/// another way ("bread at the reading corner, or failing that an apple" read as the apple
-/// at table 3; "trim the strawberry plants, then water them" read as the peppers
-/// watered). `None` when every object is named, or the request names none or several of
-/// the kind. Returns the goal, and the object replaced and its replacement.
-pub fn understood_object(
-    goal: &Formula,
-    request: &str,
-    lexicon: &Lexicon,
-    vocabulary: &crate::domain::Vocabulary,
-) -> Option<(Formula, String, String)> {
-    let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
-    let every: Vec<&crate::domain::Object> = vocabulary.objects.iter().collect();
-    let words = every_term(&without_numbering(request));
-    let spans = mentions(&words, &every, &[]);
-    let mentioned: Vec<&String> = spans.iter().map(|(_, _, name)| name).collect();
-    // Words that are part of another object's name of several words as said ("plants" of
-    // "the strawberry plants") do not name this one, even where it answers to them (the
-    // pepper plants). A name of one word names whatever answers to it ("coffee" of the
-    // coffee station too).
-    let free: Vec<&String> = words
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| {
-            !spans
-                .iter()
-                .any(|(at, len, _)| *len > 1 && (*at..at + len).contains(i))
-        })
-        .map(|(_, w)| w)
-        .collect();
-    let named_apart = |object: &str| {
-        lexicon
-            .words(object)
-            .iter()
-            .any(|w| free.iter().any(|a| same_word(a, w)))
-    };
-    in_goal
-        .iter()
-        .filter(|arg| !is_placeholder(arg) && !mentioned.contains(arg) && !named_apart(arg))
-        .find_map(|from| {
-            let from = from.clone();
-            let mut of_kind = of_a_kind_with(vocabulary, &from)?;
-            of_kind.retain(|o| o.name != from);
-            let mut named = named_in(request, &of_kind);
-            named.sort();
-            named.dedup();
-            let [to] = named.as_slice() else {
-                return None;
-            };
-            let renamed = rename(goal, &from, to);
-            // An answer that becomes one condition where it had two ("the downlight or
-            // the hall light") had two things in mind, not one left understood.
-            (in_goal.contains(to) && renamed.atoms().len() == goal.atoms().len())
-                .then(|| (renamed, from.clone(), to.clone()))
-        })
 }
 
 /// `goal` with the conjuncts every alternative shares taken out of the alternatives:

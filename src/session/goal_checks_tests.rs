@@ -3,8 +3,7 @@
 use super::*;
 use crate::goal::Formula;
 use crate::reading::names::{
-    factored, renumbered, swapped_back, swapped_object, understood_object, without_copied,
-    without_unasked,
+    factored, renumbered, swapped_back, swapped_object, without_copied, without_unasked,
 };
 use crate::reading::words::same_word;
 use std::path::Path;
@@ -165,86 +164,6 @@ fn a_swapped_object_is_put_back_when_the_word_names_one_thing_of_its_kind() {
     assert_eq!(
         (to.as_str(), goal.to_string().as_str()),
         ("SpringWater", "Holding_SpringWater")
-    );
-}
-
-#[test]
-fn an_object_left_to_be_understood_is_the_one_of_its_kind_the_request_names() {
-    let (scenario, _) = cafe();
-    let vocabulary = &scenario.domain.vocabulary;
-    let lexicon = Lexicon::new(vocabulary, &scenario.examples);
-    let g = |t: &str| Formula::parse(t).expect("parses");
-    let request = "Some chips at the bar, or else a dessert.";
-    let (goal, from, to) = understood_object(
-        &g("On_Chips_Bar | On_Dessert_Table2"),
-        request,
-        &lexicon,
-        vocabulary,
-    )
-    .expect("the place the request names");
-    assert_eq!((from.as_str(), to.as_str()), ("Table2", "Bar"));
-    assert_eq!(goal.to_string(), "On_Chips_Bar | On_Dessert_Bar");
-    // Every object named: nothing to understand.
-    assert!(
-        understood_object(
-            &g("On_Chips_Bar | On_Dessert_Bar"),
-            request,
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
-    );
-    // Two places named: which one is meant is not plain.
-    assert!(
-        understood_object(
-            &g("On_Chips_Bar | On_Dessert_Table2"),
-            "Some chips at the bar or at table 3, or else a dessert.",
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
-    );
-    // A place named by a word its longer name shares with another ("the lounge" of the
-    // lounge area and of the VIP lounge) is named.
-    assert!(
-        understood_object(
-            &g("On_Watermelon_LoungeArea & On_Chips_Bar"),
-            "Put a watermelon at the lounge and chips at the bar.",
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
-    );
-    // A word that is a whole name of one object names the others that answer to it:
-    // "coffee" of the coffee station.
-    assert!(
-        understood_object(
-            &g("On_Yogurt_Table1 & (RobotNear_WaterStation | RobotNear_CoffeeStation)"),
-            "Bring the yogurt to the first table, then go near the water or the coffee.",
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
-    );
-    // Two things where the request names one: not one left understood.
-    assert!(
-        understood_object(
-            &g("Active_HallLight | Active_TubeLight"),
-            "Turn on the ceiling lamp or the hall light.",
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
-    );
-    // The named place is nowhere in the goal: a swap, not something left understood.
-    assert!(
-        understood_object(
-            &g("On_Dessert_Table2"),
-            "A dessert at the bar.",
-            &lexicon,
-            vocabulary
-        )
-        .is_none()
     );
 }
 
