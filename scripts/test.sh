@@ -25,4 +25,11 @@ if ! python3 -c "import venv, ensurepip" >/dev/null 2>&1; then
   $SUDO apt-get install -y python3-venv
 fi
 
+# A full test build with its Python environments and models takes about 12 GB; say so
+# before the build runs out of room halfway.
+free_kb=$(df -Pk . | awk 'NR==2 {print $4}')
+if [ -n "$free_kb" ] && [ "$free_kb" -lt $((12 * 1024 * 1024)) ]; then
+  echo "warning: $((free_kb / 1024)) MB free on the disk holding $(pwd); a full test build needs about 12 GB" >&2
+fi
+
 cargo test --locked
