@@ -20,11 +20,7 @@ fn app() -> App {
         model: "qwen2.5-coder-1.5b".into(),
         objects: scenario
             .domain
-            .vocabulary
-            .objects
-            .iter()
-            .map(|o| o.name.clone())
-            .collect(),
+            .vocabulary.object_names(),
         ..Info::default()
     };
     App::new(

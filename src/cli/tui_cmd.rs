@@ -142,11 +142,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         auto_approve: args.auto_approve,
         objects: scenario
             .domain
-            .vocabulary
-            .objects
-            .iter()
-            .map(|o| o.name.clone())
-            .collect(),
+            .vocabulary.object_names(),
         no_model,
         keys_error,
     };

@@ -87,6 +87,11 @@ pub struct WrongType {
 }
 
 impl Vocabulary {
+    /// Every object's name, in the scenario's order.
+    pub fn object_names(&self) -> Vec<String> {
+        self.objects.iter().map(|o| o.name.clone()).collect()
+    }
+
     pub fn object(&self, name: &str) -> Option<&Object> {
         self.objects.iter().find(|o| o.name == name)
     }

@@ -82,11 +82,7 @@ impl Bench {
             auto_approve: false,
             objects: scenario
                 .domain
-                .vocabulary
-                .objects
-                .iter()
-                .map(|o| o.name.clone())
-                .collect(),
+                .vocabulary.object_names(),
             no_model: None,
             keys_error: None,
         };

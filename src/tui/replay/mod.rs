@@ -69,11 +69,7 @@ impl Player {
             objects: replay
                 .scenario
                 .domain
-                .vocabulary
-                .objects
-                .iter()
-                .map(|o| o.name.clone())
-                .collect(),
+                .vocabulary.object_names(),
             ..Info::default()
         };
         Player::new(replay.steps, replay.scenario, info, keys, theme)
