@@ -1,9 +1,10 @@
 //! `betr` and `betr tui [SCENARIO]`: the workbench on a scenario (scenario 1 by default)
 //! with the configured model. A model that cannot be set up (no model name for a server,
 //! an embedded model file that cannot be fetched or loaded) is shown in the LLM pane; the
-//! rest of the workbench works. An embedded model not in the cache yet is fetched while
-//! the workbench is open (`background_fetch`): its progress is in the status bar, it
-//! answers once it is loaded, and quitting cancels the fetch.
+//! rest of the workbench works. What is not in the cache yet is fetched while the
+//! workbench is open (`background_fetch`): the robot description a cell's arms need (the
+//! cell moves the arms once it is there) and the embedded model (it answers once it is
+//! loaded); the progress is in the status bar, and quitting cancels the fetch.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -47,6 +48,11 @@ pub struct TuiArgs {
     /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml).
     #[arg(long, value_name = "FILE")]
     pub keys: Option<PathBuf>,
+    /// Fetch nothing: a robot description or embedded model not in the cache is said,
+    /// and the workbench goes on without it (the cell with its reach spheres and gripper
+    /// sweep, no model answering) [env: BETR_OFFLINE].
+    #[arg(long)]
+    pub offline: bool,
     /// Milliseconds between ticks when running.
     #[arg(value_parser = clap::value_parser!(u64).range(1..=60_000), long, default_value_t = 150, value_name = "MS")]
     pub tick_ms: u64,
@@ -95,11 +101,17 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
-    // An embedded model not fetched yet arrives while the workbench is open; a failed
-    // fetch or load leaves the workbench usable without a model and says why.
+    // What is not in the cache yet arrives while the workbench is open: the robot
+    // description the cell's arms need, then the embedded model. A failed fetch or load
+    // leaves the workbench usable without it and says why.
     let (arrival_report, arrivals) = tokio::sync::mpsc::unbounded_channel();
-    let mut background = None;
+    let offline = offline(args, &var)?;
+    let mut wanted_model = None;
     let model = match llm_cmds::local_model_to_fetch(&settings) {
+        Some(spec) if offline => Err(NoModel::Unavailable(format!(
+            "the model {} is not in the cache and --offline fetches nothing (`betr model fetch` fetches it)",
+            spec.name
+        ))),
         Some(spec) => {
             let arriving = Arc::new(ArrivingModel::new(
                 spec.name,
@@ -107,16 +119,25 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
                 false,
                 &format!("the model {} is not fetched yet", spec.name),
             ));
-            background = Some(super::background_fetch::start(
+            wanted_model = Some(super::background_fetch::WantedModel {
                 spec,
-                settings.clone(),
-                ledger.clone(),
-                arriving.clone(),
-                arrival_report,
-            )?);
+                settings: settings.clone(),
+                ledger: ledger.clone(),
+                arriving: arriving.clone(),
+            });
             Ok(arriving as Arc<dyn LanguageModel>)
         }
         None => ready_model(&settings, &ledger, &var),
+    };
+    let robot = betr::world::missing_description(&scenario).filter(|_| !offline);
+    let background = if robot.is_some() || wanted_model.is_some() {
+        Some(super::background_fetch::start(
+            robot,
+            wanted_model,
+            arrival_report,
+        )?)
+    } else {
+        None
     };
     let model_name = match settings.backend {
         betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
@@ -140,9 +161,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         backend: settings.backend,
         model: model_name,
         auto_approve: args.auto_approve,
-        objects: scenario
-            .domain
-            .vocabulary.object_names(),
+        objects: scenario.domain.vocabulary.object_names(),
         no_model,
         keys_error,
     };
@@ -234,6 +253,21 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         outln!("3D view: the web viewer was stopped");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Whether the workbench fetches nothing: `--offline`, or `BETR_OFFLINE` set to true.
+fn offline(args: &TuiArgs, var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
+    if args.offline {
+        return Ok(true);
+    }
+    let Some(value) = var("BETR_OFFLINE") else {
+        return Ok(false);
+    };
+    match value.trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" => Ok(true),
+        "" | "0" | "false" | "no" => Ok(false),
+        _ => anyhow::bail!("BETR_OFFLINE={value:?} is not true or false"),
+    }
 }
 
 /// The configured model when nothing needs fetching: a server's client, or the embedded

@@ -94,6 +94,7 @@ pub fn command_text(command: &Command) -> String {
             }
         }
         Command::ResetWorld => "reset world".into(),
+        Command::RobotArrived => "robot description arrived".into(),
         // The events that follow name the nodes by their place in the tree.
         Command::Force { status: None, .. } => "clear a forced status".into(),
         Command::Force {

@@ -53,6 +53,9 @@ pub enum ModelArrival {
     Ready,
     /// It will not come: why.
     Failed(String),
+    /// The robot description the cell's arms need arrived in the cache (`Ok`), or will
+    /// not come (`Err`: why; the cell keeps its reach spheres and gripper sweep).
+    Robot(Result<(), String>),
 }
 
 /// What a component asks of the app (the event queue between them).
@@ -544,6 +547,15 @@ impl App {
             ModelArrival::Failed(why) => {
                 self.status.fetching = None;
                 self.llm.error = Some(strings::no_model(&why));
+            }
+            // The session says what the arms' arrival changes.
+            ModelArrival::Robot(Ok(())) => {
+                self.status.fetching = None;
+                self.queue.push(AppEvent::Command(Command::RobotArrived));
+            }
+            ModelArrival::Robot(Err(why)) => {
+                self.status.fetching = None;
+                self.llm.log(strings::no_robot(&why));
             }
         }
     }

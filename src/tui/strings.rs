@@ -390,6 +390,12 @@ pub fn success(ticks: u64) -> String {
 /// Said in the LLM pane's log when a model fetched while the workbench was open is there.
 pub const MODEL_READY: &str = "The model is fetched and loaded: instructions are read from now on.";
 
+pub fn no_robot(why: &str) -> String {
+    format!(
+        "No robot description: {why}. The cell checks its reach spheres and gripper sweep instead of moving the arms."
+    )
+}
+
 pub fn no_model(why: &str) -> String {
     format!(
         "No language model: {why}. You can still type goal formulas, plan, tick, and type conditions with e."

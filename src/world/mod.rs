@@ -115,6 +115,19 @@ pub fn load_execution(
     })
 }
 
+/// The robot description a scenario's cell moves its arms with, when the scenario names
+/// one and it is not in the cache yet (a front end fetches it; the world meanwhile keeps
+/// the reach spheres and gripper sweep). None for other worlds, and for a cell whose
+/// scene cannot be read (loading it says why).
+pub fn missing_description(scenario: &Scenario) -> Option<&'static crate::model::DescriptionSpec> {
+    if scenario.world_kind != "cell" {
+        return None;
+    }
+    let scene = cell::scene::read(scenario, None).ok()?;
+    let description = scene.robot.arms.as_ref()?.description;
+    (!description.urdf_in(&description.path()).is_file()).then_some(description)
+}
+
 /// Build the world a scenario describes, changed by its `[world.variants.NAME]` table when
 /// `variant` names one (the same scene without an obstacle, say). Only the cell has
 /// variants.

@@ -118,7 +118,9 @@ pub fn quote(p: &Path) -> String {
 }
 
 /// The shell command that opens the workbench on `scenario` (relative to the crate root)
-/// in `dir`, with the model answered by `server`, then says how it exited.
+/// in `dir`, with the model answered by `server`, then says how it exited. It fetches
+/// nothing (`BETR_OFFLINE`): the cache under `dir` has no robot description, so the cell
+/// keeps its reach spheres and gripper sweep, the same in every run.
 pub fn workbench_command_on(
     scenario: &str,
     dir: &Path,
@@ -127,7 +129,7 @@ pub fn workbench_command_on(
 ) -> String {
     let scenario = super::fixtures::root().join(scenario);
     format!(
-        "cd {dir} && env HOME={dir} XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+        "cd {dir} && env HOME={dir} BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
          XDG_DATA_HOME={dir}/data {key_var}={key} {env} {bin} tui {scenario} --backend openai \
          --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies} \
          --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \

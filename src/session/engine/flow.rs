@@ -389,6 +389,21 @@ impl Engine {
         }
     }
 
+    /// The arms' description is in the cache now. A world not ticked yet is rebuilt with
+    /// the arms at once; one in the middle of a run keeps its abstraction until it is
+    /// reset (by the person, or by the next tree), so no run changes its physics halfway.
+    pub(super) fn robot_arrived(&mut self) {
+        if self.ticker.tick_count() == 0 && !self.running {
+            self.reset_world(false);
+            self.notice("the robot description is in the cache: the cell now moves the real arms");
+        } else {
+            self.notice(
+                "the robot description is in the cache: the real arms move from the next \
+                 world reset or the next tree",
+            );
+        }
+    }
+
     pub(super) fn undo(&mut self) {
         let Some(entry) = self.undo.pop() else {
             return self.error("nothing to undo: no change has been applied");

@@ -167,6 +167,10 @@ pub enum Command {
     SavePolicyTo(PathBuf),
     /// A fresh execution world and ticker.
     ResetWorld,
+    /// The robot description the cell's arms need has arrived in the cache: the
+    /// execution world moves the real arms from now on if nothing has run yet, else from
+    /// its next reset.
+    RobotArrived,
     /// Keep the offered fix as a rule of its skill (`only`: for the fix's objects alone).
     KeepRule {
         only: bool,
@@ -448,6 +452,7 @@ impl Engine {
             } => self.insert(&conditions, before.as_ref(), author),
             Command::SavePolicyTo(path) => self.save_policy_to(Some(path)),
             Command::ResetWorld => self.reset_world(true),
+            Command::RobotArrived => self.robot_arrived(),
             Command::KeepRule { only } => self.keep_rule(only),
             Command::DeclineRule => self.decline_rule(),
             Command::ShowKnowledge => self.show_knowledge(),
