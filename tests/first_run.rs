@@ -339,3 +339,59 @@ fn the_robot_description_is_fetched_while_the_workbench_is_open_and_the_arms_the
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn model_fetch_robot_installs_the_description_and_refuses_an_unknown_name() {
+    let dir = tmp("fetch-robot");
+    let cache = dir.join("models");
+    let pip_cache = std::env::var_os("HOME")
+        .map(|h| Path::new(&h).join(".cache").join("pip"))
+        .unwrap_or_else(|| dir.join("pip-cache"));
+    let env = [
+        ("BETR_MODEL_DIR", cache.to_str().unwrap()),
+        ("PIP_CACHE_DIR", pip_cache.to_str().unwrap()),
+        ("PIP_DISABLE_PIP_VERSION_CHECK", "1"),
+    ];
+    let unknown = support::cli::betr_with(&dir, &["model", "fetch", "--robot", "nao"], &env);
+    assert_eq!(
+        unknown.status.code(),
+        Some(2),
+        "{}",
+        support::cli::text(&unknown)
+    );
+    assert!(
+        support::cli::text(&unknown).contains("unknown robot description \"nao\" (known: yumi)"),
+        "{}",
+        support::cli::text(&unknown)
+    );
+    let listed = support::cli::betr_with(&dir, &["model", "list"], &env);
+    assert!(
+        support::cli::text(&listed)
+            .lines()
+            .any(|l| l.starts_with("yumi ") && l.contains(" no ") && l.ends_with("[--robot]")),
+        "{}",
+        support::cli::text(&listed)
+    );
+    let fetched = support::cli::betr_with(&dir, &["model", "fetch", "--robot", "yumi"], &env);
+    assert!(fetched.status.success(), "{}", support::cli::text(&fetched));
+    let description = betr::model::YUMI_DESCRIPTION;
+    let installed = cache.join(description.dir_name);
+    assert_eq!(
+        String::from_utf8_lossy(&fetched.stdout).trim(),
+        installed.display().to_string()
+    );
+    assert!(description.urdf_in(&installed).is_file());
+    assert_eq!(
+        cache_entries(&cache),
+        vec![description.dir_name.to_string()]
+    );
+    let listed = support::cli::betr_with(&dir, &["model", "list"], &env);
+    assert!(
+        support::cli::text(&listed)
+            .lines()
+            .any(|l| l.starts_with("yumi ") && l.contains(" yes ")),
+        "{}",
+        support::cli::text(&listed)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

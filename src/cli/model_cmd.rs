@@ -1,5 +1,5 @@
-//! `betr model fetch`, `list` and `verify`, for the language model and (with `--stt`) the
-//! speech-to-text models.
+//! `betr model fetch`, `list` and `verify`, for the language model, (with `--stt`) the
+//! speech-to-text models and (with `--robot`) the robot descriptions the cell's arms need.
 
 use std::process::ExitCode;
 
@@ -12,13 +12,17 @@ use betr::model::{self, DirModelSpec, ModelSpec, Progress};
 #[derive(Subcommand)]
 pub enum ModelAction {
     /// Download, verify and install a model (the default LLM unless --model; with --stt
-    /// the default speech-to-text model, whisper-tiny.en).
+    /// the default speech-to-text model, whisper-tiny.en), or with --robot a robot
+    /// description (the workbench also fetches the one its scenario needs on first use).
     Fetch {
         #[arg(long)]
         model: Option<String>,
         /// A speech-to-text model.
         #[arg(long)]
         stt: bool,
+        /// A robot description by name (`yumi`: the ABB YuMi's URDF and meshes).
+        #[arg(long, value_name = "NAME", conflicts_with_all = ["model", "stt"])]
+        robot: Option<String>,
     },
     /// Known models, their sizes and whether they are in the cache.
     List,
@@ -34,7 +38,10 @@ pub enum ModelAction {
 
 pub fn run(action: ModelAction) -> Result<ExitCode> {
     match action {
-        ModelAction::Fetch { model, stt } => fetch(model.as_deref(), stt),
+        ModelAction::Fetch {
+            robot: Some(robot), ..
+        } => fetch_robot(&robot),
+        ModelAction::Fetch { model, stt, .. } => fetch(model.as_deref(), stt),
         ModelAction::List => list(),
         ModelAction::Verify { model, stt } => verify(model.as_deref(), stt),
     }
@@ -134,6 +141,36 @@ pub fn ensure_stt(name: Option<&str>) -> Result<std::path::PathBuf> {
     Ok(path)
 }
 
+/// Fetch a robot description unless it is already cached, and say where it is.
+fn fetch_robot(name: &str) -> Result<ExitCode> {
+    let spec = model::find_description(name).with_context(|| {
+        let known: Vec<&str> = model::DESCRIPTIONS.iter().map(|d| d.name).collect();
+        format!(
+            "unknown robot description {name:?} (known: {})",
+            known.join(", ")
+        )
+    })?;
+    let path = spec.path();
+    if !spec.urdf_in(&path).is_file() {
+        errln!(
+            "Fetching {} ({:.0} MB) into {} — once only",
+            spec.description,
+            spec.size as f64 / 1e6,
+            model::cache_dir().display()
+        );
+        let mut progress = TerminalProgress::new();
+        let path = model::ensure_description(
+            spec,
+            &model::cache_dir(),
+            model::Pip::DEFAULT,
+            &mut progress,
+        )?;
+        progress.finish(format!("verified and installed {}", path.display()));
+    }
+    outln!("{}", path.display());
+    Ok(ExitCode::SUCCESS)
+}
+
 pub fn fetch(name: Option<&str>, stt: bool) -> Result<ExitCode> {
     let path = if stt {
         ensure_stt(name)?
@@ -162,6 +199,19 @@ pub fn list() -> Result<ExitCode> {
             m.size() as f64 / 1e6,
             if m.is_present() { "yes" } else { "no" },
             m.description
+        );
+    }
+    for d in model::DESCRIPTIONS {
+        outln!(
+            "{:<22} {:>6.0} MB  {:<8} {} [--robot]",
+            d.name,
+            d.size as f64 / 1e6,
+            if d.urdf_in(&d.path()).is_file() {
+                "yes"
+            } else {
+                "no"
+            },
+            d.description
         );
     }
     outln!("\ncache: {}", model::cache_dir().display());

@@ -162,9 +162,11 @@ impl Arms {
         if !description.urdf_in(&dir).is_file() {
             return ArmsAvailability::Abstract(format!(
                 "the robot description {:?} is not in the cache ({}): the cell checks its \
-                 reach spheres and gripper sweep instead of moving the arms",
+                 reach spheres and gripper sweep instead of moving the arms (`betr model \
+                 fetch --robot {}` fetches it; the workbench does on first use)",
                 description.name,
                 dir.display(),
+                description.name,
             ));
         }
         let read = READ.get_or_init(|| Mutex::new(HashMap::new()));
