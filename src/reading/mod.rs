@@ -22,6 +22,7 @@ pub mod parts;
 pub mod placement;
 pub mod polarity;
 pub mod relation_words;
+pub mod request;
 pub mod words;
 
 pub use lexicon::Lexicon;
