@@ -22,7 +22,7 @@ use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::relation_words::{convention_followed, relation_as_said};
-pub use super::request::Request;
+use super::request::Request;
 
 /// One kind of plain misreading; see the module.
 pub trait Misreading: Sync {

@@ -148,3 +148,58 @@ impl<'a> Request<'a> {
         self.vocabulary.objects.iter().collect()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn cafe() -> Scenario {
+        Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml"))
+            .expect("cafe scenario")
+    }
+
+    #[test]
+    fn a_request_is_read_into_its_words_clauses_scopes_and_mentions() {
+        let cafe = cafe();
+        let lexicon = Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+        let request = Request::new(
+            "Bring coffee to table No. 1, don't open the curtain. Or chips?",
+            &cafe,
+            &lexicon,
+        );
+        // "No." only announces the number: gone from the unnumbered words, kept as written.
+        assert!(request.words.contains(&"no".to_string()));
+        assert!(!request.unnumbered_words.contains(&"no".to_string()));
+        assert_eq!(request.clauses.len(), 4, "{:?}", request.clauses);
+        assert_eq!(request.sentences.len(), 3, "{:?}", request.sentences);
+        // The negation is in the curtain's scope, and the sentence with "or" offers a choice.
+        let curtain = request
+            .scopes
+            .iter()
+            .find(|s| s.words.iter().any(|w| w == "curtain"))
+            .expect("a scope about the curtain");
+        assert!(curtain.words.contains(&"not".to_string()), "{curtain:?}");
+        assert!(!curtain.choice);
+        assert!(
+            request
+                .scopes
+                .iter()
+                .any(|s| s.choice && s.words.contains(&"chip".to_string())),
+            "{:?}",
+            request.scopes
+        );
+        assert_eq!(request.choices, 1);
+        let named: Vec<&str> = request
+            .mentions()
+            .iter()
+            .map(|(_, _, name)| name.as_str())
+            .collect();
+        assert_eq!(named, ["Coffee", "Table1", "Curtain", "Chips"]);
+        // Each mention's span is the object's words in the unnumbered words.
+        let (at, len, _) = &request.mentions()[1];
+        assert_eq!(request.unnumbered_words[*at..at + len], ["table", "1"]);
+        let by_clause: Vec<usize> = request.clause_mentions().iter().map(Vec::len).collect();
+        assert_eq!(by_clause, [2, 1, 1, 0]);
+    }
+}
