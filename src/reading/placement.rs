@@ -31,13 +31,18 @@ pub fn not_put(goal: &Formula, request: &Request) -> Option<Sent> {
     }
     let atoms = goal.atoms();
     let asked = said_predicates(request);
-    request.sent().iter().cloned().find(|s| {
-        let about_item: Vec<&Atom> = atoms.iter().filter(|a| a.args.contains(&s.item)).collect();
-        let together = about_item.iter().any(|a| a.args.contains(&s.place));
-        // "Hold the cup at the bar" asks for holding in its own words.
-        let unasked = about_item.iter().any(|a| !asked.contains(&a.predicate));
-        unasked && !together
-    })
+    request
+        .sent()
+        .iter()
+        .find(|s| {
+            let about_item: Vec<&Atom> =
+                atoms.iter().filter(|a| a.args.contains(&s.item)).collect();
+            let together = about_item.iter().any(|a| a.args.contains(&s.place));
+            // "Hold the cup at the bar" asks for holding in its own words.
+            let unasked = about_item.iter().any(|a| !asked.contains(&a.predicate));
+            unasked && !together
+        })
+        .cloned()
 }
 
 /// `goal` with each item the request sends to a place put there: in a conjunction, a
