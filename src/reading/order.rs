@@ -87,27 +87,14 @@ mod tests {
             .parse_goal(r#""blue cube" on "green cube""#)
             .expect("goal");
         assert_eq!(
-            reversed(
-                &reversed_goal,
-                &Request::in_scene(request, v, &[], &Lexicon::default())
-            )
-            .map(|a| a.to_string()),
+            reversed(&reversed_goal, &Request::among(request, v)).map(|a| a.to_string()),
             Some(r#""green cube" on "blue cube""#.to_string())
         );
         assert_eq!(
-            turned_round(
-                &reversed_goal,
-                &Request::in_scene(request, v, &[], &Lexicon::default())
-            ),
+            turned_round(&reversed_goal, &Request::among(request, v)),
             Some(as_said.clone())
         );
-        assert_eq!(
-            reversed(
-                &as_said,
-                &Request::in_scene(request, v, &[], &Lexicon::default())
-            ),
-            None
-        );
+        assert_eq!(reversed(&as_said, &Request::among(request, v)), None);
     }
 
     #[test]
@@ -117,21 +104,13 @@ mod tests {
         // Two places, no object sent between them.
         let goal = cafe.parse_goal("On_Coffee_Table1").expect("goal");
         assert_eq!(
-            reversed(
-                &goal,
-                &Request::in_scene("Bring coffee to table 1", v, &[], &Lexicon::default())
-            ),
+            reversed(&goal, &Request::among("Bring coffee to table 1", v)),
             None
         );
         assert_eq!(
             reversed(
                 &goal,
-                &Request::in_scene(
-                    "Is the coffee at table 1 or the bar?",
-                    v,
-                    &[],
-                    &Lexicon::default()
-                )
+                &Request::among("Is the coffee at table 1 or the bar?", v)
             ),
             None
         );

@@ -20,12 +20,7 @@ fn the_relation_said_before_the_place_is_the_one_asked_for() {
     let on = goal(&baby, r#""baby doll" on "crib""#);
     let (swapped, word) = relation_as_said(
         &on,
-        &Request::in_scene(
-            "Lay the doll to sleep in the crib, gently",
-            vocabulary,
-            &[],
-            &Lexicon::default(),
-        ),
+        &Request::among("Lay the doll to sleep in the crib, gently", vocabulary),
     )
     .expect("in the crib asks for in");
     assert_eq!(swapped, goal(&baby, r#""baby doll" in "crib""#));
@@ -33,12 +28,7 @@ fn the_relation_said_before_the_place_is_the_one_asked_for() {
     // Said the other way, the other way round.
     let (swapped, _) = relation_as_said(
         &swapped,
-        &Request::in_scene(
-            "Leave the doll on the crib",
-            vocabulary,
-            &[],
-            &Lexicon::default(),
-        ),
+        &Request::among("Leave the doll on the crib", vocabulary),
     )
     .expect("on");
     assert_eq!(swapped, on);
@@ -46,37 +36,19 @@ fn the_relation_said_before_the_place_is_the_one_asked_for() {
     assert_eq!(
         relation_as_said(
             &on,
-            &Request::in_scene(
-                "The crib is ready, the doll goes there",
-                vocabulary,
-                &[],
-                &Lexicon::default()
-            )
+            &Request::among("The crib is ready, the doll goes there", vocabulary)
         ),
         None
     );
     assert_eq!(
-        relation_as_said(
-            &on,
-            &Request::in_scene(
-                "Put the doll on the crib",
-                vocabulary,
-                &[],
-                &Lexicon::default()
-            )
-        ),
+        relation_as_said(&on, &Request::among("Put the doll on the crib", vocabulary)),
         None
     );
     // "In front of the crib" says where, not inside.
     assert_eq!(
         relation_as_said(
             &on,
-            &Request::in_scene(
-                "Put the doll in front of the crib",
-                vocabulary,
-                &[],
-                &Lexicon::default()
-            )
+            &Request::among("Put the doll in front of the crib", vocabulary)
         ),
         None
     );
@@ -89,12 +61,7 @@ fn a_scene_with_one_relation_has_nothing_to_swap() {
     assert_eq!(
         relation_as_said(
             &on,
-            &Request::in_scene(
-                "coffee in table 1",
-                &cafe.domain.vocabulary,
-                &[],
-                &Lexicon::default()
-            )
+            &Request::among("coffee in table 1", &cafe.domain.vocabulary)
         ),
         None
     );
@@ -184,10 +151,7 @@ fn the_cells_stated_goals_and_worked_examples_are_not_misreadings() {
         });
         for (request, gold) in stated.into_iter().chain(examples) {
             assert_eq!(
-                relation_as_said(
-                    &gold,
-                    &Request::in_scene(&request, vocabulary, &[], &Lexicon::default())
-                ),
+                relation_as_said(&gold, &Request::among(&request, vocabulary)),
                 None,
                 "{}: {request}",
                 path.display()

@@ -149,6 +149,27 @@ impl<'a> Request<'a> {
     }
 }
 
+/// An empty vocabulary and lexicon, for tests of readers that need less than a scene.
+#[cfg(test)]
+static NO_VOCABULARY: std::sync::LazyLock<Vocabulary> =
+    std::sync::LazyLock::new(Vocabulary::default);
+#[cfg(test)]
+static NO_WORDS: std::sync::LazyLock<Lexicon> = std::sync::LazyLock::new(Lexicon::default);
+
+#[cfg(test)]
+impl<'a> Request<'a> {
+    /// `text` read among `vocabulary`'s objects and predicates, with no conventions and an
+    /// empty lexicon: for readers that use neither.
+    pub(crate) fn among(text: &'a str, vocabulary: &'a Vocabulary) -> Self {
+        Self::in_scene(text, vocabulary, &[], &NO_WORDS)
+    }
+
+    /// `text` read in no scene: for readers that look only at the request's words.
+    pub(crate) fn words_only(text: &'a str) -> Self {
+        Self::among(text, &NO_VOCABULARY)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -48,37 +48,15 @@ fn a_condition_pasted_from_an_example_is_found() {
     let request = "Put the blue cube on the green cube";
     let pasted =
         Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#).expect("parses");
-    let why = copied_from_example(
-        &pasted,
-        &shown,
-        &Request::in_scene(request, &Vocabulary::default(), &[], &Lexicon::default()),
-    )
-    .expect("found");
+    let why = copied_from_example(&pasted, &shown, &Request::words_only(request)).expect("found");
     assert!(why.contains("grasped"), "{why}");
     let plain = Formula::parse(r#""blue cube" on "green cube""#).expect("parses");
-    assert!(
-        copied_from_example(
-            &plain,
-            &shown,
-            &Request::in_scene(request, &Vocabulary::default(), &[], &Lexicon::default())
-        )
-        .is_none()
-    );
+    assert!(copied_from_example(&plain, &shown, &Request::words_only(request)).is_none());
     // Asked for in other words ("hand empty" is not "grasped", but the object is
     // named): not a copy.
     let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
     assert!(
-        copied_from_example(
-            &named,
-            &shown,
-            &Request::in_scene(
-                "take the sponge out",
-                &Vocabulary::default(),
-                &[],
-                &Lexicon::default()
-            )
-        )
-        .is_none()
+        copied_from_example(&named, &shown, &Request::words_only("take the sponge out")).is_none()
     );
 }
 
@@ -94,12 +72,7 @@ fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
     let rest = without_copied(
         &pasted,
         &shown,
-        &Request::in_scene(
-            "Put the blue cube on the green cube",
-            &Vocabulary::default(),
-            &[],
-            &Lexicon::default(),
-        ),
+        &Request::words_only("Put the blue cube on the green cube"),
     )
     .expect("pruned");
     assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
@@ -109,12 +82,7 @@ fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
         without_copied(
             &indirect,
             &shown,
-            &Request::in_scene(
-                "It's hot here, close the curtain",
-                &Vocabulary::default(),
-                &[],
-                &Lexicon::default()
-            )
+            &Request::words_only("It's hot here, close the curtain")
         )
         .is_none()
     );
@@ -129,54 +97,33 @@ fn a_condition_no_word_asks_for_is_taken_out() {
     let request = "Please take a sandwich to the second table.";
     let appended = g("On_Sandwiches_Table2 & RobotNear_Table2");
     assert_eq!(
-        unasked(
-            &appended,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        ),
+        unasked(&appended, &Request::new(request, &scenario, &lexicon)),
         vec![g("RobotNear_Table2")]
     );
     assert_eq!(
-        without_unasked(
-            &appended,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        ),
+        without_unasked(&appended, &Request::new(request, &scenario, &lexicon)),
         Some(g("On_Sandwiches_Table2"))
     );
     // Every part answers to words of its own: nothing goes.
     let request = "Mop the floor, and bring a teacup to table two.";
     let both = g("IsClean_Floor & On_Teacup_Table2");
-    assert!(
-        unasked(
-            &both,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        )
-        .is_empty()
-    );
+    assert!(unasked(&both, &Request::new(request, &scenario, &lexicon)).is_empty());
     assert_eq!(
-        without_unasked(
-            &both,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        ),
+        without_unasked(&both, &Request::new(request, &scenario, &lexicon)),
         None
     );
     // A single condition is never taken out, however indirect the request.
     assert_eq!(
         without_unasked(
             &g("Active_AC"),
-            &Request::in_scene("I'm melting.", &scenario.domain.vocabulary, &[], &lexicon)
+            &Request::new("I'm melting.", &scenario, &lexicon)
         ),
         None
     );
     // A word said as often as conditions claim it asks for each of them.
     let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
     let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
-    assert!(
-        unasked(
-            &bars,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        )
-        .is_empty()
-    );
+    assert!(unasked(&bars, &Request::new(request, &scenario, &lexicon)).is_empty());
 }
 
 #[test]
@@ -187,7 +134,7 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     let request = "I'm at the third table, bring me either some fries or a dessert.";
     let (object, words) = swapped_object(
         &g("(Exists_Dessert | Exists_Coffee) & RobotNear_Table3"),
-        &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon),
+        &Request::new(request, &scenario, &lexicon),
     )
     .expect("a swap");
     assert_eq!(object, "Coffee");
@@ -195,7 +142,7 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     assert!(
         swapped_object(
             &g("On_Chips_Table3 | On_Dessert_Table3"),
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
+            &Request::new(request, &scenario, &lexicon)
         )
         .is_none()
     );
@@ -203,12 +150,7 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     assert!(
         swapped_object(
             &g("On_Milk_Table2"),
-            &Request::in_scene(
-                "A glass of milk to table 2",
-                &scenario.domain.vocabulary,
-                &[],
-                &lexicon
-            )
+            &Request::new("A glass of milk to table 2", &scenario, &lexicon)
         )
         .is_none()
     );
@@ -216,10 +158,9 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     assert!(
         swapped_object(
             &g("On_VacuumCup_WaterStation"),
-            &Request::in_scene(
+            &Request::new(
                 "Would you take my vacuum cup to the hydration area?",
-                &scenario.domain.vocabulary,
-                &[],
+                &scenario,
                 &lexicon
             )
         )
@@ -229,12 +170,7 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     assert!(
         swapped_object(
             &g("Active_AC"),
-            &Request::in_scene(
-                "It's so hot in here",
-                &scenario.domain.vocabulary,
-                &[],
-                &lexicon
-            )
+            &Request::new("It's so hot in here", &scenario, &lexicon)
         )
         .is_none()
     );
@@ -288,7 +224,7 @@ fn the_empty_hand_is_no_object_a_request_must_name() {
     assert_eq!(
         unnamed_object(
             g("Holding_Nothing").atoms(),
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
+            &Request::new(request, &scenario, &lexicon)
         ),
         None
     );
@@ -298,7 +234,7 @@ fn the_empty_hand_is_no_object_a_request_must_name() {
         world.as_ref(),
         &g("Holding_Nothing"),
         &[],
-        &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon),
+        &Request::new(request, &scenario, &lexicon),
     )
     .expect("it holds already");
     assert!(problem.is_doubt(), "{problem:?}");
@@ -340,14 +276,14 @@ fn a_goal_may_offer_only_the_choices_the_request_gives() {
     assert!(
         more_alternatives_than_asked(
             &g("On_Banana_Bar | On_Orange_Bar | ~Active_HallLight"),
-            &Request::in_scene(request, &Vocabulary::default(), &[], &Lexicon::default())
+            &Request::words_only(request)
         )
         .is_some()
     );
     assert_eq!(
         more_alternatives_than_asked(
             &g("(On_Banana_Bar | On_Orange_Bar) & ~Active_HallLight"),
-            &Request::in_scene(request, &Vocabulary::default(), &[], &Lexicon::default())
+            &Request::words_only(request)
         ),
         None
     );
@@ -356,12 +292,7 @@ fn a_goal_may_offer_only_the_choices_the_request_gives() {
     assert_eq!(
         more_alternatives_than_asked(
             &listed,
-            &Request::in_scene(
-                "Coffee, cake, or tea at the bar.",
-                &Vocabulary::default(),
-                &[],
-                &Lexicon::default()
-            )
+            &Request::words_only("Coffee, cake, or tea at the bar.")
         ),
         None
     );
@@ -370,24 +301,14 @@ fn a_goal_may_offer_only_the_choices_the_request_gives() {
     assert_eq!(
         more_alternatives_than_asked(
             &neither,
-            &Request::in_scene(
-                "Keep the mop away from the entrance and the exit.",
-                &Vocabulary::default(),
-                &[],
-                &Lexicon::default()
-            )
+            &Request::words_only("Keep the mop away from the entrance and the exit.")
         ),
         None
     );
     assert_eq!(
         more_alternatives_than_asked(
             &g("IsClean_Chairs | Exists_Coffee"),
-            &Request::in_scene(
-                "Clean the chairs; if not, make coffee.",
-                &Vocabulary::default(),
-                &[],
-                &Lexicon::default()
-            )
+            &Request::words_only("Clean the chairs; if not, make coffee.")
         ),
         None
     );
@@ -403,12 +324,7 @@ fn a_goal_true_through_a_place_nobody_named_is_wrong() {
         unsaid_object_holding(
             &g("On_Chips_Bar"),
             world.as_ref(),
-            &Request::in_scene(
-                "Bring me the chips",
-                &scenario.domain.vocabulary,
-                &[],
-                &lexicon
-            )
+            &Request::new("Bring me the chips", &scenario, &lexicon)
         ),
         Some("Bar".to_string())
     );
@@ -417,10 +333,9 @@ fn a_goal_true_through_a_place_nobody_named_is_wrong() {
         unsaid_object_holding(
             &g("Active_HallLight"),
             world.as_ref(),
-            &Request::in_scene(
+            &Request::new(
                 "Could you check that the hall light is on?",
-                &scenario.domain.vocabulary,
-                &[],
+                &scenario,
                 &lexicon
             )
         ),
@@ -440,12 +355,9 @@ fn what_every_alternative_repeats_is_judged_once() {
     );
     let request = "I'm at the third table, bring me fries or a dessert";
     assert_eq!(
-        without_unasked(
-            &goal,
-            &Request::in_scene(request, &scenario.domain.vocabulary, &[], &lexicon)
-        )
-        .map(|f| f.to_string())
-        .as_deref(),
+        without_unasked(&goal, &Request::new(request, &scenario, &lexicon))
+            .map(|f| f.to_string())
+            .as_deref(),
         Some("On_Chips_Table3 | On_Dessert_Table3")
     );
     // Nothing shared, or an alternative that is only the shared part: as it is.
@@ -463,22 +375,13 @@ fn alternatives_claim_each_word_once_per_condition() {
     let goal = s
         .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2) & RobotNear_Table1")
         .expect("parses");
-    let extra: Vec<String> = unasked(
-        &goal,
-        &Request::in_scene(request, &s.domain.vocabulary, &[], &lexicon),
-    )
-    .iter()
-    .map(ToString::to_string)
-    .collect();
+    let extra: Vec<String> = unasked(&goal, &Request::new(request, &s, &lexicon))
+        .iter()
+        .map(ToString::to_string)
+        .collect();
     assert_eq!(extra, ["RobotNear_Table1"]);
     let asked = s
         .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2)")
         .expect("parses");
-    assert!(
-        unasked(
-            &asked,
-            &Request::in_scene(request, &s.domain.vocabulary, &[], &lexicon)
-        )
-        .is_empty()
-    );
+    assert!(unasked(&asked, &Request::new(request, &s, &lexicon)).is_empty());
 }
