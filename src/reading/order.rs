@@ -67,7 +67,6 @@ pub fn turned_round(goal: &Formula, request: &Request) -> Option<Formula> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reading::Lexicon;
     use crate::scenario::Scenario;
     use std::path::Path;
 

@@ -1,6 +1,5 @@
 use super::*;
 use crate::domain::StateWords;
-use crate::reading::Lexicon;
 use crate::reading::words::every_term;
 
 fn object(name: &str, types: &[&str]) -> Object {

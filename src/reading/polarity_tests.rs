@@ -1,6 +1,5 @@
 use super::*;
 use crate::domain::{Object, StateWords};
-use crate::reading::Lexicon;
 
 fn object(name: &str, kind: &str, called: &[&str]) -> Object {
     Object {

@@ -1,7 +1,6 @@
 //! Tests of the checks a candidate goal must pass.
 
 use super::*;
-use crate::domain::Vocabulary;
 use crate::goal::Formula;
 use crate::reading::Lexicon;
 use crate::reading::names::{
