@@ -15,44 +15,14 @@
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
 
-use crate::domain::Vocabulary;
 use crate::goal::Formula;
-use crate::scenario::Scenario;
 
-use super::lexicon::Lexicon;
 use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::relation_words::{convention_followed, relation_as_said};
-use super::words::terms;
-
-/// A request read once, with the scene it is read in: what every detector looks at.
-pub struct Request<'a> {
-    /// The request as the person wrote it.
-    pub text: &'a str,
-    /// Its words as [`terms`] gives them.
-    pub terms: Vec<String>,
-    pub scenario: &'a Scenario,
-    pub lexicon: &'a Lexicon,
-}
-
-impl<'a> Request<'a> {
-    /// `text` read in `scenario`, whose words `lexicon` knows.
-    pub fn new(text: &'a str, scenario: &'a Scenario, lexicon: &'a Lexicon) -> Self {
-        let terms = terms(text);
-        Request {
-            terms,
-            text,
-            scenario,
-            lexicon,
-        }
-    }
-
-    pub fn vocabulary(&self) -> &'a Vocabulary {
-        &self.scenario.domain.vocabulary
-    }
-}
+use super::request::Request;
 
 /// One kind of plain misreading; see the module.
 pub trait Misreading: Sync {
@@ -112,11 +82,11 @@ impl Misreading for ReversedRelation {
         "reversed-relation"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        reversed(goal, request.text, request.vocabulary())
+        reversed(goal, request)
             .map(|atom| format!("{goal} has {atom} the other way round from the request"))
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        turned_round(goal, request.text, request.vocabulary())
+        turned_round(goal, request)
             .map(|g| {
                 (
                     g,
@@ -134,7 +104,7 @@ impl Misreading for SwappedObject {
         "swapped-object"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        swapped_object(goal, request.text, request.lexicon).map(|(object, words)| {
+        swapped_object(goal, request).map(|(object, words)| {
             format!(
                 "the request says {}, which no condition of {goal} answers, and never names {object}",
                 words.join(", ")
@@ -142,7 +112,7 @@ impl Misreading for SwappedObject {
         })
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        swapped_back(goal, request.text, request.lexicon, request.vocabulary())
+        swapped_back(goal, request)
             .map(|(g, from, to)| {
                 (
                     g,
@@ -162,13 +132,13 @@ impl Misreading for TurnedAround {
         "turned-around"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        turned_around(goal, request.text, request.vocabulary()).map(|t| t.to_string())
+        turned_around(goal, request).map(|t| t.to_string())
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
         let Some(why) = self.find(goal, request) else {
             return Vec::new();
         };
-        turned_back(goal, request.text, request.vocabulary())
+        turned_back(goal, request)
             .map(|g| (g, why))
             .into_iter()
             .collect()
@@ -181,7 +151,7 @@ impl Misreading for LeftUnanswered {
         "left-unanswered"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        let (atom, wanted, word) = left_unanswered(goal, request.text, request.vocabulary())?;
+        let (atom, wanted, word) = left_unanswered(goal, request)?;
         let asked = if wanted {
             atom.to_string()
         } else {
@@ -192,7 +162,7 @@ impl Misreading for LeftUnanswered {
         ))
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        with_unanswered(goal, request.text, request.vocabulary())
+        with_unanswered(goal, request)
             .map(|g| {
                 (
                     g,
@@ -210,14 +180,14 @@ impl Misreading for RelationAsSaid {
         "relation-as-said"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        relation_as_said(goal, request.text, request.vocabulary()).map(|(said, word)| {
+        relation_as_said(goal, request).map(|(said, word)| {
             format!(
                 "the request says \"{word}\" before the place, which asks for {said}, not {goal}"
             )
         })
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        relation_as_said(goal, request.text, request.vocabulary())
+        relation_as_said(goal, request)
             .map(|(g, word)| {
                 (
                     g,
@@ -235,12 +205,12 @@ impl Misreading for Convention {
         "convention"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        convention_followed(goal, request.text, request.scenario).map(|(put, word)| {
+        convention_followed(goal, request).map(|(put, word)| {
             format!("the request says \"{word}\", which here asks for {put}, not {goal}")
         })
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        convention_followed(goal, request.text, request.scenario)
+        convention_followed(goal, request)
             .map(|(g, word)| {
                 (
                     g,
@@ -258,7 +228,7 @@ impl Misreading for NotPut {
         "not-put"
     }
     fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        not_put(goal, request.text, request.vocabulary()).map(|sent| {
+        not_put(goal, request).map(|sent| {
             format!(
                 "the request sends {} to {}, and no condition of {goal} puts it there",
                 sent.item, sent.place
@@ -266,14 +236,13 @@ impl Misreading for NotPut {
         })
     }
     fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        let vocabulary = request.vocabulary();
-        let put = put_there(goal, request.text, vocabulary).map(|g| {
+        let put = put_there(goal, request).map(|g| {
             (
                 g,
                 format!("the request sends an item to a place that {goal} only has apart"),
             )
         });
-        let moved = moved_there(goal, request.text, vocabulary).map(|g| {
+        let moved = moved_there(goal, request).map(|g| {
             (
                 g,
                 format!("the request sends an item to a place that {goal} has it at another place, one the request never names or names as where it comes from"),

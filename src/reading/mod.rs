@@ -3,7 +3,8 @@
 //! per kind of word); which words of a scene's requests each predicate and object answers
 //! to ([`lexicon`], from the scenario's data: names, what objects are called, the words
 //! listed for each predicate and its opposite, the example pool); a request cut into the
-//! wishes it is made of ([`parts`]); and the plain misreadings of a request, each a
+//! wishes it is made of ([`parts`]); a request read once, the value every reader below
+//! takes ([`request`]); and the plain misreadings of a request, each a
 //! detector registered in one list ([`misreading`]), built on what a request's words say
 //! about conditions ([`polarity`]), about items sent to places ([`placement`]), about
 //! the relation said before a place
@@ -22,7 +23,9 @@ pub mod parts;
 pub mod placement;
 pub mod polarity;
 pub mod relation_words;
+pub mod request;
 pub mod words;
 
 pub use lexicon::Lexicon;
-pub use misreading::{MISREADINGS, Misreading, Request, UnknownMisreading, misreadings_without};
+pub use misreading::{MISREADINGS, Misreading, UnknownMisreading, misreadings_without};
+pub use request::Request;

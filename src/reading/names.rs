@@ -7,8 +7,8 @@ use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
 use super::english::{is_generic, is_phrasing, offers_choice};
-use super::lexicon::Lexicon;
 use super::placement::named_in;
+use super::request::Request;
 use super::words::{is_number, same_word, terms};
 
 /// A condition of `goal` that one of the `shown` examples' goals holds and that shares no
@@ -17,12 +17,11 @@ use super::words::{is_number, same_word, terms};
 pub fn copied_from_example(
     goal: &Formula,
     shown: &[&crate::scenario::Example],
-    request: &str,
+    request: &Request,
 ) -> Option<String> {
-    let asked: Vec<String> = terms(request);
     goal.atoms()
         .into_iter()
-        .find(|atom| is_copied(atom, shown, &asked))
+        .find(|atom| is_copied(atom, shown, &request.terms))
         .map(|atom| format!("{atom} comes from an example, and the request says nothing about it"))
 }
 
@@ -51,19 +50,19 @@ fn is_copied(
 /// near table 2" after "coffee on table 2": "table" and "2" are said once and claimed
 /// twice, and the second conjunct has no word of its own); a request that says "bar" twice
 /// ("not on the bar and bar 2, the milk to the bar") asks for every conjunct about a bar.
-pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula> {
+pub fn unasked(goal: &Formula, request: &Request) -> Vec<Formula> {
     let Formula::And(items) = factored(goal) else {
         return Vec::new();
     };
-    let asked = terms(request);
-    let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, &asked)).collect();
+    let (asked, lexicon) = (&request.terms, request.lexicon);
+    let covered: Vec<Vec<String>> = items.iter().map(|i| lexicon.covered(i, asked)).collect();
     // Each condition claims the words it answers to: alternatives "chips to table 1 or
     // juice to table 2" claim "table" twice, so a third condition about a table is one
     // more than the request says.
     let by_atom: Vec<Vec<String>> = items
         .iter()
         .flat_map(|i| i.atoms())
-        .map(|a| lexicon.covered(&Formula::Atom(a), &asked))
+        .map(|a| lexicon.covered(&Formula::Atom(a), asked))
         .collect();
     let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
     let claimed = |w: &String| by_atom.iter().filter(|c| c.contains(w)).count();
@@ -77,12 +76,14 @@ pub fn unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<Formula>
 
 /// Words of the request that name an object ("six" of window table 6, "juice") and that
 /// no condition of `goal` answers to: the goal leaves out, or misplaces, something asked.
-pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec<String> {
-    let asked = terms(request);
-    let covered = lexicon.covered(goal, &asked);
-    let mut out: Vec<String> = asked
-        .into_iter()
+pub fn unanswered_names(goal: &Formula, request: &Request) -> Vec<String> {
+    let lexicon = request.lexicon;
+    let covered = lexicon.covered(goal, &request.terms);
+    let mut out: Vec<String> = request
+        .terms
+        .iter()
         .filter(|w| lexicon.names_an_object(w) && !covered.contains(w))
+        .cloned()
         .collect();
     out.dedup();
     out
@@ -96,19 +97,15 @@ pub fn unanswered_names(goal: &Formula, request: &str, lexicon: &Lexicon) -> Vec
 /// ("a glass of milk" read as the milk) or that leaves no object word out ("it's hot"
 /// read as the AC on) is no swap. Predicates are not judged this way: the words a pool
 /// teaches them are too loose ("also", "sure") to say one was put in another's place.
-pub fn swapped_object(
-    goal: &Formula,
-    request: &str,
-    lexicon: &Lexicon,
-) -> Option<(String, Vec<String>)> {
-    let unanswered: Vec<String> = unanswered_names(goal, request, lexicon)
+pub fn swapped_object(goal: &Formula, request: &Request) -> Option<(String, Vec<String>)> {
+    let unanswered: Vec<String> = unanswered_names(goal, request)
         .into_iter()
-        .filter(|w| !is_number(w) && lexicon.names_an_object_alone(w))
+        .filter(|w| !is_number(w) && request.lexicon.names_an_object_alone(w))
         .collect();
     if unanswered.is_empty() {
         return None;
     }
-    unnamed_object(goal.atoms(), request, lexicon).map(|object| (object, unanswered))
+    unnamed_object(goal.atoms(), request).map(|object| (object, unanswered))
 }
 
 /// `goal` with the object it put in another's place ([`swapped_object`]) replaced by the
@@ -116,14 +113,9 @@ pub fn swapped_object(
 /// read as `Softdrink`: `Chips`, called fries; "spring water" is `SpringWater`, not the
 /// water its second word names). `None` when the request names no such object or several.
 /// Returns the goal, and the object replaced and its replacement.
-pub fn swapped_back(
-    goal: &Formula,
-    request: &str,
-    lexicon: &Lexicon,
-    vocabulary: &crate::domain::Vocabulary,
-) -> Option<(Formula, String, String)> {
-    let (from, _) = swapped_object(goal, request, lexicon)?;
-    let of_kind = of_a_kind_with(vocabulary, &from)?;
+pub fn swapped_back(goal: &Formula, request: &Request) -> Option<(Formula, String, String)> {
+    let (from, _) = swapped_object(goal, request)?;
+    let of_kind = of_a_kind_with(request.vocabulary, &from)?;
     let in_goal: Vec<String> = goal.atoms().into_iter().flat_map(|a| a.args).collect();
     let mut named: Vec<String> = named_in(request, &of_kind)
         .into_iter()
@@ -156,19 +148,18 @@ fn of_a_kind_with<'a>(
 /// The first object of `atoms` that no word of `request` names.
 pub fn unnamed_object(
     atoms: impl IntoIterator<Item = crate::domain::Atom>,
-    request: &str,
-    lexicon: &Lexicon,
+    request: &Request,
 ) -> Option<String> {
-    let asked = terms(request);
     atoms
         .into_iter()
         .flat_map(|a| a.args)
         .filter(|arg| !is_placeholder(arg))
         .find(|arg| {
-            !lexicon
+            !request
+                .lexicon
                 .words(arg)
                 .iter()
-                .any(|w| asked.iter().any(|a| same_word(a, w)))
+                .any(|w| request.terms.iter().any(|a| same_word(a, w)))
         })
 }
 
@@ -217,10 +208,10 @@ pub fn factored(goal: &Formula) -> Formula {
 
 /// `goal` without the conjuncts nothing asks for, taken out one at a time, the last
 /// first (an appended condition comes last), while more than one is left.
-pub fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Option<Formula> {
+pub fn without_unasked(goal: &Formula, request: &Request) -> Option<Formula> {
     let mut current = factored(goal);
     let mut changed = false;
-    while let Some(extra) = unasked(&current, request, lexicon).pop() {
+    while let Some(extra) = unasked(&current, request).pop() {
         let Formula::And(items) = &current else {
             break;
         };
@@ -243,15 +234,15 @@ pub fn without_unasked(goal: &Formula, request: &str, lexicon: &Lexicon) -> Opti
 pub fn without_copied(
     goal: &Formula,
     shown: &[&crate::scenario::Example],
-    request: &str,
+    request: &Request,
 ) -> Option<Formula> {
     let Formula::And(items) = goal else {
         return None;
     };
-    let asked = terms(request);
+    let asked = &request.terms;
     let kept: Vec<Formula> = items
         .iter()
-        .filter(|item| !item.atoms().iter().any(|a| is_copied(a, shown, &asked)))
+        .filter(|item| !item.atoms().iter().any(|a| is_copied(a, shown, asked)))
         .cloned()
         .collect();
     if kept.is_empty() || kept.len() == items.len() {
@@ -325,8 +316,9 @@ fn alternatives(goal: &Formula, negated: bool) -> usize {
 }
 
 /// How many choices a request offers: each "or" (and "if not", "otherwise", ...), and each
-/// comma of a list that ends in "or" ("coffee, cake, or tea").
-fn choices_offered(request: &str) -> usize {
+/// comma of a list that ends in "or" ("coffee, cake, or tea"). [`Request::new`] reads
+/// them once.
+pub(super) fn choices_offered(request: &str) -> usize {
     let lower = request.to_lowercase();
     let mut choices = lower.matches("if not").count();
     for part in lower.split(['.', ';', ':', '!', '?']) {
@@ -352,9 +344,9 @@ fn choices_offered(request: &str) -> usize {
 /// Why `goal` offers more alternatives than `request` does, if it does: "a banana or an
 /// orange, and switch the light off" written `A | B | ~C` makes switching the light off
 /// one of three alternatives, when the request asks for it in any case.
-pub fn more_alternatives_than_asked(goal: &Formula, request: &str) -> Option<String> {
+pub fn more_alternatives_than_asked(goal: &Formula, request: &Request) -> Option<String> {
     let offered = alternatives(goal, false);
-    let asked = choices_offered(request);
+    let asked = request.choices;
     (offered > asked).then(|| {
         format!(
             "it offers {} alternatives joined by |, where the request gives {} choice(s); \

@@ -4,23 +4,19 @@
 //! the second, in one clause; a goal that relates them the other way, and never this way,
 //! has them reversed.
 
-use crate::domain::{Atom, Object, Vocabulary};
+use crate::domain::Atom;
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
 use super::english::TOWARDS;
-use super::placement::{PLACE_WITHIN, mentions};
-use super::polarity::without_numbering;
-use super::words::every_term;
+use super::placement::PLACE_WITHIN;
+use super::request::Request;
 
 /// The pairs (first, second) the request relates: the first named, then within a few
 /// words a word that sends it, then the second.
-fn said_pairs(request: &str, vocabulary: &Vocabulary) -> Vec<(String, String)> {
-    let objects: Vec<&Object> = vocabulary.objects.iter().collect();
+fn said_pairs(request: &Request) -> Vec<(String, String)> {
     let mut out = Vec::new();
-    for clause in without_numbering(request).split(['.', ';', '!', '?', ',']) {
-        let words = every_term(clause);
-        let named = mentions(&words, &objects, &[]);
+    for (words, named) in request.clauses.iter().zip(request.clause_mentions()) {
         for (i, (at, len, first)) in named.iter().enumerate() {
             let Some((next_at, _, second)) = named.get(i + 1) else {
                 continue;
@@ -39,8 +35,8 @@ fn said_pairs(request: &str, vocabulary: &Vocabulary) -> Vec<(String, String)> {
 
 /// The first positive two-object condition of `goal` that relates a pair the request
 /// says the other way round, when no condition of `goal` relates it as said: the atom.
-pub fn reversed(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Atom> {
-    let pairs = said_pairs(request, vocabulary);
+pub fn reversed(goal: &Formula, request: &Request) -> Option<Atom> {
+    let pairs = said_pairs(request);
     let atoms = goal.atoms_in_order();
     let relates =
         |a: &Atom, x: &str, y: &str| a.args.len() == 2 && a.args[0] == x && a.args[1] == y;
@@ -53,8 +49,8 @@ pub fn reversed(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Optio
 }
 
 /// `goal` with every reversed relation ([`reversed`]) turned the way the request says.
-pub fn turned_round(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
-    let atom = reversed(goal, request, vocabulary)?;
+pub fn turned_round(goal: &Formula, request: &Request) -> Option<Formula> {
+    let atom = reversed(goal, request)?;
     let swapped = Atom::new(
         atom.predicate.clone(),
         vec![atom.args[1].clone(), atom.args[0].clone()],
@@ -90,14 +86,14 @@ mod tests {
             .parse_goal(r#""blue cube" on "green cube""#)
             .expect("goal");
         assert_eq!(
-            reversed(&reversed_goal, request, v).map(|a| a.to_string()),
+            reversed(&reversed_goal, &Request::among(request, v)).map(|a| a.to_string()),
             Some(r#""green cube" on "blue cube""#.to_string())
         );
         assert_eq!(
-            turned_round(&reversed_goal, request, v),
+            turned_round(&reversed_goal, &Request::among(request, v)),
             Some(as_said.clone())
         );
-        assert_eq!(reversed(&as_said, request, v), None);
+        assert_eq!(reversed(&as_said, &Request::among(request, v)), None);
     }
 
     #[test]
@@ -106,9 +102,15 @@ mod tests {
         let v = &cafe.domain.vocabulary;
         // Two places, no object sent between them.
         let goal = cafe.parse_goal("On_Coffee_Table1").expect("goal");
-        assert_eq!(reversed(&goal, "Bring coffee to table 1", v), None);
         assert_eq!(
-            reversed(&goal, "Is the coffee at table 1 or the bar?", v),
+            reversed(&goal, &Request::among("Bring coffee to table 1", v)),
+            None
+        );
+        assert_eq!(
+            reversed(
+                &goal,
+                &Request::among("Is the coffee at table 1 or the bar?", v)
+            ),
             None
         );
     }

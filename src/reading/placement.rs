@@ -9,9 +9,9 @@ use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
 use super::english::{MOVING_VERBS, SOURCES, TOWARDS};
-use super::words::{every_term, same_word, terms};
-
-use super::polarity::{find_phrase, without_numbering};
+use super::polarity::find_phrase;
+use super::request::{Mention, Request};
+use super::words::{same_word, terms};
 
 /// How far after such a word the place's name may start ("to the third table").
 pub(super) const PLACE_WITHIN: usize = 3;
@@ -25,48 +25,52 @@ pub struct Sent {
 
 /// The first item the request sends to a place that `goal` has in a condition but never
 /// in one with that place, if any.
-pub fn not_put(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Sent> {
-    let relating = relating(vocabulary);
-    if relating.is_empty() {
+pub fn not_put(goal: &Formula, request: &Request) -> Option<Sent> {
+    if relating(request.vocabulary).is_empty() {
         return None;
     }
     let atoms = goal.atoms();
-    let asked = said_predicates(request, vocabulary);
-    sent(request, vocabulary, &relating).into_iter().find(|s| {
-        let about_item: Vec<&Atom> = atoms.iter().filter(|a| a.args.contains(&s.item)).collect();
-        let together = about_item.iter().any(|a| a.args.contains(&s.place));
-        // "Hold the cup at the bar" asks for holding in its own words.
-        let unasked = about_item.iter().any(|a| !asked.contains(&a.predicate));
-        unasked && !together
-    })
+    let asked = said_predicates(request);
+    request
+        .sent()
+        .iter()
+        .find(|s| {
+            let about_item: Vec<&Atom> =
+                atoms.iter().filter(|a| a.args.contains(&s.item)).collect();
+            let together = about_item.iter().any(|a| a.args.contains(&s.place));
+            // "Hold the cup at the bar" asks for holding in its own words.
+            let unasked = about_item.iter().any(|a| !asked.contains(&a.predicate));
+            unasked && !together
+        })
+        .cloned()
 }
 
 /// `goal` with each item the request sends to a place put there: in a conjunction, a
 /// condition about the item alone (made, `Exists_Dessert`) becomes the one relating
 /// condition (`On_Dessert_Table1`) and one about the place alone (the robot there) goes.
 /// `None` when nothing changes, or when more than one predicate could relate them.
-pub fn put_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
-    let relating = relating(vocabulary);
+pub fn put_there(goal: &Formula, request: &Request) -> Option<Formula> {
+    let relating = relating(request.vocabulary);
     let [relation] = relating.as_slice() else {
         return None;
     };
-    let sent = sent(request, vocabulary, &[relation]);
+    // With one relating predicate, what the request sends is sent by it.
+    let sent = request.sent();
     if sent.is_empty() {
         return None;
     }
-    put_sent(goal, request, vocabulary, &sent, &relation.name)
+    put_sent(goal, request, sent, &relation.name)
 }
 
 /// `goal` with each item of `sent` put at its place by `relation`, as [`put_there`] does;
 /// `None` when nothing changes.
 pub(super) fn put_sent(
     goal: &Formula,
-    request: &str,
-    vocabulary: &Vocabulary,
+    request: &Request,
     sent: &[Sent],
     relation: &str,
 ) -> Option<Formula> {
-    let asked = said_predicates(request, vocabulary);
+    let asked = said_predicates(request);
     let rewritten = rewrite(goal, sent, relation, &asked);
     (rewritten != *goal).then_some(rewritten)
 }
@@ -75,20 +79,19 @@ pub(super) fn put_sent(
 /// request never names ("bring yogurt to the bar" read as yogurt on the second bar):
 /// small models pick a place of the same kind, or one of an example; or from the place
 /// the request says it comes from ("the lettuce in from the cold frame to the bench").
-pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
-    let relating = relating(vocabulary);
-    let sent = sent(request, vocabulary, &relating);
+pub fn moved_there(goal: &Formula, request: &Request) -> Option<Formula> {
+    let relating = relating(request.vocabulary);
+    let sent = request.sent();
     if sent.is_empty() {
         return None;
     }
-    let objects: Vec<&Object> = vocabulary.objects.iter().collect();
-    let named = named_in(request, &objects);
-    let sources = sources(request, &objects);
+    let named: Vec<&String> = request.mentions().iter().map(|(_, _, name)| name).collect();
+    let sources = sources(request);
     let moved = map_atoms(goal, &|a| {
         let to = match a.args.as_slice() {
             [item, place]
                 if relating.iter().any(|p| p.name == a.predicate)
-                    && (!named.contains(place) || sources.contains(place)) =>
+                    && (!named.contains(&place) || sources.contains(place)) =>
             {
                 // Only an item sent to one place is moved: "chips to table 1 and table 2"
                 // does not say which one the second bar was meant to be.
@@ -111,15 +114,15 @@ pub fn moved_there(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Op
 /// The predicates the request names by their own words ("hold" for the one it says
 /// holding): a condition about an item alone that the request asks for in its own
 /// words ("hold the cup at the bar") is not a misplaced one.
-fn said_predicates(request: &str, vocabulary: &Vocabulary) -> Vec<String> {
-    let words = every_term(request);
-    vocabulary
+fn said_predicates(request: &Request) -> Vec<String> {
+    request
+        .vocabulary
         .predicates
         .iter()
         .filter(|p| {
             std::iter::once(&p.name)
                 .chain(&p.words.says)
-                .any(|phrase| find_phrase(&words, &terms(phrase)).is_some())
+                .any(|phrase| find_phrase(&request.words, &terms(phrase)).is_some())
         })
         .map(|p| p.name.clone())
         .collect()
@@ -259,7 +262,11 @@ pub(super) fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
 /// The items the request sends to a place, each with its place: an item named before
 /// "to"/"at"/"on" and a place named right after, in one clause, with no verb of the
 /// robot's own moving between them; items named after an earlier place go to the next.
-fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<Sent> {
+/// Items and places are the objects the scene's relating predicates take.
+/// [`Request::sent`] keeps them.
+pub(super) fn sent(request: &Request) -> Vec<Sent> {
+    let vocabulary = request.vocabulary;
+    let relating = relating(vocabulary);
     let fits = |o: &Object, slot: usize| {
         relating
             .iter()
@@ -268,14 +275,13 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
     let items: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 0)).collect();
     let places: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 1)).collect();
     let mut out: Vec<Sent> = Vec::new();
-    for clause in without_numbering(request).split(['.', ';', '!', '?', ',']) {
-        let words = every_term(clause);
-        let place_spans = mentions(&words, &places, &[]);
+    for words in &request.clauses {
+        let place_spans = mentions(words, &places, &[]);
         let covered: Vec<usize> = place_spans
             .iter()
             .flat_map(|(at, len, _)| *at..at + len)
             .collect();
-        let item_spans = mentions(&words, &items, &covered);
+        let item_spans = mentions(words, &items, &covered);
         let mut waiting: Vec<String> = Vec::new();
         let mut sent_unnamed = false;
         for (at, word) in words.iter().enumerate() {
@@ -325,25 +331,25 @@ fn sent(request: &str, vocabulary: &Vocabulary, relating: &[&Predicate]) -> Vec<
     out
 }
 
-/// The names of the `objects` the request says things come from ("from the cold frame").
-fn sources(request: &str, objects: &[&Object]) -> Vec<String> {
+/// The names of the scene's objects the request says things come from ("from the cold
+/// frame").
+fn sources(request: &Request) -> Vec<String> {
     let mut out = Vec::new();
-    for clause in without_numbering(request).split(['.', ';', '!', '?', ',']) {
-        let words = every_term(clause);
-        for (start, _, name) in mentions(&words, objects, &[]) {
-            let before = &words[start.saturating_sub(PLACE_WITHIN)..start];
+    for (words, named) in request.clauses.iter().zip(request.clause_mentions()) {
+        for (start, _, name) in named {
+            let before = &words[start.saturating_sub(PLACE_WITHIN)..*start];
             if before.iter().any(|w| SOURCES.contains(&w.as_str())) {
-                out.push(name);
+                out.push(name.clone());
             }
         }
     }
     out
 }
 
-/// The names of the `objects` the whole `request` mentions (place numbers read as
+/// The names of the `objects` the whole request mentions (place numbers read as
 /// digits), in the order found; a name may come more than once.
-pub(super) fn named_in(request: &str, objects: &[&Object]) -> Vec<String> {
-    mentions(&every_term(&without_numbering(request)), objects, &[])
+pub(super) fn named_in(request: &Request, objects: &[&Object]) -> Vec<String> {
+    mentions(&request.unnumbered_words, objects, &[])
         .into_iter()
         .map(|(_, _, name)| name)
         .collect()
@@ -356,11 +362,7 @@ pub(super) fn named_in(request: &str, objects: &[&Object]) -> Vec<String> {
 /// name has them in a row. A name with a word beside it from a longer name of another
 /// object that shares its words ("the other bar", where the other bar counter is another
 /// place than the bar) names neither.
-pub(super) fn mentions(
-    words: &[String],
-    objects: &[&Object],
-    taken: &[usize],
-) -> Vec<(usize, usize, String)> {
+pub(super) fn mentions(words: &[String], objects: &[&Object], taken: &[usize]) -> Vec<Mention> {
     let mut phrases: Vec<(Vec<String>, &str)> = objects
         .iter()
         .flat_map(|o| {

@@ -1,5 +1,6 @@
 use super::*;
 use crate::domain::StateWords;
+use crate::reading::words::every_term;
 
 fn object(name: &str, types: &[&str]) -> Object {
     Object {
@@ -49,12 +50,12 @@ fn vocabulary() -> Vocabulary {
 
 fn put(goal: &str, request: &str) -> Option<String> {
     let goal = Formula::parse(goal).expect("test goal parses");
-    put_there(&goal, request, &vocabulary()).map(|g| g.to_string())
+    put_there(&goal, &Request::among(request, &vocabulary())).map(|g| g.to_string())
 }
 
 fn flagged(goal: &str, request: &str) -> Option<(String, String)> {
     let goal = Formula::parse(goal).expect("test goal parses");
-    not_put(&goal, request, &vocabulary()).map(|s| (s.item, s.place))
+    not_put(&goal, &Request::among(request, &vocabulary())).map(|s| (s.item, s.place))
 }
 
 #[test]
@@ -166,12 +167,12 @@ fn the_scenes_own_worked_examples_put_what_they_send() {
         let vocabulary = &scenario.domain.vocabulary;
         let request = &example.instruction;
         assert_eq!(
-            not_put(goal, request, vocabulary),
+            not_put(goal, &Request::among(request, vocabulary)),
             None,
             "{scene}: {request:?}"
         );
         assert_eq!(
-            put_there(goal, request, vocabulary),
+            put_there(goal, &Request::among(request, vocabulary)),
             None,
             "{scene}: {request:?}"
         );
@@ -182,7 +183,7 @@ fn the_scenes_own_worked_examples_put_what_they_send() {
 fn items_sent_where_no_name_says_are_not_sent_to_the_next_place() {
     let v = vocabulary();
     let sent = |request: &str| {
-        sent(request, &v, &relating(&v))
+        sent(&Request::among(request, &v))
             .into_iter()
             .map(|s| format!("{}@{}", s.item, s.place))
             .collect::<Vec<_>>()
@@ -251,7 +252,7 @@ fn an_item_at_a_place_the_request_never_names_is_moved_where_it_is_sent() {
     let v = vocabulary();
     let moved = |goal: &str, request: &str| {
         let goal = Formula::parse(goal).expect("test goal parses");
-        moved_there(&goal, request, &v).map(|g| g.to_string())
+        moved_there(&goal, &Request::among(request, &v)).map(|g| g.to_string())
     };
     assert_eq!(
         moved(

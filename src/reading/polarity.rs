@@ -13,9 +13,9 @@ use crate::goal::Formula;
 use crate::goal::rewrite::{flipped, undo_each};
 
 use super::english::{NUMBERING, clause_start, is_negation, is_number_word};
-use super::words::{every_term, same_word, terms};
-
 use super::placement::mentions;
+use super::request::Request;
+use super::words::{every_term, same_word, terms};
 
 /// A condition the request asks for one way and the goal has the other way.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,34 +43,31 @@ impl fmt::Display for TurnedAround {
 }
 
 /// A condition of `goal` that the request asks for the other way round, if any.
-pub fn turned_around(
-    goal: &Formula,
-    request: &str,
-    vocabulary: &Vocabulary,
-) -> Option<TurnedAround> {
-    asked_conditions(request, vocabulary)
-        .into_iter()
-        .find_map(|(subject, wanted, word)| {
+pub fn turned_around(goal: &Formula, request: &Request) -> Option<TurnedAround> {
+    request
+        .asked()
+        .iter()
+        .find_map(|(subject, wanted, word, _)| {
             let pick = |a: &Atom| subject.matches(a);
             let signs = signs_of(goal, &pick, true);
-            if signs.is_empty() || signs.contains(&wanted) {
+            if signs.is_empty() || signs.contains(wanted) {
                 return None;
             }
             Some(TurnedAround {
                 atom: first_matching(goal, &pick)?,
-                wanted,
-                word,
+                wanted: *wanted,
+                word: word.clone(),
             })
         })
 }
 
 /// `goal` with every condition the request asks for the other way round turned around.
 /// `None` when nothing is turned around.
-pub fn turned_back(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+pub fn turned_back(goal: &Formula, request: &Request) -> Option<Formula> {
     // Each atom is turned once: a second finding about it would undo the first.
     undo_each(
         goal,
-        |g| turned_around(g, request, vocabulary),
+        |g| turned_around(g, request),
         |t| t.atom.clone(),
         |g, t| flipped(g, &t.atom),
     )
@@ -80,32 +77,30 @@ pub fn turned_back(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Op
 /// choice, and that `goal` has no condition about at all ("don't forget to turn on the
 /// hall light" read as the deliveries alone); with whether it is asked to hold and the
 /// word that asks for it.
-pub fn left_unanswered(
-    goal: &Formula,
-    request: &str,
-    vocabulary: &Vocabulary,
-) -> Option<(Atom, bool, String)> {
+pub fn left_unanswered(goal: &Formula, request: &Request) -> Option<(Atom, bool, String)> {
     let atoms = goal.atoms();
-    asked_in_sentences(request, vocabulary)
-        .into_iter()
+    request
+        .asked()
+        .iter()
         .filter(|(_, _, _, choice)| !choice)
         .find(|(subject, _, _, _)| !atoms.iter().any(|a| subject.matches(a)))
         .and_then(|(subject, wanted, word, _)| {
             let atom = Atom::new(subject.predicate.clone(), vec![subject.object.clone()]);
-            let takes_one = vocabulary
+            let takes_one = request
+                .vocabulary
                 .predicates
                 .iter()
                 .any(|p| p.name == subject.predicate && p.arg_types.len() == 1);
-            takes_one.then_some((atom, wanted, word))
+            takes_one.then_some((atom, *wanted, word.clone()))
         })
 }
 
 /// `goal` with every condition [`left_unanswered`] finds put beside it, the way the
 /// request asks for it. `None` when nothing is left unanswered.
-pub fn with_unanswered(goal: &Formula, request: &str, vocabulary: &Vocabulary) -> Option<Formula> {
+pub fn with_unanswered(goal: &Formula, request: &Request) -> Option<Formula> {
     undo_each(
         goal,
-        |g| left_unanswered(g, request, vocabulary),
+        |g| left_unanswered(g, request),
         |(atom, _, _)| atom.clone(),
         |g, (atom, wanted, _)| {
             let condition = Formula::Atom(atom.clone());
@@ -120,7 +115,7 @@ pub fn with_unanswered(goal: &Formula, request: &str, vocabulary: &Vocabulary) -
 }
 
 /// What a clause asks about: a predicate and the object it is about.
-struct Subject {
+pub(super) struct Subject {
     predicate: String,
     object: String,
 }
@@ -131,37 +126,24 @@ impl Subject {
     }
 }
 
-/// The conditions the request asks for one way: each with whether it is asked to hold and
-/// the word that says so. A condition asked for both ways is left out.
-fn asked_conditions(request: &str, vocabulary: &Vocabulary) -> Vec<(Subject, bool, String)> {
-    asked_in_sentences(request, vocabulary)
-        .into_iter()
-        .map(|(subject, wanted, word, _)| (subject, wanted, word))
-        .collect()
-}
+/// A condition the request asks for one way: what it is about, whether it is asked to
+/// hold, the word that says so, and whether its sentence offers a choice ("or",
+/// "either"): a condition asked there may be one alternative of several.
+pub(super) type Asked = (Subject, bool, String, bool);
 
-/// [`asked_conditions`], each with whether its sentence offers a choice ("or", "either"):
-/// a condition asked there may be one alternative of several.
-fn asked_in_sentences(
-    request: &str,
-    vocabulary: &Vocabulary,
-) -> Vec<(Subject, bool, String, bool)> {
-    let mut found: Vec<(Subject, bool, String, bool)> = Vec::new();
+/// The conditions `request` asks for one way, in its negation scopes ([`Request::scopes`]);
+/// a condition asked for both ways is left out. [`Request::asked`] keeps them.
+pub(super) fn asked_in_sentences(request: &Request) -> Vec<Asked> {
+    let vocabulary = request.vocabulary;
+    let mut found: Vec<Asked> = Vec::new();
     let mut both: Vec<(String, String)> = Vec::new();
-    let text = without_numbering(request);
-    let sentences = text.split(['.', '!', '?', ';']).map(|sentence| {
-        let words = every_term(sentence);
-        let choice = words.iter().any(|w| w == "or" || w == "either");
-        (clauses(sentence), choice)
-    });
-    let with_choice =
-        sentences.flat_map(|(clauses, choice)| clauses.into_iter().map(move |c| (c, choice)));
-    for (clause, choice) in with_choice {
+    for scope in &request.scopes {
+        let (clause, choice) = (&scope.words, scope.choice);
         for predicate in &vocabulary.predicates {
-            let Some((wanted, word)) = clause_polarity(&clause, predicate) else {
+            let Some((wanted, word)) = clause_polarity(clause, predicate) else {
                 continue;
             };
-            for object in subjects(&clause, predicate, vocabulary) {
+            for object in subjects(clause, predicate, vocabulary) {
                 let key = (predicate.name.clone(), object.clone());
                 if both.contains(&key) {
                     continue;
@@ -211,10 +193,11 @@ pub fn without_numbering(text: &str) -> String {
         .join(" ")
 }
 
-/// The request's clauses, as [`every_term`] gives their words: split at punctuation and before
-/// the words that start a clause; "n't" is the word "not".
-fn clauses(request: &str) -> Vec<Vec<String>> {
-    let text = without_numbering(request)
+/// The clauses of `sentence`, as [`every_term`] gives their words: split at punctuation
+/// and before the words that start a clause; "n't" is the word "not". The clause splitter
+/// [`Request::new`] reads a request's negation scopes with.
+pub(super) fn clauses(sentence: &str) -> Vec<Vec<String>> {
+    let text = without_numbering(sentence)
         .replace("n't", " not")
         .replace("n’t", " not")
         .replace("N'T", " not");

@@ -52,12 +52,12 @@ fn vocabulary() -> Vocabulary {
 
 fn turned(goal: &str, request: &str) -> Option<String> {
     let goal = Formula::parse(goal).expect("test goal parses");
-    turned_around(&goal, request, &vocabulary()).map(|t| t.to_string())
+    turned_around(&goal, &Request::among(request, &vocabulary())).map(|t| t.to_string())
 }
 
 fn back(goal: &str, request: &str) -> Option<String> {
     let goal = Formula::parse(goal).expect("test goal parses");
-    turned_back(&goal, request, &vocabulary()).map(|g| g.to_string())
+    turned_back(&goal, &Request::among(request, &vocabulary())).map(|g| g.to_string())
 }
 
 #[test]
@@ -166,8 +166,11 @@ fn put_down_asks_to_hold_nothing_of_it() {
 fn the_scenes_own_worked_examples_are_read_the_way_round_they_ask() {
     crate::session::for_each_worked_example(|scene, scenario, example, goal| {
         assert_eq!(
-            turned_around(goal, &example.instruction, &scenario.domain.vocabulary)
-                .map(|t| t.to_string()),
+            turned_around(
+                goal,
+                &Request::among(&example.instruction, &scenario.domain.vocabulary)
+            )
+            .map(|t| t.to_string()),
             None,
             "{scene}: {:?}",
             example.instruction
@@ -193,15 +196,15 @@ fn words_that_only_announce_a_number_are_left_out() {
 
 fn with_asked(goal: &str, request: &str) -> Option<String> {
     let goal = Formula::parse(goal).expect("test goal parses");
-    with_unanswered(&goal, request, &vocabulary()).map(|g| g.to_string())
+    with_unanswered(&goal, &Request::among(request, &vocabulary())).map(|g| g.to_string())
 }
 
 #[test]
 fn a_condition_asked_in_its_own_words_and_left_out_is_put_beside() {
     let request = "Don't forget to turn on the hall light. And bring a coffee to table 1.";
     let goal = Formula::parse("On_Coffee_Table1").expect("parses");
-    let (atom, wanted, word) =
-        left_unanswered(&goal, request, &vocabulary()).expect("the light is asked for");
+    let (atom, wanted, word) = left_unanswered(&goal, &Request::among(request, &vocabulary()))
+        .expect("the light is asked for");
     assert_eq!(
         (atom.to_string(), wanted, word.as_str()),
         ("Active_HallLight".into(), true, "on")
@@ -241,7 +244,10 @@ fn a_longer_name_is_the_subject_not_a_shorter_one_inside_it() {
     v.objects.push(object("Water", "item", &[]));
     v.objects.push(object("Watermelon", "item", &[]));
     let goal = Formula::parse("On_Coffee_Table1").expect("parses");
-    let found = left_unanswered(&goal, "Please hold a bottle of spring water.", &v)
-        .map(|(atom, _, _)| atom.to_string());
+    let found = left_unanswered(
+        &goal,
+        &Request::among("Please hold a bottle of spring water.", &v),
+    )
+    .map(|(atom, _, _)| atom.to_string());
     assert_eq!(found.as_deref(), Some("Holding_SpringWater"));
 }

@@ -4,32 +4,27 @@
 //! where what is brought goes on the tray) ask for the convention's relation to its place
 //! for each item they name, so a goal that has the kit held instead has misread it.
 
-use crate::domain::{Atom, Object, Predicate, Vocabulary};
+use crate::domain::{Atom, Object, Predicate};
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
-use super::words::every_term;
-use crate::scenario::Scenario;
-
 use super::placement::{PLACE_WITHIN, Sent, mentions, put_sent, relating};
-use super::polarity::{find_phrase, without_numbering};
+use super::polarity::find_phrase;
+use super::request::Request;
+use super::words::every_term;
 
 /// `goal` with each condition relating two objects by a predicate other than the one the
 /// request names right before the second ("in the crib" read as `on`) given the one it
 /// names, with the word that names it; `None` when nothing changes or the scene has one
 /// such predicate only.
-pub fn relation_as_said(
-    goal: &Formula,
-    request: &str,
-    vocabulary: &Vocabulary,
-) -> Option<(Formula, String)> {
+pub fn relation_as_said(goal: &Formula, request: &Request) -> Option<(Formula, String)> {
+    let vocabulary = request.vocabulary;
     let relating = relating(vocabulary);
     if relating.len() < 2 {
         return None;
     }
-    let words = every_term(&without_numbering(request));
-    let objects: Vec<&Object> = vocabulary.objects.iter().collect();
-    let named = mentions(&words, &objects, &[]);
+    let words = &request.unnumbered_words;
+    let named = request.mentions();
     let swap = |a: &Atom| -> Option<(Atom, String)> {
         let [_, place] = a.args.as_slice() else {
             return None;
@@ -40,7 +35,7 @@ pub fn relation_as_said(
         let (p, word) = named
             .iter()
             .filter(|(_, _, name)| name == place)
-            .find_map(|(start, _, _)| said_before(&words, *start, &relating))?;
+            .find_map(|(start, _, _)| said_before(words, *start, &relating))?;
         let swapped = Atom::new(p.name.clone(), a.args.clone());
         (p.name != a.predicate && vocabulary.check_atom(&swapped).is_ok())
             .then_some((swapped, word))
@@ -77,13 +72,9 @@ fn said_before<'a>(
 /// is brought goes on the tray), with the word; `None` when no convention of the scene
 /// applies or nothing changes. Only a condition about the item alone, not asked for in
 /// its predicate's own words, is replaced, as [`super::placement::put_there`] does.
-pub fn convention_followed(
-    goal: &Formula,
-    request: &str,
-    scenario: &Scenario,
-) -> Option<(Formula, String)> {
-    let vocabulary = &scenario.domain.vocabulary;
-    for c in &scenario.conventions {
+pub fn convention_followed(goal: &Formula, request: &Request) -> Option<(Formula, String)> {
+    let vocabulary = request.vocabulary;
+    for c in request.conventions {
         let Some(puts) = &c.puts else {
             continue;
         };
@@ -103,17 +94,16 @@ pub fn convention_followed(
                         .is_ok()
             })
             .collect();
-        for sentence in without_numbering(request).split(['.', ';', '!', '?']) {
-            let words = every_term(sentence);
+        for words in &request.sentences {
             let Some(word) = puts
                 .words
                 .iter()
-                .find(|w| find_phrase(&words, &every_term(w)).is_some())
+                .find(|w| find_phrase(words, &every_term(w)).is_some())
             else {
                 continue;
             };
             let mut sent: Vec<Sent> = Vec::new();
-            for (_, _, item) in mentions(&words, &items, &[]) {
+            for (_, _, item) in mentions(words, &items, &[]) {
                 if !sent.iter().any(|s| s.item == item) {
                     sent.push(Sent {
                         item,
@@ -121,7 +111,7 @@ pub fn convention_followed(
                     });
                 }
             }
-            if let Some(g) = put_sent(goal, request, vocabulary, &sent, &puts.relation) {
+            if let Some(g) = put_sent(goal, request, &sent, &puts.relation) {
                 return Some((g, word.clone()));
             }
         }

@@ -1,6 +1,8 @@
 //! Tests of the relation a request's words ask for.
 
 use super::*;
+use crate::reading::Lexicon;
+use crate::scenario::Scenario;
 use std::path::Path;
 
 fn scene(file: &str) -> Scenario {
@@ -16,27 +18,38 @@ fn the_relation_said_before_the_place_is_the_one_asked_for() {
     let baby = scene("scenarios/cell/params/baby.toml");
     let vocabulary = &baby.domain.vocabulary;
     let on = goal(&baby, r#""baby doll" on "crib""#);
-    let (swapped, word) =
-        relation_as_said(&on, "Lay the doll to sleep in the crib, gently", vocabulary)
-            .expect("in the crib asks for in");
+    let (swapped, word) = relation_as_said(
+        &on,
+        &Request::among("Lay the doll to sleep in the crib, gently", vocabulary),
+    )
+    .expect("in the crib asks for in");
     assert_eq!(swapped, goal(&baby, r#""baby doll" in "crib""#));
     assert_eq!(word, "in");
     // Said the other way, the other way round.
-    let (swapped, _) =
-        relation_as_said(&swapped, "Leave the doll on the crib", vocabulary).expect("on");
+    let (swapped, _) = relation_as_said(
+        &swapped,
+        &Request::among("Leave the doll on the crib", vocabulary),
+    )
+    .expect("on");
     assert_eq!(swapped, on);
     // Nothing said right before the place, or the goal's own relation said: unchanged.
     assert_eq!(
-        relation_as_said(&on, "The crib is ready, the doll goes there", vocabulary),
+        relation_as_said(
+            &on,
+            &Request::among("The crib is ready, the doll goes there", vocabulary)
+        ),
         None
     );
     assert_eq!(
-        relation_as_said(&on, "Put the doll on the crib", vocabulary),
+        relation_as_said(&on, &Request::among("Put the doll on the crib", vocabulary)),
         None
     );
     // "In front of the crib" says where, not inside.
     assert_eq!(
-        relation_as_said(&on, "Put the doll in front of the crib", vocabulary),
+        relation_as_said(
+            &on,
+            &Request::among("Put the doll in front of the crib", vocabulary)
+        ),
         None
     );
 }
@@ -46,7 +59,10 @@ fn a_scene_with_one_relation_has_nothing_to_swap() {
     let cafe = scene("scenarios/cafe/cafe.toml");
     let on = goal(&cafe, "On_Coffee_Table1");
     assert_eq!(
-        relation_as_said(&on, "coffee in table 1", &cafe.domain.vocabulary),
+        relation_as_said(
+            &on,
+            &Request::among("coffee in table 1", &cafe.domain.vocabulary)
+        ),
         None
     );
 }
@@ -55,23 +71,39 @@ fn a_scene_with_one_relation_has_nothing_to_swap() {
 fn what_the_convention_brings_is_put_where_it_says() {
     let kit = scene("scenarios/cell/params/first_aid.toml");
     let held = goal(&kit, r#""first aid kit" grasped"#);
-    let (put, word) = convention_followed(&held, "Could you fetch the first aid kit for me?", &kit)
-        .expect("fetched for me goes on the tray");
+    let (put, word) = convention_followed(
+        &held,
+        &Request::new(
+            "Could you fetch the first aid kit for me?",
+            &kit,
+            &Lexicon::default(),
+        ),
+    )
+    .expect("fetched for me goes on the tray");
     assert_eq!(put, goal(&kit, r#""first aid kit" on "tray""#));
     assert_eq!(word, "fetch");
     // Asked to hold it, in the predicate's own words: held is what is asked.
     assert_eq!(
-        convention_followed(&held, "Hold the first aid kit for me", &kit),
+        convention_followed(
+            &held,
+            &Request::new("Hold the first aid kit for me", &kit, &Lexicon::default())
+        ),
         None
     );
     // Already on the tray, or no word of the convention: nothing to change.
     let on_tray = goal(&kit, r#""first aid kit" on "tray""#);
     assert_eq!(
-        convention_followed(&on_tray, "Bring me the first aid kit", &kit),
+        convention_followed(
+            &on_tray,
+            &Request::new("Bring me the first aid kit", &kit, &Lexicon::default())
+        ),
         None
     );
     assert_eq!(
-        convention_followed(&held, "Lift the first aid kit", &kit),
+        convention_followed(
+            &held,
+            &Request::new("Lift the first aid kit", &kit, &Lexicon::default())
+        ),
         None
     );
 }
@@ -82,7 +114,10 @@ fn a_convention_applies_only_in_a_scene_with_its_objects() {
     assert!(cubes.domain.vocabulary.object("tray").is_none());
     let held = goal(&cubes, r#""red cube" grasped"#);
     assert_eq!(
-        convention_followed(&held, "Bring me the red cube", &cubes),
+        convention_followed(
+            &held,
+            &Request::new("Bring me the red cube", &cubes, &Lexicon::default())
+        ),
         None
     );
 }
@@ -116,13 +151,13 @@ fn the_cells_stated_goals_and_worked_examples_are_not_misreadings() {
         });
         for (request, gold) in stated.into_iter().chain(examples) {
             assert_eq!(
-                relation_as_said(&gold, &request, vocabulary),
+                relation_as_said(&gold, &Request::among(&request, vocabulary)),
                 None,
                 "{}: {request}",
                 path.display()
             );
             assert_eq!(
-                convention_followed(&gold, &request, &s),
+                convention_followed(&gold, &Request::new(&request, &s, &Lexicon::default())),
                 None,
                 "{}: {request}",
                 path.display()

@@ -3,16 +3,16 @@
 //! alternatives than the request gives, or holds already through an object the request
 //! never names. Doubtful: it holds already, or a part of it is pasted from a shown
 //! example, or no word of the request asks for a part of it (such parts can be taken out,
-//! giving a candidate of its own). Words are matched through the scene's [`Lexicon`].
+//! giving a candidate of its own). Words are matched through the scene's lexicon, on the
+//! request as [`Request`] reads it.
 
 use crate::domain::Condition;
 use crate::goal::Formula;
 use crate::planner::{Outcome, Planner};
-use crate::reading::Lexicon;
+use crate::reading::Request;
 use crate::reading::names::{
     copied_from_example, more_alternatives_than_asked, unasked, unnamed_object,
 };
-use crate::reading::words::terms;
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -115,17 +115,12 @@ pub fn check_goal(
 /// names: a goal made true already by a place the model chose itself ("bring me a
 /// banana" read as the banana on the table it lies on). A goal that holds through what
 /// the request does say ("check that the hall light is on") stays a doubt.
-fn unsaid_object_holding(
-    goal: &Formula,
-    world: &dyn World,
-    request: &str,
-    lexicon: &Lexicon,
-) -> Option<String> {
+fn unsaid_object_holding(goal: &Formula, world: &dyn World, request: &Request) -> Option<String> {
     let holding = goal
         .atoms()
         .into_iter()
         .filter(|a| world.check(&Condition::pos(a.clone())));
-    unnamed_object(holding, request, lexicon)
+    unnamed_object(holding, request)
 }
 
 /// Every check of a readable candidate, the wrong ones first.
@@ -133,8 +128,8 @@ pub(super) fn assess(
     scenario: &Scenario,
     world: &dyn World,
     goal: &Formula,
-    (shown, lexicon): (&[&crate::scenario::Example], &Lexicon),
-    request: &str,
+    shown: &[&crate::scenario::Example],
+    request: &Request,
 ) -> Option<GoalProblem> {
     let doubt = GoalProblem::doubt;
     match check_goal(scenario, world, goal) {
@@ -142,7 +137,7 @@ pub(super) fn assess(
         _ if let Some(reason) = more_alternatives_than_asked(goal, request) => {
             Some(GoalProblem::wrong(reason))
         }
-        Err(_) if let Some(object) = unsaid_object_holding(goal, world, request, lexicon) => {
+        Err(_) if let Some(object) = unsaid_object_holding(goal, world, request) => {
             Some(GoalProblem::wrong(format!(
                 "it holds already in the scene now, through {object}, which the request \
                  never mentions; the request asks for a change"
@@ -151,7 +146,7 @@ pub(super) fn assess(
         checked => copied_from_example(goal, shown, request)
             .map(doubt)
             .or_else(|| {
-                let extra = unasked(goal, request, lexicon);
+                let extra = unasked(goal, request);
                 (!extra.is_empty()).then(|| {
                     let parts: Vec<String> = extra.iter().map(ToString::to_string).collect();
                     doubt(format!(
@@ -165,11 +160,15 @@ pub(super) fn assess(
                 // Text that names nothing of the scene (an instruction to the tool rather
                 // than the robot, or a request in words the scene does not know) gets a
                 // goal only as a doubt a person settles.
-                lexicon.covered(goal, &terms(request)).is_empty().then(|| {
-                    doubt(format!(
-                        "no word of the request names anything {goal} is about"
-                    ))
-                })
+                request
+                    .lexicon
+                    .covered(goal, &request.terms)
+                    .is_empty()
+                    .then(|| {
+                        doubt(format!(
+                            "no word of the request names anything {goal} is about"
+                        ))
+                    })
             }),
     }
 }

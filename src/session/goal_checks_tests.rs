@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::goal::Formula;
+use crate::reading::Lexicon;
 use crate::reading::names::{
     factored, renumbered, swapped_back, swapped_object, without_copied, without_unasked,
 };
@@ -46,14 +47,16 @@ fn a_condition_pasted_from_an_example_is_found() {
     let request = "Put the blue cube on the green cube";
     let pasted =
         Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#).expect("parses");
-    let why = copied_from_example(&pasted, &shown, request).expect("found");
+    let why = copied_from_example(&pasted, &shown, &Request::words_only(request)).expect("found");
     assert!(why.contains("grasped"), "{why}");
     let plain = Formula::parse(r#""blue cube" on "green cube""#).expect("parses");
-    assert!(copied_from_example(&plain, &shown, request).is_none());
+    assert!(copied_from_example(&plain, &shown, &Request::words_only(request)).is_none());
     // Asked for in other words ("hand empty" is not "grasped", but the object is
     // named): not a copy.
     let named = Formula::parse(r#"~"sponge" in "bowl""#).expect("parses");
-    assert!(copied_from_example(&named, &shown, "take the sponge out").is_none());
+    assert!(
+        copied_from_example(&named, &shown, &Request::words_only("take the sponge out")).is_none()
+    );
 }
 
 #[test]
@@ -65,12 +68,23 @@ fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
     let shown = [&example];
     let pasted =
         Formula::parse(r#""blue cube" on "green cube" & ~"any object" grasped"#).expect("parses");
-    let rest =
-        without_copied(&pasted, &shown, "Put the blue cube on the green cube").expect("pruned");
+    let rest = without_copied(
+        &pasted,
+        &shown,
+        &Request::words_only("Put the blue cube on the green cube"),
+    )
+    .expect("pruned");
     assert_eq!(rest.to_string(), r#""blue cube" on "green cube""#);
     // "hot" is not covered by the curtain: the AC may be what it asks for.
     let indirect = Formula::parse("Closed_Curtain & Active_AC").expect("parses");
-    assert!(without_copied(&indirect, &shown, "It's hot here, close the curtain").is_none());
+    assert!(
+        without_copied(
+            &indirect,
+            &shown,
+            &Request::words_only("It's hot here, close the curtain")
+        )
+        .is_none()
+    );
     assert!(same_word("clos", "close") && same_word("cube", "cube") && !same_word("ac", "at"));
 }
 
@@ -82,27 +96,33 @@ fn a_condition_no_word_asks_for_is_taken_out() {
     let request = "Please take a sandwich to the second table.";
     let appended = g("On_Sandwiches_Table2 & RobotNear_Table2");
     assert_eq!(
-        unasked(&appended, request, &lexicon),
+        unasked(&appended, &Request::new(request, &scenario, &lexicon)),
         vec![g("RobotNear_Table2")]
     );
     assert_eq!(
-        without_unasked(&appended, request, &lexicon),
+        without_unasked(&appended, &Request::new(request, &scenario, &lexicon)),
         Some(g("On_Sandwiches_Table2"))
     );
     // Every part answers to words of its own: nothing goes.
     let request = "Mop the floor, and bring a teacup to table two.";
     let both = g("IsClean_Floor & On_Teacup_Table2");
-    assert!(unasked(&both, request, &lexicon).is_empty());
-    assert_eq!(without_unasked(&both, request, &lexicon), None);
+    assert!(unasked(&both, &Request::new(request, &scenario, &lexicon)).is_empty());
+    assert_eq!(
+        without_unasked(&both, &Request::new(request, &scenario, &lexicon)),
+        None
+    );
     // A single condition is never taken out, however indirect the request.
     assert_eq!(
-        without_unasked(&g("Active_AC"), "I'm melting.", &lexicon),
+        without_unasked(
+            &g("Active_AC"),
+            &Request::new("I'm melting.", &scenario, &lexicon)
+        ),
         None
     );
     // A word said as often as conditions claim it asks for each of them.
     let request = "Ensure that chips are not on bar and bar2 and deliver the milk to bar.";
     let bars = g("~On_Chips_Bar & ~On_Chips_Bar2 & On_Milk_Bar");
-    assert!(unasked(&bars, request, &lexicon).is_empty());
+    assert!(unasked(&bars, &Request::new(request, &scenario, &lexicon)).is_empty());
 }
 
 #[test]
@@ -113,26 +133,46 @@ fn an_object_put_in_the_place_of_a_named_one_is_a_swap() {
     let request = "I'm at the third table, bring me either some fries or a dessert.";
     let (object, words) = swapped_object(
         &g("(Exists_Dessert | Exists_Coffee) & RobotNear_Table3"),
-        request,
-        &lexicon,
+        &Request::new(request, &scenario, &lexicon),
     )
     .expect("a swap");
     assert_eq!(object, "Coffee");
     assert!(words.iter().any(|w| same_word(w, "fries")), "{words:?}");
-    assert!(swapped_object(&g("On_Chips_Table3 | On_Dessert_Table3"), request, &lexicon).is_none());
+    assert!(
+        swapped_object(
+            &g("On_Chips_Table3 | On_Dessert_Table3"),
+            &Request::new(request, &scenario, &lexicon)
+        )
+        .is_none()
+    );
     // Every object named, though a word is left over: no swap.
-    assert!(swapped_object(&g("On_Milk_Table2"), "A glass of milk to table 2", &lexicon).is_none());
+    assert!(
+        swapped_object(
+            &g("On_Milk_Table2"),
+            &Request::new("A glass of milk to table 2", &scenario, &lexicon)
+        )
+        .is_none()
+    );
     // A word that is only part of a name ("area" of LoungeArea) names nothing alone.
     assert!(
         swapped_object(
             &g("On_VacuumCup_WaterStation"),
-            "Would you take my vacuum cup to the hydration area?",
-            &lexicon
+            &Request::new(
+                "Would you take my vacuum cup to the hydration area?",
+                &scenario,
+                &lexicon
+            )
         )
         .is_none()
     );
     // Nothing named is left out: no swap, whatever the goal's objects.
-    assert!(swapped_object(&g("Active_AC"), "It's so hot in here", &lexicon).is_none());
+    assert!(
+        swapped_object(
+            &g("Active_AC"),
+            &Request::new("It's so hot in here", &scenario, &lexicon)
+        )
+        .is_none()
+    );
 }
 
 #[test]
@@ -144,21 +184,28 @@ fn a_swapped_object_is_put_back_when_the_word_names_one_thing_of_its_kind() {
     let request = "I'm at the third table, bring me either some fries or a dessert.";
     let (goal, from, to) = swapped_back(
         &g("On_Dessert_Table3 | On_Softdrink_Table3"),
-        request,
-        &lexicon,
-        vocabulary,
+        &Request::in_scene(request, vocabulary, &[], &lexicon),
     )
     .expect("put back");
     assert_eq!((from.as_str(), to.as_str()), ("Softdrink", "Chips"));
     assert_eq!(goal.to_string(), "On_Dessert_Table3 | On_Chips_Table3");
     // No swap, nothing to put back.
-    assert!(swapped_back(&g("On_Chips_Table3"), request, &lexicon, vocabulary).is_none());
+    assert!(
+        swapped_back(
+            &g("On_Chips_Table3"),
+            &Request::in_scene(request, vocabulary, &[], &lexicon)
+        )
+        .is_none()
+    );
     // A name of two words is the object it names, not the one its last word names.
     let (goal, _, to) = swapped_back(
         &g("Holding_Coffee"),
-        "Please pick up and hold the spring water.",
-        &lexicon,
-        vocabulary,
+        &Request::in_scene(
+            "Please pick up and hold the spring water.",
+            vocabulary,
+            &[],
+            &lexicon,
+        ),
     )
     .expect("put back");
     assert_eq!(
@@ -174,7 +221,10 @@ fn the_empty_hand_is_no_object_a_request_must_name() {
     let g = |t: &str| Formula::parse(t).expect("parses");
     let request = "Make sure you are not holding anything.";
     assert_eq!(
-        unnamed_object(g("Holding_Nothing").atoms(), request, &lexicon),
+        unnamed_object(
+            g("Holding_Nothing").atoms(),
+            &Request::new(request, &scenario, &lexicon)
+        ),
         None
     );
     // The hand is empty now: a doubt, not a goal refused for an object nobody named.
@@ -182,8 +232,8 @@ fn the_empty_hand_is_no_object_a_request_must_name() {
         &scenario,
         world.as_ref(),
         &g("Holding_Nothing"),
-        (&[], &lexicon),
-        request,
+        &[],
+        &Request::new(request, &scenario, &lexicon),
     )
     .expect("it holds already");
     assert!(problem.is_doubt(), "{problem:?}");
@@ -225,21 +275,24 @@ fn a_goal_may_offer_only_the_choices_the_request_gives() {
     assert!(
         more_alternatives_than_asked(
             &g("On_Banana_Bar | On_Orange_Bar | ~Active_HallLight"),
-            request
+            &Request::words_only(request)
         )
         .is_some()
     );
     assert_eq!(
         more_alternatives_than_asked(
             &g("(On_Banana_Bar | On_Orange_Bar) & ~Active_HallLight"),
-            request
+            &Request::words_only(request)
         ),
         None
     );
     // A list ending in "or" offers one choice per item.
     let listed = g("On_Coffee_Bar | On_Cake_Bar | On_Tea_Bar");
     assert_eq!(
-        more_alternatives_than_asked(&listed, "Coffee, cake, or tea at the bar."),
+        more_alternatives_than_asked(
+            &listed,
+            &Request::words_only("Coffee, cake, or tea at the bar.")
+        ),
         None
     );
     // "Neither ... nor" offers no choice: the disjunction is under a negation.
@@ -247,14 +300,14 @@ fn a_goal_may_offer_only_the_choices_the_request_gives() {
     assert_eq!(
         more_alternatives_than_asked(
             &neither,
-            "Keep the mop away from the entrance and the exit."
+            &Request::words_only("Keep the mop away from the entrance and the exit.")
         ),
         None
     );
     assert_eq!(
         more_alternatives_than_asked(
             &g("IsClean_Chairs | Exists_Coffee"),
-            "Clean the chairs; if not, make coffee."
+            &Request::words_only("Clean the chairs; if not, make coffee.")
         ),
         None
     );
@@ -270,8 +323,7 @@ fn a_goal_true_through_a_place_nobody_named_is_wrong() {
         unsaid_object_holding(
             &g("On_Chips_Bar"),
             world.as_ref(),
-            "Bring me the chips",
-            &lexicon
+            &Request::new("Bring me the chips", &scenario, &lexicon)
         ),
         Some("Bar".to_string())
     );
@@ -280,8 +332,11 @@ fn a_goal_true_through_a_place_nobody_named_is_wrong() {
         unsaid_object_holding(
             &g("Active_HallLight"),
             world.as_ref(),
-            "Could you check that the hall light is on?",
-            &lexicon
+            &Request::new(
+                "Could you check that the hall light is on?",
+                &scenario,
+                &lexicon
+            )
         ),
         None
     );
@@ -299,7 +354,7 @@ fn what_every_alternative_repeats_is_judged_once() {
     );
     let request = "I'm at the third table, bring me fries or a dessert";
     assert_eq!(
-        without_unasked(&goal, request, &lexicon)
+        without_unasked(&goal, &Request::new(request, &scenario, &lexicon))
             .map(|f| f.to_string())
             .as_deref(),
         Some("On_Chips_Table3 | On_Dessert_Table3")
@@ -319,7 +374,7 @@ fn alternatives_claim_each_word_once_per_condition() {
     let goal = s
         .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2) & RobotNear_Table1")
         .expect("parses");
-    let extra: Vec<String> = unasked(&goal, request, &lexicon)
+    let extra: Vec<String> = unasked(&goal, &Request::new(request, &s, &lexicon))
         .iter()
         .map(ToString::to_string)
         .collect();
@@ -327,5 +382,5 @@ fn alternatives_claim_each_word_once_per_condition() {
     let asked = s
         .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2)")
         .expect("parses");
-    assert!(unasked(&asked, request, &lexicon).is_empty());
+    assert!(unasked(&asked, &Request::new(request, &s, &lexicon)).is_empty());
 }

@@ -17,9 +17,9 @@ use crate::goal::{self, Formula};
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
 use crate::llm::{LanguageModel, Message, Role, grammar, schema};
+use crate::reading::Request;
 use crate::reading::lexicon::{Lexicon, in_request_order};
 use crate::reading::parts::split;
-use crate::reading::words::terms;
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -147,9 +147,8 @@ pub(super) async fn read_goal(
     let judge = Judge {
         scenario,
         world,
-        instruction,
+        request: Request::new(instruction, scenario, &lexicon),
         shown: options.variant.choose(pool, instruction),
-        lexicon,
         misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
         one_of_several,
     };
@@ -333,7 +332,7 @@ pub(super) async fn read_goal(
         let chosen = judge.choose(&candidates, &set_aside, last_round);
         if let Some((mut answer, doubt)) = chosen {
             if options.ablations.check_goals {
-                let ordered = in_request_order(&judge.lexicon, &answer.goal, &terms(instruction));
+                let ordered = in_request_order(&lexicon, &answer.goal, &judge.request.terms);
                 if ordered != answer.goal {
                     emit(&Event::Notice {
                         message: format!(

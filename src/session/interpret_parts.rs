@@ -9,8 +9,8 @@
 use crate::goal::Formula;
 use crate::llm::LanguageModel;
 use crate::llm::reply::GoalAnswer;
-use crate::reading::Lexicon;
 use crate::reading::parts::{Join, Part};
+use crate::reading::{Lexicon, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -83,13 +83,8 @@ pub(super) async fn read_parts(
     let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
     let shown = options.variant.choose(pool, instruction);
-    let problem = assess(
-        scenario,
-        world.as_ref(),
-        &goal,
-        (&shown, &lexicon),
-        instruction,
-    );
+    let request = Request::new(instruction, scenario, &lexicon);
+    let problem = assess(scenario, world.as_ref(), &goal, &shown, &request);
     if let Some(p) = problem.as_ref().filter(|p| !p.is_doubt()) {
         emit(&Event::CandidateRejected {
             candidate: goal.to_string(),
@@ -108,9 +103,8 @@ pub(super) async fn read_parts(
     let judge = Judge {
         scenario,
         world: world.fork(),
-        instruction,
+        request,
         shown,
-        lexicon,
         misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
         one_of_several: false,
     };

@@ -13,7 +13,7 @@ use crate::domain::VocabularyError;
 use crate::goal::{self, Formula};
 use crate::llm::reply::{GoalAnswer, ReplyError};
 use crate::reading::names::{without_copied, without_unasked};
-use crate::reading::{Lexicon, Misreading, Request};
+use crate::reading::{Misreading, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
@@ -44,13 +44,12 @@ impl Candidate {
 }
 
 /// What every candidate goal for one request is judged against: the scene, the examples
-/// the prompt showed, the words of the vocabulary and the place numbers the request says.
+/// the prompt showed, and the request read once in the scene's words.
 pub(super) struct Judge<'a> {
     pub(super) scenario: &'a Scenario,
     pub(super) world: Box<dyn World>,
-    pub(super) instruction: &'a str,
+    pub(super) request: Request<'a>,
     pub(super) shown: Vec<&'a crate::scenario::Example>,
-    pub(super) lexicon: Lexicon,
     /// The detectors of plain misreadings in use (all registered ones but in experiments).
     pub(super) misreadings: Vec<&'static dyn Misreading>,
     /// The request is one wish of several: what it asks for may hold already (the robot
@@ -66,22 +65,18 @@ impl Judge<'_> {
             self.scenario,
             self.world.as_ref(),
             goal,
-            (&self.shown, &self.lexicon),
-            self.instruction,
+            &self.shown,
+            &self.request,
         )
         .filter(|p| !(self.one_of_several && p.kind == ProblemKind::HoldsAlready))
-    }
-
-    /// The request as every detector reads it.
-    pub(super) fn request(&self) -> Request<'_> {
-        Request::new(self.instruction, self.scenario, &self.lexicon)
     }
 
     /// How `goal` has misread the request, if it plainly has: the first finding of the
     /// detectors in use (`reading::misreading`).
     pub(super) fn misread(&self, goal: &Formula) -> Option<String> {
-        let request = self.request();
-        self.misreadings.iter().find_map(|m| m.find(goal, &request))
+        self.misreadings
+            .iter()
+            .find_map(|m| m.find(goal, &self.request))
     }
 
     pub(super) fn vocabulary(&self) -> &crate::domain::Vocabulary {
@@ -99,10 +94,9 @@ impl Judge<'_> {
     /// `goal` with each plain misreading undone that can be, each with what was undone,
     /// in the order the detectors are registered.
     fn undone(&self, goal: &Formula) -> Vec<(Formula, String)> {
-        let request = self.request();
         self.misreadings
             .iter()
-            .flat_map(|m| m.undo(goal, &request))
+            .flat_map(|m| m.undo(goal, &self.request))
             .collect()
     }
 
@@ -123,7 +117,7 @@ impl Judge<'_> {
             for (from, path) in &frontier {
                 let undone = self.undone(from).into_iter().flat_map(|(g, why)| {
                     // What was undone may make a part nothing asks for plain to see.
-                    let pruned = without_unasked(&g, self.instruction, &self.lexicon).map(|p| {
+                    let pruned = without_unasked(&g, &self.request).map(|p| {
                         (
                             p,
                             format!(
@@ -176,8 +170,8 @@ impl Judge<'_> {
         emit: &mut (dyn FnMut(&Event) + Send),
     ) -> Vec<Candidate> {
         let pruned = match read {
-            Ok(a) if problem.is_some() => without_copied(&a.goal, &self.shown, self.instruction)
-                .or_else(|| without_unasked(&a.goal, self.instruction, &self.lexicon)),
+            Ok(a) if problem.is_some() => without_copied(&a.goal, &self.shown, &self.request)
+                .or_else(|| without_unasked(&a.goal, &self.request)),
             _ => None,
         };
         // The answer and, when parts were taken out of it, what is left are both undone.

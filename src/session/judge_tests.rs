@@ -1,6 +1,7 @@
 //! Tests of the judge: misreadings undone one after another, and a wish of several.
 
 use super::*;
+use crate::reading::Lexicon;
 use std::path::Path;
 
 fn cafe() -> Scenario {
@@ -8,14 +9,17 @@ fn cafe() -> Scenario {
         .expect("cafe scenario")
 }
 
-fn judge<'a>(scenario: &'a Scenario, request: &'a str, one_of_several: bool) -> Judge<'a> {
-    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+fn judge<'a>(
+    scenario: &'a Scenario,
+    lexicon: &'a Lexicon,
+    request: &'a str,
+    one_of_several: bool,
+) -> Judge<'a> {
     Judge {
         scenario,
         world: crate::world::load(scenario).expect("cafe world"),
-        instruction: request,
+        request: Request::new(request, scenario, lexicon),
         shown: Vec::new(),
-        lexicon,
         misreadings: crate::reading::MISREADINGS.to_vec(),
         one_of_several,
     }
@@ -25,7 +29,8 @@ fn judge<'a>(scenario: &'a Scenario, request: &'a str, one_of_several: bool) -> 
 fn misreadings_are_undone_one_after_another() {
     let cafe = cafe();
     let request = "Please bring a dessert to table 3 and turn on the AC.";
-    let j = judge(&cafe, request, false);
+    let lexicon = Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+    let j = judge(&cafe, &lexicon, request, false);
     let answer = cafe
         .parse_goal("Exists_Dessert & RobotNear_Table3")
         .expect("parses");
@@ -47,7 +52,8 @@ fn misreadings_are_undone_one_after_another() {
     assert_eq!(j.misread(&done), None);
     // A step that puts an object where its predicate does not take it comes out refused:
     // the chips named in the coffee's place of `Exists_Coffee`, which only makable things fit.
-    let j = judge(&cafe, "Please bring the chips to table 3.", false);
+    let lexicon = Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+    let j = judge(&cafe, &lexicon, "Please bring the chips to table 3.", false);
     let answer = cafe
         .parse_goal("Exists_Coffee & RobotNear_Table3")
         .expect("parses");
@@ -63,16 +69,18 @@ fn a_wish_of_several_may_hold_already() {
     let cafe = cafe();
     let request = "please keep the AC switched off";
     let goal = cafe.parse_goal("~Active_AC").expect("parses");
-    let whole = judge(&cafe, request, false).assess(&goal);
+    let lexicon = Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+    let whole = judge(&cafe, &lexicon, request, false).assess(&goal);
     assert_eq!(whole.map(|p| p.kind), Some(ProblemKind::HoldsAlready));
-    assert_eq!(judge(&cafe, request, true).assess(&goal), None);
+    assert_eq!(judge(&cafe, &lexicon, request, true).assess(&goal), None);
 }
 
 #[test]
 fn what_was_undone_may_leave_a_part_nothing_asks_for_which_goes() {
     let cafe = cafe();
     let request = "Come to table 3 and pick up my vacuum cup.";
-    let j = judge(&cafe, request, false);
+    let lexicon = Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+    let j = judge(&cafe, &lexicon, request, false);
     let answer = cafe
         .parse_goal("On_Teacup_Table3 & ~On_VacuumCup_Table1")
         .expect("parses");
@@ -95,7 +103,8 @@ fn a_relation_the_other_way_round_is_a_misreading_undone() {
     )
     .expect("cell scenario");
     let request = "Put the blue cube on the green cube";
-    let j = judge(&cell, request, false);
+    let lexicon = Lexicon::new(&cell.domain.vocabulary, &cell.examples);
+    let j = judge(&cell, &lexicon, request, false);
     let reversed = cell
         .parse_goal(r#""green cube" on "blue cube""#)
         .expect("parses");
