@@ -18,9 +18,7 @@ fn app() -> App {
         scenario: "red_on_blue".into(),
         backend: Backend::Local,
         model: "qwen2.5-coder-1.5b".into(),
-        objects: scenario
-            .domain
-            .vocabulary.object_names(),
+        objects: scenario.domain.vocabulary.object_names(),
         ..Info::default()
     };
     App::new(

@@ -140,9 +140,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         backend: settings.backend,
         model: model_name,
         auto_approve: args.auto_approve,
-        objects: scenario
-            .domain
-            .vocabulary.object_names(),
+        objects: scenario.domain.vocabulary.object_names(),
         no_model,
         keys_error,
     };

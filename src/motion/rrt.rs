@@ -24,6 +24,8 @@ pub struct PlanOptions {
     pub resolution: f64,
     /// Attempts at shortening the path found.
     pub shortcuts: usize,
+    /// Whether a step stopped by a collision keeps its free part.
+    pub keep_partial: bool,
 }
 
 impl Default for PlanOptions {
@@ -34,6 +36,7 @@ impl Default for PlanOptions {
             step: 0.4,
             resolution: 0.03,
             shortcuts: 60,
+            keep_partial: std::env::var("BETR_PARTIAL").is_ok_and(|v| v == "1"),
         }
     }
 }
@@ -121,6 +124,12 @@ struct Search<'c, 'a> {
 impl Search<'_, '_> {
     /// Whether the straight segment from `a` to `b` is free (`a` is known to be free).
     fn segment_free(&mut self, a: &[f64], b: &[f64]) -> bool {
+        self.free_part(a, b) == 1.0
+    }
+
+    /// How far (0–1) along the straight segment from `a` to `b` every configuration
+    /// checked is free (`a` is known to be free): 1 when the whole segment is.
+    fn free_part(&mut self, a: &[f64], b: &[f64]) -> f64 {
         let steps = (distance(a, b) / self.options.resolution).ceil().max(1.0) as usize;
         let mut q = vec![0.0; a.len()];
         for s in 1..=steps {
@@ -131,10 +140,10 @@ impl Search<'_, '_> {
             self.checks += 1;
             if let Some(blocker) = self.check.blocker(&q) {
                 *self.blocked.entry(blocker).or_insert(0) += 1;
-                return false;
+                return (s - 1) as f64 / steps as f64;
             }
         }
-        true
+        1.0
     }
 
     /// Grow `tree` one step from its nearest node towards `target`.
@@ -154,15 +163,26 @@ impl Search<'_, '_> {
                 false,
             )
         };
-        if !self.segment_free(&from, &to) {
-            return Grown::Trapped;
+        let free = self.free_part(&from, &to);
+        if free == 1.0 {
+            let i = tree.add(&to, near);
+            return if reached {
+                Grown::Reached(i)
+            } else {
+                Grown::Advanced(i)
+            };
         }
-        let i = tree.add(&to, near);
-        if reached {
-            Grown::Reached(i)
-        } else {
-            Grown::Advanced(i)
+        // The free part of a blocked step is kept when it is a step of its own: the tree
+        // grows up to what is in the way rather than not at all.
+        if self.options.keep_partial && free * distance(&from, &to) >= self.options.step / 4.0 {
+            let part: Vec<f64> = from
+                .iter()
+                .zip(&to)
+                .map(|(a, b)| a + (b - a) * free)
+                .collect();
+            tree.add(&part, near);
         }
+        Grown::Trapped
     }
 
     /// Grow `tree` towards `target` until it gets there or is stopped.

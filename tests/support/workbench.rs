@@ -80,9 +80,7 @@ impl Bench {
             backend: betr::llm::config::Backend::Openai,
             model: "fixture-model".into(),
             auto_approve: false,
-            objects: scenario
-                .domain
-                .vocabulary.object_names(),
+            objects: scenario.domain.vocabulary.object_names(),
             no_model: None,
             keys_error: None,
         };

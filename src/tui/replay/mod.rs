@@ -66,10 +66,7 @@ impl Player {
                 || replay.header.name.clone(),
                 |s| s.to_string_lossy().into_owned(),
             ),
-            objects: replay
-                .scenario
-                .domain
-                .vocabulary.object_names(),
+            objects: replay.scenario.domain.vocabulary.object_names(),
             ..Info::default()
         };
         Player::new(replay.steps, replay.scenario, info, keys, theme)
