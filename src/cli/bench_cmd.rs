@@ -167,27 +167,6 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     let count = if args.quick { 10 } else { 200 };
     let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
     let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
-    if let Ok(sweep) = std::env::var("BETR_MOTION_SWEEP") {
-        for variant in sweep.split(';') {
-            let mut o = betr::motion::PlanOptions::default();
-            let mut f = variant.split(',');
-            o.samples = f.next().unwrap().parse().unwrap();
-            o.step = f.next().unwrap().parse().unwrap();
-            o.keep_partial = f.next() == Some("p");
-            let t = motion::betr_plan(&robot, &shapes, &rest, &boxes, &queries, &o)?;
-            eprintln!(
-                "SWEEP partial={} samples={} step={} solved={} median={:.3} p95={:.3} mean={:.3}",
-                o.keep_partial,
-                o.samples,
-                o.step,
-                t.solved,
-                t.quantile_ms(0.5),
-                t.quantile_ms(0.95),
-                t.seconds.iter().sum::<f64>() * 1000.0 / t.seconds.len() as f64
-            );
-        }
-        std::process::exit(0);
-    }
     let betr_times = motion::betr_plan(
         &robot,
         &shapes,

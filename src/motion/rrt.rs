@@ -1,6 +1,7 @@
 //! Collision-free paths in one arm's joint space: the straight segment when it is free,
 //! else RRT-Connect (two trees, from the start and from the goal, each extended towards
-//! random samples and greedily towards the other) within a budget of samples, then
+//! random samples and greedily towards the other; a step stopped by a collision keeps
+//! its free part when that is a quarter step or more) within a budget of samples, then
 //! shortcutting (random pairs of points on the path joined straight when the segment is
 //! free). Segments are checked at a fixed joint resolution. The random sequence comes
 //! from the seed, so a query gives the same path every time.
@@ -36,7 +37,7 @@ impl Default for PlanOptions {
             step: 0.4,
             resolution: 0.03,
             shortcuts: 60,
-            keep_partial: std::env::var("BETR_PARTIAL").is_ok_and(|v| v == "1"),
+            keep_partial: true,
         }
     }
 }
