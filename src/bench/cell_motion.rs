@@ -184,14 +184,13 @@ pub fn ompl_plan(
     let mut convert = |solids: &[Solid]| -> Vec<serde_json::Value> {
         solids
             .iter()
-            .filter_map(|s| match pybullet_solid(s) {
-                Ok(v) => Some(v),
-                Err(kind) => {
-                    if !skipped.contains(&kind) {
-                        skipped.push(kind);
-                    }
-                    None
+            .filter_map(|s| {
+                let converted = pybullet_solid(s);
+                let kind = format!("{:?}", s.shape.shape_type());
+                if converted.is_none() && !skipped.contains(&kind) {
+                    skipped.push(kind);
                 }
+                converted
             })
             .collect()
     };
@@ -226,8 +225,8 @@ pub fn ompl_plan(
 
 /// A solid as PyBullet makes it: its kind and sizes, and its pose (position, quaternion
 /// x y z w) with the shape's axis turned to PyBullet's (z for cylinders and capsules);
-/// `Err` with the shape's kind when PyBullet has no such primitive.
-pub fn pybullet_solid(solid: &Solid) -> Result<serde_json::Value, String> {
+/// `None` when PyBullet has no such primitive.
+pub fn pybullet_solid(solid: &Solid) -> Option<serde_json::Value> {
     let z_to_y = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f32::consts::FRAC_PI_2);
     let (kind, sizes, local) = match solid.shape.as_typed_shape() {
         TypedShape::Cuboid(c) => (
@@ -262,12 +261,12 @@ pub fn pybullet_solid(solid: &Solid) -> Result<serde_json::Value, String> {
             serde_json::json!({"vertices": p.points().iter().map(|v| [v.x, v.y, v.z]).collect::<Vec<_>>()}),
             Isometry3::identity(),
         ),
-        _ => return Err(format!("{:?}", solid.shape.shape_type())),
+        _ => return None,
     };
     let pose = solid.pose * local;
     let t = pose.translation.vector;
     let r = pose.rotation.coords;
-    Ok(serde_json::json!({
+    Some(serde_json::json!({
         "name": solid.name,
         "kind": kind,
         "sizes": sizes,
