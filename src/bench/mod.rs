@@ -10,6 +10,7 @@
 //! Pinocchio and its collision-free paths against OMPL with PyBullet (`motion`, not in the
 //! default set: it needs the robot's description in the cache). Nothing here is timed inside tests.
 
+pub mod cell_motion;
 pub mod cold;
 pub mod model;
 pub mod motion;

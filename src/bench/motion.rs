@@ -270,9 +270,9 @@ pub fn betr_plan(
     rest: &[Vec<f64>],
     boxes: &[Clutter],
     queries: &[Query],
+    options: &PlanOptions,
 ) -> Result<PlanTimes, BenchError> {
     let solids = solids(boxes);
-    let options = PlanOptions::default();
     let mut times = PlanTimes {
         seconds: Vec::with_capacity(queries.len()),
         solved: 0,
@@ -281,7 +281,7 @@ pub fn betr_plan(
         let started = Instant::now();
         let check = ArmCheck::new(robot, shapes, Isometry3::identity(), q.arm, rest, &solids)
             .map_err(|e| BenchError::Setup(e.to_string()))?;
-        let found = plan(&check, &q.start, &q.goal, &options).is_ok();
+        let found = plan(&check, &q.start, &q.goal, options).is_ok();
         times.seconds.push(started.elapsed().as_secs_f64());
         times.solved += usize::from(found);
     }
@@ -308,16 +308,39 @@ pub fn ompl_plan(
         "package_dir": dir,
         "base": [0.0, 0.0, 0.0],
         "boxes": boxes.iter().map(|b| serde_json::json!({"center": b.center, "half": b.half})).collect::<Vec<_>>(),
-        "arms": robot.arms.iter().map(|a| serde_json::json!({
-            "joints": a.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>(),
-            "lower": a.joints.iter().map(|j| j.lower).collect::<Vec<_>>(),
-            "upper": a.joints.iter().map(|j| j.upper).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
+        "arms": arms_json(robot),
         "others": rest,
         "queries": queries.iter().map(|q| serde_json::json!({"arm": q.arm, "start": q.start, "goal": q.goal})).collect::<Vec<_>>(),
         "resolution": PlanOptions::default().resolution,
         "budget_s": budget_s,
     });
+    run_ompl(python, script, &json, queries.len(), scratch)
+}
+
+/// Each arm's joints, limits and flange, as the anchors' script reads them.
+pub fn arms_json(robot: &Robot) -> serde_json::Value {
+    robot
+        .arms
+        .iter()
+        .map(|a| {
+            serde_json::json!({
+                "joints": a.joints.iter().map(|j| j.name.clone()).collect::<Vec<_>>(),
+                "lower": a.joints.iter().map(|j| j.lower).collect::<Vec<_>>(),
+                "upper": a.joints.iter().map(|j| j.upper).collect::<Vec<_>>(),
+                "tip": a.tip,
+            })
+        })
+        .collect()
+}
+
+/// OMPL + PyBullet on the `count` queries of `json` (the script's `plan` input).
+pub fn run_ompl(
+    python: &Path,
+    script: &Path,
+    json: &serde_json::Value,
+    count: usize,
+    scratch: &Path,
+) -> Result<PlanTimes, BenchError> {
     std::fs::create_dir_all(scratch)?;
     let file = scratch.join("motion-queries.json");
     crate::store::write_atomic(&file, json.to_string().as_bytes())
@@ -347,13 +370,13 @@ pub fn ompl_plan(
                 detail: format!("unreadable line: {line}"),
             })?);
     }
-    if times.seconds.len() != queries.len() {
+    if times.seconds.len() != count {
         return Err(BenchError::Anchor {
             what,
             detail: format!(
                 "{} answers for {} queries: {}",
                 times.seconds.len(),
-                queries.len(),
+                count,
                 out.trim()
             ),
         });

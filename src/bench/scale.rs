@@ -44,6 +44,41 @@ pub fn scenario_one(path: &Path, time: Duration) -> Result<Row, BenchError> {
     })
 }
 
+/// Scenario 1 end to end with the real arms, repeated for at least `time`: planned in the
+/// planning world, run in the execution world (whose arms plan every motion), repaired
+/// with the scenario's expected fix after the arm's failure, run again to success. The
+/// mean per run.
+pub fn scenario_one_arms(path: &Path, time: Duration) -> Result<Row, BenchError> {
+    let scenario = Scenario::load(path).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let exec =
+        world::load_execution(&scenario, None).map_err(|e| BenchError::Setup(e.to_string()))?;
+    if let Some(why) = exec.notice {
+        return Err(BenchError::Setup(why));
+    }
+    let planning = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let mut runs = 0u32;
+    let started = Instant::now();
+    let mut repairs = 0;
+    while runs == 0 || started.elapsed() < time {
+        (repairs, _) =
+            super::cell_motion::gold_runs(&scenario, exec.world.as_ref(), planning.as_ref(), None)?;
+        runs += 1;
+    }
+    let ms = started.elapsed().as_secs_f64() * 1e3 / f64::from(runs);
+    Ok(Row {
+        part: "motion".into(),
+        measure: "scenario 1 with the real arms: plan, fail, repair, run to success".into(),
+        unit: "ms".into(),
+        better: Better::Lower,
+        betr: ms,
+        anchor: None,
+        target: Some(Target::AtMost(50.0)),
+        note: format!(
+            "mean of {runs} runs, {repairs} repair(s) with the expected fix; every grasp and place an arm's inverse kinematics and collision-free path"
+        ),
+    })
+}
+
 /// One run: plan, repair each failing grasp, then tick the repaired tree in a fresh copy
 /// of the world until it succeeds. The number of repairs.
 fn end_to_end(scenario: &Scenario, world: &dyn World) -> Result<usize, BenchError> {

@@ -25,9 +25,10 @@ pub enum Part {
     /// Seeking to random steps of a 10,000-tick recording on a 500-node tree, as the replay
     /// workbench seeks.
     Replay,
-    /// The YuMi's forward kinematics against Pinocchio, and collision-free paths to 200
-    /// random reachable targets in a cluttered cell against OMPL's RRTConnect with
-    /// PyBullet's collision checks (same URDF, same boxes); not part of the default set.
+    /// The YuMi's forward kinematics against Pinocchio; collision-free paths to 200 random
+    /// reachable targets in a cluttered cell and on the cell scenarios' own arm motions
+    /// against OMPL's RRTConnect with PyBullet's collision checks (same URDF, same
+    /// solids); scenario 1 end to end with the real arms. Not part of the default set.
     Motion,
     /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
     /// not part of the default set.
@@ -166,7 +167,14 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     let count = if args.quick { 10 } else { 200 };
     let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
     let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
-    let betr_times = motion::betr_plan(&robot, &shapes, &rest, &boxes, &queries)?;
+    let betr_times = motion::betr_plan(
+        &robot,
+        &shapes,
+        &rest,
+        &boxes,
+        &queries,
+        &betr::motion::PlanOptions::default(),
+    )?;
     let ompl_times = motion::ompl_plan(
         &python,
         script,
@@ -186,7 +194,82 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
         "from each arm's rest values; betr: 4000 samples at most, 0.03 rad segment checks, \
          shortcutting; OMPL: 2 s at most, the same resolution, simplified",
     ));
+    rows.extend(cell_motion_rows(args, &python, script, spec, &dir)?);
+    let scenario_one = if args.quick {
+        Duration::from_millis(100)
+    } else {
+        Duration::from_secs(3)
+    };
+    rows.push(bench::scale::scenario_one_arms(
+        &args.scenario,
+        scenario_one,
+    )?);
     Ok(rows)
+}
+
+/// The cell scenarios' own arm motions (every scenario under the default scenario's
+/// folder whose robot has arms), planned by betr and by OMPL + PyBullet.
+fn cell_motion_rows(
+    args: &BenchArgs,
+    python: &Path,
+    script: &Path,
+    spec: &betr::model::DescriptionSpec,
+    dir: &Path,
+) -> Result<Vec<bench::Row>> {
+    let folder = args.scenario.parent().unwrap_or(Path::new("."));
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(folder)
+        .with_context(|| format!("cannot list {}", folder.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let mut scenarios = Vec::new();
+    let mut queries = Vec::new();
+    let mut arms = None;
+    for path in &paths {
+        // cell.toml and examples.toml are not scenarios of their own.
+        let Ok(text) = std::fs::read_to_string(path) else {
+            continue;
+        };
+        if !text.contains("[scenario]") {
+            continue;
+        }
+        if let Some(found) = bench::cell_motion::scenario_queries(path)? {
+            scenarios.push(format!("{} {}", found.scenario, found.queries.len()));
+            queries.extend(found.queries);
+            arms.get_or_insert(found.arms);
+        }
+    }
+    let Some(arms) = arms else {
+        anyhow::bail!("no scenario in {} moves the real arms", folder.display());
+    };
+    let betr_times = bench::cell_motion::betr_plan(&arms, &queries)?;
+    let (ompl_times, skipped) = bench::cell_motion::ompl_plan(
+        python,
+        script,
+        spec,
+        dir,
+        &arms,
+        &queries,
+        2.0,
+        Path::new("target"),
+    )?;
+    let mut note = format!(
+        "each scenario's tree failing, repaired with its expected fix, run to success; queries per scenario: {}; the same start, goal, solids, other arm and carried object for both",
+        scenarios.join(", ")
+    );
+    if !skipped.is_empty() {
+        note.push_str(&format!(
+            "; shapes PyBullet was not given: {}",
+            skipped.join(", ")
+        ));
+    }
+    Ok(motion::plan_rows(
+        &format!("the cell scenarios' {} arm motions", queries.len()),
+        &betr_times,
+        &ompl_times,
+        &note,
+    ))
 }
 
 fn ticks_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {

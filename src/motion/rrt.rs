@@ -1,6 +1,7 @@
 //! Collision-free paths in one arm's joint space: the straight segment when it is free,
 //! else RRT-Connect (two trees, from the start and from the goal, each extended towards
-//! random samples and greedily towards the other) within a budget of samples, then
+//! random samples and greedily towards the other; a step stopped by a collision keeps
+//! its free part when that is a quarter step or more) within a budget of samples, then
 //! shortcutting (random pairs of points on the path joined straight when the segment is
 //! free). Segments are checked at a fixed joint resolution. The random sequence comes
 //! from the seed, so a query gives the same path every time.
@@ -24,6 +25,8 @@ pub struct PlanOptions {
     pub resolution: f64,
     /// Attempts at shortening the path found.
     pub shortcuts: usize,
+    /// Whether a step stopped by a collision keeps its free part.
+    pub keep_partial: bool,
 }
 
 impl Default for PlanOptions {
@@ -34,6 +37,7 @@ impl Default for PlanOptions {
             step: 0.4,
             resolution: 0.03,
             shortcuts: 60,
+            keep_partial: true,
         }
     }
 }
@@ -121,6 +125,12 @@ struct Search<'c, 'a> {
 impl Search<'_, '_> {
     /// Whether the straight segment from `a` to `b` is free (`a` is known to be free).
     fn segment_free(&mut self, a: &[f64], b: &[f64]) -> bool {
+        self.free_part(a, b) == 1.0
+    }
+
+    /// How far (0–1) along the straight segment from `a` to `b` every configuration
+    /// checked is free (`a` is known to be free): 1 when the whole segment is.
+    fn free_part(&mut self, a: &[f64], b: &[f64]) -> f64 {
         let steps = (distance(a, b) / self.options.resolution).ceil().max(1.0) as usize;
         let mut q = vec![0.0; a.len()];
         for s in 1..=steps {
@@ -131,10 +141,10 @@ impl Search<'_, '_> {
             self.checks += 1;
             if let Some(blocker) = self.check.blocker(&q) {
                 *self.blocked.entry(blocker).or_insert(0) += 1;
-                return false;
+                return (s - 1) as f64 / steps as f64;
             }
         }
-        true
+        1.0
     }
 
     /// Grow `tree` one step from its nearest node towards `target`.
@@ -154,15 +164,26 @@ impl Search<'_, '_> {
                 false,
             )
         };
-        if !self.segment_free(&from, &to) {
-            return Grown::Trapped;
+        let free = self.free_part(&from, &to);
+        if free == 1.0 {
+            let i = tree.add(&to, near);
+            return if reached {
+                Grown::Reached(i)
+            } else {
+                Grown::Advanced(i)
+            };
         }
-        let i = tree.add(&to, near);
-        if reached {
-            Grown::Reached(i)
-        } else {
-            Grown::Advanced(i)
+        // The free part of a blocked step is kept when it is a step of its own: the tree
+        // grows up to what is in the way rather than not at all.
+        if self.options.keep_partial && free * distance(&from, &to) >= self.options.step / 4.0 {
+            let part: Vec<f64> = from
+                .iter()
+                .zip(&to)
+                .map(|(a, b)| a + (b - a) * free)
+                .collect();
+            tree.add(&part, near);
         }
+        Grown::Trapped
     }
 
     /// Grow `tree` towards `target` until it gets there or is stopped.

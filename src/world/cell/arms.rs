@@ -42,6 +42,22 @@ pub struct Arms {
     pub rest: Vec<Vec<f64>>,
     pub plan: PlanOptions,
     pub ik: IkOptions,
+    /// Every path query posed while recording is on (for the benchmark), else `None`.
+    recorded: Mutex<Option<Vec<PathQuery>>>,
+}
+
+/// One collision-free path asked of the planner by a skill's motion: the arm, the joint
+/// values from and to, and everything its check held (the robot's root, the other arms'
+/// values, the scene's solids and what the hand carries, in the flange's frame).
+#[derive(Debug, Clone)]
+pub struct PathQuery {
+    pub arm: usize,
+    pub base: Isometry3<f64>,
+    pub configs: Vec<Vec<f64>>,
+    pub solids: Vec<Solid>,
+    pub carried: Vec<Solid>,
+    pub start: Vec<f64>,
+    pub goal: Vec<f64>,
 }
 
 impl std::fmt::Debug for Arms {
@@ -216,7 +232,39 @@ impl Arms {
             rest: spec.rest.clone(),
             plan: PlanOptions::default(),
             ik: IkOptions::default(),
+            recorded: Mutex::new(None),
         })
+    }
+
+    /// Start keeping every path query posed from now on (forgetting any kept before).
+    pub fn record_queries(&self) {
+        if let Ok(mut recorded) = self.recorded.lock() {
+            *recorded = Some(Vec::new());
+        }
+    }
+
+    /// The path queries kept since [`Arms::record_queries`]; recording stops.
+    pub fn take_queries(&self) -> Vec<PathQuery> {
+        self.recorded
+            .lock()
+            .ok()
+            .and_then(|mut r| r.take())
+            .unwrap_or_default()
+    }
+
+    /// A path for `check`'s arm, the query kept when recording.
+    fn plan_path(
+        &self,
+        check: &ArmCheck<'_>,
+        query: PathQuery,
+    ) -> Result<crate::motion::JointPath, MotionError> {
+        let found = plan(check, &query.start, &query.goal, &self.plan);
+        if let Ok(mut recorded) = self.recorded.lock()
+            && let Some(kept) = recorded.as_mut()
+        {
+            kept.push(query);
+        }
+        found
     }
 
     /// The arm's name as people read it.
@@ -392,6 +440,15 @@ impl Arms {
                 shape: p.shape.clone(),
             })
             .collect();
+        let query = |carried: Vec<Solid>, start: &[f64], goal: &[f64]| PathQuery {
+            arm,
+            base: reach.base,
+            configs: reach.configs.to_vec(),
+            solids: reach.solids.to_vec(),
+            carried,
+            start: start.to_vec(),
+            goal: goal.to_vec(),
+        };
         let check = ArmCheck::new(
             &self.robot,
             &self.shapes,
@@ -401,7 +458,7 @@ impl Arms {
             reach.solids,
         )
         .map_err(|e| no_path(&e))?
-        .carrying(carried);
+        .carrying(carried.clone());
         for q in &line {
             if let Some(blocker) = check.blocker(q) {
                 return Err(Refusal::NoPath {
@@ -414,7 +471,9 @@ impl Arms {
                 });
             }
         }
-        let path = plan(&check, &start, &above, &self.plan).map_err(|e| no_path(&e))?;
+        let path = self
+            .plan_path(&check, query(carried, &start, &above))
+            .map_err(|e| no_path(&e))?;
         // There, down the approach (`line` runs up from the bottom) and back up.
         let mut way = path.waypoints.clone();
         way.extend(line.iter().rev().skip(1).cloned());
@@ -446,8 +505,9 @@ impl Arms {
                 reach.solids,
             )
             .map_err(|e| no_path(&e))?;
-            let back =
-                plan(&empty, &above, &self.rest[arm], &self.plan).map_err(|e| no_path(&e))?;
+            let back = self
+                .plan_path(&empty, query(Vec::new(), &above, &self.rest[arm]))
+                .map_err(|e| no_path(&e))?;
             done.q.clone_from(&self.rest[arm]);
             done.length += back.length();
             done.samples += back.samples;

@@ -173,6 +173,11 @@ impl CellWorld {
         self.arms.is_some()
     }
 
+    /// The real arms this world moves, if it moves them.
+    pub fn arms(&self) -> Option<&Arc<arms::Arms>> {
+        self.arms.as_ref()
+    }
+
     /// Each real arm's joint values now (empty without real arms).
     pub fn arm_configs(&self) -> &[Vec<f64>] {
         &self.state.arms

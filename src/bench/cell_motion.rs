@@ -1,0 +1,280 @@
+//! The cell scenarios' own arm motions: every collision-free path the real arms are asked
+//! for while a scenario's tree runs in the execution world, failing first and then
+//! repaired with the scenario's expected fixes until it succeeds. The queries are kept as
+//! the arms posed them (start and goal joint values, the scene's solids, the other arm,
+//! what the hand carries), so betr and OMPL + PyBullet can plan the very same ones.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Instant;
+
+use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+use parry3d::shape::TypedShape;
+
+use super::BenchError;
+use super::motion::PlanTimes;
+use crate::domain::Condition;
+use crate::model::DescriptionSpec;
+use crate::motion::{ArmCheck, Solid, plan};
+use crate::planner::{Planner, RunEnd, run_tree};
+use crate::scenario::Scenario;
+use crate::world::cell::arms::{Arms, PathQuery};
+use crate::world::{self, CellWorld, World};
+
+/// Ticks a scenario's tree may take per run.
+const RUN_TICKS: u64 = 1000;
+
+/// The path queries of one scenario's runs.
+pub struct ScenarioQueries {
+    pub scenario: String,
+    pub arms: Arc<Arms>,
+    pub queries: Vec<PathQuery>,
+}
+
+/// The path queries posed while `path`'s tree runs with the real arms until it succeeds
+/// (each failing run, then the run after each expected fix), each query once; `None` when
+/// the scenario's world moves no real arms.
+pub fn scenario_queries(path: &Path) -> Result<Option<ScenarioQueries>, BenchError> {
+    let setup = |what: String| BenchError::Setup(format!("{}: {what}", path.display()));
+    let scenario = Scenario::load(path).map_err(|e| setup(e.to_string()))?;
+    if scenario.world_kind != "cell" {
+        return Ok(None);
+    }
+    let exec = world::load_execution(&scenario, None).map_err(|e| setup(e.to_string()))?;
+    let Some(arms) = exec
+        .world
+        .as_any()
+        .and_then(|a| a.downcast_ref::<CellWorld>())
+        .and_then(|c| c.arms().cloned())
+    else {
+        return Ok(None);
+    };
+    if scenario.goal.is_none() {
+        return Ok(None);
+    }
+    let planning = world::load(&scenario).map_err(|e| setup(e.to_string()))?;
+    let (_, queries) = gold_runs(
+        &scenario,
+        exec.world.as_ref(),
+        planning.as_ref(),
+        Some(&arms),
+    )?;
+    Ok(Some(ScenarioQueries {
+        scenario: scenario.name.clone(),
+        arms,
+        queries,
+    }))
+}
+
+/// Plan the scenario's goal in `planning`, run the tree in a fresh copy of `exec`, and
+/// after each failure repair it with the next expected fix (the one a person approves),
+/// until a run succeeds. The repairs made, and with `arms` the path queries posed during
+/// the runs, each once.
+pub fn gold_runs(
+    scenario: &Scenario,
+    exec: &dyn World,
+    planning: &dyn World,
+    arms: Option<&Arms>,
+) -> Result<(usize, Vec<PathQuery>), BenchError> {
+    let setup = |what: String| BenchError::Setup(format!("{}: {what}", scenario.name));
+    let goal = scenario
+        .goal
+        .clone()
+        .ok_or_else(|| setup("the scenario has no goal".into()))?;
+    let planner = Planner::new(&scenario.domain);
+    let mut tree = planner
+        .plan(&goal.to_dnf(), planning)
+        .map_err(|e| setup(e.to_string()))?
+        .tree;
+    let mut fixes = scenario.expected_fix.iter();
+    let mut queries: Vec<PathQuery> = Vec::new();
+    let mut repairs = 0;
+    loop {
+        let mut run = exec.fork();
+        if let Some(arms) = arms {
+            arms.record_queries();
+        }
+        let report = run_tree(&tree, run.as_mut(), &scenario.domain, RUN_TICKS, |_, _| {
+            true
+        });
+        for q in arms.map(Arms::take_queries).unwrap_or_default() {
+            if !queries.iter().any(|kept| same_query(kept, &q)) {
+                queries.push(q);
+            }
+        }
+        let (node, error) = match report.end {
+            RunEnd::Success => return Ok((repairs, queries)),
+            RunEnd::Failure {
+                action: Some(failed),
+            } => failed,
+            other => return Err(setup(format!("the tree ended {other:?}"))),
+        };
+        let Some(fix) = fixes.next() else {
+            return Err(setup(format!("{error} with no expected fix left")));
+        };
+        let fix = Condition::parse(fix).map_err(|e| setup(e.to_string()))?;
+        // Repaired in the planning world, or where the planning world predicted the
+        // failed motion's success, in the execution world, as the engine does.
+        let repair_in = if error.ends_with(world::DISAGREEMENT_NOTE) {
+            exec
+        } else {
+            planning
+        };
+        tree = planner
+            .repair(tree, node, &[fix], repair_in)
+            .map_err(|e| setup(e.to_string()))?
+            .tree;
+        repairs += 1;
+    }
+}
+
+fn same_query(a: &PathQuery, b: &PathQuery) -> bool {
+    a.arm == b.arm
+        && a.start == b.start
+        && a.goal == b.goal
+        && a.configs == b.configs
+        && a.base == b.base
+        && a.solids.len() == b.solids.len()
+        && a.solids
+            .iter()
+            .zip(&b.solids)
+            .all(|(x, y)| x.name == y.name && x.pose == y.pose)
+        && a.carried.len() == b.carried.len()
+}
+
+/// betr's planner on each query (the check made and the path planned), timed one by one.
+pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchError> {
+    let mut times = PlanTimes {
+        seconds: Vec::with_capacity(queries.len()),
+        solved: 0,
+    };
+    for q in queries {
+        let started = Instant::now();
+        let check = ArmCheck::new(
+            &arms.robot,
+            &arms.shapes,
+            q.base,
+            q.arm,
+            &q.configs,
+            &q.solids,
+        )
+        .map_err(|e| BenchError::Setup(e.to_string()))?
+        .carrying(q.carried.clone());
+        let found = plan(&check, &q.start, &q.goal, &arms.plan).is_ok();
+        times.seconds.push(started.elapsed().as_secs_f64());
+        times.solved += usize::from(found);
+    }
+    Ok(times)
+}
+
+/// OMPL + PyBullet on the same queries (`budget_s` seconds each), and the kinds of shape
+/// PyBullet was not given (none when every solid converts).
+#[allow(clippy::too_many_arguments)]
+pub fn ompl_plan(
+    python: &Path,
+    script: &Path,
+    spec: &DescriptionSpec,
+    dir: &Path,
+    arms: &Arms,
+    queries: &[PathQuery],
+    budget_s: f64,
+    scratch: &Path,
+) -> Result<(PlanTimes, Vec<String>), BenchError> {
+    let mut skipped: Vec<String> = Vec::new();
+    let mut convert = |solids: &[Solid]| -> Vec<serde_json::Value> {
+        solids
+            .iter()
+            .filter_map(|s| {
+                let converted = pybullet_solid(s);
+                let kind = format!("{:?}", s.shape.shape_type());
+                if converted.is_none() && !skipped.contains(&kind) {
+                    skipped.push(kind);
+                }
+                converted
+            })
+            .collect()
+    };
+    let queries_json: Vec<serde_json::Value> = queries
+        .iter()
+        .map(|q| {
+            let t = q.base.translation.vector;
+            serde_json::json!({
+                "arm": q.arm,
+                "start": q.start,
+                "goal": q.goal,
+                "others": q.configs,
+                "base": [t.x, t.y, t.z],
+                "solids": convert(&q.solids),
+                "carried": convert(&q.carried),
+            })
+        })
+        .collect();
+    let json = serde_json::json!({
+        "urdf": spec.urdf_in(dir),
+        "package": spec.package,
+        "package_dir": dir,
+        "base": [0.0, 0.0, 0.0],
+        "arms": super::motion::arms_json(&arms.robot),
+        "queries": queries_json,
+        "resolution": arms.plan.resolution,
+        "budget_s": budget_s,
+    });
+    let times = super::motion::run_ompl(python, script, &json, queries.len(), scratch)?;
+    Ok((times, skipped))
+}
+
+/// A solid as PyBullet makes it: its kind and sizes, and its pose (position, quaternion
+/// x y z w) with the shape's axis turned to PyBullet's (z for cylinders and capsules);
+/// `None` when PyBullet has no such primitive.
+pub fn pybullet_solid(solid: &Solid) -> Option<serde_json::Value> {
+    let z_to_y = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f32::consts::FRAC_PI_2);
+    let (kind, sizes, local) = match solid.shape.as_typed_shape() {
+        TypedShape::Cuboid(c) => (
+            "box",
+            serde_json::json!({"half": [c.half_extents.x, c.half_extents.y, c.half_extents.z]}),
+            Isometry3::identity(),
+        ),
+        TypedShape::Ball(b) => (
+            "sphere",
+            serde_json::json!({"radius": b.radius}),
+            Isometry3::identity(),
+        ),
+        // parry's cylinder stands along y.
+        TypedShape::Cylinder(c) => (
+            "cylinder",
+            serde_json::json!({"radius": c.radius, "height": 2.0 * c.half_height}),
+            Isometry3::from_parts(Default::default(), z_to_y),
+        ),
+        TypedShape::Capsule(c) => {
+            let axis = c.segment.b - c.segment.a;
+            let turn = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
+                .unwrap_or_else(UnitQuaternion::identity);
+            let mid = nalgebra::center(&c.segment.a, &c.segment.b);
+            (
+                "capsule",
+                serde_json::json!({"radius": c.radius, "height": axis.norm()}),
+                Isometry3::from_parts(mid.coords.into(), turn),
+            )
+        }
+        TypedShape::ConvexPolyhedron(p) => (
+            "mesh",
+            serde_json::json!({"vertices": p.points().iter().map(|v| [v.x, v.y, v.z]).collect::<Vec<_>>()}),
+            Isometry3::identity(),
+        ),
+        _ => return None,
+    };
+    let pose = solid.pose * local;
+    let t = pose.translation.vector;
+    let r = pose.rotation.coords;
+    Some(serde_json::json!({
+        "name": solid.name,
+        "kind": kind,
+        "sizes": sizes,
+        "position": [t.x, t.y, t.z],
+        "orientation": [r.x, r.y, r.z, r.w],
+    }))
+}
+
+#[cfg(test)]
+#[path = "cell_motion_tests.rs"]
+mod tests;
