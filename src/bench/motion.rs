@@ -396,6 +396,16 @@ pub fn plan_rows(label: &str, betr: &PlanTimes, ompl: &PlanTimes, note: &str) ->
         ompl.solved,
         ompl.seconds.len()
     );
+    // An anchor that solved none of the queries timed only its failures: its times and
+    // its success rate say nothing about planning these motions, so nothing is compared.
+    let compared = ompl.solved > 0;
+    if !compared {
+        how.push_str(
+            "; OMPL + PyBullet solved none of these queries, so its times are those of \
+             failed attempts and are not compared",
+        );
+    }
+    let time_anchor = |value: f64| compared.then(|| (anchor.clone(), value));
     vec![
         Row {
             part: "motion".into(),
@@ -403,7 +413,7 @@ pub fn plan_rows(label: &str, betr: &PlanTimes, ompl: &PlanTimes, note: &str) ->
             unit: "ms".into(),
             better: Better::Lower,
             betr: betr.quantile_ms(0.5),
-            anchor: Some((anchor.clone(), ompl.quantile_ms(0.5))),
+            anchor: time_anchor(ompl.quantile_ms(0.5)),
             target: Some(super::Target::AtMost(1.0)),
             note: how.clone(),
         },
@@ -413,7 +423,7 @@ pub fn plan_rows(label: &str, betr: &PlanTimes, ompl: &PlanTimes, note: &str) ->
             unit: "ms".into(),
             better: Better::Lower,
             betr: betr.quantile_ms(0.95),
-            anchor: Some((anchor.clone(), ompl.quantile_ms(0.95))),
+            anchor: time_anchor(ompl.quantile_ms(0.95)),
             target: None,
             note: how.clone(),
         },
@@ -423,9 +433,41 @@ pub fn plan_rows(label: &str, betr: &PlanTimes, ompl: &PlanTimes, note: &str) ->
             unit: "fraction".into(),
             better: Better::Higher,
             betr: betr.success(),
-            anchor: Some((anchor, ompl.success())),
-            target: Some(super::Target::RatioAtLeast(1.0)),
+            anchor: Some((anchor.clone(), ompl.success())),
+            target: compared.then_some(super::Target::RatioAtLeast(1.0)),
             note: how,
         },
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn times(seconds: &[f64], solved: usize) -> PlanTimes {
+        PlanTimes {
+            seconds: seconds.to_vec(),
+            solved,
+        }
+    }
+
+    #[test]
+    fn an_anchor_that_solved_nothing_is_not_compared() {
+        let betr = times(&[0.001, 0.002, 0.003], 3);
+        let rows = plan_rows("q", &betr, &times(&[2.0, 2.0, 2.0], 0), "n");
+        assert!(rows[0].anchor.is_none() && rows[1].anchor.is_none());
+        assert!(rows[2].target.is_none());
+        assert!(rows.iter().all(|r| r.note.contains("solved none")));
+        // The median's own target (betr's time) still stands.
+        assert!(rows[0].target.is_some());
+    }
+
+    #[test]
+    fn an_anchor_that_solved_some_is_compared() {
+        let betr = times(&[0.001, 0.002, 0.003], 3);
+        let rows = plan_rows("q", &betr, &times(&[0.1, 0.2, 2.0], 2), "n");
+        assert!(rows.iter().all(|r| r.anchor.is_some()));
+        assert!(rows[2].target.is_some());
+        assert!(rows.iter().all(|r| !r.note.contains("solved none")));
+    }
 }
