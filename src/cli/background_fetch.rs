@@ -90,15 +90,15 @@ fn fetch_robot(
     let arrival = match fetched {
         Ok(path) => {
             tracing::info!(path = %path.display(), "robot description fetched");
-            Ok(())
+            ModelArrival::RobotReady
         }
         Err(FetchError::Cancelled) => return false,
         Err(e) => {
             tracing::warn!(robot = robot.name, error = %e, "no robot description");
-            Err(e.to_string())
+            ModelArrival::RobotFailed(e.to_string())
         }
     };
-    let _ = report.send(ModelArrival::Robot(arrival));
+    let _ = report.send(arrival);
     !cancelled.load(Ordering::Relaxed)
 }
 

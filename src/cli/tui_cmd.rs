@@ -129,7 +129,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         }
         None => ready_model(&settings, &ledger, &var),
     };
-    let robot = betr::world::missing_description(&scenario).filter(|_| !offline);
+    let robot = betr::session::missing_description(&scenario).filter(|_| !offline);
     let background = if robot.is_some() || wanted_model.is_some() {
         Some(super::background_fetch::start(
             robot,

@@ -26,6 +26,9 @@ mod value_levels;
 pub mod values;
 
 pub use crate::planner::RunLimits;
+/// The robot description a scenario's arms need and the cache lacks: what a front end
+/// fetches before the session's world can move the arms ([`Command::RobotArrived`]).
+pub use crate::world::missing_description;
 pub use ask::missing_value;
 pub use edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use engine::{Command, Engine, EngineHandle, Setup};

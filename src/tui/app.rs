@@ -53,9 +53,11 @@ pub enum ModelArrival {
     Ready,
     /// It will not come: why.
     Failed(String),
-    /// The robot description the cell's arms need arrived in the cache (`Ok`), or will
-    /// not come (`Err`: why; the cell keeps its reach spheres and gripper sweep).
-    Robot(Result<(), String>),
+    /// The robot description the cell's arms need arrived in the cache.
+    RobotReady,
+    /// The robot description will not come: why (the cell keeps its reach spheres and
+    /// gripper sweep).
+    RobotFailed(String),
 }
 
 /// What a component asks of the app (the event queue between them).
@@ -549,11 +551,11 @@ impl App {
                 self.llm.error = Some(strings::no_model(&why));
             }
             // The session says what the arms' arrival changes.
-            ModelArrival::Robot(Ok(())) => {
+            ModelArrival::RobotReady => {
                 self.status.fetching = None;
                 self.queue.push(AppEvent::Command(Command::RobotArrived));
             }
-            ModelArrival::Robot(Err(why)) => {
+            ModelArrival::RobotFailed(why) => {
                 self.status.fetching = None;
                 self.llm.log(strings::no_robot(&why));
             }
