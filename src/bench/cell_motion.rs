@@ -6,7 +6,6 @@
 
 use std::path::Path;
 use std::sync::Arc;
-use std::time::Instant;
 
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use parry3d::shape::TypedShape;
@@ -144,12 +143,7 @@ fn same_query(a: &PathQuery, b: &PathQuery) -> bool {
 
 /// betr's planner on each query (the check made and the path planned), timed one by one.
 pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchError> {
-    let mut times = PlanTimes {
-        seconds: Vec::with_capacity(queries.len()),
-        solved: 0,
-    };
-    for q in queries {
-        let started = Instant::now();
+    PlanTimes::measure(queries, |q| {
         let check = ArmCheck::new(
             &arms.robot,
             &arms.shapes,
@@ -160,11 +154,8 @@ pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchE
         )
         .map_err(|e| BenchError::Setup(e.to_string()))?
         .carrying(q.carried.clone());
-        let found = plan(&check, &q.start, &q.goal, &arms.plan).is_ok();
-        times.seconds.push(started.elapsed().as_secs_f64());
-        times.solved += usize::from(found);
-    }
-    Ok(times)
+        Ok(plan(&check, &q.start, &q.goal, &arms.plan).is_ok())
+    })
 }
 
 /// OMPL + PyBullet on the same queries (`budget_s` seconds each), and the kinds of shape

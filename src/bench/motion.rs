@@ -50,6 +50,24 @@ pub struct PlanTimes {
 }
 
 impl PlanTimes {
+    /// `solve` on each of `queries`, timed one by one (true: a path was found).
+    pub fn measure<Q>(
+        queries: &[Q],
+        mut solve: impl FnMut(&Q) -> Result<bool, BenchError>,
+    ) -> Result<PlanTimes, BenchError> {
+        let mut times = PlanTimes {
+            seconds: Vec::with_capacity(queries.len()),
+            solved: 0,
+        };
+        for q in queries {
+            let started = Instant::now();
+            let found = solve(q)?;
+            times.seconds.push(started.elapsed().as_secs_f64());
+            times.solved += usize::from(found);
+        }
+        Ok(times)
+    }
+
     /// The `q` quantile (0–1) of the times, in milliseconds.
     pub fn quantile_ms(&self, q: f64) -> f64 {
         let mut s = self.seconds.clone();
@@ -273,19 +291,11 @@ pub fn betr_plan(
     options: &PlanOptions,
 ) -> Result<PlanTimes, BenchError> {
     let solids = solids(boxes);
-    let mut times = PlanTimes {
-        seconds: Vec::with_capacity(queries.len()),
-        solved: 0,
-    };
-    for q in queries {
-        let started = Instant::now();
+    PlanTimes::measure(queries, |q| {
         let check = ArmCheck::new(robot, shapes, Isometry3::identity(), q.arm, rest, &solids)
             .map_err(|e| BenchError::Setup(e.to_string()))?;
-        let found = plan(&check, &q.start, &q.goal, options).is_ok();
-        times.seconds.push(started.elapsed().as_secs_f64());
-        times.solved += usize::from(found);
-    }
-    Ok(times)
+        Ok(plan(&check, &q.start, &q.goal, options).is_ok())
+    })
 }
 
 /// OMPL + PyBullet on the same queries, with `budget_s` seconds per query.
