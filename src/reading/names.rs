@@ -90,8 +90,8 @@ pub fn unanswered_names(goal: &Formula, request: &Request) -> Vec<String> {
 }
 
 /// An object of `goal` that no word of the request names, when a word of the request
-/// that names an object by itself ("fries", not the "area" of a lounge area, nor a number:
-/// those are [`renumbered`]'s) is answered by no condition: the goal has put one thing in
+/// that names an object by itself ("fries", not the "area" of a lounge area, nor a
+/// number) is answered by no condition: the goal has put one thing in
 /// another's place ("fries" read as coffee).
 /// Returns that object and the words left unanswered. A goal whose objects are all named
 /// ("a glass of milk" read as the milk) or that leaves no object word out ("it's hot"
@@ -258,46 +258,6 @@ pub fn without_copied(
         .iter()
         .any(|w| !is_phrasing(w) && !covered.iter().any(|c| same_word(c, w)));
     (!unexplained).then_some(rest)
-}
-
-/// `goal` with the one numbered object it names replaced by the one object of the same
-/// kind that has the number the request says and the goal leaves out (`missing`, as
-/// [`terms`] gives numbers): "table six" read as `Table1`, where `WindowTable6` is the only
-/// place numbered 6. `None` when any of it is ambiguous. Returns the goal, and the object
-/// replaced and its replacement.
-pub fn renumbered(
-    goal: &Formula,
-    missing: &[String],
-    vocabulary: &crate::domain::Vocabulary,
-) -> Option<(Formula, String, String)> {
-    let [number] = missing else {
-        return None;
-    };
-    let numbered = |name: &str| terms(name).into_iter().any(|w| is_number(&w));
-    let mut named: Vec<String> = goal
-        .atoms()
-        .iter()
-        .flat_map(|a| a.args.clone())
-        .filter(|arg| numbered(arg))
-        .collect();
-    named.sort();
-    named.dedup();
-    let [from] = named.as_slice() else {
-        return None;
-    };
-    let kinds = &vocabulary.objects.iter().find(|o| &o.name == from)?.types;
-    let mut to = vocabulary
-        .objects
-        .iter()
-        .filter(|o| o.types.iter().any(|t| kinds.contains(t)) && terms(&o.name).contains(number));
-    let (Some(to), None) = (to.next(), to.next()) else {
-        return None;
-    };
-    Some((
-        rename(goal, from, &to.name),
-        from.to_string(),
-        to.name.clone(),
-    ))
 }
 
 /// How many alternatives `goal` offers beyond the first where it asks for something:

@@ -4,7 +4,7 @@ use super::*;
 use crate::goal::Formula;
 use crate::reading::Lexicon;
 use crate::reading::names::{
-    factored, renumbered, swapped_back, swapped_object, without_copied, without_unasked,
+    factored, swapped_back, swapped_object, without_copied, without_unasked,
 };
 use crate::reading::words::same_word;
 use std::path::Path;
@@ -237,35 +237,6 @@ fn the_empty_hand_is_no_object_a_request_must_name() {
     )
     .expect("it holds already");
     assert!(problem.is_doubt(), "{problem:?}");
-}
-
-#[test]
-fn a_place_read_with_the_wrong_number_is_renumbered_when_unambiguous() {
-    let (scenario, _) = cafe();
-    let vocabulary = &scenario.domain.vocabulary;
-    let g = |t: &str| Formula::parse(t).expect("parses");
-    let six = ["6".to_string()];
-    let (goal, from, to) =
-        renumbered(&g("On_Coffee_Table1"), &six, vocabulary).expect("renumbered");
-    assert_eq!(goal, g("On_Coffee_WindowTable6"));
-    assert_eq!((from.as_str(), to.as_str()), ("Table1", "WindowTable6"));
-    // Every occurrence of the place, and nothing else, changes.
-    let (goal, ..) = renumbered(
-        &g("On_Chips_Table2 & (On_Milk_Table2 | RobotNear_Bar)"),
-        &six,
-        vocabulary,
-    )
-    .expect("renumbered");
-    assert_eq!(
-        goal,
-        g("On_Chips_WindowTable6 & (On_Milk_WindowTable6 | RobotNear_Bar)")
-    );
-    // Two numbered places, or two numbers left out: which is which is not known.
-    assert!(renumbered(&g("On_Coffee_Table1 & RobotNear_Table2"), &six, vocabulary).is_none());
-    let two = ["6".to_string(), "2".to_string()];
-    assert!(renumbered(&g("On_Coffee_Table1"), &two, vocabulary).is_none());
-    // No place numbered 12.
-    assert!(renumbered(&g("On_Coffee_Table1"), &["12".to_string()], vocabulary).is_none());
 }
 
 #[test]
