@@ -132,4 +132,9 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "greenhouse/greenhouse.toml",
         include_str!("../../scenarios/greenhouse/greenhouse.toml"),
     ),
+    (
+        "lab/examples.toml",
+        include_str!("../../scenarios/lab/examples.toml"),
+    ),
+    ("lab/lab.toml", include_str!("../../scenarios/lab/lab.toml")),
 ];
