@@ -119,16 +119,19 @@ pub fn anchor_python(venv: &Path) -> Result<PathBuf, BenchError> {
     Ok(python)
 }
 
-/// The rest values the cell's arms start from (the cell scenarios' `[world.robot] rest`),
-/// in radians.
+/// The joint values (degrees, right arm first) the cell's arms start from: the cell
+/// scenarios' `[world.robot] rest`.
+pub const CELL_REST_DEGREES: [[f64; 7]; 2] = [
+    [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
+    [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
+];
+
+/// [`CELL_REST_DEGREES`] in radians.
 pub fn cell_rest() -> Vec<Vec<f64>> {
-    [
-        [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
-        [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
-    ]
-    .iter()
-    .map(|a| a.iter().map(|d: &f64| d.to_radians()).collect())
-    .collect()
+    CELL_REST_DEGREES
+        .iter()
+        .map(|a| a.iter().map(|d: &f64| d.to_radians()).collect())
+        .collect()
 }
 
 /// Joint values of every arm drawn within the limits.

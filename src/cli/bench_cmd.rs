@@ -198,6 +198,16 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
         &args.scenario,
         scenario_one,
     )?);
+    // The towers extend the cell's base file, beside scenario 1's.
+    let base = args
+        .scenario
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join("cell.toml");
+    rows.push(bench::scale::towers_arms(
+        if args.quick { 100 } else { 1000 },
+        &base,
+    )?);
     Ok(rows)
 }
 
