@@ -1,8 +1,9 @@
 //! The links' collision shapes: for each collision mesh of an arm's link, the tighter of
 //! the capsule along the mesh's main axis and the box on its principal axes, each holding
 //! every vertex by construction, in the link's frame, with the ball around it for a quick
-//! first test; for each mesh of a link that stays with the root (the torso), a few boxes
-//! stacked along one of its axes that together hold the mesh (`slabs.rs`).
+//! first test — or, for a bent link where they are much tighter, a few boxes stacked along
+//! one of the mesh's axes that together hold it (`slabs.rs`); for each mesh of a link that
+//! stays with the root (the torso), such stacked boxes.
 //!
 //! A configuration whose shapes are apart is one whose meshes are apart. Capsules and
 //! boxes rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
@@ -57,11 +58,11 @@ impl RobotShapes {
     /// The collision elements of every link, made convex.
     pub fn new(model: &Model, arms: &[Chain]) -> Result<RobotShapes, RobotError> {
         let shapes_of = |link: usize| -> Result<Vec<LinkShape>, RobotError> {
-            model.links[link]
-                .collisions
-                .iter()
-                .map(|e| link_shape(model, link, e))
-                .collect()
+            let mut shapes = Vec::new();
+            for element in &model.links[link].collisions {
+                shapes.extend(moving_link_shapes(model, link, element)?);
+            }
+            Ok(shapes)
         };
         let carried: Vec<usize> = arms
             .iter()
@@ -129,6 +130,40 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
         center: aabb.center(),
         radius: aabb.half_extents().norm(),
     })
+}
+
+/// Stacked boxes are an arm link's shapes when together they take at most this fraction
+/// of the volume of the one capsule or box around its mesh: the YuMi's links are bent, and
+/// one shape around a bend fills the space beside it (the shoulders' boxes overlapped the
+/// other arm's in configurations where the meshes are centimetres apart).
+const STACK_WHEN_TIGHTER: f32 = 0.75;
+
+/// The shapes of a link an arm moves: the capsule or box around its mesh, or the boxes
+/// stacked along one of the mesh's axes (`slabs.rs`) when they are much tighter; any other
+/// geometry as [`link_shape`] makes it.
+fn moving_link_shapes(
+    model: &Model,
+    link: usize,
+    element: &Element,
+) -> Result<Vec<LinkShape>, RobotError> {
+    let single = link_shape(model, link, element)?;
+    if !matches!(element.geometry, Geometry::Mesh { .. }) {
+        return Ok(vec![single]);
+    }
+    let stacked = still_link_shapes(model, link, element)?;
+    let volume = |shapes: &[LinkShape]| -> f32 {
+        shapes
+            .iter()
+            .map(|s| s.shape.mass_properties(1.0).mass())
+            .sum()
+    };
+    Ok(
+        if volume(&stacked) <= STACK_WHEN_TIGHTER * volume(std::slice::from_ref(&single)) {
+            stacked
+        } else {
+            vec![single]
+        },
+    )
 }
 
 /// The shapes of a link that does not move with an arm: a mesh as boxes stacked along one
