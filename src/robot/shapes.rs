@@ -1,8 +1,8 @@
 //! The links' collision shapes: for each collision mesh of an arm's link, the tighter of
 //! the capsule along the mesh's main axis and the box on its principal axes, each holding
 //! every vertex by construction, in the link's frame, with the ball around it for a quick
-//! first test — or, for a bent link where they are much tighter, a few boxes stacked along
-//! one of the mesh's axes that together hold it (`slabs.rs`); for each mesh of a link that
+//! first test — or, for a bent link where they are much tighter, up to three boxes stacked
+//! along one of the mesh's axes that together hold it (`slabs.rs`); for each mesh of a link that
 //! stays with the root (the torso), such stacked boxes.
 //!
 //! A configuration whose shapes are apart is one whose meshes are apart. Capsules and
@@ -19,7 +19,7 @@ use parry3d::shape::SharedShape;
 
 use super::RobotError;
 use super::chain::Chain;
-use super::slabs::stacked_boxes;
+use super::slabs::{MAX_ARM_BOXES, MAX_BOXES, stacked_boxes};
 use super::urdf::{Element, Geometry, Model};
 
 /// One link's collision shape, in the link's frame.
@@ -138,8 +138,9 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
 /// other arm's in configurations where the meshes are centimetres apart).
 const STACK_WHEN_TIGHTER: f32 = 0.75;
 
-/// The shapes of a link an arm moves: the capsule or box around its mesh, or the boxes
-/// stacked along one of the mesh's axes (`slabs.rs`) when they are much tighter; any other
+/// The shapes of a link an arm moves: the capsule or box around its mesh, or up to
+/// [`MAX_ARM_BOXES`] boxes stacked along one of the mesh's axes (`slabs.rs`) when they are
+/// much tighter; any other
 /// geometry as [`link_shape`] makes it.
 fn moving_link_shapes(
     model: &Model,
@@ -150,7 +151,7 @@ fn moving_link_shapes(
     if !matches!(element.geometry, Geometry::Mesh { .. }) {
         return Ok(vec![single]);
     }
-    let stacked = still_link_shapes(model, link, element)?;
+    let stacked = stacked_link_shapes(model, link, element, MAX_ARM_BOXES)?;
     let volume = |shapes: &[LinkShape]| -> f32 {
         shapes
             .iter()
@@ -173,6 +174,17 @@ fn still_link_shapes(
     link: usize,
     element: &Element,
 ) -> Result<Vec<LinkShape>, RobotError> {
+    stacked_link_shapes(model, link, element, MAX_BOXES)
+}
+
+/// A mesh as at most `max_boxes` boxes stacked along one of its axes (`slabs.rs`), any
+/// other geometry as [`link_shape`] makes it.
+fn stacked_link_shapes(
+    model: &Model,
+    link: usize,
+    element: &Element,
+    max_boxes: usize,
+) -> Result<Vec<LinkShape>, RobotError> {
     let Geometry::Mesh { path, scale } = &element.geometry else {
         return Ok(vec![link_shape(model, link, element)?]);
     };
@@ -183,7 +195,7 @@ fn still_link_shapes(
         .collect();
     let name = model.links[link].name.clone();
     let origin = element.origin.cast::<f32>();
-    let boxes = stacked_boxes(&triangles);
+    let boxes = stacked_boxes(&triangles, max_boxes);
     if boxes.is_empty() {
         return Err(RobotError::Urdf {
             file: model.file.clone(),
