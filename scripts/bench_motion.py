@@ -8,9 +8,17 @@
 
     bench_motion.py plan QUERIES_JSON
         OMPL's RRTConnect (path simplified afterwards, as betr shortcuts) with PyBullet's
-        contact test as the state validity checker, on the same URDF and solids (boxes
-        for every query, or each query's own solids and what its hand carries). Prints one
-        `ompl query=i solved=0|1 seconds=...` line per query.
+        contact test as the state validity checker. PyBullet checks what betr checks: the
+        URDF's kinematics with betr's collision shapes of the links in place of the
+        meshes, the same solids (shared by every query, or each query's own and what its
+        hand carries), and only the pairs of parts betr's check of that query tests, a
+        pair colliding when the two overlap. Prints one `ompl query=i solved=0|1
+        seconds=...` line per query, and on standard error the pair a start or goal
+        state collides with.
+
+    bench_motion.py check QUERIES_JSON
+        The same check on each query's `states` (joint values of its arm): one
+        `check query=i free=0110...` line per query.
 """
 import json
 import os
@@ -41,19 +49,43 @@ def fk(urdf, package_dir, seconds, tips):
     print(f"pinocchio fk_per_s={count / elapsed:.1f} configurations={count}")
 
 
-def resolved_urdf(urdf, package, package_dir):
-    """The URDF with package:// paths made absolute, for PyBullet."""
-    with open(urdf) as f:
-        text = f.read()
-    text = text.replace(f"package://{package}/", package_dir.rstrip("/") + "/")
+def checked_urdf(urdf, model):
+    """The URDF with betr's collision shapes in place of its own (visuals dropped): per
+    link the shapes `collision_model` lists, in the link's frame."""
+    import xml.etree.ElementTree as ET
+    import pybullet as p
+
+    tree = ET.parse(urdf)
+    for link in tree.getroot().iter("link"):
+        for child in list(link):
+            if child.tag in ("collision", "visual"):
+                link.remove(child)
+        for shape in model["links"].get(link.get("name"), []):
+            collision = ET.SubElement(link, "collision")
+            rpy = p.getEulerFromQuaternion(shape["orientation"])
+            ET.SubElement(collision, "origin", {
+                "xyz": " ".join(repr(v) for v in shape["position"]),
+                "rpy": " ".join(repr(v) for v in rpy),
+            })
+            geometry = ET.SubElement(collision, "geometry")
+            sizes = shape["sizes"]
+            if shape["kind"] == "box":
+                ET.SubElement(geometry, "box", {"size": " ".join(repr(2 * h) for h in sizes["half"])})
+            elif shape["kind"] == "sphere":
+                ET.SubElement(geometry, "sphere", {"radius": repr(sizes["radius"])})
+            elif shape["kind"] in ("capsule", "cylinder"):
+                ET.SubElement(geometry, shape["kind"], {
+                    "radius": repr(sizes["radius"]), "length": repr(sizes["height"])})
+            else:
+                raise ValueError(f"link {link.get('name')}: no URDF primitive for {shape['kind']}")
     out = tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False)
-    out.write(text)
+    tree.write(out, encoding="unicode")
     out.close()
     return out.name
 
 
 def make_shape(p, solid):
-    """A PyBullet collision shape for one of betr's solids (see bench/cell_motion.rs)."""
+    """A PyBullet collision shape for one of betr's solids (see bench/pybullet.rs)."""
     kind, sizes = solid["kind"], solid["sizes"]
     if kind == "box":
         return p.createCollisionShape(p.GEOM_BOX, halfExtents=sizes["half"])
@@ -68,60 +100,146 @@ def make_shape(p, solid):
     raise ValueError(f"unknown solid kind {kind!r}")
 
 
-def plan(queries_json):
+def place_solid(p, solid):
+    shape = make_shape(p, solid)
+    return p.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape,
+                             basePosition=solid["position"], baseOrientation=solid["orientation"])
+
+
+class Cell:
+    """The robot with betr's collision shapes, the joints no arm moves where betr holds
+    them, and the solids shared by every query."""
+
+    def __init__(self, p, spec):
+        self.p = p
+        model = spec["collision_model"]
+        urdf = checked_urdf(spec["urdf"], model)
+        flags = p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
+        self.robot = p.loadURDF(urdf, basePosition=spec["base"], useFixedBase=True, flags=flags)
+        os.unlink(urdf)
+        self.joints, self.links = {}, {model["root"]: -1}
+        for j in range(p.getNumJoints(self.robot)):
+            info = p.getJointInfo(self.robot, j)
+            self.joints[info[1].decode()] = j
+            self.links[info[12].decode()] = j
+        for name, value in model["held_joints"].items():
+            p.resetJointState(self.robot, self.joints[name], value)
+        # The parts of the robot with shapes, as the tested pairs name them.
+        self.robot_parts = {f"link:{name}": (self.robot, self.links[name]) for name in model["links"]}
+        self.shared = {s["part"]: (place_solid(p, s), -1) for s in spec.get("solids", [])}
+
+
+class Query:
+    """One query's check: its arm's joints, its solids and what the hand carries placed,
+    and PyBullet told to test only the pairs betr's check of this query tests."""
+
+    def __init__(self, cell, spec, query, pairs):
+        p = self.p = cell.p
+        self.cell = cell
+        arms = spec["arms"]
+        arm = arms[query["arm"]]
+        self.ids = [cell.joints[n] for n in arm["joints"]]
+        self.flange = cell.links[arm["tip"]]
+        p.resetBasePositionAndOrientation(
+            cell.robot, query.get("base", spec["base"]), query.get("base_orientation", [0, 0, 0, 1]))
+        others = query.get("others", spec.get("others"))
+        for k, other in enumerate(arms):
+            if k != query["arm"]:
+                for name, v in zip(other["joints"], others[k]):
+                    p.resetJointState(cell.robot, cell.joints[name], v)
+        self.own = {s["part"]: (place_solid(p, s), -1) for s in query.get("solids", [])}
+        self.carried = []
+        for s in query.get("carried", []):
+            body = p.createMultiBody(baseMass=0, baseCollisionShapeIndex=make_shape(p, s))
+            self.carried.append((s["part"], body, s["position"], s["orientation"]))
+        parts = dict(cell.robot_parts)
+        parts.update(cell.shared)
+        parts.update(self.own)
+        parts.update({part: (body, -1) for part, body, _, _ in self.carried})
+        self.names = {v: k for k, v in parts.items()}
+        self.tested = set()
+        for a, b in pairs:
+            if a in parts and b in parts:
+                self.tested.add(frozenset((parts[a], parts[b])))
+        # Untested pairs are left out of PyBullet's own work too.
+        everything = list(parts.values())
+        for i, a in enumerate(everything):
+            for b in everything[i + 1:]:
+                p.setCollisionFilterPair(a[0], b[0], a[1], b[1], int(frozenset((a, b)) in self.tested))
+
+    def collision(self, state):
+        """The first tested pair that overlaps at `state` (names), or None."""
+        p = self.p
+        for k, joint in enumerate(self.ids):
+            p.resetJointState(self.cell.robot, joint, state[k])
+        if self.carried:
+            at = p.getLinkState(self.cell.robot, self.flange, computeForwardKinematics=True)
+            for _, body, pos, orn in self.carried:
+                wp, wo = p.multiplyTransforms(at[4], at[5], pos, orn)
+                p.resetBasePositionAndOrientation(body, wp, wo)
+        p.performCollisionDetection()
+        for c in p.getContactPoints():
+            # Overlapping only: PyBullet also reports parts within its contact threshold.
+            if c[8] >= 0:
+                continue
+            a, b = (c[1], c[3]), (c[2], c[4])
+            if frozenset((a, b)) in self.tested:
+                return self.names.get(a), self.names.get(b)
+        return None
+
+    def close(self):
+        for body, _ in self.own.values():
+            self.p.removeBody(body)
+        for _, body, _, _ in self.carried:
+            self.p.removeBody(body)
+
+
+class QuietNative:
+    """Standard output of native code silenced (PyBullet prints while it loads a URDF,
+    unbuffered, into the lines this script answers on)."""
+
+    def __enter__(self):
+        sys.stdout.flush()
+        self.saved = os.dup(1)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 1)
+        os.close(devnull)
+
+    def __exit__(self, *_):
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+        os.dup2(self.saved, 1)
+        os.close(self.saved)
+
+
+def queries(spec):
+    """Each query of `spec` with its check, in order."""
     import pybullet as p
+
+    with QuietNative():
+        p.connect(p.DIRECT)
+        cell = Cell(p, spec)
+    for i, query in enumerate(spec["queries"]):
+        pairs = query.get("pairs") or spec["pairs_by_arm"][query["arm"]]
+        check = Query(cell, spec, query, pairs)
+        yield i, query, check
+        check.close()
+
+
+def plan(queries_json):
     from ompl import base as ob, geometric as og
 
     with open(queries_json) as f:
         spec = json.load(f)
-    p.connect(p.DIRECT)
-    urdf = resolved_urdf(spec["urdf"], spec["package"], spec["package_dir"])
-    robot = p.loadURDF(urdf, basePosition=spec["base"], useFixedBase=True)
-    os.unlink(urdf)
-    joints, links = {}, {}
-    parents = {}
-    for j in range(p.getNumJoints(robot)):
-        info = p.getJointInfo(robot, j)
-        joints[info[1].decode()] = j
-        links[info[12].decode()] = j
-        parents[j] = info[16]
-    # The random targets' clutter: boxes for every query.
-    for box in spec.get("boxes", []):
-        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=box["half"])
-        p.createMultiBody(baseMass=0, baseCollisionShapeIndex=shape, basePosition=box["center"])
-    arms = spec["arms"]  # per arm: joint names, lower, upper, tip link
-    for i, query in enumerate(spec["queries"]):
+    arms = spec["arms"]
+    for i, query, check in queries(spec):
         arm = arms[query["arm"]]
-        ids = [joints[n] for n in arm["joints"]]
-        others = query.get("others", spec.get("others"))
-        p.resetBasePositionAndOrientation(robot, query.get("base", spec["base"]), [0, 0, 0, 1])
-        # The other arms where the query holds them.
-        for k, other in enumerate(arms):
-            if k != query["arm"]:
-                for name, v in zip(other["joints"], others[k]):
-                    p.resetJointState(robot, joints[name], v)
-        # The query's own solids (the cell scenarios' motions), and what the hand carries,
-        # placed relative to the flange at every check.
-        bodies = []
-        for solid in query.get("solids", []):
-            bodies.append(p.createMultiBody(
-                baseMass=0, baseCollisionShapeIndex=make_shape(p, solid),
-                basePosition=solid["position"], baseOrientation=solid["orientation"]))
-        carried = []
-        for solid in query.get("carried", []):
-            body = p.createMultiBody(baseMass=0, baseCollisionShapeIndex=make_shape(p, solid))
-            carried.append((body, solid["position"], solid["orientation"]))
-        carried_ids = {b for b, _, _ in carried}
-        flange = links.get(arm.get("tip", ""), ids[-1])
-
-        def own_link(j, first=ids[0]):
-            while j >= 0:
-                if j == first:
-                    return True
-                j = parents[j]
-            return False
-
-        dof = len(ids)
+        dof = len(check.ids)
+        for which in ("start", "goal"):
+            hit = check.collision(query[which])
+            if hit:
+                print(f"query {i}: the {which} collides: {hit[0]} with {hit[1]}", file=sys.stderr)
         space = ob.RealVectorStateSpace(dof)
         bounds = ob.RealVectorBounds(dof)
         for k in range(dof):
@@ -129,32 +247,7 @@ def plan(queries_json):
             bounds.setHigh(k, arm["upper"][k])
         space.setBounds(bounds)
         ss = og.SimpleSetup(space)
-
-        def valid(state, ids=ids, dof=dof, carried=carried, carried_ids=carried_ids, flange=flange, own_link=own_link):
-            for k in range(dof):
-                p.resetJointState(robot, ids[k], state[k])
-            if carried:
-                at = p.getLinkState(robot, flange, computeForwardKinematics=True)
-                for body, pos, orn in carried:
-                    wp, wo = p.multiplyTransforms(at[4], at[5], pos, orn)
-                    p.resetBasePositionAndOrientation(body, wp, wo)
-            p.performCollisionDetection()
-            # Without URDF_USE_SELF_COLLISION PyBullet reports only the robot against
-            # the solids; the hand holds what it carries.
-            for c in p.getContactPoints(bodyA=robot):
-                if c[2] not in carried_ids:
-                    return False
-            # What the hand carries against the solids and the robot but this arm.
-            for body in carried_ids:
-                for c in p.getContactPoints(bodyA=body):
-                    if c[2] == robot and own_link(c[4]):
-                        continue
-                    if c[2] in carried_ids:
-                        continue
-                    return False
-            return True
-
-        ss.setStateValidityChecker(valid)
+        ss.setStateValidityChecker(lambda state, check=check: check.collision(state) is None)
         si = ss.getSpaceInformation()
         # The same joint-space resolution as betr's segment checks.
         si.setStateValidityCheckingResolution(spec["resolution"] / space.getMaximumExtent())
@@ -171,8 +264,15 @@ def plan(queries_json):
             ss.simplifySolution()
         seconds = time.perf_counter() - began
         print(f"ompl query={i} solved={int(exact)} seconds={seconds:.6f}", flush=True)
-        for body in bodies + [b for b, _, _ in carried]:
-            p.removeBody(body)
+
+
+def check(queries_json):
+    """PyBullet's verdict on each query's `states` (1: free), one line per query."""
+    with open(queries_json) as f:
+        spec = json.load(f)
+    for i, query, check in queries(spec):
+        verdicts = "".join("0" if check.collision(q) else "1" for q in query["states"])
+        print(f"check query={i} free={verdicts}", flush=True)
 
 
 def main():
@@ -180,6 +280,8 @@ def main():
         fk(sys.argv[2], sys.argv[3], float(sys.argv[4]), sys.argv[5:])
     elif len(sys.argv) == 3 and sys.argv[1] == "plan":
         plan(sys.argv[2])
+    elif len(sys.argv) == 3 and sys.argv[1] == "check":
+        check(sys.argv[2])
     else:
         sys.exit(__doc__)
 

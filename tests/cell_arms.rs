@@ -417,3 +417,55 @@ fn parameter_scenarios_run_with_the_arms_once_given_a_good_value() {
         succeeds_twice(rel, &tree, &scenario, exec.as_ref(), moves);
     }
 }
+
+/// A tower cell of many cubes plans with the real arms too: the first run fails at the
+/// grasp of cube A for the arm's reason (cube 1 lies on it), the expected fixes (nothing on
+/// cube A, then nothing on cube 1) repair it, and the repaired tree runs to success with
+/// every motion an arm's path among all the cubes.
+#[test]
+fn a_tower_cell_of_a_hundred_cubes_plans_and_runs_with_the_arms() {
+    description();
+    let dir = support::cli::tmp("towers-arms");
+    let base = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/cell.toml");
+    let path = betr::bench::towers::write_arms_scenario(&dir, 100, &base).unwrap();
+    let scenario = Scenario::load(&path).unwrap();
+    let exec = arms_world(&scenario, None);
+    let planning = world::load(&scenario).unwrap();
+    let goal = scenario.goal.clone().unwrap().to_dnf();
+    let tree = Planner::new(&scenario.domain)
+        .plan(&goal, planning.as_ref())
+        .unwrap()
+        .tree;
+    let (end, _) = run(&tree, &scenario, exec.as_ref());
+    let RunEnd::Failure {
+        action: Some((_, error)),
+    } = end
+    else {
+        panic!("the unrepaired tree ends {end:?}");
+    };
+    assert!(
+        error.starts_with("No collision free path found for yumi_link_7_")
+            && error.contains("cube 1"),
+        "{error}"
+    );
+    let arms = exec
+        .as_any()
+        .and_then(|a| a.downcast_ref::<world::CellWorld>())
+        .and_then(|c| c.arms().cloned())
+        .unwrap();
+    let (repairs, queries) = betr::bench::cell_motion::gold_runs(
+        &scenario,
+        exec.as_ref(),
+        planning.as_ref(),
+        Some(&arms),
+    )
+    .unwrap();
+    assert_eq!(repairs, 2);
+    // Among the solids of every path: the 100 cubes (less one in the hand) and the table.
+    assert!(queries.len() >= 6, "{}", queries.len());
+    assert!(
+        queries.iter().all(|q| q.solids.len() >= 100),
+        "{:?}",
+        queries.iter().map(|q| q.solids.len()).collect::<Vec<_>>()
+    );
+}

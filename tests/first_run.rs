@@ -395,3 +395,67 @@ fn model_fetch_robot_installs_the_description_and_refuses_an_unknown_name() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A one-shot command on a scenario whose cell names a robot description fetches it on
+/// first use, its progress on standard error, and the run then fails where the arm does;
+/// offline (`BETR_OFFLINE=1` or `--offline`) it fetches nothing and says what is missing.
+#[test]
+fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
+    let dir = tmp("run-fetches-robot");
+    let cache = dir.join("models");
+    let pip_cache = std::env::var_os("HOME")
+        .map(|h| Path::new(&h).join(".cache").join("pip"))
+        .unwrap_or_else(|| dir.join("pip-cache"));
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml");
+    let scenario = scenario.to_str().unwrap();
+    let env = [
+        ("BETR_MODEL_DIR", cache.to_str().unwrap()),
+        ("PIP_CACHE_DIR", pip_cache.to_str().unwrap()),
+        ("PIP_DISABLE_PIP_VERSION_CHECK", "1"),
+    ];
+    let offline_env = [env[0], env[1], env[2], ("BETR_OFFLINE", "1")];
+    for (args, env) in [
+        (vec!["run", scenario], &offline_env[..]),
+        (vec!["run", scenario, "--offline"], &env[..]),
+    ] {
+        let out = support::cli::betr_with(&dir, &args, env);
+        let text = support::cli::text(&out);
+        assert_eq!(out.status.code(), Some(1), "{text}");
+        assert!(
+            text.contains("the robot description \"yumi\" is not in the cache")
+                && text.contains("betr model fetch --robot yumi"),
+            "{text}"
+        );
+        assert!(!text.contains("Fetching"), "{text}");
+        assert!(
+            cache_entries(&cache).is_empty(),
+            "{:?}",
+            cache_entries(&cache)
+        );
+    }
+    let out = support::cli::betr_with(&dir, &["run", scenario], &env);
+    let text = support::cli::text(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    // (The progress bar draws only on a terminal; the line before it is always said.)
+    assert!(
+        err.contains("Fetching ABB YuMi") && err.contains("once only"),
+        "{text}"
+    );
+    assert_eq!(out.status.code(), Some(1), "{text}");
+    assert!(
+        text.contains("No collision free path found for yumi_link_7_")
+            && !text.contains("not in the cache"),
+        "{text}"
+    );
+    let description = betr::model::YUMI_DESCRIPTION;
+    assert!(
+        description
+            .urdf_in(&cache.join(description.dir_name))
+            .is_file()
+    );
+    assert_eq!(
+        cache_entries(&cache),
+        vec![description.dir_name.to_string()]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -7,11 +7,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use nalgebra::{Isometry3, UnitQuaternion, Vector3};
-use parry3d::shape::TypedShape;
-
 use super::BenchError;
 use super::motion::PlanTimes;
+use super::pybullet::{collision_model, pybullet_solid, tested_pairs_json};
 use crate::domain::Condition;
 use crate::model::DescriptionSpec;
 use crate::motion::{ArmCheck, Solid, plan};
@@ -158,7 +156,8 @@ pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchE
     })
 }
 
-/// OMPL + PyBullet on the same queries (`budget_s` seconds each), and the kinds of shape
+/// OMPL + PyBullet on the same queries (`budget_s` seconds each), PyBullet checking
+/// what betr's check of each query checks (`super::pybullet`), and the kinds of shape
 /// PyBullet was not given (none when every solid converts).
 #[allow(clippy::too_many_arguments)]
 pub fn ompl_plan(
@@ -171,99 +170,79 @@ pub fn ompl_plan(
     budget_s: f64,
     scratch: &Path,
 ) -> Result<(PlanTimes, Vec<String>), BenchError> {
+    let (json, skipped) = anchor_input(spec, dir, arms, queries, budget_s)?;
+    let times = super::motion::run_ompl(python, script, &json, queries.len(), scratch)?;
+    Ok((times, skipped))
+}
+
+/// The anchor script's input for `queries` (see `scripts/bench_motion.py`), and the kinds
+/// of shape PyBullet is not given.
+pub fn anchor_input(
+    spec: &DescriptionSpec,
+    dir: &Path,
+    arms: &Arms,
+    queries: &[PathQuery],
+    budget_s: f64,
+) -> Result<(serde_json::Value, Vec<String>), BenchError> {
     let mut skipped: Vec<String> = Vec::new();
-    let mut convert = |solids: &[Solid]| -> Vec<serde_json::Value> {
+    // Each converted solid named as the tested pairs name it.
+    let mut convert = |solids: &[Solid], part: &dyn Fn(usize, &Solid) -> String| {
         solids
             .iter()
-            .filter_map(|s| {
-                let converted = pybullet_solid(s);
+            .enumerate()
+            .filter_map(|(i, s)| {
+                let mut converted = pybullet_solid(s);
                 let kind = format!("{:?}", s.shape.shape_type());
                 if converted.is_none() && !skipped.contains(&kind) {
                     skipped.push(kind);
                 }
+                if let Some(serde_json::Value::Object(fields)) = converted.as_mut() {
+                    fields.insert("part".into(), part(i, s).into());
+                }
                 converted
             })
-            .collect()
+            .collect::<Vec<_>>()
     };
-    let queries_json: Vec<serde_json::Value> = queries
-        .iter()
-        .map(|q| {
-            let t = q.base.translation.vector;
-            serde_json::json!({
-                "arm": q.arm,
-                "start": q.start,
-                "goal": q.goal,
-                "others": q.configs,
-                "base": [t.x, t.y, t.z],
-                "solids": convert(&q.solids),
-                "carried": convert(&q.carried),
-            })
-        })
-        .collect();
+    let mut queries_json: Vec<serde_json::Value> = Vec::with_capacity(queries.len());
+    for q in queries {
+        let check = ArmCheck::new(
+            &arms.robot,
+            &arms.shapes,
+            q.base,
+            q.arm,
+            &q.configs,
+            &q.solids,
+        )
+        .map_err(|e| BenchError::Setup(e.to_string()))?
+        .carrying(q.carried.clone());
+        let t = q.base.translation.vector;
+        let r = q.base.rotation.coords;
+        queries_json.push(serde_json::json!({
+            "arm": q.arm,
+            "start": q.start,
+            "goal": q.goal,
+            "others": q.configs,
+            "base": [t.x, t.y, t.z],
+            "base_orientation": [r.x, r.y, r.z, r.w],
+            "solids": convert(&q.solids, &|_, s| format!("solid:{}", s.name)),
+            "carried": convert(&q.carried, &|i, _| format!("carried:{i}")),
+            "pairs": tested_pairs_json(&check, &arms.robot, &arms.shapes),
+        }));
+    }
+    let model =
+        collision_model(&arms.robot, &arms.shapes).map_err(|e| BenchError::Setup(e.to_string()))?;
     let json = serde_json::json!({
         "urdf": spec.urdf_in(dir),
         "package": spec.package,
         "package_dir": dir,
         "base": [0.0, 0.0, 0.0],
         "arms": super::motion::arms_json(&arms.robot),
+        "collision_model": model,
         "queries": queries_json,
         "resolution": arms.plan.resolution,
         "budget_s": budget_s,
     });
-    let times = super::motion::run_ompl(python, script, &json, queries.len(), scratch)?;
-    Ok((times, skipped))
-}
-
-/// A solid as PyBullet makes it: its kind and sizes, and its pose (position, quaternion
-/// x y z w) with the shape's axis turned to PyBullet's (z for cylinders and capsules);
-/// `None` when PyBullet has no such primitive.
-pub fn pybullet_solid(solid: &Solid) -> Option<serde_json::Value> {
-    let z_to_y = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f32::consts::FRAC_PI_2);
-    let (kind, sizes, local) = match solid.shape.as_typed_shape() {
-        TypedShape::Cuboid(c) => (
-            "box",
-            serde_json::json!({"half": [c.half_extents.x, c.half_extents.y, c.half_extents.z]}),
-            Isometry3::identity(),
-        ),
-        TypedShape::Ball(b) => (
-            "sphere",
-            serde_json::json!({"radius": b.radius}),
-            Isometry3::identity(),
-        ),
-        // parry's cylinder stands along y.
-        TypedShape::Cylinder(c) => (
-            "cylinder",
-            serde_json::json!({"radius": c.radius, "height": 2.0 * c.half_height}),
-            Isometry3::from_parts(Default::default(), z_to_y),
-        ),
-        TypedShape::Capsule(c) => {
-            let axis = c.segment.b - c.segment.a;
-            let turn = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
-                .unwrap_or_else(UnitQuaternion::identity);
-            let mid = nalgebra::center(&c.segment.a, &c.segment.b);
-            (
-                "capsule",
-                serde_json::json!({"radius": c.radius, "height": axis.norm()}),
-                Isometry3::from_parts(mid.coords.into(), turn),
-            )
-        }
-        TypedShape::ConvexPolyhedron(p) => (
-            "mesh",
-            serde_json::json!({"vertices": p.points().iter().map(|v| [v.x, v.y, v.z]).collect::<Vec<_>>()}),
-            Isometry3::identity(),
-        ),
-        _ => return None,
-    };
-    let pose = solid.pose * local;
-    let t = pose.translation.vector;
-    let r = pose.rotation.coords;
-    Some(serde_json::json!({
-        "name": solid.name,
-        "kind": kind,
-        "sizes": sizes,
-        "position": [t.x, t.y, t.z],
-        "orientation": [r.x, r.y, r.z, r.w],
-    }))
+    Ok((json, skipped))
 }
 
 #[cfg(test)]

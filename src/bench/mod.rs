@@ -14,6 +14,7 @@ pub mod cell_motion;
 pub mod cold;
 pub mod model;
 pub mod motion;
+pub mod pybullet;
 pub mod replay;
 pub mod scale;
 pub mod ticks;

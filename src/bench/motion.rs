@@ -7,9 +7,10 @@
 //!
 //! The queries: from each arm's rest values to joint values drawn within the limits that
 //! are free among the boxes (so the target is reachable by construction), in a cell
-//! cluttered with boxes in front of the robot. betr's check is the one the cell uses (the
-//! arm against the boxes, the torso, the other arm and itself); PyBullet's, without its
-//! self-collision flag, is the robot against the boxes only — less work per check.
+//! cluttered with boxes in front of the robot. Both check the same thing: the cell's check
+//! (the arm against the boxes, the torso, the other arm and itself, with betr's collision
+//! shapes of the links), which PyBullet is given as a URDF with those shapes and the
+//! pairs to test (`super::pybullet`).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -19,6 +20,7 @@ use std::time::Instant;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use parry3d::shape::SharedShape;
 
+use super::pybullet::{collision_model, pybullet_solid, tested_pairs_json};
 use super::{BenchError, Better, Row};
 use crate::model::DescriptionSpec;
 use crate::motion::{ArmCheck, PlanOptions, Solid, plan};
@@ -115,6 +117,21 @@ pub fn anchor_python(venv: &Path) -> Result<PathBuf, BenchError> {
         });
     }
     Ok(python)
+}
+
+/// The joint values (degrees, right arm first) the cell's arms start from: the cell
+/// scenarios' `[world.robot] rest`.
+pub const CELL_REST_DEGREES: [[f64; 7]; 2] = [
+    [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
+    [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
+];
+
+/// [`CELL_REST_DEGREES`] in radians.
+pub fn cell_rest() -> Vec<Vec<f64>> {
+    CELL_REST_DEGREES
+        .iter()
+        .map(|a| a.iter().map(|d: &f64| d.to_radians()).collect())
+        .collect()
 }
 
 /// Joint values of every arm drawn within the limits.
@@ -218,7 +235,8 @@ pub fn clutter(
     )))
 }
 
-fn solids(boxes: &[Clutter]) -> Vec<Solid> {
+/// The boxes as the scene's solids (`box 0`, `box 1`, …).
+pub fn solids(boxes: &[Clutter]) -> Vec<Solid> {
     boxes
         .iter()
         .enumerate()
@@ -298,7 +316,8 @@ pub fn betr_plan(
     })
 }
 
-/// OMPL + PyBullet on the same queries, with `budget_s` seconds per query.
+/// OMPL + PyBullet on the same queries, with `budget_s` seconds per query, PyBullet
+/// checking what betr's check of each arm checks (`super::pybullet`).
 #[allow(clippy::too_many_arguments)]
 pub fn ompl_plan(
     python: &Path,
@@ -306,25 +325,60 @@ pub fn ompl_plan(
     spec: &DescriptionSpec,
     dir: &Path,
     robot: &Robot,
+    shapes: &RobotShapes,
     rest: &[Vec<f64>],
     boxes: &[Clutter],
     queries: &[Query],
     budget_s: f64,
     scratch: &Path,
 ) -> Result<PlanTimes, BenchError> {
-    let json = serde_json::json!({
+    let json = anchor_input(spec, dir, robot, shapes, rest, boxes, queries, budget_s)?;
+    run_ompl(python, script, &json, queries.len(), scratch)
+}
+
+/// The anchor script's input for `queries` among `boxes` (see `scripts/bench_motion.py`).
+#[allow(clippy::too_many_arguments)]
+pub fn anchor_input(
+    spec: &DescriptionSpec,
+    dir: &Path,
+    robot: &Robot,
+    shapes: &RobotShapes,
+    rest: &[Vec<f64>],
+    boxes: &[Clutter],
+    queries: &[Query],
+    budget_s: f64,
+) -> Result<serde_json::Value, BenchError> {
+    let solids = solids(boxes);
+    let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
+    let mut pairs = Vec::with_capacity(robot.arms.len());
+    for arm in 0..robot.arms.len() {
+        let check = ArmCheck::new(robot, shapes, Isometry3::identity(), arm, rest, &solids)
+            .map_err(|e| setup(&e))?;
+        pairs.push(tested_pairs_json(&check, robot, shapes));
+    }
+    let mut boxes_json = Vec::with_capacity(solids.len());
+    for s in &solids {
+        let mut converted = pybullet_solid(s)
+            .ok_or_else(|| BenchError::Setup(format!("{} has no PyBullet shape", s.name)))?;
+        if let serde_json::Value::Object(fields) = &mut converted {
+            fields.insert("part".into(), format!("solid:{}", s.name).into());
+        }
+        boxes_json.push(converted);
+    }
+    Ok(serde_json::json!({
         "urdf": spec.urdf_in(dir),
         "package": spec.package,
         "package_dir": dir,
         "base": [0.0, 0.0, 0.0],
-        "boxes": boxes.iter().map(|b| serde_json::json!({"center": b.center, "half": b.half})).collect::<Vec<_>>(),
+        "solids": boxes_json,
         "arms": arms_json(robot),
+        "collision_model": collision_model(robot, shapes).map_err(|e| setup(&e))?,
+        "pairs_by_arm": pairs,
         "others": rest,
         "queries": queries.iter().map(|q| serde_json::json!({"arm": q.arm, "start": q.start, "goal": q.goal})).collect::<Vec<_>>(),
         "resolution": PlanOptions::default().resolution,
         "budget_s": budget_s,
-    });
-    run_ompl(python, script, &json, queries.len(), scratch)
+    }))
 }
 
 /// Each arm's joints, limits and flange, as the anchors' script reads them.

@@ -20,7 +20,24 @@ pub const TOWER: usize = 3;
 /// file (`scenarios/cell/cell.toml`) in place, so its example pool and conventions come
 /// with it.
 pub fn write_scenario(dir: &Path, n: usize, base: &Path) -> Result<PathBuf, BenchError> {
+    write(dir, "towers.toml", &scenario_text(n, base, false)?)
+}
+
+/// The same cell with the YuMi's real arms in its execution world (the cell scenarios'
+/// `[world.robot]`), and the fixes a person approves for the grasps that fail (nothing
+/// on cube A, then nothing on cube 1) as its expected fixes (`n` ≥ 4).
+pub fn write_arms_scenario(dir: &Path, n: usize, base: &Path) -> Result<PathBuf, BenchError> {
+    write(dir, "towers-arms.toml", &scenario_text(n, base, true)?)
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> Result<PathBuf, BenchError> {
     std::fs::create_dir_all(dir)?;
+    let path = dir.join(name);
+    std::fs::write(&path, text)?;
+    Ok(path)
+}
+
+fn scenario_text(n: usize, base: &Path, arms: bool) -> Result<String, BenchError> {
     let base = std::path::absolute(base)?;
     let mut names = vec!["cube A".to_string(), "cube B".to_string()];
     names.extend((1..n.saturating_sub(1)).map(|i| format!("cube {i}")));
@@ -30,7 +47,25 @@ pub fn write_scenario(dir: &Path, n: usize, base: &Path) -> Result<PathBuf, Benc
         "extends = '{}'\n[scenario]\nname = \"{n} cubes in towers\"",
         base.display()
     )?;
-    writeln!(t, "goal = '\"cube A\" on \"cube B\"'\n[objects]")?;
+    writeln!(t, "goal = '\"cube A\" on \"cube B\"'")?;
+    if arms {
+        // The tower on cube A is cube 1 with cube 2 on it: grasping A fails for cube 1,
+        // then grasping cube 1 for cube 2.
+        writeln!(
+            t,
+            "expected_fix = ['~\"any object\" on \"cube A\"', '~\"any object\" on \"cube 1\"']"
+        )?;
+        let rest: Vec<String> = super::motion::CELL_REST_DEGREES
+            .iter()
+            .map(|a| format!("{a:?}"))
+            .collect();
+        writeln!(
+            t,
+            "[world.robot]\ndescription = \"yumi\"\nrest = [{}]\ntool = 0.143",
+            rest.join(", ")
+        )?;
+    }
+    writeln!(t, "[objects]")?;
     let quoted: Vec<String> = names.iter().map(|n| format!("\"{n}\"")).collect();
     writeln!(t, "item = [{}]", quoted.join(", "))?;
     // A big table: the towers stand beyond a free area in front of the robot.
@@ -75,9 +110,7 @@ pub fn write_scenario(dir: &Path, n: usize, base: &Path) -> Result<PathBuf, Benc
             support = (*name).clone();
         }
     }
-    let path = dir.join("towers.toml");
-    std::fs::write(&path, t)?;
-    Ok(path)
+    Ok(t)
 }
 
 /// The tree planned and repaired, with the plan time, the repair time and the repairs.

@@ -156,14 +156,7 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
             "{seconds} s each on 1000 random configurations; Pinocchio computes every joint and the two flange frames"
         ),
     }];
-    // The rest values the cell's arms start from (the cell scenarios' `[world.robot] rest`).
-    let rest: Vec<Vec<f64>> = [
-        [2.9, -60.2, -62.7, 37.1, -68.2, 30.6, -92.5],
-        [13.5, -34.1, 64.4, 34.3, -7.8, 16.8, -23.3],
-    ]
-    .iter()
-    .map(|a| a.iter().map(|d: &f64| d.to_radians()).collect())
-    .collect();
+    let rest = motion::cell_rest();
     let count = if args.quick { 10 } else { 200 };
     let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
     let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
@@ -181,6 +174,7 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
         spec,
         &dir,
         &robot,
+        &shapes,
         &rest,
         &boxes,
         &queries,
@@ -203,6 +197,16 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     rows.push(bench::scale::scenario_one_arms(
         &args.scenario,
         scenario_one,
+    )?);
+    // The towers extend the cell's base file, beside scenario 1's.
+    let base = args
+        .scenario
+        .parent()
+        .unwrap_or(Path::new("."))
+        .join("cell.toml");
+    rows.push(bench::scale::towers_arms(
+        if args.quick { 100 } else { 1000 },
+        &base,
     )?);
     Ok(rows)
 }

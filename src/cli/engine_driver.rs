@@ -107,6 +107,8 @@ impl Run {
 
 impl Driver {
     pub fn start(start: Start) -> Result<Driver> {
+        // The robot the scenario's cell moves, fetched on first use as the workbench does.
+        super::model_cmd::ensure_scenario_robot(start.scenario, super::offline())?;
         let path = match start.scenario_path {
             Some(path) => path.to_path_buf(),
             None => start

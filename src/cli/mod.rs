@@ -46,6 +46,11 @@ pub struct Cli {
     /// Print trees with ASCII symbols instead of Unicode.
     #[arg(long, global = true)]
     pub ascii: bool,
+    /// Fetch nothing: a robot description or embedded model not in the cache is said, and
+    /// the command goes on without it (the cell with its reach spheres and gripper sweep,
+    /// no embedded model answering) [env: BETR_OFFLINE].
+    #[arg(long, global = true)]
+    pub offline: bool,
 }
 
 #[derive(Subcommand)]
@@ -151,11 +156,22 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     } else {
         &betr::bt::UNICODE
     };
+    let var = |k: &str| std::env::var(k).ok();
+    let offline = cli.offline || offline_from_env(&var)?;
     let Some(command) = cli.command else {
-        return tui_cmd::tui(&tui_cmd::TuiArgs::default(), cli.ascii);
+        let args = tui_cmd::TuiArgs {
+            offline,
+            ..Default::default()
+        };
+        return tui_cmd::tui(&args, cli.ascii);
     };
+    // Every engine a one-shot command starts reads it (`engine_driver::Driver::start`).
+    let _ = OFFLINE.set(offline);
     match command {
-        Command::Tui(args) => tui_cmd::tui(&args, cli.ascii),
+        Command::Tui(mut args) => {
+            args.offline = offline;
+            tui_cmd::tui(&args, cli.ascii)
+        }
         Command::Bench(args) => bench_cmd::run(&args),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
         Command::Fuzz(args) => fuzz_cmd::run(&args),
@@ -189,6 +205,26 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         Command::Replay(args) => replay_cmd::replay(&args, cli.ascii),
         Command::Repair(args) => tree_cmds::repair_command(&args, glyphs),
         Command::Verify(args) => verify_cmd::command(&args, cli.ascii),
+    }
+}
+
+/// Whether this command fetches nothing (`--offline` or `BETR_OFFLINE`); set once, before
+/// the command runs.
+static OFFLINE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+
+fn offline() -> bool {
+    OFFLINE.get().copied().unwrap_or(false)
+}
+
+/// `BETR_OFFLINE` set to true (1, true, yes) or false (unset, empty, 0, false, no).
+pub fn offline_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
+    let Some(value) = var("BETR_OFFLINE") else {
+        return Ok(false);
+    };
+    match value.trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" => Ok(true),
+        "" | "0" | "false" | "no" => Ok(false),
+        _ => bail!("BETR_OFFLINE={value:?} is not true or false"),
     }
 }
 

@@ -146,6 +146,29 @@ pub fn ensure_stt(name: Option<&str>) -> Result<std::path::PathBuf> {
     })
 }
 
+/// The robot description `scenario`'s cell moves its arms with, fetched now with its
+/// progress on standard error when it is not in the cache yet (as the workbench fetches
+/// it in the background), unless `offline`: then the world says what is missing and keeps
+/// its reach spheres and gripper sweep.
+pub fn ensure_scenario_robot(scenario: &betr::scenario::Scenario, offline: bool) -> Result<()> {
+    let Some(spec) = betr::session::missing_description(scenario) else {
+        return Ok(());
+    };
+    if offline {
+        return Ok(());
+    }
+    fetch_once(spec.description, spec.size, |progress| {
+        model::ensure_description(spec, &model::cache_dir(), model::Pip::DEFAULT, progress)
+    })
+    .with_context(|| {
+        format!(
+            "fetching the robot description {} that {} names (--offline or BETR_OFFLINE=1 runs without it)",
+            spec.name, scenario.name
+        )
+    })?;
+    Ok(())
+}
+
 /// Fetch a robot description unless it is already cached, and say where it is.
 fn fetch_robot(name: &str) -> Result<ExitCode> {
     let spec = model::find_description(name).with_context(|| {

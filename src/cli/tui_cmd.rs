@@ -48,10 +48,8 @@ pub struct TuiArgs {
     /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml).
     #[arg(long, value_name = "FILE")]
     pub keys: Option<PathBuf>,
-    /// Fetch nothing: a robot description or embedded model not in the cache is said,
-    /// and the workbench goes on without it (the cell with its reach spheres and gripper
-    /// sweep, no model answering) [env: BETR_OFFLINE].
-    #[arg(long)]
+    /// Fetch nothing (the command line's global `--offline` or `BETR_OFFLINE`).
+    #[arg(skip)]
     pub offline: bool,
     /// Milliseconds between ticks when running.
     #[arg(value_parser = clap::value_parser!(u64).range(1..=60_000), long, default_value_t = 150, value_name = "MS")]
@@ -105,7 +103,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // description the cell's arms need, then the embedded model. A failed fetch or load
     // leaves the workbench usable without it and says why.
     let (arrival_report, arrivals) = tokio::sync::mpsc::unbounded_channel();
-    let offline = offline(args, &var)?;
+    let offline = args.offline;
     let mut wanted_model = None;
     let model = match llm_cmds::local_model_to_fetch(&settings) {
         Some(spec) if offline => Err(NoModel::Unavailable(format!(
@@ -253,21 +251,6 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         outln!("3D view: the web viewer was stopped");
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// Whether the workbench fetches nothing: `--offline`, or `BETR_OFFLINE` set to true.
-fn offline(args: &TuiArgs, var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
-    if args.offline {
-        return Ok(true);
-    }
-    let Some(value) = var("BETR_OFFLINE") else {
-        return Ok(false);
-    };
-    match value.trim().to_ascii_lowercase().as_str() {
-        "1" | "true" | "yes" => Ok(true),
-        "" | "0" | "false" | "no" => Ok(false),
-        _ => anyhow::bail!("BETR_OFFLINE={value:?} is not true or false"),
-    }
 }
 
 /// The configured model when nothing needs fetching: a server's client, or the embedded

@@ -43,6 +43,18 @@ struct Still {
     /// Part of the torso or a link fixed beside it (the other arm's first link): the
     /// links this arm's first joint carries touch these by design.
     torso: bool,
+    /// What it is, for [`ArmCheck::tested_pairs`].
+    part: Part,
+}
+
+/// A part of what an arm's check tests: a link of the robot (an index into the
+/// description's links), a scene solid (by name) or what the hand carries (an index into
+/// [`ArmCheck::carrying`]'s parts).
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Part {
+    Link(usize),
+    Solid(String),
+    Carried(usize),
 }
 
 /// The collision test of one arm's configurations.
@@ -84,6 +96,7 @@ impl<'a> ArmCheck<'a> {
                     center: s.pose * aabb.center(),
                     radius: aabb.half_extents().norm(),
                     torso: false,
+                    part: Part::Solid(s.name.clone()),
                 }
             })
             .collect();
@@ -199,6 +212,36 @@ impl<'a> ArmCheck<'a> {
     pub fn is_free(&self, q: &[f64]) -> bool {
         self.chain.within_limits(q) && self.blocker(q).is_none()
     }
+
+    /// Every pair of parts [`ArmCheck::blocker`] tests against each other, each once and
+    /// in the same loops: the arm's links against what stays still (but its first link
+    /// against the torso), what the hand carries against what stays still, and the arm's
+    /// links more than two joints apart against each other. Another checker (the
+    /// benchmark's anchor) tests these and nothing else, so both solve the same problem.
+    pub fn tested_pairs(&self) -> Vec<(Part, Part)> {
+        let mut pairs = std::collections::BTreeSet::new();
+        for (i, link_shapes) in self.shapes.iter().enumerate() {
+            let first = self.chain.carried[i].joint == Some(0);
+            for shape in link_shapes {
+                for s in self.still.iter().filter(|s| !(s.torso && first)) {
+                    pairs.insert((Part::Link(shape.link), s.part.clone()));
+                }
+            }
+        }
+        for c in 0..self.carried.len() {
+            for s in &self.still {
+                pairs.insert((Part::Carried(c), s.part.clone()));
+            }
+        }
+        for &(i, k) in &self.self_pairs {
+            for a in &self.shapes[i] {
+                for b in &self.shapes[k] {
+                    pairs.insert((Part::Link(a.link), Part::Link(b.link)));
+                }
+            }
+        }
+        pairs.into_iter().collect()
+    }
 }
 
 fn placed(shape: &LinkShape, at: Isometry3<f32>, torso: bool) -> Still {
@@ -210,6 +253,7 @@ fn placed(shape: &LinkShape, at: Isometry3<f32>, torso: bool) -> Still {
         center: pose * shape.center,
         radius: shape.radius,
         torso,
+        part: Part::Link(shape.link),
     }
 }
 

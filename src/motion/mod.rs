@@ -9,7 +9,7 @@
 mod check;
 mod rrt;
 
-pub use check::{ArmCheck, Solid};
+pub use check::{ArmCheck, Part, Solid};
 pub use rrt::{JointPath, PlanOptions, plan};
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -1,8 +1,9 @@
 //! The links' collision shapes: for each collision mesh of an arm's link, the tighter of
 //! the capsule along the mesh's main axis and the box on its principal axes, each holding
 //! every vertex by construction, in the link's frame, with the ball around it for a quick
-//! first test; for each mesh of a link that stays with the root (the torso), a few boxes
-//! stacked along one of its axes that together hold the mesh (`slabs.rs`).
+//! first test — or, for a bent link where they are much tighter, up to three boxes stacked
+//! along one of the mesh's axes that together hold it (`slabs.rs`); for each mesh of a link that
+//! stays with the root (the torso), such stacked boxes.
 //!
 //! A configuration whose shapes are apart is one whose meshes are apart. Capsules and
 //! boxes rather than convex hulls: parry3d 0.25's hulls of the YuMi's coarse meshes answer
@@ -18,7 +19,7 @@ use parry3d::shape::SharedShape;
 
 use super::RobotError;
 use super::chain::Chain;
-use super::slabs::stacked_boxes;
+use super::slabs::{MAX_ARM_BOXES, MAX_BOXES, stacked_boxes};
 use super::urdf::{Element, Geometry, Model};
 
 /// One link's collision shape, in the link's frame.
@@ -57,11 +58,11 @@ impl RobotShapes {
     /// The collision elements of every link, made convex.
     pub fn new(model: &Model, arms: &[Chain]) -> Result<RobotShapes, RobotError> {
         let shapes_of = |link: usize| -> Result<Vec<LinkShape>, RobotError> {
-            model.links[link]
-                .collisions
-                .iter()
-                .map(|e| link_shape(model, link, e))
-                .collect()
+            let mut shapes = Vec::new();
+            for element in &model.links[link].collisions {
+                shapes.extend(moving_link_shapes(model, link, element)?);
+            }
+            Ok(shapes)
         };
         let carried: Vec<usize> = arms
             .iter()
@@ -131,12 +132,58 @@ fn link_shape(model: &Model, link: usize, element: &Element) -> Result<LinkShape
     })
 }
 
+/// Stacked boxes are an arm link's shapes when together they take at most this fraction
+/// of the volume of the one capsule or box around its mesh: the YuMi's links are bent, and
+/// one shape around a bend fills the space beside it (the shoulders' boxes overlapped the
+/// other arm's in configurations where the meshes are centimetres apart).
+const STACK_WHEN_TIGHTER: f32 = 0.75;
+
+/// The shapes of a link an arm moves: the capsule or box around its mesh, or up to
+/// [`MAX_ARM_BOXES`] boxes stacked along one of the mesh's axes (`slabs.rs`) when they are
+/// much tighter; any other
+/// geometry as [`link_shape`] makes it.
+fn moving_link_shapes(
+    model: &Model,
+    link: usize,
+    element: &Element,
+) -> Result<Vec<LinkShape>, RobotError> {
+    let single = link_shape(model, link, element)?;
+    if !matches!(element.geometry, Geometry::Mesh { .. }) {
+        return Ok(vec![single]);
+    }
+    let stacked = stacked_link_shapes(model, link, element, MAX_ARM_BOXES)?;
+    let volume = |shapes: &[LinkShape]| -> f32 {
+        shapes
+            .iter()
+            .map(|s| s.shape.mass_properties(1.0).mass())
+            .sum()
+    };
+    Ok(
+        if volume(&stacked) <= STACK_WHEN_TIGHTER * volume(std::slice::from_ref(&single)) {
+            stacked
+        } else {
+            vec![single]
+        },
+    )
+}
+
 /// The shapes of a link that does not move with an arm: a mesh as boxes stacked along one
 /// of its axes (`slabs.rs`), any other geometry as [`link_shape`] makes it.
 fn still_link_shapes(
     model: &Model,
     link: usize,
     element: &Element,
+) -> Result<Vec<LinkShape>, RobotError> {
+    stacked_link_shapes(model, link, element, MAX_BOXES)
+}
+
+/// A mesh as at most `max_boxes` boxes stacked along one of its axes (`slabs.rs`), any
+/// other geometry as [`link_shape`] makes it.
+fn stacked_link_shapes(
+    model: &Model,
+    link: usize,
+    element: &Element,
+    max_boxes: usize,
 ) -> Result<Vec<LinkShape>, RobotError> {
     let Geometry::Mesh { path, scale } = &element.geometry else {
         return Ok(vec![link_shape(model, link, element)?]);
@@ -148,7 +195,7 @@ fn still_link_shapes(
         .collect();
     let name = model.links[link].name.clone();
     let origin = element.origin.cast::<f32>();
-    let boxes = stacked_boxes(&triangles);
+    let boxes = stacked_boxes(&triangles, max_boxes);
     if boxes.is_empty() {
         return Err(RobotError::Urdf {
             file: model.file.clone(),

@@ -1,6 +1,6 @@
-//! A tight collision shape for a big link that does not move with an arm (the torso): a
-//! few boxes stacked along one of the link's axes, each holding the part of the mesh that
-//! lies between its two cutting planes.
+//! A tight collision shape for a big link that does not move with an arm (the torso), or
+//! for a bent one that does: a few boxes stacked along one of the link's axes, each
+//! holding the part of the mesh that lies between its two cutting planes.
 //!
 //! The part of a triangle between two parallel planes is the convex polygon whose corners
 //! are the triangle's corners between the planes and the points where its edges cross
@@ -13,8 +13,11 @@ use nalgebra::{Point3, Vector3};
 
 /// Thin slabs the mesh is cut into before neighbouring ones are merged.
 const FINE_SLABS: usize = 48;
-/// Boxes at most: every one is a shape each arm link is tested against.
+/// Boxes at most for a link that stays still: every one is a shape each arm link is
+/// tested against.
 pub(super) const MAX_BOXES: usize = 6;
+/// Boxes at most for a link an arm moves: every one is tested at every configuration.
+pub(super) const MAX_ARM_BOXES: usize = 3;
 /// A box more must make the union at least this much smaller (a fraction of the volume of
 /// one box around everything) to be worth its collision tests.
 const WORTH_A_BOX: f32 = 0.02;
@@ -58,13 +61,13 @@ impl Bounds {
     }
 }
 
-/// The boxes (at most `MAX_BOXES`, fewer when one more is hardly smaller) that together
+/// The boxes (at most `max_boxes`, fewer when one more is hardly smaller) that together
 /// hold `triangles`, cut along whichever of the mesh's three axes gives the least volume.
 /// Empty when there are no triangles.
-pub(super) fn stacked_boxes(triangles: &[[Point3<f32>; 3]]) -> Vec<Bounds> {
+pub(super) fn stacked_boxes(triangles: &[[Point3<f32>; 3]], max_boxes: usize) -> Vec<Bounds> {
     let mut best: Option<(f32, Vec<Bounds>)> = None;
     for axis in 0..3 {
-        let boxes = along(triangles, axis);
+        let boxes = along(triangles, axis, max_boxes);
         let volume: f32 = boxes.iter().map(Bounds::volume).sum();
         if best.as_ref().is_none_or(|(v, _)| volume < *v) {
             best = Some((volume, boxes));
@@ -74,7 +77,7 @@ pub(super) fn stacked_boxes(triangles: &[[Point3<f32>; 3]]) -> Vec<Bounds> {
 }
 
 /// The fine slabs' boxes along `axis`, merged into the fewest groups worth having.
-fn along(triangles: &[[Point3<f32>; 3]], axis: usize) -> Vec<Bounds> {
+fn along(triangles: &[[Point3<f32>; 3]], axis: usize, max_boxes: usize) -> Vec<Bounds> {
     let (lo, hi) = triangles
         .iter()
         .flatten()
@@ -98,7 +101,7 @@ fn along(triangles: &[[Point3<f32>; 3]], axis: usize) -> Vec<Bounds> {
         .windows(2)
         .map(|w| slab(triangles, axis, w[0], w[1]))
         .collect();
-    merge(&fine)
+    merge(&fine, max_boxes)
 }
 
 /// The box around the parts of `triangles` with `a <= p[axis] <= b`.
@@ -127,9 +130,9 @@ fn slab(triangles: &[[Point3<f32>; 3]], axis: usize, a: f32, b: f32) -> Bounds {
 }
 
 /// The partition of `fine` into consecutive groups with the least total volume for each
-/// number of groups up to `MAX_BOXES`, and of those the fewest groups whose next one would
+/// number of groups up to `max_boxes`, and of those the fewest groups whose next one would
 /// not save `WORTH_A_BOX`.
-fn merge(fine: &[Bounds]) -> Vec<Bounds> {
+fn merge(fine: &[Bounds], max_boxes: usize) -> Vec<Bounds> {
     let n = fine.len();
     if n == 0 {
         return Vec::new();
@@ -145,7 +148,7 @@ fn merge(fine: &[Bounds]) -> Vec<Bounds> {
     }
     // cost[k][j]: least volume of the first j slabs in k groups; from[k][j]: where the
     // last group starts.
-    let groups = MAX_BOXES.min(n);
+    let groups = max_boxes.min(n);
     let mut cost = vec![vec![f32::INFINITY; n + 1]; groups + 1];
     let mut from = vec![vec![0usize; n + 1]; groups + 1];
     cost[0][0] = 0.0;
@@ -211,7 +214,7 @@ mod tests {
         // Long triangles across every slab: the column's sides span its whole height.
         let mut mesh = cuboid([-0.3, -0.2, 0.0], [0.3, 0.2, 0.1]);
         mesh.extend(cuboid([-0.05, -0.05, 0.1], [0.05, 0.05, 0.6]));
-        let boxes = stacked_boxes(&mesh);
+        let boxes = stacked_boxes(&mesh, MAX_BOXES);
         assert_eq!(boxes.len(), 2, "{boxes:?}");
         // The two solids' own volumes, and one slab's worth of the foot more at most.
         let exact: f32 = 0.6 * 0.4 * 0.1 + 0.1 * 0.1 * 0.5;
@@ -243,6 +246,6 @@ mod tests {
 
     #[test]
     fn no_triangles_no_boxes() {
-        assert!(stacked_boxes(&[]).is_empty());
+        assert!(stacked_boxes(&[], MAX_BOXES).is_empty());
     }
 }

@@ -179,7 +179,8 @@ impl Arms {
             return ArmsAvailability::Abstract(format!(
                 "the robot description {:?} is not in the cache ({}): the cell checks its \
                  reach spheres and gripper sweep instead of moving the arms (`betr model \
-                 fetch --robot {}` fetches it; the workbench does on first use)",
+                 fetch --robot {}` fetches it, as the workbench and the commands that run a \
+                 scenario do on first use unless offline)",
                 description.name,
                 dir.display(),
                 description.name,
