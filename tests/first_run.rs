@@ -412,6 +412,7 @@ fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
         ("BETR_MODEL_DIR", cache.to_str().unwrap()),
         ("PIP_CACHE_DIR", pip_cache.to_str().unwrap()),
         ("PIP_DISABLE_PIP_VERSION_CHECK", "1"),
+        ("BETR_OFFLINE", "0"),
     ];
     let offline_env = [env[0], env[1], env[2], ("BETR_OFFLINE", "1")];
     for (args, env) in [

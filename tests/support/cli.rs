@@ -38,6 +38,10 @@ pub fn command(dir: &Path, args: &[&str]) -> Command {
         .env("XDG_STATE_HOME", dir.join("state"))
         .env("XDG_DATA_HOME", dir.join("data"))
         .env("XDG_CONFIG_HOME", dir.join("config"))
+        // The home is empty: a one-shot command fetches nothing into it (a cell whose
+        // robot description is not in the cache runs its abstraction). A test of the
+        // fetch sets BETR_OFFLINE=0.
+        .env("BETR_OFFLINE", "1")
         .env(KEY_VAR, KEY)
         .env_remove("BETR_CONFIG")
         .env_remove("BETR_BACKEND")
