@@ -116,16 +116,7 @@ fn pybullet_calls_the_cell_motions_states_free_where_betr_does() {
     assert_eq!(exported.len(), found.queries.len());
     assert!(found.queries.iter().any(|q| !q.carried.is_empty()));
     for (q, json) in found.queries.iter().zip(exported) {
-        let check = ArmCheck::new(
-            &arms.robot,
-            &arms.shapes,
-            q.base,
-            q.arm,
-            &q.configs,
-            &q.solids,
-        )
-        .unwrap()
-        .carrying(q.carried.clone());
+        let check = arms.check_of(q).unwrap();
         // The motions the arms made start and end where betr's own check is free.
         assert!(check.is_free(&q.start) && check.is_free(&q.goal), "{q:?}");
         // And states around the way, near the solids and the other arm.

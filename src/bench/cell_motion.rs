@@ -12,7 +12,7 @@ use super::motion::PlanTimes;
 use super::pybullet::{collision_model, pybullet_solid, tested_pairs_json};
 use crate::domain::Condition;
 use crate::model::DescriptionSpec;
-use crate::motion::{ArmCheck, Solid, plan};
+use crate::motion::{Solid, plan};
 use crate::planner::{Planner, RunEnd, run_tree};
 use crate::scenario::Scenario;
 use crate::world::cell::arms::{Arms, PathQuery};
@@ -142,16 +142,9 @@ fn same_query(a: &PathQuery, b: &PathQuery) -> bool {
 /// betr's planner on each query (the check made and the path planned), timed one by one.
 pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchError> {
     PlanTimes::measure(queries, |q| {
-        let check = ArmCheck::new(
-            &arms.robot,
-            &arms.shapes,
-            q.base,
-            q.arm,
-            &q.configs,
-            &q.solids,
-        )
-        .map_err(|e| BenchError::Setup(e.to_string()))?
-        .carrying(q.carried.clone());
+        let check = arms
+            .check_of(q)
+            .map_err(|e| BenchError::Setup(e.to_string()))?;
         Ok(plan(&check, &q.start, &q.goal, &arms.plan).is_ok())
     })
 }
@@ -205,16 +198,9 @@ pub fn anchor_input(
     };
     let mut queries_json: Vec<serde_json::Value> = Vec::with_capacity(queries.len());
     for q in queries {
-        let check = ArmCheck::new(
-            &arms.robot,
-            &arms.shapes,
-            q.base,
-            q.arm,
-            &q.configs,
-            &q.solids,
-        )
-        .map_err(|e| BenchError::Setup(e.to_string()))?
-        .carrying(q.carried.clone());
+        let check = arms
+            .check_of(q)
+            .map_err(|e| BenchError::Setup(e.to_string()))?;
         let t = q.base.translation.vector;
         let r = q.base.rotation.coords;
         queries_json.push(serde_json::json!({

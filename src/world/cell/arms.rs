@@ -170,6 +170,20 @@ pub enum Refusal {
 }
 
 impl Arms {
+    /// The check `query` is planned against: its robot root, the other arms' values, the
+    /// scene's solids and what the hand carries.
+    pub fn check_of(&self, query: &PathQuery) -> Result<ArmCheck<'_>, MotionError> {
+        Ok(ArmCheck::new(
+            &self.robot,
+            &self.shapes,
+            query.base,
+            query.arm,
+            &query.configs,
+            &query.solids,
+        )?
+        .carrying(query.carried.clone()))
+    }
+
     /// The arms of `spec`'s description when it is in the cache, read once per process.
     pub fn available(spec: &ArmsSpec) -> ArmsAvailability {
         static READ: OnceLock<Mutex<ReadRobots>> = OnceLock::new();
