@@ -35,10 +35,6 @@ pub struct Lexicon {
     /// Words that name an object by themselves: a one-word name (`Chips`) or a one-word
     /// thing it is called ("fries"), not a part of a longer name ("area" of `LoungeArea`).
     whole_names: Vec<String>,
-    /// The words a wish for a condition of this scene begins with: the first word of each
-    /// phrase the scene lists for a predicate ("prune" of "prune", "cut back"), unless
-    /// it is an object's word too ("water" where water is served).
-    asking_words: Vec<String>,
 }
 
 impl Lexicon {
@@ -140,30 +136,11 @@ impl Lexicon {
             .collect();
         whole_names.sort_unstable();
         whole_names.dedup();
-        let mut asking_words: Vec<String> = vocabulary
-            .predicates
-            .iter()
-            .flat_map(|p| p.words.says.iter().chain(&p.words.opposite))
-            .filter_map(|phrase| phrase.split_whitespace().next())
-            .filter_map(|word| terms(word).into_iter().next())
-            // The object's word itself, not one that shares its stem: "prune" is a verb
-            // although "pruners" are shears.
-            .filter(|w| !is_generic(w) && !object_words.contains(w))
-            .collect();
-        asking_words.sort_unstable();
-        asking_words.dedup();
         Lexicon {
             words,
             object_words,
             whole_names,
-            asking_words,
         }
-    }
-
-    /// Whether `word` (lower case, as written) begins a wish for one of the scene's
-    /// conditions in the scene's own words ("prune the peppers" in a greenhouse).
-    pub fn asks_for_a_condition(&self, word: &str) -> bool {
-        self.asking_words.iter().any(|w| same_word(w, word))
     }
 
     /// Whether `word` is part of some object's name ("6" of `WindowTable6`).

@@ -4,10 +4,8 @@
 //! out, mixes their parts, or turns a negation around. A request is cut where a new wish
 //! begins — at the end of a sentence, before "also", "and then", "alternatively" and the
 //! like after a comma, and before "and", "but" or "or" followed by a verb of asking ("clean
-//! the chairs and deliver coffee", "either clear the table or turn off the light"; the
-//! verbs are English's and the scene's own, the first words of what it lists for its
-//! conditions: "or keep the fan running, and prune the peppers") — and each piece that
-//! names an object becomes a part. Pieces
+//! the chairs and deliver coffee", "either clear the table or turn off the light") — and
+//! each piece that names an object becomes a part. Pieces
 //! that name none ("Thank you.", "It looks like it needs a good cleaning.") stay with the
 //! part before them, so no part is read without the thing it is about.
 //!
@@ -38,7 +36,7 @@ pub fn split(request: &str, lexicon: &Lexicon) -> Vec<Part> {
     // another ("pick up and hold a bottle").
     let mut pieces: Vec<(Part, &str)> = Vec::new();
     for (i, sentence) in sentences(request).into_iter().enumerate() {
-        for (j, (clause, joined)) in clauses(sentence, lexicon).into_iter().enumerate() {
+        for (j, (clause, joined)) in clauses(sentence).into_iter().enumerate() {
             let (join, text) = match joined {
                 Some((join, word)) => (join, clause.get(word..).unwrap_or(clause)),
                 None => opening(clause, j == 0 && i > 0),
@@ -145,7 +143,7 @@ fn sentences(text: &str) -> Vec<&str> {
 /// word followed by a verb of asking; a clause cut at a joining word begins with it and
 /// comes with how it joins and the word's length, one cut at an opener keeps the opener
 /// for [`opening`] to read.
-fn clauses<'a>(sentence: &'a str, lexicon: &Lexicon) -> Vec<(&'a str, Option<(Join, usize)>)> {
+fn clauses(sentence: &str) -> Vec<(&str, Option<(Join, usize)>)> {
     let mut by_opener = Vec::new();
     let mut start = 0;
     for (at, _) in sentence.match_indices(',') {
@@ -160,11 +158,9 @@ fn clauses<'a>(sentence: &'a str, lexicon: &Lexicon) -> Vec<(&'a str, Option<(Jo
     for clause in by_opener {
         let mut join = None;
         let mut rest = clause;
-        let mut after_or = false;
-        while let Some((cut, after, how)) = verb_join(rest, lexicon, after_or) {
+        while let Some((cut, after, how)) = verb_join(rest) {
             out.push((&rest[..cut], join));
             join = Some((how, after - cut));
-            after_or = how == Join::Or;
             rest = &rest[cut..];
         }
         out.push((rest, join));
@@ -172,29 +168,20 @@ fn clauses<'a>(sentence: &'a str, lexicon: &Lexicon) -> Vec<(&'a str, Option<(Jo
     out
 }
 
-/// The first joining word of `clause` that a verb of asking follows (English's or the
-/// scene's), after some words of the clause: where the word starts, where it ends, and how
-/// it joins. `after_or`: the clause is an alternative cut at "or", so a comma and "and"
-/// close it whatever follows ("pick the strawberries or prune the orchid, and either way
-/// leave the vent shut" asks for the last whichever of the first two is done).
-fn verb_join(clause: &str, lexicon: &Lexicon, after_or: bool) -> Option<(usize, usize, Join)> {
+/// The first joining word of `clause` that a verb of asking follows, after some words of
+/// the clause: where the word starts, where it ends, and how it joins.
+fn verb_join(clause: &str) -> Option<(usize, usize, Join)> {
     let words = word_spans(clause);
     let lower = |k: usize| clause[words[k].0..words[k].1].to_lowercase();
     for k in 1..words.len() {
         let Some((_, how)) = CONJUNCTIONS.iter().find(|(w, _)| *w == lower(k)) else {
             continue;
         };
-        let after_comma = clause[words[k - 1].1..words[k].0].contains(',');
-        if after_or && after_comma && *how == Join::And {
-            return Some((words[k].0, words[k].1, Join::And));
-        }
         let mut next = k + 1;
         while next < words.len() && may_precede_verb(&lower(next)) {
             next += 1;
         }
-        if next >= words.len()
-            || !(asks(&lower(next)) || lexicon.asks_for_a_condition(&lower(next)))
-        {
+        if next >= words.len() || !asks(&lower(next)) {
             continue;
         }
         if *how == Join::Or && (0..k).any(|i| is_negation(&lower(i)) || is_negated_form(&lower(i)))
@@ -287,83 +274,6 @@ mod tests {
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
         let scenario = crate::scenario::Scenario::load(&path).expect("cafe scenario");
         Lexicon::new(&scenario.domain.vocabulary, &scenario.examples)
-    }
-
-    /// A vineyard of the test's own: its verbs ("graft", "bottle") are no English list's.
-    fn vineyard_lexicon() -> Lexicon {
-        use crate::domain::{Object, Predicate, StateWords, Vocabulary};
-        let object = |n: &str, t: &str| Object {
-            name: n.into(),
-            types: vec![t.into()],
-            called: Vec::new(),
-        };
-        let predicate = |n: &str, says: &[&str]| Predicate {
-            name: n.into(),
-            arg_types: vec![vec!["plant".into()]],
-            description: String::new(),
-            words: StateWords {
-                says: says.iter().map(|w| (*w).to_string()).collect(),
-                opposite: Vec::new(),
-            },
-        };
-        Lexicon::new(
-            &Vocabulary {
-                objects: vec![
-                    // Shares its stem with "graft", which is still a verb here.
-                    object("Grafters", "plant"),
-                    object("Merlot", "plant"),
-                    object("Riesling", "plant"),
-                    object("Press", "plant"),
-                ],
-                predicates: vec![
-                    predicate("Grafted", &["graft"]),
-                    predicate("Bottled", &["bottle up", "fill"]),
-                    // Listed for a condition, but the name of a thing here.
-                    predicate("Pressed", &["press"]),
-                ],
-            },
-            &[],
-        )
-    }
-
-    #[test]
-    fn the_scenes_own_verbs_begin_wishes() {
-        let lex = vineyard_lexicon();
-        let parts = split(
-            "Graft the merlot or bottle up the riesling, and fill the merlot.",
-            &lex,
-        );
-        assert_eq!(
-            texts(&parts),
-            vec![
-                (Join::And, "Graft the merlot"),
-                (Join::Or, "bottle up the riesling,"),
-                (Join::And, "fill the merlot."),
-            ]
-        );
-        // A word that names a thing of the scene does not begin a wish ("the press").
-        let parts = split("Graft the merlot and press the riesling.", &lex);
-        assert_eq!(parts.len(), 1);
-    }
-
-    #[test]
-    fn a_comma_and_closes_the_alternatives_before_it() {
-        let lex = vineyard_lexicon();
-        let parts = split(
-            "Graft the merlot or fill the riesling, and in any case the merlot stays grafted.",
-            &lex,
-        );
-        assert_eq!(
-            texts(&parts),
-            vec![
-                (Join::And, "Graft the merlot"),
-                (Join::Or, "fill the riesling,"),
-                (Join::And, "in any case the merlot stays grafted."),
-            ]
-        );
-        // Without a choice before it, a comma and "and" with no verb after go on.
-        let parts = split("Graft the merlot, and the riesling too.", &lex);
-        assert_eq!(parts.len(), 1);
     }
 
     fn texts(parts: &[Part]) -> Vec<(Join, &str)> {
