@@ -221,10 +221,12 @@ pub fn offline_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
     let Some(value) = var("BETR_OFFLINE") else {
         return Ok(false);
     };
-    match value.trim().to_ascii_lowercase().as_str() {
-        "1" | "true" | "yes" => Ok(true),
-        "" | "0" | "false" | "no" => Ok(false),
-        _ => bail!("BETR_OFFLINE={value:?} is not true or false"),
+    if value.trim().is_empty() {
+        return Ok(false);
+    }
+    match betr::config_file::switch_value(&value) {
+        Some(on) => Ok(on),
+        None => bail!("BETR_OFFLINE={value:?} is not true or false"),
     }
 }
 

@@ -137,10 +137,9 @@ impl Layer {
         let get = |k: &str| var(k).filter(|v| !v.trim().is_empty());
         let bool_var = |k: &str| -> Result<Option<bool>, LlmError> {
             get(k)
-                .map(|v| match v.trim().to_ascii_lowercase().as_str() {
-                    "1" | "true" | "yes" => Ok(true),
-                    "0" | "false" | "no" => Ok(false),
-                    _ => Err(LlmError::Config(format!("{k}={v:?} is not true or false"))),
+                .map(|v| {
+                    crate::config_file::switch_value(&v)
+                        .ok_or_else(|| LlmError::Config(format!("{k}={v:?} is not true or false")))
                 })
                 .transpose()
         };
