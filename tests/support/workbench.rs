@@ -179,7 +179,9 @@ fn on_session_steady(app: &mut App, event: Event) {
     }
 }
 
-/// Hand what arrives on `rx` to the app until one matches; panics after 20 s.
+/// Hand what arrives on `rx` to the app until one matches; panics after 120 s (a guard
+/// against a hang, not a speed check: on a loaded 2-core machine a step with the real arms
+/// has taken over 20 s).
 pub async fn feed_until<T>(
     rx: &mut UnboundedReceiver<T>,
     app: &mut App,
@@ -196,7 +198,7 @@ pub async fn feed_until<T>(
             }
         }
     };
-    tokio::time::timeout(Duration::from_secs(20), wait)
+    tokio::time::timeout(Duration::from_secs(120), wait)
         .await
         .expect("timed out");
 }
