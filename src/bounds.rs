@@ -1,7 +1,7 @@
-//! Numbers from outside — flags, `betr.toml`, the environment — checked against the
-//! range betr can work with before anything uses them, so a typo such as `1e20` seconds
-//! or `4294967296` examples is a clear error rather than a panic, an abort or hours of
-//! work. Every range here is inclusive.
+//! Values from outside — flags, `betr.toml`, the environment — checked before anything
+//! uses them: numbers against the range betr can work with, so a typo such as `1e20`
+//! seconds or `4294967296` examples is a clear error rather than a panic, an abort or
+//! hours of work (every range here is inclusive), and on/off switches read one way.
 
 use std::fmt::Display;
 use std::time::Duration;
@@ -49,6 +49,16 @@ pub fn within<T: PartialOrd + Display>(
     }
 }
 
+/// An on/off setting as an environment variable gives it: `1`, `true`, `yes` (any case)
+/// are on, `0`, `false`, `no` off, anything else `None`.
+pub fn switch_value(value: &str) -> Option<bool> {
+    match value.trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" => Some(true),
+        "0" | "false" | "no" => Some(false),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -73,5 +83,17 @@ mod tests {
             within("n", 0u32, 1, 8).unwrap_err().to_string(),
             "n = 0 is out of range: expected 1 to 8"
         );
+    }
+
+    #[test]
+    fn switches_read_on_off_or_neither() {
+        for on in ["1", "true", " YES "] {
+            assert_eq!(switch_value(on), Some(true), "{on}");
+        }
+        for off in ["0", "False", "no"] {
+            assert_eq!(switch_value(off), Some(false), "{off}");
+        }
+        assert_eq!(switch_value("maybe"), None);
+        assert_eq!(switch_value(""), None);
     }
 }

@@ -6,16 +6,6 @@ use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
-/// An on/off setting as an environment variable gives it: `1`, `true`, `yes` (any case)
-/// are on, `0`, `false`, `no` off, anything else `None`.
-pub fn switch_value(value: &str) -> Option<bool> {
-    match value.trim().to_ascii_lowercase().as_str() {
-        "1" | "true" | "yes" => Some(true),
-        "0" | "false" | "no" => Some(false),
-        _ => None,
-    }
-}
-
 /// Why the settings file cannot be used; names the file.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{0}")]
@@ -105,17 +95,5 @@ mod tests {
         let e = FileConfig::read(&path).unwrap_err().to_string();
         assert!(e.contains("betr.toml"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn switches_read_on_off_or_neither() {
-        for on in ["1", "true", " YES "] {
-            assert_eq!(switch_value(on), Some(true), "{on}");
-        }
-        for off in ["0", "False", "no"] {
-            assert_eq!(switch_value(off), Some(false), "{off}");
-        }
-        assert_eq!(switch_value("maybe"), None);
-        assert_eq!(switch_value(""), None);
     }
 }

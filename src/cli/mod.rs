@@ -224,7 +224,7 @@ pub fn offline_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
     if value.trim().is_empty() {
         return Ok(false);
     }
-    match betr::config_file::switch_value(&value) {
+    match betr::bounds::switch_value(&value) {
         Some(on) => Ok(on),
         None => bail!("BETR_OFFLINE={value:?} is not true or false"),
     }

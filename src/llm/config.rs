@@ -138,7 +138,7 @@ impl Layer {
         let bool_var = |k: &str| -> Result<Option<bool>, LlmError> {
             get(k)
                 .map(|v| {
-                    crate::config_file::switch_value(&v)
+                    crate::bounds::switch_value(&v)
                         .ok_or_else(|| LlmError::Config(format!("{k}={v:?} is not true or false")))
                 })
                 .transpose()
