@@ -17,6 +17,10 @@ pub const ARTICLES: &[&str] = &["a", "an", "the", "some", "any"];
 /// Words that soften a request without changing it ("maybe bring", "either the milk").
 pub const HEDGES: &[&str] = &["either", "maybe", "perhaps"];
 
+/// Words that ask for every object of the kind named after them ("both vents", "all the
+/// tables").
+pub const QUANTIFIERS: &[&str] = &["both", "all", "every", "each"];
+
 /// Words that restrict what follows: before a verb they soften it ("or just bring"),
 /// before a thing they make it the only one ("or just a mug").
 pub const RESTRICTING: &[&str] = &["just"];
@@ -156,6 +160,11 @@ pub const SHARED: &[(&str, &str)] = &[(
 
 fn has(list: &[&str], word: &str) -> bool {
     list.contains(&word)
+}
+
+/// Whether `word` asks for every object of the kind named after it.
+pub fn is_quantifier(word: &str) -> bool {
+    has(QUANTIFIERS, word)
 }
 
 /// Whether `word` says nothing about what is asked (matches are made without it).
@@ -312,6 +321,7 @@ mod tests {
                     .flat_map(|(c, o, d)| [c.to_string(), o.to_string(), d.to_string()])
                     .collect(),
             ),
+            ("QUANTIFIERS", plain(QUANTIFIERS)),
             ("SENDING_VERBS", plain(SENDING_VERBS)),
             ("MOVING_VERBS", plain(MOVING_VERBS)),
             ("STATE_VERBS", plain(STATE_VERBS)),

@@ -13,10 +13,12 @@
 //! | `left-unanswered` | a condition the request asks for in its own words, left out where the request offers no choice | putting it beside the goal |
 //! | `relation-as-said` | a relation other than the one the request says before the place ("in the crib" read as on) | the relation said |
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
+//! | `fewer-than-every` | a condition asked of every object of a kind ("both vents", "all the tables") held for some of them only | the same condition for the others beside it |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
 
 use crate::goal::Formula;
 
+use super::kinds::{fewer_than_every, with_every};
 use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
@@ -43,6 +45,7 @@ pub const MISREADINGS: &[&dyn Misreading] = &[
     &LeftUnanswered,
     &RelationAsSaid,
     &Convention,
+    &FewerThanEvery,
     &NotPut,
 ];
 
@@ -217,6 +220,25 @@ impl Misreading for Convention {
                     format!("the request says \"{word}\", which by this scene's conventions asks for where {goal} does not put it"),
                 )
             })
+            .into_iter()
+            .collect()
+    }
+}
+
+struct FewerThanEvery;
+impl Misreading for FewerThanEvery {
+    fn name(&self) -> &'static str {
+        "fewer-than-every"
+    }
+    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
+        fewer_than_every(goal, request)
+    }
+    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
+        let Some(why) = fewer_than_every(goal, request) else {
+            return Vec::new();
+        };
+        with_every(goal, request)
+            .map(|g| (g, why))
             .into_iter()
             .collect()
     }

@@ -9,12 +9,14 @@
 //! about conditions ([`polarity`]), about items sent to places ([`placement`]), about
 //! the relation said before a place
 //! and a scene's conventions ([`relation_words`]), and about a goal's objects and
-//! conjuncts ([`names`]), and about the order of a relation's objects ([`order`]).
+//! conjuncts ([`names`]), about the order of a relation's objects ([`order`]), and about
+//! the kinds a "both", "all" or "every" asks each object of ([`kinds`]).
 //!
 //! The session asks the model and judges its answers with what is here; formula rewrites
 //! that know nothing of words (rename, map atoms, flip) are [`crate::goal::rewrite`]'s.
 
 pub mod english;
+pub mod kinds;
 pub mod lexicon;
 pub mod misreading;
 pub mod names;

@@ -7,6 +7,7 @@ use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
 use super::english::{is_generic, is_phrasing, offers_choice};
+use super::kinds::{asked_of_every, every_of_kind};
 use super::placement::named_in;
 use super::request::Request;
 use super::words::{is_number, same_word, terms};
@@ -66,9 +67,12 @@ pub fn unasked(goal: &Formula, request: &Request) -> Vec<Formula> {
         .collect();
     let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
     let claimed = |w: &String| by_atom.iter().filter(|c| c.contains(w)).count();
+    // "Both benches" asks for each bench's condition with one word for the kind.
+    let every = every_of_kind(request);
     items
         .iter()
         .zip(&covered)
+        .filter(|(item, _)| !asked_of_every(item, &every))
         .filter(|(_, words)| words.iter().all(|w| claimed(w) > said(w)))
         .map(|(item, _)| item.clone())
         .collect()

@@ -13,6 +13,7 @@ use crate::goal::Formula;
 use crate::goal::rewrite::{flipped, undo_each};
 
 use super::english::{NUMBERING, clause_start, is_negation, is_number_word};
+use super::kinds::every_of_kind_in;
 use super::placement::mentions;
 use super::request::Request;
 use super::words::{every_term, same_word, terms};
@@ -143,7 +144,25 @@ pub(super) fn asked_in_sentences(request: &Request) -> Vec<Asked> {
             let Some((wanted, word)) = clause_polarity(clause, predicate) else {
                 continue;
             };
-            for object in subjects(clause, predicate, vocabulary) {
+            // "Close both vents" asks it of each vent.
+            let of_every = every_of_kind_in(clause, vocabulary, request.lexicon)
+                .into_iter()
+                .flat_map(|k| k.objects)
+                .filter(|name| {
+                    predicate.arg_types.first().is_some_and(|slot| {
+                        vocabulary
+                            .objects
+                            .iter()
+                            .any(|o| &o.name == name && o.fits(slot))
+                    })
+                });
+            let mut named = subjects(clause, predicate, vocabulary);
+            for object in of_every {
+                if !named.contains(&object) {
+                    named.push(object);
+                }
+            }
+            for object in named {
                 let key = (predicate.name.clone(), object.clone());
                 if both.contains(&key) {
                     continue;
