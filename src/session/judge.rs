@@ -1,13 +1,9 @@
 //! Judging the candidate goals of one reading: the checks each passes or fails, the plain
 //! misreadings of the request and the candidates made by undoing them, and the vote.
 //!
-//! Plain misreadings: a number the request says left out ("table six" read as table 1);
-//! a condition the other way round from the request's words ("do not open the curtain"
-//! read as open); an item the request sends to a place with no condition relating them
-//! ("a dessert at the bar" read as a dessert made and the robot at the bar); one of two
-//! things named side by side left out ("fries or a dessert" read as the dessert); a
-//! measure in the place of what it holds ("a glass of water" read as the glass); an
-//! object nobody named in the place of one the request names ("fries" read as coffee).
+//! The plain misreadings are the detectors registered in [`crate::reading::misreading`]
+//! (its table lists each: what it finds and how it undoes it); an evaluation may leave
+//! any of them out.
 
 use crate::domain::VocabularyError;
 use crate::goal::{self, Formula};
