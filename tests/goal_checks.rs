@@ -407,6 +407,18 @@ async fn a_misreading_that_can_be_undone_gives_the_undone_goal_as_a_candidate() 
             "Goal: Exists_Dessert & RobotNear_Bar",
             "On_Dessert_Bar",
         ),
+        // One of two things named side by side left out.
+        (
+            "I'm at the third table, could you bring me some fries or a dessert?",
+            "Goal: On_Dessert_Table3",
+            "On_Chips_Table3 | On_Dessert_Table3",
+        ),
+        // A condition asked of both objects of a kind held for one of them.
+        (
+            "Please keep away from both bars.",
+            "Goal: ~RobotNear_Bar",
+            "~RobotNear_Bar & ~RobotNear_Bar2",
+        ),
         // An object no word names in the place of one a word names alone.
         (
             "I'm at the third table, could you bring me some fries or a dessert?",

@@ -14,6 +14,7 @@
 //! | `relation-as-said` | a relation other than the one the request says before the place ("in the crib" read as on) | the relation said |
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
 //! | `fewer-than-every` | a condition asked of every object of a kind ("both vents", "all the tables") held for some of them only | the same condition for the others beside it |
+//! | `left-out` | one of two things named side by side left out ("fries or a dessert" read as the dessert) | the one left out put beside the other, joined as the request joins them |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
 
 use crate::goal::Formula;
@@ -25,6 +26,7 @@ use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
 use super::relation_words::{convention_followed, relation_as_said};
 use super::request::Request;
+use super::side_by_side::{left_out, with_left_out};
 
 /// One kind of plain misreading; see the module.
 pub trait Misreading: Sync {
@@ -47,6 +49,7 @@ pub const MISREADINGS: &[&dyn Misreading] = &[
     &Convention,
     &FewerThanEvery,
     &NotPut,
+    &LeftOut,
 ];
 
 /// A misreading named that no detector has.
@@ -271,6 +274,32 @@ impl Misreading for NotPut {
             )
         });
         put.into_iter().chain(moved).collect()
+    }
+}
+
+struct LeftOut;
+impl Misreading for LeftOut {
+    fn name(&self) -> &'static str {
+        "left-out"
+    }
+    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
+        left_out(goal, request).map(|gap| {
+            format!(
+                "the request names {} beside {}, and {goal} leaves {} out",
+                gap.left_out, gap.kept, gap.left_out
+            )
+        })
+    }
+    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
+        with_left_out(goal, request)
+            .map(|g| {
+                (
+                    g,
+                    format!("the request names things side by side that {goal} has only one of"),
+                )
+            })
+            .into_iter()
+            .collect()
     }
 }
 

@@ -26,6 +26,7 @@ pub mod placement;
 pub mod polarity;
 pub mod relation_words;
 pub mod request;
+pub mod side_by_side;
 pub mod words;
 
 pub use lexicon::Lexicon;
