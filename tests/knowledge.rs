@@ -378,7 +378,7 @@ mod engine {
                 }
             }
         };
-        tokio::time::timeout(Duration::from_secs(20), wait)
+        tokio::time::timeout(Duration::from_secs(120), wait)
             .await
             .expect("timed out")
     }

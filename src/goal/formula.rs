@@ -41,7 +41,8 @@ impl Formula {
         Formula::and(literals.into_iter().map(Formula::literal).collect())
     }
 
-    /// A flattened conjunction: nested `And`s are merged and a single item is returned as is.
+    /// A flattened conjunction: nested `And`s are merged, an item said twice is kept once
+    /// (`A & A` is `A`), and a single item is returned as is.
     pub fn and(items: Vec<Formula>) -> Formula {
         let mut out = Vec::with_capacity(items.len());
         for item in items {
@@ -50,10 +51,11 @@ impl Formula {
                 other => out.push(other),
             }
         }
-        single_or(out, Formula::And)
+        single_or(once_each(out), Formula::And)
     }
 
-    /// A flattened disjunction: nested `Or`s are merged and a single item is returned as is.
+    /// A flattened disjunction: nested `Or`s are merged, an item said twice is kept once,
+    /// and a single item is returned as is.
     pub fn or(items: Vec<Formula>) -> Formula {
         let mut out = Vec::with_capacity(items.len());
         for item in items {
@@ -62,7 +64,7 @@ impl Formula {
                 other => out.push(other),
             }
         }
-        single_or(out, Formula::Or)
+        single_or(once_each(out), Formula::Or)
     }
 
     /// The same formula with every nested `And` / `Or` merged into its parent and every
@@ -150,6 +152,17 @@ impl Formula {
     }
 }
 
+/// `items` in their order with each repeated item left out after its first time.
+fn once_each(items: Vec<Formula>) -> Vec<Formula> {
+    let mut out: Vec<Formula> = Vec::with_capacity(items.len());
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
+}
+
 fn single_or(mut items: Vec<Formula>, wrap: fn(Vec<Formula>) -> Formula) -> Formula {
     if items.len() == 1
         && let Some(only) = items.pop()
@@ -198,6 +211,9 @@ mod tests {
         }
         assert_eq!(p("((A)) & ((B & C))").to_string(), "A & B & C");
         assert_eq!(p("(A | (B | C)) | D").to_string(), "A | B | C | D");
+        // An item said twice is one.
+        assert_eq!(p("A & B & A").to_string(), "A & B");
+        assert_eq!(p("(A | B) & (A | B)").to_string(), "A | B");
     }
 
     #[test]

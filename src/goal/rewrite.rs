@@ -40,13 +40,14 @@ pub fn rename(goal: &Formula, from: &str, to: &str) -> Formula {
     })
 }
 
-/// `goal` with each atom replaced by what `f` makes of it.
+/// `goal` with each atom replaced by what `f` makes of it; two items made the same are
+/// one (`A & B` with B renamed to A is `A`).
 pub fn map_atoms(goal: &Formula, f: &impl Fn(&Atom) -> Atom) -> Formula {
     match goal {
         Formula::Atom(a) => Formula::Atom(f(a)),
         Formula::Not(inner) => Formula::Not(Box::new(map_atoms(inner, f))),
-        Formula::And(items) => Formula::And(items.iter().map(|i| map_atoms(i, f)).collect()),
-        Formula::Or(items) => Formula::Or(items.iter().map(|i| map_atoms(i, f)).collect()),
+        Formula::And(items) => Formula::and(items.iter().map(|i| map_atoms(i, f)).collect()),
+        Formula::Or(items) => Formula::or(items.iter().map(|i| map_atoms(i, f)).collect()),
     }
 }
 
@@ -59,7 +60,7 @@ pub fn flipped(goal: &Formula, atom: &Atom) -> Formula {
             Formula::Atom(a) if a == atom => Formula::Atom(a.clone()),
             _ => Formula::Not(Box::new(flipped(inner, atom))),
         },
-        Formula::And(items) => Formula::And(items.iter().map(|i| flipped(i, atom)).collect()),
-        Formula::Or(items) => Formula::Or(items.iter().map(|i| flipped(i, atom)).collect()),
+        Formula::And(items) => Formula::and(items.iter().map(|i| flipped(i, atom)).collect()),
+        Formula::Or(items) => Formula::or(items.iter().map(|i| flipped(i, atom)).collect()),
     }
 }

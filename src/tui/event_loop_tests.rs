@@ -109,7 +109,7 @@ async fn keys_and_session_events_share_the_queue_and_quitting_stops_the_engine()
         &mut bench.dictation,
         &mut tap,
     );
-    tokio::time::timeout(Duration::from_secs(20), ran)
+    tokio::time::timeout(Duration::from_secs(120), ran)
         .await
         .expect("the loop did not end on q");
     assert_eq!(recorder.commands, [Command::Plan]);
@@ -163,7 +163,7 @@ async fn the_loop_ends_with_the_session_and_takes_in_what_was_waiting() {
         &mut bench.dictation,
         &mut no_tap,
     );
-    tokio::time::timeout(Duration::from_secs(20), ran)
+    tokio::time::timeout(Duration::from_secs(120), ran)
         .await
         .expect("the loop did not end with the session");
     assert!(!bench.app.should_quit());

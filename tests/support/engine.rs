@@ -102,7 +102,7 @@ impl Session {
                 }
             }
         };
-        if tokio::time::timeout(Duration::from_secs(20), wait)
+        if tokio::time::timeout(Duration::from_secs(120), wait)
             .await
             .is_err()
         {
