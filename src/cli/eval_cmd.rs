@@ -38,9 +38,9 @@ pub enum EvalExperiment {
         #[arg(long, default_value_t = 1)]
         runs: usize,
         /// Run every set of requests a suite file names (docs/eval-suite.toml: the cafe
-        /// dataset, held-out cafe requests, the cell's scenarios, and the greenhouse's and
-        /// the lab's held-out requests), each into a folder of its own, and print them side
-        /// by side; --dataset and --scenario are not used.
+        /// dataset, held-out cafe requests, the cell's scenarios, and the greenhouse's, the
+        /// lab's and the warehouse's held-out requests), each into a folder of its own, and
+        /// print them side by side; --dataset and --scenario are not used.
         #[arg(long, value_name = "FILE")]
         suite: Option<PathBuf>,
         #[command(flatten)]

@@ -137,4 +137,12 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../scenarios/lab/examples.toml"),
     ),
     ("lab/lab.toml", include_str!("../../scenarios/lab/lab.toml")),
+    (
+        "warehouse/examples.toml",
+        include_str!("../../scenarios/warehouse/examples.toml"),
+    ),
+    (
+        "warehouse/warehouse.toml",
+        include_str!("../../scenarios/warehouse/warehouse.toml"),
+    ),
 ];
