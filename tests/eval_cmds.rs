@@ -239,11 +239,11 @@ fn goals_against_the_fake_server_are_scored_and_tabled() {
     // scene's own words for everything the answer leaves out ("turn on the tube light"
     // answered `Active_AC`: the tube light put beside, the unasked AC taken out; likewise
     // "try not to hang around bar and bar 2 ... hold a bottle of spring water"); the
-    // others stay wrong (the fixtures repeat them). One hard answer the removed
-    // side-by-side and place-number detectors mended on these tuned requests stays wrong.
+    // others stay wrong (the fixtures repeat them), but for one hard answer with one of
+    // two things named side by side left out, which `left-out` mends.
     assert_eq!(tally(&r, "easy"), (28, 30));
     assert_eq!(tally(&r, "medium"), (27, 30));
-    assert_eq!(tally(&r, "hard"), (35, 40));
+    assert_eq!(tally(&r, "hard"), (36, 40));
     assert_eq!(
         r["usage"]["sources"]["hand-written"].as_u64().unwrap() as usize,
         server.received().len()
@@ -313,7 +313,7 @@ fn an_interrupted_run_resumes_without_asking_finished_cases_again() {
     }
     assert_eq!(r["cases"].as_array().unwrap().len(), 100);
     assert_eq!(tally(&r, "easy"), (28, 30));
-    assert_eq!(tally(&r, "hard"), (35, 40));
+    assert_eq!(tally(&r, "hard"), (36, 40));
     assert!(text(&o).contains(MODEL_ROW), "{}", text(&o));
 }
 
@@ -371,7 +371,7 @@ fn a_run_killed_midway_resumes_to_the_same_results() {
     let r = read_json(&dir.join("out/results.json"));
     assert_eq!(r["cases"].as_array().unwrap().len(), 100);
     assert_eq!(tally(&r, "easy"), (28, 30));
-    assert_eq!(tally(&r, "hard"), (35, 40));
+    assert_eq!(tally(&r, "hard"), (36, 40));
     // Every case the killed run finished is kept as it was, once.
     let after = std::fs::read_to_string(&journal).unwrap();
     for line in before.lines().filter(|l| l.ends_with('}')) {
