@@ -67,6 +67,10 @@ pub struct BenchArgs {
     /// Runs per model measure (llama-bench's -r), warm calls in the cold and llm parts.
     #[arg(long, default_value_t = 3)]
     repeats: usize,
+    /// The seed of the motion part's random targets and the boxes among them (both
+    /// planners get the same cell and queries).
+    #[arg(long, default_value_t = 39)]
+    motion_seed: u64,
 }
 
 /// Run the chosen parts, print the table and write the JSON.
@@ -158,8 +162,9 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     }];
     let rest = motion::cell_rest();
     let count = if args.quick { 10 } else { 200 };
-    let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
-    let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
+    let seed = args.motion_seed;
+    let boxes = motion::clutter(&robot, &shapes, &rest, 12, seed)?;
+    let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, seed)?;
     let betr_times = motion::betr_plan(
         &robot,
         &shapes,
@@ -182,11 +187,12 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
         Path::new("target"),
     )?;
     rows.extend(motion::plan_rows(
-        &format!("{count} random reachable targets among 12 boxes"),
+        &format!("{count} random reachable targets among 12 boxes (seed {seed})"),
         &betr_times,
         &ompl_times,
-        "from each arm's rest values; betr: 4000 samples at most, 0.03 rad segment checks, \
-         shortcutting; OMPL: 2 s at most, the same resolution, simplified",
+        "from each arm's rest values; betr: 4000 samples at most, steps up to a fifth of \
+         the joint space across, 0.03 rad segment checks, shortcutting; OMPL: 2 s at most, \
+         its default range (the same fifth), the same resolution, simplified",
     ));
     rows.extend(cell_motion_rows(args, &python, script, spec, &dir)?);
     let scenario_one = if args.quick {
