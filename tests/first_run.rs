@@ -396,9 +396,10 @@ fn model_fetch_robot_installs_the_description_and_refuses_an_unknown_name() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A one-shot command on a scenario whose cell names a robot description fetches it on
-/// first use, its progress on standard error, and the run then fails where the arm does;
-/// offline (`BETR_OFFLINE=1` or `--offline`) it fetches nothing and says what is missing.
+/// A one-shot command that runs a scenario whose cell names a robot description fetches
+/// it on first use, its progress on standard error, and the run then fails where the arm
+/// does; offline (`BETR_OFFLINE=1` or `--offline`) it fetches nothing and says what is
+/// missing. A command that only plans (a BT.CPP export) fetches nothing.
 #[test]
 fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
     let dir = tmp("run-fetches-robot");
@@ -434,6 +435,20 @@ fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
             cache_entries(&cache)
         );
     }
+    // A BT.CPP export only plans, and planning never moves the arms: nothing is fetched.
+    let out = support::cli::betr_with(&dir, &["export", scenario, "--format", "btcpp"], &env);
+    let text = support::cli::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("BTCPP_format=\"4\""),
+        "{text}"
+    );
+    assert!(!text.contains("Fetching"), "{text}");
+    assert!(
+        cache_entries(&cache).is_empty(),
+        "{:?}",
+        cache_entries(&cache)
+    );
     let out = support::cli::betr_with(&dir, &["run", scenario], &env);
     let text = support::cli::text(&out);
     let err = String::from_utf8_lossy(&out.stderr);

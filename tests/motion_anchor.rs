@@ -169,17 +169,13 @@ fn pybullet_calls_states_among_the_random_targets_boxes_free_where_betr_does() {
             goal: rest[arm].clone(),
         })
         .collect();
-    let mut input = motion::anchor_input(
-        &YUMI_DESCRIPTION,
-        dir,
-        &robot,
-        &shapes,
-        &rest,
-        &boxes,
-        &queries,
-        1.0,
-    )
-    .unwrap();
+    let cell = motion::ClutteredCell {
+        robot: &robot,
+        shapes: &shapes,
+        rest: &rest,
+        boxes: &boxes,
+    };
+    let mut input = motion::anchor_input(&YUMI_DESCRIPTION, dir, &cell, &queries, 1.0).unwrap();
     let mut betr = Vec::new();
     for (q, json) in queries.iter().zip(input["queries"].as_array_mut().unwrap()) {
         let check = ArmCheck::new(

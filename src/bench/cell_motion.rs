@@ -8,7 +8,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use super::BenchError;
-use super::motion::PlanTimes;
+use super::motion::{AnchorRun, PlanTimes};
 use super::pybullet::{collision_model, pybullet_solid, tested_pairs_json};
 use crate::domain::Condition;
 use crate::model::DescriptionSpec;
@@ -142,29 +142,21 @@ fn same_query(a: &PathQuery, b: &PathQuery) -> bool {
 /// betr's planner on each query (the check made and the path planned), timed one by one.
 pub fn betr_plan(arms: &Arms, queries: &[PathQuery]) -> Result<PlanTimes, BenchError> {
     PlanTimes::measure(queries, |q| {
-        let check = arms
-            .check_of(q)
-            .map_err(|e| BenchError::Setup(e.to_string()))?;
+        let check = arms.check_of(q)?;
         Ok(plan(&check, &q.start, &q.goal, &arms.plan).is_ok())
     })
 }
 
-/// OMPL + PyBullet on the same queries (`budget_s` seconds each), PyBullet checking
-/// what betr's check of each query checks (`super::pybullet`), and the kinds of shape
-/// PyBullet was not given (none when every solid converts).
-#[allow(clippy::too_many_arguments)]
+/// OMPL + PyBullet on the same queries, PyBullet checking what betr's check of each
+/// query checks (`super::pybullet`), and the kinds of shape PyBullet was not given (none
+/// when every solid converts).
 pub fn ompl_plan(
-    python: &Path,
-    script: &Path,
-    spec: &DescriptionSpec,
-    dir: &Path,
+    anchor: &AnchorRun<'_>,
     arms: &Arms,
     queries: &[PathQuery],
-    budget_s: f64,
-    scratch: &Path,
 ) -> Result<(PlanTimes, Vec<String>), BenchError> {
-    let (json, skipped) = anchor_input(spec, dir, arms, queries, budget_s)?;
-    let times = super::motion::run_ompl(python, script, &json, queries.len(), scratch)?;
+    let (json, skipped) = anchor_input(anchor.spec, anchor.dir, arms, queries, anchor.budget_s)?;
+    let times = super::motion::run_ompl(anchor, &json, queries.len())?;
     Ok((times, skipped))
 }
 
@@ -198,9 +190,7 @@ pub fn anchor_input(
     };
     let mut queries_json: Vec<serde_json::Value> = Vec::with_capacity(queries.len());
     for q in queries {
-        let check = arms
-            .check_of(q)
-            .map_err(|e| BenchError::Setup(e.to_string()))?;
+        let check = arms.check_of(q)?;
         let t = q.base.translation.vector;
         let r = q.base.rotation.coords;
         queries_json.push(serde_json::json!({
@@ -215,8 +205,7 @@ pub fn anchor_input(
             "pairs": tested_pairs_json(&check, &arms.robot, &arms.shapes),
         }));
     }
-    let model =
-        collision_model(&arms.robot, &arms.shapes).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let model = collision_model(&arms.robot, &arms.shapes)?;
     let json = serde_json::json!({
         "urdf": spec.urdf_in(dir),
         "package": spec.package,

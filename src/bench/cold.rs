@@ -36,9 +36,8 @@ pub struct GoalPrompt {
 
 impl GoalPrompt {
     pub fn load(path: &Path) -> Result<GoalPrompt, BenchError> {
-        let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
-        let scenario = Scenario::load(path).map_err(|e| setup(&e))?;
-        let facts = world::load(&scenario).map_err(|e| setup(&e))?.facts();
+        let scenario = Scenario::load(path)?;
+        let facts = world::load(&scenario)?.facts();
         let gbnf = grammar::goal_grammar(&scenario.domain.vocabulary, true, false);
         Ok(GoalPrompt {
             scenario,
@@ -56,8 +55,7 @@ impl GoalPrompt {
             variant: &Variant::default(),
         };
         let messages = ctx
-            .goal(&Templates::builtin())
-            .map_err(|e| BenchError::Setup(e.to_string()))?
+            .goal(&Templates::builtin())?
             .into_iter()
             .map(|m| (m.role.name().to_string(), m.content))
             .collect();
@@ -97,7 +95,6 @@ pub fn latencies(
     states: &Path,
     warm_calls: usize,
 ) -> Result<Latencies, BenchError> {
-    let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
     let prompt = GoalPrompt::load(scenario)?;
     let job = |instruction: &str| prompt.generation(instruction, true);
     if states.exists() {
@@ -110,13 +107,12 @@ pub fn latencies(
             threads,
             context: 4096,
             prompt_states: Some(states.to_path_buf()),
-        })
-        .map_err(|e| setup(&e))?;
+        })?;
         Ok((engine, started.elapsed()))
     };
     let timed = |engine: &Engine, g: Generation| {
         let started = Instant::now();
-        let out = engine.generate_blocking(g).map_err(|e| setup(&e))?;
+        let out = engine.generate_blocking(g)?;
         Ok::<_, BenchError>((started.elapsed(), out))
     };
 

@@ -37,6 +37,16 @@ pub enum BenchError {
     Io(#[from] std::io::Error),
     #[error("cannot write the scenario text: {0}")]
     Format(#[from] std::fmt::Error),
+    #[error(transparent)]
+    Scenario(#[from] crate::scenario::ScenarioError),
+    #[error(transparent)]
+    Motion(#[from] crate::motion::MotionError),
+    #[error(transparent)]
+    Shape(#[from] pybullet::UnconvertedShape),
+    #[error(transparent)]
+    Prompt(#[from] crate::llm::prompt::PromptError),
+    #[error(transparent)]
+    Model(#[from] crate::llm::local::EngineError),
 }
 
 /// Run an anchor's command: its standard output, or an error naming `what` with the end

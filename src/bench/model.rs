@@ -126,23 +126,20 @@ pub fn betr_speeds(model: &Path, threads: u32, sizes: ModelSizes) -> Result<Spee
         threads,
         context: (sizes.prompt + sizes.generate + 64).max(512),
         prompt_states: None,
-    })
-    .map_err(|e| BenchError::Setup(e.to_string()))?;
+    })?;
     let (mut prompt, mut generation) = (Vec::new(), Vec::new());
     for run in 0..sizes.repeats.max(1) {
         // Each run's text starts differently, so no prompt token is reused from the last.
-        let g = engine
-            .generate_blocking(Generation {
-                messages: vec![("user".into(), filler(run, sizes.prompt))],
-                max_tokens: sizes.generate,
-                temperature: 0.0,
-                seed: 0,
-                stop: Vec::new(),
-                grammar: None,
-                beams: 1,
-                prefill: String::new(),
-            })
-            .map_err(|e| BenchError::Setup(e.to_string()))?;
+        let g = engine.generate_blocking(Generation {
+            messages: vec![("user".into(), filler(run, sizes.prompt))],
+            max_tokens: sizes.generate,
+            temperature: 0.0,
+            seed: 0,
+            stop: Vec::new(),
+            grammar: None,
+            beams: 1,
+            prefill: String::new(),
+        })?;
         let evaluated = g.prompt_tokens.saturating_sub(g.cached_tokens);
         prompt.push(f64::from(evaluated) / g.prompt_time.as_secs_f64().max(1e-9));
         if g.completion_tokens > 1 {

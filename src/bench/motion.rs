@@ -36,6 +36,43 @@ pub struct Clutter {
     pub half: [f32; 3],
 }
 
+/// The random targets' cell: the robot, its links' collision shapes, every arm's rest
+/// values (where each query starts and the other arm stays) and the boxes.
+#[derive(Clone, Copy)]
+pub struct ClutteredCell<'a> {
+    pub robot: &'a Robot,
+    pub shapes: &'a RobotShapes,
+    pub rest: &'a [Vec<f64>],
+    pub boxes: &'a [Clutter],
+}
+
+impl ClutteredCell<'_> {
+    /// The check of arm `arm` among the boxes, the other arm at its rest values.
+    fn check<'c>(&'c self, solids: &'c [Solid], arm: usize) -> Result<ArmCheck<'c>, BenchError> {
+        Ok(ArmCheck::new(
+            self.robot,
+            self.shapes,
+            Isometry3::identity(),
+            arm,
+            self.rest,
+            solids,
+        )?)
+    }
+}
+
+/// How the anchors' side is run: the venv's Python, the script, the robot description
+/// and its folder, the seconds each query may take, and the folder the script's input
+/// is written to.
+#[derive(Clone, Copy)]
+pub struct AnchorRun<'a> {
+    pub python: &'a Path,
+    pub script: &'a Path,
+    pub spec: &'a DescriptionSpec,
+    pub dir: &'a Path,
+    pub budget_s: f64,
+    pub scratch: &'a Path,
+}
+
 /// One query: arm `arm` from `start` to `goal`, the other arms at their rest values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Query {
@@ -253,18 +290,15 @@ pub fn solids(boxes: &[Clutter]) -> Vec<Solid> {
 
 /// `count` queries, arms taken in turn, from the rest values to free joint values.
 pub fn random_queries(
-    robot: &Robot,
-    shapes: &RobotShapes,
-    rest: &[Vec<f64>],
-    boxes: &[Clutter],
+    cell: &ClutteredCell<'_>,
     count: usize,
     seed: u64,
 ) -> Result<Vec<Query>, BenchError> {
-    let solids = solids(boxes);
+    let (robot, rest) = (cell.robot, cell.rest);
+    let solids = solids(cell.boxes);
     let checks: Vec<ArmCheck<'_>> = (0..robot.arms.len())
-        .map(|arm| ArmCheck::new(robot, shapes, Isometry3::identity(), arm, rest, &solids))
-        .collect::<Result<_, _>>()
-        .map_err(|e| BenchError::Setup(e.to_string()))?;
+        .map(|arm| cell.check(&solids, arm))
+        .collect::<Result<_, _>>()?;
     for (arm, check) in checks.iter().enumerate() {
         if !check.is_free(&rest[arm]) {
             return Err(BenchError::Setup(format!(
@@ -301,59 +335,42 @@ pub fn random_queries(
 
 /// betr's planner on every query, timed one by one.
 pub fn betr_plan(
-    robot: &Robot,
-    shapes: &RobotShapes,
-    rest: &[Vec<f64>],
-    boxes: &[Clutter],
+    cell: &ClutteredCell<'_>,
     queries: &[Query],
     options: &PlanOptions,
 ) -> Result<PlanTimes, BenchError> {
-    let solids = solids(boxes);
+    let solids = solids(cell.boxes);
     PlanTimes::measure(queries, |q| {
-        let check = ArmCheck::new(robot, shapes, Isometry3::identity(), q.arm, rest, &solids)
-            .map_err(|e| BenchError::Setup(e.to_string()))?;
+        let check = cell.check(&solids, q.arm)?;
         Ok(plan(&check, &q.start, &q.goal, options).is_ok())
     })
 }
 
-/// OMPL + PyBullet on the same queries, with `budget_s` seconds per query, PyBullet
-/// checking what betr's check of each arm checks (`super::pybullet`).
-#[allow(clippy::too_many_arguments)]
+/// OMPL + PyBullet on the same queries, PyBullet checking what betr's check of each arm
+/// checks (`super::pybullet`).
 pub fn ompl_plan(
-    python: &Path,
-    script: &Path,
-    spec: &DescriptionSpec,
-    dir: &Path,
-    robot: &Robot,
-    shapes: &RobotShapes,
-    rest: &[Vec<f64>],
-    boxes: &[Clutter],
+    anchor: &AnchorRun<'_>,
+    cell: &ClutteredCell<'_>,
     queries: &[Query],
-    budget_s: f64,
-    scratch: &Path,
 ) -> Result<PlanTimes, BenchError> {
-    let json = anchor_input(spec, dir, robot, shapes, rest, boxes, queries, budget_s)?;
-    run_ompl(python, script, &json, queries.len(), scratch)
+    let json = anchor_input(anchor.spec, anchor.dir, cell, queries, anchor.budget_s)?;
+    run_ompl(anchor, &json, queries.len())
 }
 
-/// The anchor script's input for `queries` among `boxes` (see `scripts/bench_motion.py`).
-#[allow(clippy::too_many_arguments)]
+/// The anchor script's input for `queries` in `cell`, with `budget_s` seconds per query
+/// (see `scripts/bench_motion.py`).
 pub fn anchor_input(
     spec: &DescriptionSpec,
     dir: &Path,
-    robot: &Robot,
-    shapes: &RobotShapes,
-    rest: &[Vec<f64>],
-    boxes: &[Clutter],
+    cell: &ClutteredCell<'_>,
     queries: &[Query],
     budget_s: f64,
 ) -> Result<serde_json::Value, BenchError> {
-    let solids = solids(boxes);
-    let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
+    let (robot, shapes) = (cell.robot, cell.shapes);
+    let solids = solids(cell.boxes);
     let mut pairs = Vec::with_capacity(robot.arms.len());
     for arm in 0..robot.arms.len() {
-        let check = ArmCheck::new(robot, shapes, Isometry3::identity(), arm, rest, &solids)
-            .map_err(|e| setup(&e))?;
+        let check = cell.check(&solids, arm)?;
         pairs.push(tested_pairs_json(&check, robot, shapes));
     }
     let mut boxes_json = Vec::with_capacity(solids.len());
@@ -372,9 +389,9 @@ pub fn anchor_input(
         "base": [0.0, 0.0, 0.0],
         "solids": boxes_json,
         "arms": arms_json(robot),
-        "collision_model": collision_model(robot, shapes).map_err(|e| setup(&e))?,
+        "collision_model": collision_model(robot, shapes)?,
         "pairs_by_arm": pairs,
-        "others": rest,
+        "others": cell.rest,
         "queries": queries.iter().map(|q| serde_json::json!({"arm": q.arm, "start": q.start, "goal": q.goal})).collect::<Vec<_>>(),
         "resolution": PlanOptions::default().resolution,
         "budget_s": budget_s,
@@ -399,16 +416,14 @@ pub fn arms_json(robot: &Robot) -> serde_json::Value {
 
 /// OMPL + PyBullet on the `count` queries of `json` (the script's `plan` input).
 pub fn run_ompl(
-    python: &Path,
-    script: &Path,
+    anchor: &AnchorRun<'_>,
     json: &serde_json::Value,
     count: usize,
-    scratch: &Path,
 ) -> Result<PlanTimes, BenchError> {
-    std::fs::create_dir_all(scratch)?;
-    let file = scratch.join("motion-queries.json");
-    crate::store::write_atomic(&file, json.to_string().as_bytes())
-        .map_err(|e| BenchError::Setup(e.to_string()))?;
+    let (python, script) = (anchor.python, anchor.script);
+    std::fs::create_dir_all(anchor.scratch)?;
+    let file = anchor.scratch.join("motion-queries.json");
+    crate::store::write_atomic(&file, json.to_string().as_bytes())?;
     let what = format!("OMPL + PyBullet ({})", script.display());
     let out = super::run_anchor(
         &what,

@@ -19,8 +19,8 @@ const RUN_TICKS: u64 = 10_000;
 
 /// Scenario 1 end to end, repeated for at least `time`; the mean per run.
 pub fn scenario_one(path: &Path, time: Duration) -> Result<Row, BenchError> {
-    let scenario = Scenario::load(path).map_err(|e| BenchError::Setup(e.to_string()))?;
-    let world = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let scenario = Scenario::load(path)?;
+    let world = world::load(&scenario)?;
     let mut runs = 0u32;
     let started = Instant::now();
     let mut repairs = 0;
@@ -49,13 +49,12 @@ pub fn scenario_one(path: &Path, time: Duration) -> Result<Row, BenchError> {
 /// with the scenario's expected fix after the arm's failure, run again to success. The
 /// mean per run.
 pub fn scenario_one_arms(path: &Path, time: Duration) -> Result<Row, BenchError> {
-    let scenario = Scenario::load(path).map_err(|e| BenchError::Setup(e.to_string()))?;
-    let exec =
-        world::load_execution(&scenario, None).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let scenario = Scenario::load(path)?;
+    let exec = world::load_execution(&scenario, None)?;
     if let Some(why) = exec.notice {
         return Err(BenchError::Setup(why));
     }
-    let planning = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+    let planning = world::load(&scenario)?;
     let mut runs = 0u32;
     let started = Instant::now();
     let mut repairs = 0;
@@ -91,15 +90,14 @@ pub fn towers_arms(n: usize, base: &Path) -> Result<Row, BenchError> {
 }
 
 fn towers_arms_in(n: usize, base: &Path, dir: &Path) -> Result<Row, BenchError> {
-    let setup = |e: &dyn std::fmt::Display| BenchError::Setup(e.to_string());
     let path = towers::write_arms_scenario(dir, n, base)?;
     let started = Instant::now();
-    let scenario = Scenario::load(&path).map_err(|e| setup(&e))?;
-    let exec = world::load_execution(&scenario, None).map_err(|e| setup(&e))?;
+    let scenario = Scenario::load(&path)?;
+    let exec = world::load_execution(&scenario, None)?;
     if let Some(why) = exec.notice {
         return Err(BenchError::Setup(why));
     }
-    let planning = world::load(&scenario).map_err(|e| setup(&e))?;
+    let planning = world::load(&scenario)?;
     let loaded = started.elapsed();
     let started = Instant::now();
     let (repairs, _) =
@@ -157,8 +155,8 @@ fn tower_rows(sizes: &[usize], base: &Path, dir: &Path) -> Result<Vec<Row>, Benc
     let mut rows = Vec::new();
     for &n in sizes {
         let path = towers::write_scenario(dir, n, base)?;
-        let scenario = Scenario::load(&path).map_err(|e| BenchError::Setup(e.to_string()))?;
-        let world = world::load(&scenario).map_err(|e| BenchError::Setup(e.to_string()))?;
+        let scenario = Scenario::load(&path)?;
+        let world = world::load(&scenario)?;
         let r = towers::plan_and_repair(&scenario, world.as_ref())?;
         let target = match n {
             1000 => Some(Target::AtMost(20.0)),

@@ -67,6 +67,10 @@ pub struct BenchArgs {
     /// Runs per model measure (llama-bench's -r), warm calls in the cold and llm parts.
     #[arg(long, default_value_t = 3)]
     repeats: usize,
+    /// The seed of the motion part's random targets and the boxes among them (both
+    /// planners get the same cell and queries).
+    #[arg(long, default_value_t = 39)]
+    motion_seed: u64,
 }
 
 /// Run the chosen parts, print the table and write the JSON.
@@ -158,37 +162,34 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
     }];
     let rest = motion::cell_rest();
     let count = if args.quick { 10 } else { 200 };
-    let boxes = motion::clutter(&robot, &shapes, &rest, 12, 39)?;
-    let queries = motion::random_queries(&robot, &shapes, &rest, &boxes, count, 39)?;
-    let betr_times = motion::betr_plan(
-        &robot,
-        &shapes,
-        &rest,
-        &boxes,
-        &queries,
-        &betr::motion::PlanOptions::default(),
-    )?;
-    let ompl_times = motion::ompl_plan(
-        &python,
+    let seed = args.motion_seed;
+    let boxes = motion::clutter(&robot, &shapes, &rest, 12, seed)?;
+    let cell = motion::ClutteredCell {
+        robot: &robot,
+        shapes: &shapes,
+        rest: &rest,
+        boxes: &boxes,
+    };
+    let anchor = motion::AnchorRun {
+        python: &python,
         script,
         spec,
-        &dir,
-        &robot,
-        &shapes,
-        &rest,
-        &boxes,
-        &queries,
-        2.0,
-        Path::new("target"),
-    )?;
+        dir: &dir,
+        budget_s: 2.0,
+        scratch: Path::new("target"),
+    };
+    let queries = motion::random_queries(&cell, count, seed)?;
+    let betr_times = motion::betr_plan(&cell, &queries, &betr::motion::PlanOptions::default())?;
+    let ompl_times = motion::ompl_plan(&anchor, &cell, &queries)?;
     rows.extend(motion::plan_rows(
-        &format!("{count} random reachable targets among 12 boxes"),
+        &format!("{count} random reachable targets among 12 boxes (seed {seed})"),
         &betr_times,
         &ompl_times,
-        "from each arm's rest values; betr: 4000 samples at most, 0.03 rad segment checks, \
-         shortcutting; OMPL: 2 s at most, the same resolution, simplified",
+        "from each arm's rest values; betr: 4000 samples at most, steps up to a fifth of \
+         the joint space across, 0.03 rad segment checks, shortcutting; OMPL: 2 s at most, \
+         its default range (the same fifth), the same resolution, simplified",
     ));
-    rows.extend(cell_motion_rows(args, &python, script, spec, &dir)?);
+    rows.extend(cell_motion_rows(args, &anchor)?);
     let scenario_one = if args.quick {
         Duration::from_millis(100)
     } else {
@@ -213,13 +214,7 @@ fn motion_part(args: &BenchArgs) -> Result<Vec<bench::Row>> {
 
 /// The cell scenarios' own arm motions (every scenario under the default scenario's
 /// folder whose robot has arms), planned by betr and by OMPL + PyBullet.
-fn cell_motion_rows(
-    args: &BenchArgs,
-    python: &Path,
-    script: &Path,
-    spec: &betr::model::DescriptionSpec,
-    dir: &Path,
-) -> Result<Vec<bench::Row>> {
+fn cell_motion_rows(args: &BenchArgs, anchor: &motion::AnchorRun<'_>) -> Result<Vec<bench::Row>> {
     let folder = args.scenario.parent().unwrap_or(Path::new("."));
     let mut paths: Vec<PathBuf> = std::fs::read_dir(folder)
         .with_context(|| format!("cannot list {}", folder.display()))?
@@ -248,16 +243,7 @@ fn cell_motion_rows(
         anyhow::bail!("no scenario in {} moves the real arms", folder.display());
     };
     let betr_times = bench::cell_motion::betr_plan(&arms, &queries)?;
-    let (ompl_times, skipped) = bench::cell_motion::ompl_plan(
-        python,
-        script,
-        spec,
-        dir,
-        &arms,
-        &queries,
-        2.0,
-        Path::new("target"),
-    )?;
+    let (ompl_times, skipped) = bench::cell_motion::ompl_plan(anchor, &arms, &queries)?;
     let mut note = format!(
         "each scenario's tree failing, repaired with its expected fix, run to success; queries per scenario: {}; the same start, goal, solids, other arm and carried object for both",
         scenarios.join(", ")

@@ -50,10 +50,14 @@ pub struct Start<'a> {
     pub limits: RunLimits,
     pub viz: Option<Viz>,
     pub record: Option<SessionRecorder>,
+    /// Whether the command runs the tree in the execution world, where a cell moves its
+    /// robot's real arms: only then is a missing robot description fetched first
+    /// (planning never moves the arms).
+    pub runs_tree: bool,
 }
 
 impl<'a> Start<'a> {
-    /// The scenario's own world, the default limits, no 3D view.
+    /// The scenario's own world, the default limits, no 3D view, a tree that is run.
     pub fn new(scenario: &'a Scenario) -> Start<'a> {
         Start {
             scenario,
@@ -62,6 +66,7 @@ impl<'a> Start<'a> {
             limits: RunLimits::DEFAULT,
             viz: None,
             record: None,
+            runs_tree: true,
         }
     }
 }
@@ -108,7 +113,9 @@ impl Run {
 impl Driver {
     pub fn start(start: Start) -> Result<Driver> {
         // The robot the scenario's cell moves, fetched on first use as the workbench does.
-        super::model_cmd::ensure_scenario_robot(start.scenario, super::offline())?;
+        if start.runs_tree {
+            super::model_cmd::ensure_scenario_robot(start.scenario, super::offline())?;
+        }
         let path = match start.scenario_path {
             Some(path) => path.to_path_buf(),
             None => start

@@ -52,7 +52,11 @@ pub fn export(
         let path = super::find_scenario(source)?;
         let scenario = load(&path)?;
         super::goal_of(&scenario, None)?;
-        let mut session = Driver::start(Start::new(&scenario))?;
+        // Planned only: the run that colours a DOT export starts its own session below.
+        let mut session = Driver::start(Start {
+            runs_tree: false,
+            ..Start::new(&scenario)
+        })?;
         session.plan(None)?;
         let tree = Arc::unwrap_or_clone(session.tree()?);
         (path, tree, Vec::new())

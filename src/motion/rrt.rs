@@ -1,7 +1,8 @@
 //! Collision-free paths in one arm's joint space: the straight segment when it is free,
 //! else RRT-Connect (two trees, from the start and from the goal, each extended towards
-//! random samples and greedily towards the other; a step stopped by a collision keeps
-//! its free part when that is a quarter step or more) within a budget of samples, then
+//! random samples and greedily towards the other, a step reaching up to a fifth of the
+//! arm's joint space across as OMPL's RRTConnect does; a step stopped by a collision
+//! keeps its free part when that is a quarter step or more) within a budget of samples, then
 //! shortcutting (random pairs of points on the path joined straight when the segment is
 //! free). Segments are checked at a fixed joint resolution. The random sequence comes
 //! from the seed, so a query gives the same path every time.
@@ -19,8 +20,10 @@ pub struct PlanOptions {
     pub seed: u64,
     /// Random samples drawn at most before giving up.
     pub samples: usize,
-    /// Longest step (radians, joint-space distance) a tree grows at once.
-    pub step: f64,
+    /// Longest step a tree grows at once, as a fraction of the diagonal of the arm's
+    /// joint limits (its joint space across). Short steps explore slowly: a goal far from
+    /// the start behind a narrow way then needs many more samples than the budget.
+    pub range: f64,
     /// Largest joint-space distance between two configurations checked along a segment.
     pub resolution: f64,
     /// Attempts at shortening the path found.
@@ -34,7 +37,7 @@ impl Default for PlanOptions {
         PlanOptions {
             seed: 39,
             samples: 4000,
-            step: 0.4,
+            range: 0.2,
             resolution: 0.03,
             shortcuts: 60,
             keep_partial: true,
@@ -117,6 +120,8 @@ enum Grown {
 struct Search<'c, 'a> {
     check: &'c ArmCheck<'a>,
     options: PlanOptions,
+    /// Longest step (radians, joint-space distance) a tree grows at once.
+    step: f64,
     checks: usize,
     /// How often each blocker stopped a step.
     blocked: BTreeMap<String, usize>,
@@ -152,10 +157,10 @@ impl Search<'_, '_> {
         let near = tree.nearest(target);
         let from = tree.point(near).to_vec();
         let d = distance(&from, target);
-        let (to, reached) = if d <= self.options.step {
+        let (to, reached) = if d <= self.step {
             (target.to_vec(), true)
         } else {
-            let t = self.options.step / d;
+            let t = self.step / d;
             (
                 from.iter()
                     .zip(target)
@@ -175,7 +180,7 @@ impl Search<'_, '_> {
         }
         // The free part of a blocked step is kept when it is a step of its own: the tree
         // grows up to what is in the way rather than not at all.
-        if self.options.keep_partial && free * distance(&from, &to) >= self.options.step / 4.0 {
+        if self.options.keep_partial && free * distance(&from, &to) >= self.step / 4.0 {
             let part: Vec<f64> = from
                 .iter()
                 .zip(&to)
@@ -227,9 +232,16 @@ pub fn plan(
             });
         }
     }
+    let across = chain
+        .joints
+        .iter()
+        .map(|j| (j.upper - j.lower).powi(2))
+        .sum::<f64>()
+        .sqrt();
     let mut search = Search {
         check,
         options: *options,
+        step: options.range * across,
         checks: 2,
         blocked: BTreeMap::new(),
     };
