@@ -317,7 +317,10 @@ fn the_robot_description_is_fetched_while_the_workbench_is_open_and_the_arms_the
     }
     assert!(screen.contains("No collision free path"), "{screen}");
     assert!(screen.contains("collides with red cube"), "{screen}");
-    // The proposal waits for approval, so q asks once more.
+    // The proposal waits for approval, so q asks once more. The model is asked after the
+    // failure's conditions are tried in simulation, so the proposal may come a little
+    // after the failure shows.
+    tmux.wait_for(&["a approve · x reject · e edit"], 60);
     tmux.keys(&["q"]);
     tmux.wait_for(&["Press q again to quit"], 10);
     tmux.keys(&["q"]);
