@@ -134,8 +134,8 @@ pub const BACK_REFERENCES: &[&str] = &["it", "them", "it's", "its", "they", "tho
 pub const TOWARDS: &[&str] = &["to", "at", "on", "onto", "into", "in"];
 
 /// Words that say where an item comes from, not where it goes ("bring the lettuce in
-/// from the cold frame to the bench", "take the flask out of the incubator").
-pub const SOURCES: &[&str] = &["from", "out of"];
+/// from the cold frame to the bench").
+pub const SOURCES: &[&str] = &["from"];
 
 /// Words of courtesy and time that ask for nothing ("thanks", "right away").
 pub const COURTESY: &[&str] = &[
@@ -160,17 +160,6 @@ pub const SHARED: &[(&str, &str)] = &[(
 
 fn has(list: &[&str], word: &str) -> bool {
     list.contains(&word)
-}
-
-/// Whether `words` (a request's words in a row) say that what follows is where an item
-/// comes from.
-pub fn says_source(words: &[String]) -> bool {
-    SOURCES.iter().any(|phrase| {
-        let phrase: Vec<&str> = phrase.split(' ').collect();
-        words
-            .windows(phrase.len())
-            .any(|w| w.iter().zip(&phrase).all(|(a, b)| a == b))
-    })
 }
 
 /// Whether `word` asks for every object of the kind named after it.

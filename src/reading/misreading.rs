@@ -15,7 +15,6 @@
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
 //! | `fewer-than-every` | a condition asked of every object of a kind ("both vents", "all the tables") held for some of them only | the same condition for the others beside it |
 //! | `left-out` | one of two things named side by side left out ("fries or a dessert" read as the dessert) | the one left out put beside the other, joined as the request joins them |
-//! | `referent` | "it" or "them" read as an object no word names ("prune the basil, then water it" read as watering the mint) | the object named last before it, in that condition |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
 
 use crate::goal::Formula;
@@ -25,7 +24,6 @@ use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
 use super::polarity::{left_unanswered, turned_around, turned_back, with_unanswered};
-use super::referents::{referent_back, referent_swapped};
 use super::relation_words::{convention_followed, relation_as_said};
 use super::request::Request;
 use super::side_by_side::{left_out, with_left_out};
@@ -50,7 +48,6 @@ pub const MISREADINGS: &[&dyn Misreading] = &[
     &RelationAsSaid,
     &Convention,
     &FewerThanEvery,
-    &Referent,
     &NotPut,
     &LeftOut,
 ];
@@ -244,29 +241,6 @@ impl Misreading for FewerThanEvery {
             return Vec::new();
         };
         with_every(goal, request)
-            .map(|g| (g, why))
-            .into_iter()
-            .collect()
-    }
-}
-
-struct Referent;
-impl Misreading for Referent {
-    fn name(&self) -> &'static str {
-        "referent"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        referent_swapped(goal, request).map(|(atom, referent)| {
-            format!(
-                "the request's \"it\" or \"them\" stands for {referent}, which {atom} of {goal} has another object in place of"
-            )
-        })
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        let Some(why) = self.find(goal, request) else {
-            return Vec::new();
-        };
-        referent_back(goal, request)
             .map(|g| (g, why))
             .into_iter()
             .collect()

@@ -10,8 +10,7 @@
 //! the relation said before a place
 //! and a scene's conventions ([`relation_words`]), and about a goal's objects and
 //! conjuncts ([`names`]), about the order of a relation's objects ([`order`]), and about
-//! the kinds a "both", "all" or "every" asks each object of ([`kinds`]), and what "it" and
-//! "them" stand for ([`referents`]).
+//! the kinds a "both", "all" or "every" asks each object of ([`kinds`]).
 //!
 //! The session asks the model and judges its answers with what is here; formula rewrites
 //! that know nothing of words (rename, map atoms, flip) are [`crate::goal::rewrite`]'s.
@@ -25,7 +24,6 @@ pub mod order;
 pub mod parts;
 pub mod placement;
 pub mod polarity;
-pub mod referents;
 pub mod relation_words;
 pub mod request;
 pub mod side_by_side;

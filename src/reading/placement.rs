@@ -8,7 +8,7 @@ use crate::domain::{Atom, Object, Predicate, Vocabulary};
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
-use super::english::{BACK_REFERENCES, MOVING_VERBS, TOWARDS, says_source};
+use super::english::{MOVING_VERBS, SOURCES, TOWARDS};
 use super::polarity::find_phrase;
 use super::request::{Mention, Request};
 use super::words::{same_word, terms};
@@ -261,8 +261,7 @@ pub(super) fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
 
 /// The items the request sends to a place, each with its place: an item named before
 /// "to"/"at"/"on" and a place named right after, in one clause, with no verb of the
-/// robot's own moving between them; items named after an earlier place go to the next;
-/// "it" or "them" is the item named last, in this clause or one before.
+/// robot's own moving between them; items named after an earlier place go to the next.
 /// Items and places are the objects the scene's relating predicates take.
 /// [`Request::sent`] keeps them.
 pub(super) fn sent(request: &Request) -> Vec<Sent> {
@@ -276,9 +275,6 @@ pub(super) fn sent(request: &Request) -> Vec<Sent> {
     let items: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 0)).collect();
     let places: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 1)).collect();
     let mut out: Vec<Sent> = Vec::new();
-    // The item named last, which "it" or "them" stands for ("repot the seedlings, put
-    // them on bench 3").
-    let mut last_item: Option<String> = None;
     for words in &request.clauses {
         let place_spans = mentions(words, &places, &[]);
         let covered: Vec<usize> = place_spans
@@ -303,12 +299,6 @@ pub(super) fn sent(request: &Request) -> Vec<Sent> {
                     waiting.clear();
                 }
                 waiting.push(item.clone());
-                last_item = Some(item.clone());
-            } else if waiting.is_empty()
-                && BACK_REFERENCES.contains(&word.as_str())
-                && let Some(item) = &last_item
-            {
-                waiting.push(item.clone());
             }
             if !TOWARDS.contains(&word.as_str()) || waiting.is_empty() {
                 continue;
@@ -322,7 +312,10 @@ pub(super) fn sent(request: &Request) -> Vec<Sent> {
             };
             // "In from the cold frame": the place the item comes from; where it goes is
             // said next.
-            if says_source(&words[at + 1..*start]) {
+            if words[at + 1..*start]
+                .iter()
+                .any(|w| SOURCES.contains(&w.as_str()))
+            {
                 continue;
             }
             for item in waiting.drain(..) {
@@ -345,7 +338,7 @@ fn sources(request: &Request) -> Vec<String> {
     for (words, named) in request.clauses.iter().zip(request.clause_mentions()) {
         for (start, _, name) in named {
             let before = &words[start.saturating_sub(PLACE_WITHIN)..*start];
-            if says_source(before) {
+            if before.iter().any(|w| SOURCES.contains(&w.as_str())) {
                 out.push(name.clone());
             }
         }

@@ -308,28 +308,3 @@ fn an_alternative_about_an_item_alone_is_put_where_it_is_sent() {
         None
     );
 }
-
-#[test]
-fn it_is_the_item_named_last_and_out_of_says_where_it_comes_from() {
-    let v = vocabulary();
-    let moved = |goal: &str, request: &str| {
-        let goal = Formula::parse(goal).expect("test goal parses");
-        moved_there(&goal, &Request::among(request, &v)).map(|g| g.to_string())
-    };
-    // "it" in a clause of its own is the cup named before.
-    assert_eq!(
-        flagged("Holding_Cup", "Wash the cup, then put it on the bar."),
-        Some(("Cup".into(), "Bar".into()))
-    );
-    // "Out of table 1": where the cup comes from, so a cup left there is moved.
-    assert_eq!(
-        moved(
-            "On_Cup_Table1",
-            "Take the cup out of table 1, and put it on the bar."
-        )
-        .as_deref(),
-        Some("On_Cup_Bar")
-    );
-    // Nothing named before "it": nothing is sent.
-    assert_eq!(flagged("Holding_Cup", "Put it on the bar."), None);
-}
