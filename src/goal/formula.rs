@@ -41,6 +41,14 @@ impl Formula {
         Formula::and(literals.into_iter().map(Formula::literal).collect())
     }
 
+    /// The items of a conjunction, or the formula itself as the one item of any other.
+    pub fn conjuncts(&self) -> Vec<Formula> {
+        match self {
+            Formula::And(items) => items.clone(),
+            other => vec![other.clone()],
+        }
+    }
+
     /// A flattened conjunction: nested `And`s are merged, an item said twice is kept once
     /// (`A & A` is `A`), and a single item is returned as is.
     pub fn and(items: Vec<Formula>) -> Formula {

@@ -20,19 +20,10 @@ pub struct EveryOfKind {
     pub said: String,
 }
 
-/// The kinds `request` asks for every object of: a quantifier, then (past articles and
-/// "of") the words of a name, the last one what the object is, that at least two of the
-/// scene's objects share — exactly two after "both".
-pub fn every_of_kind(request: &Request) -> Vec<EveryOfKind> {
-    every_of_kind_in(
-        &request.unnumbered_words,
-        request.vocabulary,
-        request.lexicon,
-    )
-}
-
-/// [`every_of_kind`] in a run of words (a clause, say), as [`super::words::every_term`]
-/// gives them.
+/// The kinds `words` (a request's, or a clause's, as [`super::words::every_term`] gives
+/// them) ask for every object of: a quantifier, then (past articles and "of") the words
+/// of a name, the last one what the object is, that at least two of the scene's objects
+/// share — exactly two after "both". [`Request::every_of_kind`] keeps the whole request's.
 pub fn every_of_kind_in(
     words: &[String],
     vocabulary: &Vocabulary,
@@ -129,15 +120,8 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
     }
 }
 
-fn conjuncts(goal: &Formula) -> Vec<Formula> {
-    match goal {
-        Formula::And(items) => items.clone(),
-        other => vec![other.clone()],
-    }
-}
-
 fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>> {
-    let items = conjuncts(goal);
+    let items = goal.conjuncts();
     for kind in kinds {
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
@@ -172,8 +156,7 @@ fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>>
 
 /// How `goal` reads a request's "both"/"all"/"every" as fewer objects than the kind has.
 pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
-    let kinds = every_of_kind(request);
-    let found = left_out(goal, &kinds)?;
+    let found = left_out(goal, request.every_of_kind())?;
     let missing: Vec<String> = found.missing.iter().map(ToString::to_string).collect();
     Some(format!(
         "the request says \"{}\", which asks it of {}; {goal} leaves out {}",
@@ -185,9 +168,8 @@ pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
 
 /// `goal` with the conditions [`fewer_than_every`] finds left out put beside it.
 pub fn with_every(goal: &Formula, request: &Request) -> Option<Formula> {
-    let kinds = every_of_kind(request);
-    let found = left_out(goal, &kinds)?;
-    let mut items = conjuncts(goal);
+    let found = left_out(goal, request.every_of_kind())?;
+    let mut items = goal.conjuncts();
     items.extend(found.missing);
     Some(Formula::and(items))
 }
@@ -227,21 +209,21 @@ mod tests {
         ]);
         let lexicon = Lexicon::new(&v, &[]);
         let r = Request::in_scene("Clean both benches and the lamp.", &v, &[], &lexicon);
-        let kinds = every_of_kind(&r);
+        let kinds = r.every_of_kind();
         assert_eq!(kinds.len(), 1, "{kinds:?}");
         assert_eq!(kinds[0].objects, ["Bench1", "Bench2"]);
         // The words after the quantifier narrow the kind: "tube racks" is not the tube.
         let r = Request::in_scene("Move all the tube racks.", &v, &[], &lexicon);
-        assert!(every_of_kind(&r).is_empty(), "one tube rack is no kind");
+        assert!(r.every_of_kind().is_empty(), "one tube rack is no kind");
         // "both" of three is not every one; "each with" names no kind.
         let v3 = scene(&["Table1", "Table2", "Table3"]);
         let lexicon3 = Lexicon::new(&v3, &[]);
         let r = Request::in_scene("Wipe both tables.", &v3, &[], &lexicon3);
-        assert!(every_of_kind(&r).is_empty());
+        assert!(r.every_of_kind().is_empty());
         let r = Request::in_scene("Wipe all of the tables.", &v3, &[], &lexicon3);
-        assert_eq!(every_of_kind(&r)[0].objects.len(), 3);
+        assert_eq!(r.every_of_kind()[0].objects.len(), 3);
         let r = Request::in_scene("Two coffees, each with milk.", &v3, &[], &lexicon3);
-        assert!(every_of_kind(&r).is_empty());
+        assert!(r.every_of_kind().is_empty());
     }
 
     #[test]
@@ -258,8 +240,8 @@ mod tests {
         // Both there: nothing to find.
         let whole = goal("~Open_RoofVent & ~Open_SideVent & Running_Heater");
         assert_eq!(fewer_than_every(&whole, &r), None);
-        assert!(asked_of_every(&goal("~Open_SideVent"), &every_of_kind(&r)));
-        assert!(!asked_of_every(&goal("Running_Heater"), &every_of_kind(&r)));
+        assert!(asked_of_every(&goal("~Open_SideVent"), r.every_of_kind()));
+        assert!(!asked_of_every(&goal("Running_Heater"), r.every_of_kind()));
         // A request without a quantifier asks nothing of the kind.
         let r = Request::in_scene("Close the roof vent.", &v, &[], &lexicon);
         assert_eq!(fewer_than_every(&goal("~Open_RoofVent"), &r), None);

@@ -7,7 +7,7 @@ use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
 use super::english::{is_generic, is_phrasing, offers_choice};
-use super::kinds::{asked_of_every, every_of_kind};
+use super::kinds::asked_of_every;
 use super::placement::named_in;
 use super::request::Request;
 use super::words::{is_number, same_word, terms};
@@ -68,11 +68,11 @@ pub fn unasked(goal: &Formula, request: &Request) -> Vec<Formula> {
     let said = |w: &String| asked.iter().filter(|a| same_word(a, w)).count();
     let claimed = |w: &String| by_atom.iter().filter(|c| c.contains(w)).count();
     // "Both benches" asks for each bench's condition with one word for the kind.
-    let every = every_of_kind(request);
+    let every = request.every_of_kind();
     items
         .iter()
         .zip(&covered)
-        .filter(|(item, _)| !asked_of_every(item, &every))
+        .filter(|(item, _)| !asked_of_every(item, every))
         .filter(|(_, words)| words.iter().all(|w| claimed(w) > said(w)))
         .map(|(item, _)| item.clone())
         .collect()
@@ -182,11 +182,7 @@ pub fn factored(goal: &Formula) -> Formula {
     let Formula::Or(alternatives) = goal else {
         return goal.clone();
     };
-    let conjuncts = |f: &Formula| match f {
-        Formula::And(items) => items.clone(),
-        other => vec![other.clone()],
-    };
-    let lists: Vec<Vec<Formula>> = alternatives.iter().map(conjuncts).collect();
+    let lists: Vec<Vec<Formula>> = alternatives.iter().map(Formula::conjuncts).collect();
     let Some((first, rest)) = lists.split_first() else {
         return goal.clone();
     };

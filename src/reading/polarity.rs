@@ -140,26 +140,23 @@ pub(super) fn asked_in_sentences(request: &Request) -> Vec<Asked> {
     let mut both: Vec<(String, String)> = Vec::new();
     for scope in &request.scopes {
         let (clause, choice) = (&scope.words, scope.choice);
+        // "Close both vents" asks it of each vent.
+        let of_every: Vec<String> = every_of_kind_in(clause, vocabulary, request.lexicon)
+            .into_iter()
+            .flat_map(|k| k.objects)
+            .collect();
         for predicate in &vocabulary.predicates {
             let Some((wanted, word)) = clause_polarity(clause, predicate) else {
                 continue;
             };
-            // "Close both vents" asks it of each vent.
-            let of_every = every_of_kind_in(clause, vocabulary, request.lexicon)
-                .into_iter()
-                .flat_map(|k| k.objects)
-                .filter(|name| {
-                    predicate.arg_types.first().is_some_and(|slot| {
-                        vocabulary
-                            .objects
-                            .iter()
-                            .any(|o| &o.name == name && o.fits(slot))
-                    })
-                });
             let mut named = subjects(clause, predicate, vocabulary);
-            for object in of_every {
-                if !named.contains(&object) {
-                    named.push(object);
+            let slot = predicate.arg_types.first();
+            for object in of_every
+                .iter()
+                .filter(|o| slot.is_some_and(|slot| vocabulary.fits(o, slot)))
+            {
+                if !named.contains(object) {
+                    named.push(object.clone());
                 }
             }
             for object in named {

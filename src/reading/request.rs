@@ -1,7 +1,7 @@
 //! A request read once, with the scene it is read in: its words, its clauses and
 //! sentences, the negation scopes its conditions are read in, the choices it offers, and
-//! (computed on first use, then kept) the scene's objects it mentions and what it asks
-//! for in the scene's words. Every reader of a request takes this value, so no reader
+//! (computed on first use, then kept) the scene's objects it mentions, what it asks for
+//! in the scene's words and the kinds it asks for every object of. Every reader of a request takes this value, so no reader
 //! splits the text again.
 
 use std::sync::OnceLock;
@@ -9,6 +9,7 @@ use std::sync::OnceLock;
 use crate::domain::{Object, Vocabulary};
 use crate::scenario::{Convention, Scenario};
 
+use super::kinds::{EveryOfKind, every_of_kind_in};
 use super::lexicon::Lexicon;
 use super::names::choices_offered;
 use super::placement::{Sent, mentions, sent};
@@ -60,6 +61,7 @@ pub struct Request<'a> {
     clause_mentions: OnceLock<Vec<Vec<Mention>>>,
     asked: OnceLock<Vec<Asked>>,
     sent: OnceLock<Vec<Sent>>,
+    every_of_kind: OnceLock<Vec<EveryOfKind>>,
 }
 
 impl<'a> Request<'a> {
@@ -111,6 +113,7 @@ impl<'a> Request<'a> {
             clause_mentions: OnceLock::new(),
             asked: OnceLock::new(),
             sent: OnceLock::new(),
+            every_of_kind: OnceLock::new(),
         }
     }
 
@@ -142,6 +145,12 @@ impl<'a> Request<'a> {
     /// The items the request sends to a place ([`super::placement`]).
     pub(super) fn sent(&self) -> &[Sent] {
         self.sent.get_or_init(|| sent(self))
+    }
+
+    /// The kinds it asks for every object of ("both vents"; [`super::kinds`]).
+    pub fn every_of_kind(&self) -> &[EveryOfKind] {
+        self.every_of_kind
+            .get_or_init(|| every_of_kind_in(&self.unnumbered_words, self.vocabulary, self.lexicon))
     }
 
     fn objects(&self) -> Vec<&'a Object> {
