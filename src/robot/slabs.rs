@@ -41,11 +41,6 @@ impl Bounds {
         (0..3).any(|k| self.mins[k] > self.maxs[k])
     }
 
-    fn take(&mut self, p: &Point3<f32>) {
-        self.mins = self.mins.inf(p);
-        self.maxs = self.maxs.sup(p);
-    }
-
     fn merged(&self, other: &Bounds) -> Bounds {
         Bounds {
             mins: self.mins.inf(&other.mins),
@@ -61,13 +56,26 @@ impl Bounds {
     }
 }
 
+/// A triangle's corners as plain arrays: the cutting runs for every triangle of every
+/// mesh at each start, and nalgebra's generic indexing is slow in an unoptimized build.
+type Corners = [[f32; 3]; 3];
+
+/// The least and greatest corner of what a slab holds so far.
+type Extent = ([f32; 3], [f32; 3]);
+
+const NO_EXTENT: Extent = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+
 /// The boxes (at most `max_boxes`, fewer when one more is hardly smaller) that together
 /// hold `triangles`, cut along whichever of the mesh's three axes gives the least volume.
 /// Empty when there are no triangles.
 pub(super) fn stacked_boxes(triangles: &[[Point3<f32>; 3]], max_boxes: usize) -> Vec<Bounds> {
+    let corners: Vec<Corners> = triangles
+        .iter()
+        .map(|t| [t[0].into(), t[1].into(), t[2].into()])
+        .collect();
     let mut best: Option<(f32, Vec<Bounds>)> = None;
     for axis in 0..3 {
-        let boxes = along(triangles, axis, max_boxes);
+        let boxes = merge(&fine_slabs(&corners, axis), max_boxes);
         let volume: f32 = boxes.iter().map(Bounds::volume).sum();
         if best.as_ref().is_none_or(|(v, _)| volume < *v) {
             best = Some((volume, boxes));
@@ -76,8 +84,9 @@ pub(super) fn stacked_boxes(triangles: &[[Point3<f32>; 3]], max_boxes: usize) ->
     best.map(|(_, b)| b).unwrap_or_default()
 }
 
-/// The fine slabs' boxes along `axis`, merged into the fewest groups worth having.
-fn along(triangles: &[[Point3<f32>; 3]], axis: usize, max_boxes: usize) -> Vec<Bounds> {
+/// The boxes of `FINE_SLABS` equal slabs along `axis` between the mesh's extremes; none
+/// when there are no triangles.
+fn fine_slabs(triangles: &[Corners], axis: usize) -> Vec<Bounds> {
     let (lo, hi) = triangles
         .iter()
         .flatten()
@@ -97,36 +106,65 @@ fn along(triangles: &[[Point3<f32>; 3]], axis: usize, max_boxes: usize) -> Vec<B
             }
         })
         .collect();
-    let fine: Vec<Bounds> = cuts
-        .windows(2)
-        .map(|w| slab(triangles, axis, w[0], w[1]))
-        .collect();
-    merge(&fine, max_boxes)
+    // A triangle adds to the slabs its extent along the axis meets and to no other, so
+    // each is cut only against those (one more either side for the rounding of `step`).
+    let mut fine = vec![NO_EXTENT; FINE_SLABS];
+    for t in triangles {
+        let (t_lo, t_hi) = t
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[axis]), h.max(p[axis]))
+            });
+        let (first, last) = if step > 0.0 {
+            let index = |x: f32| ((x - lo) / step).floor().max(0.0) as usize;
+            (
+                index(t_lo).saturating_sub(1),
+                (index(t_hi) + 1).min(FINE_SLABS - 1),
+            )
+        } else {
+            (0, FINE_SLABS - 1)
+        };
+        for (i, extent) in fine.iter_mut().enumerate().take(last + 1).skip(first) {
+            take_part(extent, t, axis, cuts[i], cuts[i + 1]);
+        }
+    }
+    fine.into_iter()
+        .map(|(mins, maxs)| Bounds {
+            mins: Point3::from(mins),
+            maxs: Point3::from(maxs),
+        })
+        .collect()
 }
 
-/// The box around the parts of `triangles` with `a <= p[axis] <= b`.
-fn slab(triangles: &[[Point3<f32>; 3]], axis: usize, a: f32, b: f32) -> Bounds {
-    let mut bounds = Bounds::empty();
-    for t in triangles {
-        for (i, p) in t.iter().enumerate() {
-            if (a..=b).contains(&p[axis]) {
-                bounds.take(p);
-            }
-            let q = &t[(i + 1) % 3];
-            for plane in [a, b] {
-                let (u, v) = (p[axis] - plane, q[axis] - plane);
-                // The edge crosses the plane (strictly: a corner on it is taken above).
-                if u * v < 0.0 {
-                    let s = u / (u - v);
-                    let mut x = p + (q - p) * s;
-                    // Exactly on the plane, whatever the rounding of the line above.
-                    x[axis] = plane;
-                    bounds.take(&x);
+/// Takes into `extent` the part of triangle `t` with `a <= p[axis] <= b`.
+fn take_part(extent: &mut Extent, t: &Corners, axis: usize, a: f32, b: f32) {
+    let (lo, hi) = extent;
+    let mut take = |x: &[f32; 3]| {
+        for k in 0..3 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    };
+    for (i, p) in t.iter().enumerate() {
+        if a <= p[axis] && p[axis] <= b {
+            take(p);
+        }
+        let q = &t[(i + 1) % 3];
+        for plane in [a, b] {
+            let (u, v) = (p[axis] - plane, q[axis] - plane);
+            // The edge crosses the plane (strictly: a corner on it is taken above).
+            if u * v < 0.0 {
+                let s = u / (u - v);
+                let mut x = [0.0; 3];
+                for k in 0..3 {
+                    x[k] = p[k] + (q[k] - p[k]) * s;
                 }
+                // Exactly on the plane, whatever the rounding of the line above.
+                x[axis] = plane;
+                take(&x);
             }
         }
     }
-    bounds
 }
 
 /// The partition of `fine` into consecutive groups with the least total volume for each
@@ -241,6 +279,53 @@ mod tests {
                     "{p:?} outside {boxes:?}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn each_slab_holds_what_cutting_every_triangle_against_it_gives() {
+        // Triangles of every size and slant, some corners exactly on cuts.
+        let mut state = 7u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let mut mesh: Vec<Corners> = cuboid([0.0, 0.0, 0.0], [1.0, 0.5, 0.25])
+            .iter()
+            .map(|t| [t[0].into(), t[1].into(), t[2].into()])
+            .collect();
+        for _ in 0..300 {
+            let mut corner = || [next(), next() * 0.5, next() * 0.25];
+            mesh.push([corner(), corner(), corner()]);
+        }
+        for axis in 0..3 {
+            let (lo, hi) = mesh
+                .iter()
+                .flatten()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), p| {
+                    (l.min(p[axis]), h.max(p[axis]))
+                });
+            let step = (hi - lo) / FINE_SLABS as f32;
+            let cut = |i: usize| {
+                if i == FINE_SLABS {
+                    hi
+                } else {
+                    lo + step * i as f32
+                }
+            };
+            let every: Vec<Bounds> = (0..FINE_SLABS)
+                .map(|i| {
+                    let mut e = NO_EXTENT;
+                    for t in &mesh {
+                        take_part(&mut e, t, axis, cut(i), cut(i + 1));
+                    }
+                    Bounds {
+                        mins: Point3::from(e.0),
+                        maxs: Point3::from(e.1),
+                    }
+                })
+                .collect();
+            assert_eq!(fine_slabs(&mesh, axis), every, "axis {axis}");
         }
     }
 
