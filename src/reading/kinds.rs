@@ -1,29 +1,34 @@
-//! Every object of a kind: a request that says "both vents", "all the tables" or "every
+//! The objects of a kind: a request that says "both vents", "all the tables" or "every
 //! bench" asks the same of each of the scene's objects whose name says that kind, though
-//! it names none of them by itself. A goal that has the condition for some of them only
-//! has read the plural as one object; a check that counts the words a condition answers
-//! to must not take the second bench's condition for one no word asks for.
+//! it names none of them by itself; one that says "either tote" asks it of one of the
+//! two, whichever. A goal that has the condition for some of every one only has read the
+//! plural as one object, and one that has it for one tote (or for both, side by side) has
+//! made the choice the request left open; a check that counts the words a condition
+//! answers to must not take the second bench's condition for one no word asks for.
 
 use crate::domain::{Atom, Vocabulary};
 use crate::goal::Formula;
 
-use super::english::{is_quantifier, may_precede_thing};
+use super::english::{Quantity, may_precede_thing, quantity};
 use super::lexicon::Lexicon;
 use super::request::Request;
 use super::words::{is_number, same_word, terms};
 
-/// The objects a quantifier asks for each of, with the words that said so ("both
-/// benches").
+/// The objects a quantifier asks something of, with the words that said so ("both
+/// benches") and whether it asks it of each or of one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EveryOfKind {
     pub objects: Vec<String>,
     pub said: String,
+    pub quantity: Quantity,
 }
 
 /// The kinds `words` (a request's, or a clause's, as [`super::words::every_term`] gives
-/// them) ask for every object of: a quantifier, then (past articles and "of") the words
-/// of a name, the last one what the object is, that at least two of the scene's objects
-/// share — exactly two after "both". [`Request::every_of_kind`] keeps the whole request's.
+/// them) ask something of every object of, or of one: a quantifier, then (past articles
+/// and "of") the words of a name, the last one what the object is, that at least two of
+/// the scene's objects share — exactly two after "both" or "either" (an "either" that an
+/// "or" follows offers its own choice). [`Request::every_of_kind`] keeps the whole
+/// request's, sentence by sentence.
 pub fn every_of_kind_in(
     words: &[String],
     vocabulary: &Vocabulary,
@@ -31,9 +36,9 @@ pub fn every_of_kind_in(
 ) -> Vec<EveryOfKind> {
     let mut out = Vec::new();
     for (at, word) in words.iter().enumerate() {
-        if !is_quantifier(word) {
+        let Some(quantity) = quantity(word) else {
             continue;
-        }
+        };
         let mut next = at + 1;
         while words
             .get(next)
@@ -69,7 +74,12 @@ pub fn every_of_kind_in(
             })
             .map(|o| o.name.clone())
             .collect();
-        let enough = if word == "both" {
+        // "Either yogurt or an apple" offers its own choice: "either" is no quantifier
+        // when an "or" follows it.
+        if quantity == Quantity::OneOf && words[next..].iter().any(|w| w == "or") {
+            continue;
+        }
+        let enough = if word == "both" || quantity == Quantity::OneOf {
             objects.len() == 2
         } else {
             objects.len() >= 2
@@ -82,14 +92,15 @@ pub fn every_of_kind_in(
             out.push(EveryOfKind {
                 objects,
                 said: said.join(" "),
+                quantity,
             });
         }
     }
     out
 }
 
-/// Whether every atom of `part` is about an object of a kind the request asks for each
-/// of: such a condition is asked for though no word names its object alone.
+/// Whether every atom of `part` is about an object of a kind the request asks something of
+/// (each, or one): such a condition is asked for though no word names its object alone.
 pub fn asked_of_every(part: &Formula, kinds: &[EveryOfKind]) -> bool {
     let atoms = part.atoms();
     !atoms.is_empty()
@@ -122,7 +133,7 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
 
 fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>> {
     let items = goal.conjuncts();
-    for kind in kinds {
+    for kind in kinds.iter().filter(|k| k.quantity == Quantity::Every) {
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
             let Some((atom, holds)) = literal(item) else {
@@ -171,6 +182,74 @@ pub fn with_every(goal: &Formula, request: &Request) -> Option<Formula> {
     let found = left_out(goal, request.every_of_kind())?;
     let mut items = goal.conjuncts();
     items.extend(found.missing);
+    Some(Formula::and(items))
+}
+
+/// A condition of `goal` about one object of a kind the request leaves the choice of
+/// ("either tote"), held for it alone or for each side by side: the kind, the conjuncts
+/// that made the choice, and the choice left open.
+struct Chosen<'k> {
+    kind: &'k EveryOfKind,
+    made: Vec<Formula>,
+    open: Formula,
+}
+
+fn chosen<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<Chosen<'k>> {
+    let items = goal.conjuncts();
+    for kind in kinds.iter().filter(|k| k.quantity == Quantity::OneOf) {
+        for item in &items {
+            let Some((atom, holds)) = literal(item) else {
+                continue;
+            };
+            let Some(slot) = atom.args.iter().position(|a| kind.objects.contains(a)) else {
+                continue;
+            };
+            let each: Vec<Formula> = kind
+                .objects
+                .iter()
+                .map(|o| {
+                    let mut args = atom.args.clone();
+                    args[slot] = o.clone();
+                    let same = Formula::Atom(Atom::new(atom.predicate.clone(), args));
+                    if holds {
+                        same
+                    } else {
+                        Formula::Not(Box::new(same))
+                    }
+                })
+                .collect();
+            let open = Formula::or(each.clone());
+            if items.contains(&open) {
+                continue;
+            }
+            let made: Vec<Formula> = items.iter().filter(|i| each.contains(i)).cloned().collect();
+            return Some(Chosen { kind, made, open });
+        }
+    }
+    None
+}
+
+/// How `goal` makes the choice a request's "either" leaves open.
+pub fn choice_made(goal: &Formula, request: &Request) -> Option<String> {
+    let found = chosen(goal, request.every_of_kind())?;
+    let made: Vec<String> = found.made.iter().map(ToString::to_string).collect();
+    Some(format!(
+        "the request says \"{}\", which leaves the choice between {}; {goal} asks for {}",
+        found.kind.said,
+        found.kind.objects.join(" and "),
+        made.join(" and ")
+    ))
+}
+
+/// `goal` with the choice [`choice_made`] finds left open again.
+pub fn with_choice_open(goal: &Formula, request: &Request) -> Option<Formula> {
+    let found = chosen(goal, request.every_of_kind())?;
+    let mut items: Vec<Formula> = goal
+        .conjuncts()
+        .into_iter()
+        .filter(|i| !found.made.contains(i))
+        .collect();
+    items.push(found.open);
     Some(Formula::and(items))
 }
 
@@ -245,5 +324,43 @@ mod tests {
         // A request without a quantifier asks nothing of the kind.
         let r = Request::in_scene("Close the roof vent.", &v, &[], &lexicon);
         assert_eq!(fewer_than_every(&goal("~Open_RoofVent"), &r), None);
+    }
+
+    #[test]
+    fn either_of_a_kind_of_two_leaves_the_choice_open() {
+        let v = scene(&["Tote1", "Tote2", "Conveyor", "BigBox"]);
+        let lexicon = Lexicon::new(&v, &[]);
+        let r = Request::in_scene(
+            "Scan either tote and start the conveyor.",
+            &v,
+            &[],
+            &lexicon,
+        );
+        assert_eq!(r.every_of_kind()[0].quantity, Quantity::OneOf);
+        let one = goal("Scanned_Tote1 & Running_Conveyor");
+        assert!(choice_made(&one, &r).is_some_and(|m| m.contains("either tote")));
+        let open = goal("Running_Conveyor & (Scanned_Tote1 | Scanned_Tote2)");
+        assert_eq!(with_choice_open(&one, &r), Some(open.clone()));
+        // Both, side by side, also made the choice.
+        let both = goal("Scanned_Tote1 & Scanned_Tote2 & Running_Conveyor");
+        assert_eq!(with_choice_open(&both, &r), Some(open.clone()));
+        assert_eq!(choice_made(&open, &r), None);
+        // "Either" asks nothing of every tote, and the other tote is asked for.
+        assert_eq!(fewer_than_every(&one, &r), None);
+        assert!(asked_of_every(
+            &goal("Scanned_Tote1 | Scanned_Tote2"),
+            r.every_of_kind()
+        ));
+        // "Either … or" offers its own choice, whatever the kind of the first thing.
+        let r = Request::in_scene("Scan either tote or the big box.", &v, &[], &lexicon);
+        assert!(r.every_of_kind().is_empty(), "{:?}", r.every_of_kind());
+        // "Either" before a name of one object leaves no choice of a kind.
+        let r = Request::in_scene(
+            "Either scan the big box or start the conveyor.",
+            &v,
+            &[],
+            &lexicon,
+        );
+        assert!(r.every_of_kind().is_empty(), "{:?}", r.every_of_kind());
     }
 }
