@@ -23,7 +23,8 @@ fn repo() -> &'static Path {
 /// `betr bench PARTS --quick` in the repository (it reads scenarios/ and ../shared), the
 /// JSON written to a scratch file.
 fn bench(parts: &[&str], extra: &[&str]) -> (Output, serde_json::Value) {
-    let json = support::cli::tmp(&format!("bench-{}", parts.join("-"))).join("bench.json");
+    let scratch = support::cli::tmp(&format!("bench-{}", parts.join("-")));
+    let json = scratch.join("bench.json");
     let out = Command::new(env!("CARGO_BIN_EXE_betr"))
         .arg("bench")
         .args(parts)

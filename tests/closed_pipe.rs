@@ -7,10 +7,10 @@
 
 mod support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Output, Stdio};
 
-use support::cli::{command, openai_flags, resolve_yes, text, tmp};
+use support::cli::{Scratch, command, openai_flags, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -39,13 +39,13 @@ fn closed_early(dir: &Path, args: &[&str]) -> Output {
 }
 
 /// Two scratch directories, one for each way of running.
-fn twins(name: &str) -> (PathBuf, PathBuf) {
+fn twins(name: &str) -> (Scratch, Scratch) {
     (tmp(&format!("{name}-read")), tmp(&format!("{name}-closed")))
 }
 
 /// Run `args` both ways in their own directory and check that they end alike; the
 /// directories are returned for what they saved.
-fn both_ways(name: &str, args: &[&str]) -> (PathBuf, PathBuf) {
+fn both_ways(name: &str, args: &[&str]) -> (Scratch, Scratch) {
     let (read, closed) = twins(name);
     let whole = read_whole(&read, args);
     let cut = closed_early(&closed, args);

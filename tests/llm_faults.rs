@@ -7,11 +7,10 @@
 
 mod support;
 
-use std::path::PathBuf;
 use std::process::Output;
 use std::time::Duration;
 
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{KEY_VAR, Scratch, betr, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -19,7 +18,7 @@ use support::fixtures;
 const SAVED: &str = "fallback\n  On_Coffee_WindowTable6?\n";
 
 struct Case {
-    dir: PathBuf,
+    dir: Scratch,
     scenario: String,
 }
 

@@ -399,7 +399,8 @@ fn a_recording_can_be_discarded_and_a_silent_one_is_refused() {
 #[test]
 fn a_replay_steps_back_to_the_failure_and_on_to_the_proposal() {
     use betr::tui::replay::{Player, ReplayScreen};
-    let file = support::cli::tmp("snapshot-replay").join("session.jsonl");
+    let scratch = support::cli::tmp("snapshot-replay");
+    let file = scratch.join("session.jsonl");
     let replay = support::recorded::scenario_1(&file);
     let player = Player::of(replay, KeyBindings::default(), Theme::default());
     let mut s = ReplayScreen::open(player, usize::MAX);

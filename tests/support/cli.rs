@@ -7,11 +7,43 @@ use std::process::{Command, Output};
 pub const KEY_VAR: &str = "BETR_TEST_SECRET_KEY";
 pub const KEY: &str = "sk-betr-e2e-SECRET-5f3c9a1e7d";
 
-pub fn tmp(name: &str) -> PathBuf {
+/// A scratch directory of one test, removed when the test is done with it; a failing
+/// test leaves it, for looking into.
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+/// A new, empty scratch directory named after the test's `name` and the process.
+pub fn tmp(name: &str) -> Scratch {
     let d = std::env::temp_dir().join(format!("betr-e2e-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    Scratch(d)
 }
 
 /// Run the binary in `dir` with HOME and XDG dirs inside it, so every file it writes lands
