@@ -145,4 +145,12 @@ pub const SHIPPED: &[(&str, &str)] = &[
         "warehouse/warehouse.toml",
         include_str!("../../scenarios/warehouse/warehouse.toml"),
     ),
+    (
+        "hospital/examples.toml",
+        include_str!("../../scenarios/hospital/examples.toml"),
+    ),
+    (
+        "hospital/hospital.toml",
+        include_str!("../../scenarios/hospital/hospital.toml"),
+    ),
 ];
