@@ -133,6 +133,14 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../scenarios/greenhouse/greenhouse.toml"),
     ),
     (
+        "hospital/examples.toml",
+        include_str!("../../scenarios/hospital/examples.toml"),
+    ),
+    (
+        "hospital/hospital.toml",
+        include_str!("../../scenarios/hospital/hospital.toml"),
+    ),
+    (
         "lab/examples.toml",
         include_str!("../../scenarios/lab/examples.toml"),
     ),
@@ -144,13 +152,5 @@ pub const SHIPPED: &[(&str, &str)] = &[
     (
         "warehouse/warehouse.toml",
         include_str!("../../scenarios/warehouse/warehouse.toml"),
-    ),
-    (
-        "hospital/examples.toml",
-        include_str!("../../scenarios/hospital/examples.toml"),
-    ),
-    (
-        "hospital/hospital.toml",
-        include_str!("../../scenarios/hospital/hospital.toml"),
     ),
 ];
