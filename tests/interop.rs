@@ -91,9 +91,9 @@ fn the_trees_of_every_scenario_round_trip_through_btcpp_xml() {
         checked += 1;
     }
     // 10 failure scenarios, 7 parameter scenarios, the cafe of the dataset, the 7 new
-    // tasks of cell/tasks, the greenhouse, the lab, the warehouse, and the 2 scenarios
-    // only real arms fail.
-    assert_eq!(checked, 30, "{files:?}");
+    // tasks of cell/tasks, the greenhouse, the lab, the warehouse, the hospital, and the 2
+    // scenarios only real arms fail.
+    assert_eq!(checked, 31, "{files:?}");
     assert_eq!(with_value_ports, 7);
 }
 

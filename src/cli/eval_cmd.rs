@@ -39,8 +39,8 @@ pub enum EvalExperiment {
         runs: usize,
         /// Run every set of requests a suite file names (docs/eval-suite.toml: the cafe
         /// dataset, held-out cafe requests, the cell's scenarios, and the greenhouse's, the
-        /// lab's and the warehouse's held-out requests), each into a folder of its own, and
-        /// print them side by side; --dataset and --scenario are not used.
+        /// lab's, the warehouse's and the hospital's held-out requests), each into a folder
+        /// of its own, and print them side by side; --dataset and --scenario are not used.
         #[arg(long, value_name = "FILE")]
         suite: Option<PathBuf>,
         #[command(flatten)]

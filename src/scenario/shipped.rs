@@ -133,6 +133,14 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../scenarios/greenhouse/greenhouse.toml"),
     ),
     (
+        "hospital/examples.toml",
+        include_str!("../../scenarios/hospital/examples.toml"),
+    ),
+    (
+        "hospital/hospital.toml",
+        include_str!("../../scenarios/hospital/hospital.toml"),
+    ),
+    (
         "lab/examples.toml",
         include_str!("../../scenarios/lab/examples.toml"),
     ),
