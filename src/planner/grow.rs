@@ -424,6 +424,26 @@ pub(super) fn lead_condition(tree: &Tree, node: NodeId) -> Option<(NodeId, Condi
     }
 }
 
+/// Whether condition `node` is still needed after a tick that ended in `now`: not when a
+/// fallback above it has a first child, a condition other than the way to `node`, that
+/// holds now — what `node` was a precondition for is done ("the door open" for putting
+/// the linen at bed 3, once the linen is there, may be undone by closing the door).
+fn still_needed(tree: &Tree, node: NodeId, now: &dyn World) -> bool {
+    let mut child = node;
+    while let Ok(Some(parent)) = tree.parent(child) {
+        if matches!(tree.kind(parent), Ok(NodeKind::Fallback))
+            && let Some(&first) = tree.children(parent).ok().and_then(|c| c.first())
+            && first != child
+            && let Ok(NodeKind::Condition(goal)) = tree.kind(first)
+            && now.check(goal)
+        {
+            return false;
+        }
+        child = parent;
+    }
+    true
+}
+
 /// Watches a simulated run for a condition that held, then stopped holding because an
 /// action in a later sibling subtree undid it: either seen when the condition is ticked
 /// again and fails, or at the end of the very tick that checked it (a stale success that
@@ -457,7 +477,7 @@ impl FlipDetector {
                 }
                 Status::Success => {
                     self.held_since.remove(&node);
-                    if found.is_none() {
+                    if found.is_none() && still_needed(tree, node, now) {
                         found = self.culprit(tree, domain, node, condition, record.tick);
                     }
                 }
