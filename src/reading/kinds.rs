@@ -8,6 +8,7 @@
 
 use crate::domain::{Atom, Vocabulary};
 use crate::goal::Formula;
+use crate::goal::rewrite::rename;
 
 use super::english::{Quantity, may_precede_thing, quantity};
 use super::lexicon::Lexicon;
@@ -131,8 +132,16 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
     }
 }
 
-fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>> {
+fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
     let items = goal.conjuncts();
+    // A condition about an object the request names by itself ("lay bed two flat" beside
+    // "rails up on every bed") is said of that object, not of the kind.
+    let named: Vec<&str> = request
+        .mentions()
+        .iter()
+        .map(|(_, _, name)| name.as_str())
+        .collect();
+    let kinds = request.every_of_kind();
     for kind in kinds.iter().filter(|k| k.quantity == Quantity::Every) {
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
@@ -140,7 +149,7 @@ fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>>
                 continue;
             };
             for (slot, arg) in atom.args.iter().enumerate() {
-                if !kind.objects.contains(arg) {
+                if !kind.objects.contains(arg) || named.contains(&arg.as_str()) {
                     continue;
                 }
                 for other in kind.objects.iter().filter(|o| *o != arg) {
@@ -167,7 +176,7 @@ fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>>
 
 /// How `goal` reads a request's "both"/"all"/"every" as fewer objects than the kind has.
 pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
-    let found = left_out(goal, request.every_of_kind())?;
+    let found = left_out(goal, request)?;
     let missing: Vec<String> = found.missing.iter().map(ToString::to_string).collect();
     Some(format!(
         "the request says \"{}\", which asks it of {}; {goal} leaves out {}",
@@ -179,7 +188,7 @@ pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
 
 /// `goal` with the conditions [`fewer_than_every`] finds left out put beside it.
 pub fn with_every(goal: &Formula, request: &Request) -> Option<Formula> {
-    let found = left_out(goal, request.every_of_kind())?;
+    let found = left_out(goal, request)?;
     let mut items = goal.conjuncts();
     items.extend(found.missing);
     Some(Formula::and(items))
@@ -196,35 +205,35 @@ struct Chosen<'k> {
 
 fn chosen<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<Chosen<'k>> {
     let items = goal.conjuncts();
+    let about = |item: &Formula, object: &str| {
+        literal(item).is_some_and(|(atom, _)| atom.args.iter().any(|a| a == object))
+    };
     for kind in kinds.iter().filter(|k| k.quantity == Quantity::OneOf) {
-        for item in &items {
-            let Some((atom, holds)) = literal(item) else {
-                continue;
-            };
-            let Some(slot) = atom.args.iter().position(|a| kind.objects.contains(a)) else {
-                continue;
-            };
-            let each: Vec<Formula> = kind
-                .objects
-                .iter()
-                .map(|o| {
-                    let mut args = atom.args.clone();
-                    args[slot] = o.clone();
-                    let same = Formula::Atom(Atom::new(atom.predicate.clone(), args));
-                    if holds {
-                        same
-                    } else {
-                        Formula::Not(Box::new(same))
-                    }
-                })
-                .collect();
-            let open = Formula::or(each.clone());
-            if items.contains(&open) {
-                continue;
-            }
-            let made: Vec<Formula> = items.iter().filter(|i| each.contains(i)).cloned().collect();
-            return Some(Chosen { kind, made, open });
+        // The first object of the kind the goal has a condition about: what it asks of
+        // that one ("a full jug at bed three": full, and there) is asked of whichever.
+        let Some(first) = kind
+            .objects
+            .iter()
+            .find(|o| items.iter().any(|i| about(i, o)))
+        else {
+            continue;
+        };
+        let of_first: Vec<&Formula> = items.iter().filter(|i| about(i, first)).collect();
+        let each: Vec<Formula> = kind
+            .objects
+            .iter()
+            .map(|o| Formula::and(of_first.iter().map(|i| rename(i, first, o)).collect()))
+            .collect();
+        let open = Formula::or(each);
+        if items.contains(&open) {
+            continue;
         }
+        let made: Vec<Formula> = items
+            .iter()
+            .filter(|i| kind.objects.iter().any(|o| about(i, o)))
+            .cloned()
+            .collect();
+        return Some(Chosen { kind, made, open });
     }
     None
 }
@@ -362,5 +371,51 @@ mod tests {
             &lexicon,
         );
         assert!(r.every_of_kind().is_empty(), "{:?}", r.every_of_kind());
+    }
+
+    #[test]
+    fn a_condition_about_an_object_the_request_names_is_not_the_quantifiers() {
+        let v = scene(&["Bed1", "Bed2", "Bed3", "Jug1"]);
+        let lexicon = Lexicon::new(&v, &[]);
+        let r = Request::in_scene(
+            "Night round: rails up on every bed, and lay bed two flat.",
+            &v,
+            &[],
+            &lexicon,
+        );
+        // Bed two's head is said of bed two alone; every bed's rails of each.
+        let g = goal("RailsUp_Bed1 & ~HeadUp_Bed2");
+        assert_eq!(
+            with_every(&g, &r),
+            Some(goal(
+                "RailsUp_Bed1 & ~HeadUp_Bed2 & RailsUp_Bed2 & RailsUp_Bed3"
+            ))
+        );
+        assert_eq!(
+            fewer_than_every(
+                &goal("RailsUp_Bed1 & RailsUp_Bed2 & RailsUp_Bed3 & ~HeadUp_Bed2"),
+                &r
+            ),
+            None
+        );
+    }
+
+    #[test]
+    fn what_is_asked_of_the_one_chosen_is_asked_of_whichever() {
+        let v = scene(&["Jug1", "Jug2", "Bed3", "Room2Door"]);
+        let lexicon = Lexicon::new(&v, &[]);
+        let r = Request::in_scene(
+            "A full jug needs to end up at bed three, either jug will do.",
+            &v,
+            &[],
+            &lexicon,
+        );
+        let g = goal("Full_Jug1 & At_Jug1_Bed3 & ~Open_Room2Door");
+        assert_eq!(
+            with_choice_open(&g, &r),
+            Some(goal(
+                "~Open_Room2Door & ((Full_Jug1 & At_Jug1_Bed3) | (Full_Jug2 & At_Jug2_Bed3))"
+            ))
+        );
     }
 }
