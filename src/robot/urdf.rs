@@ -86,6 +86,8 @@ pub struct Model {
     pub joints: Vec<Joint>,
     /// The link no joint moves.
     pub root: usize,
+    /// The folders its `package://NAME/` mesh paths were resolved into, by package name.
+    pub packages: Vec<(String, PathBuf)>,
 }
 
 /// Where the `package://NAME/` paths of a URDF point.
@@ -225,6 +227,10 @@ impl Model {
             links,
             joints,
             root,
+            packages: packages
+                .iter()
+                .map(|p| (p.name.to_string(), p.dir.to_path_buf()))
+                .collect(),
         })
     }
 
