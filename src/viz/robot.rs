@@ -62,7 +62,7 @@ fn transform(pose: &Isometry3<f64>, parent: &str, child: &str) -> Transform3D {
 /// `text` with every `package://NAME/` of a package in `packages` turned into the path of
 /// that package's folder relative to `urdf_dir` (or its absolute path when the package
 /// is not a folder above the URDF).
-fn with_local_packages(
+pub(super) fn with_local_packages(
     text: &str,
     urdf_dir: &Path,
     packages: &[(String, std::path::PathBuf)],
@@ -105,7 +105,7 @@ impl std::str::FromStr for RobotMeshes {
 /// The URDF `text` with each link's collision elements drawn in place of its visual
 /// ones, in the colour of its first visual material, and no collision elements left (so
 /// the importer draws each link once, from its coarse meshes).
-fn coarse_only(text: &str) -> Result<String, urdf_rs::UrdfError> {
+pub(super) fn coarse_only(text: &str) -> Result<String, urdf_rs::UrdfError> {
     let mut robot = urdf_rs::read_from_string(text)?;
     for link in &mut robot.links {
         if link.collision.is_empty() {
