@@ -23,9 +23,8 @@ pub struct VizFlags {
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
     /// Which of the robot's meshes the 3D view draws: `coarse` (each link's collision
-    /// mesh, in its colour; about 2 MB for the YuMi) or `detailed` (the visual and the
-    /// collision meshes as the robot's URDF gives them; about 32 MB for the YuMi, in every
-    /// recording and sent to every viewer).
+    /// mesh, in its colour; 2.7 MB for the YuMi) or `detailed` (each link's visual mesh;
+    /// 29 MB for the YuMi, in every recording and sent to every viewer).
     #[arg(long, value_name = "coarse|detailed", default_value = "coarse")]
     pub robot_meshes: RobotMeshes,
     /// Record the session to FILE: the tree after each change, every tick, every model

@@ -78,15 +78,15 @@ pub(super) fn with_local_packages(
     out
 }
 
-/// Which of a link's meshes the 3D view draws.
+/// Which of a link's meshes the 3D view draws: one kind, so each link is drawn once (the
+/// importer would otherwise draw both, one around the other).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum RobotMeshes {
     /// Its collision meshes (the coarse ones of a description that has both) in the colour
-    /// of its visual material: the YuMi's take about 2.7 MB of a recording.
+    /// of its visual material: the YuMi's take 2.7 MB of a recording.
     #[default]
     Coarse,
-    /// Its visual and its collision meshes, as the URDF gives them: the YuMi's add about
-    /// 32 MB to a recording.
+    /// Its visual meshes (the detailed ones): the YuMi's take 29 MB of a recording.
     Detailed,
 }
 
@@ -102,17 +102,21 @@ impl std::str::FromStr for RobotMeshes {
     }
 }
 
-/// The URDF `text` with each link's collision elements drawn in place of its visual
-/// ones, in the colour of its first visual material, and no collision elements left (so
-/// the importer draws each link once, from its coarse meshes).
-pub(super) fn coarse_only(text: &str) -> Result<String, urdf_rs::UrdfError> {
+/// The URDF `text` as the importer is given it for `meshes`: no collision elements left,
+/// and for [`RobotMeshes::Coarse`] each link's collision elements drawn in place of its
+/// visual ones, in the colour of its first visual material.
+pub(super) fn one_kind_of_mesh(
+    text: &str,
+    meshes: RobotMeshes,
+) -> Result<String, urdf_rs::UrdfError> {
     let mut robot = urdf_rs::read_from_string(text)?;
     for link in &mut robot.links {
-        if link.collision.is_empty() {
+        let collisions = std::mem::take(&mut link.collision);
+        if meshes == RobotMeshes::Detailed || collisions.is_empty() {
             continue;
         }
         let material = link.visual.iter().find_map(|v| v.material.clone());
-        link.visual = std::mem::take(&mut link.collision)
+        link.visual = collisions
             .into_iter()
             .map(|c| urdf_rs::Visual {
                 name: c.name,
@@ -143,15 +147,12 @@ pub fn log_description(
     rec.log_static(ROBOT_DESCRIPTION, &TextDocument::new(urdf.as_str()))?;
     let urdf_dir = model.file.parent().unwrap_or(Path::new("."));
     let local = with_local_packages(&urdf, urdf_dir, &model.packages);
-    let given = match meshes {
-        RobotMeshes::Detailed => local,
-        RobotMeshes::Coarse => match coarse_only(&local) {
-            Ok(text) => text,
-            Err(e) => {
-                tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
-                return Ok(());
-            }
-        },
+    let given = match one_kind_of_mesh(&local, meshes) {
+        Ok(text) => text,
+        Err(e) => {
+            tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
+            return Ok(());
+        }
     };
     rec.log_file_from_contents(
         &model.file,

@@ -166,9 +166,9 @@ fn the_importer_finds_the_meshes_from_the_urdf_folder() {
 }
 
 /// The coarse drawing gives the importer each link's collision mesh as its visual one
-/// (in the visual material's colour) and no collision elements; the detailed one the
-/// URDF's own, both kinds. Every link is drawn either way, and the detailed recording is
-/// many times bigger.
+/// (in the visual material's colour), the detailed one the URDF's visual meshes; neither
+/// has collision elements, so each link is drawn once, and the detailed recording is many
+/// times bigger.
 #[test]
 fn coarse_and_detailed_meshes_are_both_drawn_by_the_importer() {
     let (coarse, coarse_bytes) = description_logged(RobotMeshes::Coarse);
@@ -183,7 +183,6 @@ fn coarse_and_detailed_meshes_are_both_drawn_by_the_importer() {
     let robot = "world/robot/yumi";
     for link in &links {
         let visual = format!("{robot}/visual_geometries/{link}/visual_0");
-        let collision = format!("{robot}/collision_geometries/mesh/{link}/collision_0");
         for (logged, kind) in [(&coarse, "coarse"), (&detailed, "detailed")] {
             let comps = logged.components.get(&visual);
             assert!(
@@ -193,13 +192,14 @@ fn coarse_and_detailed_meshes_are_both_drawn_by_the_importer() {
                 "{kind}: {visual}: {comps:?}"
             );
         }
-        assert!(!coarse.components.contains_key(&collision), "{collision}");
+    }
+    for logged in [&coarse, &detailed] {
         assert!(
-            detailed
+            !logged
                 .components
-                .get(&collision)
-                .is_some_and(|c| c.contains("Asset3D:blob")),
-            "{collision}"
+                .keys()
+                .any(|p| p.contains("collision_geometries")),
+            "each link drawn once"
         );
     }
     assert!(
@@ -208,10 +208,11 @@ fn coarse_and_detailed_meshes_are_both_drawn_by_the_importer() {
     );
 }
 
-/// The coarse URDF keeps the robot's links, joints and materials and leaves no collision
-/// element; a text that is no URDF is refused.
+/// Both kinds keep the robot's links, joints and materials and leave no collision
+/// element; the coarse one draws the collision mesh in the visual material, the detailed
+/// one keeps the visual mesh; a text that is no URDF is refused.
 #[test]
-fn the_coarse_urdf_swaps_collision_meshes_in_for_visual_ones() {
+fn the_importer_is_given_one_kind_of_mesh_per_link() {
     let text = r#"<robot name="tiny">
   <material name="Grey"><color rgba="0.5 0.5 0.5 1"/></material>
   <link name="base">
@@ -226,28 +227,34 @@ fn the_coarse_urdf_swaps_collision_meshes_in_for_visual_ones() {
     <limit lower="-1" upper="1" effort="1" velocity="1"/>
   </joint>
 </robot>"#;
-    let coarse = robot::coarse_only(text).unwrap();
-    let robot = urdf_rs::read_from_string(&coarse).unwrap();
-    assert_eq!(robot.joints.len(), 1);
-    assert_eq!(robot.materials.len(), 1);
-    let base = &robot.links[0];
-    assert!(base.collision.is_empty());
-    assert_eq!(base.visual.len(), 1);
-    let urdf_rs::Geometry::Mesh { filename, .. } = &base.visual[0].geometry else {
-        panic!("{:?}", base.visual[0].geometry);
+    let mesh_of = |visual: &urdf_rs::Visual| match &visual.geometry {
+        urdf_rs::Geometry::Mesh { filename, .. } => filename.clone(),
+        other => panic!("{other:?}"),
     };
-    assert_eq!(filename, "meshes/coarse/base.stl");
-    assert_eq!(base.visual[0].origin.xyz.0, [0.0, 0.0, 0.1]);
-    assert_eq!(
-        base.visual[0].material.as_ref().map(|m| m.name.as_str()),
-        Some("Grey")
-    );
-    let tip = &robot.links[1];
-    assert!(matches!(
-        tip.visual[0].geometry,
-        urdf_rs::Geometry::Box { .. }
-    ));
-    assert!(robot::coarse_only("<robot").is_err());
+    for (meshes, file, z) in [
+        (RobotMeshes::Coarse, "meshes/coarse/base.stl", 0.1),
+        (RobotMeshes::Detailed, "meshes/base.stl", 0.0),
+    ] {
+        let given = robot::one_kind_of_mesh(text, meshes).unwrap();
+        let robot = urdf_rs::read_from_string(&given).unwrap();
+        assert_eq!(robot.joints.len(), 1);
+        assert_eq!(robot.materials.len(), 1);
+        let base = &robot.links[0];
+        assert!(base.collision.is_empty(), "{meshes:?}");
+        assert_eq!(base.visual.len(), 1);
+        assert_eq!(mesh_of(&base.visual[0]), file);
+        assert_eq!(base.visual[0].origin.xyz.0, [0.0, 0.0, z]);
+        assert_eq!(
+            base.visual[0].material.as_ref().map(|m| m.name.as_str()),
+            Some("Grey")
+        );
+        let tip = &robot.links[1];
+        assert!(matches!(
+            tip.visual[0].geometry,
+            urdf_rs::Geometry::Box { .. }
+        ));
+    }
+    assert!(robot::one_kind_of_mesh("<robot", RobotMeshes::Coarse).is_err());
 }
 
 /// With real arms a grasped solid is drawn in the hand: at the tool of the arm's joint
