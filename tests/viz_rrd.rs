@@ -71,7 +71,7 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
     // The robot is its meshes when its description is in the cache (the arms test below
     // fetches it), else boxes and segments.
     let robot: &[&str] = if listing.contains("/world/robot/yumi/") {
-        &["/world/robot/yumi/collision_geometries/mesh/yumi_body"]
+        &["/world/robot/yumi/visual_geometries/yumi_body"]
     } else {
         &["/world/robot/torso", "/world/robot/arms"]
     };
@@ -134,7 +134,9 @@ fn rows_of(data: &str, entity: &str) -> Vec<std::collections::BTreeMap<String, S
 }
 
 /// Scenario 1 run with the YuMi's real arms, recorded and read back with the viewer's
-/// CLI: the robot's links as meshes in frames named after its links, the root hung from
+/// CLI: what rerun's URDF importer makes of the robot's description (the links' meshes in
+/// frames named after the links, every joint's transform at value 0 in `tf_static`), the
+/// URDF's text, the root hung from
 /// the view's `world`, every arm joint's transform (from its parent link's frame to its
 /// child's) at each tick and, between the ticks an arm moved in, along its way on the
 /// `motion` timeline, the gripper's path, and the solid that blocked the failing grasp
@@ -162,7 +164,7 @@ fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
     }
     for link in &links {
         let mesh = format!(
-            "{robot}/collision_geometries/mesh/{link}/collision_0 - data columns: [Asset3D:albedo_factor Asset3D:blob Asset3D:media_type]"
+            "{robot}/visual_geometries/{link}/visual_0 - data columns: [Asset3D:albedo_factor Asset3D:blob Asset3D:media_type]"
         );
         assert!(listing.contains(&mesh), "{mesh} not in:\n{listing}");
     }
@@ -191,7 +193,7 @@ fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
     // Each link's meshes sit in the link's frame.
     let frames = rows_of(
         &data,
-        &format!("{robot}/collision_geometries/mesh/yumi_link_4_l/collision_0"),
+        &format!("{robot}/visual_geometries/yumi_link_4_l/visual_0"),
     );
     assert!(
         frames.iter().any(|r| r
@@ -224,8 +226,32 @@ fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
         base_steps.len(),
         "the base does not move between steps"
     );
+    // The importer's static joint transforms, one per joint, between the links' frames.
+    let tf_static = rows_of(&data, "/tf_static");
+    let static_pairs: std::collections::BTreeSet<(String, String)> = tf_static
+        .iter()
+        .filter_map(|r| {
+            Some((
+                r.get("Transform3D:parent_frame")?.clone(),
+                r.get("Transform3D:child_frame")?.clone(),
+            ))
+        })
+        .collect();
+    assert!(
+        static_pairs.len() >= 2 * 7 + 6,
+        "tf_static: {} pairs: {static_pairs:?}",
+        static_pairs.len()
+    );
+    assert!(
+        tf_static
+            .iter()
+            .all(|r| r.get("step").is_none() && r.get("tick").is_none()),
+        "tf_static is static: {:?}",
+        tf_static.first()
+    );
     // The left arm makes scenario 1's motions: each of its joints at several ticks, its
-    // parent and child links named, and more values of `motion` than ticks (the way between).
+    // parent and child links named as the importer names them, and more values of
+    // `motion` than ticks (the way between).
     for n in 1..=7 {
         let joint = format!("yumi_joint_{n}_l");
         let rows = rows_of(&data, &format!("{robot}/joints/{joint}"));
@@ -254,6 +280,16 @@ fn scenario1_with_real_arms_records_the_robot_and_its_joints_per_tick() {
                     .is_some_and(|f| f.starts_with("[yumi_"))),
             "{joint}: {:?}",
             rows.first()
+        );
+        let pair = rows.first().and_then(|r| {
+            Some((
+                r.get("Transform3D:parent_frame")?.clone(),
+                r.get("Transform3D:child_frame")?.clone(),
+            ))
+        });
+        assert!(
+            pair.as_ref().is_some_and(|p| static_pairs.contains(p)),
+            "{joint}: {pair:?} is not a joint the importer logged"
         );
     }
     assert!(

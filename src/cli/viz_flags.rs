@@ -8,7 +8,7 @@ use anyhow::{Context as _, Result};
 use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
 use betr::session::{Command, Event};
-use betr::viz::{Sinks, Viewer, ViewerLife, Viz};
+use betr::viz::{RobotMeshes, Sinks, Viewer, ViewerLife, Viz};
 
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct VizFlags {
@@ -22,6 +22,11 @@ pub struct VizFlags {
     /// Save a rerun recording of the session to FILE (.rrd).
     #[arg(long, value_name = "FILE")]
     pub rrd: Option<PathBuf>,
+    /// Which of the robot's meshes the 3D view draws: `coarse` (each link's collision
+    /// mesh, in its colour; 2.7 MB for the YuMi) or `detailed` (each link's visual mesh;
+    /// 29 MB for the YuMi, in every recording and sent to every viewer).
+    #[arg(long, value_name = "coarse|detailed", default_value = "coarse")]
+    pub robot_meshes: RobotMeshes,
     /// Record the session to FILE: the tree after each change, every tick, every model
     /// reply and every approval, written as it happens (`betr replay FILE` shows it again,
     /// without the model).
@@ -40,6 +45,7 @@ impl VizFlags {
             viewer: self.viewer.clone(),
             rrd: self.rrd.clone(),
             web_viewer,
+            meshes: self.robot_meshes,
         })?;
         if let Some(moved) = viz.as_ref().and_then(Viz::web_moved) {
             errln!("3D view: {moved}");

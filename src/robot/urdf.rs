@@ -36,9 +36,6 @@ pub enum Geometry {
 pub struct Element {
     pub origin: Isometry3<f64>,
     pub geometry: Geometry,
-    /// Linear RGBA from the element's material, its own or one the URDF defines by name
-    /// (visual elements only).
-    pub colour: Option<[f32; 4]>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -86,6 +83,8 @@ pub struct Model {
     pub joints: Vec<Joint>,
     /// The link no joint moves.
     pub root: usize,
+    /// The folders its `package://NAME/` mesh paths were resolved into, by package name.
+    pub packages: Vec<(String, PathBuf)>,
 }
 
 /// Where the `package://NAME/` paths of a URDF point.
@@ -124,13 +123,10 @@ impl Model {
             if links.iter().any(|l: &Link| l.name == link.name) {
                 return Err(bad(format!("link \"{}\" is defined twice", link.name)));
             }
-            let element = |origin: &urdf_rs::Pose,
-                           geometry: &urdf_rs::Geometry,
-                           material: Option<&urdf_rs::Material>| {
+            let element = |origin: &urdf_rs::Pose, geometry: &urdf_rs::Geometry| {
                 Ok::<_, RobotError>(Element {
                     origin: pose(origin),
                     geometry: geometry_of(geometry, file, &link.name, packages)?,
-                    colour: material.and_then(|m| colour_of(m, &robot.materials)),
                 })
             };
             links.push(Link {
@@ -138,12 +134,12 @@ impl Model {
                 visuals: link
                     .visual
                     .iter()
-                    .map(|v| element(&v.origin, &v.geometry, v.material.as_ref()))
+                    .map(|v| element(&v.origin, &v.geometry))
                     .collect::<Result<_, _>>()?,
                 collisions: link
                     .collision
                     .iter()
-                    .map(|c| element(&c.origin, &c.geometry, None))
+                    .map(|c| element(&c.origin, &c.geometry))
                     .collect::<Result<_, _>>()?,
             });
         }
@@ -225,6 +221,10 @@ impl Model {
             links,
             joints,
             root,
+            packages: packages
+                .iter()
+                .map(|p| (p.name.to_string(), p.dir.to_path_buf()))
+                .collect(),
         })
     }
 
@@ -278,17 +278,6 @@ impl Joint {
             }
         }
     }
-}
-
-/// A material's colour: its own, else that of the URDF's material of the same name.
-fn colour_of(material: &urdf_rs::Material, defined: &[urdf_rs::Material]) -> Option<[f32; 4]> {
-    let rgba = |m: &urdf_rs::Material| m.color.as_ref().map(|c| c.rgba.0.map(|v| v as f32));
-    rgba(material).or_else(|| {
-        defined
-            .iter()
-            .find(|d| d.name == material.name)
-            .and_then(rgba)
-    })
 }
 
 /// A URDF `<origin xyz rpy>` (roll about x, then pitch about y, then yaw about z, all

@@ -22,6 +22,7 @@ mod tests;
 pub mod tree;
 mod viewer;
 
+pub use robot::RobotMeshes;
 pub use viewer::{GRPC_PORT, ViewerLife, WEB_PORT, WebServer};
 
 use std::ffi::OsStr;
@@ -87,6 +88,8 @@ pub struct Sinks {
     pub rrd: Option<PathBuf>,
     /// How long a web viewer started for the session lives.
     pub web_viewer: ViewerLife,
+    /// Which of the robot's meshes are drawn.
+    pub meshes: RobotMeshes,
 }
 
 impl Sinks {
@@ -137,6 +140,8 @@ pub struct Viz {
     motion: i64,
     /// The robot's description is in the recording.
     robot_drawn: bool,
+    /// Which of the robot's meshes are drawn.
+    meshes: RobotMeshes,
     /// The arms' joint values last drawn, per arm.
     arms_drawn: Vec<Vec<f64>>,
     /// The solids last drawn (what a motion since picked up or let go is found in them).
@@ -232,6 +237,7 @@ impl Viz {
         viz.web_moved = web_moved;
         viz.web_server = web_server;
         viz.file = sinks.rrd.is_some();
+        viz.meshes = sinks.meshes;
         Ok(Some(viz))
     }
 
@@ -249,6 +255,7 @@ impl Viz {
             ticks: 0,
             motion: 0,
             robot_drawn: false,
+            meshes: RobotMeshes::default(),
             arms_drawn: Vec::new(),
             solids_drawn: Vec::new(),
             repairing: false,
@@ -357,7 +364,7 @@ impl Viz {
         }
         if let Some(arms) = &scene.arms {
             if !self.robot_drawn {
-                Self::warn(robot::log_description(&self.rec, arms));
+                Self::warn(robot::log_description(&self.rec, arms, self.meshes));
                 self.robot_drawn = true;
             }
             let between = robot::sub_steps(arms, &self.arms_drawn);

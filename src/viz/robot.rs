@@ -1,24 +1,27 @@
-//! The robot drawn from its description, laid out the way rerun's own URDF importer lays
-//! a robot out, so the viewer's frame tools read it the same: an entity named after the
-//! robot in its root link's frame, each link's meshes under
-//! `collision_geometries/mesh/LINK/collision_N` in the link's frame (an `InstancePoses3D`
-//! for the element's origin, an `Asset3D` with the STL), and every joint as a
-//! `Transform3D` from its parent link's frame to its child's. Meshes and fixed joints are
-//! logged once (static); the arms' joints at every tick, and between two ticks in which an
-//! arm moved, along the way it went on the `motion` timeline.
+//! The robot drawn by rerun's own URDF importer, given the description's URDF once per
+//! recording (static): an entity named after the robot in its root link's frame, each
+//! link's meshes in the link's frame, and every joint's transform at value 0 from its
+//! parent link's frame to its child's (the importer's `tf_static`). The arms' joints are
+//! logged here, with the importer's frame names (the link names), at every tick, and
+//! between two ticks in which an arm moved, along the way it went on the `motion` timeline;
+//! a transform logged on the timelines overrides the importer's static one for that frame.
 //!
-//! The coarse collision meshes are drawn, in the colour of the link's visual material: the
-//! detailed visual meshes of the YuMi weigh 58 MB, which every recording would carry.
+//! The importer finds `package://` meshes only through ROS's environment variables, but
+//! reads a relative mesh path from the folder of the URDF it is told it reads, so it is
+//! given the URDF's text with the packages' paths made relative to that folder, in memory
+//! (the cached description stays as it was fetched).
 
+use std::borrow::Cow;
 use std::collections::HashMap;
+use std::path::Path;
 
 use nalgebra::{Isometry3, UnitQuaternion};
 use rerun::{
-    Asset3D, Clear, Color, CoordinateFrame, InstancePoses3D, LineStrips3D, Points3D, Quaternion,
-    RecordingStream, RecordingStreamResult, Rgba32, TextDocument, Transform3D,
+    Clear, Color, CoordinateFrame, EntityPath, EntityPathPart, LineStrips3D, Points3D, Quaternion,
+    RecordingStream, RecordingStreamResult, TextDocument, Transform3D,
 };
 
-use crate::robot::{Geometry, JointKind, Model};
+use crate::robot::{JointKind, Model};
 use crate::world::cell::snapshot::ArmsView;
 
 /// Where the robot's entities hang (the robot's name below it).
@@ -36,12 +39,13 @@ pub const WORLD_FRAME: &str = "tf#/world";
 /// every n-th so a motion stays a few seconds of scrubbing.
 const MOST_SUB_STEPS: usize = 120;
 
-fn robot_path(model: &Model) -> String {
-    format!("{ROBOT_ROOT}/{}", super::scene::slug(&model.name))
+/// The robot's entity, as the importer names it: its URDF name below [`ROBOT_ROOT`].
+fn robot_path(model: &Model) -> EntityPath {
+    EntityPath::from(ROBOT_ROOT) / EntityPathPart::new(model.name.as_str())
 }
 
-fn joint_path(model: &Model, joint: &str) -> String {
-    format!("{}/joints/{}", robot_path(model), super::scene::slug(joint))
+fn joint_path(model: &Model, joint: &str) -> EntityPath {
+    robot_path(model) / EntityPathPart::new("joints") / EntityPathPart::new(joint)
 }
 
 fn transform(pose: &Isometry3<f64>, parent: &str, child: &str) -> Transform3D {
@@ -55,83 +59,107 @@ fn transform(pose: &Isometry3<f64>, parent: &str, child: &str) -> Transform3D {
     .with_child_frame(child)
 }
 
-/// The static part: the URDF's text, the root's frame, every link's meshes in its frame,
-/// and the joints no arm moves (fixed ones, and the fingers at their resting value).
-pub fn log_description(rec: &RecordingStream, view: &ArmsView) -> RecordingStreamResult<()> {
-    let model = view.model.as_ref();
-    match std::fs::read_to_string(&model.file) {
-        Ok(urdf) => rec.log_static(ROBOT_DESCRIPTION, &TextDocument::new(urdf))?,
-        Err(e) => {
-            tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
+/// `text` with every `package://NAME/` of a package in `packages` turned into the path of
+/// that package's folder relative to `urdf_dir` (or its absolute path when the package
+/// is not a folder above the URDF).
+pub(super) fn with_local_packages(
+    text: &str,
+    urdf_dir: &Path,
+    packages: &[(String, std::path::PathBuf)],
+) -> String {
+    let mut out = text.to_string();
+    for (name, dir) in packages {
+        let local = match urdf_dir.strip_prefix(dir) {
+            Ok(below) => "../".repeat(below.components().count()),
+            Err(_) => format!("{}/", dir.display()),
+        };
+        out = out.replace(&format!("package://{name}/"), &local);
+    }
+    out
+}
+
+/// Which of a link's meshes the 3D view draws: one kind, so each link is drawn once (the
+/// importer would otherwise draw both, one around the other).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum RobotMeshes {
+    /// Its collision meshes (the coarse ones of a description that has both) in the colour
+    /// of its visual material: the YuMi's take 2.7 MB of a recording.
+    #[default]
+    Coarse,
+    /// Its visual meshes (the detailed ones): the YuMi's take 29 MB of a recording.
+    Detailed,
+}
+
+impl std::str::FromStr for RobotMeshes {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "coarse" => Ok(RobotMeshes::Coarse),
+            "detailed" => Ok(RobotMeshes::Detailed),
+            _ => Err(format!("{s:?}: expected `coarse` or `detailed`")),
         }
     }
-    let root = &model.links[model.root].name;
-    rec.log_static(robot_path(model), &CoordinateFrame::new(root.as_str()))?;
-    for link in &model.links {
-        let colour = link
-            .visuals
-            .iter()
-            .find_map(|v| v.colour)
-            .unwrap_or([0.7, 0.7, 0.72, 1.0]);
-        for (i, element) in link.collisions.iter().enumerate() {
-            let Geometry::Mesh { path, scale } = &element.geometry else {
-                continue;
-            };
-            let asset = match Asset3D::from_file_path(path) {
-                Ok(a) => a.with_albedo_factor(Rgba32::from_linear_unmultiplied_rgba_f32(
-                    colour[0], colour[1], colour[2], colour[3],
-                )),
-                Err(e) => {
-                    tracing::warn!(mesh = %path.display(), error = %e, "cannot read a link's mesh");
-                    continue;
-                }
-            };
-            let entity = format!(
-                "{}/collision_geometries/mesh/{}/collision_{i}",
-                robot_path(model),
-                super::scene::slug(&link.name)
-            );
-            let t = element.origin.translation.vector;
-            let q: UnitQuaternion<f32> = element.origin.rotation.cast();
-            rec.log_static(
-                entity.as_str(),
-                &InstancePoses3D::new()
-                    .with_translations([[t.x as f32, t.y as f32, t.z as f32]])
-                    .with_quaternions([Quaternion::from_xyzw([q.i, q.j, q.k, q.w])])
-                    .with_scales([[scale.x as f32, scale.y as f32, scale.z as f32]]),
-            )?;
-            rec.log_static(entity.as_str(), &CoordinateFrame::new(link.name.as_str()))?;
-            rec.log_static(entity.as_str(), &asset)?;
-        }
-    }
-    let driven: Vec<&str> = view
-        .joints
-        .iter()
-        .flatten()
-        .map(|(name, _)| name.as_str())
-        .collect();
-    for joint in &model.joints {
-        if driven.contains(&joint.name.as_str()) {
+}
+
+/// The URDF `text` as the importer is given it for `meshes`: no collision elements left,
+/// and for [`RobotMeshes::Coarse`] each link's collision elements drawn in place of its
+/// visual ones, in the colour of its first visual material.
+pub(super) fn one_kind_of_mesh(
+    text: &str,
+    meshes: RobotMeshes,
+) -> Result<String, urdf_rs::UrdfError> {
+    let mut robot = urdf_rs::read_from_string(text)?;
+    for link in &mut robot.links {
+        let collisions = std::mem::take(&mut link.collision);
+        if meshes == RobotMeshes::Detailed || collisions.is_empty() {
             continue;
         }
-        let value = match &joint.mimic {
-            Some((other, multiplier, offset)) => model
-                .joints
-                .iter()
-                .find(|j| j.name == *other)
-                .map_or(0.0, |j| multiplier * j.resting_value() + offset),
-            None => joint.resting_value(),
-        };
-        rec.log_static(
-            joint_path(model, &joint.name),
-            &transform(
-                &joint.transform_at(value),
-                &model.links[joint.parent].name,
-                &model.links[joint.child].name,
-            ),
-        )?;
+        let material = link.visual.iter().find_map(|v| v.material.clone());
+        link.visual = collisions
+            .into_iter()
+            .map(|c| urdf_rs::Visual {
+                name: c.name,
+                origin: c.origin,
+                geometry: c.geometry,
+                material: material.clone(),
+            })
+            .collect();
     }
-    Ok(())
+    urdf_rs::write_to_string(&robot)
+}
+
+/// The static part: the URDF's text at [`ROBOT_DESCRIPTION`], and the robot drawn by
+/// rerun's URDF importer below [`ROBOT_ROOT`] with the meshes `meshes` says.
+pub fn log_description(
+    rec: &RecordingStream,
+    view: &ArmsView,
+    meshes: RobotMeshes,
+) -> RecordingStreamResult<()> {
+    let model = view.model.as_ref();
+    let urdf = match std::fs::read_to_string(&model.file) {
+        Ok(urdf) => urdf,
+        Err(e) => {
+            tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
+            return Ok(());
+        }
+    };
+    rec.log_static(ROBOT_DESCRIPTION, &TextDocument::new(urdf.as_str()))?;
+    let urdf_dir = model.file.parent().unwrap_or(Path::new("."));
+    let local = with_local_packages(&urdf, urdf_dir, &model.packages);
+    let given = match one_kind_of_mesh(&local, meshes) {
+        Ok(text) => text,
+        Err(e) => {
+            tracing::warn!(urdf = %model.file.display(), error = %e, "cannot read the robot's URDF");
+            return Ok(());
+        }
+    };
+    rec.log_file_from_contents(
+        &model.file,
+        Cow::Owned(given.into_bytes()),
+        Some(EntityPath::from(ROBOT_ROOT)),
+        true,
+    )
 }
 
 /// The robot's root link in the world (hung from the frame of the view's origin).
@@ -139,7 +167,7 @@ pub fn log_base(rec: &RecordingStream, view: &ArmsView) -> RecordingStreamResult
     let model = view.model.as_ref();
     let root = &model.links[model.root].name;
     rec.log(
-        format!("{}/base", robot_path(model)),
+        robot_path(model) / EntityPathPart::new("base"),
         &transform(&view.base.cast(), WORLD_FRAME, root),
     )
 }
@@ -239,18 +267,18 @@ pub fn log_blocking_link(
     blocker: Option<&str>,
 ) -> RecordingStreamResult<()> {
     let model = view.model.as_ref();
-    let entity = format!("{}/blocked_by", robot_path(model));
+    let entity = robot_path(model) / EntityPathPart::new("blocked_by");
     match blocker.filter(|b| model.link(b).is_some()) {
         Some(link) => {
-            rec.log(entity.as_str(), &CoordinateFrame::new(link))?;
+            rec.log(entity.clone(), &CoordinateFrame::new(link))?;
             rec.log(
-                entity.as_str(),
+                entity,
                 &Points3D::new([[0.0, 0.0, 0.0]])
                     .with_radii([0.04])
                     .with_colors([Color::from_unmultiplied_rgba(230, 40, 40, 255)])
                     .with_labels([format!("{link} blocks the arm")]),
             )
         }
-        None => rec.log(entity.as_str(), &Clear::flat()),
+        None => rec.log(entity, &Clear::flat()),
     }
 }

@@ -69,11 +69,21 @@ fn real_arms_are_drawn_from_the_description_and_move_between_ticks() {
     };
     assert!(!logged.components.contains_key(scene::ROBOT_TORSO));
     assert!(!logged.components.contains_key(scene::ROBOT_ARMS));
+    // The importer's output: the robot's root frame, each link's mesh in its frame (the
+    // coarse ones by default, as visual geometry), and every joint at value 0 in
+    // `tf_static`.
     assert!(has(
-        "world/robot/yumi/collision_geometries/mesh/yumi_link_3_l/collision_0",
+        "world/robot/yumi/visual_geometries/yumi_link_3_l/visual_0",
         "Asset3D:blob"
     ));
+    assert!(has(
+        "world/robot/yumi/visual_geometries/yumi_link_3_l/visual_0",
+        "CoordinateFrame:frame"
+    ));
     assert!(has("world/robot/yumi", "CoordinateFrame:frame"));
+    assert!(has("tf_static", "Transform3D:child_frame"));
+    assert!(!logged.steps.contains_key("tf_static"), "static");
+    assert!(has(robot::ROBOT_DESCRIPTION, "TextDocument:text"));
     assert!(has("world/robot/yumi/base", "Transform3D:parent_frame"));
     assert!(has(robot::GRIPPER_PATH, "LineStrips3D:strips"));
     // Each left-arm joint at every step of the scene, and many more values of `motion`
@@ -95,12 +105,156 @@ fn real_arms_are_drawn_from_the_description_and_move_between_ticks() {
         logged.motions[cube].len(),
         logged.steps[cube].len()
     );
-    // The fingers and fixed joints are static: not on any timeline.
+    // The fingers and fixed joints are left at the importer's static transforms.
     assert!(
         !logged
-            .steps
+            .components
             .contains_key("world/robot/yumi/joints/gripper_l_joint")
     );
+}
+
+/// The YuMi's description drawn once into a memory recording with `meshes`: what was
+/// logged, and the bytes of the recording's messages.
+fn description_logged(meshes: RobotMeshes) -> (Logged, usize) {
+    crate::robot::tests::yumi_dir();
+    let scenario = scenario1();
+    let world = crate::world::load_execution(&scenario, None).unwrap().world;
+    let arms = CellWorld::scene_of(world.as_ref()).unwrap().arms.unwrap();
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    robot::log_description(&rec, &arms, meshes).unwrap();
+    rec.flush_blocking().unwrap();
+    let msgs = storage.take();
+    let bytes = msgs
+        .iter()
+        .map(|m| match m {
+            LogMsg::ArrowMsg(_, arrow) => arrow.batch.get_array_memory_size(),
+            _ => 0,
+        })
+        .sum();
+    (decode(msgs), bytes)
+}
+
+/// The importer is given the URDF with its `package://` paths made relative to the URDF's
+/// folder: every mesh the URDF names is found from there, and the cached file is left as
+/// it was fetched.
+#[test]
+fn the_importer_finds_the_meshes_from_the_urdf_folder() {
+    crate::robot::tests::yumi_dir();
+    let scenario = scenario1();
+    let world = crate::world::load_execution(&scenario, None).unwrap().world;
+    let arms = CellWorld::scene_of(world.as_ref()).unwrap().arms.unwrap();
+    let model = arms.model.as_ref();
+    let text = std::fs::read_to_string(&model.file).unwrap();
+    let urdf_dir = model.file.parent().unwrap();
+    assert!(text.contains("package://yumi_description/meshes/coarse/body.stl"));
+    let local = robot::with_local_packages(&text, urdf_dir, &model.packages);
+    assert!(!local.contains("package://"), "every package path replaced");
+    let meshes: Vec<&str> = local
+        .split("<mesh filename=\"")
+        .skip(1)
+        .filter_map(|rest| rest.split('"').next())
+        .collect();
+    assert!(meshes.len() >= 40, "{meshes:?}");
+    for mesh in &meshes {
+        assert!(mesh.starts_with("../meshes/"), "{mesh}");
+        assert!(urdf_dir.join(mesh).is_file(), "{mesh} from {urdf_dir:?}");
+    }
+    let (rec, _storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    robot::log_description(&rec, &arms, RobotMeshes::Coarse).unwrap();
+    rec.flush_blocking().unwrap();
+    assert_eq!(std::fs::read_to_string(&model.file).unwrap(), text);
+}
+
+/// The coarse drawing gives the importer each link's collision mesh as its visual one
+/// (in the visual material's colour), the detailed one the URDF's visual meshes; neither
+/// has collision elements, so each link is drawn once, and the detailed recording is many
+/// times bigger.
+#[test]
+fn coarse_and_detailed_meshes_are_both_drawn_by_the_importer() {
+    let (coarse, coarse_bytes) = description_logged(RobotMeshes::Coarse);
+    let (detailed, detailed_bytes) = description_logged(RobotMeshes::Detailed);
+    let mut links = vec!["yumi_body".to_string()];
+    for side in ["l", "r"] {
+        links.extend((1..=7).map(|n| format!("yumi_link_{n}_{side}")));
+        for part in ["base", "finger_r", "finger_l"] {
+            links.push(format!("gripper_{side}_{part}"));
+        }
+    }
+    let robot = "world/robot/yumi";
+    for link in &links {
+        let visual = format!("{robot}/visual_geometries/{link}/visual_0");
+        for (logged, kind) in [(&coarse, "coarse"), (&detailed, "detailed")] {
+            let comps = logged.components.get(&visual);
+            assert!(
+                comps.is_some_and(|c| c.contains("Asset3D:blob")
+                    && c.contains("Asset3D:albedo_factor")
+                    && c.contains("CoordinateFrame:frame")),
+                "{kind}: {visual}: {comps:?}"
+            );
+        }
+    }
+    for logged in [&coarse, &detailed] {
+        assert!(
+            !logged
+                .components
+                .keys()
+                .any(|p| p.contains("collision_geometries")),
+            "each link drawn once"
+        );
+    }
+    assert!(
+        detailed_bytes > 8 * coarse_bytes,
+        "detailed {detailed_bytes} B, coarse {coarse_bytes} B"
+    );
+}
+
+/// Both kinds keep the robot's links, joints and materials and leave no collision
+/// element; the coarse one draws the collision mesh in the visual material, the detailed
+/// one keeps the visual mesh; a text that is no URDF is refused.
+#[test]
+fn the_importer_is_given_one_kind_of_mesh_per_link() {
+    let text = r#"<robot name="tiny">
+  <material name="Grey"><color rgba="0.5 0.5 0.5 1"/></material>
+  <link name="base">
+    <visual><geometry><mesh filename="meshes/base.stl"/></geometry><material name="Grey"/></visual>
+    <collision><origin xyz="0 0 0.1" rpy="0 0 0"/><geometry><mesh filename="meshes/coarse/base.stl"/></geometry></collision>
+  </link>
+  <link name="tip">
+    <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>
+  </link>
+  <joint name="j" type="revolute">
+    <parent link="base"/><child link="tip"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>"#;
+    let mesh_of = |visual: &urdf_rs::Visual| match &visual.geometry {
+        urdf_rs::Geometry::Mesh { filename, .. } => filename.clone(),
+        other => panic!("{other:?}"),
+    };
+    for (meshes, file, z) in [
+        (RobotMeshes::Coarse, "meshes/coarse/base.stl", 0.1),
+        (RobotMeshes::Detailed, "meshes/base.stl", 0.0),
+    ] {
+        let given = robot::one_kind_of_mesh(text, meshes).unwrap();
+        let robot = urdf_rs::read_from_string(&given).unwrap();
+        assert_eq!(robot.joints.len(), 1);
+        assert_eq!(robot.materials.len(), 1);
+        let base = &robot.links[0];
+        assert!(base.collision.is_empty(), "{meshes:?}");
+        assert_eq!(base.visual.len(), 1);
+        assert_eq!(mesh_of(&base.visual[0]), file);
+        assert_eq!(base.visual[0].origin.xyz.0, [0.0, 0.0, z]);
+        assert_eq!(
+            base.visual[0].material.as_ref().map(|m| m.name.as_str()),
+            Some("Grey")
+        );
+        let tip = &robot.links[1];
+        assert!(matches!(
+            tip.visual[0].geometry,
+            urdf_rs::Geometry::Box { .. }
+        ));
+    }
+    assert!(robot::one_kind_of_mesh("<robot", RobotMeshes::Coarse).is_err());
 }
 
 /// With real arms a grasped solid is drawn in the hand: at the tool of the arm's joint
