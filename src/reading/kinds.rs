@@ -134,15 +134,23 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
 
 fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
     let items = goal.conjuncts();
-    // A condition about an object the request names by itself ("lay bed two flat" beside
-    // "rails up on every bed") is said of that object, not of the kind.
-    let named: Vec<&str> = request
-        .mentions()
-        .iter()
-        .map(|(_, _, name)| name.as_str())
-        .collect();
     let kinds = request.every_of_kind();
     for kind in kinds.iter().filter(|k| k.quantity == Quantity::Every) {
+        // A condition about an object the request names by itself ("lay bed two flat"
+        // beside "rails up on every bed") is said of that object, not of the kind; the
+        // kind's own words ("both bars", where one bar is called Bar) name none by itself.
+        let said: Vec<&str> = kind.said.split(' ').collect();
+        let named: Vec<&str> = request
+            .mentions()
+            .iter()
+            .filter(|(first, count, _)| {
+                request
+                    .unnumbered_words
+                    .get(*first..first + count)
+                    .is_some_and(|run| run.iter().any(|w| !said.contains(&w.as_str())))
+            })
+            .map(|(_, _, name)| name.as_str())
+            .collect();
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
             let Some((atom, holds)) = literal(item) else {
