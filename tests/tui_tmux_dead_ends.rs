@@ -10,7 +10,7 @@ mod support;
 
 use std::time::Duration;
 
-use support::cli::tmp;
+use support::cli::{Scratch, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 use support::tmux::Tmux;
@@ -40,7 +40,9 @@ fn step_to_proposal(tmux: &Tmux) -> String {
     )
 }
 
-fn start(name: &str) -> (FakeServer, Tmux) {
+/// The scratch directory the workbench runs in (removed when dropped, after the
+/// workbench), the fake server, and the workbench in tmux.
+fn start(name: &str) -> (Scratch, FakeServer, Tmux) {
     // Scenario 1's own replies: another scenario's would answer its prompts first.
     let server = FakeServer::start(
         vec![],
@@ -54,12 +56,12 @@ fn start(name: &str) -> (FakeServer, Tmux) {
         ("", ""),
     );
     let tmux = Tmux::start(&command);
-    (server, tmux)
+    (dir, server, tmux)
 }
 
 #[test]
 fn undo_then_the_undone_fix_is_proposed_again() {
-    let (_server, tmux) = start("tmux-undo");
+    let (_dir, _server, tmux) = start("tmux-undo");
     to_the_first_proposal(&tmux);
     tmux.keys(&["a"]);
     tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
@@ -76,7 +78,7 @@ fn undo_then_the_undone_fix_is_proposed_again() {
 
 #[test]
 fn reject_then_the_model_is_asked_again_and_a_mistyped_edit_is_kept() {
-    let (_server, tmux) = start("tmux-reject");
+    let (_dir, _server, tmux) = start("tmux-reject");
     to_the_first_proposal(&tmux);
     tmux.keys(&["x"]);
     tmux.wait_for(&["rejected: the tree is unchanged"], 10);

@@ -13,7 +13,7 @@ use std::collections::BTreeSet;
 use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
-use support::cli::tmp;
+use support::cli::{Scratch, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 use support::tmux::Tmux;
@@ -143,8 +143,10 @@ fn page_status(port: u16) -> String {
     page.lines().next().unwrap_or_default().to_string()
 }
 
-/// The workbench on scenario 1 with `--viewer web`, the pinned `rerun` first on PATH.
-fn workbench(name: &str, server: &FakeServer) -> Tmux {
+/// The scratch directory the workbench runs in (removed when dropped, after the
+/// workbench, which is declared after it) and the workbench on scenario 1 with `--viewer
+/// web`, the pinned `rerun` first on PATH.
+fn workbench(name: &str, server: &FakeServer) -> (Scratch, Tmux) {
     let dir = tmp(name);
     let path = format!(
         "PATH={}:{}",
@@ -157,7 +159,7 @@ fn workbench(name: &str, server: &FakeServer) -> Tmux {
         server,
         (&path, "--viewer web"),
     );
-    Tmux::start(&command)
+    (dir, Tmux::start(&command))
 }
 
 /// Its group's page port, which the workbench's log names.
@@ -174,7 +176,7 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
     support::rerun::rerun_cli();
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
 
-    let first = workbench("viz-web-first", &server);
+    let (_first_dir, first) = workbench("viz-web-first", &server);
     first.wait_for(&["Behavior tree", "3D view: open", "http://127.0.0.1:"], 60);
     let first_viewers = viewers_of(&first);
     let (first_group, first_port) = port_of(&first_viewers);
@@ -182,7 +184,7 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
     assert!(first_viewers.len() >= 2, "{first_viewers:?}");
     first.wait_for(&[&format!("http://127.0.0.1:{first_port}/?url=")], 10);
 
-    let second = workbench("viz-web-second", &server);
+    let (_second_dir, second) = workbench("viz-web-second", &server);
     second.wait_for(&["Behavior tree", "3D view: open", "http://127.0.0.1:"], 60);
     let second_viewers = viewers_of(&second);
     let (second_group, second_port) = port_of(&second_viewers);
