@@ -244,7 +244,44 @@ fn skills(
         sources.retain(|s| !names.contains(&s.raw.name.get_ref().as_str()));
         sources.extend(raw.skills.iter().map(|raw| SkillSource { raw, file }));
     }
-    sources.iter().map(|s| build_skill(s, vocabulary)).collect()
+    let skills = sources
+        .iter()
+        .map(|s| build_skill(s, vocabulary))
+        .collect::<Result<Vec<Skill>, _>>()?;
+    // Skills may share a name when they take different objects ("open" a door, "open" a
+    // cabinet): an action names its skill by name and objects, so two that could take the
+    // same objects leave an action meaning either, and the world would run the first.
+    for (later, skill) in skills.iter().enumerate() {
+        if let Some(earlier) = skills[..later]
+            .iter()
+            .position(|e| e.name == skill.name && take_the_same_objects(e, skill, vocabulary))
+        {
+            let (at, first) = (&sources[later], &sources[earlier]);
+            let line = first.file.error_at(first.raw.name.span().start, "").line;
+            return Err(at.file.error_in_string(
+                &at.raw.name.span(),
+                0,
+                format!(
+                    "the skill {:?} can take the same objects as the {:?} at line {line} of {}, so an action naming it could mean either: give one another name, or parameters of types the other does not take",
+                    skill.name,
+                    skill.name,
+                    first.file.path.display()
+                ),
+            ));
+        }
+    }
+    Ok(skills)
+}
+
+/// Whether some objects fit every parameter of both `a` and `b`.
+fn take_the_same_objects(a: &Skill, b: &Skill, vocabulary: &Vocabulary) -> bool {
+    a.params.len() == b.params.len()
+        && a.params.iter().zip(&b.params).all(|(p, q)| {
+            vocabulary
+                .objects
+                .iter()
+                .any(|o| p.admits(vocabulary, &o.name) && q.admits(vocabulary, &o.name))
+        })
 }
 
 /// A goal of the `[scenario]` table, its errors located inside its string.
@@ -466,6 +503,40 @@ mod tests {
     use crate::scenario::Scenario;
 
     const BASE: &str = "[scenario]\nname = \"t\"\n\n[objects]\nitem = [\"Chips\", \"Cup\"]\n\n[[predicates]]\nname = \"Holding\"\nargs = [\"item\"]\ndescription = \"held\"\n\n";
+
+    #[test]
+    fn two_skills_of_one_name_that_take_the_same_objects_are_refused_with_both_places() {
+        let skill = |name: &str, param: &str| {
+            format!(
+                "[[skills]]\nname = \"{name}\"\nparams = [\"{param}\"]\nadd = [\"Holding_{{i}}\"]\n\n"
+            )
+        };
+        let text = format!(
+            "{BASE}{}{}",
+            skill("Raise", "i: item"),
+            skill("Raise", "i: item")
+        );
+        let err = Scenario::from_text(Path::new("twice.toml"), text)
+            .expect_err("two Raise on an item")
+            .to_string();
+        assert!(
+            err.contains("twice.toml:18:") && err.contains("line 13"),
+            "{err}"
+        );
+        assert!(err.contains("could mean either"), "{err}");
+        // One name over objects no object fits both of is fine.
+        let text = format!(
+            "{}{}{}",
+            BASE.replace(
+                "item = [\"Chips\", \"Cup\"]",
+                "item = [\"Chips\", \"Cup\"]\nbox = [\"Crate\"]"
+            )
+            .replace("args = [\"item\"]", "args = [\"item|box\"]"),
+            skill("Raise", "i: item"),
+            skill("Raise", "i: box")
+        );
+        Scenario::from_text(Path::new("apart.toml"), text).expect("different objects");
+    }
 
     #[test]
     fn what_objects_are_called_reaches_the_vocabulary() {
