@@ -1,5 +1,5 @@
 //! The English every reader of requests knows, in one place: one list per kind of word,
-//! each word in one list (a test checks it; the words two lists share say why in
+//! each word in one list (a test checks it; the one word two lists share says why in
 //! [`SHARED`]). What a domain's words mean — what its objects are called, the words that
 //! ask for each predicate and its opposite, its conventions — is not here: it is data in
 //! the domain's scenario file, read through [`super::lexicon::Lexicon`].
@@ -17,23 +17,9 @@ pub const ARTICLES: &[&str] = &["a", "an", "the", "some", "any"];
 /// Words that soften a request without changing it ("maybe bring", "either the milk").
 pub const HEDGES: &[&str] = &["either", "maybe", "perhaps"];
 
-/// How many objects of a kind a quantifier asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Quantity {
-    /// Each of them ("both vents", "all the tables").
-    Every,
-    /// One of them, whichever ("either tote").
-    OneOf,
-}
-
-/// Words that ask something of the objects of the kind named after them, and of how many.
-pub const QUANTIFIERS: &[(&str, Quantity)] = &[
-    ("both", Quantity::Every),
-    ("all", Quantity::Every),
-    ("every", Quantity::Every),
-    ("each", Quantity::Every),
-    ("either", Quantity::OneOf),
-];
+/// Words that ask for every object of the kind named after them ("both vents", "all the
+/// tables").
+pub const QUANTIFIERS: &[&str] = &["both", "all", "every", "each"];
 
 /// Words that restrict what follows: before a verb they soften it ("or just bring"),
 /// before a thing they make it the only one ("or just a mug").
@@ -167,27 +153,18 @@ pub const FUNCTION_WORDS: &[&str] = &[
 pub const ROBOT_WORDS: &[&str] = &["robot", "nothing"];
 
 /// The words two lists share, and why.
-pub const SHARED: &[(&str, &str)] = &[
-    (
-        "no",
-        "a negation, and before a number only the announcement of the number (\"table No. 6\")",
-    ),
-    (
-        "either",
-        "a hedge before a wish or a thing (\"either bring…\"), and before a kind's noun the choice of one of its two objects (\"either tote\")",
-    ),
-];
+pub const SHARED: &[(&str, &str)] = &[(
+    "no",
+    "a negation, and before a number only the announcement of the number (\"table No. 6\")",
+)];
 
 fn has(list: &[&str], word: &str) -> bool {
     list.contains(&word)
 }
 
-/// How many objects of the kind named after it `word` asks for, if it is a quantifier.
-pub fn quantity(word: &str) -> Option<Quantity> {
-    QUANTIFIERS
-        .iter()
-        .find(|(w, _)| *w == word)
-        .map(|(_, q)| *q)
+/// Whether `word` asks for every object of the kind named after it.
+pub fn is_quantifier(word: &str) -> bool {
+    has(QUANTIFIERS, word)
 }
 
 /// Whether `word` says nothing about what is asked (matches are made without it).
@@ -344,10 +321,7 @@ mod tests {
                     .flat_map(|(c, o, d)| [c.to_string(), o.to_string(), d.to_string()])
                     .collect(),
             ),
-            (
-                "QUANTIFIERS",
-                QUANTIFIERS.iter().map(|(w, _)| w.to_string()).collect(),
-            ),
+            ("QUANTIFIERS", plain(QUANTIFIERS)),
             ("SENDING_VERBS", plain(SENDING_VERBS)),
             ("MOVING_VERBS", plain(MOVING_VERBS)),
             ("STATE_VERBS", plain(STATE_VERBS)),

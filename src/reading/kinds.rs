@@ -1,35 +1,29 @@
-//! The objects of a kind: a request that says "both vents", "all the tables" or "every
+//! Every object of a kind: a request that says "both vents", "all the tables" or "every
 //! bench" asks the same of each of the scene's objects whose name says that kind, though
-//! it names none of them by itself; one that says "either tote" asks it of one of the
-//! two, whichever. A goal that has the condition for some of every one only has read the
-//! plural as one object, and one that has it for one tote (or for both, side by side) has
-//! made the choice the request left open; a check that counts the words a condition
-//! answers to must not take the second bench's condition for one no word asks for.
+//! it names none of them by itself. A goal that has the condition for some of them only
+//! has read the plural as one object; a check that counts the words a condition answers
+//! to must not take the second bench's condition for one no word asks for.
 
 use crate::domain::{Atom, Vocabulary};
 use crate::goal::Formula;
-use crate::goal::rewrite::rename;
 
-use super::english::{Quantity, may_precede_thing, quantity};
+use super::english::{is_quantifier, may_precede_thing};
 use super::lexicon::Lexicon;
 use super::request::Request;
 use super::words::{is_number, same_word, terms};
 
-/// The objects a quantifier asks something of, with the words that said so ("both
-/// benches") and whether it asks it of each or of one.
+/// The objects a quantifier asks for each of, with the words that said so ("both
+/// benches").
 #[derive(Debug, Clone, PartialEq)]
 pub struct EveryOfKind {
     pub objects: Vec<String>,
     pub said: String,
-    pub quantity: Quantity,
 }
 
 /// The kinds `words` (a request's, or a clause's, as [`super::words::every_term`] gives
-/// them) ask something of every object of, or of one: a quantifier, then (past articles
-/// and "of") the words of a name, the last one what the object is, that at least two of
-/// the scene's objects share — exactly two after "both" or "either" (an "either" that an
-/// "or" follows offers its own choice). [`Request::every_of_kind`] keeps the whole
-/// request's, sentence by sentence.
+/// them) ask for every object of: a quantifier, then (past articles and "of") the words
+/// of a name, the last one what the object is, that at least two of the scene's objects
+/// share — exactly two after "both". [`Request::every_of_kind`] keeps the whole request's.
 pub fn every_of_kind_in(
     words: &[String],
     vocabulary: &Vocabulary,
@@ -37,9 +31,9 @@ pub fn every_of_kind_in(
 ) -> Vec<EveryOfKind> {
     let mut out = Vec::new();
     for (at, word) in words.iter().enumerate() {
-        let Some(quantity) = quantity(word) else {
+        if !is_quantifier(word) {
             continue;
-        };
+        }
         let mut next = at + 1;
         while words
             .get(next)
@@ -75,12 +69,7 @@ pub fn every_of_kind_in(
             })
             .map(|o| o.name.clone())
             .collect();
-        // "Either yogurt or an apple" offers its own choice: "either" is no quantifier
-        // when an "or" follows it.
-        if quantity == Quantity::OneOf && words[next..].iter().any(|w| w == "or") {
-            continue;
-        }
-        let enough = if word == "both" || quantity == Quantity::OneOf {
+        let enough = if word == "both" {
             objects.len() == 2
         } else {
             objects.len() >= 2
@@ -93,15 +82,14 @@ pub fn every_of_kind_in(
             out.push(EveryOfKind {
                 objects,
                 said: said.join(" "),
-                quantity,
             });
         }
     }
     out
 }
 
-/// Whether every atom of `part` is about an object of a kind the request asks something of
-/// (each, or one): such a condition is asked for though no word names its object alone.
+/// Whether every atom of `part` is about an object of a kind the request asks for each
+/// of: such a condition is asked for though no word names its object alone.
 pub fn asked_of_every(part: &Formula, kinds: &[EveryOfKind]) -> bool {
     let atoms = part.atoms();
     !atoms.is_empty()
@@ -132,32 +120,16 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
     }
 }
 
-fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
+fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>> {
     let items = goal.conjuncts();
-    let kinds = request.every_of_kind();
-    for kind in kinds.iter().filter(|k| k.quantity == Quantity::Every) {
-        // A condition about an object the request names by itself ("lay bed two flat"
-        // beside "rails up on every bed") is said of that object, not of the kind; the
-        // kind's own words ("both bars", where one bar is called Bar) name none by itself.
-        let said: Vec<&str> = kind.said.split(' ').collect();
-        let named: Vec<&str> = request
-            .mentions()
-            .iter()
-            .filter(|(first, count, _)| {
-                request
-                    .unnumbered_words
-                    .get(*first..first + count)
-                    .is_some_and(|run| run.iter().any(|w| !said.contains(&w.as_str())))
-            })
-            .map(|(_, _, name)| name.as_str())
-            .collect();
+    for kind in kinds {
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
             let Some((atom, holds)) = literal(item) else {
                 continue;
             };
             for (slot, arg) in atom.args.iter().enumerate() {
-                if !kind.objects.contains(arg) || named.contains(&arg.as_str()) {
+                if !kind.objects.contains(arg) {
                     continue;
                 }
                 for other in kind.objects.iter().filter(|o| *o != arg) {
@@ -184,7 +156,7 @@ fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
 
 /// How `goal` reads a request's "both"/"all"/"every" as fewer objects than the kind has.
 pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
-    let found = left_out(goal, request)?;
+    let found = left_out(goal, request.every_of_kind())?;
     let missing: Vec<String> = found.missing.iter().map(ToString::to_string).collect();
     Some(format!(
         "the request says \"{}\", which asks it of {}; {goal} leaves out {}",
@@ -196,77 +168,9 @@ pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
 
 /// `goal` with the conditions [`fewer_than_every`] finds left out put beside it.
 pub fn with_every(goal: &Formula, request: &Request) -> Option<Formula> {
-    let found = left_out(goal, request)?;
+    let found = left_out(goal, request.every_of_kind())?;
     let mut items = goal.conjuncts();
     items.extend(found.missing);
-    Some(Formula::and(items))
-}
-
-/// A condition of `goal` about one object of a kind the request leaves the choice of
-/// ("either tote"), held for it alone or for each side by side: the kind, the conjuncts
-/// that made the choice, and the choice left open.
-struct Chosen<'k> {
-    kind: &'k EveryOfKind,
-    made: Vec<Formula>,
-    open: Formula,
-}
-
-fn chosen<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<Chosen<'k>> {
-    let items = goal.conjuncts();
-    let about = |item: &Formula, object: &str| {
-        literal(item).is_some_and(|(atom, _)| atom.args.iter().any(|a| a == object))
-    };
-    for kind in kinds.iter().filter(|k| k.quantity == Quantity::OneOf) {
-        // The first object of the kind the goal has a condition about: what it asks of
-        // that one ("a full jug at bed three": full, and there) is asked of whichever.
-        let Some(first) = kind
-            .objects
-            .iter()
-            .find(|o| items.iter().any(|i| about(i, o)))
-        else {
-            continue;
-        };
-        let of_first: Vec<&Formula> = items.iter().filter(|i| about(i, first)).collect();
-        let each: Vec<Formula> = kind
-            .objects
-            .iter()
-            .map(|o| Formula::and(of_first.iter().map(|i| rename(i, first, o)).collect()))
-            .collect();
-        let open = Formula::or(each);
-        if items.contains(&open) {
-            continue;
-        }
-        let made: Vec<Formula> = items
-            .iter()
-            .filter(|i| kind.objects.iter().any(|o| about(i, o)))
-            .cloned()
-            .collect();
-        return Some(Chosen { kind, made, open });
-    }
-    None
-}
-
-/// How `goal` makes the choice a request's "either" leaves open.
-pub fn choice_made(goal: &Formula, request: &Request) -> Option<String> {
-    let found = chosen(goal, request.every_of_kind())?;
-    let made: Vec<String> = found.made.iter().map(ToString::to_string).collect();
-    Some(format!(
-        "the request says \"{}\", which leaves the choice between {}; {goal} asks for {}",
-        found.kind.said,
-        found.kind.objects.join(" and "),
-        made.join(" and ")
-    ))
-}
-
-/// `goal` with the choice [`choice_made`] finds left open again.
-pub fn with_choice_open(goal: &Formula, request: &Request) -> Option<Formula> {
-    let found = chosen(goal, request.every_of_kind())?;
-    let mut items: Vec<Formula> = goal
-        .conjuncts()
-        .into_iter()
-        .filter(|i| !found.made.contains(i))
-        .collect();
-    items.push(found.open);
     Some(Formula::and(items))
 }
 
@@ -341,89 +245,5 @@ mod tests {
         // A request without a quantifier asks nothing of the kind.
         let r = Request::in_scene("Close the roof vent.", &v, &[], &lexicon);
         assert_eq!(fewer_than_every(&goal("~Open_RoofVent"), &r), None);
-    }
-
-    #[test]
-    fn either_of_a_kind_of_two_leaves_the_choice_open() {
-        let v = scene(&["Tote1", "Tote2", "Conveyor", "BigBox"]);
-        let lexicon = Lexicon::new(&v, &[]);
-        let r = Request::in_scene(
-            "Scan either tote and start the conveyor.",
-            &v,
-            &[],
-            &lexicon,
-        );
-        assert_eq!(r.every_of_kind()[0].quantity, Quantity::OneOf);
-        let one = goal("Scanned_Tote1 & Running_Conveyor");
-        assert!(choice_made(&one, &r).is_some_and(|m| m.contains("either tote")));
-        let open = goal("Running_Conveyor & (Scanned_Tote1 | Scanned_Tote2)");
-        assert_eq!(with_choice_open(&one, &r), Some(open.clone()));
-        // Both, side by side, also made the choice.
-        let both = goal("Scanned_Tote1 & Scanned_Tote2 & Running_Conveyor");
-        assert_eq!(with_choice_open(&both, &r), Some(open.clone()));
-        assert_eq!(choice_made(&open, &r), None);
-        // "Either" asks nothing of every tote, and the other tote is asked for.
-        assert_eq!(fewer_than_every(&one, &r), None);
-        assert!(asked_of_every(
-            &goal("Scanned_Tote1 | Scanned_Tote2"),
-            r.every_of_kind()
-        ));
-        // "Either … or" offers its own choice, whatever the kind of the first thing.
-        let r = Request::in_scene("Scan either tote or the big box.", &v, &[], &lexicon);
-        assert!(r.every_of_kind().is_empty(), "{:?}", r.every_of_kind());
-        // "Either" before a name of one object leaves no choice of a kind.
-        let r = Request::in_scene(
-            "Either scan the big box or start the conveyor.",
-            &v,
-            &[],
-            &lexicon,
-        );
-        assert!(r.every_of_kind().is_empty(), "{:?}", r.every_of_kind());
-    }
-
-    #[test]
-    fn a_condition_about_an_object_the_request_names_is_not_the_quantifiers() {
-        let v = scene(&["Bed1", "Bed2", "Bed3", "Jug1"]);
-        let lexicon = Lexicon::new(&v, &[]);
-        let r = Request::in_scene(
-            "Night round: rails up on every bed, and lay bed two flat.",
-            &v,
-            &[],
-            &lexicon,
-        );
-        // Bed two's head is said of bed two alone; every bed's rails of each.
-        let g = goal("RailsUp_Bed1 & ~HeadUp_Bed2");
-        assert_eq!(
-            with_every(&g, &r),
-            Some(goal(
-                "RailsUp_Bed1 & ~HeadUp_Bed2 & RailsUp_Bed2 & RailsUp_Bed3"
-            ))
-        );
-        assert_eq!(
-            fewer_than_every(
-                &goal("RailsUp_Bed1 & RailsUp_Bed2 & RailsUp_Bed3 & ~HeadUp_Bed2"),
-                &r
-            ),
-            None
-        );
-    }
-
-    #[test]
-    fn what_is_asked_of_the_one_chosen_is_asked_of_whichever() {
-        let v = scene(&["Jug1", "Jug2", "Bed3", "Room2Door"]);
-        let lexicon = Lexicon::new(&v, &[]);
-        let r = Request::in_scene(
-            "A full jug needs to end up at bed three, either jug will do.",
-            &v,
-            &[],
-            &lexicon,
-        );
-        let g = goal("Full_Jug1 & At_Jug1_Bed3 & ~Open_Room2Door");
-        assert_eq!(
-            with_choice_open(&g, &r),
-            Some(goal(
-                "~Open_Room2Door & ((Full_Jug1 & At_Jug1_Bed3) | (Full_Jug2 & At_Jug2_Bed3))"
-            ))
-        );
     }
 }

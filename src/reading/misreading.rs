@@ -14,13 +14,12 @@
 //! | `relation-as-said` | a relation other than the one the request says before the place ("in the crib" read as on) | the relation said |
 //! | `convention` | an item a convention's words name left elsewhere ("bring me the kit" read as held) | the condition the convention asks for |
 //! | `fewer-than-every` | a condition asked of every object of a kind ("both vents", "all the tables") held for some of them only | the same condition for the others beside it |
-//! | `choice-made` | a condition asked of one object of a kind, whichever ("either tote"), held for one of them or for each | the choice between them left open |
 //! | `left-out` | one of two things named side by side left out ("fries or a dessert" read as the dessert) | the one left out put beside the other, joined as the request joins them |
 //! | `not-put` | an item the request sends to a place with no condition relating them | the item at the place (made and the robot there becomes the item there; an item at a place nobody named is moved there) |
 
 use crate::goal::Formula;
 
-use super::kinds::{choice_made, fewer_than_every, with_choice_open, with_every};
+use super::kinds::{fewer_than_every, with_every};
 use super::names::{swapped_back, swapped_object};
 use super::order::{reversed, turned_round};
 use super::placement::{moved_there, not_put, put_there};
@@ -49,7 +48,6 @@ pub const MISREADINGS: &[&dyn Misreading] = &[
     &RelationAsSaid,
     &Convention,
     &FewerThanEvery,
-    &ChoiceMade,
     &NotPut,
     &LeftOut,
 ];
@@ -243,25 +241,6 @@ impl Misreading for FewerThanEvery {
             return Vec::new();
         };
         with_every(goal, request)
-            .map(|g| (g, why))
-            .into_iter()
-            .collect()
-    }
-}
-
-struct ChoiceMade;
-impl Misreading for ChoiceMade {
-    fn name(&self) -> &'static str {
-        "choice-made"
-    }
-    fn find(&self, goal: &Formula, request: &Request) -> Option<String> {
-        choice_made(goal, request)
-    }
-    fn undo(&self, goal: &Formula, request: &Request) -> Vec<(Formula, String)> {
-        let Some(why) = choice_made(goal, request) else {
-            return Vec::new();
-        };
-        with_choice_open(goal, request)
             .map(|g| (g, why))
             .into_iter()
             .collect()

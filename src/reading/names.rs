@@ -6,7 +6,6 @@
 use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
-use super::english::Quantity;
 use super::english::{is_generic, is_phrasing, offers_choice};
 use super::kinds::asked_of_every;
 use super::placement::named_in;
@@ -304,16 +303,10 @@ pub(super) fn choices_offered(request: &str) -> usize {
 
 /// Why `goal` offers more alternatives than `request` does, if it does: "a banana or an
 /// orange, and switch the light off" written `A | B | ~C` makes switching the light off
-/// one of three alternatives, when the request asks for it in any case. Each "or" offers
-/// a choice, and so does each "either" before a kind of two ("either tote").
+/// one of three alternatives, when the request asks for it in any case.
 pub fn more_alternatives_than_asked(goal: &Formula, request: &Request) -> Option<String> {
     let offered = alternatives(goal, false);
-    let of_a_kind = request
-        .every_of_kind()
-        .iter()
-        .filter(|k| k.quantity == Quantity::OneOf)
-        .count();
-    let asked = request.choices + of_a_kind;
+    let asked = request.choices;
     (offered > asked).then(|| {
         format!(
             "it offers {} alternatives joined by |, where the request gives {} choice(s); \

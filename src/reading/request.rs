@@ -147,20 +147,10 @@ impl<'a> Request<'a> {
         self.sent.get_or_init(|| sent(self))
     }
 
-    /// The kinds it asks something of every object of, or of one ("both vents", "either
-    /// tote"; [`super::kinds`]), read sentence by sentence.
+    /// The kinds it asks for every object of ("both vents"; [`super::kinds`]).
     pub fn every_of_kind(&self) -> &[EveryOfKind] {
-        self.every_of_kind.get_or_init(|| {
-            let mut out: Vec<EveryOfKind> = Vec::new();
-            for sentence in &self.sentences {
-                for kind in every_of_kind_in(sentence, self.vocabulary, self.lexicon) {
-                    if !out.iter().any(|k| k.objects == kind.objects) {
-                        out.push(kind);
-                    }
-                }
-            }
-            out
-        })
+        self.every_of_kind
+            .get_or_init(|| every_of_kind_in(&self.unnumbered_words, self.vocabulary, self.lexicon))
     }
 
     fn objects(&self) -> Vec<&'a Object> {

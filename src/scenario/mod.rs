@@ -16,6 +16,7 @@ mod build;
 pub mod catalog;
 mod file;
 mod shipped;
+mod skills;
 
 use crate::domain::Atom;
 use crate::domain::names::{MIN_SIMILARITY, did_you_mean, nearest};
