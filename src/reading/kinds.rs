@@ -120,16 +120,31 @@ fn literal(f: &Formula) -> Option<(&Atom, bool)> {
     }
 }
 
-fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>> {
+fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
     let items = goal.conjuncts();
-    for kind in kinds {
+    for kind in request.every_of_kind() {
+        // A condition about an object the request names by itself ("lay bed two flat"
+        // beside "rails up on every bed") is said of that object, not of the kind; the
+        // kind's own words ("both bars", where one bar is called Bar) name none by itself.
+        let said: Vec<&str> = kind.said.split(' ').collect();
+        let named: Vec<&str> = request
+            .mentions()
+            .iter()
+            .filter(|(first, count, _)| {
+                request
+                    .unnumbered_words
+                    .get(*first..first + count)
+                    .is_some_and(|run| run.iter().any(|w| !said.contains(&w.as_str())))
+            })
+            .map(|(_, _, name)| name.as_str())
+            .collect();
         let mut missing: Vec<Formula> = Vec::new();
         for item in &items {
             let Some((atom, holds)) = literal(item) else {
                 continue;
             };
             for (slot, arg) in atom.args.iter().enumerate() {
-                if !kind.objects.contains(arg) {
+                if !kind.objects.contains(arg) || named.contains(&arg.as_str()) {
                     continue;
                 }
                 for other in kind.objects.iter().filter(|o| *o != arg) {
@@ -156,7 +171,7 @@ fn left_out<'k>(goal: &Formula, kinds: &'k [EveryOfKind]) -> Option<LeftOut<'k>>
 
 /// How `goal` reads a request's "both"/"all"/"every" as fewer objects than the kind has.
 pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
-    let found = left_out(goal, request.every_of_kind())?;
+    let found = left_out(goal, request)?;
     let missing: Vec<String> = found.missing.iter().map(ToString::to_string).collect();
     Some(format!(
         "the request says \"{}\", which asks it of {}; {goal} leaves out {}",
@@ -168,7 +183,7 @@ pub fn fewer_than_every(goal: &Formula, request: &Request) -> Option<String> {
 
 /// `goal` with the conditions [`fewer_than_every`] finds left out put beside it.
 pub fn with_every(goal: &Formula, request: &Request) -> Option<Formula> {
-    let found = left_out(goal, request.every_of_kind())?;
+    let found = left_out(goal, request)?;
     let mut items = goal.conjuncts();
     items.extend(found.missing);
     Some(Formula::and(items))
@@ -245,5 +260,32 @@ mod tests {
         // A request without a quantifier asks nothing of the kind.
         let r = Request::in_scene("Close the roof vent.", &v, &[], &lexicon);
         assert_eq!(fewer_than_every(&goal("~Open_RoofVent"), &r), None);
+    }
+
+    #[test]
+    fn a_condition_about_an_object_the_request_names_is_not_the_quantifiers() {
+        let v = scene(&["Bed1", "Bed2", "Bed3", "Jug1"]);
+        let lexicon = Lexicon::new(&v, &[]);
+        let r = Request::in_scene(
+            "Night round: rails up on every bed, and lay bed two flat.",
+            &v,
+            &[],
+            &lexicon,
+        );
+        // Bed two's head is said of bed two alone; every bed's rails of each.
+        let g = goal("RailsUp_Bed1 & ~HeadUp_Bed2");
+        assert_eq!(
+            with_every(&g, &r),
+            Some(goal(
+                "RailsUp_Bed1 & ~HeadUp_Bed2 & RailsUp_Bed2 & RailsUp_Bed3"
+            ))
+        );
+        assert_eq!(
+            fewer_than_every(
+                &goal("RailsUp_Bed1 & RailsUp_Bed2 & RailsUp_Bed3 & ~HeadUp_Bed2"),
+                &r
+            ),
+            None
+        );
     }
 }
