@@ -4,7 +4,7 @@
 //! has read the plural as one object; a check that counts the words a condition answers
 //! to must not take the second bench's condition for one no word asks for.
 
-use crate::domain::{Atom, Vocabulary};
+use crate::domain::{Atom, Condition, Vocabulary};
 use crate::goal::Formula;
 
 use super::english::{is_quantifier, may_precede_thing};
@@ -150,12 +150,10 @@ fn left_out<'r>(goal: &Formula, request: &'r Request) -> Option<LeftOut<'r>> {
                 for other in kind.objects.iter().filter(|o| *o != arg) {
                     let mut args = atom.args.clone();
                     args[slot] = other.clone();
-                    let same = Formula::Atom(Atom::new(atom.predicate.clone(), args));
-                    let wanted = if holds {
-                        same
-                    } else {
-                        Formula::Not(Box::new(same))
-                    };
+                    let wanted = Formula::literal(&Condition {
+                        atom: Atom::new(atom.predicate.clone(), args),
+                        negated: !holds,
+                    });
                     if !items.contains(&wanted) && !missing.contains(&wanted) {
                         missing.push(wanted);
                     }
