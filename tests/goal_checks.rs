@@ -551,3 +551,124 @@ async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() 
     assert_eq!((goal.to_string().as_str(), calls), ("On_Coffee_Table1", 1));
     assert!(grammar(&model.seen.lock().unwrap()[0]).contains("\"Table2\""));
 }
+
+/// Answers a goal question with `goal` and each question about one condition with the
+/// verdict `verdicts` gives for the condition it names (`true` when not listed).
+struct Verdicts {
+    goal: String,
+    verdicts: Vec<(&'static str, &'static str)>,
+    asked: Mutex<Vec<String>>,
+}
+
+impl LanguageModel for Verdicts {
+    fn model(&self) -> &str {
+        "scripted"
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            let last = request.messages.last().map(|m| m.content.clone());
+            let about = last.as_deref().and_then(|m| {
+                m.split("Think only of this condition: ")
+                    .nth(1)
+                    .and_then(|rest| rest.split_whitespace().next())
+                    .map(str::to_string)
+            });
+            Ok(scripted(match about {
+                Some(condition) => {
+                    self.asked.lock().unwrap().push(condition.clone());
+                    self.verdicts
+                        .iter()
+                        .find(|(c, _)| *c == condition)
+                        .map_or("true", |(_, v)| *v)
+                        .to_string()
+                }
+                None => self.goal.clone(),
+            }))
+        })
+    }
+}
+
+#[tokio::test]
+async fn conditions_asked_about_one_at_a_time_are_turned_round_or_taken_out() {
+    let cafe = scenario("scenarios/cafe/cafe.toml");
+    let model = Verdicts {
+        goal: "Goal: On_Coffee_Table1 & Active_TubeLight & Closed_Curtain".into(),
+        verdicts: vec![("Active_TubeLight", "false"), ("Closed_Curtain", "unasked")],
+        asked: Mutex::default(),
+    };
+    let options = Options {
+        // The checks off, so that the conditions asked about are the model's as written.
+        ablations: Ablations {
+            confirm_conditions: true,
+            check_goals: false,
+            ..Ablations::default()
+        },
+        ..Options::default()
+    };
+    let mut notices = Vec::new();
+    let reading = session::interpret::interpret(
+        &cafe,
+        world::load(&cafe).unwrap(),
+        "Coffee to table one, please.",
+        &model,
+        &options,
+        &mut |e| {
+            if let Event::Notice { message } = e {
+                notices.push(message.clone());
+            }
+        },
+    )
+    .await
+    .unwrap();
+    // Each condition asked about once; the light turned round, the curtain taken out.
+    assert_eq!(
+        *model.asked.lock().unwrap(),
+        ["On_Coffee_Table1", "Active_TubeLight", "Closed_Curtain"]
+    );
+    assert!(
+        equivalent(
+            &reading.answer.goal,
+            &Formula::parse("On_Coffee_Table1 & ~Active_TubeLight").unwrap()
+        )
+        .unwrap()
+    );
+    // The goal as written first stays a reading the person can choose.
+    assert_eq!(reading.readings.len(), 2);
+    assert!(
+        equivalent(
+            &reading.readings[1],
+            &Formula::parse("On_Coffee_Table1 & Active_TubeLight & Closed_Curtain").unwrap()
+        )
+        .unwrap()
+    );
+    assert!(
+        notices
+            .iter()
+            .any(|n| n.contains("asked condition by condition")),
+        "{notices:?}"
+    );
+
+    // A change that fails the goal's checks is not kept: the tube light is off already,
+    // so the light alone turned round asks for nothing.
+    let model = Verdicts {
+        goal: "Goal: Active_TubeLight".into(),
+        verdicts: vec![("Active_TubeLight", "false")],
+        asked: Mutex::default(),
+    };
+    let reading = session::interpret::interpret(
+        &cafe,
+        world::load(&cafe).unwrap(),
+        "The tube light.",
+        &model,
+        &options,
+        &mut |_| {},
+    )
+    .await
+    .unwrap();
+    assert_eq!(reading.answer.goal.to_string(), "Active_TubeLight");
+}

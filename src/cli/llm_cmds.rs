@@ -117,6 +117,11 @@ pub struct LlmFlags {
     /// the whole answer.
     #[arg(long, help_heading = ABLATIONS)]
     pub goal_prefix_in_prompt: bool,
+    /// After a goal is read, ask the model about each of its conditions (must it be true,
+    /// false, or is it not asked about) and turn round or take out a condition where the
+    /// answer says so and the goal still passes its checks.
+    #[arg(long, help_heading = ABLATIONS)]
+    pub confirm_conditions: bool,
     /// Ask a numeric parameter's first value as a number, instead of as a level (very low
     /// … very high) of the range the robot can do that betr turns into a number.
     #[arg(long, help_heading = ABLATIONS)]
@@ -253,6 +258,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
             read_by_parts: !flags.whole_request,
             small_steps: flags.small_steps,
             goal_prefix_in_prompt: flags.goal_prefix_in_prompt,
+            confirm_conditions: flags.confirm_conditions,
             value_levels: !flags.value_as_number,
             shortlist: !flags.no_shortlist,
             without_misreadings: Vec::new(),

@@ -114,6 +114,12 @@ pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) ->
     g
 }
 
+/// An answer that is exactly one of `words`.
+pub fn one_of_grammar(words: &[&str]) -> String {
+    let alternatives: Vec<String> = words.iter().map(|w| lit(w)).collect();
+    format!("root ::= {}\n", alternatives.join(" | "))
+}
+
 /// The rest of a goal's answer after [`GOAL_PREFIX`], written for the model: a space and
 /// the formula, as [`goal_grammar`] types it.
 pub fn goal_grammar_after_prefix(vocabulary: &Vocabulary, wildcard: bool) -> String {

@@ -114,6 +114,10 @@ pub struct Context<'a> {
     pub variant: &'a Variant,
 }
 
+/// The answers to [`Context::condition_question`]: the condition must be true, must be
+/// false, or is not asked about.
+pub const CONDITION_VERDICTS: [&str; 3] = ["true", "false", "unasked"];
+
 /// The role statement shared by all prompts (the system message).
 pub const ROLE: &str = "You are the reasoning part of a robot that plans with behavior trees. You answer in the exact format asked for, using only the conditions and objects you are given.";
 
@@ -176,6 +180,29 @@ impl Context<'_> {
         values.push((
             "answer_format",
             "Do not write the goal yet. First name the objects and places of this scene that the request names or means (a kind of thing means every object of that kind), by their names in the list of objects, exactly like this:\nNamed: <name>, <name>".into(),
+        ));
+        Ok(messages(fill("goal.md", &templates.goal, &values)?))
+    }
+
+    /// The goal prompt asking, instead of the goal, about one condition of a goal read
+    /// from the request: must it be true when the request has been carried out, must it
+    /// be false, or does the request not ask about it. The same prompt up to its answer
+    /// format, so a model that keeps a prompt's state answers each condition for the few
+    /// tokens of its question. `condition`: the atom as written; `words`: it in words.
+    pub fn condition_question(
+        &self,
+        templates: &Templates,
+        condition: &str,
+        words: &str,
+    ) -> Result<Vec<Message>, PromptError> {
+        let mut values = self.common();
+        values.push(("conventions", self.conventions_text()));
+        values.push((
+            "answer_format",
+            format!(
+                "Do not write the goal. Think only of this condition: {condition} ({words}). When the request has been carried out, must it be true, must it be false, or does the request not ask about it at all? Answer with one word: {}, {} or {}.",
+                CONDITION_VERDICTS[0], CONDITION_VERDICTS[1], CONDITION_VERDICTS[2]
+            ),
         ));
         Ok(messages(fill("goal.md", &templates.goal, &values)?))
     }

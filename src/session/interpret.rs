@@ -80,6 +80,7 @@ pub async fn interpret(
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Interpretation, SessionError> {
     let mut earlier_calls = 0;
+    let asked_in = world.fork();
     if options.ablations.check_goals && options.ablations.read_by_parts {
         let lexicon = Lexicon::new(&scenario.domain.vocabulary, example_pool(scenario, options));
         let parts = split(instruction, &lexicon);
@@ -87,6 +88,16 @@ pub async fn interpret(
             let forked = world.fork();
             match read_parts(scenario, forked, &parts, instruction, model, options, emit).await? {
                 PartsRead::Read(found) => {
+                    let found = super::confirm::confirmed(
+                        scenario,
+                        asked_in,
+                        instruction,
+                        found,
+                        model,
+                        options,
+                        emit,
+                    )
+                    .await?;
                     announce(scenario, &found, emit);
                     return Ok(found);
                 }
@@ -96,6 +107,9 @@ pub async fn interpret(
     }
     let mut found = read_goal(scenario, world, instruction, false, model, options, emit).await?;
     found.calls += earlier_calls;
+    let found =
+        super::confirm::confirmed(scenario, asked_in, instruction, found, model, options, emit)
+            .await?;
     announce(scenario, &found, emit);
     Ok(found)
 }

@@ -4,6 +4,7 @@
 //! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
+mod confirm;
 pub mod edit;
 pub mod engine;
 pub mod evidence;

@@ -101,6 +101,10 @@ pub struct Ablations {
     /// continue and type only the formula; off: the grammar types the whole answer,
     /// `Goal:` included.
     pub goal_prefix_in_prompt: bool,
+    /// After a goal is read, ask the model about each of its conditions (wanted true,
+    /// false, or not asked about) and change the goal where the answers say so
+    /// (`session::confirm`); off: the goal stands as read and checked.
+    pub confirm_conditions: bool,
 }
 
 impl Default for Ablations {
@@ -113,6 +117,7 @@ impl Default for Ablations {
             shortlist: true,
             without_misreadings: Vec::new(),
             goal_prefix_in_prompt: false,
+            confirm_conditions: false,
         }
     }
 }
