@@ -9,7 +9,9 @@
 //! the request asks for is taken out; a
 //! failure is asked about with the conditions that fix it in simulation as the only
 //! choices. And with a model that answers by the request it is asked about: a request of
-//! several wishes is read a wish at a time.
+//! several wishes is read a wish at a time; asked about each condition of its goal, a
+//! condition the model says is wanted the other way round is turned and one it says is
+//! not asked about taken out, the goal as first read staying a reading.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
@@ -439,14 +441,23 @@ async fn a_misreading_that_can_be_undone_gives_the_undone_goal_as_a_candidate() 
     assert_eq!(goal.to_string(), "Closed_Curtain");
 }
 
-/// Answers the question of the objects named with `named`, any goal question with `goal`.
-struct NamesFirst {
-    named: String,
-    goal: String,
+/// A grammar-following model that answers each request as `answer` says, keeping every
+/// request seen.
+struct AnswersBy<F> {
+    answer: F,
     seen: Mutex<Vec<ChatRequest>>,
 }
 
-impl LanguageModel for NamesFirst {
+impl<F: Fn(&ChatRequest) -> String + Send + Sync> AnswersBy<F> {
+    fn new(answer: F) -> Self {
+        AnswersBy {
+            answer,
+            seen: Mutex::default(),
+        }
+    }
+}
+
+impl<F: Fn(&ChatRequest) -> String + Send + Sync> LanguageModel for AnswersBy<F> {
     fn model(&self) -> &str {
         "scripted"
     }
@@ -458,27 +469,31 @@ impl LanguageModel for NamesFirst {
     fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
         Box::pin(async move {
             self.seen.lock().unwrap().push(request.clone());
-            let asks_names = matches!(
-                &request.constraint,
-                Some(OutputConstraint::Grammar { gbnf, .. }) if gbnf.starts_with("root ::= \"Named: \"")
-            );
-            Ok(scripted(if asks_names {
-                self.named.clone()
-            } else {
-                self.goal.clone()
-            }))
+            Ok(scripted((self.answer)(request)))
         })
     }
+}
+
+/// Answers the question of the objects named with `named`, any goal question with `goal`.
+fn names_first(named: &str, goal: &str) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {
+    let (named, goal) = (named.to_string(), goal.to_string());
+    AnswersBy::new(move |request: &ChatRequest| {
+        let asks_names = matches!(
+            &request.constraint,
+            Some(OutputConstraint::Grammar { gbnf, .. }) if gbnf.starts_with("root ::= \"Named: \"")
+        );
+        if asks_names {
+            named.clone()
+        } else {
+            goal.clone()
+        }
+    })
 }
 
 #[tokio::test]
 async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
-    let model = NamesFirst {
-        named: "Named: Table1, Coffee".into(),
-        goal: "Goal: On_Coffee_Table1".into(),
-        seen: Mutex::default(),
-    };
+    let model = names_first("Named: Table1, Coffee", "Goal: On_Coffee_Table1");
     let options = Options {
         ablations: Ablations {
             small_steps: true,
@@ -530,11 +545,7 @@ async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() 
     }
 
     // Off (the default): one call, typed over the whole scene.
-    let model = NamesFirst {
-        named: "Named: Table1".into(),
-        goal: "Goal: On_Coffee_Table1".into(),
-        seen: Mutex::default(),
-    };
+    let model = names_first("Named: Table1", "Goal: On_Coffee_Table1");
     let (goal, calls) = {
         let r = session::interpret::interpret(
             &cafe,
@@ -552,55 +563,42 @@ async fn small_steps_type_the_first_answer_over_the_objects_the_request_names() 
     assert!(grammar(&model.seen.lock().unwrap()[0]).contains("\"Table2\""));
 }
 
-/// Answers a goal question with `goal` and each question about one condition with the
-/// verdict `verdicts` gives for the condition it names (`true` when not listed).
-struct Verdicts {
-    goal: String,
-    verdicts: Vec<(&'static str, &'static str)>,
-    asked: Mutex<Vec<String>>,
+/// The condition a question about one condition asks about, if it is one.
+fn condition_asked(request: &ChatRequest) -> Option<String> {
+    let last = request.messages.last()?;
+    let rest = last
+        .content
+        .split("Think only of this condition: ")
+        .nth(1)?;
+    rest.split_whitespace().next().map(str::to_string)
 }
 
-impl LanguageModel for Verdicts {
-    fn model(&self) -> &str {
-        "scripted"
-    }
-
-    fn supports_grammar(&self) -> bool {
-        true
-    }
-
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(async move {
-            let last = request.messages.last().map(|m| m.content.clone());
-            let about = last.as_deref().and_then(|m| {
-                m.split("Think only of this condition: ")
-                    .nth(1)
-                    .and_then(|rest| rest.split_whitespace().next())
-                    .map(str::to_string)
-            });
-            Ok(scripted(match about {
-                Some(condition) => {
-                    self.asked.lock().unwrap().push(condition.clone());
-                    self.verdicts
-                        .iter()
-                        .find(|(c, _)| *c == condition)
-                        .map_or("true", |(_, v)| *v)
-                        .to_string()
-                }
-                None => self.goal.clone(),
-            }))
-        })
-    }
+/// Answers a goal question with `goal` and each question about one condition with the
+/// verdict `verdicts` gives for it (`true` when not listed).
+fn verdicts(
+    goal: &str,
+    verdicts: &[(&'static str, &'static str)],
+) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {
+    let (goal, verdicts) = (goal.to_string(), verdicts.to_vec());
+    AnswersBy::new(
+        move |request: &ChatRequest| match condition_asked(request) {
+            Some(condition) => verdicts
+                .iter()
+                .find(|(c, _)| *c == condition)
+                .map_or("true", |(_, v)| *v)
+                .to_string(),
+            None => goal.clone(),
+        },
+    )
 }
 
 #[tokio::test]
 async fn conditions_asked_about_one_at_a_time_are_turned_round_or_taken_out() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
-    let model = Verdicts {
-        goal: "Goal: On_Coffee_Table1 & Active_TubeLight & Closed_Curtain".into(),
-        verdicts: vec![("Active_TubeLight", "false"), ("Closed_Curtain", "unasked")],
-        asked: Mutex::default(),
-    };
+    let model = verdicts(
+        "Goal: On_Coffee_Table1 & Active_TubeLight & Closed_Curtain",
+        &[("Active_TubeLight", "false"), ("Closed_Curtain", "unasked")],
+    );
     let options = Options {
         // The checks off, so that the conditions asked about are the model's as written.
         ablations: Ablations {
@@ -626,8 +624,15 @@ async fn conditions_asked_about_one_at_a_time_are_turned_round_or_taken_out() {
     .await
     .unwrap();
     // Each condition asked about once; the light turned round, the curtain taken out.
+    let asked: Vec<String> = model
+        .seen
+        .lock()
+        .unwrap()
+        .iter()
+        .filter_map(condition_asked)
+        .collect();
     assert_eq!(
-        *model.asked.lock().unwrap(),
+        asked,
         ["On_Coffee_Table1", "Active_TubeLight", "Closed_Curtain"]
     );
     assert!(
@@ -655,11 +660,7 @@ async fn conditions_asked_about_one_at_a_time_are_turned_round_or_taken_out() {
 
     // A change that fails the goal's checks is not kept: the tube light is off already,
     // so the light alone turned round asks for nothing.
-    let model = Verdicts {
-        goal: "Goal: Active_TubeLight".into(),
-        verdicts: vec![("Active_TubeLight", "false")],
-        asked: Mutex::default(),
-    };
+    let model = verdicts("Goal: Active_TubeLight", &[("Active_TubeLight", "false")]);
     let reading = session::interpret::interpret(
         &cafe,
         world::load(&cafe).unwrap(),
