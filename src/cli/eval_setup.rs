@@ -163,6 +163,9 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     if options.ablations.small_steps {
         settings.insert("small_steps".into(), "true".into());
     }
+    if options.variant.scene_word_examples {
+        settings.insert("scene_word_examples".into(), "true".into());
+    }
     if options.ablations.confirm_conditions {
         settings.insert("confirm_conditions".into(), "true".into());
     }

@@ -10,6 +10,7 @@
 
 use std::collections::HashMap;
 
+use crate::reading::Request;
 use crate::reading::words::terms;
 use crate::scenario::Example;
 
@@ -82,6 +83,49 @@ pub fn nearest<'a>(pool: &'a [Example], request: &str, k: usize) -> Vec<&'a Exam
     chosen
 }
 
+/// Worked examples made from the scene's own words for what `request` asks: each
+/// condition of one object it asks for in the words the scene lists
+/// ([`Request::asked_of_one_object`]), said with the first phrase the scene lists for it
+/// (or for its opposite, when it is asked not to hold) and the object's name ("head over
+/// to the pantry" asks for `RobotAt_Pantry`: "Head to Pantry."). At most `most`, in the
+/// order the request asks them; none for a condition whose predicate lists no phrase the
+/// way it is asked, or not even one for the other way.
+pub fn from_scene_words(request: &Request, most: usize) -> Vec<Example> {
+    let vocabulary = request.vocabulary;
+    let mut made: Vec<Example> = Vec::new();
+    for (atom, wanted) in request.asked_of_one_object() {
+        let Some(predicate) = vocabulary.predicate(&atom.predicate) else {
+            continue;
+        };
+        let (says, opposite) = (&predicate.words.says, &predicate.words.opposite);
+        let phrase = match (wanted, says.first(), opposite.first()) {
+            (true, Some(p), _) | (false, _, Some(p)) => p.clone(),
+            (false, Some(p), None) => format!("do not {p}"),
+            _ => continue,
+        };
+        let Some(object) = atom.args.first() else {
+            continue;
+        };
+        let goal = if wanted {
+            atom.to_string()
+        } else {
+            format!("~{atom}")
+        };
+        if made.iter().any(|e| e.goal == goal) {
+            continue;
+        }
+        let mut instruction = format!("{phrase} {object}.");
+        if let Some(first) = instruction.get(..1) {
+            instruction = first.to_uppercase() + &instruction[1..];
+        }
+        made.push(Example { instruction, goal });
+        if made.len() == most {
+            break;
+        }
+    }
+    made
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,6 +153,39 @@ mod tests {
         // The goal's words count: "light" finds the light example.
         let chosen = nearest(&pool, "it is dark, I need light", 1);
         assert_eq!(chosen[0].goal, "Active_TubeLight");
+    }
+
+    #[test]
+    fn the_scene_words_a_request_uses_make_examples_of_their_conditions() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
+        let cafe = crate::scenario::Scenario::load(&path).expect("cafe scenario");
+        let lexicon = crate::reading::Lexicon::new(&cafe.domain.vocabulary, &cafe.examples);
+        let made = |text: &str, most: usize| -> Vec<(String, String)> {
+            let request = Request::new(text, &cafe, &lexicon);
+            from_scene_words(&request, most)
+                .into_iter()
+                .map(|e| (e.instruction, e.goal))
+                .collect()
+        };
+        // Said with the scene's first phrase for the condition or for its opposite, the
+        // negation read: "don't leave the tube light on" asks for it off.
+        assert_eq!(
+            made("Close the curtain and don't leave the tube light on.", 3),
+            [
+                ("Close Curtain.".to_string(), "Closed_Curtain".to_string()),
+                (
+                    "Off TubeLight.".to_string(),
+                    "~Active_TubeLight".to_string()
+                ),
+            ]
+        );
+        assert_eq!(
+            made("Close the curtain and don't leave the tube light on.", 1).len(),
+            1
+        );
+        // Nothing where no listed phrase is said of an object the request names.
+        assert!(made("Bring a coffee to table 2.", 3).is_empty());
     }
 
     #[test]

@@ -16,6 +16,9 @@ use crate::scenario::{Example, Scenario};
 /// How many worked examples a prompt shows when it chooses them per request.
 pub const DEFAULT_EXAMPLES_SHOWN: usize = 6;
 
+/// The most examples made from the scene's own words one prompt shows.
+const SCENE_WORD_EXAMPLES: usize = 3;
+
 /// Which ablation of the prompt to write.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
@@ -33,6 +36,10 @@ pub struct Variant {
     /// Show the pool's first `examples_shown` examples for every request instead of the
     /// most similar ones (the ablation of retrieval).
     pub fixed_examples: bool,
+    /// Also show examples made from the scene's own words for the request
+    /// (`examples::from_scene_words`): a phrase the scene lists for a condition that the
+    /// request uses, said of an object the request names, with the condition.
+    pub scene_word_examples: bool,
 }
 
 impl Default for Variant {
@@ -44,6 +51,7 @@ impl Default for Variant {
             examples: None,
             examples_shown: Some(DEFAULT_EXAMPLES_SHOWN),
             fixed_examples: false,
+            scene_word_examples: false,
         }
     }
 }
@@ -143,10 +151,20 @@ impl Context<'_> {
                     OBJECT_RULE.to_string()
                 },
             ),
-            (
-                "examples",
-                examples_text(&self.variant.choose(examples, self.instruction)),
-            ),
+            ("examples", {
+                let derived = if self.variant.scene_word_examples {
+                    let lexicon = crate::reading::Lexicon::new(vocabulary, examples);
+                    let request =
+                        crate::reading::Request::new(self.instruction, self.scenario, &lexicon);
+                    super::examples::from_scene_words(&request, SCENE_WORD_EXAMPLES)
+                } else {
+                    Vec::new()
+                };
+                let mut shown = self.variant.choose(examples, self.instruction);
+                // Last, next to the request: they are about its own words and objects.
+                shown.extend(&derived);
+                examples_text(&shown)
+            }),
             ("scene", scene_text(self.facts)),
             ("instruction", self.instruction.trim().to_string()),
         ]

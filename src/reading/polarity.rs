@@ -122,6 +122,11 @@ pub(super) struct Subject {
 }
 
 impl Subject {
+    /// The condition it is about.
+    pub(super) fn atom(&self) -> Atom {
+        Atom::new(self.predicate.clone(), vec![self.object.clone()])
+    }
+
     fn matches(&self, atom: &Atom) -> bool {
         atom.predicate == self.predicate && atom.args.first() == Some(&self.object)
     }

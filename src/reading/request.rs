@@ -6,7 +6,7 @@
 
 use std::sync::OnceLock;
 
-use crate::domain::{Object, Vocabulary};
+use crate::domain::{Atom, Object, Vocabulary};
 use crate::scenario::{Convention, Scenario};
 
 use super::kinds::{EveryOfKind, every_of_kind_in};
@@ -140,6 +140,24 @@ impl<'a> Request<'a> {
     /// ([`super::polarity`]).
     pub(super) fn asked(&self) -> &[Asked] {
         self.asked.get_or_init(|| asked_in_sentences(self))
+    }
+
+    /// The conditions about one object the request asks for one way in the scene's words,
+    /// each with whether it is asked to hold ([`super::polarity`]: the words the scene
+    /// lists for the condition and its opposite, turned by the negations before them; "both
+    /// rooms" asks it of each).
+    pub fn asked_of_one_object(&self) -> Vec<(Atom, bool)> {
+        self.asked()
+            .iter()
+            .filter_map(|(subject, wanted, _, _)| {
+                let atom = subject.atom();
+                let takes_one = self
+                    .vocabulary
+                    .predicate(&atom.predicate)
+                    .is_some_and(|p| p.arg_types.len() == 1);
+                takes_one.then_some((atom, *wanted))
+            })
+            .collect()
     }
 
     /// The items the request sends to a place ([`super::placement`]).
