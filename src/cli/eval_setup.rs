@@ -123,6 +123,8 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
                     "--prompt original-examples: the examples of the original LLM-OBTEA prompt are not shipped with betr; give them with --examples FILE (TOML: [[examples]] with instruction and goal)"
                 );
             }
+            // The original prompt's examples alone, as that prompt showed them.
+            llm_flags.no_scene_word_examples = true;
         }
     }
     let mut llm = llm_cmds::setup(&llm_flags)?;
@@ -163,9 +165,10 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     if options.ablations.small_steps {
         settings.insert("small_steps".into(), "true".into());
     }
-    if options.variant.scene_word_examples {
-        settings.insert("scene_word_examples".into(), "true".into());
-    }
+    settings.insert(
+        "scene_word_examples".into(),
+        options.variant.scene_word_examples.to_string(),
+    );
     if options.ablations.confirm_conditions {
         settings.insert("confirm_conditions".into(), "true".into());
     }

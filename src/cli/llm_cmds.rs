@@ -87,11 +87,11 @@ pub struct LlmFlags {
     /// (ablation of retrieval).
     #[arg(long)]
     pub fixed_examples: bool,
-    /// Also show up to three examples made from the scene's own words for the request: a
-    /// phrase the scene lists for a condition (`says`, `opposite`) that the request uses,
-    /// said of an object the request names, with that condition.
+    /// Show only the pool's examples, without the up to three made from the scene's own
+    /// words for the request (what it asks of one object in the words the scene lists for
+    /// a condition or its opposite, said with the scene's phrase, with that condition).
     #[arg(long, help_heading = ABLATIONS)]
-    pub scene_word_examples: bool,
+    pub no_scene_word_examples: bool,
     /// Candidates per question: drawn when a goal's first answer fails its checks, and
     /// for every failure, each tried in simulation before it is offered (default 4).
     #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
@@ -253,7 +253,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
                 (None, None) => Some(DEFAULT_EXAMPLES_SHOWN),
             },
             fixed_examples: flags.fixed_examples,
-            scene_word_examples: flags.scene_word_examples,
+            scene_word_examples: !flags.no_scene_word_examples,
             examples,
         },
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),

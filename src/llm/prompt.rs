@@ -37,8 +37,9 @@ pub struct Variant {
     /// most similar ones (the ablation of retrieval).
     pub fixed_examples: bool,
     /// Also show examples made from the scene's own words for the request
-    /// (`examples::from_scene_words`): a phrase the scene lists for a condition that the
-    /// request uses, said of an object the request names, with the condition.
+    /// (`examples::from_scene_words`, after the pool's): what the request asks of one
+    /// object in the words the scene lists, said with the scene's phrase, with the
+    /// condition; off: the pool's examples alone.
     pub scene_word_examples: bool,
 }
 
@@ -51,7 +52,7 @@ impl Default for Variant {
             examples: None,
             examples_shown: Some(DEFAULT_EXAMPLES_SHOWN),
             fixed_examples: false,
-            scene_word_examples: false,
+            scene_word_examples: true,
         }
     }
 }
