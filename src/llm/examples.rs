@@ -86,10 +86,12 @@ pub fn nearest<'a>(pool: &'a [Example], request: &str, k: usize) -> Vec<&'a Exam
 /// Worked examples made from the scene's own words for what `request` asks: each
 /// condition of one object it asks for in the words the scene lists
 /// ([`Request::asked_of_one_object`]), said with the first phrase the scene lists for it
-/// (or for its opposite, when it is asked not to hold) and the object's name ("head over
-/// to the pantry" asks for `RobotAt_Pantry`: "Head to Pantry."). At most `most`, in the
-/// order the request asks them; none for a condition whose predicate lists no phrase the
-/// way it is asked, or not even one for the other way.
+/// (or for its opposite, when it is asked not to hold) and the object's name ("don't leave
+/// the pharmacy cabinet open": "Close PharmacyCabinet." with `~Open_PharmacyCabinet`);
+/// then each item it sends to a place ([`Request::sent_by_the_relation`]), said with the
+/// relation's first phrase ("to" when it lists none). At most `most`, in that order; none
+/// for a condition whose predicate lists no phrase the way it is asked, or not even one
+/// for the other way.
 pub fn from_scene_words(request: &Request, most: usize) -> Vec<Example> {
     let vocabulary = request.vocabulary;
     let mut made: Vec<Example> = Vec::new();
@@ -119,6 +121,28 @@ pub fn from_scene_words(request: &Request, most: usize) -> Vec<Example> {
             instruction = first.to_uppercase() + &instruction[1..];
         }
         made.push(Example { instruction, goal });
+        if made.len() == most {
+            return made;
+        }
+    }
+    // Then the items it sends to a place, with the scene's one relation that puts an
+    // item at a place, said with the relation's first phrase ("Specimen to Bed3.").
+    for atom in request.sent_by_the_relation() {
+        let Some(predicate) = vocabulary.predicate(&atom.predicate) else {
+            continue;
+        };
+        let [item, place] = atom.args.as_slice() else {
+            continue;
+        };
+        let goal = atom.to_string();
+        if made.iter().any(|e| e.goal == goal) {
+            continue;
+        }
+        let phrase = predicate.words.says.first().map_or("to", String::as_str);
+        made.push(Example {
+            instruction: format!("{item} {phrase} {place}."),
+            goal,
+        });
         if made.len() == most {
             break;
         }
@@ -156,7 +180,7 @@ mod tests {
     }
 
     #[test]
-    fn the_scene_words_a_request_uses_make_examples_of_their_conditions() {
+    fn the_scene_words_a_request_uses_and_the_items_it_sends_make_examples() {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
         let cafe = crate::scenario::Scenario::load(&path).expect("cafe scenario");
@@ -184,8 +208,21 @@ mod tests {
             made("Close the curtain and don't leave the tube light on.", 1).len(),
             1
         );
-        // Nothing where no listed phrase is said of an object the request names.
-        assert!(made("Bring a coffee to table 2.", 3).is_empty());
+        // An item sent to a place, with the scene's one relation of an item and a place
+        // (the cafe's `On` lists no phrase: "to").
+        assert_eq!(
+            made("Bring a coffee to table 2 and close the curtain.", 3),
+            [
+                ("Close Curtain.".to_string(), "Closed_Curtain".to_string()),
+                (
+                    "Coffee to Table2.".to_string(),
+                    "On_Coffee_Table2".to_string()
+                ),
+            ]
+        );
+        // Nothing where the request asks nothing in the scene's words of an object it
+        // names and sends nothing anywhere.
+        assert!(made("What a nice day it is.", 3).is_empty());
     }
 
     #[test]

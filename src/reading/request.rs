@@ -160,6 +160,21 @@ impl<'a> Request<'a> {
             .collect()
     }
 
+    /// The items the request sends to a place, each as the condition of the scene's one
+    /// relation of an item and a place that puts it there; none in a scene with no such
+    /// relation or several (which one a request means is not read here).
+    pub fn sent_by_the_relation(&self) -> Vec<Atom> {
+        let relating = super::placement::relating(self.vocabulary);
+        let [relation] = relating.as_slice() else {
+            return Vec::new();
+        };
+        self.sent()
+            .iter()
+            .map(|s| Atom::new(relation.name.clone(), vec![s.item.clone(), s.place.clone()]))
+            .filter(|a| self.vocabulary.check_atom(a).is_ok())
+            .collect()
+    }
+
     /// The items the request sends to a place ([`super::placement`]).
     pub(super) fn sent(&self) -> &[Sent] {
         self.sent.get_or_init(|| sent(self))
