@@ -131,7 +131,10 @@ pub const CONDITION_VERDICTS: [&str; 3] = ["true", "false", "unasked"];
 pub const ROLE: &str = "You are the reasoning part of a robot that plans with behavior trees. You answer in the exact format asked for, using only the conditions and objects you are given.";
 
 impl Context<'_> {
-    fn common(&self) -> Vec<(&'static str, String)> {
+    /// The values every prompt fills in. `goal_question`: the prompt asks about a goal, so
+    /// its examples include those made from the scene's own words for the request (when
+    /// the variant shows them); a failure's or a value's prompt shows the pool's alone.
+    fn common(&self, goal_question: bool) -> Vec<(&'static str, String)> {
         let vocabulary = &self.scenario.domain.vocabulary;
         let examples = self
             .variant
@@ -153,7 +156,7 @@ impl Context<'_> {
                 },
             ),
             ("examples", {
-                let derived = if self.variant.scene_word_examples {
+                let derived = if goal_question && self.variant.scene_word_examples {
                     let lexicon = crate::reading::Lexicon::new(vocabulary, examples);
                     let request =
                         crate::reading::Request::new(self.instruction, self.scenario, &lexicon);
@@ -177,7 +180,7 @@ impl Context<'_> {
     /// the request although it is the same every time: moved before the examples (about
     /// 20 tokens, 0.3 s a call) it read the request of a failure scenario wrong.
     pub fn goal(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common();
+        let mut values = self.common(true);
         values.push(("conventions", self.conventions_text()));
         values.push((
             "answer_format",
@@ -194,7 +197,7 @@ impl Context<'_> {
     /// their names in the scene (`Named: a, b`), not yet for the goal: the same prompt
     /// up to its answer format, so a model that keeps a prompt's state reuses it.
     pub fn names(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common();
+        let mut values = self.common(true);
         values.push(("conventions", self.conventions_text()));
         values.push((
             "answer_format",
@@ -214,7 +217,7 @@ impl Context<'_> {
         condition: &str,
         words: &str,
     ) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common();
+        let mut values = self.common(true);
         values.push(("conventions", self.conventions_text()));
         values.push((
             "answer_format",
@@ -239,7 +242,7 @@ impl Context<'_> {
         tried: &[String],
         shortlist: &[Condition],
     ) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common();
+        let mut values = self.common(false);
         values.push(("tried", tried_text(tried)));
         values.push((
             "shortlist",
@@ -295,7 +298,7 @@ impl Context<'_> {
         error: &str,
         (tried, bounds): (&[String], Option<&str>),
     ) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common();
+        let mut values = self.common(false);
         let mut tried = tried_text(tried);
         if let Some(bounds) = bounds {
             tried.push_str(bounds);

@@ -76,3 +76,18 @@ impl LanguageModel for FixtureModel {
         })
     }
 }
+
+/// A reply a test wrote, labelled as such (`note`: where), never as a model's.
+pub fn scripted(text: String, note: &str) -> ChatReply {
+    ChatReply {
+        ranked: Vec::new(),
+        text,
+        model: "scripted".into(),
+        usage: TokenUsage {
+            prompt_tokens: 10,
+            completion_tokens: 5,
+        },
+        latency: Duration::ZERO,
+        source: ReplySource::HandWritten { note: note.into() },
+    }
+}
