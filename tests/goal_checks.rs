@@ -17,62 +17,32 @@ mod support;
 use std::sync::{Arc, Mutex};
 
 use betr::goal::{Formula, equivalent};
-use betr::llm::{ChatFuture, ChatReply, ChatRequest, LanguageModel, OutputConstraint};
+use betr::llm::{ChatFuture, ChatRequest, LanguageModel, OutputConstraint};
 use betr::scenario::Scenario;
 use betr::session::{self, Event, Options, Proposal};
 use betr::world;
+use support::fake_model::{AnswersBy, scripted};
 
 /// Answers by draw: `greedy` for the first call, `sampled[k - 1]` for seed k.
-struct ByDraw {
-    greedy: String,
-    sampled: Vec<String>,
-    /// Every request seen, for checking what was asked and how it was constrained.
-    seen: Mutex<Vec<ChatRequest>>,
-}
-
-impl ByDraw {
-    fn new(greedy: &str, sampled: &[&str]) -> ByDraw {
-        ByDraw {
-            greedy: greedy.into(),
-            sampled: sampled.iter().map(|s| (*s).to_string()).collect(),
-            seen: Mutex::default(),
-        }
-    }
-}
-
-impl LanguageModel for ByDraw {
-    fn model(&self) -> &str {
-        "scripted"
-    }
-
-    fn supports_grammar(&self) -> bool {
-        true
-    }
-
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(async move {
-            self.seen.lock().unwrap().push(request.clone());
-            let text = match request.seed {
-                None => self.greedy.clone(),
-                Some(k) => self
-                    .sampled
-                    .get(usize::try_from(k).unwrap() - 1)
-                    .cloned()
-                    .unwrap_or_else(|| self.greedy.clone()),
-            };
-            Ok(scripted(text))
-        })
-    }
-}
-
-/// A scripted model's reply.
-fn scripted(text: String) -> ChatReply {
-    support::fake_model::scripted(text, "tests/goal_checks.rs")
+fn by_draw(greedy: &str, sampled: &[&str]) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {
+    let greedy = greedy.to_string();
+    let sampled: Vec<String> = sampled.iter().map(|s| (*s).to_string()).collect();
+    AnswersBy::new(move |request: &ChatRequest| match request.seed {
+        None => greedy.clone(),
+        Some(k) => sampled
+            .get(usize::try_from(k).unwrap() - 1)
+            .cloned()
+            .unwrap_or_else(|| greedy.clone()),
+    })
 }
 
 use support::repo::scenario;
 
-async fn read(scenario: &Scenario, model: &ByDraw, instruction: &str) -> (Formula, usize) {
+async fn read(
+    scenario: &Scenario,
+    model: &dyn LanguageModel,
+    instruction: &str,
+) -> (Formula, usize) {
     let w = world::load(scenario).unwrap();
     let mut notices = Vec::new();
     let reading = session::interpret::interpret(
@@ -96,19 +66,19 @@ async fn read(scenario: &Scenario, model: &ByDraw, instruction: &str) -> (Formul
 async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
     // One place in the answer, one place of its kind numbered 5: put right, one call.
-    let model = ByDraw::new("Goal: On_Coffee_Table1", &[]);
+    let model = by_draw("Goal: On_Coffee_Table1", &[]);
     let (goal, calls) = read(&cafe, &model, "Take a coffee to table five by the window.").await;
     assert_eq!(goal.to_string(), "On_Coffee_WindowTable5");
     assert_eq!(calls, 1);
 
     // The second place asked by no word: taken out, and the place left renumbered; one call.
-    let model = ByDraw::new("Goal: On_Coffee_Table1 & RobotNear_Table2", &[]);
+    let model = by_draw("Goal: On_Coffee_Table1 & RobotNear_Table2", &[]);
     let (goal, calls) = read(&cafe, &model, "Take a coffee to table five by the window.").await;
     assert_eq!(goal.to_string(), "On_Coffee_WindowTable5");
     assert_eq!(calls, 1);
 
     // No number in the request: the first clean answer is taken, one call.
-    let model = ByDraw::new("Goal: On_Coffee_Table1", &["Goal: On_Coffee_Bar"]);
+    let model = by_draw("Goal: On_Coffee_Table1", &["Goal: On_Coffee_Bar"]);
     let (goal, calls) = read(&cafe, &model, "Take a coffee to the first table.").await;
     assert_eq!(goal.to_string(), "On_Coffee_Table1");
     assert_eq!(calls, 1);
@@ -117,7 +87,7 @@ async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
 #[tokio::test]
 async fn a_condition_no_word_asks_for_is_taken_out() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
-    let model = ByDraw::new("Goal: On_Chips_Table3 & RobotNear_Table3", &[]);
+    let model = by_draw("Goal: On_Chips_Table3 & RobotNear_Table3", &[]);
     let (goal, calls) = read(&cafe, &model, "Some crisps for table three, please.").await;
     let expected = Formula::parse("On_Chips_Table3").unwrap();
     assert!(equivalent(&goal, &expected).unwrap(), "{goal}");
@@ -128,13 +98,13 @@ async fn a_condition_no_word_asks_for_is_taken_out() {
 async fn the_relation_and_the_convention_the_request_says_undo_a_misread_relation() {
     // "In the crib" asks for in; the answer's on is undone with no more calls.
     let baby = scenario("scenarios/cell/params/baby.toml");
-    let model = ByDraw::new(r#"Goal: "baby doll" on "crib""#, &[]);
+    let model = by_draw(r#"Goal: "baby doll" on "crib""#, &[]);
     let (goal, calls) = read(&baby, &model, "Lay the doll to sleep in the crib, gently.").await;
     assert_eq!(goal.to_string(), r#""baby doll" in "crib""#);
     assert_eq!(calls, 1);
     // "Fetch ... for me": what is brought goes on the tray in this cell, not held.
     let kit = scenario("scenarios/cell/params/first_aid.toml");
-    let model = ByDraw::new(r#"Goal: "first aid kit" grasped"#, &[]);
+    let model = by_draw(r#"Goal: "first aid kit" grasped"#, &[]);
     let (goal, calls) = read(&kit, &model, "Quick, fetch the first aid kit for me.").await;
     assert_eq!(goal.to_string(), r#""first aid kit" on "tray""#);
     assert_eq!(calls, 1);
@@ -146,7 +116,7 @@ async fn the_relation_and_the_convention_the_request_says_undo_a_misread_relatio
 #[tokio::test]
 async fn a_failure_is_asked_about_with_the_conditions_that_fix_it_as_the_only_choices() {
     let cell = Arc::new(scenario("scenarios/cell/red_on_blue.toml"));
-    let model = Arc::new(ByDraw::new(
+    let model = Arc::new(by_draw(
         "Reasoning: the red cube lies on the blue cube and blocks the gripper.\nConditions:\n~\"any object\" on \"blue cube\"",
         &[],
     ));
@@ -253,7 +223,7 @@ impl LanguageModel for ByRequest {
                 .iter()
                 .find(|(r, _)| *r == asked)
                 .map_or_else(|| self.otherwise.clone(), |(_, a)| a.clone());
-            Ok(scripted(text))
+            Ok(scripted(text, "tests/goal_checks.rs"))
         })
     }
 }
@@ -345,7 +315,7 @@ async fn an_object_put_in_the_place_of_a_named_one_draws_candidates() {
     let cafe = scenario("scenarios/cafe/cafe.toml");
     // "fries" read as coffee: more candidates are drawn, and one that names the fries'
     // object wins, though the misread one came first.
-    let model = ByDraw::new(
+    let model = by_draw(
         "Goal: (Exists_Dessert | Exists_Coffee) & RobotNear_Table3",
         &[
             "Goal: (Exists_Dessert | Exists_Coffee) & RobotNear_Table3",
@@ -412,13 +382,13 @@ async fn a_misreading_that_can_be_undone_gives_the_undone_goal_as_a_candidate() 
     ];
     for (request, answer, expected) in cases {
         // Every sampled draw repeats the misreading: only the undone goal can win.
-        let model = ByDraw::new(answer, &[answer, answer, answer]);
+        let model = by_draw(answer, &[answer, answer, answer]);
         let (goal, calls) = read(&cafe, &model, request).await;
         assert_eq!(goal.to_string(), expected, "{request}");
         assert_eq!(calls, 1, "{request}: the undone goal passes, no more draws");
     }
     // A right answer is taken as it is.
-    let model = ByDraw::new("Goal: Closed_Curtain", &[]);
+    let model = by_draw("Goal: Closed_Curtain", &[]);
     let (goal, _) = read(&cafe, &model, "Do not open the curtain, please.").await;
     assert_eq!(goal.to_string(), "Closed_Curtain");
 }

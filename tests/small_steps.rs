@@ -7,48 +7,13 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
 mod support;
-use std::sync::Mutex;
-
 use betr::goal::{Formula, equivalent};
-use betr::llm::{ChatFuture, ChatRequest, LanguageModel, OutputConstraint};
+use betr::llm::{ChatRequest, OutputConstraint};
 use betr::session::types::Ablations;
 use betr::session::{self, Event, Options};
 use betr::world;
-use support::fake_model::scripted;
+use support::fake_model::AnswersBy;
 use support::repo::scenario;
-
-/// A grammar-following model that answers each request as `answer` says, keeping every
-/// request seen.
-struct AnswersBy<F> {
-    answer: F,
-    seen: Mutex<Vec<ChatRequest>>,
-}
-
-impl<F: Fn(&ChatRequest) -> String + Send + Sync> AnswersBy<F> {
-    fn new(answer: F) -> Self {
-        AnswersBy {
-            answer,
-            seen: Mutex::default(),
-        }
-    }
-}
-
-impl<F: Fn(&ChatRequest) -> String + Send + Sync> LanguageModel for AnswersBy<F> {
-    fn model(&self) -> &str {
-        "scripted"
-    }
-
-    fn supports_grammar(&self) -> bool {
-        true
-    }
-
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(async move {
-            self.seen.lock().unwrap().push(request.clone());
-            Ok(scripted((self.answer)(request), "tests/small_steps.rs"))
-        })
-    }
-}
 
 /// Answers the question of the objects named with `named`, any goal question with `goal`.
 fn names_first(named: &str, goal: &str) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {

@@ -2,8 +2,8 @@
 //! hand-written fixture whose `when` strings all occur in the prompt, optionally after a
 //! delay, and counts its calls. Its replies are labelled as fixtures, never as a model's.
 
-use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use betr::llm::{
@@ -89,5 +89,39 @@ pub fn scripted(text: String, note: &str) -> ChatReply {
         },
         latency: Duration::ZERO,
         source: ReplySource::HandWritten { note: note.into() },
+    }
+}
+
+/// A grammar-following model that answers each request as `answer` says, keeping every
+/// request seen.
+pub struct AnswersBy<F> {
+    answer: F,
+    /// Every request seen, for checking what was asked and how it was constrained.
+    pub seen: Mutex<Vec<ChatRequest>>,
+}
+
+impl<F: Fn(&ChatRequest) -> String + Send + Sync> AnswersBy<F> {
+    pub fn new(answer: F) -> Self {
+        AnswersBy {
+            answer,
+            seen: Mutex::default(),
+        }
+    }
+}
+
+impl<F: Fn(&ChatRequest) -> String + Send + Sync> LanguageModel for AnswersBy<F> {
+    fn model(&self) -> &str {
+        "scripted"
+    }
+
+    fn supports_grammar(&self) -> bool {
+        true
+    }
+
+    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
+        Box::pin(async move {
+            self.seen.lock().unwrap().push(request.clone());
+            Ok(scripted((self.answer)(request), "a test's scripted answer"))
+        })
     }
 }
