@@ -14,14 +14,14 @@
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
 mod support;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use betr::goal::{Formula, equivalent};
-use betr::llm::{ChatFuture, ChatRequest, LanguageModel, OutputConstraint};
+use betr::llm::{ChatRequest, LanguageModel, OutputConstraint};
 use betr::scenario::Scenario;
 use betr::session::{self, Event, Options, Proposal};
 use betr::world;
-use support::fake_model::{AnswersBy, scripted};
+use support::fake_model::AnswersBy;
 
 /// Answers by draw: `greedy` for the first call, `sampled[k - 1]` for seed k.
 fn by_draw(greedy: &str, sampled: &[&str]) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {
@@ -178,59 +178,40 @@ async fn a_failure_is_asked_about_with_the_conditions_that_fix_it_as_the_only_ch
     );
 }
 
-/// Answers by the request the prompt asks about (the line after `## Request`): each entry
-/// is a request and its reply; any other request gets `otherwise`.
-struct ByRequest {
-    replies: Vec<(String, String)>,
-    otherwise: String,
-    asked: Mutex<Vec<String>>,
+/// The request a prompt asks about: the line after its last `## Request`.
+fn request_asked(request: &ChatRequest) -> String {
+    let prompt = &request.messages.last().unwrap().content;
+    prompt
+        .rsplit_once("## Request\n")
+        .and_then(|(_, rest)| rest.lines().next())
+        .unwrap_or("")
+        .trim()
+        .to_string()
 }
 
-impl ByRequest {
-    fn new(replies: &[(&str, &str)], otherwise: &str) -> ByRequest {
-        ByRequest {
-            replies: replies
-                .iter()
-                .map(|(r, a)| ((*r).to_string(), (*a).to_string()))
-                .collect(),
-            otherwise: otherwise.into(),
-            asked: Mutex::default(),
-        }
-    }
-}
-
-impl LanguageModel for ByRequest {
-    fn model(&self) -> &str {
-        "scripted"
-    }
-
-    fn supports_grammar(&self) -> bool {
-        true
-    }
-
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> ChatFuture<'a> {
-        Box::pin(async move {
-            let prompt = &request.messages.last().unwrap().content;
-            let asked = prompt
-                .rsplit_once("## Request\n")
-                .and_then(|(_, rest)| rest.lines().next())
-                .unwrap_or("")
-                .trim()
-                .to_string();
-            self.asked.lock().unwrap().push(asked.clone());
-            let text = self
-                .replies
-                .iter()
-                .find(|(r, _)| *r == asked)
-                .map_or_else(|| self.otherwise.clone(), |(_, a)| a.clone());
-            Ok(scripted(text, "tests/goal_checks.rs"))
-        })
-    }
+/// Answers by the request the prompt asks about ([`request_asked`]): each entry is a
+/// request and its reply; any other request gets `otherwise`.
+fn by_request(
+    replies: &[(&str, &str)],
+    otherwise: &str,
+) -> AnswersBy<impl Fn(&ChatRequest) -> String + use<>> {
+    let replies: Vec<(String, String)> = replies
+        .iter()
+        .map(|(r, a)| ((*r).to_string(), (*a).to_string()))
+        .collect();
+    let otherwise = otherwise.to_string();
+    AnswersBy::new(move |request: &ChatRequest| {
+        let asked = request_asked(request);
+        replies
+            .iter()
+            .find(|(r, _)| *r == asked)
+            .map_or_else(|| otherwise.clone(), |(_, a)| a.clone())
+    })
 }
 
 async fn read_by_request(
     scenario: &Scenario,
-    model: &ByRequest,
+    model: &AnswersBy<impl Fn(&ChatRequest) -> String + Send + Sync>,
     instruction: &str,
 ) -> (Formula, usize, Vec<String>) {
     let w = world::load(scenario).unwrap();
@@ -244,7 +225,13 @@ async fn read_by_request(
     )
     .await
     .unwrap();
-    let asked = model.asked.lock().unwrap().clone();
+    let asked: Vec<String> = model
+        .seen
+        .lock()
+        .unwrap()
+        .iter()
+        .map(request_asked)
+        .collect();
     (reading.answer.goal, reading.calls, asked)
 }
 
@@ -254,7 +241,7 @@ async fn a_request_of_several_wishes_is_read_a_wish_at_a_time() {
     let f = |t: &str| Formula::parse(t).unwrap();
     // Two sentences, the thanks kept with the second: each part asked on its own, the
     // goals joined by and.
-    let model = ByRequest::new(
+    let model = by_request(
         &[
             (
                 "Please switch off the hall light.",
@@ -278,7 +265,7 @@ async fn a_request_of_several_wishes_is_read_a_wish_at_a_time() {
     assert!(!asked.iter().any(|a| a == request), "{asked:?}");
 
     // A part offered as the alternative to the one before: joined by or.
-    let model = ByRequest::new(
+    let model = by_request(
         &[
             ("Could you mop the floor?", "Goal: IsClean_Floor"),
             ("bring a banana to the bar.", "Goal: On_Banana_Bar"),
@@ -296,7 +283,7 @@ async fn a_request_of_several_wishes_is_read_a_wish_at_a_time() {
 
     // Parts whose goals contradict each other: the request is read whole.
     let request = "Switch on the AC. Also, I want the AC off.";
-    let model = ByRequest::new(
+    let model = by_request(
         &[
             ("Switch on the AC.", "Goal: Active_AC"),
             ("I want the AC off.", "Goal: ~Active_AC"),
