@@ -158,14 +158,8 @@ pub(super) async fn read_goal(
     let mut messages = ctx.goal(&options.templates)?;
     let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
-    let judge = Judge {
-        scenario,
-        world,
-        request: Request::new(instruction, scenario, &lexicon),
-        shown: options.variant.choose(pool, instruction),
-        misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
-        one_of_several,
-    };
+    let request = Request::new(instruction, scenario, &lexicon);
+    let judge = Judge::new(scenario, world, request, options, one_of_several)?;
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;

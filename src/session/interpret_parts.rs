@@ -100,14 +100,7 @@ pub(super) async fn read_parts(
     // Each part was judged against its own words; what the whole request says about the
     // joined goal ("bread at the reading corner, or failing that an apple": the apple's
     // place is said only in the other part) is judged here.
-    let judge = Judge {
-        scenario,
-        world: world.fork(),
-        request,
-        shown,
-        misreadings: crate::reading::misreadings_without(&options.ablations.without_misreadings)?,
-        one_of_several: false,
-    };
+    let judge = Judge::new(scenario, world.fork(), request, options, false)?;
     let (goal, problem) = match undone_whole(&judge, &goal) {
         Some((undone, why, problem)) => {
             emit(&Event::CandidateRejected {

@@ -54,6 +54,30 @@ pub(super) struct Judge<'a> {
     pub(super) one_of_several: bool,
 }
 
+impl<'a> Judge<'a> {
+    /// The judge of `request` read in `scenario` from `world`: the examples a prompt
+    /// shows for it from the pool `options` give, and the detectors of misreadings in use.
+    pub(super) fn new(
+        scenario: &'a Scenario,
+        world: Box<dyn World>,
+        request: Request<'a>,
+        options: &'a super::types::Options,
+        one_of_several: bool,
+    ) -> Result<Self, super::types::SessionError> {
+        let pool = super::interpret::example_pool(scenario, options);
+        Ok(Judge {
+            scenario,
+            world,
+            shown: options.variant.choose(pool, request.text),
+            request,
+            misreadings: crate::reading::misreadings_without(
+                &options.ablations.without_misreadings,
+            )?,
+            one_of_several,
+        })
+    }
+}
+
 impl Judge<'_> {
     /// Why `goal` should not be used, if it should not.
     pub(super) fn assess(&self, goal: &Formula) -> Option<GoalProblem> {
