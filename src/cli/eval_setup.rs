@@ -169,6 +169,9 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         "scene_word_examples".into(),
         options.variant.scene_word_examples.to_string(),
     );
+    if options.variant.scene_phrases {
+        settings.insert("scene_phrases".into(), "true".into());
+    }
     if options.ablations.confirm_conditions {
         settings.insert("confirm_conditions".into(), "true".into());
     }

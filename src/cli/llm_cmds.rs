@@ -92,6 +92,10 @@ pub struct LlmFlags {
     /// a condition or its opposite, said with the scene's phrase, with that condition).
     #[arg(long, help_heading = ABLATIONS)]
     pub no_scene_word_examples: bool,
+    /// Show beside each condition of the goal prompt the phrases the scene lists for it and
+    /// for its opposite, not only its description.
+    #[arg(long, help_heading = ABLATIONS)]
+    pub scene_phrases: bool,
     /// Candidates per question: drawn when a goal's first answer fails its checks, and
     /// for every failure, each tried in simulation before it is offered (default 4).
     #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
@@ -254,6 +258,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
             },
             fixed_examples: flags.fixed_examples,
             scene_word_examples: !flags.no_scene_word_examples,
+            scene_phrases: flags.scene_phrases,
             examples,
         },
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),

@@ -41,6 +41,9 @@ pub struct Variant {
     /// object in the words the scene lists, said with the scene's phrase, with the
     /// condition; off: the pool's examples alone.
     pub scene_word_examples: bool,
+    /// Show beside each condition the phrases the scene lists for it and for its opposite
+    /// (`says`, `opposite`); off: its description alone.
+    pub scene_phrases: bool,
 }
 
 impl Default for Variant {
@@ -53,6 +56,7 @@ impl Default for Variant {
             examples_shown: Some(DEFAULT_EXAMPLES_SHOWN),
             fixed_examples: false,
             scene_word_examples: true,
+            scene_phrases: false,
         }
     }
 }
@@ -144,7 +148,11 @@ impl Context<'_> {
         vec![
             (
                 "vocabulary",
-                vocabulary_text(vocabulary, !self.variant.no_descriptions),
+                vocabulary_text(
+                    vocabulary,
+                    !self.variant.no_descriptions,
+                    self.variant.scene_phrases,
+                ),
             ),
             ("objects", objects_text(vocabulary)),
             (
@@ -466,10 +474,11 @@ pub fn fill(
     Ok(cleaned)
 }
 
-/// One line per predicate: its written form with argument types, and its description;
-/// for quoted-form vocabularies, a line on the `"any object"` wildcard.
-pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
-    let mut text = predicate_lines(vocabulary, descriptions);
+/// One line per predicate: its written form with argument types, its description, and
+/// with `phrases` the phrases the scene lists for it and its opposite; for quoted-form
+/// vocabularies, a line on the `"any object"` wildcard.
+pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool, phrases: bool) -> String {
+    let mut text = predicate_lines(vocabulary, descriptions, phrases);
     // Explained with a placeholder, not a real object: small models copy a concrete
     // example verbatim as their answer.
     let binary = vocabulary
@@ -485,7 +494,7 @@ pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
     text
 }
 
-fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
+fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool, phrases: bool) -> String {
     vocabulary
         .predicates
         .iter()
@@ -508,14 +517,40 @@ fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
                 }
                 s
             };
-            if descriptions && !p.description.is_empty() {
+            let mut line = if descriptions && !p.description.is_empty() {
                 format!("- {form}: {}", p.description)
             } else {
                 format!("- {form}")
+            };
+            if phrases {
+                line.push_str(&said_phrases(&p.words.says, &p.words.opposite));
             }
+            line
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// The phrases a scene lists for a condition and for its opposite, as the end of its line
+/// (` (said: "go to", "head to"; the opposite: "leave")`), or nothing when it lists none.
+fn said_phrases(says: &[String], opposite: &[String]) -> String {
+    let quoted = |phrases: &[String]| {
+        phrases
+            .iter()
+            .map(|w| format!("\"{w}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match (says.is_empty(), opposite.is_empty()) {
+        (true, true) => String::new(),
+        (false, true) => format!(" (said: {})", quoted(says)),
+        (true, false) => format!(" (the opposite said: {})", quoted(opposite)),
+        (false, false) => format!(
+            " (said: {}; the opposite: {})",
+            quoted(says),
+            quoted(opposite)
+        ),
+    }
 }
 
 /// The objects grouped by type, types in first-seen order; an object the scene says people

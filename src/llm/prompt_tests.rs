@@ -241,3 +241,41 @@ fn everything_before_the_examples_is_the_same_for_every_request() {
         "after the examples:\n{rest}"
     );
 }
+
+#[test]
+fn the_scenes_phrases_are_shown_beside_their_conditions_when_asked() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
+    let s = Scenario::load(&path).unwrap();
+    let facts = vec![Condition::parse("Holding_Nothing").unwrap()];
+    let prompt = |variant: &Variant| {
+        let ctx = Context {
+            scenario: &s,
+            facts: &facts,
+            instruction: "Bring coffee to table six",
+            variant,
+        };
+        ctx.goal(&Templates::builtin()).unwrap()[1].content.clone()
+    };
+    let with = prompt(&Variant {
+        scene_phrases: true,
+        ..Variant::default()
+    });
+    let holding = with
+        .lines()
+        .find(|l| l.starts_with("- Holding_<"))
+        .expect("the holding condition's line");
+    assert!(
+        holding.ends_with(
+            "(said: \"hold\", \"grab\", \"grasp\", \"pick up\"; the opposite: \"put down\", \"set down\", \"release\", \"let go\")"
+        ),
+        "{holding}"
+    );
+    // A condition the scene lists no phrase for has its description alone.
+    let on = with
+        .lines()
+        .find(|l| l.starts_with("- On_<"))
+        .expect("the placing condition's line");
+    assert_eq!(on, "- On_<item>_<place>: the item is at the place");
+    // Off by default: the descriptions alone.
+    assert!(!prompt(&Variant::default()).contains("(said: "));
+}
