@@ -17,6 +17,7 @@ pub mod openai;
 pub mod printable;
 pub mod prompt;
 pub mod reply;
+pub mod scene_text;
 pub mod schema;
 pub mod usage;
 
