@@ -14,7 +14,6 @@ use crate::reading::{Lexicon, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::goal_checks::assess;
 use super::interpret::{Interpretation, example_pool, read_goal};
 use super::judge::Judge;
 use super::types::{Event, Options, SessionError};
@@ -82,9 +81,9 @@ pub(super) async fn read_parts(
     let goal = joined(parts, read.iter().map(|r| r.answer.goal.clone()).collect());
     let pool = example_pool(scenario, options);
     let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
-    let shown = options.variant.choose(pool, instruction);
     let request = Request::new(instruction, scenario, &lexicon);
-    let problem = assess(scenario, world.as_ref(), &goal, &shown, &request);
+    let judge = Judge::new(scenario, world.fork(), request, options, false)?;
+    let problem = judge.assess(&goal);
     if let Some(p) = problem.as_ref().filter(|p| !p.is_doubt()) {
         emit(&Event::CandidateRejected {
             candidate: goal.to_string(),
@@ -100,7 +99,6 @@ pub(super) async fn read_parts(
     // Each part was judged against its own words; what the whole request says about the
     // joined goal ("bread at the reading corner, or failing that an apple": the apple's
     // place is said only in the other part) is judged here.
-    let judge = Judge::new(scenario, world.fork(), request, options, false)?;
     let (goal, problem) = match undone_whole(&judge, &goal) {
         Some((undone, why, problem)) => {
             emit(&Event::CandidateRejected {
