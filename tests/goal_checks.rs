@@ -84,57 +84,6 @@ async fn a_number_the_first_answer_leaves_out_draws_candidates_that_use_it() {
     assert_eq!(calls, 1);
 }
 
-/// A model that searches beams: its answers to a goal question, best first, the first
-/// as its text, all of them ranked when beams are asked for.
-struct RanksAnswers(Vec<&'static str>);
-
-impl LanguageModel for RanksAnswers {
-    fn model(&self) -> &str {
-        "scripted"
-    }
-
-    fn supports_grammar(&self) -> bool {
-        true
-    }
-
-    fn chat<'a>(&'a self, request: &'a ChatRequest) -> betr::llm::ChatFuture<'a> {
-        Box::pin(async move {
-            let mut reply = support::fake_model::scripted(
-                self.0.first().copied().unwrap_or_default().to_string(),
-                "a test's ranked answers",
-            );
-            if request.beams.is_some_and(|b| b > 1) {
-                reply.ranked = self
-                    .0
-                    .iter()
-                    .zip(0..)
-                    .map(|(a, k)| ((*a).to_string(), -f64::from(k)))
-                    .collect();
-            }
-            Ok(reply)
-        })
-    }
-}
-
-#[tokio::test]
-async fn a_first_answer_that_holds_already_gives_way_to_the_models_next_answer_that_passes() {
-    let cafe = scenario("scenarios/cafe/cafe.toml");
-    // The hall light is on: the first answer holds already; the model's next most likely
-    // answer passes every check and is taken, with no further call.
-    let model = RanksAnswers(vec!["Goal: Active_HallLight", "Goal: ~Active_HallLight"]);
-    let (goal, calls) = read(&cafe, &model, "The hall light, please.").await;
-    assert_eq!(goal.to_string(), "~Active_HallLight");
-    assert_eq!(calls, 1);
-    // Without a runner-up that passes, the first answer is kept, with its doubt.
-    let model = RanksAnswers(vec![
-        "Goal: Active_HallLight",
-        "Goal: Active_HallLight & Active_AC",
-    ]);
-    let (goal, calls) = read(&cafe, &model, "The hall light, please.").await;
-    assert_eq!(goal.to_string(), "Active_HallLight");
-    assert_eq!(calls, 1);
-}
-
 #[tokio::test]
 async fn a_condition_no_word_asks_for_is_taken_out() {
     let cafe = scenario("scenarios/cafe/cafe.toml");

@@ -17,11 +17,6 @@ pub const ARTICLES: &[&str] = &["a", "an", "the", "some", "any"];
 /// Words that soften a request without changing it ("maybe bring", "either the milk").
 pub const HEDGES: &[&str] = &["either", "maybe", "perhaps"];
 
-/// The word that opens the first of two alternatives ("lock the cabinet, and either answer
-/// the call light or turn the light off"): the choice begins there, not where the sentence
-/// does. (It is also a hedge, for the words after it: "either the milk".)
-pub const OPENS_ALTERNATIVES: &str = "either";
-
 /// Words that ask for every object of the kind named after them ("both vents", "all the
 /// tables").
 pub const QUANTIFIERS: &[&str] = &["both", "all", "every", "each"];

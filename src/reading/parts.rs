@@ -11,14 +11,12 @@
 //!
 //! Parts are joined by "and", unless a part offers itself as the alternative to the one
 //! before ("If not, ...", "Or ...", "Alternatively, ..."); "and" joins groups of
-//! alternatives, as it does in speech ("A. Or B. Also C" is (A or B) and C). The first of
-//! the alternatives begins at "either" when the part before the "or" has one after other
-//! words ("A, and either B or C" is A and (B or C)).
+//! alternatives, as it does in speech ("A. Or B. Also C" is (A or B) and C).
 
 pub use super::english::Join;
 use super::english::{
-    BACK_REFERENCES, CONJUNCTIONS, OPENS_ALTERNATIVES, asks, clause_start, is_negated_form,
-    is_negation, may_precede_verb, wish_openers,
+    BACK_REFERENCES, CONJUNCTIONS, asks, is_negated_form, is_negation, may_precede_verb,
+    wish_openers,
 };
 use super::lexicon::Lexicon;
 use super::words::terms;
@@ -97,55 +95,7 @@ pub fn split(request: &str, lexicon: &Lexicon) -> Vec<Part> {
     {
         push_text(&mut last.text, &leading);
     }
-    alternatives_from_either(&mut parts, names_something);
     parts
-}
-
-/// "Lock the cabinet, and either answer the call light or turn the light off" offers the
-/// call light or the light, not the cabinet or the light: where an alternative follows a
-/// part that says "either" after naming something, that part is cut before the "either"
-/// (the joining words before it dropped), and the alternatives begin there.
-fn alternatives_from_either(parts: &mut Vec<Part>, names_something: impl Fn(&str) -> bool) {
-    let mut k = 1;
-    while k < parts.len() {
-        let first_of_its_group = k == 1 || parts[k - 1].join == Join::And;
-        if parts[k].join != Join::Or || !first_of_its_group {
-            k += 1;
-            continue;
-        }
-        let text = parts[k - 1].text.clone();
-        let cut = word_spans(&text)
-            .into_iter()
-            .skip(1)
-            .filter(|&(from, to)| text[from..to].eq_ignore_ascii_case(OPENS_ALTERNATIVES))
-            .map(|(from, _)| from)
-            .next_back();
-        let Some(cut) = cut.filter(|&cut| names_something(&text[..cut])) else {
-            k += 1;
-            continue;
-        };
-        parts[k - 1].text = without_trailing_joins(&text[..cut]).to_string();
-        parts.insert(
-            k,
-            Part {
-                text: text[cut..].to_string(),
-                join: Join::And,
-            },
-        );
-        k += 2;
-    }
-}
-
-/// `text` without the commas, spaces and joining words ("and", "and then") it ends with.
-fn without_trailing_joins(text: &str) -> &str {
-    let mut rest = text.trim_end_matches(|c: char| c == ',' || c.is_whitespace());
-    while let Some(&(from, to)) = word_spans(rest).last() {
-        if to != rest.len() || clause_start(&rest[from..to].to_lowercase()).is_none() {
-            break;
-        }
-        rest = rest[..from].trim_end_matches(|c: char| c == ',' || c.is_whitespace());
-    }
-    rest
 }
 
 fn push_text(to: &mut String, text: &str) {
@@ -430,19 +380,6 @@ mod tests {
                 Join::And,
                 "Please pick up and hold a bottle of spring water."
             )]
-        );
-        // The alternatives begin at "either", not at the start of the sentence.
-        let parts = split(
-            "Bring coffee to table 2, and either dust the chairs or turn off the hall light.",
-            &lex,
-        );
-        assert_eq!(
-            texts(&parts),
-            vec![
-                (Join::And, "Bring coffee to table 2"),
-                (Join::And, "either dust the chairs"),
-                (Join::Or, "turn off the hall light."),
-            ]
         );
         // "Don't ... or ..." asks for neither: no alternatives.
         let request = "Don't bring coffee or serve the dessert.";

@@ -9,7 +9,6 @@ use std::sync::OnceLock;
 use crate::domain::{Atom, Object, Vocabulary};
 use crate::scenario::{Convention, Scenario};
 
-use super::english::OPENS_ALTERNATIVES;
 use super::kinds::{EveryOfKind, every_of_kind_in};
 use super::lexicon::Lexicon;
 use super::names::choices_offered;
@@ -92,7 +91,7 @@ impl<'a> Request<'a> {
             .split(['.', '!', '?', ';'])
             .zip(&sentences)
             .flat_map(|(sentence, words)| {
-                let choice = words.iter().any(|w| w == "or" || w == OPENS_ALTERNATIVES);
+                let choice = words.iter().any(|w| w == "or" || w == "either");
                 clauses(sentence)
                     .into_iter()
                     .map(move |words| Scope { words, choice })

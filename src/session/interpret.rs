@@ -306,23 +306,6 @@ pub(super) async fn read_goal(
             if draw > 0 {
                 continue;
             }
-            // A first answer that holds already gives way to the model's own next most
-            // likely answer when that one passes every check: it costs no call, and unlike
-            // a sampled answer it is what the model itself ranks next. (Not one doubted for
-            // a condition pasted from an example: the runner-up then mostly drops a
-            // condition the person asked for.)
-            let held_already = candidates.iter().any(Candidate::holds_already)
-                && !candidates.iter().any(|c| judge.answers_request(c));
-            if held_already
-                && options.ablations.check_goals
-                && runners_up.iter().any(|c| judge.answers_request(c))
-            {
-                candidates.append(&mut runners_up);
-                emit(&Event::Notice {
-                    message: "the first answer holds already: the model's next most likely answer that passes every check is a candidate".into(),
-                });
-                break;
-            }
             let settled = match &misread {
                 Some(_) if options.ablations.check_goals => {
                     candidates.iter().any(|c| judge.answers_request(c))

@@ -37,14 +37,6 @@ impl Candidate {
     pub(super) fn doubtful(&self) -> bool {
         self.read.is_ok() && self.problem.as_ref().is_some_and(GoalProblem::is_doubt)
     }
-    /// Doubtful only because it holds already in the scene.
-    pub(super) fn holds_already(&self) -> bool {
-        self.read.is_ok()
-            && self
-                .problem
-                .as_ref()
-                .is_some_and(|p| p.kind == ProblemKind::HoldsAlready)
-    }
 }
 
 /// What every candidate goal for one request is judged against: the scene, the examples
