@@ -77,6 +77,66 @@ pub fn run_anchor(what: &str, command: &mut Command) -> Result<String, BenchErro
     Ok(String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
+/// A Python in the virtual environment `venv` (made the first time, with `packages`
+/// installed by pip with `pip_flags`) on which the script `check` runs cleanly. The venv's
+/// lock (`<venv>.lock`) is held while it is looked at and made: two benchmarks or two
+/// tests of one run would otherwise create and install into the same venv at once and
+/// find it half-made; the operating system releases the lock of a killed process.
+pub fn anchor_venv(
+    venv: &Path,
+    packages: &[&str],
+    pip_flags: &[&str],
+    check: &str,
+) -> Result<std::path::PathBuf, BenchError> {
+    let python = venv.join("bin").join("python");
+    let has = |python: &Path| {
+        Command::new(python)
+            .args(["-c", check])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    let what = format!("installing {} into {}", packages.join(" "), venv.display());
+    if let Some(parent) = venv.parent() {
+        std::fs::create_dir_all(parent)?;
+    }
+    let lock_path = venv.with_extension("lock");
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(|e| BenchError::Anchor {
+            what: what.clone(),
+            detail: format!("cannot open the lock {}: {e}", lock_path.display()),
+        })?;
+    lock.lock().map_err(|e| BenchError::Anchor {
+        what: what.clone(),
+        detail: format!("cannot take the lock {}: {e}", lock_path.display()),
+    })?;
+    if python.is_file() && has(&python) {
+        return Ok(python);
+    }
+    eprintln!("bench: {what} (once)");
+    run_anchor(
+        &what,
+        Command::new("python3").arg("-m").arg("venv").arg(venv),
+    )?;
+    run_anchor(
+        &what,
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet"])
+            .args(pip_flags)
+            .args(packages),
+    )?;
+    if !has(&python) {
+        return Err(BenchError::Anchor {
+            what,
+            detail: format!("`{check}` fails after installing"),
+        });
+    }
+    Ok(python)
+}
+
 /// Which way a measure is better.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -125,35 +125,12 @@ impl PlanTimes {
 
 /// A Python with the anchors in a virtual environment under `venv` (made the first time).
 pub fn anchor_python(venv: &Path) -> Result<PathBuf, BenchError> {
-    let python = venv.join("bin").join("python");
-    let has = |python: &Path| {
-        Command::new(python)
-            .args(["-c", "import pinocchio, ompl, pybullet"])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if python.is_file() && has(&python) {
-        return Ok(python);
-    }
-    let what = format!("installing {} into {}", ANCHORS.join(" "), venv.display());
-    eprintln!("bench: {what} (once)");
-    super::run_anchor(
-        &what,
-        Command::new("python3").arg("-m").arg("venv").arg(venv),
-    )?;
-    super::run_anchor(
-        &what,
-        Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet", "--only-binary=:all:"])
-            .args(ANCHORS),
-    )?;
-    if !has(&python) {
-        return Err(BenchError::Anchor {
-            what,
-            detail: "pinocchio, ompl or pybullet is not importable after installing".into(),
-        });
-    }
-    Ok(python)
+    super::anchor_venv(
+        venv,
+        ANCHORS,
+        &["--only-binary=:all:"],
+        "import pinocchio, ompl, pybullet",
+    )
 }
 
 /// The joint values (degrees, right arm first) the cell's arms start from: the cell

@@ -121,36 +121,12 @@ pub fn betr_ticks(tree: &Tree, time: Duration) -> TickRate {
 
 /// A Python with py_trees in a virtual environment under `venv` (made the first time).
 pub fn pytrees_python(venv: &Path) -> Result<PathBuf, BenchError> {
-    let python = venv.join("bin").join("python");
-    let has = |python: &Path| {
-        Command::new(python)
-            .args([
-                "-c",
-                "import py_trees, importlib.metadata as m; assert m.version('py_trees') == '2.6.0'",
-            ])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if python.is_file() && has(&python) {
-        return Ok(python);
-    }
-    let what = format!("installing {PY_TREES} into {}", venv.display());
-    eprintln!("bench: {what} (once)");
-    super::run_anchor(
-        &what,
-        Command::new("python3").arg("-m").arg("venv").arg(venv),
-    )?;
-    super::run_anchor(
-        &what,
-        Command::new(&python).args(["-m", "pip", "install", "--quiet", PY_TREES]),
-    )?;
-    if !has(&python) {
-        return Err(BenchError::Anchor {
-            what,
-            detail: "py_trees 2.6.0 is not importable after installing".into(),
-        });
-    }
-    Ok(python)
+    super::anchor_venv(
+        venv,
+        &[PY_TREES],
+        &[],
+        "import py_trees, importlib.metadata as m; assert m.version('py_trees') == '2.6.0'",
+    )
 }
 
 /// Run the anchor script for `time` on about `nodes` nodes.
