@@ -63,7 +63,7 @@ fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
     let whisper =
         LocalWhisper::load(model_dir(), WHISPER_TINY_EN.name, LocalSettings::default()).unwrap();
     eprintln!("model load: {:.2} s", whisper.load_time().as_secs_f64());
-    let llm = support::embedded::language_model();
+    let llm = support::embedded::language_model(betr::llm::config::DEFAULT_THREADS);
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()

@@ -16,7 +16,7 @@ use betr::session::{self, Ending, Options, Proposal};
 use betr::world;
 
 fn local() -> &'static Arc<LocalModel> {
-    support::embedded::language_model()
+    support::embedded::language_model(support::embedded::every_core())
 }
 
 use support::repo::scenario;

@@ -25,8 +25,11 @@ pub fn default_model_file() -> PathBuf {
     DEFAULT_MODEL.path()
 }
 
-/// The default language model in llama.cpp.
-pub fn language_model() -> &'static Arc<LocalModel> {
+/// The default language model in llama.cpp, on `threads` threads (the first call of a
+/// test binary decides). One thread where other tests of the binary keep the machine
+/// busy, since two threads stall waiting for each other there; every core where the
+/// binary's tests are all model calls, which its one worker answers one at a time.
+pub fn language_model(threads: u32) -> &'static Arc<LocalModel> {
     static MODEL: OnceLock<Arc<LocalModel>> = OnceLock::new();
     MODEL.get_or_init(|| {
         let path = default_model_file();
@@ -35,7 +38,7 @@ pub fn language_model() -> &'static Arc<LocalModel> {
                 DEFAULT_MODEL.name,
                 EngineOptions {
                     model_path: path,
-                    threads: betr::llm::config::DEFAULT_THREADS,
+                    threads,
                     context: 4096,
                     prompt_states: None,
                 },
@@ -43,6 +46,12 @@ pub fn language_model() -> &'static Arc<LocalModel> {
             .unwrap(),
         )
     })
+}
+
+/// Threads for a test binary whose only work is the model's: the machine's cores, at most
+/// four.
+pub fn every_core() -> u32 {
+    std::thread::available_parallelism().map_or(1, |n| n.get().min(4)) as u32
 }
 
 /// The directory of the default speech-to-text model (Whisper tiny.en).
