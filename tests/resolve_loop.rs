@@ -144,8 +144,25 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+// The library's loop in two tests, so the harness runs the halves side by side.
 #[test]
-fn the_library_loop_applies_the_expected_fixes() {
+fn the_library_loop_applies_the_expected_fixes_of_the_failure_scenarios() {
+    library_loop_applies_the_expected_fixes(|p| !is_param(p));
+}
+
+#[test]
+fn the_library_loop_applies_the_expected_values_of_the_parameter_scenarios() {
+    library_loop_applies_the_expected_fixes(is_param);
+}
+
+/// Every resolvable scenario `which` selects resolves through `session::resolve` with the
+/// fixture replies, reading the scenario's goal and inserting its expected fix.
+fn library_loop_applies_the_expected_fixes(which: fn(&Path) -> bool) {
+    let scenarios: Vec<PathBuf> = resolvable_scenarios()
+        .into_iter()
+        .filter(|p| which(p))
+        .collect();
+    assert!(!scenarios.is_empty(), "no scenario selected");
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let client = OpenAiClient::new(OpenAiSettings {
         base_url: server.base_url(),
@@ -166,7 +183,7 @@ fn the_library_loop_applies_the_expected_fixes() {
         .enable_all()
         .build()
         .unwrap();
-    for path in &resolvable_scenarios() {
+    for path in &scenarios {
         let scenario = Scenario::load(path).unwrap();
         let mut approved: Vec<Proposal> = Vec::new();
         let mut events = Vec::new();
