@@ -133,44 +133,82 @@ const FAILURES: &[(&str, &[Expected])] = &[
     ),
 ];
 
-#[test]
-fn failure_scenarios_fail_for_the_arms_reason_and_succeed_after_their_fix() {
-    for (rel, steps) in FAILURES {
-        let scenario = load(rel);
-        let exec = arms_world(&scenario, None);
-        let planning = world::load(&scenario).unwrap();
-        let planner = Planner::new(&scenario.domain);
-        let goal = scenario.goal.clone().unwrap();
-        let mut tree = planner
-            .plan(&goal.to_dnf(), planning.as_ref())
-            .expect("a plan")
-            .tree;
-        assert_eq!(scenario.expected_fix.len(), steps.len(), "{rel}");
-        for ((action, begins, reason), fix) in steps.iter().zip(&scenario.expected_fix) {
-            let (end, _) = run(&tree, &scenario, exec.as_ref());
-            let RunEnd::Failure {
-                action: Some((node, error)),
-            } = end
-            else {
-                panic!(
-                    "{rel}: expected {action} to fail, got {end:?}\n{}",
-                    bt::to_text(&tree)
-                );
-            };
-            let failed = tree.kind(node).unwrap().as_action().unwrap().to_string();
-            assert_eq!(failed, *action, "{rel}: the failing action ({error})");
-            assert!(error.starts_with(begins), "{rel}: {error}");
-            assert!(error.contains(reason), "{rel}: {error}");
-            // The planning world's sweep agrees here: no disagreement is reported.
-            assert!(!error.contains(world::DISAGREEMENT_NOTE), "{rel}: {error}");
-            let fix = Condition::parse(fix).unwrap();
-            tree = planner
-                .repair(tree, node, &[fix], planning.as_ref())
-                .expect("a repair")
-                .tree;
+/// A test per failure scenario (so the harness runs them side by side), and one that
+/// every scenario of [`FAILURES`] has its test.
+macro_rules! failure_scenario_tests {
+    ($($test:ident => $file:literal),* $(,)?) => {
+        $(
+            #[test]
+            fn $test() {
+                fails_for_the_arms_reason_and_succeeds_after_its_fix($file);
+            }
+        )*
+
+        #[test]
+        fn every_failure_scenario_has_its_test() {
+            let tested: Vec<&str> = vec![$($file),*];
+            let listed: Vec<&str> = FAILURES.iter().map(|(rel, _)| *rel).collect();
+            assert_eq!(tested, listed);
         }
-        succeeds_twice(rel, &tree, &scenario, exec.as_ref(), true);
+    };
+}
+
+failure_scenario_tests! {
+    red_on_blue_fails_for_the_arms_reason_and_succeeds_after_its_fix => "red_on_blue.toml",
+    blocked_both_fails_for_the_arms_reason_and_succeeds_after_its_fix => "blocked_both.toml",
+    flip_cup_fails_for_the_arms_reason_and_succeeds_after_its_fix => "flip_cup.toml",
+    centrifuge_fails_for_the_arms_reason_and_succeeds_after_its_fix => "centrifuge.toml",
+    cupboard_fails_for_the_arms_reason_and_succeeds_after_its_fix => "cupboard.toml",
+    banana_unknown_fails_for_the_arms_reason_and_succeeds_after_its_fix => "banana_unknown.toml",
+    banana_far_fails_for_the_arms_reason_and_succeeds_after_its_fix => "banana_far.toml",
+}
+
+/// The failure scenario `rel` of [`FAILURES`] fails in the arms' world for each expected
+/// reason in turn, is repaired with its expected fix each time, and then succeeds.
+fn fails_for_the_arms_reason_and_succeeds_after_its_fix(rel: &str) {
+    let (rel, steps) = FAILURES
+        .iter()
+        .find(|(r, _)| *r == rel)
+        .unwrap_or_else(|| panic!("{rel} is not in FAILURES"));
+    let scenario = load(rel);
+    let exec = arms_world(&scenario, None);
+    let planning = world::load(&scenario).expect("the planning world");
+    let planner = Planner::new(&scenario.domain);
+    let goal = scenario.goal.clone().expect("the scenario's goal");
+    let mut tree = planner
+        .plan(&goal.to_dnf(), planning.as_ref())
+        .expect("a plan")
+        .tree;
+    assert_eq!(scenario.expected_fix.len(), steps.len(), "{rel}");
+    for ((action, begins, reason), fix) in steps.iter().zip(&scenario.expected_fix) {
+        let (end, _) = run(&tree, &scenario, exec.as_ref());
+        let RunEnd::Failure {
+            action: Some((node, error)),
+        } = end
+        else {
+            panic!(
+                "{rel}: expected {action} to fail, got {end:?}\n{}",
+                bt::to_text(&tree)
+            );
+        };
+        let failed = tree
+            .kind(node)
+            .ok()
+            .and_then(|k| k.as_action())
+            .expect("the failing node is an action")
+            .to_string();
+        assert_eq!(failed, *action, "{rel}: the failing action ({error})");
+        assert!(error.starts_with(begins), "{rel}: {error}");
+        assert!(error.contains(reason), "{rel}: {error}");
+        // The planning world's sweep agrees here: no disagreement is reported.
+        assert!(!error.contains(world::DISAGREEMENT_NOTE), "{rel}: {error}");
+        let fix = Condition::parse(fix).expect("the expected fix parses");
+        tree = planner
+            .repair(tree, node, &[fix], planning.as_ref())
+            .expect("a repair")
+            .tree;
     }
+    succeeds_twice(rel, &tree, &scenario, exec.as_ref(), true);
 }
 
 /// `tree` runs to success in `exec` and the scenario's goal holds; a second run from the
