@@ -27,6 +27,7 @@ use betr::scenario::Scenario;
 use betr::world;
 use serde_json::{Value as Json, json};
 use support::cli::{betr, text, tmp};
+use support::spread;
 use support::verify::{repaired, root, scenario_files};
 
 /// The venv's python, installed through the script when missing; a failed install fails
@@ -284,39 +285,53 @@ fn compare(name: &str, report: &Json, expected: &[(String, Statuses)], xml: &str
 fn btcpp_ticks_every_scenario_tree_as_betr_does() {
     let python = btcpp_python();
     let dir = tmp("btcpp-runs");
-    let mut trees = 0;
-    let mut ticks = 0;
-    let mut outcomes = BTreeMap::<String, usize>::new();
-    let mut halts = 0;
-    for file in scenario_files(&root().join("scenarios")) {
-        let s = Scenario::load(&file).unwrap();
-        let Some(goal) = s.goal.clone() else { continue };
-        let world = world::load(&s).unwrap();
-        let planned = Planner::new(&s.domain)
-            .plan(&goal.to_dnf(), world.as_ref())
-            .unwrap()
-            .tree;
-        let mut cases = vec![("planned", planned)];
-        if !s.expected_fix.is_empty() {
-            cases.push(("repaired", repaired(&s)));
-        }
-        let stem = file.file_stem().unwrap().to_string_lossy().to_string();
-        for (what, tree) in cases {
-            let name = format!("{stem}-{what}");
-            let xml = interop::to_btcpp(&tree, &s.domain, "Main").unwrap();
-            let (script, expected) = betr_run(&s, &tree);
-            halts += script["ticks"]
-                .as_array()
+    // Each scenario's trees are exported, run in BT.CPP and compared on their own, so the
+    // scenarios run on every core; per tree: what it is, its last outcome, ticks, halts.
+    let files = scenario_files(&root().join("scenarios"));
+    let runs = spread::each(
+        &files,
+        |f| f.display().to_string(),
+        |file| {
+            let s = Scenario::load(file).unwrap();
+            let Some(goal) = s.goal.clone() else {
+                return Vec::new();
+            };
+            let world = world::load(&s).unwrap();
+            let planned = Planner::new(&s.domain)
+                .plan(&goal.to_dnf(), world.as_ref())
                 .unwrap()
-                .iter()
-                .map(|t| t["halted"].as_array().unwrap().len())
-                .sum::<usize>();
-            let report = btcpp_run(&python, &dir, &name, &xml, &script);
-            ticks += compare(&name, &report, &expected, &xml);
-            let last = expected.last().unwrap().0.clone();
-            *outcomes.entry(format!("{what} {last}")).or_default() += 1;
-            trees += 1;
-        }
+                .tree;
+            let mut cases = vec![("planned", planned)];
+            if !s.expected_fix.is_empty() {
+                cases.push(("repaired", repaired(&s)));
+            }
+            let stem = file.file_stem().unwrap().to_string_lossy().to_string();
+            let mut runs = Vec::new();
+            for (what, tree) in cases {
+                let name = format!("{stem}-{what}");
+                let xml = interop::to_btcpp(&tree, &s.domain, "Main").unwrap();
+                let (script, expected) = betr_run(&s, &tree);
+                let halts = script["ticks"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|t| t["halted"].as_array().unwrap().len())
+                    .sum::<usize>();
+                let report = btcpp_run(&python, &dir, &name, &xml, &script);
+                let ticks = compare(&name, &report, &expected, &xml);
+                let last = expected.last().unwrap().0.clone();
+                runs.push((format!("{what} {last}"), ticks, halts));
+            }
+            runs
+        },
+    );
+    let (mut trees, mut ticks, mut halts) = (0, 0, 0);
+    let mut outcomes = BTreeMap::<String, usize>::new();
+    for (outcome, tree_ticks, tree_halts) in runs.into_iter().flatten() {
+        *outcomes.entry(outcome).or_default() += 1;
+        ticks += tree_ticks;
+        halts += tree_halts;
+        trees += 1;
     }
     eprintln!("{trees} trees, {ticks} ticks compared, {halts} halts; last ticks: {outcomes:?}");
     // 31 scenarios with a goal, 19 of them with an expected fix (as tests/interop.rs

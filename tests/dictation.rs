@@ -24,6 +24,7 @@ use betr::session::{self, Event, Options};
 use betr::voice::{self, Audio16k, LocalSettings, LocalWhisper, VoiceError, word_error_rate};
 use support::cli::{betr_with, text, tmp};
 use support::fixtures;
+use support::spread;
 
 /// The highest word error rate accepted for a clearly synthesised short instruction.
 const MAX_WER: f64 = 0.25;
@@ -63,70 +64,77 @@ fn dictated_instructions_of_scenarios_1_3_4_give_their_goals() {
     let whisper =
         LocalWhisper::load(model_dir(), WHISPER_TINY_EN.name, LocalSettings::default()).unwrap();
     eprintln!("model load: {:.2} s", whisper.load_time().as_secs_f64());
-    let llm = support::embedded::language_model(betr::llm::config::DEFAULT_THREADS);
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .unwrap();
+    // The model's answers do not depend on its threads; every core reads the three
+    // transcripts sooner.
+    let llm = support::embedded::language_model(support::embedded::every_core());
     let dir = tmp("dictation");
-    for rel in SCENARIOS {
-        let scenario = Scenario::load(&fixtures::root().join(rel)).unwrap();
-        let instruction = scenario.instruction.clone().unwrap();
-        let wav = dir.join(format!("{}.wav", scenario.name.replace(' ', "_")));
-        speak(&instruction, FAST, &wav);
-        let fast = whisper
-            .transcribe_blocking(&Audio16k::from_wav(&wav).unwrap())
-            .unwrap();
-        eprintln!(
-            "{rel} at 175 wpm: heard {:?}: WER {:.3} (not asserted)",
-            fast.text,
-            word_error_rate(&instruction, &fast.text)
-        );
-        speak(&instruction, DICTATION, &wav);
-        let audio = Audio16k::from_wav(&wav).unwrap();
-        let transcript = rt.block_on(voice::transcribe(&whisper, &audio)).unwrap();
-        let wer = word_error_rate(&instruction, &transcript.text);
-        eprintln!(
-            "{rel}: said {instruction:?}, heard {:?}: WER {wer:.3}; {:.2} s of audio in {:.2} s",
-            transcript.text,
-            transcript.audio_seconds,
-            transcript.elapsed.as_secs_f64()
-        );
-        assert!(
-            wer <= MAX_WER,
-            "{rel}: WER {wer:.3} for {:?}",
-            transcript.text
-        );
+    // Each scenario is spoken, heard and read on its own, so they run side by side.
+    spread::each(
+        &SCENARIOS,
+        |rel| (*rel).to_string(),
+        |rel| {
+            let rt = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap();
+            let scenario = Scenario::load(&fixtures::root().join(rel)).unwrap();
+            let instruction = scenario.instruction.clone().unwrap();
+            let wav = dir.join(format!("{}.wav", scenario.name.replace(' ', "_")));
+            speak(&instruction, FAST, &wav);
+            let fast = whisper
+                .transcribe_blocking(&Audio16k::from_wav(&wav).unwrap())
+                .unwrap();
+            eprintln!(
+                "{rel} at 175 wpm: heard {:?}: WER {:.3} (not asserted)",
+                fast.text,
+                word_error_rate(&instruction, &fast.text)
+            );
+            speak(&instruction, DICTATION, &wav);
+            let audio = Audio16k::from_wav(&wav).unwrap();
+            let transcript = rt.block_on(voice::transcribe(&whisper, &audio)).unwrap();
+            let wer = word_error_rate(&instruction, &transcript.text);
+            eprintln!(
+                "{rel}: said {instruction:?}, heard {:?}: WER {wer:.3}; {:.2} s of audio in {:.2} s",
+                transcript.text,
+                transcript.audio_seconds,
+                transcript.elapsed.as_secs_f64()
+            );
+            assert!(
+                wer <= MAX_WER,
+                "{rel}: WER {wer:.3} for {:?}",
+                transcript.text
+            );
 
-        let world = betr::world::load(&scenario).unwrap();
-        let mut events = Vec::new();
-        let answer = rt
-            .block_on(session::interpret(
-                &scenario,
-                world,
-                &transcript.text,
-                llm.as_ref(),
-                &Options::default(),
-                &mut |e| events.push(e.clone()),
-            ))
-            .unwrap_or_else(|e| panic!("{rel}: {e} (transcript {:?})", transcript.text))
-            .answer;
-        let matches = events.iter().any(|e| {
-            matches!(
-                e,
-                Event::Goal {
-                    matches_expected: Some(true),
-                    ..
-                }
-            )
-        });
-        eprintln!("{rel}: the embedded language model's goal: {}", answer.goal);
-        assert!(
-            matches,
-            "{rel}: goal {} differs from the scenario's",
-            answer.goal
-        );
-    }
+            let world = betr::world::load(&scenario).unwrap();
+            let mut events = Vec::new();
+            let answer = rt
+                .block_on(session::interpret(
+                    &scenario,
+                    world,
+                    &transcript.text,
+                    llm.as_ref(),
+                    &Options::default(),
+                    &mut |e| events.push(e.clone()),
+                ))
+                .unwrap_or_else(|e| panic!("{rel}: {e} (transcript {:?})", transcript.text))
+                .answer;
+            let matches = events.iter().any(|e| {
+                matches!(
+                    e,
+                    Event::Goal {
+                        matches_expected: Some(true),
+                        ..
+                    }
+                )
+            });
+            eprintln!("{rel}: the embedded language model's goal: {}", answer.goal);
+            assert!(
+                matches,
+                "{rel}: goal {} differs from the scenario's",
+                answer.goal
+            );
+        },
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

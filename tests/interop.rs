@@ -19,6 +19,7 @@ use betr::planner::Planner;
 use betr::scenario::Scenario;
 use betr::world;
 use support::cli::{betr, text, tmp};
+use support::spread;
 use support::verify::{repaired, root, scenario_files};
 
 /// The tree survives BT.CPP XML and back, node for node.
@@ -67,29 +68,37 @@ fn with_values(mut tree: Tree, scenario: &Scenario) -> Tree {
 #[test]
 fn the_trees_of_every_scenario_round_trip_through_btcpp_xml() {
     let files = scenario_files(&root().join("scenarios"));
-    let mut checked = 0;
-    let mut with_value_ports = 0;
-    for file in &files {
-        let s = Scenario::load(file).unwrap();
-        let Some(goal) = s.goal.clone() else { continue };
-        let world = world::load(&s).unwrap();
-        let planned = Planner::new(&s.domain)
-            .plan(&goal.to_dnf(), world.as_ref())
-            .unwrap()
-            .tree;
-        let name = file.display().to_string();
-        assert_round_trip(&planned, &s, &name);
-        if !s.expected_fix.is_empty() {
-            assert_round_trip(&repaired(&s), &s, &format!("{name}, repaired"));
-        }
-        if s.domain.skills.iter().any(|k| !k.values.is_empty()) {
-            let valued = with_values(planned, &s);
-            assert!(bt::to_text(&valued).contains(" {"), "{name}: no value set");
-            assert_round_trip(&valued, &s, &format!("{name}, with values"));
-            with_value_ports += 1;
-        }
-        checked += 1;
-    }
+    // Each scenario's trees round-trip on their own, so the scenarios run on every core;
+    // per scenario: whether it has a goal, and whether its trees carry values.
+    let trips = spread::each(
+        &files,
+        |f| f.display().to_string(),
+        |file| {
+            let s = Scenario::load(file).unwrap();
+            let Some(goal) = s.goal.clone() else {
+                return (false, false);
+            };
+            let world = world::load(&s).unwrap();
+            let planned = Planner::new(&s.domain)
+                .plan(&goal.to_dnf(), world.as_ref())
+                .unwrap()
+                .tree;
+            let name = file.display().to_string();
+            assert_round_trip(&planned, &s, &name);
+            if !s.expected_fix.is_empty() {
+                assert_round_trip(&repaired(&s), &s, &format!("{name}, repaired"));
+            }
+            let valued = s.domain.skills.iter().any(|k| !k.values.is_empty());
+            if valued {
+                let with = with_values(planned, &s);
+                assert!(bt::to_text(&with).contains(" {"), "{name}: no value set");
+                assert_round_trip(&with, &s, &format!("{name}, with values"));
+            }
+            (true, valued)
+        },
+    );
+    let checked = trips.iter().filter(|(goal, _)| *goal).count();
+    let with_value_ports = trips.iter().filter(|(_, valued)| *valued).count();
     // 10 failure scenarios, 7 parameter scenarios, the cafe of the dataset, the 7 new
     // tasks of cell/tasks, the greenhouse, the lab, the warehouse, the hospital, and the 2
     // scenarios only real arms fail.

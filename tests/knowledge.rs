@@ -477,6 +477,8 @@ fn learn_without_yes_asks_and_can_keep_the_rule_for_the_fixs_objects_only() {
         .env("HOME", &dir)
         .env("XDG_STATE_HOME", dir.join("state"))
         .env("XDG_DATA_HOME", dir.join("data"))
+        .env("XDG_CACHE_HOME", dir.join("cache"))
+        .env_remove("BETR_MODEL_DIR")
         .env("BETR_OFFLINE", "1")
         .env(KEY_VAR, support::cli::KEY)
         .env_remove("BETR_CONFIG")

@@ -15,6 +15,7 @@ use betr::session::{self, Ending, Event, Options, Proposal};
 use support::cli::{KEY_VAR, betr, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
+use support::spread;
 
 fn scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -179,68 +180,73 @@ fn library_loop_applies_the_expected_fixes(which: fn(&Path) -> bool) {
     })
     .unwrap();
     let client: std::sync::Arc<dyn betr::llm::LanguageModel> = std::sync::Arc::new(client);
-    let rt = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .unwrap();
-    for path in &scenarios {
-        let scenario = Scenario::load(path).unwrap();
-        let mut approved: Vec<Proposal> = Vec::new();
-        let mut events = Vec::new();
-        let r = rt
-            .block_on(session::resolve(
-                &scenario,
-                None,
-                client.clone(),
-                &Options::default(),
-                &mut |p| {
-                    approved.push(p.clone());
-                    true
-                },
-                &mut |e| events.push(e.clone()),
-            ))
-            .unwrap();
-        assert!(
-            matches!(r.ending, Ending::Success { .. }),
-            "{}: {:?}",
-            scenario.name,
-            r.ending
-        );
-        let goal_ok = events.iter().any(|e| {
-            matches!(
-                e,
-                Event::Goal {
-                    matches_expected: Some(true),
-                    ..
-                }
-            )
-        });
-        assert!(
-            goal_ok,
-            "{}: the interpreted goal differs from the scenario's",
-            scenario.name
-        );
-        let inserted: Vec<String> = approved
-            .iter()
-            .flat_map(|p| match p {
-                Proposal::Conditions { conditions, .. } => {
-                    conditions.iter().map(ToString::to_string).collect()
-                }
-                Proposal::Value { .. } => vec![],
-            })
-            .collect();
-        assert_eq!(inserted, scenario.expected_fix, "{}", scenario.name);
-        let values = approved
-            .iter()
-            .filter(|p| matches!(p, Proposal::Value { .. }))
-            .count();
-        assert_eq!(
-            values > 0,
-            is_param(path),
-            "{}: {approved:?}",
-            scenario.name
-        );
-    }
+    // Each scenario resolves in a world of its own, so they run on every core.
+    spread::each(
+        &scenarios,
+        |p| relative(p),
+        |path| {
+            let rt = tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+                .unwrap();
+            let scenario = Scenario::load(path).unwrap();
+            let mut approved: Vec<Proposal> = Vec::new();
+            let mut events = Vec::new();
+            let r = rt
+                .block_on(session::resolve(
+                    &scenario,
+                    None,
+                    client.clone(),
+                    &Options::default(),
+                    &mut |p| {
+                        approved.push(p.clone());
+                        true
+                    },
+                    &mut |e| events.push(e.clone()),
+                ))
+                .unwrap();
+            assert!(
+                matches!(r.ending, Ending::Success { .. }),
+                "{}: {:?}",
+                scenario.name,
+                r.ending
+            );
+            let goal_ok = events.iter().any(|e| {
+                matches!(
+                    e,
+                    Event::Goal {
+                        matches_expected: Some(true),
+                        ..
+                    }
+                )
+            });
+            assert!(
+                goal_ok,
+                "{}: the interpreted goal differs from the scenario's",
+                scenario.name
+            );
+            let inserted: Vec<String> = approved
+                .iter()
+                .flat_map(|p| match p {
+                    Proposal::Conditions { conditions, .. } => {
+                        conditions.iter().map(ToString::to_string).collect()
+                    }
+                    Proposal::Value { .. } => vec![],
+                })
+                .collect();
+            assert_eq!(inserted, scenario.expected_fix, "{}", scenario.name);
+            let values = approved
+                .iter()
+                .filter(|p| matches!(p, Proposal::Value { .. }))
+                .count();
+            assert_eq!(
+                values > 0,
+                is_param(path),
+                "{}: {approved:?}",
+                scenario.name
+            );
+        },
+    );
 }
 
 #[test]
@@ -350,4 +356,30 @@ fn resolve_yes_never_keeps_a_change_that_fails_verification() {
         !dir.join("data/betr/policies").exists() && !dir.join("policies").exists(),
         "nothing may be saved"
     );
+}
+
+#[test]
+fn spread_cases_come_back_in_order() {
+    let items: Vec<u32> = (0..20).collect();
+    assert_eq!(
+        spread::each(&items, |i| i.to_string(), |i| i * 2),
+        (0..20).map(|i| i * 2).collect::<Vec<u32>>()
+    );
+}
+
+#[test]
+fn every_spread_case_that_fails_is_named() {
+    let items = [1, 2, 3, 4];
+    let told = std::panic::catch_unwind(|| {
+        spread::each(
+            &items,
+            |i| format!("case {i}"),
+            |i| assert!(i % 2 == 1, "{i} is even"),
+        )
+    })
+    .unwrap_err();
+    let told = spread::message(told.as_ref());
+    assert!(told.starts_with("2 of 4 cases failed"), "{told}");
+    assert!(told.contains("case 2: 2 is even"), "{told}");
+    assert!(told.contains("case 4: 4 is even"), "{told}");
 }

@@ -23,7 +23,7 @@ fn the_workbench_opens_on_scenario_1_in_a_directory_outside_the_repository() {
     assert!(!dir.join("scenarios").exists());
     // `betr tui` with no scenario, only the model's flags.
     let command = format!(
-        "cd {dir} && env HOME={dir} BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+        "cd {dir} && env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
          XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {bin} tui --backend openai --base-url {url} \
          --model fake-model --api-key-env {KEY_VAR} --tick-ms 50; \
          echo \"betr exited with status $?\"; sleep 60",

@@ -16,6 +16,7 @@ use betr::scenario::Scenario;
 use betr::verify::{self, Limits, VerifyConfig, VerifyInput, plan_in_model};
 use betr::world;
 use support::cli::{betr, text, tmp};
+use support::spread;
 use support::verify::{check, root, spin_agrees};
 
 /// Every scenario file: the ten failure scenarios, the seven parameter scenarios and the
@@ -128,16 +129,28 @@ fn the_trees_of_the_hundred_cafe_gold_goals_verify_in_the_model() {
 
 #[test]
 fn spin_agrees_on_every_scenario_model_planned_in_the_model() {
-    for file in scenario_files() {
-        let s = Scenario::load(&file).unwrap();
-        let initial = world::load(&s).unwrap().facts();
-        let tree = model_tree(&s, &initial, &s.goal.clone().unwrap().to_dnf());
-        let (report, model) = check(&s, &tree, false);
-        assert!(report.holds(), "{}:\n{report:#?}", file.display());
-        let name = format!("model-{}", s.name.replace([' ', ':', '/'], "_"));
-        // `None`: SPIN is missing outside CI (said loudly by the helper).
-        if let Some(claims) = spin_agrees(&report, &model, &name) {
-            assert!(!claims.is_empty(), "{}", file.display());
-        }
-    }
+    // Each scenario is checked on its own, so they run on every core.
+    spread::each(
+        &scenario_files(),
+        |f| f.display().to_string(),
+        |file| {
+            let s = Scenario::load(file).unwrap();
+            let initial = world::load(&s).unwrap().facts();
+            let tree = model_tree(&s, &initial, &s.goal.clone().unwrap().to_dnf());
+            let (report, model) = check(&s, &tree, false);
+            assert!(report.holds(), "{}:\n{report:#?}", file.display());
+            // Named by the file: the checks run side by side, each in a directory of its own.
+            let name = format!(
+                "model-{}",
+                file.strip_prefix(root())
+                    .unwrap_or(file)
+                    .to_string_lossy()
+                    .replace(['/', '.', ' '], "_")
+            );
+            // `None`: SPIN is missing outside CI (said loudly by the helper).
+            if let Some(claims) = spin_agrees(&report, &model, &name) {
+                assert!(!claims.is_empty(), "{}", file.display());
+            }
+        },
+    );
 }

@@ -14,6 +14,7 @@ use betr::scenario::Scenario;
 use betr::verify::counterexample::Event;
 use betr::verify::{PropertyKind, Rule};
 use betr::world;
+use support::spread;
 use support::verify::{
     before_last, check, counterexample, has, load, repaired, root, spin_agrees, tick_over,
 };
@@ -36,29 +37,39 @@ const TEN: [&str; 10] = [
 fn repaired_trees_of_the_ten_scenarios_pass_and_spin_agrees() {
     let mut table =
         vec!["| scenario | action failures | states | betr/SPIN per claim |".to_string()];
-    for file in TEN {
-        let s = load(file);
-        let tree = repaired(&s);
-        for failures in [false, true] {
-            let (report, model) = check(&s, &tree, failures);
-            assert!(
-                report.holds(),
-                "{file} (failures {failures}):\n{}\n{report:#?}",
-                bt::to_text(&tree)
-            );
-            let m = report.model.as_ref().unwrap();
-            assert!(m.complete && m.states > 1, "{file}: {m:?}");
-            let name = format!("{}-{failures}", s.name.replace(' ', "_"));
-            let spin = spin_agrees(&report, &model, &name);
-            table.push(format!(
-                "| {} | {} | {} | {} |",
-                s.name,
-                if failures { "on" } else { "off" },
-                m.states,
-                spin.map_or("SPIN not run".into(), |l| l.join(", "))
-            ));
-        }
-    }
+    // Each scenario is checked on its own, so they run on every core; the rows come back
+    // in the scenarios' order.
+    let rows = spread::each(
+        &TEN,
+        |file| (*file).to_string(),
+        |file| {
+            let s = load(file);
+            let tree = repaired(&s);
+            let mut rows = Vec::new();
+            for failures in [false, true] {
+                let (report, model) = check(&s, &tree, failures);
+                assert!(
+                    report.holds(),
+                    "{file} (failures {failures}):\n{}\n{report:#?}",
+                    bt::to_text(&tree)
+                );
+                let m = report.model.as_ref().unwrap();
+                assert!(m.complete && m.states > 1, "{file}: {m:?}");
+                // Named by the file: the checks run side by side, each in a directory of its own.
+                let name = format!("{}-{failures}", file.replace(['/', '.'], "_"));
+                let spin = spin_agrees(&report, &model, &name);
+                rows.push(format!(
+                    "| {} | {} | {} | {} |",
+                    s.name,
+                    if failures { "on" } else { "off" },
+                    m.states,
+                    spin.map_or("SPIN not run".into(), |l| l.join(", "))
+                ));
+            }
+            rows
+        },
+    );
+    table.extend(rows.into_iter().flatten());
     eprintln!("{}", table.join("\n"));
 }
 

@@ -70,6 +70,11 @@ pub fn command(dir: &Path, args: &[&str]) -> Command {
         .env("XDG_STATE_HOME", dir.join("state"))
         .env("XDG_DATA_HOME", dir.join("data"))
         .env("XDG_CONFIG_HOME", dir.join("config"))
+        // The cache too, and no model directory from the caller's environment: with the
+        // caller's cache, a robot description fetched there would give the cell its real
+        // arms, and every command would plan their motions.
+        .env("XDG_CACHE_HOME", dir.join("cache"))
+        .env_remove("BETR_MODEL_DIR")
         // The home is empty: a one-shot command fetches nothing into it (a cell whose
         // robot description is not in the cache runs its abstraction). A test of the
         // fetch sets BETR_OFFLINE=0.

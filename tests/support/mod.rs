@@ -14,6 +14,7 @@ pub mod multipart;
 pub mod recorded;
 pub mod repo;
 pub mod rerun;
+pub mod spread;
 pub mod tmux;
 pub mod verify;
 pub mod workbench;

@@ -129,7 +129,7 @@ pub fn workbench_command_on(
 ) -> String {
     let scenario = super::fixtures::root().join(scenario);
     format!(
-        "cd {dir} && env HOME={dir} BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
+        "cd {dir} && env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
          XDG_DATA_HOME={dir}/data {key_var}={key} {env} {bin} tui {scenario} --backend openai \
          --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies} \
          --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
