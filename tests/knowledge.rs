@@ -462,7 +462,7 @@ mod engine {
 #[test]
 fn learn_without_yes_asks_and_can_keep_the_rule_for_the_fixs_objects_only() {
     use std::io::Write;
-    use std::process::{Command, Stdio};
+    use std::process::Stdio;
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let dir = tmp("knowledge-ask");
     let policies = dir.join("p").to_string_lossy().into_owned();
@@ -471,17 +471,7 @@ fn learn_without_yes_asks_and_can_keep_the_rule_for_the_fixs_objects_only() {
     let mut args = resolve(&first, &base, &policies);
     args.retain(|a| *a != "--yes");
     args.push("--learn");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_betr"))
-        .args(&args)
-        .current_dir(&dir)
-        .env("HOME", &dir)
-        .env("XDG_STATE_HOME", dir.join("state"))
-        .env("XDG_DATA_HOME", dir.join("data"))
-        .env("XDG_CACHE_HOME", dir.join("cache"))
-        .env_remove("BETR_MODEL_DIR")
-        .env("BETR_OFFLINE", "1")
-        .env(KEY_VAR, support::cli::KEY)
-        .env_remove("BETR_CONFIG")
+    let mut child = support::cli::command(&dir, &args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

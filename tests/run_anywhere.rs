@@ -12,7 +12,7 @@ use std::path::Path;
 use support::cli::{KEY, KEY_VAR, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
-use support::tmux::{Tmux, quote};
+use support::tmux::{Tmux, isolated_env, quote};
 
 #[test]
 fn the_workbench_opens_on_scenario_1_in_a_directory_outside_the_repository() {
@@ -23,11 +23,11 @@ fn the_workbench_opens_on_scenario_1_in_a_directory_outside_the_repository() {
     assert!(!dir.join("scenarios").exists());
     // `betr tui` with no scenario, only the model's flags.
     let command = format!(
-        "cd {dir} && env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
-         XDG_DATA_HOME={dir}/data {KEY_VAR}={KEY} {bin} tui --backend openai --base-url {url} \
+        "cd {dir} && {isolated} {KEY_VAR}={KEY} {bin} tui --backend openai --base-url {url} \
          --model fake-model --api-key-env {KEY_VAR} --tick-ms 50; \
          echo \"betr exited with status $?\"; sleep 60",
         dir = quote(&dir),
+        isolated = isolated_env(&dir),
         bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
         url = server.base_url(),
     );

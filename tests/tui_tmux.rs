@@ -494,9 +494,10 @@ fn a_person_replays_a_recorded_session_without_the_model() {
     }
     // No server from here on, and no key: the replay needs neither.
     let tmux = Tmux::start(&format!(
-        "cd {dir} && env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
-         {bin} replay session.jsonl; echo \"betr exited with status $?\"; sleep 60",
+        "cd {dir} && {isolated} {bin} replay session.jsonl; echo \"betr exited with status $?\"; \
+         sleep 60",
         dir = quote(&dir),
+        isolated = support::tmux::isolated_env(&dir),
         bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
     ));
     let end = tmux.wait_for(&["REPLAY  step", "SUCCESS", "Replay (read-only)"], 20);

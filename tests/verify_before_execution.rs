@@ -139,14 +139,7 @@ fn spin_agrees_on_every_scenario_model_planned_in_the_model() {
             let tree = model_tree(&s, &initial, &s.goal.clone().unwrap().to_dnf());
             let (report, model) = check(&s, &tree, false);
             assert!(report.holds(), "{}:\n{report:#?}", file.display());
-            // Named by the file: the checks run side by side, each in a directory of its own.
-            let name = format!(
-                "model-{}",
-                file.strip_prefix(root())
-                    .unwrap_or(file)
-                    .to_string_lossy()
-                    .replace(['/', '.', ' '], "_")
-            );
+            let name = format!("model-{}", s.name.replace([' ', ':', '/'], "_"));
             // `None`: SPIN is missing outside CI (said loudly by the helper).
             if let Some(claims) = spin_agrees(&report, &model, &name) {
                 assert!(!claims.is_empty(), "{}", file.display());

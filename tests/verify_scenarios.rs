@@ -55,8 +55,7 @@ fn repaired_trees_of_the_ten_scenarios_pass_and_spin_agrees() {
                 );
                 let m = report.model.as_ref().unwrap();
                 assert!(m.complete && m.states > 1, "{file}: {m:?}");
-                // Named by the file: the checks run side by side, each in a directory of its own.
-                let name = format!("{}-{failures}", file.replace(['/', '.'], "_"));
+                let name = format!("{}-{failures}", s.name.replace(' ', "_"));
                 let spin = spin_agrees(&report, &model, &name);
                 rows.push(format!(
                     "| {} | {} | {} | {} |",

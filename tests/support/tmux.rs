@@ -117,6 +117,17 @@ pub fn quote(p: &Path) -> String {
     format!("'{}'", p.display())
 }
 
+/// `env` with the home, state, config, data and cache directories inside `dir`, no model
+/// directory from the caller's environment and nothing fetched: the shell's form of
+/// [`super::cli::command`]'s isolated home, for a command line tmux runs.
+pub fn isolated_env(dir: &Path) -> String {
+    format!(
+        "env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 \
+         XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config XDG_DATA_HOME={dir}/data",
+        dir = quote(dir)
+    )
+}
+
 /// The shell command that opens the workbench on `scenario` (relative to the crate root)
 /// in `dir`, with the model answered by `server`, then says how it exited. It fetches
 /// nothing (`BETR_OFFLINE`): the cache under `dir` has no robot description, so the cell
@@ -129,12 +140,12 @@ pub fn workbench_command_on(
 ) -> String {
     let scenario = super::fixtures::root().join(scenario);
     format!(
-        "cd {dir} && env -u BETR_MODEL_DIR HOME={dir} XDG_CACHE_HOME={dir}/cache BETR_OFFLINE=1 XDG_STATE_HOME={dir}/state XDG_CONFIG_HOME={dir}/config \
-         XDG_DATA_HOME={dir}/data {key_var}={key} {env} {bin} tui {scenario} --backend openai \
+        "cd {dir} && {isolated} {key_var}={key} {env} {bin} tui {scenario} --backend openai \
          --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies} \
          --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
          sleep 60",
         dir = quote(dir),
+        isolated = isolated_env(dir),
         bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
         scenario = quote(&scenario),
         url = server.base_url(),

@@ -167,8 +167,12 @@ pub fn spin_available() -> bool {
 
 /// Run SPIN on the model, one claim at a time; returns (claim, holds).
 fn spin_verdicts(model: &verify::promela::PromelaModel, name: &str) -> Vec<(String, bool)> {
+    // A directory of its own for every run, so checks running side by side never share
+    // SPIN's generated files, whatever they are named.
+    static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let dir: PathBuf =
-        std::env::temp_dir().join(format!("betr-spin-{name}-{}", std::process::id()));
+        std::env::temp_dir().join(format!("betr-spin-{name}-{}-{run}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("model.pml"), &model.text).unwrap();
     let run = |cmd: &mut Command| {
