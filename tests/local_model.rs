@@ -23,6 +23,7 @@ use support::repo::scenario;
 
 #[tokio::test]
 async fn interprets_scenario_1_exactly() {
+    let _turn = support::embedded::turn().await;
     let s = scenario("scenarios/cell/red_on_blue.toml");
     let reading = session::interpret(
         &s,
@@ -43,6 +44,7 @@ async fn interprets_scenario_1_exactly() {
 
 #[tokio::test]
 async fn reads_a_cafe_request_with_a_disjunction_and_a_negation() {
+    let _turn = support::embedded::turn().await;
     // Written for this test (not from the evaluation dataset, nor from the example pool).
     let s = scenario("scenarios/cafe/cafe.toml");
     let instruction = "I'm at the quiet table number nine: bring me a banana or an orange, and please switch off the hall light.";
@@ -70,6 +72,7 @@ async fn reads_a_cafe_request_with_a_disjunction_and_a_negation() {
 
 #[tokio::test]
 async fn resolves_scenario_1_with_a_condition_that_fixes_it_in_simulation() {
+    let _turn = support::embedded::turn().await;
     let s = scenario("scenarios/cell/red_on_blue.toml");
     let mut proposals = Vec::new();
     let resolved = session::resolve(
@@ -130,6 +133,7 @@ fn goal_prompt(s: &betr::scenario::Scenario, instruction: &str) -> Vec<betr::llm
 
 #[tokio::test]
 async fn an_answer_begun_in_the_prompt_is_continued_and_returned_whole() {
+    let _turn = support::embedded::turn().await;
     // `Goal:` written for the model, the grammar typing the formula after it: the reply
     // (and each beam's) begins with the words written, and reads as the goal.
     let s = scenario("scenarios/cell/red_on_blue.toml");
@@ -159,6 +163,7 @@ async fn an_answer_begun_in_the_prompt_is_continued_and_returned_whole() {
 
 #[tokio::test]
 async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
+    let _turn = support::embedded::turn().await;
     // Ask for a banana in a scene that has none, several times with sampling on: every
     // reply must still parse and use only the scene's objects, with no substitution.
     let s = scenario("scenarios/cell/red_on_blue.toml");
@@ -204,6 +209,7 @@ async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
 
 #[tokio::test]
 async fn a_greedy_reply_follows_a_grammar_that_refuses_the_models_own_first_choice() {
+    let _turn = support::embedded::turn().await;
     // The model would answer "blue cube" on "green cube"; a grammar that allows only
     // another goal must still be followed token by token, ending where the grammar ends.
     let s = scenario("scenarios/cell/red_on_blue.toml");
@@ -224,6 +230,7 @@ async fn a_greedy_reply_follows_a_grammar_that_refuses_the_models_own_first_choi
 
 #[tokio::test]
 async fn a_reply_cut_by_the_token_limit_is_refused_after_bounded_calls() {
+    let _turn = support::embedded::turn().await;
     let s = scenario("scenarios/cell/red_on_blue.toml");
     let mut calls = 0;
     let reading = session::interpret(

@@ -48,6 +48,16 @@ pub fn language_model(threads: u32) -> &'static Arc<LocalModel> {
     })
 }
 
+/// A test's turn with the model. Its one worker answers one call at a time anyway, but
+/// tests that interleave their calls evict each other's prompt from the worker's cache,
+/// and a test simulating between calls takes a core from the threads answering another
+/// test's call, which then stall. Tests holding the turn for their whole body run one
+/// after another at full speed.
+pub async fn turn() -> tokio::sync::MutexGuard<'static, ()> {
+    static TURN: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
+    TURN.lock().await
+}
+
 /// Threads for a test binary whose only work is the model's: the machine's cores, at most
 /// four.
 pub fn every_core() -> u32 {
