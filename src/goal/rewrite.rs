@@ -64,3 +64,54 @@ pub fn flipped(goal: &Formula, atom: &Atom) -> Formula {
         Formula::Or(items) => Formula::or(items.iter().map(|i| flipped(i, atom)).collect()),
     }
 }
+
+/// `goal`, a conjunction, without one of its conjuncts that `holds` makes true: one goal
+/// for each such conjunct, in the conjunction's order (none when `goal` is no conjunction).
+pub fn without_each_holding(goal: &Formula, holds: &dyn Fn(&Atom) -> bool) -> Vec<Formula> {
+    let Formula::And(items) = goal else {
+        return Vec::new();
+    };
+    items
+        .iter()
+        .enumerate()
+        .filter(|(_, item)| item.eval(holds))
+        .map(|(i, _)| {
+            Formula::and(
+                items
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .map(|(_, item)| item.clone())
+                    .collect(),
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_conjunct_that_holds_is_taken_out_in_turn() {
+        let goal = Formula::parse("In_Flask_Incubator & In_Flask_Shaker & ~Lit_Lamp").unwrap();
+        let holds = |a: &Atom| a.to_string() == "In_Flask_Incubator";
+        // `~Lit_Lamp` holds too, since the lamp is not lit.
+        let out: Vec<String> = without_each_holding(&goal, &holds)
+            .iter()
+            .map(Formula::to_string)
+            .collect();
+        assert_eq!(
+            out,
+            [
+                "In_Flask_Shaker & ~Lit_Lamp",
+                "In_Flask_Incubator & In_Flask_Shaker"
+            ]
+        );
+        // A single condition or an alternative is no conjunction to take a part out of.
+        let single = Formula::parse("In_Flask_Incubator").unwrap();
+        assert!(without_each_holding(&single, &holds).is_empty());
+        let either = Formula::parse("In_Flask_Incubator | In_Flask_Shaker").unwrap();
+        assert!(without_each_holding(&either, &holds).is_empty());
+    }
+}
