@@ -79,7 +79,6 @@ pub fn check_goal(
     world: &dyn World,
     goal: &Formula,
 ) -> Result<(), GoalProblem> {
-    let unreachable = |reason: String| GoalProblem::unreachable(reason);
     let dnf = goal.to_dnf();
     if dnf.is_false() {
         return Err(GoalProblem::unreachable(
@@ -94,7 +93,7 @@ pub fn check_goal(
     let planner = Planner::new(&scenario.domain);
     let plan = planner
         .plan(&dnf, world)
-        .map_err(|e| unreachable(e.to_string()))?;
+        .map_err(|e| GoalProblem::unreachable(e.to_string()))?;
     match plan.outcome {
         // An action that fails in simulation is what failure resolution is for: the goal
         // itself was plannable.
@@ -102,12 +101,14 @@ pub fn check_goal(
         Outcome::Unreachable {
             condition, reason, ..
         } => {
-            return Err(unreachable(format!(
+            return Err(GoalProblem::unreachable(format!(
                 "the robot cannot make {condition} true: {reason}"
             )));
         }
         Outcome::Exhausted { reason } => {
-            return Err(unreachable(format!("the robot cannot reach it: {reason}")));
+            return Err(GoalProblem::unreachable(format!(
+                "the robot cannot reach it: {reason}"
+            )));
         }
     }
     // The world answers for "any object" as well as for plain atoms.
