@@ -27,11 +27,8 @@ pub struct GoalProblem {
 /// pasted can be taken out; a wrong one (unreadable, contradictory, unplannable) never is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ProblemKind {
-    /// Proven wrong: unreadable, asks for nothing, or not what the words say.
+    /// Proven wrong: unreadable, contradictory, unplannable, or not what the words say.
     Wrong,
-    /// Proven wrong: no situation the skills reach from the scene makes it true (it
-    /// contradicts itself, or the planner cannot achieve it).
-    Unreachable,
     /// A doubt: a condition comes from a shown example or no word asks for it (an
     /// indirect request may mean just that).
     Doubt,
@@ -48,13 +45,6 @@ impl GoalProblem {
         }
     }
 
-    pub fn unreachable(reason: impl Into<String>) -> Self {
-        Self {
-            reason: reason.into(),
-            kind: ProblemKind::Unreachable,
-        }
-    }
-
     pub fn doubt(reason: impl Into<String>) -> Self {
         Self {
             reason: reason.into(),
@@ -64,7 +54,7 @@ impl GoalProblem {
 
     /// A doubt rather than a proof.
     pub fn is_doubt(&self) -> bool {
-        !matches!(self.kind, ProblemKind::Wrong | ProblemKind::Unreachable)
+        self.kind != ProblemKind::Wrong
     }
 }
 
@@ -79,21 +69,22 @@ pub fn check_goal(
     world: &dyn World,
     goal: &Formula,
 ) -> Result<(), GoalProblem> {
+    let wrong = GoalProblem::wrong;
     let dnf = goal.to_dnf();
     if dnf.is_false() {
-        return Err(GoalProblem::unreachable(
-            "it contradicts itself: no situation makes it true",
+        return Err(wrong(
+            "it contradicts itself: no situation makes it true".into(),
         ));
     }
     if Formula::Not(Box::new(goal.clone())).to_dnf().is_false() {
-        return Err(GoalProblem::wrong(
-            "it is true in every situation (something and its negation as alternatives), so it asks for nothing",
+        return Err(wrong(
+            "it is true in every situation (something and its negation as alternatives), so it asks for nothing".into(),
         ));
     }
     let planner = Planner::new(&scenario.domain);
     let plan = planner
         .plan(&dnf, world)
-        .map_err(|e| GoalProblem::unreachable(e.to_string()))?;
+        .map_err(|e| wrong(e.to_string()))?;
     match plan.outcome {
         // An action that fails in simulation is what failure resolution is for: the goal
         // itself was plannable.
@@ -101,14 +92,12 @@ pub fn check_goal(
         Outcome::Unreachable {
             condition, reason, ..
         } => {
-            return Err(GoalProblem::unreachable(format!(
+            return Err(wrong(format!(
                 "the robot cannot make {condition} true: {reason}"
             )));
         }
         Outcome::Exhausted { reason } => {
-            return Err(GoalProblem::unreachable(format!(
-                "the robot cannot reach it: {reason}"
-            )));
+            return Err(wrong(format!("the robot cannot reach it: {reason}")));
         }
     }
     // The world answers for "any object" as well as for plain atoms.

@@ -179,8 +179,7 @@ impl Judge<'_> {
 
     /// Candidates made from an answer that failed a check: without what it pasted from an
     /// example, or without the parts no word of the request asks for; and, when checks
-    /// are on, an answer that cannot be reached without each of its conditions that hold
-    /// now, and any answer with its plain misreadings undone ([`Judge::undone`]). Each is
+    /// are on, any answer with its plain misreadings undone ([`Judge::undone`]). Each is
     /// checked like the others.
     pub(super) fn derived(
         &self,
@@ -209,30 +208,6 @@ impl Judge<'_> {
             }
         }
         let mut made = Vec::new();
-        // A goal no situation the robot reaches makes true often names where something is
-        // as well as where it is to go ("take the flask out of the incubator and put it on
-        // the shaker" read as in the incubator and on the shaker): each of its conditions
-        // that holds now, taken out, makes a candidate.
-        if let (Ok(a), Some(p)) = (read, problem)
-            && check_goals
-            && p.kind == ProblemKind::Unreachable
-        {
-            let world = self.world.as_ref();
-            let holds = |atom: &crate::domain::Atom| {
-                world.check(&crate::domain::Condition::pos(atom.clone()))
-            };
-            for goal in goal::rewrite::without_each_holding(&a.goal, &holds) {
-                if Some(&goal) != pruned.as_ref() && !undone.iter().any(|(g, _)| *g == goal) {
-                    emit(&Event::Notice {
-                        message: format!(
-                            "{} cannot be reached, and a condition of it holds now, so {goal} is a candidate too",
-                            a.goal
-                        ),
-                    });
-                    made.push(goal);
-                }
-            }
-        }
         for (goal, why) in undone {
             match why {
                 Ok(why) => {

@@ -121,39 +121,3 @@ fn a_relation_the_other_way_round_is_a_misreading_undone() {
         "turned round as the request says"
     );
 }
-
-#[test]
-fn a_goal_that_cannot_be_reached_is_tried_without_what_holds_now() {
-    // The lab's flask stands in the incubator: "in the incubator and on the shaker" cannot
-    // be reached, and without where the flask is now it is the move asked for.
-    let lab = Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/lab/lab.toml"))
-        .expect("lab scenario");
-    let lexicon = Lexicon::new(&lab.domain.vocabulary, &lab.examples);
-    let request = "Take the culture flask out of the incubator and put it on the shaker.";
-    let j = judge(&lab, &lexicon, request, false);
-    let answer = lab
-        .parse_goal("In_CultureFlask_Incubator & In_CultureFlask_Shaker")
-        .expect("parses");
-    let problem = j.assess(&answer).expect("both places at once is refused");
-    assert_eq!(problem.kind, ProblemKind::Unreachable, "{}", problem.reason);
-    let read = Ok(GoalAnswer {
-        goal: answer,
-        reasoning: None,
-    });
-    let made = j.derived(&read, Some(&problem), true, true, &mut |_| {});
-    let clean: Vec<String> = made
-        .iter()
-        .filter(|c| c.clean())
-        .filter_map(|c| c.read.as_ref().ok().map(|a| a.goal.to_string()))
-        .collect();
-    assert_eq!(clean, ["In_CultureFlask_Shaker"]);
-    // Without the checks, the condition that holds now stays.
-    assert!(
-        j.derived(&read, Some(&problem), false, true, &mut |_| {})
-            .iter()
-            .all(|c| c
-                .read
-                .as_ref()
-                .is_ok_and(|a| a.goal.to_string() != "In_CultureFlask_Shaker"))
-    );
-}
