@@ -28,7 +28,7 @@ use betr::world;
 use serde_json::{Value as Json, json};
 use support::cli::{betr, text, tmp};
 use support::spread;
-use support::verify::{repaired, root, scenario_files};
+use support::verify::{planned, repaired, root, scenario_files};
 
 /// The venv's python, installed through the script when missing; a failed install fails
 /// the test with the script's reason.
@@ -293,14 +293,9 @@ fn btcpp_ticks_every_scenario_tree_as_betr_does() {
         |f| f.display().to_string(),
         |file| {
             let s = Scenario::load(file).unwrap();
-            let Some(goal) = s.goal.clone() else {
+            let Some(planned) = planned(&s) else {
                 return Vec::new();
             };
-            let world = world::load(&s).unwrap();
-            let planned = Planner::new(&s.domain)
-                .plan(&goal.to_dnf(), world.as_ref())
-                .unwrap()
-                .tree;
             let mut cases = vec![("planned", planned)];
             if !s.expected_fix.is_empty() {
                 cases.push(("repaired", repaired(&s)));

@@ -20,7 +20,7 @@ use betr::scenario::Scenario;
 use betr::world;
 use support::cli::{betr, text, tmp};
 use support::spread;
-use support::verify::{repaired, root, scenario_files};
+use support::verify::{planned, repaired, root, scenario_files};
 
 /// The tree survives BT.CPP XML and back, node for node.
 fn assert_round_trip(tree: &Tree, scenario: &Scenario, what: &str) {
@@ -75,14 +75,9 @@ fn the_trees_of_every_scenario_round_trip_through_btcpp_xml() {
         |f| f.display().to_string(),
         |file| {
             let s = Scenario::load(file).unwrap();
-            let Some(goal) = s.goal.clone() else {
+            let Some(planned) = planned(&s) else {
                 return (false, false);
             };
-            let world = world::load(&s).unwrap();
-            let planned = Planner::new(&s.domain)
-                .plan(&goal.to_dnf(), world.as_ref())
-                .unwrap()
-                .tree;
             let name = file.display().to_string();
             assert_round_trip(&planned, &s, &name);
             if !s.expected_fix.is_empty() {

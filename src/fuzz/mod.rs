@@ -27,7 +27,9 @@ use std::path::PathBuf;
 
 pub use corpus::Corpus;
 pub use rng::Rng;
-pub use runner::{Failure, Progress, Report, RunOptions, check_caught, make_input, run};
+pub use runner::{
+    Failure, Progress, Report, RunOptions, check_caught, make_input, panic_message, run,
+};
 
 /// The targets, in the order `all` runs them.
 pub const TARGETS: &[&str] = &[

@@ -90,12 +90,7 @@ fn install_hook() {
                     location = format!("{location} in {caller}");
                 }
             }
-            let payload = info.payload();
-            let message = payload
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "a panic without a message".into());
+            let message = panic_message(info.payload());
             LAST_PANIC.with(|p| *p.borrow_mut() = Some((location, message)));
         }));
     });
@@ -234,6 +229,15 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), FuzzError> {
         std::fs::create_dir_all(dir).map_err(io)?;
     }
     std::fs::write(path, bytes).map_err(io)
+}
+
+/// What a panic said: its message, or that it had none.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".into())
 }
 
 #[cfg(test)]

@@ -7,6 +7,8 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+pub use betr::fuzz::panic_message as message;
+
 /// `check` of every item, run on as many threads as the machine has cores (no more than
 /// there are items), returned in the items' order. Panics after all have run when any
 /// check panicked, naming each such item (by `name`) with its panic's message.
@@ -55,13 +57,4 @@ where
     let mut done = done.into_inner().unwrap();
     done.sort_by_key(|(i, _)| *i);
     done.into_iter().map(|(_, r)| r).collect()
-}
-
-/// What a panic said.
-pub fn message(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| (*s).to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic without a message".into())
 }

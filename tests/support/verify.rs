@@ -52,6 +52,18 @@ fn collect_scenario_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The scenario's goal planned in its first state, `None` when it states no goal.
+pub fn planned(s: &Scenario) -> Option<Tree> {
+    let goal = s.goal.as_ref()?.to_dnf();
+    let world = world::load(s).unwrap();
+    Some(
+        Planner::new(&s.domain)
+            .plan(&goal, world.as_ref())
+            .unwrap()
+            .tree,
+    )
+}
+
 /// The scenario's goal planned, then repaired with its `expected_fix`, one fix per
 /// failure in order (scenario 2 needs two), each at the action that fails. A scenario
 /// whose failure only the real arms produce is planned in the execution world, as the
@@ -170,9 +182,9 @@ fn spin_verdicts(model: &verify::promela::PromelaModel, name: &str) -> Vec<(Stri
     // A directory of its own for every run, so checks running side by side never share
     // SPIN's generated files, whatever they are named.
     static RUNS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let nth = RUNS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let dir: PathBuf =
-        std::env::temp_dir().join(format!("betr-spin-{name}-{}-{run}", std::process::id()));
+        std::env::temp_dir().join(format!("betr-spin-{name}-{}-{nth}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("model.pml"), &model.text).unwrap();
     let run = |cmd: &mut Command| {
