@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Run the experiments of `betr eval` with the embedded models and copy the tables and
-# charts into docs/ (docs/EVAL.md, "Results with the embedded models"). The models are
+# charts into docs/ (docs/EVAL.md, "Results with the embedded models", and the failures
+# and parameters in docs/EVAL-failures.md). The models are
 # fetched into the cache on first use. Each command resumes from its directory if
 # interrupted: run this script again.
 # Usage: bash scripts/eval_default_model.sh [RUNS] [THREADS]
