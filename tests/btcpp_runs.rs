@@ -22,7 +22,7 @@ use betr::bt::{
 };
 use betr::domain::{ActionCall, Condition, Domain, Value};
 use betr::interop;
-use betr::planner::{Planner, RunLimits, WorldLeaves};
+use betr::planner::{RunLimits, WorldLeaves};
 use betr::scenario::Scenario;
 use betr::world;
 use serde_json::{Value as Json, json};
@@ -371,11 +371,7 @@ fn a_leaf_the_script_does_not_answer_is_a_problem_the_driver_reports() {
     let python = btcpp_python();
     let dir = tmp("btcpp-driver-problem");
     let s = Scenario::load(&root().join("scenarios/cell/red_on_blue.toml")).unwrap();
-    let world = world::load(&s).unwrap();
-    let tree = Planner::new(&s.domain)
-        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
-        .unwrap()
-        .tree;
+    let tree = planned(&s).unwrap();
     let xml = interop::to_btcpp(&tree, &s.domain, "Main").unwrap();
     let (mut script, _) = betr_run(&s, &tree);
     // The first tick's first answer taken away: BT.CPP asks a leaf nobody answers.
@@ -400,11 +396,7 @@ fn a_guard_that_stops_holding_halts_the_running_action_in_btcpp_as_in_betr() {
     let python = btcpp_python();
     let dir = tmp("btcpp-halt");
     let s = Scenario::load(&root().join("scenarios/cafe/cafe.toml")).unwrap();
-    let world = world::load(&s).unwrap();
-    let tree = Planner::new(&s.domain)
-        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
-        .unwrap()
-        .tree;
+    let tree = planned(&s).unwrap();
     // The first tick with an action running whose sequence checks a condition before it:
     // that condition stops holding in the next tick.
     let (_, _, records) = betr_run_disturbed(&s, &tree, None);

@@ -9,14 +9,12 @@
 mod support;
 
 use betr::bt::{self, NodeKind, Outcome};
-use betr::planner::Planner;
 use betr::scenario::Scenario;
 use betr::verify::counterexample::Event;
 use betr::verify::{PropertyKind, Rule};
-use betr::world;
 use support::spread;
 use support::verify::{
-    before_last, check, counterexample, has, load, repaired, root, spin_agrees, tick_over,
+    before_last, check, counterexample, has, load, planned, repaired, root, spin_agrees, tick_over,
 };
 
 /// The ten failure scenarios of SCENARIOS.md, in its order.
@@ -180,11 +178,8 @@ del = ["Holding_Nothing"]
 #[test]
 fn the_unrepaired_sweep_violates_its_scenario_property() {
     let s = load("scenarios/cafe/sweep.toml");
-    let world = world::load(&s).unwrap();
-    let plan = Planner::new(&s.domain)
-        .plan(&s.goal.clone().unwrap().to_dnf(), world.as_ref())
-        .unwrap();
-    let (report, model) = check(&s, &plan.tree, false);
+    let tree = planned(&s).unwrap();
+    let (report, model) = check(&s, &tree, false);
     let cx = counterexample(&report, PropertyKind::User(0));
     assert!(has(cx.last_state(), "IsClean_Floor") && !has(cx.last_state(), "Holding_Mop"));
     spin_agrees(&report, &model, "unrepaired-sweep");
