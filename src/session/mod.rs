@@ -16,6 +16,7 @@ pub mod knowledge;
 mod named_first;
 pub mod planned;
 pub mod policy;
+mod question;
 pub mod readings;
 pub mod resolve;
 pub mod screen;

@@ -14,7 +14,9 @@ use super::super::policy::{Approval, now_rfc3339};
 use super::super::screen::{apply, helped};
 use super::super::types::{Event, Proposal};
 use super::super::values::{self, Setting, conform};
-use super::{AppliedFix, Engine, Failure, Pending, UndoEntry};
+use super::Engine;
+use super::phase::{AppliedProposal, Failure, Pending, Phase};
+use super::task::AppliedFix;
 
 /// Why what a person wrote does not fit the proposal it is for; each names the edit as
 /// written.
@@ -52,21 +54,24 @@ enum Unfit {
 pub(super) const REJECTED: &str = "rejected by a person";
 
 impl Engine {
-    pub(super) fn approve(&mut self) {
-        if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
-            return self.approve_violation();
-        }
-        if self.pending.is_none() {
-            return self.error("no proposal to approve");
-        }
-        self.apply_pending(Approval::Person);
+    /// Take the pending proposal out of the phase; the failure it was for, if any, stays.
+    fn take_pending(&mut self) -> Option<Pending> {
+        let Phase::Proposed(pending) = &self.phase else {
+            return None;
+        };
+        let pending = pending.clone();
+        self.phase = match &pending.failure {
+            Some(failure) => Phase::Failed {
+                failure: failure.clone(),
+            },
+            None => self.settled(),
+        };
+        Some(pending)
     }
 
+    /// Drop the pending proposal; the model is asked again with it told as rejected.
     pub(super) fn reject(&mut self) {
-        if self.pending.is_none() && self.gate == Some(super::checks::Gate::Violated) {
-            return self.reject_violation();
-        }
-        let Some(pending) = self.pending.take() else {
+        let Some(pending) = self.take_pending() else {
             return self.error("no proposal to reject");
         };
         self.emit(Event::Rejected);
@@ -76,7 +81,7 @@ impl Engine {
         // The model is asked again with what the person rejected told to it as tried (and
         // left out of the conditions it may choose from), a few times; then the person
         // types the fix.
-        self.tried.push((
+        self.task.tried.push((
             failure.clone(),
             Tried {
                 proposal: pending.proposal,
@@ -84,11 +89,12 @@ impl Engine {
             },
         ));
         let rejected = self
+            .task
             .tried
             .iter()
             .filter(|(f, t)| *f == failure && t.why == REJECTED)
             .count();
-        if rejected > self.options.max_rejections || self.model.is_err() {
+        if rejected > self.settings.options.max_rejections || self.settings.model.is_err() {
             return self.notice(format!(
                 "{rejected} proposal(s) for {}! rejected: type the missing condition(s) or value yourself (e)",
                 failure.action
@@ -99,16 +105,21 @@ impl Engine {
 
     /// Apply the pending proposal; keep it only if it helps.
     pub(super) fn apply_pending(&mut self, approval: Approval) {
-        let Some(pending) = self.pending.take() else {
+        let Some(pending) = self.take_pending() else {
             return;
         };
-        let Some(tree) = self.tree.clone() else {
+        let Some(tree) = self.task.tree.clone() else {
             return self.error("no tree to change");
         };
         self.emit(Event::Approved);
-        let planner = Planner::new(&self.scenario.domain);
-        let before = pending.failure.clone().or_else(|| self.failure.clone());
-        let result = apply(&planner, &tree, &pending.proposal, self.planning.as_ref());
+        let planner = Planner::new(&self.settings.scenario.domain);
+        let before = pending.failure.clone();
+        let result = apply(
+            &planner,
+            &tree,
+            &pending.proposal,
+            self.run.planning.as_ref(),
+        );
         let (plan, valued_nodes) = match result {
             Ok(r) => r,
             Err(e) => return self.did_not_help(&pending, &tree, before.as_ref(), e.to_string()),
@@ -120,24 +131,21 @@ impl Engine {
             added_nodes: plan.new_nodes.len(),
             valued_nodes,
         });
-        self.undo.push(UndoEntry {
-            tree,
-            fixes: self.fixes.len(),
-            proposal: Some(pending.proposal.clone()),
-        });
+        self.task.push_undo(tree, Some(pending.proposal.clone()));
         let change = pending.proposal.to_string();
-        self.last_change = Some((before.clone(), pending.proposal.clone()));
-        self.fixes.push(AppliedFix {
+        self.task.fixes.push(AppliedFix {
             change: change.clone(),
             nodes: plan.new_nodes.clone(),
             author: pending.author.clone(),
             approval,
             at: now_rfc3339(),
         });
-        self.failure = None;
         let why = format!("{} ({})", change, approval_text(approval));
         self.set_tree(plan.tree, plan.new_nodes, why);
-        self.check_change();
+        self.check_change(Some(AppliedProposal {
+            failure: before,
+            proposal: pending.proposal.clone(),
+        }));
         self.offer_rules(&pending.proposal, &pending.author);
     }
 
@@ -152,7 +160,7 @@ impl Engine {
         reason: String,
     ) {
         if let Some(f) = before {
-            self.tried.push((
+            self.task.tried.push((
                 f.clone(),
                 Tried {
                     proposal: pending.proposal.clone(),
@@ -161,13 +169,13 @@ impl Engine {
             ));
         }
         self.emit(Event::DidNotHelp { reason });
-        let planner = Planner::new(&self.scenario.domain);
+        let planner = Planner::new(&self.settings.scenario.domain);
         match narrowed(
             &planner,
             tree,
             &pending.proposal,
             before,
-            self.planning.as_ref(),
+            self.run.planning.as_ref(),
         ) {
             Some((proposal, dropped)) => {
                 let dropped: Vec<String> = dropped.iter().map(ToString::to_string).collect();
@@ -194,12 +202,12 @@ impl Engine {
                         doubt: None,
                     })),
                 });
-                self.pending = Some(Pending {
+                self.enter(Phase::Proposed(Pending {
                     proposal,
                     author,
                     failure: before.cloned(),
-                });
-                if self.auto_approve {
+                }));
+                if self.settings.auto_approve {
                     self.apply_pending(Approval::Auto);
                 } else {
                     self.reset_world(false);
@@ -213,10 +221,11 @@ impl Engine {
     /// front end: checked against what is pending and the vocabulary, then applied. On an
     /// error nothing changes.
     pub(super) fn edit(&mut self, edit: Edit) {
-        let base = match (&self.pending, &self.failure) {
-            (Some(p), _) => Some((p.proposal.clone(), p.failure.clone())),
-            (None, Some(f)) => self.blank_proposal(f).map(|p| (p, Some(f.clone()))),
-            (None, None) => None,
+        let base = match &self.phase {
+            Phase::Proposed(p) => Some((p.proposal.clone(), p.failure.clone())),
+            phase => phase
+                .failure()
+                .and_then(|f| self.blank_proposal(f).map(|p| (p, Some(f.clone())))),
         };
         let Some((base, failure)) = base else {
             return self.error("nothing to edit: no action has failed and nothing is proposed");
@@ -225,38 +234,39 @@ impl Engine {
             Ok(p) => p,
             Err(e) => return self.error(e.to_string()),
         };
-        // What the person wrote answers the failure: a question still out about it is
-        // dropped.
-        self.cancel_request();
         self.emit(Event::Proposal {
             proposal: edited.clone(),
             reasoning: None,
             author: "a person".into(),
             evidence: None,
         });
-        self.pending = Some(Pending {
+        // What the person wrote answers the failure: a question still out about it is
+        // dropped.
+        self.enter(Phase::Proposed(Pending {
             proposal: edited,
             author: "a person".into(),
             failure,
-        });
+        }));
         self.apply_pending(Approval::Edited);
     }
 
     /// The kind of proposal a failure calls for, with nothing filled in.
     fn blank_proposal(&self, f: &Failure) -> Option<Proposal> {
-        Some(match missing_value(&self.scenario, &f.action, &f.error) {
-            Some(param) => Proposal::Value {
-                skill: f.action.skill.clone(),
-                object: f.action.args.first().cloned().unwrap_or_default(),
-                param: param.name.clone(),
-                value: crate::domain::Value::Category(String::new()),
+        Some(
+            match missing_value(&self.settings.scenario, &f.action, &f.error) {
+                Some(param) => Proposal::Value {
+                    skill: f.action.skill.clone(),
+                    object: f.action.args.first().cloned().unwrap_or_default(),
+                    param: param.name.clone(),
+                    value: crate::domain::Value::Category(String::new()),
+                },
+                None => Proposal::Conditions {
+                    action: f.action.clone(),
+                    node: f.node,
+                    conditions: Vec::new(),
+                },
             },
-            None => Proposal::Conditions {
-                action: f.action.clone(),
-                node: f.node,
-                conditions: Vec::new(),
-            },
-        })
+        )
     }
 
     /// `base` with the edit in it: conditions for an action, a value for a parameter.
@@ -271,7 +281,8 @@ impl Engine {
                     });
                 }
                 for c in &conditions {
-                    self.scenario
+                    self.settings
+                        .scenario
                         .domain
                         .vocabulary
                         .check_atom(&c.atom)
@@ -335,7 +346,8 @@ impl Engine {
 
     /// The declaration of `skill`'s value `param`.
     fn declared_value(&self, skill: &str, param: &str) -> Option<&ValueParam> {
-        self.scenario
+        self.settings
+            .scenario
             .domain
             .skills
             .iter()
@@ -346,7 +358,7 @@ impl Engine {
     /// `force of egg = 5 N`, read by the front end: checked against the skills' declared
     /// values, set on every action that uses it, then re-plan.
     pub(super) fn set_value(&mut self, setting: &Setting) {
-        let Some(tree) = self.tree.clone() else {
+        let Some(tree) = self.task.tree.clone() else {
             return self.error("no tree: plan first");
         };
         for (skill, param) in &setting.targets {
@@ -362,28 +374,23 @@ impl Engine {
                 setting.text, setting.object
             ));
         }
-        let plan = Planner::new(&self.scenario.domain).grow(changed, self.planning.as_ref());
+        let plan =
+            Planner::new(&self.settings.scenario.domain).grow(changed, self.run.planning.as_ref());
         self.emit(Event::Repaired {
             added_nodes: plan.new_nodes.len(),
             valued_nodes: valued,
         });
-        self.undo.push(UndoEntry {
-            tree,
-            fixes: self.fixes.len(),
-            proposal: None,
-        });
+        self.task.push_undo(tree, None);
         let change = format!("set {} ({valued} action(s))", setting.text);
-        self.fixes.push(AppliedFix {
+        self.task.fixes.push(AppliedFix {
             change: change.clone(),
             nodes: plan.new_nodes.clone(),
             author: "a person".into(),
             approval: Approval::Edited,
             at: now_rfc3339(),
         });
-        self.pending = None;
-        self.failure = None;
         self.set_tree(plan.tree, plan.new_nodes, change);
-        self.check_change();
+        self.check_change(None);
     }
 }
 
@@ -397,7 +404,7 @@ impl Engine {
         before: Option<&ActionCall>,
         author: String,
     ) {
-        let Some(tree) = self.tree.clone() else {
+        let Some(tree) = self.task.tree.clone() else {
             return self.error("no tree: plan first");
         };
         if conditions.is_empty() {
@@ -408,20 +415,16 @@ impl Engine {
             .map(ToString::to_string)
             .collect::<Vec<_>>()
             .join(" & ");
-        let planner = Planner::new(&self.scenario.domain);
+        let planner = Planner::new(&self.settings.scenario.domain);
+        let planning = self.run.planning.as_ref();
         let started = std::time::Instant::now();
-        let (result, change) = match (before, &self.failure) {
+        let (result, change) = match (before, self.phase.failure()) {
             (Some(action), _) => (
-                planner.repair_at(tree.clone(), action, conditions, self.planning.as_ref()),
+                planner.repair_at(tree.clone(), action, conditions, planning),
                 format!("insert {names} before {action}!"),
             ),
             (None, Some(failure)) => (
-                planner.repair(
-                    tree.clone(),
-                    failure.node,
-                    conditions,
-                    self.planning.as_ref(),
-                ),
+                planner.repair(tree.clone(), failure.node, conditions, planning),
                 format!(
                     "insert {names} as the first precondition(s) of {}!",
                     failure.action
@@ -442,23 +445,17 @@ impl Engine {
             added_nodes: plan.new_nodes.len(),
             valued_nodes: 0,
         });
-        self.undo.push(UndoEntry {
-            tree,
-            fixes: self.fixes.len(),
-            proposal: None,
-        });
-        self.fixes.push(AppliedFix {
+        self.task.push_undo(tree, None);
+        self.task.fixes.push(AppliedFix {
             change: change.clone(),
             nodes: plan.new_nodes.clone(),
             author,
             approval: Approval::Edited,
             at: now_rfc3339(),
         });
-        self.pending = None;
-        self.failure = None;
         self.drop_offers();
         self.set_tree(plan.tree, plan.new_nodes, change);
-        self.check_change();
+        self.check_change(None);
     }
 }
 

@@ -17,16 +17,9 @@ use crate::verify::{
 use super::super::planned::Prediction;
 use super::super::types::{Event, VerifyRequest, VerifyScope};
 use super::Engine;
+use super::phase::{AppliedProposal, Phase};
 use super::requests::Internal;
-
-/// The check of the last applied change.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Gate {
-    /// Under way; `run_after`: a `Run` came meanwhile and starts when the check passes.
-    Checking { id: u64, run_after: bool },
-    /// The changed tree fails verification.
-    Violated,
-}
+use super::task::Origin;
 
 /// Why the Promela model could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -113,38 +106,39 @@ fn violation_summary(report: &Report) -> String {
 impl Engine {
     /// Where the current tree came from, for the verification report.
     fn origin(&self) -> String {
-        let fixes = self.fixes.len();
-        match (&self.loaded_from, fixes) {
-            (Some(path), 0) => format!("loaded from {}", path.display()),
-            (Some(path), n) => format!("loaded from {} with {n} fix(es)", path.display()),
-            (None, 0) if self.planned_in_model => "planned in the planner's model".to_string(),
-            (None, 0) => "planned in simulation".to_string(),
-            (None, n) => format!("repaired: planned, then changed by {n} approved fix(es)"),
+        match (&self.task.origin, self.task.fixes.len()) {
+            (Origin::File(path), 0) => format!("loaded from {}", path.display()),
+            (Origin::File(path), n) => format!("loaded from {} with {n} fix(es)", path.display()),
+            (Origin::Model, 0) => "planned in the planner's model".to_string(),
+            (Origin::Simulation, 0) => "planned in simulation".to_string(),
+            (_, n) => format!("repaired: planned, then changed by {n} approved fix(es)"),
         }
     }
 
     /// Structural checks and model checking, off the engine's thread.
     pub(super) fn verify(&mut self, request: VerifyRequest) {
-        let Some(tree) = self.tree.clone() else {
+        let Some(tree) = self.task.tree.clone() else {
             return self.error("nothing to verify: submit an instruction or plan first");
         };
-        let config = match VerifyConfig::from_scenario(&self.scenario) {
+        let config = match VerifyConfig::from_scenario(&self.settings.scenario) {
             Ok(c) => c,
             Err(e) => return self.error(format!("cannot verify: {e}")),
         };
         let left_out = request.no_disturbances && !config.disturbances.is_empty();
         let checks = Checks::of(config, &request);
-        let fresh = self.last.is_none() && self.fixes.is_empty() && self.loaded_from.is_none();
+        let fresh = self.run.last.is_none()
+            && self.task.fixes.is_empty()
+            && !matches!(self.task.origin, Origin::File(_));
         let current = tree;
         let mut added = Vec::new();
         let mut planned_note = None;
-        let (tree, origin) = match (&self.task, fresh) {
-            (Some(task), true) => {
-                let initial = self.planning.facts();
+        let (tree, origin) = match (&self.task.goal, fresh) {
+            (Some(goal), true) => {
+                let initial = self.run.planning.facts();
                 let planned = match plan_in_model(
-                    &self.scenario.domain,
+                    &self.settings.scenario.domain,
                     &initial,
-                    &task.goal.to_dnf(),
+                    &goal.formula.to_dnf(),
                     &checks.properties,
                     &checks.disturbances,
                 ) {
@@ -167,7 +161,7 @@ impl Engine {
                 if to_text(&tree) != to_text(&current) {
                     self.replace_tree(tree.clone(), planned.plan.new_nodes, origin.clone());
                 }
-                self.planned_in_model = true;
+                self.task.origin = Origin::Model;
                 (tree, origin)
             }
             _ => (current, self.origin()),
@@ -190,7 +184,7 @@ impl Engine {
                 promela,
             }),
         });
-        self.verifications += 1;
+        self.calls.verifications += 1;
         self.notice("verifying the tree …");
         self.spawn_check(tree, checks, None, origin);
     }
@@ -202,8 +196,9 @@ impl Engine {
         checks: &Checks,
         path: &std::path::Path,
     ) -> Result<Vec<String>, PromelaError> {
-        let initial = self.planning.facts();
-        let model = verify::export_promela(&checks.input(&self.scenario.domain, tree, &initial))?;
+        let initial = self.run.planning.facts();
+        let domain = &self.settings.scenario.domain;
+        let model = verify::export_promela(&checks.input(domain, tree, &initial))?;
         crate::store::write_atomic(path, model.text.as_bytes()).map_err(|source| {
             PromelaError::Write {
                 path: path.to_path_buf(),
@@ -213,20 +208,21 @@ impl Engine {
         Ok(model.claims.into_iter().map(|(name, _)| name).collect())
     }
 
-    /// Check the tree an applied change produced before it may run.
-    pub(super) fn check_change(&mut self) {
-        let Some(tree) = self.tree.clone() else {
+    /// Check the tree an applied change produced before it may run (`change`: the
+    /// proposal applied, told to the model as tried if the change is rejected).
+    pub(super) fn check_change(&mut self, change: Option<AppliedProposal>) {
+        let Some(tree) = self.task.tree.clone() else {
             return;
         };
-        let config = match VerifyConfig::from_scenario(&self.scenario) {
+        let config = match VerifyConfig::from_scenario(&self.settings.scenario) {
             Ok(c) => c,
             Err(e) => return self.error(format!("cannot verify the change: {e}")),
         };
-        self.next_id += 1;
-        let id = self.next_id;
-        self.gate = Some(Gate::Checking {
+        let id = self.calls.next_id();
+        self.enter(Phase::Checking {
             id,
             run_after: false,
+            change,
         });
         self.notice("verifying the changed tree in the model before it runs …");
         let origin = self.origin();
@@ -235,8 +231,8 @@ impl Engine {
     }
 
     fn spawn_check(&self, tree: Tree, checks: Checks, gate: Option<u64>, origin: String) {
-        let scenario = self.scenario.clone();
-        let initial = self.planning.facts();
+        let scenario = self.settings.scenario.clone();
+        let initial = self.run.planning.facts();
         let tx = self.internal_tx.clone();
         tokio::task::spawn_blocking(move || {
             let input = checks.input(&scenario.domain, &tree, &initial);
@@ -252,29 +248,32 @@ impl Engine {
     /// A verification finished: a report for the person, or the verdict on a change.
     pub(super) fn on_verified(&mut self, report: Arc<Report>, origin: String, gate: Option<u64>) {
         let Some(id) = gate else {
-            self.verifications = self.verifications.saturating_sub(1);
+            self.calls.verifications = self.calls.verifications.saturating_sub(1);
             return self.emit(Event::Verified { report, origin });
         };
-        let Some(Gate::Checking {
+        let Phase::Checking {
             id: current,
             run_after,
-        }) = self.gate
+            change,
+        } = &self.phase
         else {
             return;
         };
-        if id != current {
+        if id != *current {
             return;
         }
+        let (run_after, change) = (*run_after, change.clone());
         if report.holds() {
-            self.gate = None;
+            self.enter(Phase::Ready);
             self.notice("the changed tree verifies in the model");
             if run_after {
                 self.start_running();
             }
         } else {
-            self.gate = Some(Gate::Violated);
-            self.violation = Some(violation_summary(&report));
-            self.set_running(false);
+            self.enter(Phase::Violated {
+                summary: violation_summary(&report),
+                change,
+            });
             self.emit(Event::ChangeViolates { report });
             self.notice(
                 "the changed tree fails verification: it does not run until the change is approved again with the counterexample in view, rejected (the model is told why), or undone",
@@ -285,26 +284,33 @@ impl Engine {
     /// A change that failed verification is rejected: undone, and remembered as tried for
     /// its failure with what verification found, so the next question tells the model.
     pub(super) fn reject_violation(&mut self) {
+        let Phase::Violated { summary, change } = &self.phase else {
+            return self.error("no change fails verification");
+        };
         let why = format!(
-            "it fixes the failure in simulation, but the changed tree fails verification in the model: {}",
-            self.violation.take().unwrap_or_default()
+            "it fixes the failure in simulation, but the changed tree fails verification in the model: {summary}"
         );
-        let refused = self.last_change.take();
+        let refused = change.clone();
         self.emit(Event::DidNotHelp {
             reason: why.clone(),
         });
         // Undone first: undoing makes the undone change a candidate again, and this one is
         // refused, so it is remembered as tried after.
         self.undo();
-        if let Some((Some(failure), proposal)) = refused {
-            self.tried
+        if let Some(AppliedProposal {
+            failure: Some(failure),
+            proposal,
+        }) = refused
+        {
+            self.task
+                .tried
                 .push((failure, super::super::ask::Tried { proposal, why }));
         }
     }
 
     /// A person approves a change that failed verification, having seen why.
     pub(super) fn approve_violation(&mut self) {
-        self.gate = None;
+        self.enter(Phase::Ready);
         self.notice(
             "the change was approved again with the counterexample in view: the tree may run",
         );

@@ -44,8 +44,8 @@ impl Engine {
             return self.error(why);
         }
         let changed = match status {
-            Some(s) => self.debug.forced.insert(node, s) != Some(s),
-            None => self.debug.forced.remove(&node).is_some(),
+            Some(s) => self.run.debug.forced.insert(node, s) != Some(s),
+            None => self.run.debug.forced.remove(&node).is_some(),
         };
         if changed {
             self.emit_forced();
@@ -53,7 +53,7 @@ impl Engine {
     }
 
     pub(super) fn cycle_force(&mut self, node: NodeId) {
-        let next = next_forced(self.debug.forced.get(&node).copied());
+        let next = next_forced(self.run.debug.forced.get(&node).copied());
         self.force(node, next);
     }
 
@@ -61,22 +61,22 @@ impl Engine {
         if let Some(why) = self.unmarkable(node, "break at") {
             return self.error(why);
         }
-        if !self.debug.breakpoints.remove(&node) {
-            self.debug.breakpoints.insert(node);
+        if !self.run.debug.breakpoints.remove(&node) {
+            self.run.debug.breakpoints.insert(node);
         }
         self.emit_breakpoints();
     }
 
     pub(super) fn break_on_failure(&mut self, on: bool) {
-        if self.debug.on_failure != on {
-            self.debug.on_failure = on;
+        if self.run.debug.on_failure != on {
+            self.run.debug.on_failure = on;
             self.emit_breakpoints();
         }
     }
 
     /// Why `node` cannot be marked, if it cannot.
     fn unmarkable(&self, node: NodeId, what: &str) -> Option<String> {
-        match &self.tree {
+        match &self.task.tree {
             None => Some(format!("nothing to {what}: plan first")),
             Some(tree) if !tree.contains(node) => Some(format!("no node {node} in the tree")),
             Some(_) => None,
@@ -85,24 +85,30 @@ impl Engine {
 
     fn emit_forced(&self) {
         self.emit(Event::Forced {
-            forced: self.debug.forced.iter().map(|(n, s)| (*n, *s)).collect(),
+            forced: self
+                .run
+                .debug
+                .forced
+                .iter()
+                .map(|(n, s)| (*n, *s))
+                .collect(),
         });
     }
 
     fn emit_breakpoints(&self) {
         self.emit(Event::Breakpoints {
-            nodes: self.debug.breakpoints.iter().copied().collect(),
-            on_failure: self.debug.on_failure,
+            nodes: self.run.debug.breakpoints.iter().copied().collect(),
+            on_failure: self.run.debug.on_failure,
         });
     }
 
     /// Clear every forced status and breakpoint: the tree is being replaced, and their
     /// ids would name other nodes in the new one.
     pub(super) fn clear_marks(&mut self) {
-        let forced = !self.debug.forced.is_empty();
-        let breakpoints = !self.debug.breakpoints.is_empty();
-        self.debug.forced.clear();
-        self.debug.breakpoints.clear();
+        let forced = !self.run.debug.forced.is_empty();
+        let breakpoints = !self.run.debug.breakpoints.is_empty();
+        self.run.debug.forced.clear();
+        self.run.debug.breakpoints.clear();
         if forced {
             self.emit_forced();
         }
@@ -119,14 +125,14 @@ impl Engine {
     /// Drop the marks of nodes `tree` no longer has (a change of the current tree keeps
     /// the ids of the nodes it leaves).
     pub(super) fn prune_marks(&mut self, tree: &Tree) {
-        let forced = self.debug.forced.len();
-        let breakpoints = self.debug.breakpoints.len();
-        self.debug.forced.retain(|n, _| tree.contains(*n));
-        self.debug.breakpoints.retain(|n| tree.contains(*n));
-        if self.debug.forced.len() != forced {
+        let forced = self.run.debug.forced.len();
+        let breakpoints = self.run.debug.breakpoints.len();
+        self.run.debug.forced.retain(|n, _| tree.contains(*n));
+        self.run.debug.breakpoints.retain(|n| tree.contains(*n));
+        if self.run.debug.forced.len() != forced {
             self.emit_forced();
         }
-        if self.debug.breakpoints.len() != breakpoints {
+        if self.run.debug.breakpoints.len() != breakpoints {
             self.emit_breakpoints();
         }
     }
@@ -135,26 +141,27 @@ impl Engine {
     /// and, with break-on-failure, stop after it when a node failed.
     pub(super) fn run_step(&mut self) {
         if let Some((node, tick)) = self.breakpoint_ahead() {
-            self.debug.stopped_before = Some(tick);
-            self.set_running(false);
+            self.run.debug.stopped_before = Some(tick);
+            self.stop_running();
             return self.emit_hit(node, tick, BreakReason::Breakpoint);
         }
-        let before = self.last.clone();
+        let before = self.run.last.clone();
         self.tick();
         // A failure that ends the run is told by its own events (an action failed, the
         // tree gave up).
-        if !self.running || !self.debug.on_failure {
+        if !self.is_running() || !self.run.debug.on_failure {
             return;
         }
-        let Some(after) = self.last.clone() else {
+        let Some(after) = self.run.last.clone() else {
             return;
         };
         if let Some(node) = self
+            .task
             .tree
             .as_ref()
             .and_then(|t| newly_failed(t, before.as_deref(), &after))
         {
-            self.set_running(false);
+            self.stop_running();
             self.emit_hit(node, after.tick, BreakReason::Failure);
         }
     }
@@ -163,35 +170,37 @@ impl Engine {
     /// number; the tick is tried on a fork of the execution world with a copy of the
     /// ticker, so nothing of the session changes.
     fn breakpoint_ahead(&self) -> Option<(NodeId, u64)> {
-        if self.debug.breakpoints.is_empty() {
+        if self.run.debug.breakpoints.is_empty() {
             return None;
         }
-        let next = self.ticker.tick_count() + 1;
-        if self.debug.stopped_before == Some(next) {
+        let next = self.run.ticker.tick_count() + 1;
+        if self.run.debug.stopped_before == Some(next) {
             return None;
         }
-        let tree = self.tree.as_ref()?;
-        let mut world = self.exec.fork();
-        let mut ticker = self.ticker.clone();
+        let tree = self.task.tree.as_ref()?;
+        let mut world = self.run.exec.fork();
+        let mut ticker = self.run.ticker.clone();
         let mut leaves = WorldLeaves {
             world: world.as_mut(),
-            domain: &self.scenario.domain,
+            domain: &self.settings.scenario.domain,
         };
-        let preview = ticker.tick_forced(tree, &mut leaves, &self.debug.forced);
+        let preview = ticker.tick_forced(tree, &mut leaves, &self.run.debug.forced);
         let entered = |n: &NodeId| {
-            self.last
+            self.run
+                .last
                 .as_ref()
                 .is_none_or(|last| !last.visited.contains(n))
         };
         preview
             .visited
             .iter()
-            .find(|n| self.debug.breakpoints.contains(n) && entered(n))
+            .find(|n| self.run.debug.breakpoints.contains(n) && entered(n))
             .map(|n| (*n, next))
     }
 
     fn emit_hit(&self, node: NodeId, tick: u64, reason: BreakReason) {
         let node_path = self
+            .task
             .tree
             .as_ref()
             .and_then(|t| t.path(node).ok())

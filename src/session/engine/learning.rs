@@ -13,6 +13,22 @@ use crate::session::types::{Event, Proposal};
 
 use super::Engine;
 
+/// The knowledge file, and the fixes of the last applied change that may be kept in it.
+pub(super) struct Learning {
+    /// Where kept rules are written (none: nothing is offered).
+    knowledge: Option<knowledge::Knowledge>,
+    offers: Vec<RuleOffer>,
+}
+
+impl Learning {
+    pub(super) fn new(knowledge: Option<knowledge::Knowledge>) -> Learning {
+        Learning {
+            knowledge,
+            offers: Vec::new(),
+        }
+    }
+}
+
 /// A fix that may be kept as a rule.
 #[derive(Debug, Clone)]
 pub(super) struct RuleOffer {
@@ -27,7 +43,7 @@ impl Engine {
     /// Queue the conditions of an applied change as rule offers (only when the engine has
     /// a knowledge file), and show the first.
     pub(super) fn offer_rules(&mut self, proposal: &Proposal, author: &str) {
-        if self.knowledge.is_none() {
+        if self.learning.knowledge.is_none() {
             return;
         }
         let Proposal::Conditions {
@@ -36,7 +52,7 @@ impl Engine {
         else {
             return;
         };
-        self.offers = conditions
+        self.learning.offers = conditions
             .iter()
             .map(|c| RuleOffer {
                 action: action.clone(),
@@ -51,14 +67,14 @@ impl Engine {
 
     /// Offers of a change that was undone are gone with it.
     pub(super) fn drop_offers(&mut self) {
-        self.offers.clear();
+        self.learning.offers.clear();
     }
 
     fn show_offer(&self) {
-        let Some(offer) = self.offers.first() else {
+        let Some(offer) = self.learning.offers.first() else {
             return;
         };
-        let domain = &self.scenario.domain;
+        let domain = &self.settings.scenario.domain;
         let general = offer.lifted != offer.only;
         self.emit(Event::RuleOffered {
             rule: if general {
@@ -67,22 +83,23 @@ impl Engine {
                 offer.only.describe(domain)
             },
             only: general.then(|| offer.only.describe(domain)),
-            remaining: self.offers.len(),
+            remaining: self.learning.offers.len(),
         });
     }
 
     /// Keep the first offer as a rule (`only`: for the fix's objects alone).
     pub(super) fn keep_rule(&mut self, only: bool) {
-        if self.offers.is_empty() {
+        if self.learning.offers.is_empty() {
             return self.error("no fix to keep as a rule: approve a fix of conditions first");
         }
-        let offer = self.offers.remove(0);
+        let offer = self.learning.offers.remove(0);
         let rule = if only { offer.only } else { offer.lifted };
-        let words = rule.describe(&self.scenario.domain);
-        let Some(store) = self.knowledge.as_mut() else {
+        let settings = &mut self.settings;
+        let words = rule.describe(&settings.scenario.domain);
+        let Some(store) = self.learning.knowledge.as_mut() else {
             return;
         };
-        if let Err(refusal) = knowledge::check_rule(&rule, &self.scenario, store) {
+        if let Err(refusal) = knowledge::check_rule(&rule, &settings.scenario, store) {
             self.emit(Event::RuleRefused {
                 rule: words,
                 reason: refusal.to_string(),
@@ -91,9 +108,9 @@ impl Engine {
         }
         let kept = store.keep(KeptRule::new(
             &rule,
-            &self.scenario,
+            &settings.scenario,
             Provenance {
-                scenario_file: self.scenario_path.display().to_string(),
+                scenario_file: settings.scenario_path.display().to_string(),
                 action: &offer.action,
                 condition: &offer.condition,
                 proposed_by: offer.author.clone(),
@@ -105,17 +122,17 @@ impl Engine {
                 let mut learned = rule.clone();
                 learned.id = kept.id.clone();
                 // Checked above: the rule fits this domain.
-                let _ = Arc::make_mut(&mut self.scenario).domain.learn(&learned);
+                let _ = Arc::make_mut(&mut settings.scenario).domain.learn(&learned);
                 let path = store.path.clone();
                 self.emit(Event::RuleKept {
                     id: kept.id,
                     rule: words,
                     path,
                 });
-                if let Some(tree) = self.tree.clone() {
+                if let Some(tree) = self.task.tree.clone() {
                     // The tree is unchanged; its conditions from rules are marked now.
                     self.emit(Event::TreeChanged {
-                        learned: learned_in_tree(&self.scenario.domain, &tree)
+                        learned: learned_in_tree(&self.settings.scenario.domain, &tree)
                             .into_iter()
                             .map(|l| (l.node, l.rules))
                             .collect(),
@@ -132,24 +149,25 @@ impl Engine {
 
     /// Keep nothing of the first offer.
     pub(super) fn decline_rule(&mut self) {
-        if self.offers.is_empty() {
+        if self.learning.offers.is_empty() {
             return self.error("no fix is offered as a rule");
         }
-        self.offers.remove(0);
+        self.learning.offers.remove(0);
         self.notice("not kept as a rule");
         self.show_offer();
     }
 
     /// The kept rules of this scenario's domain, in words, for a view.
     pub(super) fn show_knowledge(&self) {
-        let Some(store) = &self.knowledge else {
+        let Some(store) = &self.learning.knowledge else {
             return self.error("no knowledge file: the workbench has no policy directory");
         };
-        let domain = knowledge::domain_of(&self.scenario);
+        let scenario = &self.settings.scenario;
+        let domain = knowledge::domain_of(scenario);
         let rules = store
             .rules_of(&domain)
             .map(|r| {
-                let words = r.rule().describe(&self.scenario.domain);
+                let words = r.rule().describe(&scenario.domain);
                 format!(
                     "{}: {words}. From {} ({} before {}!), proposed by {}, kept by {} at {}",
                     r.id, r.scenario, r.condition, r.action, r.proposed_by, r.kept_by, r.kept_at

@@ -18,8 +18,11 @@ mod checks;
 mod debug;
 mod flow;
 mod learning;
+mod phase;
 mod policies;
 mod requests;
+mod run;
+mod task;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -27,19 +30,20 @@ use std::time::Duration;
 
 use tokio::sync::mpsc::{UnboundedReceiver, UnboundedSender, unbounded_channel};
 
-use crate::bt::{Forced, NodeId, TickRecord, Ticker, Tree};
+use crate::bt::{Forced, NodeId, Tree};
 use crate::domain::Condition;
-use crate::goal::Formula;
 use crate::llm::LanguageModel;
 use crate::llm::usage::{Ledger, UsageTotals};
 use crate::scenario::Scenario;
-use crate::world::{self, World};
+use crate::world;
 
-use super::ask::Tried;
 use super::policy::{Approval, PolicyStore};
-use super::types::{Event, NoModel, Options, Proposal, SessionError};
+use super::types::{Event, NoModel, Options, SessionError};
 
+use phase::Phase;
 use requests::Internal;
+use run::Run;
+use task::Task;
 
 /// What the engine is given.
 pub struct Setup {
@@ -185,53 +189,9 @@ pub enum Command {
     Shutdown,
 }
 
-/// An action that failed in the execution world.
-use super::screen::FailureAt as Failure;
-
-/// The goal being worked on, and the instruction it came from.
-#[derive(Debug, Clone)]
-struct Task {
-    goal: Formula,
-    instruction: Option<String>,
-}
-
-/// A proposal waiting for approval, with who made it.
-#[derive(Debug, Clone)]
-struct Pending {
-    proposal: Proposal,
-    /// Who answered (`model gpt-4o`, a fixture's label, or `a person`).
-    author: String,
-    failure: Option<Failure>,
-}
-
-/// A change that is in the tree, for the policy header.
-#[derive(Debug, Clone)]
-struct AppliedFix {
-    change: String,
-    /// The nodes it added (ids are stable; a later change may remove some).
-    nodes: Vec<NodeId>,
-    author: String,
-    approval: Approval,
-    at: String,
-}
-
-/// The tree before an applied change.
-#[derive(Debug, Clone)]
-struct UndoEntry {
-    tree: Tree,
-    fixes: usize,
-    /// The change this entry undoes, when it was a proposal: undone, it is a candidate
-    /// for its failure again, whatever was said of it before.
-    proposal: Option<Proposal>,
-}
-
-/// A model call under way.
-struct Request {
-    id: u64,
-    handle: tokio::task::JoinHandle<()>,
-}
-
-pub struct Engine {
+/// What the engine works with and never changes on its own (but the scenario's domain,
+/// which learns the rules a person keeps).
+struct Settings {
     scenario: Arc<Scenario>,
     scenario_path: PathBuf,
     variant: Option<String>,
@@ -243,51 +203,36 @@ pub struct Engine {
     tick_interval: Duration,
     max_ticks: u64,
     scenes: bool,
-    knowledge: Option<super::knowledge::Knowledge>,
-    /// Fixes of the last applied change that may still be kept as rules.
-    offers: Vec<learning::RuleOffer>,
+}
 
-    planning: Box<dyn World>,
-    exec: Box<dyn World>,
-    ticker: Ticker,
-    /// Forced statuses and breakpoints.
-    debug: debug::Debugger,
-    /// Ticks since the last Run command (for the limit).
-    run_ticks: u64,
-    facts: Vec<Condition>,
-    /// The last arm motion told (`Event::ArmMotion`).
-    motion: Option<crate::world::cell::snapshot::MotionView>,
-    task: Option<Task>,
-    tree: Option<Tree>,
-    last: Option<Arc<TickRecord>>,
-    failure: Option<Failure>,
-    pending: Option<Pending>,
-    /// Changes tried for a failure that did not fix it, told to the model when it is asked
-    /// about the same failure again.
-    tried: Vec<(Failure, Tried)>,
-    request: Option<Request>,
+/// Model calls and verifications: their ids, how many reports are awaited, and what the
+/// replies cost.
+#[derive(Default)]
+struct Calls {
     next_id: u64,
-    undo: Vec<UndoEntry>,
-    fixes: Vec<AppliedFix>,
-    rounds: usize,
-    running: bool,
-    usage: UsageTotals,
+    /// Verifications a person asked for whose reports are still to come.
     verifications: usize,
-    /// The check of the last applied change, while it is under way or failed.
-    gate: Option<checks::Gate>,
-    /// The last proposal applied and the failure it was for, so a change that fails
-    /// verification and is rejected is told to the model as tried.
-    last_change: Option<(Option<Failure>, Proposal)>,
-    /// What the last failed check found, in one line.
-    violation: Option<String>,
-    /// The file the tree was loaded from, until the next plan.
-    loaded_from: Option<PathBuf>,
-    /// Whether the tree was planned in the planner's model (by `Verify` before the first
-    /// tick) rather than in simulation.
-    planned_in_model: bool,
-    /// The readings of an instruction offered for the person to choose among, with it.
-    choosing: Option<(String, Vec<super::readings::Reading>)>,
+    usage: UsageTotals,
+}
 
+impl Calls {
+    fn next_id(&mut self) -> u64 {
+        self.next_id += 1;
+        self.next_id
+    }
+}
+
+pub struct Engine {
+    settings: Settings,
+    /// What the engine is doing, with the data of that alone.
+    phase: Phase,
+    /// The goal, the tree and how it came to be.
+    task: Task,
+    /// The planning and execution worlds and what ticking them showed.
+    run: Run,
+    /// The knowledge file and the fixes of the last change that may be kept as rules.
+    learning: learning::Learning,
+    calls: Calls,
     events: UnboundedSender<Event>,
     internal_tx: UnboundedSender<Internal>,
     internal_rx: UnboundedReceiver<Internal>,
@@ -311,51 +256,27 @@ impl Engine {
     pub fn new(setup: Setup) -> Result<(Engine, UnboundedReceiver<Event>), SessionError> {
         let planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
         let execution = world::load_execution(&setup.scenario, setup.variant.as_deref())?;
-        let exec = execution.world;
-        let facts = exec.facts();
         let (events, events_rx) = unbounded_channel();
         let (internal_tx, internal_rx) = unbounded_channel();
         let engine = Engine {
-            scenario: setup.scenario,
-            scenario_path: setup.scenario_path,
-            variant: setup.variant,
-            model: setup.model,
-            ledger: setup.ledger,
-            options: setup.options,
-            auto_approve: setup.auto_approve,
-            policies: setup.policies,
-            tick_interval: setup.tick_interval,
-            max_ticks: setup.limits.run_ticks,
-            scenes: setup.scenes,
-            knowledge: setup.knowledge,
-            offers: Vec::new(),
-            planning,
-            exec,
-            ticker: Ticker::new(),
-            debug: debug::Debugger::default(),
-            run_ticks: 0,
-            motion: None,
-            facts,
-            task: None,
-            tree: None,
-            last: None,
-            failure: None,
-            pending: None,
-            tried: Vec::new(),
-            request: None,
-            next_id: 0,
-            undo: Vec::new(),
-            fixes: Vec::new(),
-            rounds: 0,
-            running: false,
-            usage: UsageTotals::default(),
-            verifications: 0,
-            gate: None,
-            loaded_from: None,
-            last_change: None,
-            violation: None,
-            planned_in_model: false,
-            choosing: None,
+            settings: Settings {
+                scenario: setup.scenario,
+                scenario_path: setup.scenario_path,
+                variant: setup.variant,
+                model: setup.model,
+                ledger: setup.ledger,
+                options: setup.options,
+                auto_approve: setup.auto_approve,
+                policies: setup.policies,
+                tick_interval: setup.tick_interval,
+                max_ticks: setup.limits.run_ticks,
+                scenes: setup.scenes,
+            },
+            phase: Phase::Idle,
+            task: Task::default(),
+            run: Run::new(planning, execution.world),
+            learning: learning::Learning::new(setup.knowledge),
+            calls: Calls::default(),
             events,
             internal_tx,
             internal_rx,
@@ -364,7 +285,7 @@ impl Engine {
             engine.notice(why);
         }
         engine.emit(Event::WorldChanged {
-            facts: engine.facts.clone(),
+            facts: engine.run.facts.clone(),
             reset: true,
         });
         engine.emit_scene();
@@ -382,8 +303,8 @@ impl Engine {
     /// The engine's loop: commands, answers of model calls, and ticks while running.
     pub async fn run(mut self, mut commands: UnboundedReceiver<Command>) {
         loop {
-            let running = self.running;
-            let interval = self.tick_interval;
+            let running = self.is_running();
+            let interval = self.settings.tick_interval;
             tokio::select! {
                 biased;
                 command = commands.recv() => match command {
@@ -394,77 +315,93 @@ impl Engine {
                 () = pace(interval), if running => self.run_step(),
             }
         }
-        if let Some(r) = self.request.take() {
-            r.handle.abort();
-        }
+        self.phase.abort_call();
     }
 
     /// Carry out one command (model calls it starts run on the current tokio runtime).
+    /// What a command does depends on the phase; commands that mean the same in every
+    /// phase come last.
     pub fn handle(&mut self, command: Command) {
-        match command {
-            Command::Submit(text) => self.submit(&text),
-            Command::SubmitGoal { goal, instruction } => self.submit_goal(goal, instruction),
-            Command::Plan => self.plan(),
-            Command::Run if matches!(self.gate, Some(checks::Gate::Checking { .. })) => {
-                if let Some(checks::Gate::Checking { run_after, .. }) = &mut self.gate {
-                    *run_after = true;
-                }
+        match (&mut self.phase, command) {
+            (Phase::Idle, Command::Tick) => {
+                self.error("nothing to tick: submit an instruction or plan first");
+            }
+            (Phase::Idle, Command::Run) => {
+                self.error("nothing to run: submit an instruction or plan first");
+            }
+            (Phase::Checking { run_after, .. }, Command::Run) => {
+                *run_after = true;
                 self.notice("the changed tree is being verified; it runs when the check passes");
             }
-            Command::Tick | Command::Run if self.awaiting().is_some() => {
-                let what = self.awaiting().unwrap_or_default();
-                let message = if self.gate.is_some() {
-                    format!("not ticked: the changed tree waits for {what}")
-                } else {
-                    format!(
-                        "not ticked: the failure waits for {what}; the failed tree would only fail again"
-                    )
-                };
-                self.emit(Event::Notice { message });
+            (
+                phase @ (Phase::Checking { .. }
+                | Phase::Violated { .. }
+                | Phase::Asking { .. }
+                | Phase::Proposed(_)),
+                Command::Tick | Command::Run,
+            ) => {
+                let message = phase.why_not_ticked();
+                self.notice(message);
             }
-            Command::Tick => {
-                if self.running {
-                    self.set_running(false);
-                }
+            (Phase::Reading { .. } | Phase::Choosing { .. }, Command::Run) => self.notice(
+                "not run: the tree is replaced when the instruction is read; step it with a tick meanwhile",
+            ),
+            (Phase::Running, Command::Tick) => {
+                self.stop_running();
                 self.tick();
             }
-            Command::Run => self.start_running(),
-            Command::Pause => self.set_running(false),
-            Command::Force { node, status } => self.force(node, status),
-            Command::CycleForce(node) => self.cycle_force(node),
-            Command::ToggleBreakpoint(node) => self.toggle_breakpoint(node),
-            Command::BreakOnFailure(on) => self.break_on_failure(on),
-            Command::Approve => self.approve(),
-            Command::Reject => self.reject(),
-            Command::Edit(edit) => self.edit(edit),
-            Command::SetValue(setting) => self.set_value(&setting),
-            Command::Undo => self.undo(),
-            Command::Verify => self.verify(super::types::VerifyRequest::default()),
-            Command::VerifyWith(request) => self.verify(request),
-            Command::SavePolicy => self.save_policy_to(None),
-            Command::Export => self.export(),
-            Command::LoadPolicy(path) => self.load_policy(path, true),
-            Command::LoadTree { path, grow } => self.load_policy(Some(path), grow),
-            Command::Insert {
-                conditions,
-                before,
-                author,
-            } => self.insert(&conditions, before.as_ref(), author),
-            Command::SavePolicyTo(path) => self.save_policy_to(Some(path)),
-            Command::ResetWorld => self.reset_world(true),
-            Command::RobotArrived => self.robot_arrived(),
-            Command::KeepRule { only } => self.keep_rule(only),
-            Command::DeclineRule => self.decline_rule(),
-            Command::ShowKnowledge => self.show_knowledge(),
-            Command::ChooseReading(index) => self.choose_reading(index),
-            Command::Shutdown => self.set_running(false),
+            (_, Command::Tick) => self.tick(),
+            (_, Command::Run) => self.start_running(),
+            (Phase::Running, Command::Pause) => self.stop_running(),
+            (_, Command::Pause) => {}
+            (Phase::Proposed(_), Command::Approve) => self.apply_pending(Approval::Person),
+            (Phase::Violated { .. }, Command::Approve) => self.approve_violation(),
+            (_, Command::Approve) => self.error("no proposal to approve"),
+            (Phase::Proposed(_), Command::Reject) => self.reject(),
+            (Phase::Violated { .. }, Command::Reject) => self.reject_violation(),
+            (_, Command::Reject) => self.error("no proposal to reject"),
+            (Phase::Proposed(_) | Phase::Failed { .. } | Phase::Asking { .. }, Command::Edit(e)) => {
+                self.edit(e);
+            }
+            (_, Command::Edit(_)) => {
+                self.error("nothing to edit: no action has failed and nothing is proposed");
+            }
+            (Phase::Choosing { .. }, Command::ChooseReading(index)) => self.choose_reading(index),
+            (_, Command::ChooseReading(_)) => {
+                self.error("no readings to choose among: type an instruction first (i)");
+            }
+            (_, Command::Submit(text)) => self.submit(&text),
+            (_, Command::SubmitGoal { goal, instruction }) => self.submit_goal(goal, instruction),
+            (_, Command::Plan) => self.plan(),
+            (_, Command::Force { node, status }) => self.force(node, status),
+            (_, Command::CycleForce(node)) => self.cycle_force(node),
+            (_, Command::ToggleBreakpoint(node)) => self.toggle_breakpoint(node),
+            (_, Command::BreakOnFailure(on)) => self.break_on_failure(on),
+            (_, Command::SetValue(setting)) => self.set_value(&setting),
+            (_, Command::Undo) => self.undo(),
+            (_, Command::Verify) => self.verify(super::types::VerifyRequest::default()),
+            (_, Command::VerifyWith(request)) => self.verify(request),
+            (_, Command::SavePolicy) => self.save_policy_to(None),
+            (_, Command::SavePolicyTo(path)) => self.save_policy_to(Some(path)),
+            (_, Command::Export) => self.export(),
+            (_, Command::LoadPolicy(path)) => self.load_policy(path, true),
+            (_, Command::LoadTree { path, grow }) => self.load_policy(Some(path), grow),
+            (_, Command::Insert { conditions, before, author }) => {
+                self.insert(&conditions, before.as_ref(), author);
+            }
+            (_, Command::ResetWorld) => self.reset_world(true),
+            (_, Command::RobotArrived) => self.robot_arrived(),
+            (_, Command::KeepRule { only }) => self.keep_rule(only),
+            (_, Command::DeclineRule) => self.decline_rule(),
+            (_, Command::ShowKnowledge) => self.show_knowledge(),
+            (_, Command::Shutdown) => self.stop_running(),
         }
     }
 
     /// Wait for the next answer of a model call (or verification) and take it in; false
     /// when nothing is under way. For drivers that run the engine in their own task.
     pub async fn next_internal(&mut self) -> bool {
-        if self.request.is_none() && self.verifications == 0 {
+        if !self.phase.has_call() && self.calls.verifications == 0 {
             return false;
         }
         match self.internal_rx.recv().await {
@@ -476,40 +413,19 @@ impl Engine {
         }
     }
 
-    /// What a failure waits for before the tree can change: a person's approval of the
-    /// pending proposal, or the model's proposal. Ticking the failed tree meanwhile would
-    /// only fail again.
-    fn awaiting(&self) -> Option<&'static str> {
-        if let Some(gate) = self.gate {
-            return Some(match gate {
-                checks::Gate::Checking { .. } => "the verification of the change",
-                checks::Gate::Violated => {
-                    "approval of the change that fails verification (approve again, reject, or undo)"
-                }
-            });
-        }
-        if self.pending.is_some() {
-            Some("approval of the proposal")
-        } else if self.request.is_some() && self.failure.is_some() {
-            Some("the model's proposal")
-        } else {
-            None
-        }
-    }
-
     /// Whether the engine is ticking on its own.
     pub fn is_running(&self) -> bool {
-        self.running
+        matches!(self.phase, Phase::Running)
     }
 
     /// Whether a model call is under way.
     pub fn is_asking(&self) -> bool {
-        self.request.is_some()
+        self.phase.has_call()
     }
 
     /// The current tree.
     pub fn tree(&self) -> Option<&Tree> {
-        self.tree.as_ref()
+        self.task.tree.as_ref()
     }
 
     fn emit(&self, event: Event) {
@@ -527,13 +443,6 @@ impl Engine {
         self.emit(Event::Notice {
             message: message.into(),
         });
-    }
-
-    fn set_running(&mut self, running: bool) {
-        if self.running != running {
-            self.running = running;
-            self.emit(Event::RunState { running });
-        }
     }
 }
 

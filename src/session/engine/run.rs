@@ -1,0 +1,222 @@
+//! The run: the planning world (the planner ticks trees in forks of it), the execution
+//! world with its ticker (what "tick" and "run" advance), the debugger's marks, and what
+//! the last tick showed; ticking, running and resetting the world.
+
+use std::sync::Arc;
+
+use crate::bt::{Outcome as TickOutcome, TickRecord, Ticker, path_text};
+use crate::domain::Condition;
+use crate::planner::WorldLeaves;
+use crate::world::cell::snapshot::MotionView;
+use crate::world::{self, World};
+
+use super::super::types::Event;
+use super::Engine;
+use super::debug::Debugger;
+use super::phase::{Failure, Phase};
+
+pub(super) struct Run {
+    pub(super) planning: Box<dyn World>,
+    pub(super) exec: Box<dyn World>,
+    pub(super) ticker: Ticker,
+    /// Forced statuses and breakpoints.
+    pub(super) debug: Debugger,
+    /// Ticks since the last Run command (for the limit).
+    pub(super) ticks: u64,
+    pub(super) facts: Vec<Condition>,
+    /// The last arm motion told (`Event::ArmMotion`).
+    pub(super) motion: Option<MotionView>,
+    pub(super) last: Option<Arc<TickRecord>>,
+}
+
+impl Run {
+    pub(super) fn new(planning: Box<dyn World>, exec: Box<dyn World>) -> Run {
+        let facts = exec.facts();
+        Run {
+            planning,
+            exec,
+            ticker: Ticker::new(),
+            debug: Debugger::default(),
+            ticks: 0,
+            facts,
+            motion: None,
+            last: None,
+        }
+    }
+}
+
+impl Engine {
+    pub(super) fn start_running(&mut self) {
+        if self.task.tree.is_none() {
+            return self.error("nothing to run: submit an instruction or plan first");
+        }
+        self.run.ticks = 0;
+        self.enter(Phase::Running);
+    }
+
+    /// The execution cell's scene, when a front end asked for scenes.
+    pub(super) fn emit_scene(&self) {
+        if !self.settings.scenes {
+            return;
+        }
+        if let Some(scene) = crate::world::CellWorld::scene_of(self.run.exec.as_ref()) {
+            self.emit(Event::Scene {
+                scene: Arc::new(scene),
+            });
+        }
+    }
+
+    /// One tick in the execution world.
+    pub(super) fn tick(&mut self) {
+        let Some(tree) = &self.task.tree else {
+            self.stop_running();
+            return self.error("nothing to tick: submit an instruction or plan first");
+        };
+        let mut leaves = WorldLeaves {
+            world: self.run.exec.as_mut(),
+            domain: &self.settings.scenario.domain,
+        };
+        let record = Arc::new(self.run.ticker.tick_forced(
+            tree,
+            &mut leaves,
+            &self.run.debug.forced,
+        ));
+        self.run.ticks += 1;
+        let failed = record.failures.first().and_then(|(node, error)| {
+            let action = tree.kind(*node).ok()?.as_action()?.clone();
+            Some(Failure {
+                node: *node,
+                action,
+                error: error.clone(),
+            })
+        });
+        self.run.last = Some(record.clone());
+        self.emit(Event::Ticked {
+            record: record.clone(),
+        });
+        self.emit_scene();
+        self.tell_world_change();
+        self.end_of_tick(&record, failed);
+        if self.is_running() && self.run.ticks >= self.settings.max_ticks {
+            self.stop_running();
+            self.emit(Event::GaveUp {
+                reason: format!("the tree still runs after {} ticks", self.run.ticks),
+            });
+        }
+    }
+
+    /// Tell front ends what a tick changed in the world: its facts, the arm's motion.
+    fn tell_world_change(&mut self) {
+        let facts = self.run.exec.facts();
+        if facts != self.run.facts {
+            self.run.facts = facts;
+            self.emit(Event::WorldChanged {
+                facts: self.run.facts.clone(),
+                reset: false,
+            });
+        }
+        let motion = crate::world::CellWorld::motion_of(self.run.exec.as_ref());
+        if motion.is_some() && motion != self.run.motion {
+            self.run.motion.clone_from(&motion);
+            if let Some(motion) = motion {
+                self.emit(Event::ArmMotion { motion });
+            }
+        }
+    }
+
+    /// What the root's status means: running goes on; success ends a run; a failure is
+    /// asked about, or told when no action failed.
+    fn end_of_tick(&mut self, record: &TickRecord, failed: Option<Failure>) {
+        match (record.root, failed) {
+            (TickOutcome::Running, _) => {}
+            (TickOutcome::Success, _) if !record.completed.is_empty() => {}
+            (TickOutcome::Success, _) => {
+                self.stop_running();
+                self.emit(Event::Success {
+                    ticks: self.run.ticker.tick_count(),
+                });
+            }
+            (TickOutcome::Failure, Some(failure)) => {
+                self.stop_running();
+                self.on_failure(failure);
+            }
+            (TickOutcome::Failure, None) => {
+                self.stop_running();
+                let reason = if record.forced.is_empty() {
+                    "the tree failed without an action failing: a condition it needs is false and nothing achieves it".to_string()
+                } else {
+                    format!(
+                        "the tree failed with {} forced status(es) and no action failing",
+                        record.forced.len()
+                    )
+                };
+                self.emit(Event::GaveUp { reason });
+            }
+        }
+    }
+
+    fn on_failure(&mut self, failure: Failure) {
+        let node_path = self
+            .task
+            .tree
+            .as_ref()
+            .and_then(|t| t.path(failure.node).ok())
+            .map(|p| path_text(&p))
+            .unwrap_or_default();
+        self.emit(Event::ActionFailed {
+            action: failure.action.clone(),
+            node: failure.node,
+            node_path,
+            error: failure.error.clone(),
+        });
+        if failure.error.contains(world::DISAGREEMENT_NOTE) {
+            // The planning world keeps its abstraction (re-planning every candidate with
+            // the arms costs seconds per candidate); the fix approved is checked by
+            // running it with the arms.
+            self.notice(
+                "planning and execution disagree: the planning world found the way clear and the \
+                 arm found no path; a fix is checked in the planning world, then by the arm",
+            );
+        }
+        self.ask_about(failure);
+    }
+
+    /// A fresh execution world and ticker (the tree stays).
+    pub(super) fn reset_world(&mut self, announce: bool) {
+        self.stop_running();
+        let settings = &self.settings;
+        match world::load_execution(&settings.scenario, settings.variant.as_deref()) {
+            Ok(e) => self.run.exec = e.world,
+            Err(e) => return self.error(format!("cannot reset the world: {e}")),
+        }
+        self.run.ticker = Ticker::new();
+        self.run.debug.forget_stop();
+        self.run.last = None;
+        self.run.ticks = 0;
+        self.run.motion = None;
+        self.run.facts = self.run.exec.facts();
+        self.emit(Event::WorldChanged {
+            facts: self.run.facts.clone(),
+            reset: true,
+        });
+        self.emit_scene();
+        if announce {
+            self.notice("world reset: the tree starts again from the scenario's first state");
+        }
+    }
+
+    /// The arms' description is in the cache now. A world not ticked yet is rebuilt with
+    /// the arms at once; one in the middle of a run keeps its abstraction until it is
+    /// reset (by the person, or by the next tree), so no run changes its physics halfway.
+    pub(super) fn robot_arrived(&mut self) {
+        if self.run.ticker.tick_count() == 0 && !self.is_running() {
+            self.reset_world(false);
+            self.notice("the robot description is in the cache: the cell now moves the real arms");
+        } else {
+            self.notice(
+                "the robot description is in the cache: the real arms move from the next \
+                 world reset or the next tree",
+            );
+        }
+    }
+}
