@@ -329,16 +329,17 @@ fn a_dot_export_renders_to_png_with_graphviz() {
 }
 
 #[test]
-fn the_readme_shows_the_xml_betr_writes_for_scenario_ones_repaired_tree() {
+fn the_tree_files_guide_shows_the_xml_betr_writes_for_scenario_ones_repaired_tree() {
     let s = Scenario::load(&root().join("scenarios/cell/red_on_blue.toml")).unwrap();
     let xml = interop::to_btcpp(&repaired(&s), &s.domain, "red_on_blue").unwrap();
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
-    let start = readme.find("```xml\n").expect("an xml block in the README") + "```xml\n".len();
+    let readme = std::fs::read_to_string(root().join("docs/TREE-FILES.md")).unwrap();
+    let start =
+        readme.find("```xml\n").expect("an xml block in docs/TREE-FILES.md") + "```xml\n".len();
     let end = start + readme[start..].find("```").unwrap();
     assert_eq!(
         &readme[start..end],
         xml,
-        "regenerate the README's XML with betr export"
+        "regenerate the XML of docs/TREE-FILES.md with betr export"
     );
     assert!(
         root()
