@@ -4,7 +4,7 @@
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
-mod support;
+use crate::support;
 
 use support::cli::{KEY, KEY_VAR, betr, files_under, relative_to, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};

@@ -3,7 +3,7 @@
 //! why the goal is unreachable. Only contradictory goals may be unreachable.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use betr::dataset::{self, Case};
 use betr::goal::Formula;

@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
-mod support;
+use crate::support;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 

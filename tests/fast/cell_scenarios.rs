@@ -6,7 +6,7 @@
 //! scenarios fail without a value, fail with a wrong one in their own words, and succeed
 //! with a good one that reaches every node using that skill with that object.
 
-mod support;
+use crate::support;
 use std::path::{Path, PathBuf};
 
 use betr::bt::{self, NodeId, NodeKind, Status, Tree};

@@ -6,50 +6,17 @@
 
 #![allow(clippy::unwrap_used)]
 
-mod support;
+use crate::support;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use betr::dataset::{self, Case};
-use betr::goal::{Formula, same_dnf};
 use serde_json::Value as Json;
-use support::cli::{KEY_VAR, betr, openai_flags, text, tmp};
+use support::cli::{betr, openai_flags, text, tmp};
+use support::eval_goals::{
+    cafe, cases, dataset_dir, different_goal, goal_fixtures, model_goals, read_json, tally,
+};
 use support::fake_openai::{Behavior, FakeServer};
-use support::fixtures::{self, FixtureReply};
-
-fn dataset_dir() -> PathBuf {
-    fixtures::root().join("../shared/datasets/llm-obtea")
-}
-
-fn cafe() -> String {
-    fixtures::root()
-        .join("scenarios/cafe/cafe.toml")
-        .display()
-        .to_string()
-}
-
-fn cases() -> Vec<Case> {
-    dataset::load(&dataset_dir()).unwrap()
-}
-
-fn read_json(path: &Path) -> Json {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn tally(results: &Json, difficulty: &str) -> (u64, u64) {
-    let t = &results[difficulty];
-    (t["correct"].as_u64().unwrap(), t["total"].as_u64().unwrap())
-}
-
-/// A goal that is valid in the vocabulary but not the gold one.
-fn different_goal(gold: &str) -> String {
-    let g = Formula::parse(gold).unwrap();
-    ["Active_AC", "~Active_AC", "Active_TubeLight"]
-        .into_iter()
-        .find(|a| !same_dnf(&Formula::parse(a).unwrap(), &g))
-        .unwrap()
-        .to_string()
-}
+use support::fixtures;
 
 fn score_answers(dir: &Path, lines: &[String]) -> std::process::Output {
     std::fs::write(dir.join("answers.txt"), lines.join("\n") + "\n").unwrap();
@@ -138,58 +105,6 @@ fn a_wrong_line_count_is_bad_input() {
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("expected 100 lines"), "{}", text(&o));
     assert!(text(&o).contains("found 99"), "{}", text(&o));
-}
-
-/// Fixture replies for all 100 instructions: the gold goal, except a deliberately wrong
-/// goal for every case whose index ends in 3 (3 easy, 3 medium, 4 hard).
-fn goal_fixtures() -> Vec<FixtureReply> {
-    cases()
-        .iter()
-        .map(|c| FixtureReply {
-            seed: None,
-            when: vec![
-                "# Task: goal interpretation".into(),
-                format!("## Request\n{}\n", c.instruction),
-            ],
-            text: if c.index % 10 == 3 {
-                format!("Goal: {}", different_goal(&c.gold))
-            } else {
-                format!("Goal: {}", c.gold)
-            },
-            note: format!(
-                "{}: generated from the gold goals in tests/eval_cmds.rs",
-                fixtures::SOURCE
-            ),
-        })
-        .collect()
-}
-
-fn model_goals(dir: &Path, server: &FakeServer, extra: &[&str]) -> std::process::Output {
-    let d = dataset_dir().display().to_string();
-    let url = server.base_url();
-    let scenario = cafe();
-    let mut args = vec![
-        "eval",
-        "goals",
-        "--dataset",
-        &d,
-        "--scenario",
-        &scenario,
-        "--out",
-        "out",
-        "--backend",
-        "openai",
-        "--base-url",
-        &url,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-        // The fixtures answer whole requests; reading by parts is tested elsewhere.
-        "--whole-request",
-    ];
-    args.extend_from_slice(extra);
-    betr(dir, &args)
 }
 
 /// The first answers as they came: the fixtures' gold goals and their 10 wrong ones.
@@ -315,72 +230,6 @@ fn an_interrupted_run_resumes_without_asking_finished_cases_again() {
     assert_eq!(tally(&r, "easy"), (28, 30));
     assert_eq!(tally(&r, "hard"), (36, 40));
     assert!(text(&o).contains(MODEL_ROW), "{}", text(&o));
-}
-
-#[test]
-fn a_run_killed_midway_resumes_to_the_same_results() {
-    let dir = tmp("eval-kill");
-    let server = FakeServer::start(vec![], Behavior::Fixtures(goal_fixtures()));
-    let d = dataset_dir().display().to_string();
-    let url = server.base_url();
-    let scenario = cafe();
-    let args = [
-        "eval",
-        "goals",
-        "--dataset",
-        &d,
-        "--scenario",
-        &scenario,
-        "--out",
-        "out",
-        "--backend",
-        "openai",
-        "--base-url",
-        &url,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-        "--whole-request",
-    ];
-    let mut child = support::cli::command(&dir, &args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    // Killed (SIGKILL: no chance to tidy up) once some cases are in the journal.
-    let journal = dir.join("out/cases.jsonl");
-    let started = std::time::Instant::now();
-    while std::fs::read_to_string(&journal).map_or(0, |j| j.lines().count()) < 5 {
-        assert!(
-            started.elapsed() < std::time::Duration::from_secs(120),
-            "the run wrote no journal"
-        );
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
-    let before = std::fs::read_to_string(&journal).unwrap();
-    assert!(before.lines().count() >= 5);
-
-    let o = model_goals(&dir, &server, &[]);
-    assert!(o.status.success(), "{}", text(&o));
-    let r = read_json(&dir.join("out/results.json"));
-    assert_eq!(r["cases"].as_array().unwrap().len(), 100);
-    assert_eq!(tally(&r, "easy"), (28, 30));
-    assert_eq!(tally(&r, "hard"), (36, 40));
-    // Every case the killed run finished is kept as it was, once.
-    let after = std::fs::read_to_string(&journal).unwrap();
-    for line in before.lines().filter(|l| l.ends_with('}')) {
-        assert_eq!(
-            after.lines().filter(|l| *l == line).count(),
-            1,
-            "a finished case was lost or asked again: {line}"
-        );
-    }
 }
 
 #[test]

@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
-mod support;
+use crate::support;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 

@@ -1,11 +1,12 @@
 //! A recording asked for and not made is a failed command: `--record` on a disk that
 //! fills up during the run ends it with an error (exit 2), and what was written stays
-//! readable. The disk is a 64 KiB tmpfs filled to its last page, which needs root to
-//! mount; elsewhere the test says so and checks nothing.
+//! readable. The disk is a 64 KiB tmpfs filled to its last page, which needs root (in a
+//! container, one allowed to mount) to mount. Where it cannot be mounted the test fails
+//! under CI saying so, and elsewhere prints why it checks nothing.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
-mod support;
+use crate::support;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,14 +19,22 @@ use support::fixtures;
 struct Tmpfs(PathBuf);
 
 impl Tmpfs {
-    fn mount(dir: &Path) -> Option<Tmpfs> {
+    /// The tmpfs mounted at `dir`, or what `mount` said when it could not be.
+    fn mount(dir: &Path) -> Result<Tmpfs, String> {
         std::fs::create_dir_all(dir).unwrap();
-        let mounted = Command::new("mount")
+        let out = Command::new("mount")
             .args(["-t", "tmpfs", "-o", "size=64k", "tmpfs"])
             .arg(dir)
-            .status()
-            .is_ok_and(|s| s.success());
-        mounted.then(|| Tmpfs(dir.to_path_buf()))
+            .output()
+            .map_err(|e| format!("`mount` could not be run: {e}"))?;
+        if !out.status.success() {
+            return Err(format!(
+                "`mount -t tmpfs` failed ({}): {}",
+                out.status,
+                String::from_utf8_lossy(&out.stderr).trim()
+            ));
+        }
+        Ok(Tmpfs(dir.to_path_buf()))
     }
 
     /// Fill the disk, leaving one page free.
@@ -47,9 +56,19 @@ impl Drop for Tmpfs {
 #[test]
 fn a_disk_that_fills_during_a_recorded_repair_fails_it() {
     let dir = tmp("full-disk");
-    let Some(disk) = Tmpfs::mount(&dir.join("disk")) else {
-        eprintln!("cannot mount a tmpfs here (not root): the full-disk test checks nothing");
-        return;
+    let disk = match Tmpfs::mount(&dir.join("disk")) {
+        Ok(disk) => disk,
+        Err(why) => {
+            support::check::cannot_check(
+                "the full-disk test",
+                &format!(
+                    "it could not make a full filesystem: a 64 KiB tmpfs at {} needs root \
+                     (in a container, one allowed to mount); {why}",
+                    dir.join("disk").display()
+                ),
+            );
+            return;
+        }
     };
     disk.fill_but_a_page();
     let scenario = fixtures::root()

@@ -2,7 +2,7 @@
 //! input saved under `fuzz/regressions/TARGET/` replayed, and `betr fuzz` itself. Longer
 //! runs are `scripts/fuzz.sh` (docs/FUZZ.md).
 
-mod support;
+use crate::support;
 
 use std::sync::OnceLock;
 

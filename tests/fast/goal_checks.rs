@@ -13,7 +13,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
-mod support;
+use crate::support;
 use std::sync::Arc;
 
 use betr::goal::{Formula, equivalent};

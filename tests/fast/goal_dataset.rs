@@ -1,7 +1,7 @@
 //! The goal parser, minimal DNF and goal comparison on the 100 gold goals of LLM-OBTEA.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use betr::dataset::{self, Case, Difficulty};
 use betr::goal::{Formula, equivalent, same_dnf};

@@ -2,7 +2,7 @@
 //! reported with its file, line and column and what was expected.
 
 #![allow(clippy::unwrap_used)]
-mod support;
+use crate::support;
 use std::path::{Path, PathBuf};
 
 use betr::scenario::{Scenario, ScenarioError};

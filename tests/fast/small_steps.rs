@@ -6,7 +6,7 @@
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
 
-mod support;
+use crate::support;
 use betr::goal::{Formula, equivalent};
 use betr::llm::{ChatRequest, OutputConstraint};
 use betr::session::types::Ablations;

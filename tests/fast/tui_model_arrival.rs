@@ -2,7 +2,7 @@
 //! beside the model's name; when the model is there the progress goes and the LLM pane
 //! says so; when the fetch fails the LLM pane says why, as for any missing model.
 
-mod support;
+use crate::support;
 
 use std::sync::Arc;
 

@@ -4,7 +4,7 @@
 //! The gate on approved changes is tested in `engine.rs` and `resolve_loop.rs`.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 

@@ -7,7 +7,7 @@
 //! and not from one it has no branch for. SPIN agrees on every verdict.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use betr::bt::{NodeId, NodeKind, Outcome, Tree};
 use betr::domain::{Atom, Condition};

@@ -6,7 +6,7 @@
 //! The broken cell trees and the cell's disturbances are in `verify_cell.rs`.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use betr::bt::{self, NodeKind, Outcome};
 use betr::scenario::Scenario;

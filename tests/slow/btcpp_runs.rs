@@ -11,7 +11,7 @@
 //! the test.
 
 #![allow(clippy::unwrap_used)] // tests may panic on what they check
-mod support;
+use crate::support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

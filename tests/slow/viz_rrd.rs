@@ -3,7 +3,7 @@
 //! (`rerun rrd verify`, `rerun rrd print`) from `rerun-sdk==0.36.3`, installed once into
 //! a virtual environment under the target directory when it is missing.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 use std::process::Command;
@@ -476,7 +476,11 @@ fn the_viewer_flags_say_what_they_started_or_why_not() {
     // Ports 9876 and 9090 are the web viewer's; another program on them is not ours
     // to stop.
     if port_open(9876) || port_open(9090) {
-        eprintln!("ports 9876/9090 are taken: the web viewer part is not run");
+        support::check::cannot_check(
+            "the web viewer part of the viewer flags' test",
+            "ports 9876/9090 (the web viewer's) are taken by another program, which is not \
+             this test's to stop",
+        );
         return;
     }
     let without_rerun = run("web", std::ffi::OsStr::new("/usr/bin:/bin"));
