@@ -12,8 +12,8 @@ packages=(cmake g++ pkg-config libclang-dev libasound2-dev fonts-dejavu-core)
 if [ "${1:-}" = "--test" ]; then
   # spin cross-checks `betr verify`; tmux drives the real binary as a person would;
   # espeak-ng speaks the instructions the dictation tests transcribe; graphviz renders
-  # the DOT export.
-  packages+=(spin tmux espeak-ng graphviz)
+  # the DOT export; mount makes the small full filesystem of the full-disk test (as root).
+  packages+=(spin tmux espeak-ng graphviz mount)
 fi
 
 missing=()

@@ -3,9 +3,12 @@
 #![allow(dead_code)]
 #![allow(clippy::unwrap_used)] // test helpers: a failure is a failed test
 
+pub mod bench;
+pub mod check;
 pub mod cli;
 pub mod embedded;
 pub mod engine;
+pub mod eval_goals;
 pub mod fake_model;
 pub mod fake_openai;
 pub mod fixtures;

@@ -1,0 +1,134 @@
+//! No dead ends after a person turns a proposal down: undo puts the undone fix back among
+//! the candidates of the next question, and a rejection asks the model again with the
+//! rejected fix left out, until a limit after which the person types the fix.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+use crate::support;
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use betr::session::{Command, Event, Proposal};
+use support::engine::{Session, model, setup};
+use support::fake_model::FixtureModel;
+use support::fixtures;
+use support::repo::runtime as rt;
+
+/// The conditions of the last proposal among `events`, as text.
+fn proposed(events: &[Event]) -> Option<String> {
+    events.iter().rev().find_map(|e| match e {
+        Event::Proposal {
+            proposal: Proposal::Conditions { conditions, .. },
+            ..
+        } => Some(
+            conditions
+                .iter()
+                .map(ToString::to_string)
+                .collect::<Vec<_>>()
+                .join(" & "),
+        ),
+        _ => None,
+    })
+}
+
+/// The notice telling the conditions tried in simulation before the model was asked.
+fn shortlist_notice(events: &[Event]) -> Option<String> {
+    events.iter().rev().find_map(|e| match e {
+        Event::Notice { message } if message.contains("condition(s) about") => {
+            Some(message.clone())
+        }
+        _ => None,
+    })
+}
+
+#[test]
+fn an_undone_fix_is_a_candidate_again() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        s.send(Command::Approve);
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Undo);
+        s.until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.seen.clear();
+        let again = s.run_to_proposal().await;
+        let notice = shortlist_notice(&again).unwrap();
+        assert!(!notice.contains("refused before"), "{notice}");
+        // The undone fix is among the choices again (how many others fix the failure
+        // depends on where the arm left things).
+        assert!(
+            notice.contains("chooses among: ~\"any object\" on \"blue cube\""),
+            "{notice}"
+        );
+        assert_eq!(
+            proposed(&again).as_deref(),
+            Some("~\"any object\" on \"blue cube\"")
+        );
+    });
+}
+
+#[test]
+fn a_rejected_fix_applied_by_hand_then_undone_is_a_candidate_again() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
+        s.run_to_proposal().await;
+        s.send(Command::Reject);
+        s.until("rejected", |e| matches!(e, Event::Rejected)).await;
+        s.send(support::engine::edit(support::engine::FIX).unwrap());
+        s.until("edited", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Undo);
+        s.until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.seen.clear();
+        let again = s.run_to_proposal().await;
+        let notice = shortlist_notice(&again).unwrap();
+        assert!(!notice.contains("refused before"), "{notice}");
+        assert_eq!(
+            proposed(&again).as_deref(),
+            Some("~\"any object\" on \"blue cube\"")
+        );
+    });
+}
+
+#[test]
+fn a_rejection_asks_again_without_the_rejected_fix_then_leaves_it_to_the_person() {
+    rt().block_on(async {
+        let mut s = Session::start(one_rejection());
+        s.run_to_proposal().await;
+        s.send(Command::Reject);
+        let got = s
+            .until("the next proposal", |e| matches!(e, Event::Proposal { .. }))
+            .await;
+        let notice = shortlist_notice(&got).unwrap();
+        assert!(notice.contains("1 refused before, left out"), "{notice}");
+        assert_eq!(
+            proposed(&got).as_deref(),
+            Some("~\"red cube\" on \"blue cube\"")
+        );
+        // Rejected again: past the limit (one, here), the model is not asked again and
+        // the person types the fix.
+        s.send(Command::Reject);
+        let got = s
+            .until("left to the person", |e| {
+                matches!(e, Event::Notice { message } if message.contains("type the missing condition(s) or value yourself"))
+            })
+            .await;
+        assert!(
+            !got.iter().any(|e| matches!(e, Event::Asking { .. })),
+            "{got:#?}"
+        );
+    });
+}
+
+/// A session whose person may reject one proposal per failure before typing the fix.
+fn one_rejection() -> betr::session::Setup {
+    // Scenario 1's own replies: another scenario's would answer its prompt first.
+    let model = FixtureModel::new(fixtures::replies_of("red_on_blue.toml"));
+    let mut setup = setup(Ok(Arc::new(model)), None);
+    setup.options.max_rejections = 1;
+    setup
+}
