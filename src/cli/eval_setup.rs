@@ -146,10 +146,6 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
             .examples_shown
             .map_or("all".into(), |k| k.to_string()),
     );
-    settings.insert(
-        "fixed_examples".into(),
-        options.variant.fixed_examples.to_string(),
-    );
     settings.insert("checks".into(), options.ablations.check_goals.to_string());
     settings.insert("candidates".into(), options.candidates.to_string());
     settings.insert("beams".into(), options.beams.to_string());
@@ -162,22 +158,10 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         "read_by_parts".into(),
         options.ablations.read_by_parts.to_string(),
     );
-    if options.ablations.small_steps {
-        settings.insert("small_steps".into(), "true".into());
-    }
     settings.insert(
         "scene_word_examples".into(),
         options.variant.scene_word_examples.to_string(),
     );
-    if options.variant.scene_phrases {
-        settings.insert("scene_phrases".into(), "true".into());
-    }
-    if options.ablations.confirm_conditions {
-        settings.insert("confirm_conditions".into(), "true".into());
-    }
-    if options.ablations.goal_prefix_in_prompt {
-        settings.insert("goal_prefix_in_prompt".into(), "true".into());
-    }
     settings.insert(
         "value_levels".into(),
         options.ablations.value_levels.to_string(),
@@ -213,27 +197,19 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         label: format!(
             "{model} ({backend}), prompt {}, {}, {}",
             flags.prompt.name(),
-            match (
-                llm.options.variant.examples_shown,
-                llm.options.variant.fixed_examples
-            ) {
-                (None, _) => "all examples".to_string(),
-                (Some(k), true) => format!("{k} fixed examples"),
-                (Some(k), false) => format!("{k} retrieved examples"),
+            match llm.options.variant.examples_shown {
+                None => "all examples".to_string(),
+                Some(k) => format!("{k} retrieved examples"),
             },
             if llm.options.ablations.check_goals {
                 format!(
                     "checked ({} candidates, {} feedback rounds{})",
                     llm.options.candidates,
                     llm.options.goal_feedback_rounds,
-                    match (
-                        llm.options.ablations.read_by_parts,
-                        llm.options.ablations.small_steps
-                    ) {
-                        (true, false) => ", a wish at a time",
-                        (false, false) => ", whole request",
-                        (true, true) => ", a wish at a time, the objects named first",
-                        (false, true) => ", whole request, the objects named first",
+                    if llm.options.ablations.read_by_parts {
+                        ", a wish at a time"
+                    } else {
+                        ", whole request"
                     }
                 )
             } else {

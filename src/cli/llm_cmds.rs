@@ -83,19 +83,11 @@ pub struct LlmFlags {
     /// to the request (default 6; 0: none).
     #[arg(value_parser = super::ranged(0, 100), long, value_name = "K")]
     pub examples_shown: Option<usize>,
-    /// Show the pool's first K examples for every request instead of the most similar
-    /// (ablation of retrieval).
-    #[arg(long)]
-    pub fixed_examples: bool,
     /// Show only the pool's examples, without the up to three made from the scene's own
     /// words for the request (what it asks of one object in the words the scene lists for
     /// a condition or its opposite, said with the scene's phrase, with that condition).
     #[arg(long, help_heading = ABLATIONS)]
     pub no_scene_word_examples: bool,
-    /// Show beside each condition of the goal prompt the phrases the scene lists for it and
-    /// for its opposite, not only its description.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub scene_phrases: bool,
     /// Candidates per question: drawn when a goal's first answer fails its checks, and
     /// for every failure, each tried in simulation before it is offered (default 4).
     #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
@@ -116,21 +108,6 @@ pub struct LlmFlags {
     /// goals joined as the request joins them.
     #[arg(long, help_heading = ABLATIONS)]
     pub whole_request: bool,
-    /// Ask first which of the scene's objects and places the request names, and type the
-    /// goal's first answer over those only (the embedded model, or any model held to a
-    /// grammar).
-    #[arg(long, help_heading = ABLATIONS)]
-    pub small_steps: bool,
-    /// With a grammar: write a goal answer's `Goal:` into the prompt for the model to
-    /// continue and let the grammar type only the formula, instead of the grammar typing
-    /// the whole answer.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub goal_prefix_in_prompt: bool,
-    /// After a goal is read, ask the model about each of its conditions (must it be true,
-    /// false, or is it not asked about) and turn round or take out a condition where the
-    /// answer says so and the goal still passes its checks.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub confirm_conditions: bool,
     /// Ask a numeric parameter's first value as a number, instead of as a level (very low
     /// … very high) of the range the robot can do that betr turns into a number.
     #[arg(long, help_heading = ABLATIONS)]
@@ -256,9 +233,7 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
                 (None, Some(_)) => None,
                 (None, None) => Some(DEFAULT_EXAMPLES_SHOWN),
             },
-            fixed_examples: flags.fixed_examples,
             scene_word_examples: !flags.no_scene_word_examples,
-            scene_phrases: flags.scene_phrases,
             examples,
         },
         candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
@@ -267,9 +242,6 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         ablations: Ablations {
             check_goals: !flags.no_checks,
             read_by_parts: !flags.whole_request,
-            small_steps: flags.small_steps,
-            goal_prefix_in_prompt: flags.goal_prefix_in_prompt,
-            confirm_conditions: flags.confirm_conditions,
             value_levels: !flags.value_as_number,
             shortlist: !flags.no_shortlist,
             without_misreadings: Vec::new(),

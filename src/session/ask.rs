@@ -26,14 +26,11 @@ pub(crate) async fn ask(
     (schema, grammar): (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
     seed: Option<u64>,
-    prefill: Option<&str>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
     request.seed = seed;
     if options.grammar && model.supports_grammar() {
-        // `grammar` types what follows the words written for the model.
-        request.prefill = prefill.map(str::to_string);
         request.constraint = Some(OutputConstraint::Grammar {
             name: "answer".into(),
             gbnf: grammar(),
@@ -176,7 +173,6 @@ async fn draw_and_screen(
             (constraint.0.clone(), constraint.1),
             &opts,
             seed,
-            None,
             emit,
         )
         .await?;

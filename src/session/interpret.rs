@@ -80,7 +80,6 @@ pub async fn interpret(
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Interpretation, SessionError> {
     let mut earlier_calls = 0;
-    let asked_in = world.fork();
     if options.ablations.check_goals && options.ablations.read_by_parts {
         let lexicon = Lexicon::new(&scenario.domain.vocabulary, example_pool(scenario, options));
         let parts = split(instruction, &lexicon);
@@ -88,16 +87,6 @@ pub async fn interpret(
             let forked = world.fork();
             match read_parts(scenario, forked, &parts, instruction, model, options, emit).await? {
                 PartsRead::Read(found) => {
-                    let found = super::confirm::confirmed(
-                        scenario,
-                        asked_in,
-                        instruction,
-                        found,
-                        model,
-                        options,
-                        emit,
-                    )
-                    .await?;
                     announce(scenario, &found, emit);
                     return Ok(found);
                 }
@@ -107,9 +96,6 @@ pub async fn interpret(
     }
     let mut found = read_goal(scenario, world, instruction, false, model, options, emit).await?;
     found.calls += earlier_calls;
-    let found =
-        super::confirm::confirmed(scenario, asked_in, instruction, found, model, options, emit)
-            .await?;
     announce(scenario, &found, emit);
     Ok(found)
 }
@@ -163,27 +149,8 @@ pub(super) async fn read_goal(
     let vocabulary = &scenario.domain.vocabulary;
     let constraint = schema::goal(vocabulary);
     let cot = options.variant.chain_of_thought;
-    // The answer's `Goal:` written into the prompt for the model to continue, the grammar
-    // typing only the formula (an ablation), or the grammar typing both.
-    let prefill = (options.ablations.goal_prefix_in_prompt && !cot).then_some(grammar::GOAL_PREFIX);
-    let typed = |v: &crate::domain::Vocabulary| match prefill {
-        Some(_) => grammar::goal_grammar_after_prefix(v, true),
-        None => grammar::goal_grammar(v, true, cot),
-    };
-    let goal_grammar = || typed(vocabulary);
+    let goal_grammar = || grammar::goal_grammar(vocabulary, true, cot);
     let mut calls = 0;
-    // The small step first: the objects the request names type the first answer.
-    let mut narrowed: Option<crate::domain::Vocabulary> = None;
-    if options.ablations.small_steps && !cot && options.grammar && model.supports_grammar() {
-        calls += 1;
-        if let Some(named) = super::named_first::named_objects(&ctx, model, options, emit).await? {
-            narrowed = super::named_first::narrowed(vocabulary, &named);
-        }
-    }
-    let narrowed_grammar = || match &narrowed {
-        Some(v) => typed(v),
-        None => goal_grammar(),
-    };
     let mut first: Option<Option<Formula>> = None;
     let rounds = if options.ablations.check_goals {
         options.goal_feedback_rounds + 1
@@ -217,18 +184,12 @@ pub(super) async fn read_goal(
             } else {
                 None
             };
-            let typed_by: &(dyn Fn() -> String + Sync) = if round == 0 && draw == 0 {
-                &narrowed_grammar
-            } else {
-                &goal_grammar
-            };
             let r = ask(
                 model,
                 messages.clone(),
-                (constraint.clone(), typed_by),
+                (constraint.clone(), &goal_grammar),
                 &opts,
                 seed,
-                prefill,
                 emit,
             )
             .await?;

@@ -4,7 +4,6 @@
 //! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
-mod confirm;
 pub mod edit;
 pub mod engine;
 pub mod evidence;
@@ -13,7 +12,6 @@ pub mod interpret;
 mod interpret_parts;
 mod judge;
 pub mod knowledge;
-mod named_first;
 pub mod planned;
 pub mod policy;
 pub mod readings;

@@ -83,10 +83,6 @@ pub struct Ablations {
     /// With checks on, read a request of several wishes one wish at a time and join the
     /// goals as the request joins them; off: the request is read whole.
     pub read_by_parts: bool,
-    /// Before a goal's first answer, ask the model which of the scene's objects and places
-    /// the request names, and type the first answer over those only
-    /// (`session::named_first`); off: the first answer is typed over the whole scene.
-    pub small_steps: bool,
     /// Ask the first value of a numeric parameter as a level of the robot's declared
     /// range (very low … very high), turned into a number by betr; off: as a number.
     pub value_levels: bool,
@@ -97,14 +93,6 @@ pub struct Ablations {
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
     /// evaluation's way to measure what each earns; empty in use.
     pub without_misreadings: Vec<String>,
-    /// With a grammar, write a goal answer's `Goal:` into the prompt for the model to
-    /// continue and type only the formula; off: the grammar types the whole answer,
-    /// `Goal:` included.
-    pub goal_prefix_in_prompt: bool,
-    /// After a goal is read, ask the model about each of its conditions (wanted true,
-    /// false, or not asked about) and change the goal where the answers say so
-    /// (`session::confirm`); off: the goal stands as read and checked.
-    pub confirm_conditions: bool,
 }
 
 impl Default for Ablations {
@@ -112,12 +100,9 @@ impl Default for Ablations {
         Ablations {
             check_goals: true,
             read_by_parts: true,
-            small_steps: false,
             value_levels: true,
             shortlist: true,
             without_misreadings: Vec::new(),
-            goal_prefix_in_prompt: false,
-            confirm_conditions: false,
         }
     }
 }
