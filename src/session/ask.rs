@@ -322,7 +322,7 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let list = if options.ablations.shortlist {
+    let list = if options.steps.shortlist {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a
@@ -407,7 +407,7 @@ pub(crate) async fn ask_value(
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
     // The first question about a number asks for a level of the robot's range; once the
     // world has answered, the next ones ask for numbers.
-    let levels = if tried.is_empty() && options.ablations.value_levels {
+    let levels = if tried.is_empty() && options.steps.value_levels {
         as_levels(param)
     } else {
         None

@@ -179,7 +179,7 @@ impl Engine {
                     scenario: &scenario,
                     facts: &facts,
                     instruction: &instruction,
-                    variant: &options.variant,
+                    variant: &options.steps.prompt,
                 };
                 let failed = FailedAction {
                     node: failure.node,
