@@ -17,10 +17,8 @@ local=(--backend local --threads "$threads")
 
 # Goals: the default model as the product reads instructions (examples retrieved per
 # request, candidates checked, vote, feedback; the first call alone is scored too, which
-# is the run without checks), then a single call with the pool's first examples instead
-# of retrieved ones (the examples lever alone), then the fast model.
+# is the run without checks), then the fast model.
 "$betr" eval goals "${local[@]}" --out "$out/goals-1.5b"
-"$betr" eval goals "${local[@]}" --fixed-examples --no-checks --out "$out/goals-1.5b-fixed-examples"
 "$betr" eval goals "${local[@]}" --model qwen2.5-coder-0.5b --out "$out/goals-0.5b"
 
 # Failures and values: the goal read from the instruction (a misread goal is its own
@@ -40,7 +38,7 @@ done
 cp "$out/goals-1.5b/accuracy.png" docs/images/eval-goals-default-model.png
 cp "$out/resolve/resolve.png" docs/images/eval-resolve-default-model.png
 cp "$out/params/params.png" docs/images/eval-params-default-model.png
-for e in goals-1.5b goals-1.5b-fixed-examples goals-0.5b resolve params resolve-scenario-goal params-scenario-goal; do
+for e in goals-1.5b goals-0.5b resolve params resolve-scenario-goal params-scenario-goal; do
   echo "=== $e ($out/$e/table.md)"
   cat "$out/$e/table.md"
 done

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What each part of reading earns: the held-out suite read once with every part on, then
 # again with each misreading detector left out, all of them left out, and the request read
-# whole; and the unseen sets with small steps on. Every run shares one cassette reused
+# whole. Every run shares one cassette reused
 # (--reuse-cassette), so a run asks the model only the questions that part changes.
 # Prints the lever table of docs/EVAL.md (scripts/lever_table.py).
 #
@@ -20,7 +20,6 @@ sets = text.split("[[set]]")[1:]
 def keep(names):
     return "[[set]]" + "[[set]]".join(s for s in sets if any(f'name = "{n}"' in s for n in names))
 open(f"{sys.argv[1]}/heldout-suite.toml", "w").write(keep(["cafe-heldout", "cell", "greenhouse"]))
-open(f"{sys.argv[1]}/unseen-suite.toml", "w").write(keep(["cafe-heldout", "greenhouse"]))
 PY
 common=(--threads "${BETR_THREADS:-2}" --cassette "$out/cassette.jsonl" --reuse-cassette)
 run() { local name=$1 suite=$2; shift 2; "$betr" eval goals --suite "$out/$suite" "${common[@]}" "$@" --out "$out/$name" > "$out/$name.log" 2>&1; }
@@ -34,7 +33,6 @@ for d in $detectors; do
   rows+=("without $d=$out/without-$d")
 done
 run without-all heldout-suite.toml "${all[@]}"
-run small-steps unseen-suite.toml --small-steps
 run whole-request heldout-suite.toml --whole-request
 python3 scripts/lever_table.py "$out/base" "${rows[@]}" "every detector left out=$out/without-all" \
-  "request read whole=$out/whole-request" "small steps on=$out/small-steps"
+  "request read whole=$out/whole-request"

@@ -7,15 +7,21 @@
 //! by these modules.
 #![forbid(unsafe_code)]
 
+// The lab: evaluations, benchmarks and fuzzing of the product, behind the `lab` feature
+// (on by default). Nothing outside these modules imports them.
+#[cfg(feature = "lab")]
 pub mod bench;
+#[cfg(feature = "lab")]
+pub mod eval;
+#[cfg(feature = "lab")]
+pub mod fuzz;
+
 pub mod bounds;
 pub mod bt;
 pub mod config_file;
 pub mod dataset;
 pub mod domain;
-pub mod eval;
 pub mod excerpt;
-pub mod fuzz;
 pub mod goal;
 pub mod http_retry;
 pub mod http_text;

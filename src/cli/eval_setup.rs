@@ -14,7 +14,8 @@ use betr::eval::run::Progress;
 use betr::llm::LanguageModel;
 use betr::llm::config::Backend;
 
-use super::llm_cmds::{self, LlmFlags};
+use super::lab_flags::LabFlags;
+use super::llm_cmds::{self, CallFlags, LlmFlags};
 
 /// The prompt ablations of the paper's Table III.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -54,13 +55,12 @@ pub struct RunFlags {
     /// Stop after this many newly finished cases (for testing interruption).
     #[arg(value_parser = super::ranged(1, 100_000_000), long, hide = true)]
     pub limit: Option<usize>,
-    /// Leave out a detector of plain misreadings when goals are judged, to measure what it
-    /// earns (repeatable; the names are listed in docs/ARCHITECTURE.md and in the error
-    /// for an unknown one).
-    #[arg(long, value_name = "NAME")]
-    pub without_misreading: Vec<String>,
     #[command(flatten)]
     pub llm: LlmFlags,
+    #[command(flatten)]
+    pub call: CallFlags,
+    #[command(flatten)]
+    pub lab: LabFlags,
 }
 
 /// Draws a progress bar on stderr when it is a terminal; otherwise draws nothing.
@@ -111,25 +111,28 @@ pub(super) struct Prepared {
 }
 
 pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prepared> {
-    let mut llm_flags = flags.llm.clone();
+    let mut lab = flags.lab.clone();
     match flags.prompt {
         PromptVariant::Full => {}
-        PromptVariant::NoDescriptions => llm_flags.no_descriptions = true,
-        PromptVariant::NoObjectRule => llm_flags.no_object_rule = true,
-        PromptVariant::Cot => llm_flags.cot = true,
+        PromptVariant::NoDescriptions => lab.no_descriptions = true,
+        PromptVariant::NoObjectRule => lab.no_object_rule = true,
+        PromptVariant::Cot => lab.cot = true,
         PromptVariant::OriginalExamples => {
-            if llm_flags.examples.is_none() {
+            if lab.examples.is_none() {
                 bail!(
                     "--prompt original-examples: the examples of the original LLM-OBTEA prompt are not shipped with betr; give them with --examples FILE (TOML: [[examples]] with instruction and goal)"
                 );
             }
             // The original prompt's examples alone, as that prompt showed them.
-            llm_flags.no_scene_word_examples = true;
+            lab.no_scene_word_examples = true;
         }
     }
-    let mut llm = llm_cmds::setup(&llm_flags)?;
-    betr::reading::misreadings_without(&flags.without_misreading)?;
-    llm.options.ablations.without_misreadings = flags.without_misreading.clone();
+    let levers = lab.levers()?;
+    let mut layer = llm_cmds::layer(&flags.llm, &flags.call)?;
+    lab.layer(&mut layer);
+    let (settings, mut options) = llm_cmds::settings_from(&flags.llm, layer)?;
+    levers.apply(&mut options);
+    let llm = llm_cmds::build(settings, options)?;
     let backend = format!("{:?}", llm.settings.backend).to_lowercase();
     let model = llm.model.model().to_string();
     let mut settings: BTreeMap<String, String> = BTreeMap::new();
@@ -142,57 +145,42 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     settings.insert(
         "examples_shown".into(),
         options
-            .variant
+            .steps
+            .prompt
             .examples_shown
             .map_or("all".into(), |k| k.to_string()),
     );
-    settings.insert(
-        "fixed_examples".into(),
-        options.variant.fixed_examples.to_string(),
-    );
-    settings.insert("checks".into(), options.ablations.check_goals.to_string());
+    settings.insert("checks".into(), options.steps.check_goals.to_string());
     settings.insert("candidates".into(), options.candidates.to_string());
     settings.insert("beams".into(), options.beams.to_string());
     settings.insert(
         "feedback_rounds".into(),
         options.goal_feedback_rounds.to_string(),
     );
-    settings.insert("shortlist".into(), options.ablations.shortlist.to_string());
+    settings.insert("shortlist".into(), options.steps.shortlist.to_string());
     settings.insert(
         "read_by_parts".into(),
-        options.ablations.read_by_parts.to_string(),
+        options.steps.read_by_parts.to_string(),
     );
-    if options.ablations.small_steps {
-        settings.insert("small_steps".into(), "true".into());
-    }
     settings.insert(
         "scene_word_examples".into(),
-        options.variant.scene_word_examples.to_string(),
+        options.steps.prompt.scene_word_examples.to_string(),
     );
-    if options.variant.scene_phrases {
-        settings.insert("scene_phrases".into(), "true".into());
-    }
-    if options.ablations.confirm_conditions {
-        settings.insert("confirm_conditions".into(), "true".into());
-    }
-    if options.ablations.goal_prefix_in_prompt {
-        settings.insert("goal_prefix_in_prompt".into(), "true".into());
-    }
     settings.insert(
         "value_levels".into(),
-        options.ablations.value_levels.to_string(),
+        options.steps.value_levels.to_string(),
     );
     settings.insert("grammar".into(), llm.settings.grammar.to_string());
-    if !options.ablations.without_misreadings.is_empty() {
+    if !options.steps.without_misreadings.is_empty() {
         settings.insert(
             "without_misreadings".into(),
-            options.ablations.without_misreadings.join(" "),
+            options.steps.without_misreadings.join(" "),
         );
     }
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
     for (k, v) in [
-        ("examples", optional(&llm_flags.examples)),
-        ("prompts", optional(&llm_flags.prompts)),
+        ("examples", optional(&lab.examples)),
+        ("prompts", optional(&lab.prompts)),
     ] {
         if let Some(v) = v {
             settings.insert(k.into(), v);
@@ -213,27 +201,19 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         label: format!(
             "{model} ({backend}), prompt {}, {}, {}",
             flags.prompt.name(),
-            match (
-                llm.options.variant.examples_shown,
-                llm.options.variant.fixed_examples
-            ) {
-                (None, _) => "all examples".to_string(),
-                (Some(k), true) => format!("{k} fixed examples"),
-                (Some(k), false) => format!("{k} retrieved examples"),
+            match llm.options.steps.prompt.examples_shown {
+                None => "all examples".to_string(),
+                Some(k) => format!("{k} retrieved examples"),
             },
-            if llm.options.ablations.check_goals {
+            if llm.options.steps.check_goals {
                 format!(
                     "checked ({} candidates, {} feedback rounds{})",
                     llm.options.candidates,
                     llm.options.goal_feedback_rounds,
-                    match (
-                        llm.options.ablations.read_by_parts,
-                        llm.options.ablations.small_steps
-                    ) {
-                        (true, false) => ", a wish at a time",
-                        (false, false) => ", whole request",
-                        (true, true) => ", a wish at a time, the objects named first",
-                        (false, true) => ", whole request, the objects named first",
+                    if llm.options.steps.read_by_parts {
+                        ", a wish at a time"
+                    } else {
+                        ", whole request"
                     }
                 )
             } else {

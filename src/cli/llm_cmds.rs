@@ -1,27 +1,20 @@
-//! The language-model flags every command that asks a model shares, and the settings
-//! and model they make.
+//! The language-model flags of the product's commands, and the settings and model they
+//! make. The lab's flags (`betr eval`) are its own (`lab_flags`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
-use anyhow::{Context as _, Result};
+use anyhow::Result;
 use clap::Args;
 
 use betr::config_file::FileConfig;
 use betr::llm::LanguageModel;
 use betr::llm::config::{Backend, Layer, Settings};
-use betr::llm::prompt::{DEFAULT_EXAMPLES_SHOWN, Templates, Variant};
 use betr::llm::usage::{Ledger, Metered};
-use betr::scenario::Example;
 use betr::session::Options;
-use betr::session::types::{Ablations, DEFAULT_CANDIDATES};
 
-/// The help heading of the flags an evaluation turns parts off with
-/// (`session::types::Ablations`).
-const ABLATIONS: &str = "Ablations (what an evaluation turns off to measure each part)";
-
-/// Flags shared by every command that asks a language model. Each overrides the
-/// matching `BETR_*` variable, which overrides `betr.toml`.
+/// Which model answers: the flags every command that asks a model takes, the workbench
+/// included. Each overrides the matching `BETR_*` variable, which overrides `betr.toml`.
 #[derive(Args, Debug, Clone, Default)]
 pub struct LlmFlags {
     /// Settings file (default: $BETR_CONFIG, ./betr.toml, ~/.config/betr/betr.toml).
@@ -41,15 +34,17 @@ pub struct LlmFlags {
     /// [env: BETR_API_KEY_ENV].
     #[arg(long, value_name = "VAR")]
     pub api_key_env: Option<String>,
+}
+
+/// How a one-shot command (`interpret`, `resolve`, and the lab's commands) calls the
+/// model. The workbench keeps its command line short and takes these from `betr.toml`
+/// and the `BETR_*` variables.
+#[derive(Args, Debug, Clone, Default)]
+pub struct CallFlags {
     /// Cassette: replayed with --backend replay, else every exchange is recorded to it
     /// [env: BETR_CASSETTE].
     #[arg(long, value_name = "FILE")]
     pub cassette: Option<PathBuf>,
-    /// With a live backend and --cassette: answer what the cassette already holds for the
-    /// model from it, ask the model only the rest and record that (a run repeated with
-    /// one setting changed asks only the questions that changed).
-    #[arg(long, requires = "cassette")]
-    pub reuse_cassette: bool,
     /// Constrain replies to the vocabulary with a JSON schema (servers with response_format)
     /// [env: BETR_STRUCTURED].
     #[arg(long)]
@@ -66,83 +61,6 @@ pub struct LlmFlags {
     /// Sampling temperature.
     #[arg(long)]
     pub temperature: Option<f32>,
-    /// Ablation: leave the condition descriptions out of the prompt.
-    #[arg(help_heading = ABLATIONS, long)]
-    pub no_descriptions: bool,
-    /// Ablation: leave out the rule that only listed objects may be used.
-    #[arg(help_heading = ABLATIONS, long)]
-    pub no_object_rule: bool,
-    /// Ablation: ask for reasoning before the goal (chain of thought).
-    #[arg(help_heading = ABLATIONS, long)]
-    pub cot: bool,
-    /// Ablation: examples from this TOML file ([[examples]] instruction, goal) instead of
-    /// the scenario's, e.g. the original prompt's examples.
-    #[arg(help_heading = ABLATIONS, long, value_name = "FILE")]
-    pub examples: Option<PathBuf>,
-    /// Worked examples per prompt, chosen from the scenario's pool as the most similar
-    /// to the request (default 6; 0: none).
-    #[arg(value_parser = super::ranged(0, 100), long, value_name = "K")]
-    pub examples_shown: Option<usize>,
-    /// Show the pool's first K examples for every request instead of the most similar
-    /// (ablation of retrieval).
-    #[arg(long)]
-    pub fixed_examples: bool,
-    /// Show only the pool's examples, without the up to three made from the scene's own
-    /// words for the request (what it asks of one object in the words the scene lists for
-    /// a condition or its opposite, said with the scene's phrase, with that condition).
-    #[arg(long, help_heading = ABLATIONS)]
-    pub no_scene_word_examples: bool,
-    /// Show beside each condition of the goal prompt the phrases the scene lists for it and
-    /// for its opposite, not only its description.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub scene_phrases: bool,
-    /// Candidates per question: drawn when a goal's first answer fails its checks, and
-    /// for every failure, each tried in simulation before it is offered (default 4).
-    #[arg(value_parser = super::ranged(1, 64), long, value_name = "N")]
-    pub candidates: Option<usize>,
-    /// Local backend: a goal's first answer is the most likely whole answer of N beams
-    /// searched under the grammar, the runners-up candidates too (default 4; 1: one
-    /// greedy answer).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=6))]
-    pub beams: Option<u32>,
-    /// Take the first usable goal as it is: no checks, no vote, no feedback (the paper's
-    /// single call).
-    #[arg(long, help_heading = ABLATIONS)]
-    pub no_checks: bool,
-    /// Times the model is told why its goals were refused and asked again (default 2).
-    #[arg(value_parser = super::ranged(0, 10), long, value_name = "N")]
-    pub feedback_rounds: Option<usize>,
-    /// Read a request of several wishes whole, instead of one wish at a time with the
-    /// goals joined as the request joins them.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub whole_request: bool,
-    /// Ask first which of the scene's objects and places the request names, and type the
-    /// goal's first answer over those only (the embedded model, or any model held to a
-    /// grammar).
-    #[arg(long, help_heading = ABLATIONS)]
-    pub small_steps: bool,
-    /// With a grammar: write a goal answer's `Goal:` into the prompt for the model to
-    /// continue and let the grammar type only the formula, instead of the grammar typing
-    /// the whole answer.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub goal_prefix_in_prompt: bool,
-    /// After a goal is read, ask the model about each of its conditions (must it be true,
-    /// false, or is it not asked about) and turn round or take out a condition where the
-    /// answer says so and the goal still passes its checks.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub confirm_conditions: bool,
-    /// Ask a numeric parameter's first value as a number, instead of as a level (very low
-    /// … very high) of the range the robot can do that betr turns into a number.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub value_as_number: bool,
-    /// Let the model name a failure's missing condition out of the whole vocabulary,
-    /// instead of choosing among the conditions over the action's objects that fix the
-    /// failure when tried in simulation.
-    #[arg(long, help_heading = ABLATIONS)]
-    pub no_shortlist: bool,
-    /// Read goal.md, resolve.md and value.md from this directory instead of the built-in prompts.
-    #[arg(long, value_name = "DIR")]
-    pub prompts: Option<PathBuf>,
     /// Print each reply's raw text too.
     #[arg(long)]
     pub show_replies: bool,
@@ -154,10 +72,6 @@ pub struct LlmFlags {
     /// [env: BETR_THREADS].
     #[arg(long, value_name = "N")]
     pub threads: Option<u32>,
-    /// Local backend: let the model write freely instead of following a grammar built
-    /// from the scenario's vocabulary [env: BETR_GRAMMAR=false].
-    #[arg(long)]
-    pub no_grammar: bool,
 }
 
 /// The configured model and its ledger (also used by `betr eval`).
@@ -167,8 +81,13 @@ pub(super) struct Llm {
     pub(super) settings: Settings,
 }
 
-pub(super) fn setup(flags: &LlmFlags) -> Result<Llm> {
-    let (settings, options) = settings(flags)?;
+pub(super) fn setup(flags: &LlmFlags, call: &CallFlags) -> Result<Llm> {
+    let (settings, options) = settings_from(flags, layer(flags, call)?)?;
+    build(settings, options)
+}
+
+/// The model the settings ask for, fetched first when it is the embedded one and missing.
+pub(super) fn build(settings: Settings, options: Options) -> Result<Llm> {
     ensure_local_model(&settings)?;
     let ledger = Ledger::new(settings.usage_log.clone());
     let model = settings.build(ledger, &|k: &str| std::env::var(k).ok())?;
@@ -200,14 +119,15 @@ pub fn local_model_to_fetch(settings: &Settings) -> Option<&'static betr::model:
     (!spec.is_present()).then_some(spec)
 }
 
-/// The resolved settings and the session options the flags ask for (no model built yet).
+/// The resolved settings and the session options the workbench's flags ask for (no model
+/// built yet).
 pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
-    let var = |k: &str| std::env::var(k).ok();
-    let file = match FileConfig::locate(flags.config.as_deref(), &var) {
-        Some(path) => Some((FileConfig::read(&path)?, path)),
-        None => None,
-    };
-    let flag_layer = Layer {
+    settings_from(flags, layer(flags, &CallFlags::default())?)
+}
+
+/// The settings the flags give, over the environment's and the settings file's.
+pub(super) fn layer(flags: &LlmFlags, call: &CallFlags) -> Result<Layer> {
+    Ok(Layer {
         backend: flags
             .backend
             .as_deref()
@@ -217,17 +137,25 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         base_url: flags.base_url.clone(),
         model: flags.model.clone(),
         api_key_env: flags.api_key_env.clone(),
-        structured: flags.structured.then_some(true),
-        temperature: flags.temperature,
-        timeout_secs: flags.timeout,
-        max_retries: flags.max_retries,
-        cassette: flags.cassette.clone(),
-        reuse_cassette: flags.reuse_cassette.then_some(true),
-        usage_log: flags.usage_log.clone(),
-        model_path: flags.model_path.clone(),
-        threads: flags.threads,
-        grammar: flags.no_grammar.then_some(false),
+        structured: call.structured.then_some(true),
+        temperature: call.temperature,
+        timeout_secs: call.timeout,
+        max_retries: call.max_retries,
+        cassette: call.cassette.clone(),
+        usage_log: call.usage_log.clone(),
+        model_path: call.model_path.clone(),
+        threads: call.threads,
         ..Layer::default()
+    })
+}
+
+/// `flag_layer` over the `BETR_*` variables over the settings file (`--config` or the
+/// usual places), and the product's session options for those settings.
+pub(super) fn settings_from(flags: &LlmFlags, flag_layer: Layer) -> Result<(Settings, Options)> {
+    let var = |k: &str| std::env::var(k).ok();
+    let file = match FileConfig::locate(flags.config.as_deref(), &var) {
+        Some(path) => Some((FileConfig::read(&path)?, path)),
+        None => None,
     };
     let settings = Settings::resolve(
         file.as_ref()
@@ -235,71 +163,12 @@ pub fn settings(flags: &LlmFlags) -> Result<(Settings, Options)> {
         Layer::from_env(&var)?,
         flag_layer,
     )?;
-    let examples = flags.examples.as_deref().map(read_examples).transpose()?;
-    let templates = match &flags.prompts {
-        Some(dir) => Templates::from_dir(dir)?,
-        None => Templates::builtin(),
-    };
     let options = Options {
         temperature: settings.temperature,
         max_tokens: settings.max_tokens,
         structured: settings.structured,
         grammar: settings.grammar,
-        templates,
-        variant: Variant {
-            no_descriptions: flags.no_descriptions,
-            no_object_rule: flags.no_object_rule,
-            chain_of_thought: flags.cot,
-            // Examples given in a file (another prompt's) are shown as they are, all of them.
-            examples_shown: match (flags.examples_shown, &examples) {
-                (Some(k), _) => Some(k),
-                (None, Some(_)) => None,
-                (None, None) => Some(DEFAULT_EXAMPLES_SHOWN),
-            },
-            fixed_examples: flags.fixed_examples,
-            scene_word_examples: !flags.no_scene_word_examples,
-            scene_phrases: flags.scene_phrases,
-            examples,
-        },
-        candidates: flags.candidates.unwrap_or(DEFAULT_CANDIDATES).max(1),
-        beams: flags.beams.unwrap_or(betr::session::types::DEFAULT_BEAMS),
-        goal_feedback_rounds: flags.feedback_rounds.unwrap_or(2),
-        ablations: Ablations {
-            check_goals: !flags.no_checks,
-            read_by_parts: !flags.whole_request,
-            small_steps: flags.small_steps,
-            goal_prefix_in_prompt: flags.goal_prefix_in_prompt,
-            confirm_conditions: flags.confirm_conditions,
-            value_levels: !flags.value_as_number,
-            shortlist: !flags.no_shortlist,
-            without_misreadings: Vec::new(),
-        },
         ..Options::default()
     };
     Ok((settings, options))
-}
-
-fn read_examples(path: &Path) -> Result<Vec<Example>> {
-    #[derive(serde::Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct File {
-        examples: Vec<Raw>,
-    }
-    #[derive(serde::Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct Raw {
-        instruction: String,
-        goal: String,
-    }
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let file: File = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
-    Ok(file
-        .examples
-        .into_iter()
-        .map(|r| Example {
-            instruction: r.instruction,
-            goal: r.goal,
-        })
-        .collect())
 }

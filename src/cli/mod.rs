@@ -3,12 +3,8 @@
 #[macro_use]
 pub mod out;
 mod background_fetch;
-mod bench_cmd;
 mod engine_driver;
-mod eval_cmd;
-mod eval_setup;
 mod export_cmd;
-mod fuzz_cmd;
 mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
@@ -21,6 +17,19 @@ mod values;
 mod verify_cmd;
 mod viz_flags;
 mod voice_cmd;
+
+// The lab: experiments, benchmarks and fuzzing, which the product never uses (the `lab`
+// feature, on by default).
+#[cfg(feature = "lab")]
+mod bench_cmd;
+#[cfg(feature = "lab")]
+mod eval_cmd;
+#[cfg(feature = "lab")]
+mod eval_setup;
+#[cfg(feature = "lab")]
+mod fuzz_cmd;
+#[cfg(feature = "lab")]
+mod lab_flags;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -58,6 +67,7 @@ pub enum Command {
     /// betr against the tools it replaces, measured back to back on this machine: ticks
     /// against py_trees, planning and repair at scale, the embedded model against
     /// llama-bench, and the first answer of a one-shot command; one table, also as JSON.
+    #[cfg(feature = "lab")]
     Bench(bench_cmd::BenchArgs),
     /// The workbench: type an instruction, plan, step or run the tree, approve the fixes a
     /// model proposes when an action fails, verify, save the policy.
@@ -65,6 +75,7 @@ pub enum Command {
     #[command(hide = true)]
     PolicySaveTest(PolicySaveTest),
     /// Hidden: fuzz a reader of outside input (or all of them); see docs/FUZZ.md.
+    #[cfg(feature = "lab")]
     #[command(hide = true)]
     Fuzz(fuzz_cmd::FuzzArgs),
     /// Check the planned (or a saved) tree before it runs: structural rules, then every
@@ -92,6 +103,7 @@ pub enum Command {
     /// rerun recording (--to-rrd).
     Replay(replay_cmd::ReplayArgs),
     /// Reproduce the paper's experiments.
+    #[cfg(feature = "lab")]
     Eval {
         #[command(subcommand)]
         experiment: eval_cmd::EvalExperiment,
@@ -172,9 +184,12 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
             args.offline = offline;
             tui_cmd::tui(&args, cli.ascii)
         }
+        #[cfg(feature = "lab")]
         Command::Bench(args) => bench_cmd::run(&args),
         Command::PolicySaveTest(args) => policy_cmd::save_test(&args),
+        #[cfg(feature = "lab")]
         Command::Fuzz(args) => fuzz_cmd::run(&args),
+        #[cfg(feature = "lab")]
         Command::Eval { experiment } => eval_cmd::run(experiment),
         Command::Model { action } => model_cmd::run(action),
         Command::Knowledge { action } => knowledge_cmd::run(action),

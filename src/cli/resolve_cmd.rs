@@ -15,7 +15,7 @@ use betr::scenario::Scenario;
 use betr::session::submitted::{self, Submitted};
 use betr::session::{self, Ending, Event};
 
-use super::llm_cmds::{LlmFlags, setup};
+use super::llm_cmds::{CallFlags, LlmFlags, setup};
 
 /// What `betr resolve` is asked.
 #[derive(clap::Args)]
@@ -57,6 +57,8 @@ pub struct ResolveFlags {
     #[command(flatten)]
     pub llm: LlmFlags,
     #[command(flatten)]
+    pub call: CallFlags,
+    #[command(flatten)]
     pub stt: super::voice_cmd::SttFlags,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
@@ -83,6 +85,8 @@ pub struct InterpretArgs {
     #[command(flatten)]
     pub llm: LlmFlags,
     #[command(flatten)]
+    pub call: CallFlags,
+    #[command(flatten)]
     pub stt: super::voice_cmd::SttFlags,
 }
 
@@ -96,7 +100,12 @@ pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
         &args.stt,
         args.yes,
     )?;
-    interpret(&scenario, instruction.as_deref(), args.reading, &args.llm)
+    interpret(
+        &scenario,
+        instruction.as_deref(),
+        args.reading,
+        (&args.llm, &args.call),
+    )
 }
 
 /// `betr resolve`: the instruction typed or dictated, then the whole loop.
@@ -123,7 +132,7 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
             reading: args.reading,
             policies: &args.knowledge.dir,
         },
-        &args.llm,
+        (&args.llm, &args.call),
         glyphs,
     )
 }
@@ -132,7 +141,7 @@ fn interpret(
     scenario: &Scenario,
     instruction: Option<&str>,
     chosen: Option<u16>,
-    flags: &LlmFlags,
+    (flags, call): (&LlmFlags, &CallFlags),
 ) -> Result<ExitCode> {
     let instruction = instruction
         .map(str::to_string)
@@ -147,11 +156,11 @@ fn interpret(
         }
         Submitted::Instruction(text) => text,
     };
-    let llm = setup(flags)?;
+    let llm = setup(flags, call)?;
     llm.model.set_purpose("interpret");
     outln!("Scenario:    {}", scenario.name);
     outln!("Instruction: {instruction}");
-    let mut emit = |e: &Event| print_event(e, flags.show_replies);
+    let mut emit = |e: &Event| print_event(e, call.show_replies);
     let result = super::runtime()?.block_on(session::interpret::interpret_in_scenario(
         scenario,
         &instruction,
@@ -277,7 +286,7 @@ pub struct ResolveArgs<'a> {
 fn resolve(
     scenario: &Scenario,
     args: &ResolveArgs,
-    flags: &LlmFlags,
+    (flags, call): (&LlmFlags, &CallFlags),
     glyphs: &Glyphs,
 ) -> Result<ExitCode> {
     // The instruction read before any model is asked: empty text and a formula the scene
@@ -307,7 +316,7 @@ fn resolve(
     {
         betr::store::check_writable(&path).context("--learn")?;
     }
-    let mut llm = setup(flags)?;
+    let mut llm = setup(flags, call)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
     llm.options.choose_reading = true;
@@ -338,7 +347,7 @@ fn resolve(
             Event::TreeChanged { .. } => last = None,
             _ => {}
         }
-        print_event(e, flags.show_replies);
+        print_event(e, call.show_replies);
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);

@@ -60,9 +60,6 @@ pub struct TuiArgs {
     /// machines without one, demonstrations and tests).
     #[arg(long, value_name = "FILE.wav")]
     pub audio: Option<PathBuf>,
-    /// Speech-to-text for push-to-talk (the dictation key).
-    #[command(flatten)]
-    pub stt: super::voice_cmd::SttFlags,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
 }
@@ -199,9 +196,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    // Bad speech settings disable dictation (saying why when the key is pressed), not
-    // the workbench.
-    let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &args.stt)
+    // Speech-to-text for push-to-talk comes from the settings file and the `BETR_STT*`
+    // variables. Bad speech settings disable dictation (saying why when the key is
+    // pressed), not the workbench.
+    let no_flags = super::voice_cmd::SttFlags::default();
+    let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &no_flags)
         .map(super::voice_cmd::workbench_loader)
         .map_err(|e| betr::tui::dictation::DictationError::Settings {
             reason: format!("{e:#}"),

@@ -5,6 +5,7 @@ pub mod chart;
 pub mod chart_runs;
 pub mod goals;
 pub mod goals_run;
+pub mod levers;
 pub mod params;
 pub mod resolve;
 pub mod run;

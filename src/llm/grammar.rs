@@ -97,9 +97,6 @@ pub fn atom_rules(vocabulary: &Vocabulary, wildcard: bool) -> String {
     out
 }
 
-/// The words a goal's answer begins with.
-pub const GOAL_PREFIX: &str = "Goal:";
-
 /// `Goal: <formula>` with `&`, `|`, `~` and parentheses over the vocabulary's atoms;
 /// with `reasoning`, a free `Reasoning:` line comes first (the chain-of-thought prompt).
 pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) -> String {
@@ -118,14 +115,6 @@ pub fn goal_grammar(vocabulary: &Vocabulary, wildcard: bool, reasoning: bool) ->
 pub fn one_of_grammar(words: &[&str]) -> String {
     let alternatives: Vec<String> = words.iter().map(|w| lit(w)).collect();
     format!("root ::= {}\n", alternatives.join(" | "))
-}
-
-/// The rest of a goal's answer after [`GOAL_PREFIX`], written for the model: a space and
-/// the formula, as [`goal_grammar`] types it.
-pub fn goal_grammar_after_prefix(vocabulary: &Vocabulary, wildcard: bool) -> String {
-    let mut g = String::from("root ::= \" \" formula\n");
-    g.push_str(&formula_rules(vocabulary, wildcard));
-    g
 }
 
 /// The formula's rules, below the root.
@@ -251,13 +240,6 @@ mod tests {
     fn answer_grammars_have_their_prefix() {
         let g = goal_grammar(&vocab(), false, false);
         assert!(g.starts_with("root ::= \"Goal: \" formula"));
-        // Continuing the prefix written for the model: the same formula after a space.
-        let after = goal_grammar_after_prefix(&vocab(), false);
-        assert!(after.starts_with("root ::= \" \" formula\n"), "{after}");
-        assert_eq!(
-            after.split_once('\n').map(|(_, rules)| rules),
-            g.split_once('\n').map(|(_, rules)| rules)
-        );
         // `&` and `|` never share a level: mixing them needs parentheses.
         assert!(
             g.contains("formula ::= factor ( ( \" & \" factor ){1,7} | ( \" | \" factor ){1,3} )?"),

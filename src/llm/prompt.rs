@@ -34,17 +34,11 @@ pub struct Variant {
     /// How many examples to show, chosen from the pool by similarity to the request
     /// (`None`: every example of the pool, in pool order).
     pub examples_shown: Option<usize>,
-    /// Show the pool's first `examples_shown` examples for every request instead of the
-    /// most similar ones (the ablation of retrieval).
-    pub fixed_examples: bool,
     /// Also show examples made from the scene's own words for the request
     /// (`examples::from_scene_words`, after the pool's): what the request asks of one
     /// object in the words the scene lists, said with the scene's phrase, with the
     /// condition; off: the pool's examples alone.
     pub scene_word_examples: bool,
-    /// Show beside each condition the phrases the scene lists for it and for its opposite
-    /// (`says`, `opposite`); off: its description alone.
-    pub scene_phrases: bool,
 }
 
 impl Default for Variant {
@@ -55,9 +49,7 @@ impl Default for Variant {
             chain_of_thought: false,
             examples: None,
             examples_shown: Some(DEFAULT_EXAMPLES_SHOWN),
-            fixed_examples: false,
             scene_word_examples: true,
-            scene_phrases: false,
         }
     }
 }
@@ -67,7 +59,6 @@ impl Variant {
     pub fn choose<'a>(&self, pool: &'a [Example], request: &str) -> Vec<&'a Example> {
         match self.examples_shown {
             None => pool.iter().collect(),
-            Some(k) if self.fixed_examples => pool.iter().take(k).collect(),
             Some(k) => super::examples::nearest(pool, request, k),
         }
     }
@@ -128,10 +119,6 @@ pub struct Context<'a> {
     pub variant: &'a Variant,
 }
 
-/// The answers to [`Context::condition_question`]: the condition must be true, must be
-/// false, or is not asked about.
-pub const CONDITION_VERDICTS: [&str; 3] = ["true", "false", "unasked"];
-
 /// The role statement shared by all prompts (the system message).
 pub const ROLE: &str = "You are the reasoning part of a robot that plans with behavior trees. You answer in the exact format asked for, using only the conditions and objects you are given.";
 
@@ -149,11 +136,7 @@ impl Context<'_> {
         vec![
             (
                 "vocabulary",
-                vocabulary_text(
-                    vocabulary,
-                    !self.variant.no_descriptions,
-                    self.variant.scene_phrases,
-                ),
+                vocabulary_text(vocabulary, !self.variant.no_descriptions),
             ),
             ("objects", objects_text(vocabulary)),
             (
@@ -198,42 +181,6 @@ impl Context<'_> {
             } else {
                 "Answer with exactly one line and nothing else:\nGoal: <formula>".into()
             },
-        ));
-        Ok(messages(fill("goal.md", &templates.goal, &values)?))
-    }
-
-    /// The goal prompt asking first for the objects and places the request names, by
-    /// their names in the scene (`Named: a, b`), not yet for the goal: the same prompt
-    /// up to its answer format, so a model that keeps a prompt's state reuses it.
-    pub fn names(&self, templates: &Templates) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common(true);
-        values.push(("conventions", self.conventions_text()));
-        values.push((
-            "answer_format",
-            "Do not write the goal yet. First name the objects and places of this scene that the request names or means (a kind of thing means every object of that kind), by their names in the list of objects, exactly like this:\nNamed: <name>, <name>".into(),
-        ));
-        Ok(messages(fill("goal.md", &templates.goal, &values)?))
-    }
-
-    /// The goal prompt asking, instead of the goal, about one condition of a goal read
-    /// from the request: must it be true when the request has been carried out, must it
-    /// be false, or does the request not ask about it. The same prompt up to its answer
-    /// format, so a model that keeps a prompt's state answers each condition for the few
-    /// tokens of its question. `condition`: the atom as written; `words`: it in words.
-    pub fn condition_question(
-        &self,
-        templates: &Templates,
-        condition: &str,
-        words: &str,
-    ) -> Result<Vec<Message>, PromptError> {
-        let mut values = self.common(true);
-        values.push(("conventions", self.conventions_text()));
-        values.push((
-            "answer_format",
-            format!(
-                "Do not write the goal. Think only of this condition: {condition} ({words}). When the request has been carried out, must it be true, must it be false, or does the request not ask about it at all? Answer with one word: {}, {} or {}.",
-                CONDITION_VERDICTS[0], CONDITION_VERDICTS[1], CONDITION_VERDICTS[2]
-            ),
         ));
         Ok(messages(fill("goal.md", &templates.goal, &values)?))
     }

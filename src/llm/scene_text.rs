@@ -1,14 +1,13 @@
 //! The scene as a prompt writes it: the conditions the robot understands (each with its
-//! description and, when asked, the phrases the scene lists for it), the objects grouped
+//! description), the objects grouped
 //! by type with what people call them, and the facts that hold now.
 
 use crate::domain::{ANY_OBJECT, Condition, Vocabulary};
 
-/// One line per predicate: its written form with argument types, its description, and
-/// with `phrases` the phrases the scene lists for it and its opposite; for quoted-form
-/// vocabularies, a line on the `"any object"` wildcard.
-pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool, phrases: bool) -> String {
-    let mut text = predicate_lines(vocabulary, descriptions, phrases);
+/// One line per predicate: its written form with argument types and its description; for
+/// quoted-form vocabularies, a line on the `"any object"` wildcard.
+pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool) -> String {
+    let mut text = predicate_lines(vocabulary, descriptions);
     // Explained with a placeholder, not a real object: small models copy a concrete
     // example verbatim as their answer.
     let binary = vocabulary
@@ -24,7 +23,7 @@ pub fn vocabulary_text(vocabulary: &Vocabulary, descriptions: bool, phrases: boo
     text
 }
 
-fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool, phrases: bool) -> String {
+fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool) -> String {
     vocabulary
         .predicates
         .iter()
@@ -47,40 +46,14 @@ fn predicate_lines(vocabulary: &Vocabulary, descriptions: bool, phrases: bool) -
                 }
                 s
             };
-            let mut line = if descriptions && !p.description.is_empty() {
+            if descriptions && !p.description.is_empty() {
                 format!("- {form}: {}", p.description)
             } else {
                 format!("- {form}")
-            };
-            if phrases {
-                line.push_str(&said_phrases(&p.words.says, &p.words.opposite));
             }
-            line
         })
         .collect::<Vec<_>>()
         .join("\n")
-}
-
-/// The phrases a scene lists for a condition and for its opposite, as the end of its line
-/// (` (said: "go to", "head to"; the opposite: "leave")`), or nothing when it lists none.
-fn said_phrases(says: &[String], opposite: &[String]) -> String {
-    let quoted = |phrases: &[String]| {
-        phrases
-            .iter()
-            .map(|w| format!("\"{w}\""))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    match (says.is_empty(), opposite.is_empty()) {
-        (true, true) => String::new(),
-        (false, true) => format!(" (said: {})", quoted(says)),
-        (true, false) => format!(" (the opposite said: {})", quoted(opposite)),
-        (false, false) => format!(
-            " (said: {}; the opposite: {})",
-            quoted(says),
-            quoted(opposite)
-        ),
-    }
 }
 
 /// The objects grouped by type, types in first-seen order; an object the scene says people

@@ -26,14 +26,11 @@ pub(crate) async fn ask(
     (schema, grammar): (OutputConstraint, &(dyn Fn() -> String + Sync)),
     options: &Options,
     seed: Option<u64>,
-    prefill: Option<&str>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<ChatReply, SessionError> {
     let mut request = prompt::request(messages, options.temperature, options.max_tokens);
     request.seed = seed;
     if options.grammar && model.supports_grammar() {
-        // `grammar` types what follows the words written for the model.
-        request.prefill = prefill.map(str::to_string);
         request.constraint = Some(OutputConstraint::Grammar {
             name: "answer".into(),
             gbnf: grammar(),
@@ -176,7 +173,6 @@ async fn draw_and_screen(
             (constraint.0.clone(), constraint.1),
             &opts,
             seed,
-            None,
             emit,
         )
         .await?;
@@ -326,7 +322,7 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let list = if options.ablations.shortlist {
+    let list = if options.steps.shortlist {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a
@@ -411,7 +407,7 @@ pub(crate) async fn ask_value(
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
     // The first question about a number asks for a level of the robot's range; once the
     // world has answered, the next ones ask for numbers.
-    let levels = if tried.is_empty() && options.ablations.value_levels {
+    let levels = if tried.is_empty() && options.steps.value_levels {
         as_levels(param)
     } else {
         None

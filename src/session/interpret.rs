@@ -13,10 +13,11 @@
 //! chosen goal's alternatives are put in the order the request names them, since a
 //! behavior tree tries them in that order.
 
+use crate::domain::Vocabulary;
 use crate::goal::{self, Formula};
 use crate::llm::prompt::Context;
 use crate::llm::reply::{self, GoalAnswer, ReplyError};
-use crate::llm::{LanguageModel, Message, Role, grammar, schema};
+use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, Role, grammar, schema};
 use crate::reading::Request;
 use crate::reading::lexicon::{Lexicon, in_request_order};
 use crate::reading::parts::split;
@@ -68,9 +69,9 @@ pub async fn interpret_in_scenario(
 }
 
 /// Ask for the goal `instruction` means in `scenario`, in the state of `world`, checked
-/// as the module says (`options.ablations.check_goals` off: the first usable answer, as the paper's
+/// as the module says (`options.steps.check_goals` off: the first usable answer, as the paper's
 /// single call). A request of several wishes is read a wish at a time
-/// (`options.ablations.read_by_parts`, see [`super::interpret_parts`]) when checks are on.
+/// (`options.steps.read_by_parts`, see [`super::interpret_parts`]) when checks are on.
 pub async fn interpret(
     scenario: &Scenario,
     world: Box<dyn World>,
@@ -80,24 +81,13 @@ pub async fn interpret(
     emit: &mut (dyn FnMut(&Event) + Send),
 ) -> Result<Interpretation, SessionError> {
     let mut earlier_calls = 0;
-    let asked_in = world.fork();
-    if options.ablations.check_goals && options.ablations.read_by_parts {
+    if options.steps.check_goals && options.steps.read_by_parts {
         let lexicon = Lexicon::new(&scenario.domain.vocabulary, example_pool(scenario, options));
         let parts = split(instruction, &lexicon);
         if parts.len() > 1 {
             let forked = world.fork();
             match read_parts(scenario, forked, &parts, instruction, model, options, emit).await? {
                 PartsRead::Read(found) => {
-                    let found = super::confirm::confirmed(
-                        scenario,
-                        asked_in,
-                        instruction,
-                        found,
-                        model,
-                        options,
-                        emit,
-                    )
-                    .await?;
                     announce(scenario, &found, emit);
                     return Ok(found);
                 }
@@ -107,9 +97,6 @@ pub async fn interpret(
     }
     let mut found = read_goal(scenario, world, instruction, false, model, options, emit).await?;
     found.calls += earlier_calls;
-    let found =
-        super::confirm::confirmed(scenario, asked_in, instruction, found, model, options, emit)
-            .await?;
     announce(scenario, &found, emit);
     Ok(found)
 }
@@ -121,7 +108,8 @@ pub(super) fn example_pool<'a>(
     options: &'a Options,
 ) -> &'a [crate::scenario::Example] {
     options
-        .variant
+        .steps
+        .prompt
         .examples
         .as_deref()
         .unwrap_or(&scenario.examples)
@@ -153,209 +141,48 @@ pub(super) async fn read_goal(
         scenario,
         facts: &facts,
         instruction,
-        variant: &options.variant,
+        variant: &options.steps.prompt,
     };
     let mut messages = ctx.goal(&options.templates)?;
-    let pool = example_pool(scenario, options);
-    let lexicon = Lexicon::new(&scenario.domain.vocabulary, pool);
-    let request = Request::new(instruction, scenario, &lexicon);
-    let judge = Judge::new(scenario, world, request, options, one_of_several)?;
     let vocabulary = &scenario.domain.vocabulary;
-    let constraint = schema::goal(vocabulary);
-    let cot = options.variant.chain_of_thought;
-    // The answer's `Goal:` written into the prompt for the model to continue, the grammar
-    // typing only the formula (an ablation), or the grammar typing both.
-    let prefill = (options.ablations.goal_prefix_in_prompt && !cot).then_some(grammar::GOAL_PREFIX);
-    let typed = |v: &crate::domain::Vocabulary| match prefill {
-        Some(_) => grammar::goal_grammar_after_prefix(v, true),
-        None => grammar::goal_grammar(v, true, cot),
+    let lexicon = Lexicon::new(vocabulary, example_pool(scenario, options));
+    let request = Request::new(instruction, scenario, &lexicon);
+    let mut judge = Judge::new(scenario, world, request, options, one_of_several)?;
+    let drawer = Drawer {
+        model,
+        options,
+        vocabulary,
+        constraint: schema::goal(vocabulary),
     };
-    let goal_grammar = || typed(vocabulary);
-    let mut calls = 0;
-    // The small step first: the objects the request names type the first answer.
-    let mut narrowed: Option<crate::domain::Vocabulary> = None;
-    if options.ablations.small_steps && !cot && options.grammar && model.supports_grammar() {
-        calls += 1;
-        if let Some(named) = super::named_first::named_objects(&ctx, model, options, emit).await? {
-            narrowed = super::named_first::narrowed(vocabulary, &named);
-        }
-    }
-    let narrowed_grammar = || match &narrowed {
-        Some(v) => typed(v),
-        None => goal_grammar(),
-    };
-    let mut first: Option<Option<Formula>> = None;
-    let rounds = if options.ablations.check_goals {
+    let checks = options.steps.check_goals;
+    let rounds = if checks {
         options.goal_feedback_rounds + 1
     } else {
         1
     };
-    let mut last_error = ReplyError::NoConditions;
+    let mut drawn = Drawn {
+        calls: 0,
+        first: None,
+        last_error: ReplyError::NoConditions,
+        runners_up: Vec::new(),
+    };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
-    // The model's runners-up to its first answer (beams), judged like any candidate.
-    let mut runners_up: Vec<Candidate> = Vec::new();
     for round in 0..rounds {
-        let mut candidates: Vec<Candidate> = Vec::new();
-        let draws = if options.ablations.check_goals {
-            options.candidates.max(1)
-        } else {
-            1
-        };
-        for draw in 0..draws {
-            emit(&Event::Asking {
-                what: if draw == 0 {
-                    "the goal of the instruction".into()
-                } else {
-                    format!("another candidate goal ({} of {draws})", draw + 1)
-                },
-            });
-            let mut opts = options.clone();
-            let seed = if draw > 0 {
-                opts.temperature = opts.temperature.max(SAMPLE_TEMPERATURE);
-                Some(draw as u64)
-            } else {
-                None
-            };
-            let typed_by: &(dyn Fn() -> String + Sync) = if round == 0 && draw == 0 {
-                &narrowed_grammar
-            } else {
-                &goal_grammar
-            };
-            let r = ask(
-                model,
-                messages.clone(),
-                (constraint.clone(), typed_by),
-                &opts,
-                seed,
-                prefill,
-                emit,
-            )
-            .await?;
-            calls += 1;
-            if round == 0 && draw == 0 && options.ablations.check_goals {
-                runners_up = r
-                    .ranked
-                    .iter()
-                    .skip(1)
-                    .map(|(text, _)| {
-                        let read = reply::goal(text, vocabulary, options.min_similarity);
-                        let problem = match &read {
-                            Err(e) => Some(GoalProblem::wrong(e.to_string())),
-                            Ok(a) => judge.assess(&a.goal),
-                        };
-                        Candidate {
-                            text: text.clone(),
-                            read,
-                            problem,
-                            first: false,
-                        }
-                    })
-                    .collect();
-            }
-            let read = reply::goal(&r.text, vocabulary, options.min_similarity);
-            let problem = match &read {
-                Err(e) => Some(GoalProblem::wrong(e.to_string())),
-                Ok(_) if !options.ablations.check_goals => None,
-                Ok(a) => judge.assess(&a.goal),
-            };
-            if first.is_none() {
-                first = Some(read.as_ref().ok().map(|a| a.goal.clone()));
-            }
-            match (&read, &problem) {
-                (Err(e), _) => {
-                    emit(&Event::InvalidReply {
-                        error: e.to_string(),
-                    });
-                    last_error = e.clone();
-                }
-                (Ok(a), Some(p)) => emit(&Event::CandidateRejected {
-                    candidate: a.goal.to_string(),
-                    proposal: None,
-                    reason: p.reason.clone(),
-                    author: None,
-                }),
-                (Ok(_), None) => {}
-            }
-            let first_draw = round == 0 && draw == 0;
-            let derived = judge.derived(
-                &read,
-                problem.as_ref(),
-                options.ablations.check_goals,
-                first_draw,
-                emit,
-            );
-            candidates.push(Candidate {
-                text: r.text,
-                read,
-                problem,
-                first: first_draw,
-            });
-            candidates.extend(derived);
-            // More draws only for a first answer that is wrong: one that passes (or
-            // passes once what it pasted is taken out) is taken, and a doubtful one is
-            // kept, since sampled alternatives to the model's best answer are worse more
-            // often than better.
-            // One exception: a first answer that plainly misread the request (left out a
-            // number it says, or put an unnamed object in the place of a named one); more
-            // candidates are drawn, and one that does not misread wins the vote.
-            let misread = candidates
-                .first()
-                .and_then(|c| c.read.as_ref().ok())
-                .and_then(|a| judge.misread(&a.goal));
-            if draw > 0 {
-                continue;
-            }
-            let settled = match &misread {
-                Some(_) if options.ablations.check_goals => {
-                    candidates.iter().any(|c| judge.answers_request(c))
-                }
-                _ => candidates.iter().any(|c| c.clean() || c.doubtful()),
-            };
-            if settled {
-                break;
-            }
-            // Before any sample: the model's own runners-up, which cost no call.
-            if !runners_up.is_empty() {
-                candidates.append(&mut runners_up);
-                if candidates.iter().any(|c| judge.answers_request(c)) {
-                    emit(&Event::Notice {
-                        message: "the first answer fails its checks: the model's next most likely answers are candidates".into(),
-                    });
-                    break;
-                }
-            }
-            if let Some(why) = misread
-                && options.ablations.check_goals
-            {
-                emit(&Event::Notice {
-                    message: format!("{why}: drawing more candidates"),
-                });
-            }
-        }
+        let candidates =
+            draw_round(&drawer, &mut judge, &messages, round, &mut drawn, emit).await?;
         // A doubtful answer is taken when it is the model's own first answer, or when no
         // round is left: a doubtful sample after a wrong first answer is asked about again
         // (told why), and stays eligible for the last round's vote.
         let last_round = round + 1 == rounds;
-        let chosen = judge.choose(&candidates, &set_aside, last_round);
-        if let Some((mut answer, doubt)) = chosen {
-            if options.ablations.check_goals {
-                let ordered = in_request_order(&lexicon, &answer.goal, &judge.request.terms);
-                if ordered != answer.goal {
-                    emit(&Event::Notice {
-                        message: format!(
-                            "alternatives put in the order the request names them: {ordered}"
-                        ),
-                    });
-                    answer.goal = ordered;
-                }
-            }
-            let others: Vec<&Candidate> = set_aside.iter().chain(&runners_up).collect();
+        if let Some((answer, doubt)) = judge.choose(&candidates, &set_aside, last_round) {
+            let answer = in_asked_order(answer, &lexicon, &judge, checks, emit);
+            let others: Vec<&Candidate> = set_aside.iter().chain(&drawn.runners_up).collect();
             let readings = judge.readings(&answer.goal, &candidates, &others, MAX_READINGS);
             return Ok(Interpretation {
                 answer,
-                first: first.flatten(),
-                calls,
+                first: drawn.first.flatten(),
+                calls: drawn.calls,
                 feedback_rounds: round,
                 doubt,
                 readings,
@@ -367,9 +194,223 @@ pub(super) async fn read_goal(
         }
     }
     Err(SessionError::NoGoal {
-        attempts: calls,
-        last: last_error,
+        attempts: drawn.calls,
+        last: drawn.last_error,
     })
+}
+
+/// What every draw of one reading shares: the model, the options, and the answer's format
+/// (a JSON schema for servers that take one, a grammar for the embedded model).
+struct Drawer<'a> {
+    model: &'a dyn LanguageModel,
+    options: &'a Options,
+    vocabulary: &'a Vocabulary,
+    constraint: OutputConstraint,
+}
+
+/// What the draws of one reading found so far, over its rounds.
+struct Drawn {
+    /// Calls made.
+    calls: usize,
+    /// The first call's answer as it came, once asked (`None` inside: unusable).
+    first: Option<Option<Formula>>,
+    /// Why the last unusable reply was refused (the error when no goal is found).
+    last_error: ReplyError,
+    /// The model's runners-up to its first answer (beams), judged like any candidate.
+    runners_up: Vec<Candidate>,
+}
+
+impl Drawer<'_> {
+    /// Draw `draw` of `draws` from the conversation `messages`: the first greedy, the
+    /// others sampled (seeded by their draw) at a temperature that makes them differ.
+    async fn ask(
+        &self,
+        messages: &[Message],
+        draw: usize,
+        draws: usize,
+        emit: &mut (dyn FnMut(&Event) + Send),
+    ) -> Result<ChatReply, SessionError> {
+        emit(&Event::Asking {
+            what: if draw == 0 {
+                "the goal of the instruction".into()
+            } else {
+                format!("another candidate goal ({} of {draws})", draw + 1)
+            },
+        });
+        let mut opts = self.options.clone();
+        let seed = if draw > 0 {
+            opts.temperature = opts.temperature.max(SAMPLE_TEMPERATURE);
+            Some(draw as u64)
+        } else {
+            None
+        };
+        let cot = self.options.steps.prompt.chain_of_thought;
+        let typed = || grammar::goal_grammar(self.vocabulary, true, cot);
+        let constraint = (
+            self.constraint.clone(),
+            &typed as &(dyn Fn() -> String + Sync),
+        );
+        ask(self.model, messages.to_vec(), constraint, &opts, seed, emit).await
+    }
+
+    /// A reply read as a goal over the vocabulary and, with checks on, judged.
+    fn judged(&self, judge: &Judge<'_>, text: &str, first: bool) -> Candidate {
+        let read = reply::goal(text, self.vocabulary, self.options.min_similarity);
+        let problem = match &read {
+            Err(e) => Some(GoalProblem::wrong(e.to_string())),
+            Ok(_) if !self.options.steps.check_goals => None,
+            Ok(a) => judge.assess(&a.goal),
+        };
+        Candidate {
+            text: text.to_string(),
+            read,
+            problem,
+            first,
+        }
+    }
+}
+
+/// One round's candidates: the first answer, what the judge derives from it, and more
+/// draws only when the first does not settle the round (with checks on).
+async fn draw_round(
+    drawer: &Drawer<'_>,
+    // Mutable only to be sent between threads with the future: a judge is `Send`, not
+    // `Sync` (its world is not).
+    judge: &mut Judge<'_>,
+    messages: &[Message],
+    round: usize,
+    drawn: &mut Drawn,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> Result<Vec<Candidate>, SessionError> {
+    let checks = drawer.options.steps.check_goals;
+    let draws = if checks {
+        drawer.options.candidates.max(1)
+    } else {
+        1
+    };
+    let mut candidates: Vec<Candidate> = Vec::new();
+    for draw in 0..draws {
+        let r = drawer.ask(messages, draw, draws, emit).await?;
+        drawn.calls += 1;
+        let first_draw = round == 0 && draw == 0;
+        if first_draw && checks {
+            drawn.runners_up = r
+                .ranked
+                .iter()
+                .skip(1)
+                .map(|(text, _)| drawer.judged(judge, text, false))
+                .collect();
+        }
+        let candidate = drawer.judged(judge, &r.text, first_draw);
+        if drawn.first.is_none() {
+            drawn.first = Some(candidate.read.as_ref().ok().map(|a| a.goal.clone()));
+        }
+        report(&candidate, &mut drawn.last_error, emit);
+        let derived = judge.derived(
+            &candidate.read,
+            candidate.problem.as_ref(),
+            checks,
+            first_draw,
+            emit,
+        );
+        candidates.push(candidate);
+        candidates.extend(derived);
+        if draw == 0 && settled(judge, &mut candidates, &mut drawn.runners_up, checks, emit) {
+            break;
+        }
+    }
+    Ok(candidates)
+}
+
+/// Tell the front end why a candidate is refused (unusable, or failing a check), keeping
+/// the last unusable reply's error.
+fn report(
+    candidate: &Candidate,
+    last_error: &mut ReplyError,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) {
+    match (&candidate.read, &candidate.problem) {
+        (Err(e), _) => {
+            emit(&Event::InvalidReply {
+                error: e.to_string(),
+            });
+            *last_error = e.clone();
+        }
+        (Ok(a), Some(p)) => emit(&Event::CandidateRejected {
+            candidate: a.goal.to_string(),
+            proposal: None,
+            reason: p.reason.clone(),
+            author: None,
+        }),
+        (Ok(_), None) => {}
+    }
+}
+
+/// After a round's first draw: whether its candidates settle the round, the model's
+/// runners-up (which cost no call) joined to them before any sample is drawn.
+///
+/// More draws only for a first answer that is wrong: one that passes (or passes once what
+/// it pasted is taken out) is taken, and a doubtful one is kept, since sampled
+/// alternatives to the model's best answer are worse more often than better. One
+/// exception: a first answer that plainly misread the request (left out a number it says,
+/// or put an unnamed object in the place of a named one); more candidates are drawn, and
+/// one that does not misread wins the vote.
+fn settled(
+    judge: &Judge<'_>,
+    candidates: &mut Vec<Candidate>,
+    runners_up: &mut Vec<Candidate>,
+    checks: bool,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> bool {
+    let misread = candidates
+        .first()
+        .and_then(|c| c.read.as_ref().ok())
+        .and_then(|a| judge.misread(&a.goal));
+    let settled = match &misread {
+        Some(_) if checks => candidates.iter().any(|c| judge.answers_request(c)),
+        _ => candidates.iter().any(|c| c.clean() || c.doubtful()),
+    };
+    if settled {
+        return true;
+    }
+    if !runners_up.is_empty() {
+        candidates.append(runners_up);
+        if candidates.iter().any(|c| judge.answers_request(c)) {
+            emit(&Event::Notice {
+                message: "the first answer fails its checks: the model's next most likely answers are candidates".into(),
+            });
+            return true;
+        }
+    }
+    if let Some(why) = misread
+        && checks
+    {
+        emit(&Event::Notice {
+            message: format!("{why}: drawing more candidates"),
+        });
+    }
+    false
+}
+
+/// With checks on, the chosen answer's alternatives put in the order the request names
+/// them, since a behavior tree tries them in that order.
+fn in_asked_order(
+    mut answer: GoalAnswer,
+    lexicon: &Lexicon,
+    judge: &Judge<'_>,
+    checks: bool,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) -> GoalAnswer {
+    if checks {
+        let ordered = in_request_order(lexicon, &answer.goal, &judge.request.terms);
+        if ordered != answer.goal {
+            emit(&Event::Notice {
+                message: format!("alternatives put in the order the request names them: {ordered}"),
+            });
+            answer.goal = ordered;
+        }
+    }
+    answer
 }
 
 fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Event) + Send)) {

@@ -68,11 +68,9 @@ impl<'a> Judge<'a> {
         Ok(Judge {
             scenario,
             world,
-            shown: options.variant.choose(pool, request.text),
+            shown: options.steps.prompt.choose(pool, request.text),
             request,
-            misreadings: crate::reading::misreadings_without(
-                &options.ablations.without_misreadings,
-            )?,
+            misreadings: crate::reading::misreadings_without(&options.steps.without_misreadings)?,
             one_of_several,
         })
     }

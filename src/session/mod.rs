@@ -4,7 +4,6 @@
 //! them and show the events they emit; nothing here prints or reads a terminal.
 
 pub mod ask;
-mod confirm;
 pub mod edit;
 pub mod engine;
 pub mod evidence;
@@ -13,7 +12,6 @@ pub mod interpret;
 mod interpret_parts;
 mod judge;
 pub mod knowledge;
-mod named_first;
 pub mod planned;
 pub mod policy;
 mod question;
@@ -42,7 +40,9 @@ pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use readings::Reading;
 pub use resolve::{resolve, resolve_with_scenes};
-pub use types::{BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};
+pub use types::{
+    BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError, Steps,
+};
 
 /// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),
 /// its scene's path and scenario, and its goal: the misreading checks must find nothing in

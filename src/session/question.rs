@@ -66,7 +66,7 @@ impl Question {
             scenario: &scenario,
             facts: &facts,
             instruction: &instruction,
-            variant: &options.variant,
+            variant: &options.steps.prompt,
         };
         let failed = FailedAction {
             node: failure.node,

@@ -52,7 +52,6 @@ pub struct Options {
     /// How alike a listed name must be to be offered ("did you mean …?") for a name of a
     /// reply that the scene does not have; nothing is ever replaced by it.
     pub min_similarity: f64,
-    pub variant: Variant,
     pub templates: Templates,
     /// Constrain replies with a JSON schema when the model supports it.
     pub structured: bool,
@@ -66,16 +65,19 @@ pub struct Options {
     /// different things, offer them for the person to choose (`Event::Readings`); off:
     /// the best one is taken.
     pub choose_reading: bool,
-    /// What an evaluation turns off (or on) to measure what each part earns.
-    pub ablations: Ablations,
+    /// How the instruction is read and the failure asked about: the product's are the
+    /// defaults; only the lab builds others.
+    pub steps: Steps,
 }
 
-/// The parts of reading and asking an evaluation turns off (or on) to measure what each
-/// earns (`betr eval`, and the same flags of the one-shot commands for diagnosis). The
-/// workbench and `betr resolve` run with the defaults, which are what the measurements
-/// chose.
+/// How an instruction is read and a failure asked about: the prompt's shape and the steps
+/// around each question. The workbench and the one-shot commands always run the default,
+/// which is what the measurements of docs/EVAL.md chose; only the lab (`betr eval`, which
+/// builds these from its own flags) runs others, to measure what each step earns.
 #[derive(Debug, Clone)]
-pub struct Ablations {
+pub struct Steps {
+    /// The shape of the prompts (parts left out, chain of thought, which examples).
+    pub prompt: Variant,
     /// Check every goal read from an instruction (parses, not contradictory, not true
     /// already, plannable) and draw more candidates when the first fails; off: the
     /// first usable answer is taken, as the paper's single call.
@@ -83,10 +85,6 @@ pub struct Ablations {
     /// With checks on, read a request of several wishes one wish at a time and join the
     /// goals as the request joins them; off: the request is read whole.
     pub read_by_parts: bool,
-    /// Before a goal's first answer, ask the model which of the scene's objects and places
-    /// the request names, and type the first answer over those only
-    /// (`session::named_first`); off: the first answer is typed over the whole scene.
-    pub small_steps: bool,
     /// Ask the first value of a numeric parameter as a level of the robot's declared
     /// range (very low … very high), turned into a number by betr; off: as a number.
     pub value_levels: bool,
@@ -94,30 +92,20 @@ pub struct Ablations {
     /// in simulation and let the model choose among those that fix it; off: the model
     /// names the condition out of the whole vocabulary.
     pub shortlist: bool,
-    /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): an
-    /// evaluation's way to measure what each earns; empty in use.
+    /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): empty
+    /// but in the lab, which measures what each earns.
     pub without_misreadings: Vec<String>,
-    /// With a grammar, write a goal answer's `Goal:` into the prompt for the model to
-    /// continue and type only the formula; off: the grammar types the whole answer,
-    /// `Goal:` included.
-    pub goal_prefix_in_prompt: bool,
-    /// After a goal is read, ask the model about each of its conditions (wanted true,
-    /// false, or not asked about) and change the goal where the answers say so
-    /// (`session::confirm`); off: the goal stands as read and checked.
-    pub confirm_conditions: bool,
 }
 
-impl Default for Ablations {
+impl Default for Steps {
     fn default() -> Self {
-        Ablations {
+        Steps {
+            prompt: Variant::default(),
             check_goals: true,
             read_by_parts: true,
-            small_steps: false,
             value_levels: true,
             shortlist: true,
             without_misreadings: Vec::new(),
-            goal_prefix_in_prompt: false,
-            confirm_conditions: false,
         }
     }
 }
@@ -140,13 +128,12 @@ impl Default for Options {
             temperature: 0.0,
             max_tokens: 800,
             min_similarity: reply::MIN_SIMILARITY,
-            variant: Variant::default(),
             templates: Templates::builtin(),
             structured: false,
             grammar: true,
             beams: DEFAULT_BEAMS,
             choose_reading: false,
-            ablations: Ablations::default(),
+            steps: Steps::default(),
         }
     }
 }

@@ -59,14 +59,15 @@ fn durations_and_counts_out_of_range_are_refused_with_the_range() {
         &interpret(&dir, &base, &["--max-retries", "4000000000"]),
         "max_retries = ",
     );
+    // The lab's levers, on the command that takes them.
     for k in ["4294967296", "18446744073709551615", "101"] {
         refused(
-            &interpret(&dir, &base, &["--examples-shown", k]),
+            &betr(&dir, &["eval", "goals", "--examples-shown", k]),
             "is not in 0..=100",
         );
     }
     refused(
-        &interpret(&dir, &base, &["--candidates", "0"]),
+        &betr(&dir, &["eval", "goals", "--candidates", "0"]),
         "is not in 1..=64",
     );
     let scenario = cafe();

@@ -38,7 +38,6 @@ mod resolve_loop;
 mod run_anywhere;
 mod scenario_doc;
 mod scenario_files;
-mod small_steps;
 mod stt_client;
 mod tui_model_arrival;
 mod tui_panes;

@@ -1,6 +1,7 @@
 //! The shape of the code, checked from its source: the top-level modules depend on each
 //! other one way (no cycle), the command line reaches the planner and the world only
-//! through the session layer, and library code returns typed errors, not strings.
+//! through the session layer, library code returns typed errors, not strings, and the
+//! product never imports the lab (evaluations, benchmarks, fuzzing).
 //!
 //! Test code (`tests.rs`, `*_tests.rs`, and everything after a file's `#[cfg(test)]`) is
 //! left out: tests may reach anywhere.
@@ -192,4 +193,101 @@ fn library_code_returns_typed_errors() {
         "Result<_, String> in library code:\n{}",
         found.join("\n")
     );
+}
+
+/// The lab's library modules: evaluations, benchmarks and fuzzing, behind the `lab`
+/// feature.
+const LAB_MODULES: [&str; 3] = ["eval", "bench", "fuzz"];
+
+/// The command line's files that belong to the lab (its commands and their flags).
+const LAB_COMMANDS: [&str; 5] = [
+    "bench_cmd",
+    "eval_cmd",
+    "eval_setup",
+    "fuzz_cmd",
+    "lab_flags",
+];
+
+/// Whether `file` is the lab's: under one of its modules, or one of its commands.
+fn is_lab(src: &Path, file: &Path) -> bool {
+    let top = top_module(src, file).unwrap_or_default();
+    if LAB_MODULES.contains(&top.as_str()) {
+        return true;
+    }
+    let stem = file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or_default();
+    top == "cli" && LAB_COMMANDS.contains(&stem)
+}
+
+#[test]
+fn no_product_module_imports_the_lab() {
+    let src = src();
+    let mut found = Vec::new();
+    let mut lab_files = 0;
+    for file in rust_files(&src) {
+        if is_lab(&src, &file) {
+            lab_files += 1;
+            continue;
+        }
+        let code = product_code(&file);
+        let in_cli = top_module(&src, &file).as_deref() == Some("cli");
+        // `cli/mod.rs` declares the lab's commands, each behind the feature (checked by
+        // building without it); its other lines are held to the rule like any file's.
+        let declares_commands = in_cli && file.ends_with("cli/mod.rs");
+        for (n, line) in code.lines().enumerate() {
+            if line.trim_start().starts_with("//") {
+                continue;
+            }
+            let mut named: Vec<String> = Vec::new();
+            for prefix in ["crate::", "betr::"] {
+                for m in LAB_MODULES {
+                    if line.contains(&format!("{prefix}{m}::"))
+                        || line.contains(&format!("{prefix}{m};"))
+                    {
+                        named.push(format!("{prefix}{m}"));
+                    }
+                }
+            }
+            if in_cli && !declares_commands {
+                for c in LAB_COMMANDS {
+                    if line.contains(&format!("super::{c}"))
+                        || line.contains(&format!("crate::cli::{c}"))
+                    {
+                        named.push(c.to_string());
+                    }
+                }
+            }
+            if !named.is_empty() {
+                found.push(format!("{}:{}: {}", file.display(), n + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        lab_files > 10,
+        "the lab's files were not found under {}",
+        src.display()
+    );
+    assert!(
+        found.is_empty(),
+        "product code imports the lab:\n{}",
+        found.join("\n")
+    );
+}
+
+#[test]
+fn the_lab_modules_are_declared_behind_the_lab_feature() {
+    let lib = std::fs::read_to_string(src().join("lib.rs")).expect("src/lib.rs");
+    let lines: Vec<&str> = lib.lines().map(str::trim).collect();
+    for m in LAB_MODULES {
+        let at = lines
+            .iter()
+            .position(|l| *l == format!("pub mod {m};"))
+            .unwrap_or_else(|| panic!("src/lib.rs does not declare {m}"));
+        assert!(
+            at > 0 && lines[at - 1] == "#[cfg(feature = \"lab\")]",
+            "src/lib.rs declares {m} without #[cfg(feature = \"lab\")]"
+        );
+    }
 }

@@ -301,17 +301,17 @@ fn a_recorded_cassette_replays_without_a_server_and_misses_loudly() {
         std::fs::read(dir.join("a.bt")).unwrap(),
         std::fs::read(dir.join("b.bt")).unwrap()
     );
-    // A different prompt (an ablation) is not in the cassette: replay refuses, exit 2.
+    // A different prompt (another request) is not in the cassette: replay refuses, exit 2.
     let out = betr(
         &dir,
         &[
             "interpret",
             &scenario_s,
+            "Sweep the floor by the window twice",
             "--backend",
             "replay",
             "--cassette",
             "c.jsonl",
-            "--no-descriptions",
         ],
     );
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));

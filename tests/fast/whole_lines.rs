@@ -28,7 +28,6 @@ fn interpret(dir: &Path, backend: &[&str], instruction: &str) -> Output {
         "c.jsonl",
         "--usage-log",
         "u.jsonl",
-        "--no-checks",
     ];
     args.extend_from_slice(backend);
     betr(dir, &args)

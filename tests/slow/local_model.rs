@@ -132,36 +132,6 @@ fn goal_prompt(s: &betr::scenario::Scenario, instruction: &str) -> Vec<betr::llm
 }
 
 #[tokio::test]
-async fn an_answer_begun_in_the_prompt_is_continued_and_returned_whole() {
-    let _turn = support::embedded::turn().await;
-    // `Goal:` written for the model, the grammar typing the formula after it: the reply
-    // (and each beam's) begins with the words written, and reads as the goal.
-    let s = scenario("scenarios/cell/red_on_blue.toml");
-    let vocabulary = &s.domain.vocabulary;
-    let mut request = ChatRequest::new(goal_prompt(&s, s.instruction.as_deref().unwrap()));
-    request.max_tokens = 60;
-    request.beams = Some(2);
-    request.prefill = Some(grammar::GOAL_PREFIX.into());
-    request.constraint = Some(OutputConstraint::Grammar {
-        name: "goal".into(),
-        gbnf: grammar::goal_grammar_after_prefix(vocabulary, true),
-    });
-    let r = local().chat(&request).await.unwrap();
-    assert!(r.text.starts_with("Goal: "), "{:?}", r.text);
-    for (text, _) in &r.ranked {
-        assert!(text.starts_with("Goal: "), "{text:?}");
-    }
-    let answer =
-        reply::goal(&r.text, vocabulary, 1.0).unwrap_or_else(|e| panic!("{:?}: {e}", r.text));
-    assert_eq!(
-        answer.goal.to_string(),
-        "\"blue cube\" on \"green cube\"",
-        "{}",
-        r.text
-    );
-}
-
-#[tokio::test]
 async fn under_the_grammar_no_object_outside_the_scene_can_be_named() {
     let _turn = support::embedded::turn().await;
     // Ask for a banana in a scene that has none, several times with sampling on: every

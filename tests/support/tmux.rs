@@ -140,9 +140,9 @@ pub fn workbench_command_on(
 ) -> String {
     let scenario = super::fixtures::root().join(scenario);
     format!(
-        "cd {dir} && {isolated} {key_var}={key} {env} {bin} tui {scenario} --backend openai \
-         --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies} \
-         --usage-log usage.jsonl --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
+        "cd {dir} && {isolated} {key_var}={key} BETR_USAGE_LOG=usage.jsonl {env} {bin} tui \
+         {scenario} --backend openai --base-url {url} --model fake-model --api-key-env {key_var} \
+         --policy-dir {policies} --tick-ms 50 {extra}; echo \"betr exited with status $?\"; \
          sleep 60",
         dir = quote(dir),
         isolated = isolated_env(dir),
