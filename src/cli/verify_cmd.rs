@@ -6,11 +6,12 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 
+use betr::bt::Tree;
 use betr::interop::TreeFormat;
 use betr::scenario::Scenario;
 use betr::session::Prediction;
 use betr::session::policy;
-use betr::session::types::VerifyRequest;
+use betr::session::types::{VerifyRequest, VerifyScope};
 use betr::verify::{NamedProperty, Property, Report, Rule, Verdict};
 
 use super::engine_driver::{Driver, Start};
@@ -52,8 +53,32 @@ pub fn command(args: &VerifyArgs, ascii: bool) -> Result<ExitCode> {
 }
 
 fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCode> {
+    let properties = properties_of(scenario, &args.properties)?;
+    let promela = promela_file(args.export.as_deref())?;
+    let mut session = Driver::start(Start::new(scenario))?;
+    let origin = load_or_plan(&mut session, scenario, args.tree.as_ref())?;
+    let (scope, report) = session.verify(VerifyRequest {
+        properties,
+        no_disturbances: args.no_disturbances,
+        action_failures: args.failures,
+        max_states: Some(args.max_states),
+        max_ticks: Some(args.max_ticks),
+        promela,
+    })?;
+    let tree = session.tree()?;
+    print_scope(scenario, &origin, &scope, &tree);
+    write_report(&mut super::out::Stdout, &report, ascii)?;
+    Ok(if report.holds() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The `--property` texts, each parsed and checked against the scenario's vocabulary.
+fn properties_of(scenario: &Scenario, texts: &[String]) -> Result<Vec<NamedProperty>> {
     let mut properties = Vec::new();
-    for text in &args.properties {
+    for text in texts {
         let property = Property::parse_checked(text, &scenario.domain.vocabulary)
             .map_err(|e| anyhow::anyhow!("--property {text:?}: {e}"))?;
         properties.push(NamedProperty {
@@ -61,9 +86,14 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
             property,
         });
     }
-    let promela = match &args.export {
+    Ok(properties)
+}
+
+/// The file `--export promela FILE` names, if given (promela is the only format).
+fn promela_file(export: Option<&[String]>) -> Result<Option<PathBuf>> {
+    Ok(match export {
         Some(export) => {
-            let [format, file] = export.as_slice() else {
+            let [format, file] = export else {
                 bail!("--export takes a format and a file: --export promela model.pml");
             };
             if format != "promela" {
@@ -72,9 +102,17 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
             Some(PathBuf::from(file))
         }
         None => None,
-    };
-    let mut session = Driver::start(Start::new(scenario))?;
-    let origin = match &args.tree {
+    })
+}
+
+/// Load the tree file into the session, or plan the scenario's goal when there is none;
+/// where the tree came from, for the report.
+fn load_or_plan(
+    session: &mut Driver,
+    scenario: &Scenario,
+    tree: Option<&PathBuf>,
+) -> Result<String> {
+    Ok(match tree {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("reading tree file {}", path.display()))?;
@@ -86,17 +124,13 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
             session.plan(None)?;
             format!("planned in the planner's model for {goal} (no simulation)")
         }
-    };
-    let (scope, report) = session.verify(VerifyRequest {
-        properties,
-        no_disturbances: args.no_disturbances,
-        action_failures: args.failures,
-        max_states: Some(args.max_states),
-        max_ticks: Some(args.max_ticks),
-        promela,
-    })?;
-    let tree = session.tree()?;
+    })
+}
 
+/// What was checked, before the report: the scenario, the tree and where it came from,
+/// the conditions added and learned, the planner's note, the failures and disturbances
+/// explored, and the Promela model written.
+fn print_scope(scenario: &Scenario, origin: &str, scope: &VerifyScope, tree: &Tree) {
     outln!("Scenario: {}", scenario.name);
     outln!("Tree:     {origin} ({} nodes)", scope.nodes);
     for c in &scope.added {
@@ -119,7 +153,7 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
             outln!("Note:     planning stopped: {reason}");
         }
     }
-    for learned in betr::session::knowledge::learned_in_tree(&scenario.domain, &tree) {
+    for learned in betr::session::knowledge::learned_in_tree(&scenario.domain, tree) {
         outln!(
             "Learned:  {}? before {}! (rule {})",
             learned.condition,
@@ -144,12 +178,6 @@ fn verify(scenario: &Scenario, args: &VerifyArgs, ascii: bool) -> Result<ExitCod
             claims.join(", ")
         );
     }
-    write_report(&mut super::out::Stdout, &report, ascii)?;
-    Ok(if report.holds() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(1)
-    })
 }
 
 /// How a tree file came to be, for the report: a policy with its fixes is a repaired

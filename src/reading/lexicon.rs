@@ -40,36 +40,7 @@ pub struct Lexicon {
 impl Lexicon {
     /// The words of `vocabulary`'s predicates and objects, and those `pool` teaches.
     pub fn new(vocabulary: &Vocabulary, pool: &[Example]) -> Self {
-        let mut words: HashMap<String, Vec<String>> = HashMap::new();
-        let names = vocabulary
-            .predicates
-            .iter()
-            .map(|p| p.name.as_str())
-            .chain(vocabulary.objects.iter().map(|o| o.name.as_str()));
-        for name in names {
-            let own: Vec<String> = terms(name).into_iter().filter(|t| !is_generic(t)).collect();
-            words.insert(name.to_string(), own);
-        }
-        // What an object is called is its own too ("fries" is `Chips`'s word).
-        for object in &vocabulary.objects {
-            let list = words.entry(object.name.clone()).or_default();
-            for word in object.called.iter().flat_map(|c| terms(c)) {
-                if !is_generic(&word) && !list.contains(&word) {
-                    list.push(word);
-                }
-            }
-        }
-        // So are the words the scene lists for a predicate, either way round ("come to"
-        // and "near" for the robot near a place, "off" for a device on).
-        for predicate in &vocabulary.predicates {
-            let list = words.entry(predicate.name.clone()).or_default();
-            let said = predicate.words.says.iter().chain(&predicate.words.opposite);
-            for word in said.flat_map(|c| terms(c)) {
-                if !is_generic(&word) && !list.contains(&word) {
-                    list.push(word);
-                }
-            }
-        }
+        let mut words = own_words(vocabulary);
         let mut object_words: Vec<String> = vocabulary
             .objects
             .iter()
@@ -77,53 +48,8 @@ impl Lexicon {
             .collect();
         object_words.sort_unstable();
         object_words.dedup();
-        // How many examples use each word, and each word together with each symbol.
-        let mut uses: HashMap<String, usize> = HashMap::new();
-        let mut together: HashMap<(String, String), usize> = HashMap::new();
-        for example in pool {
-            let Ok(goal) = Formula::parse(&example.goal) else {
-                continue;
-            };
-            let mut symbols: Vec<String> = Vec::new();
-            for atom in goal.atoms() {
-                for s in std::iter::once(&atom.predicate).chain(&atom.args) {
-                    if !symbols.contains(s) {
-                        symbols.push(s.clone());
-                    }
-                }
-            }
-            let mut said = terms(&example.instruction);
-            said.sort_unstable();
-            said.dedup();
-            for w in said {
-                *uses.entry(w.clone()).or_default() += 1;
-                for s in &symbols {
-                    *together.entry((s.clone(), w.clone())).or_default() += 1;
-                }
-            }
-        }
-        // A word that names a symbol belongs to that symbol alone: "coffee" is Coffee's
-        // word even though most requests for coffee also use On.
-        let named: Vec<String> = words.values().flatten().cloned().collect();
-        let objects: Vec<&str> = vocabulary.objects.iter().map(|o| o.name.as_str()).collect();
-        let mut learned: Vec<(&(String, String), &usize)> = together.iter().collect();
-        learned.sort();
-        for ((symbol, word), n) in learned {
-            let total = uses.get(word).copied().unwrap_or(0).max(1);
-            let known = words.contains_key(symbol);
-            let names_other = named.iter().any(|x| same_word(x, word));
-            if known
-                && !names_other
-                && (*n >= MIN_TOGETHER || !objects.contains(&symbol.as_str()))
-                && *n as f64 / total as f64 >= MIN_SHARE
-                && !is_generic(word)
-            {
-                let list = words.entry(symbol.clone()).or_default();
-                if !list.contains(word) {
-                    list.push(word.clone());
-                }
-            }
-        }
+        let (uses, together) = count_pool(pool);
+        learn_from_pool(&mut words, vocabulary, &uses, &together);
         let mut whole_names: Vec<String> = vocabulary
             .objects
             .iter()
@@ -177,6 +103,108 @@ impl Lexicon {
             })
             .cloned()
             .collect()
+    }
+}
+
+/// Each predicate's and object's own words: those of its name, what an object is called,
+/// and the words the scene lists for a predicate.
+fn own_words(vocabulary: &Vocabulary) -> HashMap<String, Vec<String>> {
+    let mut words: HashMap<String, Vec<String>> = HashMap::new();
+    let names = vocabulary
+        .predicates
+        .iter()
+        .map(|p| p.name.as_str())
+        .chain(vocabulary.objects.iter().map(|o| o.name.as_str()));
+    for name in names {
+        let own: Vec<String> = terms(name).into_iter().filter(|t| !is_generic(t)).collect();
+        words.insert(name.to_string(), own);
+    }
+    // What an object is called is its own too ("fries" is `Chips`'s word).
+    for object in &vocabulary.objects {
+        let list = words.entry(object.name.clone()).or_default();
+        for word in object.called.iter().flat_map(|c| terms(c)) {
+            if !is_generic(&word) && !list.contains(&word) {
+                list.push(word);
+            }
+        }
+    }
+    // So are the words the scene lists for a predicate, either way round ("come to"
+    // and "near" for the robot near a place, "off" for a device on).
+    for predicate in &vocabulary.predicates {
+        let list = words.entry(predicate.name.clone()).or_default();
+        let said = predicate.words.says.iter().chain(&predicate.words.opposite);
+        for word in said.flat_map(|c| terms(c)) {
+            if !is_generic(&word) && !list.contains(&word) {
+                list.push(word);
+            }
+        }
+    }
+    words
+}
+
+/// How many examples use a word.
+type Uses = HashMap<String, usize>;
+/// How many examples use a word together with a symbol, by (symbol, word).
+type Together = HashMap<(String, String), usize>;
+
+/// How many examples of `pool` use each word, and each word together with each symbol of
+/// their goal (examples whose goal does not parse are left out).
+fn count_pool(pool: &[Example]) -> (Uses, Together) {
+    let mut uses: Uses = HashMap::new();
+    let mut together: Together = HashMap::new();
+    for example in pool {
+        let Ok(goal) = Formula::parse(&example.goal) else {
+            continue;
+        };
+        let mut symbols: Vec<String> = Vec::new();
+        for atom in goal.atoms() {
+            for s in std::iter::once(&atom.predicate).chain(&atom.args) {
+                if !symbols.contains(s) {
+                    symbols.push(s.clone());
+                }
+            }
+        }
+        let mut said = terms(&example.instruction);
+        said.sort_unstable();
+        said.dedup();
+        for w in said {
+            *uses.entry(w.clone()).or_default() += 1;
+            for s in &symbols {
+                *together.entry((s.clone(), w.clone())).or_default() += 1;
+            }
+        }
+    }
+    (uses, together)
+}
+
+/// Add to `words` each word the pool uses mostly with a symbol, when no symbol is named
+/// by it: a word that names a symbol belongs to that symbol alone ("coffee" is Coffee's
+/// word even though most requests for coffee also use On).
+fn learn_from_pool(
+    words: &mut HashMap<String, Vec<String>>,
+    vocabulary: &Vocabulary,
+    uses: &Uses,
+    together: &Together,
+) {
+    let named: Vec<String> = words.values().flatten().cloned().collect();
+    let objects: Vec<&str> = vocabulary.objects.iter().map(|o| o.name.as_str()).collect();
+    let mut learned: Vec<(&(String, String), &usize)> = together.iter().collect();
+    learned.sort();
+    for ((symbol, word), n) in learned {
+        let total = uses.get(word).copied().unwrap_or(0).max(1);
+        let known = words.contains_key(symbol);
+        let names_other = named.iter().any(|x| same_word(x, word));
+        if known
+            && !names_other
+            && (*n >= MIN_TOGETHER || !objects.contains(&symbol.as_str()))
+            && *n as f64 / total as f64 >= MIN_SHARE
+            && !is_generic(word)
+        {
+            let list = words.entry(symbol.clone()).or_default();
+            if !list.contains(word) {
+                list.push(word.clone());
+            }
+        }
     }
 }
 

@@ -114,107 +114,13 @@ impl Model {
         file: &Path,
         packages: &[Package<'_>],
     ) -> Result<Model, RobotError> {
-        let bad = |message: String| RobotError::Urdf {
-            file: file.to_path_buf(),
-            message,
-        };
-        let mut links = Vec::with_capacity(robot.links.len());
-        for link in &robot.links {
-            if links.iter().any(|l: &Link| l.name == link.name) {
-                return Err(bad(format!("link \"{}\" is defined twice", link.name)));
-            }
-            let element = |origin: &urdf_rs::Pose, geometry: &urdf_rs::Geometry| {
-                Ok::<_, RobotError>(Element {
-                    origin: pose(origin),
-                    geometry: geometry_of(geometry, file, &link.name, packages)?,
-                })
-            };
-            links.push(Link {
-                name: link.name.clone(),
-                visuals: link
-                    .visual
-                    .iter()
-                    .map(|v| element(&v.origin, &v.geometry))
-                    .collect::<Result<_, _>>()?,
-                collisions: link
-                    .collision
-                    .iter()
-                    .map(|c| element(&c.origin, &c.geometry))
-                    .collect::<Result<_, _>>()?,
-            });
-        }
-        let index = |joint: &str, name: &str| {
-            links.iter().position(|l| l.name == name).ok_or_else(|| {
-                bad(format!(
-                    "joint \"{joint}\" names link \"{name}\", which is not defined"
-                ))
-            })
-        };
-        let mut joints = Vec::with_capacity(robot.joints.len());
-        for j in &robot.joints {
-            let kind = match j.joint_type {
-                urdf_rs::JointType::Fixed => JointKind::Fixed,
-                urdf_rs::JointType::Revolute => JointKind::Revolute,
-                urdf_rs::JointType::Continuous => JointKind::Continuous,
-                urdf_rs::JointType::Prismatic => JointKind::Prismatic,
-                ref other => {
-                    return Err(bad(format!(
-                        "joint \"{}\" is {other:?}; betr moves fixed, revolute, continuous and prismatic joints",
-                        j.name
-                    )));
-                }
-            };
-            let (lower, upper) = match kind {
-                JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
-                _ => (j.limit.lower, j.limit.upper),
-            };
-            let ordered = lower.partial_cmp(&upper).is_some_and(|o| o.is_le());
-            if matches!(kind, JointKind::Revolute | JointKind::Prismatic) && !ordered {
-                return Err(bad(format!(
-                    "joint \"{}\": lower limit {lower} is above upper limit {upper}",
-                    j.name
-                )));
-            }
-            let axis = Vector3::from(*j.axis.xyz);
-            let axis = Unit::try_new(axis, 1e-9)
-                .ok_or_else(|| bad(format!("joint \"{}\" has a zero axis", j.name)))?;
-            joints.push(Joint {
-                name: j.name.clone(),
-                kind,
-                parent: index(&j.name, &j.parent.link)?,
-                child: index(&j.name, &j.child.link)?,
-                origin: pose(&j.origin),
-                axis,
-                lower,
-                upper,
-                mimic: j.mimic.as_ref().map(|m| {
-                    (
-                        m.joint.clone(),
-                        m.multiplier.unwrap_or(1.0),
-                        m.offset.unwrap_or(0.0),
-                    )
-                }),
-            });
-        }
-        let mut parents = vec![None; links.len()];
-        for j in &joints {
-            if let Some(other) = parents[j.child] {
-                let other: &Joint = &joints[other];
-                return Err(bad(format!(
-                    "link \"{}\" is the child of both \"{}\" and \"{}\"",
-                    links[j.child].name, other.name, j.name
-                )));
-            }
-            parents[j.child] = joints.iter().position(|k| k.name == j.name);
-        }
-        let roots: Vec<usize> = (0..links.len()).filter(|&l| parents[l].is_none()).collect();
-        let [root] = roots[..] else {
-            let names: Vec<&str> = roots.iter().map(|&r| links[r].name.as_str()).collect();
-            return Err(bad(format!(
-                "expected one root link (one no joint moves), found {}: {names:?}",
-                roots.len()
-            )));
-        };
+        let links = read_links(robot, file, packages)?;
+        let joints = robot
+            .joints
+            .iter()
+            .map(|j| read_joint(j, &links, file))
+            .collect::<Result<Vec<_>, _>>()?;
+        let root = root_of(&links, &joints, file)?;
         Ok(Model {
             name: robot.name.clone(),
             file: file.to_path_buf(),
@@ -278,6 +184,143 @@ impl Joint {
             }
         }
     }
+}
+
+/// The description in `file` refused, with why.
+fn bad(file: &Path, message: String) -> RobotError {
+    RobotError::Urdf {
+        file: file.to_path_buf(),
+        message,
+    }
+}
+
+/// The description's links with their visual and collision geometry, each name once.
+fn read_links(
+    robot: &urdf_rs::Robot,
+    file: &Path,
+    packages: &[Package<'_>],
+) -> Result<Vec<Link>, RobotError> {
+    let mut links = Vec::with_capacity(robot.links.len());
+    for link in &robot.links {
+        if links.iter().any(|l: &Link| l.name == link.name) {
+            return Err(bad(
+                file,
+                format!("link \"{}\" is defined twice", link.name),
+            ));
+        }
+        let element = |origin: &urdf_rs::Pose, geometry: &urdf_rs::Geometry| {
+            Ok::<_, RobotError>(Element {
+                origin: pose(origin),
+                geometry: geometry_of(geometry, file, &link.name, packages)?,
+            })
+        };
+        links.push(Link {
+            name: link.name.clone(),
+            visuals: link
+                .visual
+                .iter()
+                .map(|v| element(&v.origin, &v.geometry))
+                .collect::<Result<_, _>>()?,
+            collisions: link
+                .collision
+                .iter()
+                .map(|c| element(&c.origin, &c.geometry))
+                .collect::<Result<_, _>>()?,
+        });
+    }
+    Ok(links)
+}
+
+/// One joint of the description: a kind betr moves, ordered limits, a non-zero axis, and
+/// links that are defined.
+fn read_joint(j: &urdf_rs::Joint, links: &[Link], file: &Path) -> Result<Joint, RobotError> {
+    let index = |joint: &str, name: &str| {
+        links.iter().position(|l| l.name == name).ok_or_else(|| {
+            bad(
+                file,
+                format!("joint \"{joint}\" names link \"{name}\", which is not defined"),
+            )
+        })
+    };
+    let kind = match j.joint_type {
+        urdf_rs::JointType::Fixed => JointKind::Fixed,
+        urdf_rs::JointType::Revolute => JointKind::Revolute,
+        urdf_rs::JointType::Continuous => JointKind::Continuous,
+        urdf_rs::JointType::Prismatic => JointKind::Prismatic,
+        ref other => {
+            return Err(bad(
+                file,
+                format!(
+                    "joint \"{}\" is {other:?}; betr moves fixed, revolute, continuous and prismatic joints",
+                    j.name
+                ),
+            ));
+        }
+    };
+    let (lower, upper) = match kind {
+        JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
+        _ => (j.limit.lower, j.limit.upper),
+    };
+    let ordered = lower.partial_cmp(&upper).is_some_and(|o| o.is_le());
+    if matches!(kind, JointKind::Revolute | JointKind::Prismatic) && !ordered {
+        return Err(bad(
+            file,
+            format!(
+                "joint \"{}\": lower limit {lower} is above upper limit {upper}",
+                j.name
+            ),
+        ));
+    }
+    let axis = Vector3::from(*j.axis.xyz);
+    let axis = Unit::try_new(axis, 1e-9)
+        .ok_or_else(|| bad(file, format!("joint \"{}\" has a zero axis", j.name)))?;
+    Ok(Joint {
+        name: j.name.clone(),
+        kind,
+        parent: index(&j.name, &j.parent.link)?,
+        child: index(&j.name, &j.child.link)?,
+        origin: pose(&j.origin),
+        axis,
+        lower,
+        upper,
+        mimic: j.mimic.as_ref().map(|m| {
+            (
+                m.joint.clone(),
+                m.multiplier.unwrap_or(1.0),
+                m.offset.unwrap_or(0.0),
+            )
+        }),
+    })
+}
+
+/// The one link no joint moves, when the joints make a tree (no link the child of two).
+fn root_of(links: &[Link], joints: &[Joint], file: &Path) -> Result<usize, RobotError> {
+    let mut parents = vec![None; links.len()];
+    for j in joints {
+        if let Some(other) = parents[j.child] {
+            let other: &Joint = &joints[other];
+            return Err(bad(
+                file,
+                format!(
+                    "link \"{}\" is the child of both \"{}\" and \"{}\"",
+                    links[j.child].name, other.name, j.name
+                ),
+            ));
+        }
+        parents[j.child] = joints.iter().position(|k| k.name == j.name);
+    }
+    let roots: Vec<usize> = (0..links.len()).filter(|&l| parents[l].is_none()).collect();
+    let [root] = roots[..] else {
+        let names: Vec<&str> = roots.iter().map(|&r| links[r].name.as_str()).collect();
+        return Err(bad(
+            file,
+            format!(
+                "expected one root link (one no joint moves), found {}: {names:?}",
+                roots.len()
+            ),
+        ));
+    };
+    Ok(root)
 }
 
 /// A URDF `<origin xyz rpy>` (roll about x, then pitch about y, then yaw about z, all

@@ -47,6 +47,72 @@ fn colour(rgb: [u8; 3], alpha: u8) -> Color {
     Color::from_unmultiplied_rgba(rgb[0], rgb[1], rgb[2], alpha)
 }
 
+/// Parts sorted by kind, in the arrays rerun logs each kind from (in the parts' order).
+#[derive(Default)]
+struct ByKind {
+    /// Boxes: centres, half sizes, rotations.
+    box_centres: Vec<[f32; 3]>,
+    box_halves: Vec<[f32; 3]>,
+    box_turns: Vec<Quaternion>,
+    /// Cylinders: centres, lengths, radii, rotations (standing along local z).
+    cylinder_centres: Vec<[f32; 3]>,
+    cylinder_lengths: Vec<f32>,
+    cylinder_radii: Vec<f32>,
+    cylinder_turns: Vec<Quaternion>,
+    /// Balls: centres, radii.
+    ball_centres: Vec<[f32; 3]>,
+    ball_radii: Vec<f32>,
+    /// Capsules: one end, lengths, radii, rotations (from local z to the other end).
+    capsule_starts: Vec<[f32; 3]>,
+    capsule_lengths: Vec<f32>,
+    capsule_radii: Vec<f32>,
+    capsule_turns: Vec<Quaternion>,
+}
+
+impl ByKind {
+    fn of(parts: &[PartView]) -> ByKind {
+        let mut k = ByKind::default();
+        for p in parts {
+            let centre = xyz(&p.pose.translation.vector);
+            match &p.shape {
+                PartShape::Box { half } => {
+                    k.box_centres.push(centre);
+                    k.box_halves.push(*half);
+                    k.box_turns.push(quat(&p.pose.rotation));
+                }
+                PartShape::Cylinder {
+                    radius,
+                    half_height,
+                } => {
+                    // parry's cylinders stand along local y, rerun's along local z.
+                    let turn = UnitQuaternion::from_axis_angle(
+                        &Vector3::x_axis(),
+                        -std::f32::consts::FRAC_PI_2,
+                    );
+                    k.cylinder_centres.push(centre);
+                    k.cylinder_lengths.push(2.0 * half_height);
+                    k.cylinder_radii.push(*radius);
+                    k.cylinder_turns.push(quat(&(p.pose.rotation * turn)));
+                }
+                PartShape::Ball { radius } => {
+                    k.ball_centres.push(centre);
+                    k.ball_radii.push(*radius);
+                }
+                PartShape::Capsule { a, b, radius } => {
+                    let d = Vector3::from(*b) - Vector3::from(*a);
+                    let turn = UnitQuaternion::rotation_between(&Vector3::z(), &d)
+                        .unwrap_or_else(UnitQuaternion::identity);
+                    k.capsule_starts.push(*a);
+                    k.capsule_lengths.push(d.norm());
+                    k.capsule_radii.push(*radius);
+                    k.capsule_turns.push(quat(&turn));
+                }
+            }
+        }
+        k
+    }
+}
+
 /// Log `parts` at `path` (boxes there, cleared when there are none; cylinders, balls and
 /// capsules below it).
 fn log_parts(
@@ -56,47 +122,7 @@ fn log_parts(
     rgb: [u8; 3],
     label: Option<&str>,
 ) -> RecordingStreamResult<()> {
-    let (mut bc, mut bh, mut bq) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut cc, mut cl, mut cr, mut cq) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut ec, mut er) = (Vec::new(), Vec::new());
-    let (mut kt, mut kl, mut kr, mut kq) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for p in parts {
-        let centre = xyz(&p.pose.translation.vector);
-        match &p.shape {
-            PartShape::Box { half } => {
-                bc.push(centre);
-                bh.push(*half);
-                bq.push(quat(&p.pose.rotation));
-            }
-            PartShape::Cylinder {
-                radius,
-                half_height,
-            } => {
-                // parry's cylinders stand along local y, rerun's along local z.
-                let turn = UnitQuaternion::from_axis_angle(
-                    &Vector3::x_axis(),
-                    -std::f32::consts::FRAC_PI_2,
-                );
-                cc.push(centre);
-                cl.push(2.0 * half_height);
-                cr.push(*radius);
-                cq.push(quat(&(p.pose.rotation * turn)));
-            }
-            PartShape::Ball { radius } => {
-                ec.push(centre);
-                er.push(*radius);
-            }
-            PartShape::Capsule { a, b, radius } => {
-                let d = Vector3::from(*b) - Vector3::from(*a);
-                let turn = UnitQuaternion::rotation_between(&Vector3::z(), &d)
-                    .unwrap_or_else(UnitQuaternion::identity);
-                kt.push(*a);
-                kl.push(d.norm());
-                kr.push(*radius);
-                kq.push(quat(&turn));
-            }
-        }
-    }
+    let k = ByKind::of(parts);
     let c = colour(rgb, 255);
     let labels = |n: usize| {
         label
@@ -109,14 +135,14 @@ fn log_parts(
             })
             .unwrap_or_default()
     };
-    if bc.is_empty() {
+    if k.box_centres.is_empty() {
         rec.log(path, &Clear::flat())?;
     } else {
-        let n = bc.len();
+        let n = k.box_centres.len();
         rec.log(
             path,
-            &Boxes3D::from_centers_and_half_sizes(bc, bh)
-                .with_quaternions(bq)
+            &Boxes3D::from_centers_and_half_sizes(k.box_centres, k.box_halves)
+                .with_quaternions(k.box_turns)
                 .with_colors([c])
                 .with_fill_mode(FillMode::Solid)
                 .with_labels(labels(n)),
@@ -124,32 +150,32 @@ fn log_parts(
     }
     let sub = |kind: &str| format!("{path}/{kind}");
     // A solid's parts never change kind, so only kinds it has are logged.
-    if !cc.is_empty() {
-        let n = cc.len();
+    if !k.cylinder_centres.is_empty() {
+        let n = k.cylinder_centres.len();
         rec.log(
             sub("cylinders"),
-            &Cylinders3D::from_lengths_and_radii(cl, cr)
-                .with_centers(cc)
-                .with_quaternions(cq)
+            &Cylinders3D::from_lengths_and_radii(k.cylinder_lengths, k.cylinder_radii)
+                .with_centers(k.cylinder_centres)
+                .with_quaternions(k.cylinder_turns)
                 .with_colors([c])
                 .with_fill_mode(FillMode::Solid)
                 .with_labels(labels(n)),
         )?;
     }
-    if !ec.is_empty() {
+    if !k.ball_centres.is_empty() {
         rec.log(
             sub("balls"),
-            &Ellipsoids3D::from_centers_and_radii(ec, er)
+            &Ellipsoids3D::from_centers_and_radii(k.ball_centres, k.ball_radii)
                 .with_colors([c])
                 .with_fill_mode(FillMode::Solid),
         )?;
     }
-    if !kt.is_empty() {
+    if !k.capsule_starts.is_empty() {
         rec.log(
             sub("capsules"),
-            &Capsules3D::from_lengths_and_radii(kl, kr)
-                .with_translations(kt)
-                .with_quaternions(kq)
+            &Capsules3D::from_lengths_and_radii(k.capsule_lengths, k.capsule_radii)
+                .with_translations(k.capsule_starts)
+                .with_quaternions(k.capsule_turns)
                 .with_colors([c]),
         )?;
     }

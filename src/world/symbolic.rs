@@ -26,9 +26,9 @@ use toml::Spanned;
 
 use super::{Snapshot, Step, World, WorldError};
 use crate::domain::names::{MIN_SIMILARITY, did_you_mean, nearest};
-use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain};
+use crate::domain::{ANY_OBJECT, ActionCall, Atom, Condition, Domain, Vocabulary};
 use crate::goal::Formula;
-use crate::scenario::{Scenario, ScenarioError};
+use crate::scenario::{Scenario, ScenarioError, SourceFile};
 
 /// What happens when a rule's requirement does not hold.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,6 +91,121 @@ struct RawRule {
     otherwise: Option<Spanned<String>>,
 }
 
+/// A fact of a `[world]` table: a plain atom of the vocabulary.
+fn read_fact(
+    file: &SourceFile,
+    vocabulary: &Vocabulary,
+    f: &Spanned<String>,
+) -> Result<Atom, ScenarioError> {
+    let c = Condition::parse(f.get_ref()).map_err(|e| {
+        file.error_in_string(
+            &f.span(),
+            e.at,
+            format!("expected {}, found {}", e.expected, e.found),
+        )
+    })?;
+    if c.negated || c.atom.has_wildcard() {
+        return Err(file.error_in_string(
+            &f.span(),
+            0,
+            "facts are plain atoms: no `~`, no \"any object\" (unlisted atoms are false)",
+        ));
+    }
+    vocabulary
+        .check_atom(&c.atom)
+        .map_err(|e| file.error_in_string(&f.span(), 0, e.to_string()))?;
+    Ok(c.atom)
+}
+
+impl RawRule {
+    /// The rule as the world keeps it, checked against the scenario.
+    fn read(self, scenario: &Scenario, file: &SourceFile) -> Result<Rule, ScenarioError> {
+        let action = self.action(scenario, file)?;
+        let requires = scenario
+            .parse_goal(self.requires.get_ref())
+            .map_err(|e| file.error_in_string(&self.requires.span(), e.at(), e))?;
+        let violation = self.violation(file)?;
+        Ok(Rule {
+            skill: action.skill,
+            args: (!action.args.is_empty()).then_some(action.args),
+            requires,
+            violation,
+        })
+    }
+
+    /// The action the rule is on: a skill of the scenario, on objects its scene has.
+    fn action(&self, scenario: &Scenario, file: &SourceFile) -> Result<ActionCall, ScenarioError> {
+        let vocabulary = &scenario.domain.vocabulary;
+        let action = ActionCall::parse(self.action.get_ref()).map_err(|e| {
+            file.error_in_string(
+                &self.action.span(),
+                e.at,
+                format!("expected {}, found {}", e.expected, e.found),
+            )
+        })?;
+        if !scenario
+            .domain
+            .skills
+            .iter()
+            .any(|s| s.name == action.skill)
+        {
+            return Err(file.error_in_string(
+                &self.action.span(),
+                0,
+                format!("no skill named {:?} in this scenario", action.skill),
+            ));
+        }
+        // A rule on an object the scene lacks would never fire.
+        if let Some(missing) = action.args.iter().find(|a| vocabulary.object(a).is_none()) {
+            let text = self.action.get_ref();
+            let at = text
+                .find(&format!("\"{missing}\""))
+                .map(|i| i + 1)
+                .or_else(|| text.find(missing.as_str()))
+                .unwrap_or(0);
+            let listed = vocabulary.objects.iter().map(|o| o.name.as_str());
+            let near = nearest(missing, listed, MIN_SIMILARITY);
+            return Err(file.error_in_string(
+                &self.action.span(),
+                at,
+                format!(
+                    "no object named {missing:?} in this scenario{}",
+                    did_you_mean(&near)
+                ),
+            ));
+        }
+        Ok(action)
+    }
+
+    /// What happens when the requirement does not hold: `otherwise` is "fail" (the
+    /// default, with `error` the text the skill reports) or "no effect".
+    fn violation(self, file: &SourceFile) -> Result<Violation, ScenarioError> {
+        match self.otherwise.as_ref().map(|o| o.get_ref().as_str()) {
+            None | Some("fail") => match self.error {
+                Some(e) if !e.trim().is_empty() => Ok(Violation::Fail(e)),
+                _ => Err(file.error_in_string(
+                    &self.action.span(),
+                    0,
+                    "a failing rule needs `error`, the text the skill reports",
+                )),
+            },
+            Some("no effect") => Ok(Violation::NoEffect),
+            Some(other) => {
+                let span = self
+                    .otherwise
+                    .as_ref()
+                    .map(Spanned::span)
+                    .unwrap_or_default();
+                Err(file.error_in_string(
+                    &span,
+                    0,
+                    format!("expected \"fail\" or \"no effect\", found {other:?}"),
+                ))
+            }
+        }
+    }
+}
+
 impl Rule {
     fn applies_to(&self, action: &ActionCall) -> bool {
         self.skill == action.skill && self.args.as_ref().is_none_or(|a| *a == action.args)
@@ -122,22 +237,7 @@ impl SymbolicWorld {
         for file in &scenario.files {
             let table: WorldTable = file.parse()?;
             let Some(world) = table.world else { continue };
-            let fact = |f: &Spanned<String>| {
-                let c = Condition::parse(f.get_ref()).map_err(|e| {
-                    file.error_in_string(
-                        &f.span(),
-                        e.at,
-                        format!("expected {}, found {}", e.expected, e.found),
-                    )
-                })?;
-                if c.negated || c.atom.has_wildcard() {
-                    return Err(file.error_in_string(&f.span(), 0, "facts are plain atoms: no `~`, no \"any object\" (unlisted atoms are false)"));
-                }
-                vocabulary
-                    .check_atom(&c.atom)
-                    .map_err(|e| file.error_in_string(&f.span(), 0, e.to_string()))?;
-                Ok(c.atom)
-            };
+            let fact = |f: &Spanned<String>| read_fact(file, vocabulary, f);
             if let Some(facts) = &world.initial {
                 initial = facts.iter().map(fact).collect::<Result<_, _>>()?;
             }
@@ -148,74 +248,7 @@ impl SymbolicWorld {
                 initial.insert(fact(f)?);
             }
             for r in world.rules {
-                let action = ActionCall::parse(r.action.get_ref()).map_err(|e| {
-                    file.error_in_string(
-                        &r.action.span(),
-                        e.at,
-                        format!("expected {}, found {}", e.expected, e.found),
-                    )
-                })?;
-                if !scenario
-                    .domain
-                    .skills
-                    .iter()
-                    .any(|s| s.name == action.skill)
-                {
-                    return Err(file.error_in_string(
-                        &r.action.span(),
-                        0,
-                        format!("no skill named {:?} in this scenario", action.skill),
-                    ));
-                }
-                // A rule on an object the scene lacks would never fire.
-                if let Some(missing) = action.args.iter().find(|a| vocabulary.object(a).is_none()) {
-                    let text = r.action.get_ref();
-                    let at = text
-                        .find(&format!("\"{missing}\""))
-                        .map(|i| i + 1)
-                        .or_else(|| text.find(missing.as_str()))
-                        .unwrap_or(0);
-                    let listed = vocabulary.objects.iter().map(|o| o.name.as_str());
-                    let near = nearest(missing, listed, MIN_SIMILARITY);
-                    return Err(file.error_in_string(
-                        &r.action.span(),
-                        at,
-                        format!(
-                            "no object named {missing:?} in this scenario{}",
-                            did_you_mean(&near)
-                        ),
-                    ));
-                }
-                let requires = scenario
-                    .parse_goal(r.requires.get_ref())
-                    .map_err(|e| file.error_in_string(&r.requires.span(), e.at(), e))?;
-                let violation = match r.otherwise.as_ref().map(|o| o.get_ref().as_str()) {
-                    None | Some("fail") => match r.error {
-                        Some(e) if !e.trim().is_empty() => Violation::Fail(e),
-                        _ => {
-                            return Err(file.error_in_string(
-                                &r.action.span(),
-                                0,
-                                "a failing rule needs `error`, the text the skill reports",
-                            ));
-                        }
-                    },
-                    Some("no effect") => Violation::NoEffect,
-                    Some(other) => {
-                        let span = r.otherwise.as_ref().map(Spanned::span).unwrap_or_default();
-                        return Err(file.error_in_string(
-                            &span,
-                            0,
-                            format!("expected \"fail\" or \"no effect\", found {other:?}"),
-                        ));
-                    }
-                };
-                rules.push(Rule {
-                    skill: action.skill,
-                    args: (!action.args.is_empty()).then_some(action.args),
-                    requires,
-                    violation,
-                });
+                rules.push(r.read(scenario, file)?);
             }
         }
         Ok(SymbolicWorld::new(

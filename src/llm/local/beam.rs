@@ -19,8 +19,9 @@ use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
 use llama_cpp_2::token::data::LlamaTokenData;
 use llama_cpp_2::token::data_array::LlamaTokenDataArray;
+use llama_cpp_2::vocab::LlamaVocab;
 
-use super::engine::EngineError;
+use super::engine::{EngineError, runtime};
 
 /// The widest beam the context is made for.
 pub(super) const MAX_BEAMS: u32 = 6;
@@ -67,16 +68,13 @@ pub(super) fn search(
     width: usize,
     (max_tokens, stop): (u32, &[String]),
 ) -> Result<Searched, EngineError> {
-    let width = width.clamp(1, MAX_BEAMS as usize);
-    let runtime = |e: &dyn std::fmt::Display| EngineError::Runtime(e.to_string());
-    let vocab = model.vocab();
-    let text_of = |tokens: &[LlamaToken]| {
-        let bytes: Vec<u8> = tokens
-            .iter()
-            .flat_map(|t| vocab.token_to_piece(*t, false, None))
-            .collect();
-        String::from_utf8_lossy(&bytes).into_owned()
+    let search = Search {
+        vocab: model.vocab(),
+        stop,
+        width: width.clamp(1, MAX_BEAMS as usize),
+        prompt_len,
     };
+    let width = search.width;
     let mut live = vec![Beam {
         tokens: Vec::new(),
         logprob: 0.0,
@@ -95,70 +93,13 @@ pub(super) fn search(
         }
     };
     for step in 0..max_tokens {
-        // Every allowed next token of every beam, scored by the whole answer so far.
-        let mut children: Vec<(usize, LlamaToken, f64)> = Vec::new();
-        for (i, beam) in live.iter_mut().enumerate() {
-            let log_z = log_sum_exp(&beam.logits);
-            for (token, logit) in allowed_best(&beam.logits, &mut beam.grammar, width) {
-                children.push((i, token, beam.logprob + f64::from(logit - log_z)));
-            }
-        }
-        children.sort_by(|a, b| b.2.total_cmp(&a.2));
-        let mut next: Vec<(usize, LlamaToken, f64)> = Vec::new();
-        for (parent, token, score) in children {
-            if found.len() + next.len() >= width {
-                break;
-            }
-            let mut tokens = live[parent].tokens.clone();
-            if vocab.is_eog(token) {
-                found.push(Found {
-                    text: text_of(&tokens),
-                    logprob: score,
-                });
-                continue;
-            }
-            tokens.push(token);
-            let text = text_of(&tokens);
-            if let Some(cut) = stop.iter().filter_map(|s| text.find(s.as_str())).min() {
-                found.push(Found {
-                    text: text[..cut].to_string(),
-                    logprob: score,
-                });
-                continue;
-            }
-            next.push((parent, token, score));
-        }
+        let children = scored_children(&mut live, width);
+        let next = search.going_on(&live, children, &mut found);
         if next.is_empty() {
             live.clear();
             break;
         }
-        batch.clear();
-        let first_seq = bank(step);
-        let mut children_beams: Vec<Beam> = Vec::with_capacity(next.len());
-        for (k, (parent, token, score)) in next.into_iter().enumerate() {
-            let seq = first_seq + i32::try_from(k).map_err(|e| runtime(&e))?;
-            let parent = &live[parent];
-            let seq_u = u32::try_from(seq).map_err(|e| runtime(&e))?;
-            ctx.clear_kv_cache_seq(Some(seq_u), None, None)
-                .map_err(|e| runtime(&e))?;
-            ctx.copy_kv_cache_seq(parent.seq, seq, None, None)
-                .map_err(|e| runtime(&e))?;
-            let pos = i32::try_from(prompt_len + parent.tokens.len()).map_err(|e| runtime(&e))?;
-            batch
-                .add(token, pos, &[seq], true)
-                .map_err(|e| runtime(&e))?;
-            let mut grammar = parent.grammar.clone();
-            grammar.accept(token);
-            let mut tokens = parent.tokens.clone();
-            tokens.push(token);
-            children_beams.push(Beam {
-                tokens,
-                logprob: score,
-                grammar,
-                seq,
-                logits: Vec::new(),
-            });
-        }
+        let mut children_beams = search.branch(ctx, &mut batch, &live, next, bank(step))?;
         ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
         decoded += u32::try_from(children_beams.len()).unwrap_or(u32::MAX);
         for (k, beam) in children_beams.iter_mut().enumerate() {
@@ -183,7 +124,7 @@ pub(super) fn search(
     // Beams cut by the token limit end where they are, as a greedy answer would.
     for beam in &live {
         found.push(Found {
-            text: text_of(&beam.tokens),
+            text: search.text_of(&beam.tokens),
             logprob: beam.logprob,
         });
     }
@@ -191,6 +132,115 @@ pub(super) fn search(
     found.sort_by(|a, b| b.logprob.total_cmp(&a.logprob));
     found.truncate(width);
     Ok(Searched { found, decoded })
+}
+
+/// A beam's next token: the index of the beam in the live ones, the token, and the
+/// whole answer's log-probability with it.
+type Child = (usize, LlamaToken, f64);
+
+/// What a search keeps from start to end besides its beams.
+struct Search<'a> {
+    vocab: LlamaVocab<'a>,
+    stop: &'a [String],
+    width: usize,
+    prompt_len: usize,
+}
+
+impl Search<'_> {
+    /// The text of `tokens` (pieces are bytes; a character may span two tokens).
+    fn text_of(&self, tokens: &[LlamaToken]) -> String {
+        let bytes: Vec<u8> = tokens
+            .iter()
+            .flat_map(|t| self.vocab.token_to_piece(*t, false, None))
+            .collect();
+        String::from_utf8_lossy(&bytes).into_owned()
+    }
+
+    /// The best `children` (best first) until the answers found and the beams going on
+    /// fill the width: a child that ends the answer (the end of generation or a stop
+    /// string) goes into `found`, the others are the beams going on.
+    fn going_on(&self, live: &[Beam], children: Vec<Child>, found: &mut Vec<Found>) -> Vec<Child> {
+        let mut next: Vec<Child> = Vec::new();
+        for (parent, token, score) in children {
+            if found.len() + next.len() >= self.width {
+                break;
+            }
+            let mut tokens = live[parent].tokens.clone();
+            if self.vocab.is_eog(token) {
+                found.push(Found {
+                    text: self.text_of(&tokens),
+                    logprob: score,
+                });
+                continue;
+            }
+            tokens.push(token);
+            let text = self.text_of(&tokens);
+            if let Some(cut) = self.stop.iter().filter_map(|s| text.find(s.as_str())).min() {
+                found.push(Found {
+                    text: text[..cut].to_string(),
+                    logprob: score,
+                });
+                continue;
+            }
+            next.push((parent, token, score));
+        }
+        next
+    }
+
+    /// The beams going on, each in its own cache sequence from `first_seq` on (a copy of
+    /// its parent's) with its token added to `batch` for decoding; their logits are not
+    /// known yet.
+    fn branch(
+        &self,
+        ctx: &mut LlamaContext<'_>,
+        batch: &mut LlamaBatch<'_>,
+        live: &[Beam],
+        next: Vec<Child>,
+        first_seq: i32,
+    ) -> Result<Vec<Beam>, EngineError> {
+        batch.clear();
+        let mut children_beams: Vec<Beam> = Vec::with_capacity(next.len());
+        for (k, (parent, token, score)) in next.into_iter().enumerate() {
+            let seq = first_seq + i32::try_from(k).map_err(|e| runtime(&e))?;
+            let parent = &live[parent];
+            let seq_u = u32::try_from(seq).map_err(|e| runtime(&e))?;
+            ctx.clear_kv_cache_seq(Some(seq_u), None, None)
+                .map_err(|e| runtime(&e))?;
+            ctx.copy_kv_cache_seq(parent.seq, seq, None, None)
+                .map_err(|e| runtime(&e))?;
+            let pos =
+                i32::try_from(self.prompt_len + parent.tokens.len()).map_err(|e| runtime(&e))?;
+            batch
+                .add(token, pos, &[seq], true)
+                .map_err(|e| runtime(&e))?;
+            let mut grammar = parent.grammar.clone();
+            grammar.accept(token);
+            let mut tokens = parent.tokens.clone();
+            tokens.push(token);
+            children_beams.push(Beam {
+                tokens,
+                logprob: score,
+                grammar,
+                seq,
+                logits: Vec::new(),
+            });
+        }
+        Ok(children_beams)
+    }
+}
+
+/// Every allowed next token of every beam (up to `width` each), scored by the whole
+/// answer so far, best first.
+fn scored_children(live: &mut [Beam], width: usize) -> Vec<Child> {
+    let mut children: Vec<Child> = Vec::new();
+    for (i, beam) in live.iter_mut().enumerate() {
+        let log_z = log_sum_exp(&beam.logits);
+        for (token, logit) in allowed_best(&beam.logits, &mut beam.grammar, width) {
+            children.push((i, token, beam.logprob + f64::from(logit - log_z)));
+        }
+    }
+    children.sort_by(|a, b| b.2.total_cmp(&a.2));
+    children
 }
 
 /// Drop the cache sequences of `beams` (never the prompt's).

@@ -16,7 +16,7 @@ use llama_cpp_2::context::params::LlamaContextParams;
 use llama_cpp_2::llama_backend::LlamaBackend;
 use llama_cpp_2::llama_batch::LlamaBatch;
 use llama_cpp_2::model::params::LlamaModelParams;
-use llama_cpp_2::model::{LlamaChatMessage, LlamaModel};
+use llama_cpp_2::model::{LlamaChatMessage, LlamaChatTemplate, LlamaModel};
 use llama_cpp_2::sampling::LlamaSampler;
 use llama_cpp_2::token::LlamaToken;
 use llama_cpp_2::token::data::LlamaTokenData;
@@ -199,43 +199,22 @@ impl Engine {
     }
 }
 
+/// The model thread: load the model and make its context, say on `ready` when it is
+/// ready (or why not), then answer the queued calls one at a time until the queue closes.
 fn worker(
     options: EngineOptions,
     ready: mpsc::Sender<Result<Duration, EngineError>>,
     queue: mpsc::Receiver<(Generation, Reply)>,
 ) {
     let started = Instant::now();
-    let setup = (|| {
-        check_gguf(&options.model_path)?;
-        let backend = backend()?;
-        let model =
-            LlamaModel::load_from_file(backend, &options.model_path, &LlamaModelParams::default())
-                .map_err(|e| EngineError::Load {
-                    path: options.model_path.clone(),
-                    detail: format!(
-                        "llama.cpp could not read it (a truncated or corrupt GGUF file?): {e}"
-                    ),
-                })?;
-        Ok::<_, EngineError>((backend, model))
-    })();
-    let (backend, model) = match setup {
+    let (backend, model) = match load_model(&options.model_path) {
         Ok(x) => x,
         Err(e) => {
             let _ = ready.send(Err(e));
             return;
         }
     };
-    let threads = i32::try_from(options.threads.max(1)).unwrap_or(1);
-    let params = LlamaContextParams::default()
-        .with_n_ctx(NonZeroU32::new(options.context.max(512)))
-        .with_n_batch(512)
-        .with_n_threads(threads)
-        .with_n_threads_batch(threads)
-        // Beams are cache sequences beside the prompt's; one unified cache keeps the whole
-        // context for each.
-        .with_n_seq_max(super::beam::SEQUENCES)
-        .with_kv_unified(true);
-    let mut ctx = match model.new_context(backend, params) {
+    let mut ctx = match model.new_context(backend, context_params(&options)) {
         Ok(c) => c,
         Err(e) => {
             let _ = ready.send(Err(EngineError::Load {
@@ -255,45 +234,90 @@ fn worker(
     if ready.send(Ok(started.elapsed())).is_err() {
         return;
     }
-    let states = options
-        .prompt_states
-        .as_deref()
-        .map(|dir| PromptStates::new(dir, &options.model_path));
-    // Tokens whose keys and values are in the cache, in order.
-    let mut cached: Vec<LlamaToken> = Vec::new();
+    let mut worker = Worker {
+        model: &model,
+        template,
+        states: options
+            .prompt_states
+            .as_deref()
+            .map(|dir| PromptStates::new(dir, &options.model_path)),
+        cached: Vec::new(),
+    };
     while let Ok((job, reply)) = queue.recv() {
+        let (result, save) = worker.answer(&mut ctx, &job);
+        // A caller that went away (a cancelled request) does not stop the worker.
+        let _ = reply.send(result);
+        // Saved after answering, so the caller does not wait for the write.
+        if save
+            && let Some(states) = &worker.states
+            && let Err(e) = states.save(&ctx, &worker.cached)
+        {
+            tracing::warn!("{e}");
+        }
+    }
+}
+
+/// The backend, and the model read from `path` after checking it is a GGUF file.
+fn load_model(path: &Path) -> Result<(&'static LlamaBackend, LlamaModel), EngineError> {
+    check_gguf(path)?;
+    let backend = backend()?;
+    let model =
+        LlamaModel::load_from_file(backend, path, &LlamaModelParams::default()).map_err(|e| {
+            EngineError::Load {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "llama.cpp could not read it (a truncated or corrupt GGUF file?): {e}"
+                ),
+            }
+        })?;
+    Ok((backend, model))
+}
+
+/// The context's size and threads as `options` ask.
+fn context_params(options: &EngineOptions) -> LlamaContextParams {
+    let threads = i32::try_from(options.threads.max(1)).unwrap_or(1);
+    LlamaContextParams::default()
+        .with_n_ctx(NonZeroU32::new(options.context.max(512)))
+        .with_n_batch(512)
+        .with_n_threads(threads)
+        .with_n_threads_batch(threads)
+        // Beams are cache sequences beside the prompt's; one unified cache keeps the whole
+        // context for each.
+        .with_n_seq_max(super::beam::SEQUENCES)
+        .with_kv_unified(true)
+}
+
+/// What the worker keeps from one call to the next besides its context.
+struct Worker<'m> {
+    model: &'m LlamaModel,
+    template: LlamaChatTemplate,
+    states: Option<PromptStates>,
+    /// Tokens whose keys and values are in the cache, in order.
+    cached: Vec<LlamaToken>,
+}
+
+impl Worker<'_> {
+    /// One call's reply, and whether the prompt's state is to be saved after it.
+    fn answer(
+        &mut self,
+        ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+        job: &Generation,
+    ) -> (Result<Generated, EngineError>, bool) {
         // From an empty cache (the first call, or after a failure) a saved state of the
         // prompt's fixed part spares evaluating it again; a state is saved after the call.
-        let cold = cached.is_empty();
+        let cold = self.cached.is_empty();
         let mut loaded = false;
-        let result = (|| {
-            let chat = job
-                .messages
-                .iter()
-                .map(|(role, content)| LlamaChatMessage::new(role.clone(), content.clone()))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| EngineError::Template(e.to_string()))?;
-            let mut prompt = model
-                .apply_chat_template(&template, &chat, true)
-                .map_err(|e| EngineError::Template(e.to_string()))?;
-            prompt.push_str(&job.prefill);
-            // The template already wrote the special tokens; parse them as such.
-            let tokens = model.vocab().tokenize(prompt.as_bytes(), false, true);
-            if cold && let Some(saved) = states.as_ref().and_then(|s| s.load(&mut ctx, &tokens)) {
+        let result = self.prompt(job).and_then(|tokens| {
+            if cold
+                && let Some(saved) = self.states.as_ref().and_then(|s| s.load(ctx, &tokens))
+            {
                 tracing::debug!(file = %saved.file.display(), tokens = saved.tokens.len(), "prompt state loaded");
-                cached = saved.tokens;
+                self.cached = saved.tokens;
                 loaded = true;
             }
-            generate(&model, &mut ctx, &mut cached, &tokens, &job).map(|mut g| {
-                if !job.prefill.is_empty() {
-                    g.text.insert_str(0, &job.prefill);
-                    for (text, _) in &mut g.ranked {
-                        text.insert_str(0, &job.prefill);
-                    }
-                }
-                g
-            })
-        })();
+            generate(self.model, ctx, &mut self.cached, &tokens, job)
+                .map(|g| with_prefill(g, &job.prefill))
+        });
         let save = match &result {
             Ok(g) => {
                 cold && (!loaded
@@ -304,21 +328,47 @@ fn worker(
             }
             Err(_) => {
                 // After a failure the cache contents are unknown: start clean next time.
-                cached.clear();
+                self.cached.clear();
                 let _ = ctx.clear_kv_cache_seq(None, None, None);
                 false
             }
         };
-        // A caller that went away (a cancelled request) does not stop the worker.
-        let _ = reply.send(result);
-        // Saved after answering, so the caller does not wait for the write.
-        if save
-            && let Some(states) = &states
-            && let Err(e) = states.save(&ctx, &cached)
-        {
-            tracing::warn!("{e}");
+        (result, save)
+    }
+
+    /// The call's messages through the model's chat template, with the prefill, as tokens.
+    fn prompt(&self, job: &Generation) -> Result<Vec<LlamaToken>, EngineError> {
+        let chat = job
+            .messages
+            .iter()
+            .map(|(role, content)| LlamaChatMessage::new(role.clone(), content.clone()))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| EngineError::Template(e.to_string()))?;
+        let mut prompt = self
+            .model
+            .apply_chat_template(&self.template, &chat, true)
+            .map_err(|e| EngineError::Template(e.to_string()))?;
+        prompt.push_str(&job.prefill);
+        // The template already wrote the special tokens; parse them as such.
+        Ok(self.model.vocab().tokenize(prompt.as_bytes(), false, true))
+    }
+}
+
+/// `g` with the reply's prefilled first words put back before its text and every ranked
+/// answer.
+fn with_prefill(mut g: Generated, prefill: &str) -> Generated {
+    if !prefill.is_empty() {
+        g.text.insert_str(0, prefill);
+        for (text, _) in &mut g.ranked {
+            text.insert_str(0, prefill);
         }
     }
+    g
+}
+
+/// A llama.cpp failure as the engine's error.
+pub(super) fn runtime(e: &dyn std::fmt::Display) -> EngineError {
+    EngineError::Runtime(e.to_string())
 }
 
 fn generate(
@@ -335,9 +385,59 @@ fn generate(
             context: n_ctx,
         });
     }
-    let runtime = |e: &dyn std::fmt::Display| EngineError::Runtime(e.to_string());
-    // Reuse the cached prefix; always evaluate at least the last prompt token, whose
-    // logits start the reply.
+    let keep = reuse_cache(ctx, cached, tokens)?;
+    let prompt_started = Instant::now();
+    let mut batch = evaluate_prompt(ctx, cached, tokens, keep)?;
+    let prompt_time = prompt_started.elapsed();
+
+    let mut grammar = match &job.grammar {
+        Some(g) => Some(
+            LlamaSampler::grammar(model, g, "root")
+                .map_err(|e| EngineError::Grammar(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let prompted = Prompted {
+        tokens,
+        keep,
+        prompt_time,
+    };
+    if job.beams > 1
+        && job.temperature <= 0.0
+        && let Some(grammar) = grammar.take()
+    {
+        let first = batch.n_tokens() - 1;
+        return beam_reply(model, ctx, &prompted, first, grammar, job);
+    }
+    let generation_started = Instant::now();
+    let (text, produced) = sample_reply(model, ctx, cached, &mut batch, grammar, job)?;
+    Ok(Generated {
+        text,
+        prompt_tokens: tokens.len() as u32,
+        cached_tokens: keep as u32,
+        completion_tokens: produced,
+        prompt_time,
+        generation_time: generation_started.elapsed(),
+        ranked: Vec::new(),
+    })
+}
+
+/// The prompt as evaluated: its tokens, how many of them were in the cache, and the time
+/// evaluating the rest took.
+struct Prompted<'t> {
+    tokens: &'t [LlamaToken],
+    keep: usize,
+    prompt_time: Duration,
+}
+
+/// Keep the cached prefix the prompt shares and drop the rest of the cache; always
+/// evaluate at least the last prompt token, whose logits start the reply. How many
+/// tokens were kept.
+fn reuse_cache(
+    ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+    cached: &mut Vec<LlamaToken>,
+    tokens: &[LlamaToken],
+) -> Result<usize, EngineError> {
     let common = cached
         .iter()
         .zip(tokens)
@@ -347,8 +447,17 @@ fn generate(
     ctx.clear_kv_cache_seq(Some(0), Some(keep as u32), None)
         .map_err(|e| runtime(&e))?;
     cached.truncate(keep);
+    Ok(keep)
+}
 
-    let prompt_started = Instant::now();
+/// Evaluate the prompt's tokens after the first `keep` in batches, adding them to
+/// `cached`; the last batch, whose last token has the logits that start the reply.
+fn evaluate_prompt<'b>(
+    ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+    cached: &mut Vec<LlamaToken>,
+    tokens: &[LlamaToken],
+    keep: usize,
+) -> Result<LlamaBatch<'b>, EngineError> {
     let batch_size = ctx.n_batch() as usize;
     let mut batch = LlamaBatch::new(batch_size.max(1), 1);
     let rest = &tokens[keep..];
@@ -363,51 +472,63 @@ fn generate(
         ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
         cached.extend_from_slice(chunk);
     }
-    let prompt_time = prompt_started.elapsed();
+    Ok(batch)
+}
 
-    let mut grammar = match &job.grammar {
-        Some(g) => Some(
-            LlamaSampler::grammar(model, g, "root")
-                .map_err(|e| EngineError::Grammar(e.to_string()))?,
-        ),
-        None => None,
-    };
-    if job.beams > 1
-        && job.temperature <= 0.0
-        && let Some(grammar) = grammar.take()
-    {
-        let generation_started = Instant::now();
-        let first = ctx.get_logits_ith(batch.n_tokens() - 1).to_vec();
-        let searched = super::beam::search(
-            model,
-            ctx,
-            (tokens.len(), first),
-            grammar,
-            job.beams as usize,
-            (job.max_tokens, &job.stop),
-        )?;
-        for f in &searched.found {
-            tracing::debug!(logprob = f.logprob, text = %f.text, "beam answer");
-        }
-        let text = searched
-            .found
-            .first()
-            .map(|f| f.text.clone())
-            .unwrap_or_default();
-        return Ok(Generated {
-            text,
-            prompt_tokens: tokens.len() as u32,
-            cached_tokens: keep as u32,
-            completion_tokens: searched.decoded,
-            prompt_time,
-            generation_time: generation_started.elapsed(),
-            ranked: searched
-                .found
-                .into_iter()
-                .map(|f| (f.text, f.logprob))
-                .collect(),
-        });
+/// The answers a beam search under `grammar` finds most likely, starting from the logits
+/// of batch index `first`; the best is the reply.
+fn beam_reply(
+    model: &LlamaModel,
+    ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+    prompted: &Prompted<'_>,
+    first: i32,
+    grammar: LlamaSampler,
+    job: &Generation,
+) -> Result<Generated, EngineError> {
+    let generation_started = Instant::now();
+    let first = ctx.get_logits_ith(first).to_vec();
+    let searched = super::beam::search(
+        model,
+        ctx,
+        (prompted.tokens.len(), first),
+        grammar,
+        job.beams as usize,
+        (job.max_tokens, &job.stop),
+    )?;
+    for f in &searched.found {
+        tracing::debug!(logprob = f.logprob, text = %f.text, "beam answer");
     }
+    let text = searched
+        .found
+        .first()
+        .map(|f| f.text.clone())
+        .unwrap_or_default();
+    Ok(Generated {
+        text,
+        prompt_tokens: prompted.tokens.len() as u32,
+        cached_tokens: prompted.keep as u32,
+        completion_tokens: searched.decoded,
+        prompt_time: prompted.prompt_time,
+        generation_time: generation_started.elapsed(),
+        ranked: searched
+            .found
+            .into_iter()
+            .map(|f| (f.text, f.logprob))
+            .collect(),
+    })
+}
+
+/// One reply drawn token by token (greedy, or at the job's temperature), within the
+/// grammar if any, until the end of generation, a stop string or `max_tokens`; its text
+/// and how many tokens it took. `batch` holds the prompt's last batch on entry.
+fn sample_reply(
+    model: &LlamaModel,
+    ctx: &mut llama_cpp_2::context::LlamaContext<'_>,
+    cached: &mut Vec<LlamaToken>,
+    batch: &mut LlamaBatch<'_>,
+    mut grammar: Option<LlamaSampler>,
+    job: &Generation,
+) -> Result<(String, u32), EngineError> {
     let mut pick = if job.temperature > 0.0 {
         LlamaSampler::chain_simple([
             LlamaSampler::temp(job.temperature),
@@ -416,8 +537,6 @@ fn generate(
     } else {
         LlamaSampler::greedy()
     };
-
-    let generation_started = Instant::now();
     let vocab = model.vocab();
     // Pieces are bytes; a character may span two tokens, so decode the whole reply.
     let mut bytes: Vec<u8> = Vec::new();
@@ -441,19 +560,11 @@ fn generate(
         batch
             .add(token, cached.len() as i32, &[0], true)
             .map_err(|e| runtime(&e))?;
-        ctx.decode(&mut batch).map_err(|e| runtime(&e))?;
+        ctx.decode(batch).map_err(|e| runtime(&e))?;
         cached.push(token);
         logits_at = 0;
     }
-    Ok(Generated {
-        text,
-        prompt_tokens: tokens.len() as u32,
-        cached_tokens: keep as u32,
-        completion_tokens: produced,
-        prompt_time,
-        generation_time: generation_started.elapsed(),
-        ranked: Vec::new(),
-    })
+    Ok((text, produced))
 }
 
 /// The next token from `logits`, drawn by `pick` among those `grammar` allows, and

@@ -74,6 +74,13 @@ pub fn check_rule(
     {
         return Err(Refusal::Known(same.id.clone()));
     }
+    fits_declarations(rule, scenario)?;
+    examples_still_plan(rule, scenario, knowledge)?;
+    scenarios_still_plan(rule, scenario, knowledge)
+}
+
+/// The rule fits the domain and contradicts no precondition or effect its skill declares.
+fn fits_declarations(rule: &LearnedRule, scenario: &Scenario) -> Result<(), Refusal> {
     let mut probe = scenario.domain.clone();
     probe.learn(rule).map_err(Refusal::DoesNotFit)?;
     for skill in scenario
@@ -106,27 +113,40 @@ pub fn check_rule(
             });
         }
     }
-    // Judged against the rules kept so far, so that only this rule's effect counts.
-    let known = |s: &Scenario| {
-        let mut s = s.clone();
-        knowledge.apply(&mut s);
-        s
-    };
-    let with_rule = |s: &Scenario| {
-        let mut s = known(s);
-        s.domain.learn(rule).ok().map(|()| s)
-    };
-    // The domain's worked examples are goals a person may ask for: in this scenario and
-    // in the domain's base file (a scenario may declare its skills differently).
+    Ok(())
+}
+
+/// `s` with the rules kept so far: a rule is judged against them, so that only its own
+/// effect counts.
+fn with_known(knowledge: &Knowledge, s: &Scenario) -> Scenario {
+    let mut s = s.clone();
+    knowledge.apply(&mut s);
+    s
+}
+
+/// `s` with the rules kept so far and `rule`, when it fits.
+fn with_rule(knowledge: &Knowledge, rule: &LearnedRule, s: &Scenario) -> Option<Scenario> {
+    let mut s = with_known(knowledge, s);
+    s.domain.learn(rule).ok().map(|()| s)
+}
+
+/// The domain's worked examples are goals a person may ask for: every one that plans
+/// without the rule still plans with it, in this scenario and in the domain's base file
+/// (a scenario may declare its skills differently).
+fn examples_still_plan(
+    rule: &LearnedRule,
+    scenario: &Scenario,
+    knowledge: &Knowledge,
+) -> Result<(), Refusal> {
     let base = scenario
         .files
         .first()
         .and_then(|f| Scenario::load(&f.path).ok());
     for scene in std::iter::once(scenario).chain(base.as_ref()) {
-        let (Some(after), Ok(facts)) = (with_rule(scene), facts_of(scene)) else {
+        let (Some(after), Ok(facts)) = (with_rule(knowledge, rule, scene), facts_of(scene)) else {
             continue;
         };
-        let before = known(scene);
+        let before = with_known(knowledge, scene);
         for example in &scenario.examples {
             let Ok(goal) = scene.parse_goal(&example.goal) else {
                 continue;
@@ -143,6 +163,15 @@ pub fn check_rule(
             }
         }
     }
+    Ok(())
+}
+
+/// Every scenario of the domain whose goal plans without the rule still plans with it.
+fn scenarios_still_plan(
+    rule: &LearnedRule,
+    scenario: &Scenario,
+    knowledge: &Knowledge,
+) -> Result<(), Refusal> {
     for (path, other) in domain_scenarios(scenario) {
         let Some(goal) = other.goal.clone() else {
             continue;
@@ -151,10 +180,10 @@ pub fn check_rule(
             continue;
         };
         // Unplannable without the rule too: not the rule's doing.
-        if plans(&known(&other), &facts, &goal).is_err() {
+        if plans(&with_known(knowledge, &other), &facts, &goal).is_err() {
             continue;
         }
-        let Some(after) = with_rule(&other) else {
+        let Some(after) = with_rule(knowledge, rule, &other) else {
             continue;
         };
         if let Err(why) = plans(&after, &facts, &goal) {

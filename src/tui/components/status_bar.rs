@@ -79,32 +79,61 @@ impl StatusBar {
             return self.draw_replay(frame, area, theme, timeline, (&sep, help));
         }
         if let Some(message) = &self.message {
-            // The message gets the width; the help key stays at the right edge.
-            let style = if message.error {
-                theme.status_bar.patch(theme.error)
-            } else {
-                theme.status_bar
-            };
-            let scenario = format!(" {}", self.scenario);
-            let fixed =
-                scenario.chars().count() + 2 * sep.content.chars().count() + help.chars().count();
-            let room = usize::from(area.width).saturating_sub(fixed);
-            let spans = vec![
-                Span::styled(scenario, theme.status_bar),
-                sep.clone(),
-                Span::styled(
-                    format!("{:<room$}", crate::excerpt::shortened(&message.text, room)),
-                    style,
-                ),
-                sep,
-                Span::styled(help, theme.status_bar),
-            ];
-            frame.render_widget(
-                Paragraph::new(Line::from(spans)).style(theme.status_bar),
-                area,
-            );
-            return;
+            return self.draw_message(frame, area, theme, message, (&sep, help));
         }
+        let mut spans = self.session_spans(theme, narrow, &sep);
+        self.push_flags(&mut spans, theme, &sep);
+        spans.push(sep);
+        spans.push(Span::styled(help, theme.status_bar));
+        frame.render_widget(
+            Paragraph::new(Line::from(spans)).style(theme.status_bar),
+            area,
+        );
+    }
+
+    /// `scenario │ message │ ? help`: the message gets the width; the help key stays at
+    /// the right edge.
+    fn draw_message(
+        &self,
+        frame: &mut Frame,
+        area: Rect,
+        theme: &Theme,
+        message: &Message,
+        (sep, help): (&Span<'static>, String),
+    ) {
+        let style = if message.error {
+            theme.status_bar.patch(theme.error)
+        } else {
+            theme.status_bar
+        };
+        let scenario = format!(" {}", self.scenario);
+        let fixed =
+            scenario.chars().count() + 2 * sep.content.chars().count() + help.chars().count();
+        let room = usize::from(area.width).saturating_sub(fixed);
+        let spans = vec![
+            Span::styled(scenario, theme.status_bar),
+            sep.clone(),
+            Span::styled(
+                format!("{:<room$}", crate::excerpt::shortened(&message.text, room)),
+                style,
+            ),
+            sep.clone(),
+            Span::styled(help, theme.status_bar),
+        ];
+        frame.render_widget(
+            Paragraph::new(Line::from(spans)).style(theme.status_bar),
+            area,
+        );
+    }
+
+    /// The session's state, each part followed by `sep` but the last: scenario, backend
+    /// and model, the model's fetch, calls, tick, and whether it runs.
+    fn session_spans(
+        &self,
+        theme: &Theme,
+        narrow: bool,
+        sep: &Span<'static>,
+    ) -> Vec<Span<'static>> {
         let who = if narrow {
             self.model.clone()
         } else {
@@ -146,6 +175,12 @@ impl StatusBar {
                 (false, None) => Span::styled(strings::PAUSED, theme.status_bar),
             },
         ]);
+        spans
+    }
+
+    /// What the run came to, and the flags that are on (break on failure, the missing
+    /// viewer, auto-approve), each after `sep`.
+    fn push_flags(&self, spans: &mut Vec<Span<'static>>, theme: &Theme, sep: &Span<'static>) {
         match self.ending {
             Some(Ending::Success) => {
                 spans.push(sep.clone());
@@ -176,12 +211,6 @@ impl StatusBar {
             spans.push(sep.clone());
             spans.push(Span::styled(strings::AUTO_APPROVE, theme.error));
         }
-        spans.push(sep);
-        spans.push(Span::styled(help, theme.status_bar));
-        frame.render_widget(
-            Paragraph::new(Line::from(spans)).style(theme.status_bar),
-            area,
-        );
     }
 
     /// `REPLAY  step 123/4567  tick 42  0:12.345 │ what the step was │ SUCCESS │ ? help`;

@@ -132,28 +132,7 @@ impl WorldPane {
         // In a short pane the error takes one row, so the facts keep theirs (the LLM pane
         // and D show it whole).
         let short = area.height < SHORT_PANE;
-        if let (Some(e), true) = (&self.last_error, short) {
-            let style = if self.error_resolved {
-                theme.dim
-            } else {
-                theme.error
-            };
-            lines.push(Line::from(Span::styled(
-                cut_to(&format!("{} {e}", strings::LAST_ERROR), width),
-                style,
-            )));
-        } else if let Some(e) = &self.last_error {
-            if self.error_resolved {
-                lines.push(Line::from(Span::styled(
-                    strings::LAST_ERROR_RESOLVED,
-                    theme.dim,
-                )));
-                lines.push(Line::from(Span::styled(format!("  {e}"), theme.dim)));
-            } else {
-                lines.push(Line::from(Span::styled(strings::LAST_ERROR, theme.title)));
-                lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
-            }
-        }
+        self.push_last_error(&mut lines, theme, width, short);
         for v in &self.values {
             lines.push(Line::from(Span::styled(
                 format!("{} {v}", strings::VALUE_SET),
@@ -184,6 +163,53 @@ impl WorldPane {
             },
             theme.dim,
         )));
+        self.push_facts(&mut lines, theme);
+        let block = Block::default()
+            .borders(Borders::ALL)
+            .border_style(if self.focused {
+                theme.focused
+            } else {
+                theme.border
+            })
+            .title(Span::styled(strings::WORLD_TITLE, theme.title));
+        frame.render_widget(
+            Paragraph::new(lines)
+                .wrap(Wrap { trim: false })
+                .block(block),
+            area,
+        );
+    }
+
+    /// The last error, dim once resolved: cut to one row of `width` in a short pane,
+    /// else a heading and the error below it.
+    fn push_last_error(&self, lines: &mut Vec<Line<'_>>, theme: &Theme, width: usize, short: bool) {
+        if let (Some(e), true) = (&self.last_error, short) {
+            let style = if self.error_resolved {
+                theme.dim
+            } else {
+                theme.error
+            };
+            lines.push(Line::from(Span::styled(
+                cut_to(&format!("{} {e}", strings::LAST_ERROR), width),
+                style,
+            )));
+        } else if let Some(e) = &self.last_error {
+            if self.error_resolved {
+                lines.push(Line::from(Span::styled(
+                    strings::LAST_ERROR_RESOLVED,
+                    theme.dim,
+                )));
+                lines.push(Line::from(Span::styled(format!("  {e}"), theme.dim)));
+            } else {
+                lines.push(Line::from(Span::styled(strings::LAST_ERROR, theme.title)));
+                lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
+            }
+        }
+    }
+
+    /// The facts' heading and the facts from the scroll position on, marked as they
+    /// changed (new, gone, the same).
+    fn push_facts(&self, lines: &mut Vec<Line<'_>>, theme: &Theme) {
         let rows = self.rows();
         let shown = rows.iter().filter(|(_, _, m)| *m != Mark::False).count();
         lines.push(Line::from(Span::styled(
@@ -211,20 +237,6 @@ impl WorldPane {
                 Span::styled(fact.clone(), style),
             ]));
         }
-        let block = Block::default()
-            .borders(Borders::ALL)
-            .border_style(if self.focused {
-                theme.focused
-            } else {
-                theme.border
-            })
-            .title(Span::styled(strings::WORLD_TITLE, theme.title));
-        frame.render_widget(
-            Paragraph::new(lines)
-                .wrap(Wrap { trim: false })
-                .block(block),
-            area,
-        );
     }
 }
 

@@ -372,98 +372,18 @@ impl Arms {
         spin: Isometry3<f64>,
         attempt: u64,
     ) -> Result<ArmMove, Refusal> {
-        let chain = &self.robot.arms[arm];
+        let tip = &self.robot.arms[arm].tip;
         let start = reach
             .configs
             .get(arm)
             .cloned()
             .unwrap_or_else(|| self.rest[arm].clone());
-        let unreachable = |pose: &Isometry3<f64>| {
-            Refusal::OutOfReach(format!(
-                "pose {} is out of reach of {} (no joint values within the limits reach it)",
-                describe_pose(pose),
-                chain.tip
-            ))
-        };
-        let at_flange = self.flange_for(reach, &reach.at, &spin);
-        // From where the arm is, then from the middle of its ranges, then from its rest.
-        let from = match attempt {
-            0 => start.clone(),
-            1 => chain
-                .joints
-                .iter()
-                .map(|j| (j.lower + j.upper) / 2.0)
-                .collect(),
-            _ => self.rest[arm].clone(),
-        };
-        // The end of the approach (the harder pose, nearest the table) first, then the
-        // straight line back up, each pose from the one below.
-        let Some((at, _, _)) = solve(chain, &at_flange, &from, &self.ik) else {
-            return Err(unreachable(&reach.at));
-        };
-        let travel = (reach.at.translation.vector - reach.above.translation.vector).norm();
-        let steps = (travel / APPROACH_STEP).ceil().max(1.0) as usize;
-        let follow = IkOptions {
-            starts: 1,
-            solutions: 1,
-            ..self.ik
-        };
-        let mut line = vec![at];
-        for k in 1..=steps {
-            let t = k as f64 / steps as f64;
-            let tool = Isometry3::from_parts(
-                Translation3::from(
-                    reach
-                        .at
-                        .translation
-                        .vector
-                        .lerp(&reach.above.translation.vector, t),
-                ),
-                reach.at.rotation.slerp(&reach.above.rotation, t),
-            );
-            let flange = self.flange_for(reach, &tool, &spin);
-            let Some(previous) = line.last().cloned() else {
-                break;
-            };
-            let Some((q, _, _)) = solve(chain, &flange, &previous, &follow) else {
-                return Err(unreachable(&tool));
-            };
-            let jump = q
-                .iter()
-                .zip(&previous)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            if jump > APPROACH_JUMP {
-                return Err(unreachable(&tool));
-            }
-            line.push(q);
-        }
+        let from = self.ik_start(arm, &start, attempt);
+        let line = self.approach_line(arm, reach, &spin, &from)?;
         let Some(above) = line.last().cloned() else {
-            return Err(unreachable(&reach.above));
+            return Err(out_of_reach(&reach.above, tip));
         };
-        // What the hand holds, from the tool's world-aligned frame into the flange's.
-        let into_flange = (self.tool
-            * spin.inverse()
-            * Isometry3::from_parts(Translation3::identity(), reach.at.rotation.inverse()))
-        .cast::<f32>();
-        let carried: Vec<Solid> = reach
-            .carried
-            .iter()
-            .map(|p| Solid {
-                name: p.name.clone(),
-                pose: into_flange * p.pose,
-                shape: p.shape.clone(),
-            })
-            .collect();
-        let query = |carried: Vec<Solid>, start: &[f64], goal: &[f64]| PathQuery {
-            arm,
-            base: reach.base,
-            configs: reach.configs.to_vec(),
-            solids: reach.solids.to_vec(),
-            carried,
-            start: start.to_vec(),
-            goal: goal.to_vec(),
-        };
+        let carried = self.carried_in_flange(reach, &spin);
         let check = ArmCheck::new(
             &self.robot,
             &self.shapes,
@@ -474,20 +394,9 @@ impl Arms {
         )
         .map_err(|e| no_path(&e))?
         .carrying(carried.clone());
-        for q in &line {
-            if let Some(blocker) = check.blocker(q) {
-                return Err(Refusal::NoPath {
-                    message: format!(
-                        "No collision free path found for {}: the straight approach to {} collides with {blocker}",
-                        chain.tip,
-                        describe_pose(&reach.at)
-                    ),
-                    blocker: Some(blocker),
-                });
-            }
-        }
+        approach_clear(&check, &line, reach, tip)?;
         let path = self
-            .plan_path(&check, query(carried, &start, &above))
+            .plan_path(&check, reach.query(arm, carried, &start, &above))
             .map_err(|e| no_path(&e))?;
         // There, down the approach (`line` runs up from the bottom) and back up.
         let mut way = path.waypoints.clone();
@@ -509,20 +418,7 @@ impl Arms {
             },
         };
         if reach.lets_go {
-            // Empty-handed, from above the object let go back to rest (the object below
-            // the hand is out of the way going up).
-            let empty = ArmCheck::new(
-                &self.robot,
-                &self.shapes,
-                reach.base,
-                arm,
-                reach.configs,
-                reach.solids,
-            )
-            .map_err(|e| no_path(&e))?;
-            let back = self
-                .plan_path(&empty, query(Vec::new(), &above, &self.rest[arm]))
-                .map_err(|e| no_path(&e))?;
+            let back = self.path_back_to_rest(arm, reach, &above)?;
             done.q.clone_from(&self.rest[arm]);
             done.length += back.length();
             done.samples += back.samples;
@@ -536,18 +432,177 @@ impl Arms {
             .first()
             .and_then(|bottom| done.path.iter().position(|q| q == bottom))
             .unwrap_or_default();
-        done.tool = done
-            .path
+        done.tool = self.tool_along(arm, reach.base, &done.path);
+        Ok(done)
+    }
+
+    /// Where the inverse kinematics starts on attempt `attempt`: from where the arm is
+    /// (`start`), then from the middle of its ranges, then from its rest.
+    fn ik_start(&self, arm: usize, start: &[f64], attempt: u64) -> Vec<f64> {
+        match attempt {
+            0 => start.to_vec(),
+            1 => self.robot.arms[arm]
+                .joints
+                .iter()
+                .map(|j| (j.lower + j.upper) / 2.0)
+                .collect(),
+            _ => self.rest[arm].clone(),
+        }
+    }
+
+    /// The straight approach in joint values, from its bottom (`reach.at`) up to
+    /// `reach.above`: the end of the approach (the harder pose, nearest the table) is
+    /// solved first from `from`, then each pose of the line back up from the one below;
+    /// refused when a pose is out of reach or the arm would flip over between two.
+    fn approach_line(
+        &self,
+        arm: usize,
+        reach: &Reach<'_>,
+        spin: &Isometry3<f64>,
+        from: &[f64],
+    ) -> Result<Vec<Vec<f64>>, Refusal> {
+        let chain = &self.robot.arms[arm];
+        let at_flange = self.flange_for(reach, &reach.at, spin);
+        let Some((at, _, _)) = solve(chain, &at_flange, from, &self.ik) else {
+            return Err(out_of_reach(&reach.at, &chain.tip));
+        };
+        let travel = (reach.at.translation.vector - reach.above.translation.vector).norm();
+        let steps = (travel / APPROACH_STEP).ceil().max(1.0) as usize;
+        let follow = IkOptions {
+            starts: 1,
+            solutions: 1,
+            ..self.ik
+        };
+        let mut line = vec![at];
+        for k in 1..=steps {
+            let t = k as f64 / steps as f64;
+            let tool = Isometry3::from_parts(
+                Translation3::from(
+                    reach
+                        .at
+                        .translation
+                        .vector
+                        .lerp(&reach.above.translation.vector, t),
+                ),
+                reach.at.rotation.slerp(&reach.above.rotation, t),
+            );
+            let flange = self.flange_for(reach, &tool, spin);
+            let Some(previous) = line.last().cloned() else {
+                break;
+            };
+            let Some((q, _, _)) = solve(chain, &flange, &previous, &follow) else {
+                return Err(out_of_reach(&tool, &chain.tip));
+            };
+            let jump = q
+                .iter()
+                .zip(&previous)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if jump > APPROACH_JUMP {
+                return Err(out_of_reach(&tool, &chain.tip));
+            }
+            line.push(q);
+        }
+        Ok(line)
+    }
+
+    /// What the hand holds, from the tool's world-aligned frame into the flange's.
+    fn carried_in_flange(&self, reach: &Reach<'_>, spin: &Isometry3<f64>) -> Vec<Solid> {
+        let into_flange = (self.tool
+            * spin.inverse()
+            * Isometry3::from_parts(Translation3::identity(), reach.at.rotation.inverse()))
+        .cast::<f32>();
+        reach
+            .carried
             .iter()
+            .map(|p| Solid {
+                name: p.name.clone(),
+                pose: into_flange * p.pose,
+                shape: p.shape.clone(),
+            })
+            .collect()
+    }
+
+    /// Empty-handed, from above the object let go back to rest (the object below the hand
+    /// is out of the way going up).
+    fn path_back_to_rest(
+        &self,
+        arm: usize,
+        reach: &Reach<'_>,
+        above: &[f64],
+    ) -> Result<crate::motion::JointPath, Refusal> {
+        let empty = ArmCheck::new(
+            &self.robot,
+            &self.shapes,
+            reach.base,
+            arm,
+            reach.configs,
+            reach.solids,
+        )
+        .map_err(|e| no_path(&e))?;
+        self.plan_path(&empty, reach.query(arm, Vec::new(), above, &self.rest[arm]))
+            .map_err(|e| no_path(&e))
+    }
+
+    /// The tool centre point (world) at each configuration of `path`.
+    fn tool_along(&self, arm: usize, base: Isometry3<f64>, path: &[Vec<f64>]) -> Vec<[f32; 3]> {
+        let chain = &self.robot.arms[arm];
+        path.iter()
             .map(|q| {
                 // The grip's turn about the tool's axis does not move its centre.
-                let at = reach.base * chain.fk(q) * self.tool;
+                let at = base * chain.fk(q) * self.tool;
                 let p = at.translation.vector;
                 [p.x as f32, p.y as f32, p.z as f32]
             })
-            .collect();
-        Ok(done)
+            .collect()
     }
+}
+
+impl Reach<'_> {
+    /// The path query for `arm` in this motion's scene, carrying `carried`.
+    fn query(&self, arm: usize, carried: Vec<Solid>, start: &[f64], goal: &[f64]) -> PathQuery {
+        PathQuery {
+            arm,
+            base: self.base,
+            configs: self.configs.to_vec(),
+            solids: self.solids.to_vec(),
+            carried,
+            start: start.to_vec(),
+            goal: goal.to_vec(),
+        }
+    }
+}
+
+/// The refusal for a tool pose no joint values within the limits of arm `tip` reach.
+fn out_of_reach(pose: &Isometry3<f64>, tip: &str) -> Refusal {
+    Refusal::OutOfReach(format!(
+        "pose {} is out of reach of {} (no joint values within the limits reach it)",
+        describe_pose(pose),
+        tip
+    ))
+}
+
+/// Every pose of the straight approach `line` free of collisions under `check`, else the
+/// refusal naming what it hits first.
+fn approach_clear(
+    check: &ArmCheck<'_>,
+    line: &[Vec<f64>],
+    reach: &Reach<'_>,
+    tip: &str,
+) -> Result<(), Refusal> {
+    for q in line {
+        if let Some(blocker) = check.blocker(q) {
+            return Err(Refusal::NoPath {
+                message: format!(
+                    "No collision free path found for {}: the straight approach to {} collides with {blocker}",
+                    tip,
+                    describe_pose(&reach.at)
+                ),
+                blocker: Some(blocker),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// `way` with configurations put in between so that no joint changes by more than `step`

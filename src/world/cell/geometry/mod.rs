@@ -108,106 +108,127 @@ pub fn cuboid_at(center: Vector3<f32>, half: Vector3<f32>) -> Part {
     }
 }
 
+/// A cup's parts (a disc for the bottom, a ring of wall segments) and its cavity.
+fn cup(radius: f32, height: f32, wall: f32, bottom: f32) -> (Vec<Part>, Cavity) {
+    let mut parts = vec![Part {
+        local: Pose::new(
+            Vector3::new(0.0, 0.0, bottom / 2.0),
+            Vector3::x() * FRAC_PI_2,
+        ),
+        shape: SharedShape::cylinder(bottom / 2.0, radius),
+    }];
+    let wall_h = (height - bottom) / 2.0;
+    let chord = radius * (PI / CUP_SEGMENTS as f32).tan();
+    for i in 0..CUP_SEGMENTS {
+        let angle = 2.0 * PI * i as f32 / CUP_SEGMENTS as f32;
+        let r = radius - wall / 2.0;
+        parts.push(Part {
+            local: Pose::new(
+                Vector3::new(r * angle.cos(), r * angle.sin(), bottom + wall_h),
+                Vector3::z() * angle,
+            ),
+            shape: SharedShape::cuboid(wall / 2.0, chord, wall_h),
+        });
+    }
+    // The largest square inside the inner ring, from the bottom to the rim.
+    let inner = (radius - wall) * (PI / CUP_SEGMENTS as f32).cos() / 2f32.sqrt();
+    let cavity = Cavity {
+        center: Point3::new(0.0, 0.0, bottom + wall_h),
+        half: Vector3::new(inner, inner, wall_h),
+        opening: Opening::Top,
+    };
+    (parts, cavity)
+}
+
+/// An open box's parts (the floor, three walls, and the fourth wall or the lid on the
+/// side that is not open) and its cavity.
+fn open_box(size: [f32; 3], wall: f32, opening: Opening) -> (Vec<Part>, Cavity) {
+    let [sx, sy, sz] = size;
+    let (hx, hy, hz, t) = (sx / 2.0, sy / 2.0, sz / 2.0, wall / 2.0);
+    let mut parts = vec![
+        cuboid_at(Vector3::new(0.0, 0.0, t), Vector3::new(hx, hy, t)),
+        cuboid_at(Vector3::new(0.0, hy - t, hz), Vector3::new(hx, t, hz)),
+        cuboid_at(Vector3::new(0.0, -hy + t, hz), Vector3::new(hx, t, hz)),
+        cuboid_at(Vector3::new(hx - t, 0.0, hz), Vector3::new(t, hy, hz)),
+    ];
+    let top = match opening {
+        Opening::Top => {
+            parts.push(cuboid_at(
+                Vector3::new(-hx + t, 0.0, hz),
+                Vector3::new(t, hy, hz),
+            ));
+            sz
+        }
+        Opening::Front => {
+            parts.push(cuboid_at(
+                Vector3::new(0.0, 0.0, sz - t),
+                Vector3::new(hx, hy, t),
+            ));
+            sz - wall
+        }
+    };
+    let front = if opening == Opening::Front {
+        -hx
+    } else {
+        -hx + wall
+    };
+    let (x0, x1) = (front, hx - wall);
+    let cavity = Cavity {
+        center: Point3::new((x0 + x1) / 2.0, 0.0, (wall + top) / 2.0),
+        half: Vector3::new((x1 - x0) / 2.0, hy - wall, (top - wall) / 2.0),
+        opening,
+    };
+    (parts, cavity)
+}
+
 impl Body {
     pub fn new(spec: &ShapeSpec) -> Body {
-        let mut cavity = None;
-        let parts = match *spec {
+        let (parts, cavity) = match *spec {
             ShapeSpec::Box { size } => {
                 let h = Vector3::from(size) / 2.0;
-                vec![cuboid_at(Vector3::new(0.0, 0.0, h.z), h)]
+                (vec![cuboid_at(Vector3::new(0.0, 0.0, h.z), h)], None)
             }
-            ShapeSpec::Cylinder { radius, height } => vec![Part {
-                // parry's cylinder stands along y; turn it to stand along z.
-                local: Pose::new(
-                    Vector3::new(0.0, 0.0, height / 2.0),
-                    Vector3::x() * FRAC_PI_2,
-                ),
-                shape: SharedShape::cylinder(height / 2.0, radius),
-            }],
-            ShapeSpec::Ball { radius } => vec![Part {
-                local: Pose::translation(0.0, 0.0, radius),
-                shape: SharedShape::ball(radius),
-            }],
-            ShapeSpec::Capsule { radius, length } => vec![Part {
-                local: Pose::translation(0.0, 0.0, radius),
-                shape: SharedShape::capsule_x((length / 2.0 - radius).max(0.0), radius),
-            }],
+            ShapeSpec::Cylinder { radius, height } => (
+                vec![Part {
+                    // parry's cylinder stands along y; turn it to stand along z.
+                    local: Pose::new(
+                        Vector3::new(0.0, 0.0, height / 2.0),
+                        Vector3::x() * FRAC_PI_2,
+                    ),
+                    shape: SharedShape::cylinder(height / 2.0, radius),
+                }],
+                None,
+            ),
+            ShapeSpec::Ball { radius } => (
+                vec![Part {
+                    local: Pose::translation(0.0, 0.0, radius),
+                    shape: SharedShape::ball(radius),
+                }],
+                None,
+            ),
+            ShapeSpec::Capsule { radius, length } => (
+                vec![Part {
+                    local: Pose::translation(0.0, 0.0, radius),
+                    shape: SharedShape::capsule_x((length / 2.0 - radius).max(0.0), radius),
+                }],
+                None,
+            ),
             ShapeSpec::Cup {
                 radius,
                 height,
                 wall,
                 bottom,
             } => {
-                let mut parts = vec![Part {
-                    local: Pose::new(
-                        Vector3::new(0.0, 0.0, bottom / 2.0),
-                        Vector3::x() * FRAC_PI_2,
-                    ),
-                    shape: SharedShape::cylinder(bottom / 2.0, radius),
-                }];
-                let wall_h = (height - bottom) / 2.0;
-                let chord = radius * (PI / CUP_SEGMENTS as f32).tan();
-                for i in 0..CUP_SEGMENTS {
-                    let angle = 2.0 * PI * i as f32 / CUP_SEGMENTS as f32;
-                    let r = radius - wall / 2.0;
-                    parts.push(Part {
-                        local: Pose::new(
-                            Vector3::new(r * angle.cos(), r * angle.sin(), bottom + wall_h),
-                            Vector3::z() * angle,
-                        ),
-                        shape: SharedShape::cuboid(wall / 2.0, chord, wall_h),
-                    });
-                }
-                // The largest square inside the inner ring, from the bottom to the rim.
-                let inner = (radius - wall) * (PI / CUP_SEGMENTS as f32).cos() / 2f32.sqrt();
-                cavity = Some(Cavity {
-                    center: Point3::new(0.0, 0.0, bottom + wall_h),
-                    half: Vector3::new(inner, inner, wall_h),
-                    opening: Opening::Top,
-                });
-                parts
+                let (parts, cavity) = cup(radius, height, wall, bottom);
+                (parts, Some(cavity))
             }
             ShapeSpec::OpenBox {
                 size,
                 wall,
                 opening,
             } => {
-                let [sx, sy, sz] = size;
-                let (hx, hy, hz, t) = (sx / 2.0, sy / 2.0, sz / 2.0, wall / 2.0);
-                let mut parts = vec![
-                    cuboid_at(Vector3::new(0.0, 0.0, t), Vector3::new(hx, hy, t)),
-                    cuboid_at(Vector3::new(0.0, hy - t, hz), Vector3::new(hx, t, hz)),
-                    cuboid_at(Vector3::new(0.0, -hy + t, hz), Vector3::new(hx, t, hz)),
-                    cuboid_at(Vector3::new(hx - t, 0.0, hz), Vector3::new(t, hy, hz)),
-                ];
-                let top = match opening {
-                    Opening::Top => {
-                        parts.push(cuboid_at(
-                            Vector3::new(-hx + t, 0.0, hz),
-                            Vector3::new(t, hy, hz),
-                        ));
-                        sz
-                    }
-                    Opening::Front => {
-                        parts.push(cuboid_at(
-                            Vector3::new(0.0, 0.0, sz - t),
-                            Vector3::new(hx, hy, t),
-                        ));
-                        sz - wall
-                    }
-                };
-                let front = if opening == Opening::Front {
-                    -hx
-                } else {
-                    -hx + wall
-                };
-                let (x0, x1) = (front, hx - wall);
-                cavity = Some(Cavity {
-                    center: Point3::new((x0 + x1) / 2.0, 0.0, (wall + top) / 2.0),
-                    half: Vector3::new((x1 - x0) / 2.0, hy - wall, (top - wall) / 2.0),
-                    opening,
-                });
-                parts
+                let (parts, cavity) = open_box(size, wall, opening);
+                (parts, Some(cavity))
             }
         };
         Body::from_parts(parts, cavity)

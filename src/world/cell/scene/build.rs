@@ -86,6 +86,50 @@ pub(super) fn build(
     robot: Robot,
 ) -> Result<Scene, ScenarioError> {
     let files = &scenario.files;
+    every_object_has_a_solid(scenario, &entries)?;
+    let solids = solids_of(scenario, &entries)?;
+    // Poses, supports first: a solid `on` another rests on that one's top face.
+    let raws: Vec<&Entry> = entries.values().collect();
+    let mut poses: Vec<Option<Pose>> = vec![None; raws.len()];
+    for i in 0..raws.len() {
+        place(
+            i,
+            &raws,
+            (&solids, &entries),
+            files,
+            &mut poses,
+            &mut Vec::new(),
+        )?;
+    }
+    let known = known_of(&entries, &unknown, files, solids.len())?;
+    let flag = |f: fn(&RawSolid) -> Option<bool>| {
+        raws.iter().map(|e| f(&e.raw).unwrap_or(false)).collect()
+    };
+    Ok(Scene {
+        initial: Initial {
+            poses: poses
+                .into_iter()
+                .map(|p| p.unwrap_or_else(Pose::identity))
+                .collect(),
+            lid_open: flag(|r| r.open),
+            locked: flag(|r| r.locked),
+            dirty: flag(|r| r.dirty),
+            known,
+            base: [0.0, 0.0],
+        },
+        solids,
+        robot,
+        judges,
+    })
+}
+
+/// Every object of the scenario has a solid; else the error points at the last file
+/// that names the object (or the last file).
+fn every_object_has_a_solid(
+    scenario: &Scenario,
+    entries: &IndexMap<String, Entry>,
+) -> Result<(), ScenarioError> {
+    let files = &scenario.files;
     for o in &scenario.domain.vocabulary.objects {
         if !entries.contains_key(&o.name) {
             let needle = format!("\"{}\"", o.name);
@@ -104,6 +148,16 @@ pub(super) fn build(
             ));
         }
     }
+    Ok(())
+}
+
+/// The solids of the entries, in their order, each an object of the scenario with a
+/// shape that checks.
+fn solids_of(
+    scenario: &Scenario,
+    entries: &IndexMap<String, Entry>,
+) -> Result<Vec<Solid>, ScenarioError> {
+    let files = &scenario.files;
     let objects: HashSet<&str> = scenario
         .domain
         .vocabulary
@@ -112,7 +166,7 @@ pub(super) fn build(
         .map(|o| o.name.as_str())
         .collect();
     let mut solids = Vec::new();
-    for (name, e) in &entries {
+    for (name, e) in entries {
         let file = &files[e.file];
         if !objects.contains(name.as_str()) {
             return Err(near(
@@ -135,21 +189,19 @@ pub(super) fn build(
             lockable: e.raw.locked.is_some(),
         });
     }
-    // Poses, supports first: a solid `on` another rests on that one's top face.
-    let raws: Vec<&Entry> = entries.values().collect();
-    let mut poses: Vec<Option<Pose>> = vec![None; raws.len()];
-    for i in 0..raws.len() {
-        place(
-            i,
-            &raws,
-            (&solids, &entries),
-            files,
-            &mut poses,
-            &mut Vec::new(),
-        )?;
-    }
-    let mut known = vec![true; solids.len()];
-    for (file, u) in &unknown {
+    Ok(solids)
+}
+
+/// Which of the `count` solids the robot knows at the start: all but those listed
+/// `unknown` (each must name a solid).
+fn known_of(
+    entries: &IndexMap<String, Entry>,
+    unknown: &[(usize, Spanned<String>)],
+    files: &[SourceFile],
+    count: usize,
+) -> Result<Vec<bool>, ScenarioError> {
+    let mut known = vec![true; count];
+    for (file, u) in unknown {
         match entries.get_index_of(u.get_ref()) {
             Some(i) => known[i] = false,
             None => {
@@ -161,25 +213,7 @@ pub(super) fn build(
             }
         }
     }
-    let flag = |f: fn(&RawSolid) -> Option<bool>| {
-        raws.iter().map(|e| f(&e.raw).unwrap_or(false)).collect()
-    };
-    Ok(Scene {
-        initial: Initial {
-            poses: poses
-                .into_iter()
-                .map(|p| p.unwrap_or_else(Pose::identity))
-                .collect(),
-            lid_open: flag(|r| r.open),
-            locked: flag(|r| r.locked),
-            dirty: flag(|r| r.dirty),
-            known,
-            base: [0.0, 0.0],
-        },
-        solids,
-        robot,
-        judges,
-    })
+    Ok(known)
 }
 
 /// The pose of solid `i`, placing its supports first. `entries` index the solids by name

@@ -284,30 +284,74 @@ fn near(file: &SourceFile, needle: &str, message: impl std::fmt::Display) -> Sce
 pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, ScenarioError> {
     let files = &scenario.files;
     let last = files.len().saturating_sub(1);
-    let mut entries: IndexMap<String, Entry> = IndexMap::new();
-    let mut robot = RawRobot::default();
-    let mut unknown: Vec<(usize, Spanned<String>)> = Vec::new();
-    let mut judges = Vec::new();
-    let mut chosen: Option<(usize, RawVariant)> = None;
-    let mut variant_names = Vec::new();
+    let mut merged = Merged::default();
     for (index, file) in files.iter().enumerate() {
         let tables: FileTables = file.parse()?;
-        for s in &tables.skills {
-            if !SKILLS.contains(&s.name.get_ref().as_str()) {
-                return Err(file.error_in_string(
-                    &s.name.span(),
-                    0,
-                    format!(
-                        "the cell world cannot perform a skill named {:?} (it performs: {})",
-                        s.name.get_ref(),
-                        SKILLS.join(", ")
-                    ),
-                ));
-            }
-        }
+        check_skills(file, &tables.skills)?;
         let Some(world) = tables.world else { continue };
+        merged.add_world(scenario, index, world, variant)?;
+    }
+    if let Some(wanted) = variant {
+        merged.apply_variant(files, wanted)?;
+    }
+    let Merged {
+        entries,
+        robot,
+        unknown,
+        judges,
+        ..
+    } = merged;
+    let base = robot.base.unwrap_or([0.0, 0.0]);
+    let robot = build_robot(&files[last], robot)?;
+    let mut scene = build(scenario, entries, unknown, judges, robot)?;
+    scene.initial.base = base;
+    Ok(scene)
+}
+
+/// Every skill a file declares is one the cell world performs.
+fn check_skills(file: &SourceFile, skills: &[SkillName]) -> Result<(), ScenarioError> {
+    for s in skills {
+        if !SKILLS.contains(&s.name.get_ref().as_str()) {
+            return Err(file.error_in_string(
+                &s.name.span(),
+                0,
+                format!(
+                    "the cell world cannot perform a skill named {:?} (it performs: {})",
+                    s.name.get_ref(),
+                    SKILLS.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The `[world]` tables of a scenario's files merged base first, and the variant asked
+/// for (from the last file that has it).
+#[derive(Default)]
+struct Merged {
+    entries: IndexMap<String, Entry>,
+    robot: RawRobot,
+    unknown: Vec<(usize, Spanned<String>)>,
+    judges: Vec<Judge>,
+    chosen: Option<(usize, RawVariant)>,
+    variant_names: Vec<String>,
+}
+
+impl Merged {
+    /// Merge file `index`'s `[world]` table: robot values and solids patch those before,
+    /// a list of unknown solids replaces the one before, values add up.
+    fn add_world(
+        &mut self,
+        scenario: &Scenario,
+        index: usize,
+        world: RawWorld,
+        variant: Option<&str>,
+    ) -> Result<(), ScenarioError> {
+        let file = &scenario.files[index];
         if let Some(r) = world.robot {
-            robot = RawRobot {
+            let robot = std::mem::take(&mut self.robot);
+            self.robot = RawRobot {
                 shoulders: r.shoulders.or(robot.shoulders),
                 reach: r.reach.or(robot.reach),
                 payload: r.payload.or(robot.payload),
@@ -320,45 +364,49 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
             };
         }
         for (name, raw) in world.solids {
-            match entries.get_mut(&name) {
+            match self.entries.get_mut(&name) {
                 Some(e) => {
                     patch(&mut e.raw, raw);
                     e.file = index;
                 }
                 None => {
-                    entries.insert(name, Entry { raw, file: index });
+                    self.entries.insert(name, Entry { raw, file: index });
                 }
             }
         }
         if let Some(u) = world.unknown {
-            unknown = u.into_iter().map(|s| (index, s)).collect();
+            self.unknown = u.into_iter().map(|s| (index, s)).collect();
         }
         for j in world.values {
-            judges.push(judge(scenario, file, j)?);
+            self.judges.push(judge(scenario, file, j)?);
         }
         for (name, v) in world.variants {
-            variant_names.push(name.clone());
+            self.variant_names.push(name.clone());
             if Some(name.as_str()) == variant {
-                chosen = Some((index, v));
+                self.chosen = Some((index, v));
             }
         }
+        Ok(())
     }
-    if let Some(wanted) = variant {
-        let Some((index, v)) = chosen.take() else {
+
+    /// Patch the merged world with variant `wanted`, which some file must have.
+    fn apply_variant(&mut self, files: &[SourceFile], wanted: &str) -> Result<(), ScenarioError> {
+        let last = files.len().saturating_sub(1);
+        let Some((index, v)) = self.chosen.take() else {
             return Err(files[last].error_at(
                 0,
                 format!(
                     "no world variant {wanted:?} in this scenario (variants: {})",
-                    if variant_names.is_empty() {
+                    if self.variant_names.is_empty() {
                         "none".to_string()
                     } else {
-                        variant_names.join(", ")
+                        self.variant_names.join(", ")
                     }
                 ),
             ));
         };
         for (name, raw) in v.solids {
-            let Some(e) = entries.get_mut(&name) else {
+            let Some(e) = self.entries.get_mut(&name) else {
                 return Err(near(
                     &files[index],
                     &format!("\"{name}\""),
@@ -369,17 +417,13 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
             e.file = index;
         }
         if let Some(u) = v.unknown {
-            unknown = u.into_iter().map(|s| (index, s)).collect();
+            self.unknown = u.into_iter().map(|s| (index, s)).collect();
         }
         if v.base.is_some() {
-            robot.base = v.base;
+            self.robot.base = v.base;
         }
+        Ok(())
     }
-    let base = robot.base.unwrap_or([0.0, 0.0]);
-    let robot = build_robot(&files[last], robot)?;
-    let mut scene = build(scenario, entries, unknown, judges, robot)?;
-    scene.initial.base = base;
-    Ok(scene)
 }
 
 fn build_robot(file: &SourceFile, r: RawRobot) -> Result<Robot, ScenarioError> {
