@@ -12,7 +12,7 @@ use betr::llm::LanguageModel;
 use betr::llm::usage::Metered;
 use betr::record::SessionRecorder;
 use betr::scenario::Scenario;
-use betr::session::submitted::{self, Submitted};
+use betr::session::interpret::submitted::{self, Submitted};
 use betr::session::{self, Ending, Event};
 
 use super::llm_cmds::{CallFlags, LlmFlags, setup};
@@ -178,7 +178,8 @@ fn interpret(
         reading.calls,
         reading.feedback_rounds
     );
-    let readings = session::readings::distinct_readings_in_scenario(scenario, &reading.readings)?;
+    let readings =
+        session::interpret::readings::distinct_readings_in_scenario(scenario, &reading.readings)?;
     if readings.len() > 1 {
         outln!();
         for line in readings_text(&readings) {

@@ -13,7 +13,7 @@ use crate::scenario::Scenario;
 use std::sync::Arc;
 
 use crate::llm::LanguageModel;
-use crate::session::ask::{MIDWAY, NOT_TRIED};
+use crate::session::repair::ask::{MIDWAY, NOT_TRIED};
 use crate::session::{Event, Options, Proposal};
 
 use super::EvalError;

@@ -220,7 +220,7 @@ impl Encoder {
             Event::Readings {
                 readings, doubt, ..
             } => Recorded::Note {
-                message: crate::session::readings::summary(readings, doubt.as_deref()),
+                message: crate::session::interpret::readings::summary(readings, doubt.as_deref()),
             },
             Event::Exported { paths } => Recorded::Note {
                 message: format!(

@@ -1,44 +1,34 @@
-//! Sessions, headless: the [`Engine`] (a state machine that owns a task from instruction
-//! to saved policy; commands in, events out), the resolve loop that drives it unattended,
-//! the questions asked of a model, and policies that last. Front ends (CLI, TUI) drive
-//! them and show the events they emit; nothing here prints or reads a terminal.
+//! Sessions, headless, in three rooms: reading an instruction as a goal ([`interpret`]),
+//! repairing a failure ([`repair`]: the question, the shortlist screened in simulation,
+//! the evidence, values), and the [`Engine`] (a state machine that owns a task from
+//! instruction to saved policy; commands in, events out), which starts a reading or a
+//! repair and takes its answer. Beside them: the resolve loop that drives the engine
+//! unattended, policies and the knowledge kept from approved fixes. Front ends (CLI, TUI)
+//! show the events; nothing here prints or reads a terminal.
 
-pub mod ask;
-pub mod edit;
 pub mod engine;
-pub mod evidence;
-pub mod goal_checks;
 pub mod interpret;
-mod interpret_parts;
-mod judge;
 pub mod knowledge;
 pub mod planned;
 pub mod policy;
-mod question;
-pub mod readings;
+pub mod repair;
 pub mod resolve;
-pub mod screen;
-pub mod shortlist;
-pub mod submitted;
 pub mod types;
-pub mod value_bounds;
-mod value_levels;
-pub mod values;
 
 pub use crate::planner::RunLimits;
 /// The robot description a scenario's arms need and the cache lacks: what a front end
 /// fetches before the session's world can move the arms ([`Command::RobotArrived`]).
 pub use crate::world::missing_description;
-pub use ask::missing_value;
-pub use edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use engine::{Command, Engine, EngineHandle, Setup};
-pub use evidence::Evidence;
-pub use goal_checks::check_goal;
+pub use interpret::goal_checks::check_goal;
+pub use interpret::readings::Reading;
 pub use interpret::{Interpretation, interpret};
 pub use knowledge::{KeptRule, Knowledge, KnowledgeError, Refusal};
 pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
-pub use readings::Reading;
+pub use repair::ask::missing_value;
+pub use repair::edit::{Edit, EditError, parse_edit, vocabulary_words};
+pub use repair::evidence::Evidence;
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{
     BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError, Steps,

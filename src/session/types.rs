@@ -259,7 +259,7 @@ pub enum Event {
     /// (`Command::ChooseReading`), best first, before anything runs.
     Readings {
         instruction: String,
-        readings: Vec<super::readings::Reading>,
+        readings: Vec<super::interpret::readings::Reading>,
         doubt: Option<String>,
     },
     /// An action failed in simulation.
@@ -278,7 +278,7 @@ pub enum Event {
         author: String,
         /// What betr itself found about the failure and the change, shown first; `None`
         /// when the change was not asked of a model (a person's edit).
-        evidence: Option<Box<super::evidence::Evidence>>,
+        evidence: Option<Box<super::repair::evidence::Evidence>>,
     },
     Approved,
     Rejected,

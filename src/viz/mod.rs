@@ -515,7 +515,7 @@ impl Viz {
                 readings, doubt, ..
             } => self.log(
                 L::INFO,
-                crate::session::readings::summary(readings, doubt.as_deref()),
+                crate::session::interpret::readings::summary(readings, doubt.as_deref()),
             ),
             Event::PolicySaved { path, .. } => {
                 self.log(L::INFO, format!("policy saved to {}", path.display()));

@@ -15,7 +15,8 @@ use std::time::Duration;
 use betr::bt::{self, NodeKind};
 use betr::domain::{Condition, Value};
 use betr::scenario::Scenario;
-use betr::session::{Command, Edit, Event, NoModel, Setup, values};
+use betr::session::repair::values;
+use betr::session::{Command, Edit, Event, NoModel, Setup};
 use support::engine::{FIX, INSTRUCTION, Session, edit, model, setup, tree_of};
 use support::repo::runtime as rt;
 

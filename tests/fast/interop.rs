@@ -332,8 +332,10 @@ fn the_tree_files_guide_shows_the_xml_betr_writes_for_scenario_ones_repaired_tre
     let s = Scenario::load(&root().join("scenarios/cell/red_on_blue.toml")).unwrap();
     let xml = interop::to_btcpp(&repaired(&s), &s.domain, "red_on_blue").unwrap();
     let readme = std::fs::read_to_string(root().join("docs/TREE-FILES.md")).unwrap();
-    let start =
-        readme.find("```xml\n").expect("an xml block in docs/TREE-FILES.md") + "```xml\n".len();
+    let start = readme
+        .find("```xml\n")
+        .expect("an xml block in docs/TREE-FILES.md")
+        + "```xml\n".len();
     let end = start + readme[start..].find("```").unwrap();
     assert_eq!(
         &readme[start..end],

@@ -46,7 +46,8 @@ fn readings_to_choose_among_are_shown_over_the_screen() {
         scenario.parse_goal("On_Dessert_Table3").unwrap(),
         scenario.parse_goal("On_Chocolate_Table3").unwrap(),
     ];
-    let readings = betr::session::readings::distinct_readings(&scenario, world.as_ref(), &goals);
+    let readings =
+        betr::session::interpret::readings::distinct_readings(&scenario, world.as_ref(), &goals);
     assert_eq!(readings.len(), 2);
     let mut app = offered(scenario, readings, None);
     let draw = |app: &mut App| {
@@ -79,7 +80,8 @@ fn a_doubted_reading_waits_for_the_person() {
         .parse_goal(r#""blue cube" on "green cube""#)
         .unwrap();
     let readings =
-        betr::session::readings::distinct_readings_in_scenario(&scenario, &[goal]).unwrap();
+        betr::session::interpret::readings::distinct_readings_in_scenario(&scenario, &[goal])
+            .unwrap();
     let doubt = "no word of the request names anything it is about";
     let mut app = offered(scenario, readings, Some(doubt.into()));
     let mut terminal = Terminal::new(TestBackend::new(120, 40)).unwrap();

@@ -7,13 +7,13 @@ use crate::bt::Tree;
 use crate::domain::{ActionCall, Condition, Value, ValueParam};
 use crate::planner::Planner;
 
-use super::super::ask::{Tried, missing_value};
-use super::super::edit::Edit;
-use super::super::evidence::Evidence;
 use super::super::policy::{Approval, now_rfc3339};
-use super::super::screen::{apply, helped};
+use super::super::repair::ask::{Tried, missing_value};
+use super::super::repair::edit::Edit;
+use super::super::repair::evidence::Evidence;
+use super::super::repair::screen::{apply, helped};
+use super::super::repair::values::{self, Setting, conform};
 use super::super::types::{Event, Proposal};
-use super::super::values::{self, Setting, conform};
 use super::Engine;
 use super::phase::{AppliedProposal, Failure, Pending, Phase};
 use super::task::AppliedFix;
@@ -47,7 +47,7 @@ enum Unfit {
     #[error("{skill} declares no value {param}")]
     Undeclared { skill: String, param: String },
     #[error(transparent)]
-    Conform(#[from] super::super::values::ConformError),
+    Conform(#[from] super::super::repair::values::ConformError),
 }
 
 /// What the model is told of a proposal a person rejected.

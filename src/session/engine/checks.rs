@@ -304,7 +304,7 @@ impl Engine {
         {
             self.task
                 .tried
-                .push((failure, super::super::ask::Tried { proposal, why }));
+                .push((failure, super::super::repair::ask::Tried { proposal, why }));
         }
     }
 

@@ -8,10 +8,10 @@ use crate::bt::Tree;
 use crate::goal;
 use crate::planner::{Plan, Planner};
 
+use super::super::interpret::readings::distinct_readings;
+use super::super::interpret::submitted::{self, Submitted};
 use super::super::planned::PlanSummary;
 use super::super::policy;
-use super::super::readings::distinct_readings;
-use super::super::submitted::{self, Submitted};
 use super::super::types::{Event, SessionError};
 use super::Engine;
 use super::phase::Phase;

@@ -141,8 +141,8 @@ pub enum Command {
     /// then applied.
     Edit(super::Edit),
     /// A value for every action using a skill with an object (`force of egg = 5 N`, read by
-    /// [`super::values::parse_setting`]).
-    SetValue(super::values::Setting),
+    /// [`super::repair::values::parse_setting`]).
+    SetValue(super::repair::values::Setting),
     /// Restore the tree from before the last applied change.
     Undo,
     Verify,

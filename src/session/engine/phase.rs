@@ -3,13 +3,13 @@
 //! a change). Leaving a phase drops its data: a call it started is aborted, so its late
 //! answer finds no phase waiting for it.
 
-use crate::session::readings::Reading;
+use crate::session::interpret::readings::Reading;
 use crate::session::types::{Event, Proposal};
 
 use super::Engine;
 
 /// An action that failed in the execution world.
-pub(super) use crate::session::screen::FailureAt as Failure;
+pub(super) use crate::session::repair::screen::FailureAt as Failure;
 
 /// A model call under way.
 pub(super) struct Call {

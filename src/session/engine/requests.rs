@@ -9,11 +9,11 @@ use crate::llm::LanguageModel;
 use crate::llm::usage::UsageTotals;
 use crate::verify::Report;
 
-use super::super::ask::{Asked, Tried};
-use super::super::evidence::Evidence;
 use super::super::interpret::{Interpretation, interpret};
 use super::super::policy::Approval;
-use super::super::question::{Answer, Question};
+use super::super::repair::ask::{Asked, Tried};
+use super::super::repair::evidence::Evidence;
+use super::super::repair::question::{Answer, Question};
 use super::super::types::{Event, SessionError};
 use super::Engine;
 use super::phase::{Call, Failure, Pending, Phase};

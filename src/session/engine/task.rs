@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use crate::bt::{NodeId, Tree};
 use crate::goal::Formula;
-use crate::session::ask::Tried;
 use crate::session::policy::Approval;
+use crate::session::repair::ask::Tried;
 use crate::session::types::Proposal;
 
 use super::phase::Failure;

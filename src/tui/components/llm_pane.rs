@@ -447,7 +447,7 @@ mod tests {
                 "grasp \"blue cube\"! failed: No collision free path found".into(),
                 "in the way: \"red cube\" on \"blue cube\" (true now)".into(),
             ],
-            doubt: crate::session::evidence::doubt(
+            doubt: crate::session::repair::evidence::doubt(
                 reasoning,
                 &objects,
                 &["red cube".to_string()],

@@ -13,8 +13,8 @@ use crate::reading::{Misreading, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
+use super::super::types::Event;
 use super::goal_checks::{GoalProblem, ProblemKind, assess};
-use super::types::Event;
 
 /// How many times a goal's misreadings are undone one after another.
 const UNDO_STEPS: usize = 3;
@@ -61,10 +61,10 @@ impl<'a> Judge<'a> {
         scenario: &'a Scenario,
         world: Box<dyn World>,
         request: Request<'a>,
-        options: &'a super::types::Options,
+        options: &'a super::super::types::Options,
         one_of_several: bool,
-    ) -> Result<Self, super::types::SessionError> {
-        let pool = super::interpret::example_pool(scenario, options);
+    ) -> Result<Self, super::super::types::SessionError> {
+        let pool = super::example_pool(scenario, options);
         Ok(Judge {
             scenario,
             world,

@@ -6,8 +6,8 @@
 //! more reliably than it names one out of the whole vocabulary. The list is told to the
 //! person as well, so what the model chose from is never hidden.
 
+use super::super::types::Proposal;
 use super::screen::{Screen, Verdict};
-use super::types::Proposal;
 use crate::domain::{ANY_OBJECT, Atom, Condition, GroundSkill};
 
 /// What trying the related conditions found.
@@ -236,7 +236,7 @@ mod tests {
     use super::*;
     use crate::planner::Planner;
     use crate::scenario::Scenario;
-    use crate::session::screen::FailureAt;
+    use crate::session::repair::screen::FailureAt;
     use crate::world::load;
 
     fn screen_at_first_failure(path: &str) -> Screen {
@@ -356,7 +356,10 @@ mod tests {
             .try_change(&around)
             .expect_err("goes around the failure");
         assert!(
-            matches!(why, crate::session::screen::NotHelped::GoesAround(_)),
+            matches!(
+                why,
+                crate::session::repair::screen::NotHelped::GoesAround(_)
+            ),
             "{why}"
         );
         assert!(

@@ -10,10 +10,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::domain::{ANY_OBJECT, Atom, Condition, Object};
 
+use super::super::types::Proposal;
 use super::ask::Tried;
 use super::screen::{FailureAt, Verdict};
 use super::shortlist::Shortlist;
-use super::types::Proposal;
 
 /// The evidence shown with a proposal, before the model's reasoning.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]

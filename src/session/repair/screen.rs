@@ -9,7 +9,7 @@ use crate::domain::{ActionCall, Condition};
 use crate::planner::{Outcome, Plan, Planner, RepairError, run_tree, set_value};
 use crate::world::World;
 
-use super::types::Proposal;
+use super::super::types::Proposal;
 
 /// The failure a change is meant to fix.
 #[derive(Debug, Clone, PartialEq)]

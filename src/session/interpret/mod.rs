@@ -13,6 +13,12 @@
 //! chosen goal's alternatives are put in the order the request names them, since a
 //! behavior tree tries them in that order.
 
+pub mod goal_checks;
+pub mod judge;
+mod parts;
+pub mod readings;
+pub mod submitted;
+
 use crate::domain::Vocabulary;
 use crate::goal::{self, Formula};
 use crate::llm::prompt::Context;
@@ -24,11 +30,11 @@ use crate::reading::parts::split;
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::ask::ask;
-use super::goal_checks::GoalProblem;
-use super::interpret_parts::{PartsRead, read_parts};
-use super::judge::{Candidate, Judge};
+use super::repair::ask::ask;
 use super::types::{Event, Options, SessionError};
+use goal_checks::GoalProblem;
+use judge::{Candidate, Judge};
+use parts::{PartsRead, read_parts};
 
 /// Sampling temperature of the extra candidates: enough to make them differ from the
 /// first answer, low enough to stay on the request.

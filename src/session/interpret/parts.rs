@@ -14,9 +14,9 @@ use crate::reading::{Lexicon, Request};
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::interpret::{Interpretation, example_pool, read_goal};
+use super::super::types::{Event, Options, SessionError};
 use super::judge::Judge;
-use super::types::{Event, Options, SessionError};
+use super::{Interpretation, example_pool, read_goal};
 
 /// What reading a request part by part came to.
 pub(super) enum PartsRead {

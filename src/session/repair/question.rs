@@ -11,14 +11,14 @@ use crate::llm::prompt::Context;
 use crate::scenario::Scenario;
 use crate::world::World;
 
+use super::super::types::{Event, Options, SessionError};
 use super::ask::{Asked, FailedAction, Tried, ask_conditions, ask_value, missing_value};
 use super::evidence::{Evidence, Found};
 use super::screen::{FailureAt, Screen};
-use super::types::{Event, Options, SessionError};
 
 /// Everything the question about one failure needs, owned, so it can be asked off the
 /// engine's thread.
-pub struct Question {
+pub(crate) struct Question {
     pub scenario: std::sync::Arc<Scenario>,
     pub failure: FailureAt,
     /// The execution world's facts when the action failed.
@@ -34,14 +34,14 @@ pub struct Question {
 }
 
 /// What asking produced: the model's answer and, for the proposal chosen, what betr found.
-pub struct Answer {
+pub(crate) struct Answer {
     pub result: Result<Asked, SessionError>,
     pub evidence: Option<Box<Evidence>>,
 }
 
 impl Question {
     /// Ask `model`, emitting what was asked and who answered.
-    pub async fn answer(
+    pub(crate) async fn answer(
         self,
         model: &dyn LanguageModel,
         options: &Options,

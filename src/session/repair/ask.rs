@@ -11,9 +11,9 @@ use crate::llm::reply::{self, ReplyError};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
+use super::super::types::{Event, Options, Proposal, SessionError};
 use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{Shortlist, shortlist, without_implied};
-use super::types::{Event, Options, Proposal, SessionError};
 use super::value_bounds::Bounds;
 use super::value_levels::{as_levels, level_value};
 

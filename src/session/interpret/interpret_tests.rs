@@ -1,7 +1,7 @@
 //! Tests of the vote among candidate goals and of reflective feedback.
 
 use super::*;
-use crate::session::judge::vote;
+use crate::session::interpret::judge::vote;
 
 fn candidate(goal: Option<&str>, problem: Option<&str>) -> Candidate {
     Candidate {
