@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use betr::eval::run::Progress;
 use betr::llm::LanguageModel;
-use betr::llm::config::Backend;
+use betr::llm::config::{Backend, Settings};
 
 use super::lab_flags::LabFlags;
 use super::llm_cmds::{self, CallFlags, LlmFlags};
@@ -107,6 +107,8 @@ pub(super) struct Prepared {
     pub(super) llm: llm_cmds::Llm,
     pub(super) label: String,
     pub(super) settings: BTreeMap<String, String>,
+    /// The model's settings (its prices among them).
+    pub(super) model_settings: Settings,
     pub(super) concurrency: usize,
 }
 
@@ -130,17 +132,17 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     let levers = lab.levers()?;
     let mut layer = llm_cmds::layer(&flags.llm, &flags.call)?;
     lab.layer(&mut layer);
-    let (settings, mut options) = llm_cmds::settings_from(&flags.llm, layer)?;
+    let (model_settings, mut options) = llm_cmds::settings_from(&flags.llm, layer)?;
     levers.apply(&mut options);
-    let llm = llm_cmds::build(settings, options)?;
-    let backend = format!("{:?}", llm.settings.backend).to_lowercase();
+    let llm = llm_cmds::build(&model_settings, options)?;
+    let backend = format!("{:?}", model_settings.backend).to_lowercase();
     let model = llm.model.model().to_string();
     let mut settings: BTreeMap<String, String> = BTreeMap::new();
     settings.insert("backend".into(), backend.clone());
     settings.insert("model".into(), model.clone());
     settings.insert("prompt".into(), flags.prompt.name().into());
-    settings.insert("temperature".into(), llm.settings.temperature.to_string());
-    settings.insert("structured".into(), llm.settings.structured.to_string());
+    settings.insert("temperature".into(), model_settings.temperature.to_string());
+    settings.insert("structured".into(), model_settings.structured.to_string());
     let options = &llm.options;
     settings.insert(
         "examples_shown".into(),
@@ -170,7 +172,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         "value_levels".into(),
         options.steps.value_levels.to_string(),
     );
-    settings.insert("grammar".into(), llm.settings.grammar.to_string());
+    settings.insert("grammar".into(), model_settings.grammar.to_string());
     if !options.steps.without_misreadings.is_empty() {
         settings.insert(
             "without_misreadings".into(),
@@ -191,7 +193,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
     }
     let concurrency = flags
         .concurrency
-        .unwrap_or(if llm.settings.backend == Backend::Local {
+        .unwrap_or(if model_settings.backend == Backend::Local {
             1
         } else {
             4
@@ -222,6 +224,7 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
         ),
         llm,
         settings,
+        model_settings,
         concurrency,
     })
 }
