@@ -275,7 +275,7 @@ fn goal_set(
         runs: runs.max(1),
         concurrency: p.concurrency,
         limit: flags.limit,
-        prices: p.llm.settings.prices.clone(),
+        prices: p.model_settings.prices.clone(),
         progress: &bar,
     };
     let results = super::runtime()?
@@ -392,7 +392,7 @@ fn sequence_experiment(
         runs: 1,
         concurrency: 1,
         limit: flags.limit,
-        prices: p.llm.settings.prices.clone(),
+        prices: p.model_settings.prices.clone(),
         progress: &bar,
     };
     let results = super::runtime()?
@@ -488,7 +488,7 @@ pub fn session_experiment(
         runs: runs.max(1),
         concurrency: p.concurrency,
         limit: flags.limit,
-        prices: p.llm.settings.prices.clone(),
+        prices: p.model_settings.prices.clone(),
         progress: &bar,
     };
     let rt = super::runtime()?;

@@ -12,7 +12,8 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use betr::eval::run::Progress;
 use betr::llm::LanguageModel;
-use betr::llm::config::Backend;
+use betr::llm::config::{Backend, Settings};
+use betr::session::Options;
 
 use super::lab_flags::LabFlags;
 use super::llm_cmds::{self, CallFlags, LlmFlags};
@@ -107,12 +108,53 @@ pub(super) struct Prepared {
     pub(super) llm: llm_cmds::Llm,
     pub(super) label: String,
     pub(super) settings: BTreeMap<String, String>,
+    /// The model's settings (its prices among them).
+    pub(super) model_settings: Settings,
     pub(super) concurrency: usize,
 }
 
 pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prepared> {
-    let mut lab = flags.lab.clone();
-    match flags.prompt {
+    let lab = with_prompt(&flags.lab, flags.prompt)?;
+    let levers = lab.levers()?;
+    let mut layer = llm_cmds::layer(&flags.llm, &flags.call)?;
+    lab.layer(&mut layer);
+    let (model_settings, mut options) = llm_cmds::settings_from(&flags.llm, layer)?;
+    levers.apply(&mut options);
+    let llm = llm_cmds::build(&model_settings, options)?;
+    let backend = format!("{:?}", model_settings.backend).to_lowercase();
+    let model = llm.model.model().to_string();
+    let mut settings = run_settings(&llm.options, &model_settings, &lab);
+    settings.insert("backend".into(), backend.clone());
+    settings.insert("model".into(), model.clone());
+    settings.insert("prompt".into(), flags.prompt.name().into());
+    for (k, v) in extra {
+        settings.insert((*k).into(), v.clone());
+    }
+    let concurrency = flags
+        .concurrency
+        .unwrap_or(if model_settings.backend == Backend::Local {
+            1
+        } else {
+            4
+        })
+        .max(1);
+    Ok(Prepared {
+        label: format!(
+            "{model} ({backend}), prompt {}, {}",
+            flags.prompt.name(),
+            reading_label(&llm.options)
+        ),
+        llm,
+        settings,
+        model_settings,
+        concurrency,
+    })
+}
+
+/// The lab's flags with the prompt variant's levers pulled too.
+fn with_prompt(lab: &LabFlags, prompt: PromptVariant) -> Result<LabFlags> {
+    let mut lab = lab.clone();
+    match prompt {
         PromptVariant::Full => {}
         PromptVariant::NoDescriptions => lab.no_descriptions = true,
         PromptVariant::NoObjectRule => lab.no_object_rule = true,
@@ -127,54 +169,47 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
             lab.no_scene_word_examples = true;
         }
     }
-    let levers = lab.levers()?;
-    let mut layer = llm_cmds::layer(&flags.llm, &flags.call)?;
-    lab.layer(&mut layer);
-    let (settings, mut options) = llm_cmds::settings_from(&flags.llm, layer)?;
-    levers.apply(&mut options);
-    let llm = llm_cmds::build(settings, options)?;
-    let backend = format!("{:?}", llm.settings.backend).to_lowercase();
-    let model = llm.model.model().to_string();
+    Ok(lab)
+}
+
+/// The settings a run's journal is made with, besides the model and the prompt variant:
+/// a run resumed with others is refused.
+fn run_settings(
+    options: &Options,
+    model_settings: &Settings,
+    lab: &LabFlags,
+) -> BTreeMap<String, String> {
+    let steps = &options.steps;
     let mut settings: BTreeMap<String, String> = BTreeMap::new();
-    settings.insert("backend".into(), backend.clone());
-    settings.insert("model".into(), model.clone());
-    settings.insert("prompt".into(), flags.prompt.name().into());
-    settings.insert("temperature".into(), llm.settings.temperature.to_string());
-    settings.insert("structured".into(), llm.settings.structured.to_string());
-    let options = &llm.options;
-    settings.insert(
-        "examples_shown".into(),
-        options
-            .steps
-            .prompt
-            .examples_shown
-            .map_or("all".into(), |k| k.to_string()),
-    );
-    settings.insert("checks".into(), options.steps.check_goals.to_string());
-    settings.insert("candidates".into(), options.candidates.to_string());
-    settings.insert("beams".into(), options.beams.to_string());
-    settings.insert(
-        "feedback_rounds".into(),
-        options.goal_feedback_rounds.to_string(),
-    );
-    settings.insert("shortlist".into(), options.steps.shortlist.to_string());
-    settings.insert(
-        "read_by_parts".into(),
-        options.steps.read_by_parts.to_string(),
-    );
-    settings.insert(
-        "scene_word_examples".into(),
-        options.steps.prompt.scene_word_examples.to_string(),
-    );
-    settings.insert(
-        "value_levels".into(),
-        options.steps.value_levels.to_string(),
-    );
-    settings.insert("grammar".into(), llm.settings.grammar.to_string());
-    if !options.steps.without_misreadings.is_empty() {
+    for (k, v) in [
+        ("temperature", model_settings.temperature.to_string()),
+        ("structured", model_settings.structured.to_string()),
+        (
+            "examples_shown",
+            steps
+                .prompt
+                .examples_shown
+                .map_or("all".into(), |k| k.to_string()),
+        ),
+        ("checks", steps.check_goals.to_string()),
+        ("candidates", options.candidates.to_string()),
+        ("beams", options.beams.to_string()),
+        ("feedback_rounds", options.goal_feedback_rounds.to_string()),
+        ("shortlist", steps.shortlist.to_string()),
+        ("read_by_parts", steps.read_by_parts.to_string()),
+        (
+            "scene_word_examples",
+            steps.prompt.scene_word_examples.to_string(),
+        ),
+        ("value_levels", steps.value_levels.to_string()),
+        ("grammar", model_settings.grammar.to_string()),
+    ] {
+        settings.insert(k.into(), v);
+    }
+    if !steps.without_misreadings.is_empty() {
         settings.insert(
             "without_misreadings".into(),
-            options.steps.without_misreadings.join(" "),
+            steps.without_misreadings.join(" "),
         );
     }
     let optional = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
@@ -186,42 +221,28 @@ pub(super) fn prepare(flags: &RunFlags, extra: &[(&str, String)]) -> Result<Prep
             settings.insert(k.into(), v);
         }
     }
-    for (k, v) in extra {
-        settings.insert((*k).into(), v.clone());
-    }
-    let concurrency = flags
-        .concurrency
-        .unwrap_or(if llm.settings.backend == Backend::Local {
-            1
-        } else {
-            4
-        })
-        .max(1);
-    Ok(Prepared {
-        label: format!(
-            "{model} ({backend}), prompt {}, {}, {}",
-            flags.prompt.name(),
-            match llm.options.steps.prompt.examples_shown {
-                None => "all examples".to_string(),
-                Some(k) => format!("{k} retrieved examples"),
-            },
-            if llm.options.steps.check_goals {
-                format!(
-                    "checked ({} candidates, {} feedback rounds{})",
-                    llm.options.candidates,
-                    llm.options.goal_feedback_rounds,
-                    if llm.options.steps.read_by_parts {
-                        ", a wish at a time"
-                    } else {
-                        ", whole request"
-                    }
-                )
+    settings
+}
+
+/// How the run reads, for the table's label: the examples shown, and the checks.
+fn reading_label(options: &Options) -> String {
+    let examples = match options.steps.prompt.examples_shown {
+        None => "all examples".to_string(),
+        Some(k) => format!("{k} retrieved examples"),
+    };
+    let checks = if options.steps.check_goals {
+        format!(
+            "checked ({} candidates, {} feedback rounds{})",
+            options.candidates,
+            options.goal_feedback_rounds,
+            if options.steps.read_by_parts {
+                ", a wish at a time"
             } else {
-                "unchecked".to_string()
+                ", whole request"
             }
-        ),
-        llm,
-        settings,
-        concurrency,
-    })
+        )
+    } else {
+        "unchecked".to_string()
+    };
+    format!("{examples}, {checks}")
 }

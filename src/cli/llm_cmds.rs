@@ -74,27 +74,25 @@ pub struct CallFlags {
     pub threads: Option<u32>,
 }
 
-/// The configured model and its ledger (also used by `betr eval`).
+/// The configured model and its ledger, and the session options for it.
 pub(super) struct Llm {
     pub(super) model: Arc<Metered<Box<dyn LanguageModel>>>,
     pub(super) options: Options,
-    pub(super) settings: Settings,
 }
 
 pub(super) fn setup(flags: &LlmFlags, call: &CallFlags) -> Result<Llm> {
     let (settings, options) = settings_from(flags, layer(flags, call)?)?;
-    build(settings, options)
+    build(&settings, options)
 }
 
 /// The model the settings ask for, fetched first when it is the embedded one and missing.
-pub(super) fn build(settings: Settings, options: Options) -> Result<Llm> {
-    ensure_local_model(&settings)?;
+pub(super) fn build(settings: &Settings, options: Options) -> Result<Llm> {
+    ensure_local_model(settings)?;
     let ledger = Ledger::new(settings.usage_log.clone());
     let model = settings.build(ledger, &|k: &str| std::env::var(k).ok())?;
     Ok(Llm {
         model: Arc::new(model),
         options,
-        settings,
     })
 }
 
