@@ -74,7 +74,7 @@ pub(super) async fn confirmed(
         let words = in_words(&Formula::Atom(atom.clone()), vocabulary);
         let messages = ctx.condition_question(&options.templates, &atom.to_string(), &words)?;
         emit(&Event::Asking {
-            what: format!("whether the instruction asks for {atom}"),
+            what: crate::session::Question::Confirm { atom: atom.clone() },
         });
         let reply = ask(
             model,

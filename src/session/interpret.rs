@@ -23,6 +23,7 @@ use crate::reading::parts::split;
 use crate::scenario::Scenario;
 use crate::world::World;
 
+use super::Question;
 use super::ask::ask;
 use super::goal_checks::GoalProblem;
 use super::interpret_parts::{PartsRead, read_parts};
@@ -204,11 +205,7 @@ pub(super) async fn read_goal(
         };
         for draw in 0..draws {
             emit(&Event::Asking {
-                what: if draw == 0 {
-                    "the goal of the instruction".into()
-                } else {
-                    format!("another candidate goal ({} of {draws})", draw + 1)
-                },
+                what: Question::Goal { draw, draws },
             });
             let mut opts = options.clone();
             let seed = if draw > 0 {

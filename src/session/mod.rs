@@ -41,7 +41,9 @@ pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use readings::Reading;
 pub use resolve::{resolve, resolve_with_scenes};
-pub use types::{BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError};
+pub use types::{
+    BreakReason, Ending, Event, NoModel, Options, Proposal, Question, Resolved, SessionError,
+};
 
 /// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),
 /// its scene's path and scenario, and its goal: the misreading checks must find nothing in

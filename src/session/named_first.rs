@@ -35,7 +35,7 @@ pub(super) async fn named_objects(
     let messages = ctx.names(&options.templates)?;
     let names_grammar = || grammar::names_grammar(&names, MOST_NAMED);
     emit(&Event::Asking {
-        what: "the objects and places the instruction names".into(),
+        what: crate::session::Question::NamedObjects,
     });
     let mut opts = options.clone();
     // One greedy answer: the runners-up of a list of names are not candidates of a goal.

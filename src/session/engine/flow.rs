@@ -4,7 +4,6 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use crate::bt::path_text;
 use crate::bt::{Outcome as TickOutcome, Tree};
 use crate::goal;
 use crate::planner::{Plan, Planner, WorldLeaves};
@@ -337,7 +336,6 @@ impl Engine {
             .tree
             .as_ref()
             .and_then(|t| t.path(failure.node).ok())
-            .map(|p| path_text(&p))
             .unwrap_or_default();
         self.emit(Event::ActionFailed {
             action: failure.action.clone(),
