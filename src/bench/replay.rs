@@ -105,10 +105,7 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
         Ok(NodeKind::Action(a)) => a.clone(),
         _ => ActionCall::new("Act", ["a0"]),
     };
-    let path = tree
-        .path(action)
-        .map(|p| crate::bt::path_text(&p))
-        .unwrap_or_default();
+    let path = tree.path(action).unwrap_or_default();
     let mut steps: Vec<(u64, Step)> = Vec::with_capacity(ticks * 6 / 5 + 64);
     let mut ms = 0;
     let mut push = |ms: u64, step: Step| steps.push((ms, step));
@@ -165,7 +162,9 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
             }),
             event(Event::RunState { running: false }),
             event(Event::Asking {
-                what: "conditions".into(),
+                what: crate::session::Question::Preconditions {
+                    action: call.clone(),
+                },
             }),
             event(Event::Replied {
                 attribution: "the benchmark".into(),

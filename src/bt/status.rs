@@ -7,7 +7,7 @@
 use std::fmt;
 
 /// The result of ticking a node once.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Outcome {
     /// The node has not finished yet; tick again to make progress.
     Running,
@@ -37,7 +37,9 @@ pub enum Status {
 /// A result a person imposes on a node (a debugger's "force"): the node returns it
 /// without its own logic running, so a forced condition is not checked, a forced action
 /// is not stepped, and a forced composite does not tick its children.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub enum Forced {
     Success,
     Failure,
@@ -72,6 +74,30 @@ impl From<Outcome> for Status {
 }
 
 impl Status {
+    /// The status as one letter (`-` idle, `R` running, `S` success, `F` failure, `H`
+    /// halted), as a recording writes a tick's statuses.
+    pub fn letter(self) -> char {
+        match self {
+            Status::Idle => '-',
+            Status::Running => 'R',
+            Status::Success => 'S',
+            Status::Failure => 'F',
+            Status::Halted => 'H',
+        }
+    }
+
+    /// The status a letter of [`Status::letter`] stands for.
+    pub fn from_letter(letter: char) -> Option<Status> {
+        Some(match letter {
+            '-' => Status::Idle,
+            'R' => Status::Running,
+            'S' => Status::Success,
+            'F' => Status::Failure,
+            'H' => Status::Halted,
+            _ => return None,
+        })
+    }
+
     /// True for `Running`.
     pub fn is_active(self) -> bool {
         matches!(self, Status::Running)
@@ -102,6 +128,26 @@ impl fmt::Display for Status {
             Status::Failure => "failure",
             Status::Halted => "halted",
         })
+    }
+}
+
+/// Serde for every node's status in a tick: one letter per node, in arena order, so a
+/// tick of a large tree stays one short string (a session writes thousands of ticks).
+pub(crate) mod letters {
+    use super::Status;
+
+    pub fn serialize<S: serde::Serializer>(statuses: &[Status], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(&statuses.iter().map(|st| st.letter()).collect::<String>())
+    }
+
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<Status>, D::Error> {
+        let text = <String as serde::Deserialize>::deserialize(d)?;
+        text.chars()
+            .map(|c| {
+                Status::from_letter(c)
+                    .ok_or_else(|| serde::de::Error::custom(format!("{c:?} is not a status")))
+            })
+            .collect()
     }
 }
 

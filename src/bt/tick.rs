@@ -36,7 +36,7 @@ pub trait Leaves {
 pub type ForcedStatuses = BTreeMap<NodeId, Forced>;
 
 /// Everything one tick did.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TickRecord {
     /// The tick's number, starting at 1.
     pub tick: u64,
@@ -44,6 +44,7 @@ pub struct TickRecord {
     pub root: Outcome,
     /// Status of every node, indexed by `NodeId::index()`; `len == tree.capacity()`.
     /// `Idle` for nodes the tick did not reach (and for removed nodes).
+    #[serde(with = "super::status::letters")]
     pub statuses: Vec<Status>,
     /// Nodes in the order they were ticked.
     pub visited: Vec<NodeId>,
@@ -54,6 +55,7 @@ pub struct TickRecord {
     /// Actions that returned Success this tick.
     pub completed: Vec<NodeId>,
     /// Nodes that returned a forced status this tick (not their own), in tick order.
+    #[serde(default)]
     pub forced: Vec<NodeId>,
 }
 

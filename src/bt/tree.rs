@@ -10,7 +10,10 @@ use std::fmt;
 use crate::domain::{ActionCall, Condition};
 
 /// The name of one node of a `Tree`; an index into its arena.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(transparent)]
 pub struct NodeId(pub u32);
 
 impl NodeId {
@@ -295,6 +298,9 @@ impl Tree {
 
 #[path = "tree_query.rs"]
 mod query;
+
+#[path = "tree_serde.rs"]
+mod serde_impl;
 
 #[cfg(test)]
 #[path = "tree_tests.rs"]

@@ -161,6 +161,7 @@ impl Driver {
             .runtime
             .block_on(self.events.recv())
             .ok_or_else(|| anyhow!("the session stopped unexpectedly"))?;
+        betr::record::trace(&event);
         if let Some(v) = self.viz.as_mut() {
             v.on_event(&event);
         }
@@ -253,7 +254,7 @@ impl Driver {
                 } => {
                     break RunEnd::ActionFailed {
                         action,
-                        node_path,
+                        node_path: betr::bt::path_text(&node_path),
                         error,
                     };
                 }
@@ -266,7 +267,7 @@ impl Driver {
                 } => {
                     break RunEnd::Break {
                         node,
-                        node_path,
+                        node_path: betr::bt::path_text(&node_path),
                         tick,
                         reason,
                     };

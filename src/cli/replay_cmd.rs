@@ -166,8 +166,11 @@ fn print_steps(replay: &Replay) {
             };
             continue;
         }
-        if let Some(line) = betr::record::describe(step) {
+        let lines = betr::record::describe_step(step);
+        if !lines.is_empty() {
             flush(&mut ticks);
+        }
+        for line in lines {
             outln!("{}  {line}", time(*ms));
         }
     }

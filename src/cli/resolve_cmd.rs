@@ -445,6 +445,7 @@ fn approve_on_terminal(proposal: &session::Proposal, yes: bool) -> bool {
 }
 
 fn print_event(event: &Event, show_replies: bool) {
+    betr::record::trace(event);
     match event {
         Event::Replied { text, .. } if show_replies => {
             print_event_line(event);
@@ -461,85 +462,22 @@ fn indent(text: &str) -> String {
         .join("\n")
 }
 
+/// One event of the loop on the terminal, in `record::describe`'s words: this chooses
+/// which events the printed log shows and lays their lines out (a new step of the loop
+/// after a blank line, the model's replies indented under its question).
 fn print_event_line(event: &Event) {
-    match event {
-        Event::Asking { what } => outln!("\n→ asking for {what}"),
-        Event::Replied {
-            attribution,
-            prompt_tokens,
-            completion_tokens,
-            latency_ms,
-            ..
-        } => outln!(
-            "  reply from {attribution}: {prompt_tokens} prompt + {completion_tokens} completion tokens, {:.2} s",
-            *latency_ms as f64 / 1000.0
-        ),
-        Event::InvalidReply { error } => outln!("  unusable reply: {error}"),
-        Event::CandidateRejected {
-            candidate, reason, ..
-        } => {
-            outln!("  set aside {candidate}: {reason}");
+    let prefix = match event {
+        Event::Asking { .. } => "\n→ ",
+        Event::ActionFailed { .. } | Event::Success { .. } | Event::GaveUp { .. } => "\n",
+        Event::Replied { .. } | Event::InvalidReply { .. } | Event::CandidateRejected { .. } => {
+            "  "
         }
-        Event::Goal {
-            goal,
-            reasoning,
-            matches_expected,
-            ..
-        } => {
-            if let Some(r) = reasoning {
-                outln!("Reasoning: {r}");
-            }
-            let check = match matches_expected {
-                Some(true) => "  (equivalent to the scenario's goal)",
-                Some(false) => "  (differs from the scenario's goal)",
-                None => "",
-            };
-            outln!("Goal: {goal}{check}");
-        }
-        Event::ActionFailed {
-            action,
-            node_path,
-            error,
-            ..
-        } => {
-            outln!("\n✗ {action}! (node {node_path}) failed in simulation: {error}");
-        }
-        Event::Proposal {
-            proposal,
-            reasoning,
-            author,
-            evidence,
-        } => {
-            // What betr found comes first; the author's reasoning is labelled as theirs.
-            let doubt = evidence.as_ref().and_then(|e| e.doubt.as_deref());
-            for finding in evidence.iter().flat_map(|e| &e.findings) {
-                outln!("Found: {finding}");
-            }
-            if let Some(r) = reasoning {
-                match doubt {
-                    Some(why) => outln!("Reasoning of {author}, doubtful ({why}): {r}"),
-                    None => outln!("Reasoning of {author}: {r}"),
-                }
-            }
-            outln!("Proposal: {proposal} (by {author})");
-        }
-        Event::Approved => {}
-        Event::Rejected => outln!("Not approved; stopping."),
-        Event::Repaired {
-            added_nodes,
-            valued_nodes: 0,
-        } => outln!("Repaired: {added_nodes} node(s) added"),
-        Event::Repaired {
-            added_nodes,
-            valued_nodes,
-        } => {
-            outln!("Repaired: value set on {valued_nodes} action(s), {added_nodes} node(s) added")
-        }
-        Event::DidNotHelp { reason } => {
-            outln!("The change did not help and was undone: {reason}")
-        }
-        Event::Success { ticks } => outln!("\n✓ SUCCESS in simulation after {ticks} tick(s)"),
-        Event::GaveUp { reason } => outln!("\nGave up: {reason}"),
+        Event::Goal { .. }
+        | Event::Proposal { .. }
+        | Event::Repaired { .. }
+        | Event::DidNotHelp { .. }
+        | Event::Error { .. } => "",
+        Event::Rejected => return outln!("Not approved; stopping."),
         Event::ChangeViolates { report } => {
             outln!(
                 "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
@@ -548,34 +486,19 @@ fn print_event_line(event: &Event) {
             if let Err(e) = super::verify_cmd::write_report(&mut err, report, false) {
                 tracing::warn!("cannot write the report to stderr: {e}");
             }
+            return;
         }
-        // What a live front end shows; the printed log keeps to the loop's steps.
-        Event::TreeChanged { .. }
-        | Event::Planned { .. }
-        | Event::Ticked { .. }
-        | Event::WorldChanged { .. }
-        | Event::Scene { .. }
-        | Event::ArmMotion { .. }
-        | Event::Usage { .. }
-        | Event::RunState { .. }
-        | Event::Forced { .. }
-        | Event::Breakpoints { .. }
-        | Event::BreakpointHit { .. }
-        | Event::Verifying { .. }
-        | Event::Verified { .. }
-        | Event::PolicySaved { .. }
-        | Event::Exported { .. }
-        | Event::PolicyLoaded { .. }
-        | Event::RuleOffered { .. }
-        | Event::RuleKept { .. }
-        | Event::RuleRefused { .. }
-        | Event::Knowledge { .. }
-        | Event::Notice { .. }
-        // Listed with the question that asks to choose among them.
-        | Event::Readings { .. } => {}
-        Event::Error { message } => outln!("error: {message}"),
-        // Returned by the loop as its error, and printed once by `main`.
-        Event::Failed { .. } => {}
+        // What a live front end shows; the printed log keeps to the loop's steps. The
+        // readings are listed with the question that asks to choose among them, and a
+        // failure is returned by the loop as its error and printed once by `main`.
+        _ => return,
+    };
+    for (i, line) in betr::record::describe(event).iter().enumerate() {
+        if i == 0 {
+            outln!("{prefix}{line}");
+        } else {
+            outln!("{line}");
+        }
     }
 }
 

@@ -260,6 +260,9 @@ fn found_at(text: &str, i: usize) -> String {
     }
 }
 
+crate::domain::as_text::serde_as_text!(Value, parse_value);
+crate::domain::as_text::serde_as_text!(ActionCall, ActionCall::parse);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -308,6 +308,9 @@ fn found_at(text: &str, i: usize) -> String {
     }
 }
 
+crate::domain::as_text::serde_as_text!(Atom, Atom::parse);
+crate::domain::as_text::serde_as_text!(Condition, Condition::parse);
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,6 +1,7 @@
 //! The planner's vocabulary: conditions, actions, skills and scenario files.
 
 pub mod action;
+pub(crate) mod as_text;
 pub mod condition;
 pub mod learned;
 pub mod names;

@@ -197,6 +197,8 @@ impl fmt::Display for Formula {
     }
 }
 
+crate::domain::as_text::serde_as_text!(Formula, Formula::parse);
+
 #[cfg(test)]
 mod tests {
     use super::*;

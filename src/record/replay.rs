@@ -11,7 +11,7 @@ use crate::scenario::{Scenario, ScenarioError};
 use crate::session::Event;
 use crate::world::{CellWorld, World};
 
-use super::{Decoder, Entry, Header, RecordError};
+use super::{Entry, Header, RecordError};
 
 /// One step of a replayed session.
 #[derive(Debug, Clone)]
@@ -54,12 +54,6 @@ pub enum ReplayError {
         recorded: String,
         found: String,
     },
-    #[error("{path}, {source}")]
-    Entry {
-        path: PathBuf,
-        #[source]
-        source: RecordError,
-    },
 }
 
 impl Replay {
@@ -84,27 +78,18 @@ impl Replay {
                 found: loaded.name,
             });
         }
-        let scenario = Arc::new(loaded);
-        let mut decoder = Decoder::new(scenario.clone());
-        let mut steps = Vec::with_capacity(recording.entries.len());
-        for (line, entry) in &recording.entries {
-            let step = match entry {
-                Entry::Command { command, .. } => Step::Command(command.clone()),
-                Entry::Event { event, .. } => {
-                    Step::Event(decoder.decode(event, *line).map_err(|source| {
-                        ReplayError::Entry {
-                            path: path.to_path_buf(),
-                            source,
-                        }
-                    })?)
-                }
-            };
-            steps.push((entry.ms(), step));
-        }
+        let steps = recording
+            .entries
+            .into_iter()
+            .map(|(_, entry)| match entry {
+                Entry::Command { ms, command } => (ms, Step::Command(command)),
+                Entry::Event { ms, event } => (ms, Step::Event(event)),
+            })
+            .collect();
         Ok(Replay {
             path: path.to_path_buf(),
             header: recording.header,
-            scenario,
+            scenario: Arc::new(loaded),
             steps,
             cut_at: recording.cut_at,
         })

@@ -7,11 +7,10 @@ use std::path::Path;
 
 use crate::session::{Command, Event};
 
-use super::{Encoder, Entry, RecordError, Recorder};
+use super::{Entry, RecordError, Recorder};
 
 pub struct SessionRecorder {
     recorder: Option<Recorder>,
-    encoder: Encoder,
     /// Why the recording stopped, if a write failed.
     stopped: Option<String>,
 }
@@ -26,18 +25,19 @@ impl SessionRecorder {
     ) -> Result<SessionRecorder, RecordError> {
         Ok(SessionRecorder {
             recorder: Some(Recorder::create(path, scenario, name, variant)?),
-            encoder: Encoder::new(),
             stopped: None,
         })
     }
 
     pub fn event(&mut self, event: &Event) {
-        if let Some(recorded) = self.encoder.encode(event) {
-            self.write(|ms| Entry::Event {
-                ms,
-                event: recorded,
-            });
+        // A replay re-simulates the cell's scenes from the recorded trees and ticks.
+        if matches!(event, Event::Scene { .. }) {
+            return;
         }
+        self.write(|ms| Entry::Event {
+            ms,
+            event: event.clone(),
+        });
     }
 
     pub fn command(&mut self, command: &Command) {

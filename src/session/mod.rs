@@ -31,7 +31,7 @@ pub use repair::edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use repair::evidence::Evidence;
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{
-    BreakReason, Ending, Event, NoModel, Options, Proposal, Resolved, SessionError, Steps,
+    BreakReason, Ending, Event, NoModel, Options, Proposal, Question, Resolved, SessionError, Steps,
 };
 
 /// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),

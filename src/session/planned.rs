@@ -8,7 +8,7 @@ use crate::domain::{ActionCall, Condition};
 use crate::planner::{Outcome, Plan};
 
 /// How the planner's simulation of the tree ended.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Prediction {
     /// The tree reaches success in simulation.
     Success,
@@ -92,7 +92,7 @@ impl std::fmt::Display for Prediction {
 }
 
 /// What one planning call did.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PlanSummary {
     pub nodes: usize,
     pub expansions: usize,

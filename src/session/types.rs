@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::bt::{Forced, NodeId, TickRecord, Tree};
-use crate::domain::{ActionCall, Condition, Value};
+use crate::domain::{ActionCall, Atom, Condition, Value};
 use crate::goal::Formula;
 use crate::llm::LlmError;
 use crate::llm::prompt::{PromptError, Templates, Variant};
@@ -155,7 +155,7 @@ pub struct VerifyRequest {
 }
 
 /// What a verification checks, told before its report.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct VerifyScope {
     pub nodes: usize,
     /// Preconditions the safety properties added when the tree was planned in the model.
@@ -171,7 +171,7 @@ pub struct VerifyScope {
 }
 
 /// What a model proposes for a failure.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Proposal {
     /// Insert these as the first preconditions of the failing action.
     Conditions {
@@ -213,14 +213,49 @@ impl std::fmt::Display for Proposal {
     }
 }
 
+/// What a question to the model asks for.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "question", rename_all = "snake_case")]
+pub enum Question {
+    /// The goal of the instruction: its first answer (`draw` 0) or another candidate
+    /// (`draw` counts from 0 among `draws`).
+    Goal { draw: usize, draws: usize },
+    /// The objects and places the instruction names.
+    NamedObjects,
+    /// The preconditions the failed `action` misses.
+    Preconditions { action: ActionCall },
+    /// A value for the parameter `param` of `action`.
+    Value { param: String, action: ActionCall },
+    /// Whether the instruction asks for `atom`.
+    Confirm { atom: Atom },
+}
+
+impl std::fmt::Display for Question {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Question::Goal { draw: 0, .. } => f.write_str("the goal of the instruction"),
+            Question::Goal { draw, draws } => {
+                write!(f, "another candidate goal ({} of {draws})", draw + 1)
+            }
+            Question::NamedObjects => f.write_str("the objects and places the instruction names"),
+            Question::Preconditions { action } => write!(f, "missing preconditions of {action}!"),
+            Question::Value { param, action } => write!(f, "a value for {param} of {action}!"),
+            Question::Confirm { atom } => write!(f, "whether the instruction asks for {atom}"),
+        }
+    }
+}
+
 /// What a session reports, in order: the steps of the resolve loop (asking, replies,
 /// goal, failure, proposal, approval, repair, success) and, for front ends that show a
-/// session live, the tree, the statuses of each tick, the world, usage and errors.
-#[derive(Debug, Clone)]
+/// session live, the tree, the statuses of each tick, the world, usage and errors. A
+/// recording is these events written as they are (`record`), one JSON object each, tagged
+/// by `event`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
 pub enum Event {
-    /// A question goes to the model (`what`: goal, conditions, or a parameter value).
+    /// A question goes to the model.
     Asking {
-        what: String,
+        what: Question,
     },
     /// A reply came back: who answered, its tokens and latency.
     Replied {
@@ -262,11 +297,12 @@ pub enum Event {
         readings: Vec<super::interpret::readings::Reading>,
         doubt: Option<String>,
     },
-    /// An action failed in simulation.
+    /// An action failed in simulation; `node_path` is the node's path (child indices
+    /// from the root), which a person reads as `1.0.1.1`.
     ActionFailed {
         action: ActionCall,
         node: NodeId,
-        node_path: String,
+        node_path: Vec<usize>,
         error: String,
     },
     /// A proposal, before approval, with who wrote it (the model, the simulation that
@@ -342,7 +378,10 @@ pub enum Event {
         record: Arc<TickRecord>,
     },
     /// The execution cell's scene after a tick or a reset, for a 3D view (only with
-    /// `Setup::scenes`, and only for cell worlds).
+    /// `Setup::scenes`, and only for cell worlds). Not written to recordings: a replay
+    /// re-simulates the cell from the recorded trees and ticks (`record::Resimulation`),
+    /// and the geometry would outweigh everything else in the file.
+    #[serde(skip)]
     Scene {
         scene: Arc<SceneSnapshot>,
     },
@@ -379,7 +418,7 @@ pub enum Event {
     /// (`Breakpoint`), or after tick `tick`, in which `node` failed (`Failure`).
     BreakpointHit {
         node: NodeId,
-        node_path: String,
+        node_path: Vec<usize>,
         tick: u64,
         reason: BreakReason,
     },
@@ -417,6 +456,7 @@ pub enum Event {
     },
     /// A step of the pipeline failed (a model call, planning); nothing changed.
     Failed {
+        #[serde(with = "failure_text")]
         error: SessionError,
     },
     /// Something worth a line in the log.
@@ -425,8 +465,22 @@ pub enum Event {
     },
 }
 
+/// A failure as a recording keeps it: its message (the errors it wraps, from the model
+/// client to the planner, are not data), read back as `SessionError::Recorded`.
+mod failure_text {
+    use super::SessionError;
+
+    pub fn serialize<S: serde::Serializer>(error: &SessionError, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(error)
+    }
+
+    pub fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<SessionError, D::Error> {
+        <String as serde::Deserialize>::deserialize(d).map(SessionError::Recorded)
+    }
+}
+
 /// Why running stopped at a node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum BreakReason {
     /// The next tick would enter a node with a breakpoint; it was not performed.
     Breakpoint,
@@ -485,6 +539,9 @@ pub enum SessionError {
     Stopped,
     #[error("{}", not_chosen(*count, doubt.as_deref()))]
     ReadingNotChosen { count: usize, doubt: Option<String> },
+    /// A failure read back from a recording, which keeps only its message.
+    #[error("{0}")]
+    Recorded(String),
 }
 
 /// Why no reading was worked on: several to choose among, or one the checks doubt.

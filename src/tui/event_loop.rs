@@ -234,6 +234,7 @@ fn dispatch(app: &mut App, event: QueueEvent, out: &mut Outlets, animated: &mut 
         QueueEvent::Input(_) => {}
         QueueEvent::InputEnded | QueueEvent::SessionEnded => return false,
         QueueEvent::Session(e) => {
+            crate::record::trace(&e);
             if let Some(t) = out.tap.as_mut() {
                 t.event(&e);
             }

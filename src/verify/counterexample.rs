@@ -11,7 +11,7 @@ use crate::bt::{NodeId, Outcome};
 use crate::domain::{ActionCall, Atom, Condition};
 
 /// An action node as a counterexample names it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ActionRef {
     pub node: NodeId,
     pub path: Vec<usize>,
@@ -19,7 +19,7 @@ pub struct ActionRef {
 }
 
 /// What happened in one step.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Event {
     /// One tick of the tree (numbered from 1 among the ticks of the counterexample).
     Tick {
@@ -38,7 +38,7 @@ pub enum Event {
 }
 
 /// One step and the facts it changed.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Step {
     pub event: Event,
     pub added: Vec<Atom>,
@@ -48,7 +48,7 @@ pub struct Step {
 }
 
 /// A run from the initial state to a violation.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Counterexample {
     /// Relevant facts true in the initial state.
     pub initial: Vec<Atom>,

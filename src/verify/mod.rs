@@ -36,7 +36,7 @@ pub use model_plan::{Constraint, ModelPlan, model_world, plan_in_model};
 pub use temporal::{Property, PropertyError, Temporal};
 
 /// Which structural rule a finding breaks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Rule {
     /// An action's declared precondition is neither checked on its path nor established
     /// by an earlier sibling.
@@ -64,7 +64,7 @@ impl Rule {
 }
 
 /// One structural problem: where, which rule, what, and how to fix it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Finding {
     pub path: Vec<usize>,
     pub rule: Rule,
@@ -85,7 +85,7 @@ impl std::fmt::Display for Finding {
 }
 
 /// Which property a result is about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum PropertyKind {
     /// The tree reaches Success from every reachable state within the tick bound.
     Success,
@@ -96,7 +96,7 @@ pub enum PropertyKind {
 }
 
 /// The outcome of checking one property.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Verdict {
     Holds,
     Violated(Box<Counterexample>),
@@ -113,7 +113,7 @@ impl Verdict {
     }
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PropertyResult {
     pub kind: PropertyKind,
     /// How the property reads (`reaches Success from every reachable state`, `never F`).
@@ -124,7 +124,7 @@ pub struct PropertyResult {
 }
 
 /// Statistics and results of model checking.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModelCheck {
     pub atoms: usize,
     pub states: usize,
@@ -135,7 +135,7 @@ pub struct ModelCheck {
 }
 
 /// Everything `verify` found.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Report {
     pub findings: Vec<Finding>,
     /// Unguarded-precondition findings that model checking refuted: the tree's shape does

@@ -27,7 +27,7 @@ use crate::planner::{Outcome, Plan, Planner, RepairError};
 use crate::world::SymbolicWorld;
 
 /// A precondition a safety property asked of an action.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Constraint {
     pub action: ActionCall,
     pub condition: Condition,

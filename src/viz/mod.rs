@@ -429,137 +429,21 @@ impl Viz {
         opens
     }
 
-    /// Follow a session: its tree, ticks, scenes and the steps of the resolve loop.
+    /// Follow a session: its tree, ticks, scenes and the steps of the resolve loop, each
+    /// step in the log in the words `record::describe` has for it.
     pub fn on_event(&mut self, event: &Event) {
-        use rerun::TextLogLevel as L;
         if self.opens_step(event) {
             self.next_step();
         }
         match event {
-            Event::TreeChanged { tree, why, .. } => {
-                self.set_tree(tree.clone());
-                self.log(L::INFO, format!("tree: {why}"));
-            }
+            Event::TreeChanged { tree, .. } => self.set_tree(tree.clone()),
             Event::Ticked { record } => self.tick(record, None),
             Event::Scene { scene } => self.scene(scene),
-            Event::WorldChanged { reset: true, .. } => self.log(L::DEBUG, "world reset"),
-            Event::WorldChanged { .. } => {}
-            Event::ArmMotion { motion } => {
-                let ms = motion.seconds * 1000.0;
-                match (motion.length, &motion.blocker) {
-                    (Some(length), _) => self.log(
-                        L::INFO,
-                        format!(
-                            "{} moved: joint path {length:.2} rad, planned in {ms:.1} ms, {} attempt(s)",
-                            motion.arm, motion.attempts
-                        ),
-                    ),
-                    (None, blocker) => self.log(
-                        L::WARN,
-                        format!(
-                            "{} found no path{}: {ms:.1} ms, {} attempt(s)",
-                            motion.arm,
-                            blocker
-                                .as_ref()
-                                .map_or(String::new(), |b| format!(", blocked by {b}")),
-                            motion.attempts
-                        ),
-                    ),
-                }
-            }
-            Event::Asking { what } => self.log(L::DEBUG, format!("asking the model for {what}")),
-            Event::Replied { attribution, .. } => {
-                self.log(L::DEBUG, format!("reply from {attribution}"));
-            }
-            Event::InvalidReply { error } => self.log(L::WARN, format!("unusable reply: {error}")),
-            Event::CandidateRejected {
-                candidate, reason, ..
-            } => {
-                self.log(L::INFO, format!("set aside {candidate}: {reason}"));
-            }
-            Event::Goal {
-                goal, reasoning, ..
-            } => {
-                if let Some(r) = reasoning {
-                    self.log(L::INFO, format!("reasoning: {r}"));
-                }
-                self.log(L::INFO, format!("goal: {goal}"));
-            }
-            // Ticked already logged the failure at its tick.
-            Event::ActionFailed {
-                action, node_path, ..
-            } => self.log(L::WARN, format!("{action}! (node {node_path}) failed")),
-            Event::Proposal {
-                proposal,
-                reasoning,
-                ..
-            } => {
-                if let Some(r) = reasoning {
-                    self.log(L::INFO, format!("reasoning: {r}"));
-                }
-                self.log(L::INFO, format!("proposal: {proposal}"));
-            }
-            Event::Planned { summary } => self.log(L::INFO, summary.log_line()),
-            Event::Approved => self.log(L::INFO, "approved"),
-            Event::Rejected => self.log(L::WARN, "rejected"),
-            Event::Repaired { added_nodes, .. } => {
-                self.log(L::INFO, format!("repaired: {added_nodes} node(s) added"));
-            }
-            Event::DidNotHelp { reason } => self.log(L::WARN, format!("did not help: {reason}")),
-            Event::Success { ticks } => self.log(L::INFO, format!("success after {ticks} tick(s)")),
-            Event::GaveUp { reason } => self.log(L::ERROR, format!("gave up: {reason}")),
-            Event::Error { message } => self.log(L::ERROR, message.clone()),
-            Event::Failed { error } => self.log(L::ERROR, error.to_string()),
-            Event::Notice { message } => self.log(L::DEBUG, message.clone()),
-            Event::Readings {
-                readings, doubt, ..
-            } => self.log(
-                L::INFO,
-                crate::session::interpret::readings::summary(readings, doubt.as_deref()),
-            ),
-            Event::PolicySaved { path, .. } => {
-                self.log(L::INFO, format!("policy saved to {}", path.display()));
-            }
-            Event::ChangeViolates { .. } => {
-                self.log(L::WARN, "the changed tree fails verification in the model");
-            }
-            Event::Exported { paths } => {
-                for path in paths {
-                    self.log(L::INFO, format!("tree exported to {}", path.display()));
-                }
-            }
-            Event::PolicyLoaded { path, .. } => {
-                self.log(L::INFO, format!("policy loaded from {}", path.display()));
-            }
-            Event::RuleKept { id, rule, .. } => {
-                self.log(L::INFO, format!("kept as rule {id}: {rule}"));
-            }
-            Event::RuleRefused { rule, reason } => {
-                self.log(L::WARN, format!("not kept as a rule: {rule}: {reason}"));
-            }
-            Event::BreakpointHit {
-                node_path,
-                tick,
-                reason,
-                ..
-            } => {
-                let when = match reason {
-                    crate::session::BreakReason::Breakpoint => "at a breakpoint before",
-                    crate::session::BreakReason::Failure => "after a failure in",
-                };
-                self.log(
-                    L::WARN,
-                    format!("stopped {when} tick {tick} (node {node_path})"),
-                );
-            }
-            Event::Usage { .. }
-            | Event::RunState { .. }
-            | Event::Forced { .. }
-            | Event::Breakpoints { .. }
-            | Event::Verifying { .. }
-            | Event::Verified { .. }
-            | Event::RuleOffered { .. }
-            | Event::Knowledge { .. } => {}
+            _ => {}
+        }
+        let level = log_level(event);
+        for line in crate::record::describe(event) {
+            self.log(level, line);
         }
         let at_rest = matches!(
             event,
@@ -590,5 +474,27 @@ impl Viz {
 impl Drop for Viz {
     fn drop(&mut self) {
         self.flush();
+    }
+}
+
+/// How loud the 3D view's log says `event`: warnings for what went wrong and waits for a
+/// person, errors for what ended the session or a command, details at debug.
+fn log_level(event: &Event) -> &'static str {
+    use rerun::TextLogLevel as L;
+    match event {
+        Event::InvalidReply { .. }
+        | Event::ActionFailed { .. }
+        | Event::Rejected
+        | Event::DidNotHelp { .. }
+        | Event::ChangeViolates { .. }
+        | Event::RuleRefused { .. }
+        | Event::BreakpointHit { .. } => L::WARN,
+        Event::ArmMotion { motion } if motion.length.is_none() => L::WARN,
+        Event::GaveUp { .. } | Event::Error { .. } | Event::Failed { .. } => L::ERROR,
+        Event::Asking { .. }
+        | Event::Replied { .. }
+        | Event::WorldChanged { .. }
+        | Event::Notice { .. } => L::DEBUG,
+        _ => L::INFO,
     }
 }

@@ -298,12 +298,14 @@ fn the_resolve_loop_takes_its_own_steps_after_the_failing_tick() {
     let failing = viz.steps();
     viz.on_event(&Event::ActionFailed {
         node: record.failures[0].0,
-        node_path: "1.0.1.1".into(),
+        node_path: vec![1, 0, 1, 1],
         action: crate::domain::ActionCall::new("grasp", ["blue cube"]),
         error: record.failures[0].1.clone(),
     });
     viz.on_event(&Event::Asking {
-        what: "a missing precondition".into(),
+        what: crate::session::Question::Preconditions {
+            action: crate::domain::ActionCall::new("grasp", ["blue cube"]),
+        },
     });
     viz.on_event(&Event::Approved);
     viz.on_event(&Event::Repaired {

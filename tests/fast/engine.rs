@@ -180,10 +180,14 @@ fn a_slow_model_call_does_not_block_ticks() {
                 break;
             }
         }
-        s.until(
-            "the question",
-            |e| matches!(e, Event::Asking { what } if what.contains("preconditions")),
-        )
+        s.until("the question", |e| {
+            matches!(
+                e,
+                Event::Asking {
+                    what: betr::session::Question::Preconditions { .. }
+                }
+            )
+        })
         .await;
         // The failure question is under way for 30 s; a tick is answered at once, and
         // the failed tree is not ticked again while the proposal is awaited.

@@ -89,8 +89,8 @@ fn a_breakpoint_stops_the_run_before_the_tick_that_enters_its_node() {
             unreachable!()
         };
         assert_eq!(
-            (*node, node_path.as_str(), *tick, *reason),
-            (place, "1.1", 3, BreakReason::Breakpoint)
+            (*node, node_path.as_slice(), *tick, *reason),
+            (place, [1, 1].as_slice(), 3, BreakReason::Breakpoint)
         );
         let performed: Vec<u64> = ticks(&got).iter().map(|r| r.tick).collect();
         assert_eq!(performed, [1, 2]);

@@ -135,7 +135,7 @@ fn an_unattended_loop_rejects_a_change_that_fails_its_check_and_asks_again() {
         assert_eq!(refused, 1, "a refused fix is not offered again");
         let asked = events
             .iter()
-            .filter(|e| matches!(e, Event::Asking { what } if what.contains("missing preconditions")))
+            .filter(|e| matches!(e, Event::Asking { what: betr::session::Question::Preconditions { .. } }))
             .count();
         assert!(asked >= 2, "asked again after the refusal: {asked}");
         assert!(events.iter().any(|e| matches!(e, Event::DidNotHelp { reason }

@@ -3,8 +3,9 @@
 //! failure and the proposal come from the file; printed with `--print`, the workbench
 //! refused without a terminal), converted to a rerun recording; a
 //! `betr repair` session likewise; a recording cut mid-entry (as a crash leaves it) replays
-//! up to its last whole entry; and the events read back carry the statuses of the
-//! recorded ticks node for node.
+//! up to its last whole entry; the events read back carry the statuses of the recorded
+//! ticks node for node; and the recordings of format version 1 in
+//! tests/fixtures/recordings still load, replay, and write again as the current version.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -13,7 +14,7 @@ use crate::support;
 use std::io::Write;
 
 use betr::bt::{self, Status};
-use betr::record::{Replay, Step};
+use betr::record::{Replay, SessionRecorder, Step};
 use betr::session::Event;
 use support::cli::{KEY_VAR, betr, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
@@ -87,11 +88,11 @@ fn a_resolve_session_is_recorded_and_replayed_without_the_model() {
     let log = text(&out);
     assert_eq!(out.status.code(), Some(0), "{log}");
     assert!(
-        log.contains("failed: No collision free path found"),
+        log.contains("failed in simulation: No collision free path found"),
         "{log}"
     );
-    assert!(log.contains("proposal by"), "{log}");
-    assert!(log.contains("✓ success"), "{log}");
+    assert!(log.contains("Proposal: "), "{log}");
+    assert!(log.contains("✓ SUCCESS"), "{log}");
     // Without --print the replay is the workbench, which needs a terminal.
     let out = betr(&dir, &["replay", &record_s]);
     assert_ne!(out.status.code(), Some(0), "{}", text(&out));
@@ -177,7 +178,7 @@ fn a_recording_cut_mid_entry_replays_up_to_its_last_whole_entry() {
     let out = betr(&dir, &["replay", &record_s, "--print"]);
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     assert!(text(&out).contains("partial entry"), "{}", text(&out));
-    assert!(text(&out).contains("failed: No collision free path found"));
+    assert!(text(&out).contains("failed in simulation: No collision free path found"));
     // A line broken in the middle of the file is an error naming it (exit 2).
     let mut broken = b"".to_vec();
     let first_newline = whole.iter().position(|b| *b == b'\n').unwrap();
@@ -188,5 +189,103 @@ fn a_recording_cut_mid_entry_replays_up_to_its_last_whole_entry() {
     let out = betr(&dir, &["replay", &record_s, "--print"]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(text(&out).contains("line 2"), "{}", text(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+/// The steps of `replay` in words, as `betr replay --print` tells them.
+fn told(replay: &Replay) -> Vec<String> {
+    replay
+        .steps
+        .iter()
+        .flat_map(|(_, s)| betr::record::describe_step(s))
+        .collect()
+}
+
+#[test]
+fn a_version_1_recording_still_loads_replays_and_writes_again() {
+    let dir = tmp("record-v1");
+    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    for name in ["v1-resolve.jsonl", "v1-repair.jsonl"] {
+        let old = fixtures::root()
+            .join("tests/fixtures/recordings")
+            .join(name);
+        let replay = Replay::load(&old, Some(&scenario)).unwrap();
+        assert_eq!(replay.header.version, 1);
+        assert_eq!(replay.cut_at, None);
+        // The failure names its node by id and by path in the tree it failed in.
+        let mut tree = None;
+        let mut failed = false;
+        for (_, step) in &replay.steps {
+            match step {
+                Step::Event(Event::TreeChanged { tree: t, .. }) => tree = Some(t.clone()),
+                Step::Event(Event::ActionFailed {
+                    node, node_path, ..
+                }) => {
+                    let tree = tree.as_ref().expect("a tree before the failure");
+                    assert_eq!(&tree.path(*node).unwrap(), node_path);
+                    failed = true;
+                }
+                _ => {}
+            }
+        }
+        assert!(failed, "{name}: the failure is read back");
+        let words = told(&replay);
+        assert!(
+            words
+                .iter()
+                .any(|w| w.contains("failed in simulation: No collision free path found")),
+            "{name}: {words:#?}"
+        );
+        assert!(words.iter().any(|w| w.starts_with("✓ SUCCESS")), "{name}");
+
+        // Written again, it is a recording of the current version that tells the same.
+        let new = dir.join(name);
+        let mut recorder =
+            SessionRecorder::create(&new, &scenario, &replay.header.name, None).unwrap();
+        for (_, step) in &replay.steps {
+            if let Step::Event(e) = step {
+                recorder.event(e);
+            }
+        }
+        drop(recorder);
+        let again = Replay::load(&new, None).unwrap();
+        assert_eq!(again.header.version, betr::record::VERSION);
+        let events = |r: &Replay| -> Vec<String> {
+            r.steps
+                .iter()
+                .filter(|(_, s)| matches!(s, Step::Event(_)))
+                .flat_map(|(_, s)| betr::record::describe_step(s))
+                .collect()
+        };
+        assert_eq!(events(&again), events(&replay), "{name}");
+        let ticks = |r: &Replay| -> Vec<Vec<Status>> {
+            r.steps
+                .iter()
+                .filter_map(|(_, s)| match s {
+                    Step::Event(Event::Ticked { record }) => Some(record.statuses.clone()),
+                    _ => None,
+                })
+                .collect()
+        };
+        assert!(!ticks(&replay).is_empty());
+        assert_eq!(
+            ticks(&again),
+            ticks(&replay),
+            "{name}: the ticks node for node"
+        );
+
+        let out = betr(
+            &dir,
+            &[
+                "replay",
+                &old.to_string_lossy(),
+                "--scenario",
+                &scenario_s,
+                "--print",
+            ],
+        );
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+        assert!(text(&out).contains("✓ SUCCESS"), "{}", text(&out));
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

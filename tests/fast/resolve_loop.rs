@@ -103,7 +103,7 @@ fn every_failure_and_parameter_scenario_resolves_through_the_cli() {
         ]);
         let out = betr(&dir, &args);
         let log = text(&out);
-        calls += log.matches("\n→ asking for ").count();
+        calls += log.matches("\n→ asking the model for ").count();
         // Shown with `cargo test --test resolve_loop -- --nocapture`.
         println!("$ betr resolve {rel} --yes ...\n{log}");
         assert_eq!(out.status.code(), Some(0), "{rel}:\n{log}");

@@ -1,27 +1,24 @@
 //! Session recordings: the file (`record::file::parse`, what `record::read` does with a
-//! file's text) and its entries decoded into session events over the recorded scenario
-//! (`record::Decoder`), then re-simulated in a symbolic world (`Resimulation`).
+//! file's text), its entries read back as session events, then re-simulated in a symbolic
+//! world (`Resimulation`).
 //!
 //! Properties: a line that does not read is an error naming a line after the header,
 //! except a cut last line, which is left out and named; the header and every entry
-//! written again read back the same; an event decoded from an entry is encoded
-//! (`Encoder`) to an entry that decodes and encodes to itself again; a decoding error
-//! names the entry's line.
+//! written again read back the same, and write the same text again.
 
 use crate::fuzz::Material;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use super::{Rng, Target, Violation, ensure, strings, text_of};
-use crate::bt::{self, NodeKind};
+use crate::bt::{self, NodeId, NodeKind, Status, TickRecord};
+use crate::domain::Condition;
 use crate::fuzz::Corpus;
 use crate::fuzz::mutate::random_char;
 use crate::llm::usage::UsageTotals;
-use crate::record::{
-    Decoder, Encoder, Entry, FORMAT, Header, RecordError, Recorded, RecordedProposal, Replay,
-    Resimulation, Step, VERSION,
-};
+use crate::record::{Entry, FORMAT, Header, RecordError, Replay, Resimulation, VERSION};
 use crate::scenario::Scenario;
+use crate::session::{BreakReason, Event, Proposal};
 
 /// Entries past this many are not decoded (a long recording is many short ones).
 const DECODED_AT_MOST: usize = 200;
@@ -51,17 +48,17 @@ impl RecordingTarget {
                 tokens: strings(&[
                     "{\"kind\":\"event\",\"ms\":1,\"event\":",
                     "{\"kind\":\"command\",\"ms\":1,\"command\":\"run\"}\n",
-                    "{\"event\":\"tick\",",
-                    "{\"event\":\"tree\",\"text\":\"sequence\\n  Sweep!\\n\",\"new_nodes\":[0,1],\"why\":\"\"}",
+                    "{\"event\":\"ticked\",\"record\":",
+                    "{\"event\":\"tree_changed\",\"tree\":{\"text\":\"sequence\\n  Sweep!\\n\",\"ids\":[0,1],\"capacity\":2},\"new_nodes\":[0,1],\"learned\":[],\"why\":\"\"}",
                     "{\"event\":\"approved\"}",
                     "\"statuses\":\"",
                     "\"root\":\"",
                     "\"node\":",
                     "\"visited\":[",
                     "\"failures\":[[",
-                    "\"forced\":[[0,\"S\"]]",
-                    "\"type\":\"conditions\"",
-                    "\"type\":\"value\"",
+                    "\"forced\":[[0,\"Success\"]]",
+                    "{\"Conditions\":",
+                    "{\"Value\":",
                     "RSFH-",
                     "18446744073709551615",
                     "18446744073709551616",
@@ -75,63 +72,24 @@ impl RecordingTarget {
         }
     }
 
-    fn decode(
-        &self,
-        rec: &crate::record::Recording,
-        scenario: &Arc<Scenario>,
-    ) -> Result<(), Violation> {
-        let (mut first, mut again) = (
-            Decoder::new(scenario.clone()),
-            Decoder::new(scenario.clone()),
-        );
-        let (mut encoder, mut encoder_again) = (Encoder::new(), Encoder::new());
-        let mut steps = Vec::new();
-        for (line, entry) in rec.entries.iter().take(DECODED_AT_MOST) {
-            let Entry::Event { event, ms } = entry else {
-                continue;
-            };
-            let decoded = match first.decode(event, *line) {
-                Ok(e) => e,
-                Err(e) => {
-                    return ensure(
-                        matches!(e, RecordError::Decode { line: l, .. } if l == *line),
-                        "a decoding error names the entry's line",
-                        || format!("line {line}: {e}"),
-                    );
-                }
-            };
-            if let Some(encoded) = encoder.encode(&decoded) {
-                let back = again.decode(&encoded, *line);
-                let Ok(back) = back else {
-                    return ensure(false, "a decoded event encoded again decodes", || {
-                        format!("{event:?} encoded as {encoded:?}: {back:?}")
-                    });
-                };
-                let twice = encoder_again.encode(&back);
-                ensure(
-                    twice.as_ref() == Some(&encoded),
-                    "a decoded event encodes to an entry that decodes and encodes the same",
-                    || format!("{event:?} encoded as {encoded:?}, then {twice:?}"),
-                )?;
-            }
-            steps.push((*ms, Step::Event(decoded)));
+    /// Re-simulate the events of `rec` on `scenario` (a symbolic world's only).
+    fn resimulate(&self, rec: &crate::record::Recording, scenario: &Arc<Scenario>) {
+        if scenario.world_kind != "symbolic" {
+            return;
         }
-        if scenario.world_kind == "symbolic" {
-            let replay = Replay {
-                path: PathBuf::from("fuzz.jsonl"),
-                header: rec.header.clone(),
-                scenario: scenario.clone(),
-                steps: Vec::new(),
-                cut_at: None,
-            };
-            let mut sim = Resimulation::new(&replay);
-            for (_, step) in &steps {
-                if let Step::Event(e) = step {
-                    let _ = sim.follow(e);
-                }
+        let replay = Replay {
+            path: PathBuf::from("fuzz.jsonl"),
+            header: rec.header.clone(),
+            scenario: scenario.clone(),
+            steps: Vec::new(),
+            cut_at: None,
+        };
+        let mut sim = Resimulation::new(&replay);
+        for (_, entry) in rec.entries.iter().take(DECODED_AT_MOST) {
+            if let Entry::Event { event, .. } = entry {
+                let _ = sim.follow(event);
             }
         }
-        Ok(())
     }
 }
 
@@ -148,116 +106,106 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
         betr: "0.1.0".into(),
         started: "2026-05-01T09:30:00Z".into(),
     };
-    let tree = bt::parse(tree_text).ok();
-    let nodes = tree.as_ref().map_or(1, bt::Tree::len);
-    let action = tree.as_ref().and_then(|t| {
-        let order = t.preorder();
-        order
-            .iter()
-            .enumerate()
-            .find_map(|(i, id)| match t.kind(*id) {
-                Ok(NodeKind::Action(a)) => Some((i, a.to_string())),
-                _ => None,
-            })
+    let Ok(tree) = bt::parse(tree_text) else {
+        return serde_json::to_string(&header).unwrap_or_default();
+    };
+    let order = tree.preorder();
+    let any = |rng: &mut Rng| NodeId(rng.below(tree.capacity() + 1) as u32);
+    let (node, action) = order
+        .iter()
+        .find_map(|id| match tree.kind(*id) {
+            Ok(NodeKind::Action(a)) => Some((*id, a.clone())),
+            _ => None,
+        })
+        .unwrap_or((
+            tree.root(),
+            crate::domain::ActionCall::new("Sweep", [""; 0]),
+        ));
+    let goal = scenario.goal.clone();
+    let fact: Option<Condition> = goal.as_ref().and_then(|g| match g {
+        crate::goal::Formula::Atom(a) => Some(Condition {
+            atom: a.clone(),
+            negated: false,
+        }),
+        _ => None,
     });
-    let (node, action) = action.unwrap_or((0, "Sweep".into()));
-    let goal = scenario
-        .goal
-        .as_ref()
-        .map(ToString::to_string)
-        .unwrap_or_default();
-    let letters = ['-', 'R', 'S', 'F', 'H'];
-    let mut events = vec![
-        Recorded::Tree {
-            text: tree_text.clone(),
-            new_nodes: (0..nodes).collect(),
-            why: "planned".into(),
-        },
-        Recorded::Goal {
-            goal: goal.clone(),
+    let statuses = [
+        Status::Idle,
+        Status::Running,
+        Status::Success,
+        Status::Failure,
+    ];
+    let mut events = vec![Event::TreeChanged {
+        tree: Arc::new(tree.clone()),
+        new_nodes: order.clone(),
+        learned: Vec::new(),
+        why: "planned".into(),
+    }];
+    if let Some(goal) = goal {
+        events.push(Event::Goal {
+            goal,
             reasoning: Some("because".into()),
             matches_expected: Some(true),
             author: "model".into(),
-        },
-    ];
+        });
+    }
     for _ in 0..1 + rng.small(6) {
-        let event = match rng.below(12) {
-            0..=2 => Recorded::Tick {
-                tick: rng.below(100) as u64,
-                root: *rng.pick(&['R', 'S', 'F']).unwrap_or(&'R'),
-                statuses: (0..nodes)
-                    .map(|_| *rng.pick(&letters).unwrap_or(&'-'))
-                    .collect(),
-                visited: (0..rng.small(nodes))
-                    .map(|_| rng.below(nodes + 1))
-                    .collect(),
-                failures: vec![(node, "No collision free path found".into())],
-                completed: vec![],
-                halted: vec![rng.below(nodes)],
-                forced: vec![],
+        let event = match rng.below(11) {
+            0..=2 => Event::Ticked {
+                record: Arc::new(TickRecord {
+                    tick: rng.below(100) as u64,
+                    root: bt::Outcome::Running,
+                    statuses: (0..tree.capacity())
+                        .map(|_| *rng.pick(&statuses).unwrap_or(&Status::Idle))
+                        .collect(),
+                    visited: (0..rng.small(order.len())).map(|_| any(rng)).collect(),
+                    halted: vec![any(rng)],
+                    failures: vec![(node, "No collision free path found".into())],
+                    completed: vec![],
+                    forced: vec![],
+                }),
             },
-            3 => Recorded::ActionFailed {
+            3 => Event::ActionFailed {
                 action: action.clone(),
                 node,
-                node_path: "0.1".into(),
+                node_path: tree.path(node).unwrap_or_default(),
                 error: "it failed".into(),
             },
-            4 => Recorded::Proposal {
-                proposal: RecordedProposal::Conditions {
+            4 => Event::Proposal {
+                proposal: Proposal::Conditions {
                     action: action.clone(),
                     node,
-                    conditions: vec![goal.clone()],
-                },
-                reasoning: None,
-                author: "model".into(),
-                evidence: None,
-            },
-            5 => Recorded::Proposal {
-                proposal: RecordedProposal::Value {
-                    skill: "grasp".into(),
-                    object: "egg".into(),
-                    param: "force".into(),
-                    value: format!("{}.{} N", rng.below(100), rng.below(10)),
+                    conditions: fact.iter().cloned().collect(),
                 },
                 reasoning: Some((0..rng.small(20)).map(|_| random_char(rng)).collect()),
                 author: "model".into(),
-                evidence: Some(crate::session::Evidence {
+                evidence: Some(Box::new(crate::session::Evidence {
                     findings: vec![(0..rng.small(20)).map(|_| random_char(rng)).collect()],
                     objects: vec!["egg".into()],
                     doubt: None,
-                }),
+                })),
             },
-            6 => Recorded::WorldChanged {
-                facts: vec![goal.clone()],
+            5 => Event::WorldChanged {
+                facts: fact.iter().cloned().collect(),
                 reset: rng.chance(50),
             },
-            7 => Recorded::Forced {
-                forced: vec![(
-                    rng.below(nodes),
-                    *rng.pick(&['S', 'F', 'R', 'x']).unwrap_or(&'S'),
-                )],
+            6 => Event::Forced {
+                forced: vec![(any(rng), bt::Forced::Failure)],
             },
-            8 => Recorded::Breakpoints {
-                nodes: vec![rng.below(nodes + 1)],
+            7 => Event::Breakpoints {
+                nodes: vec![any(rng)],
                 on_failure: rng.chance(50),
             },
-            9 => Recorded::BreakpointHit {
-                node: rng.below(nodes),
-                node_path: "0".into(),
+            8 => Event::BreakpointHit {
+                node,
+                node_path: tree.path(node).unwrap_or_default(),
                 tick: 3,
-                on_failure: rng.chance(50),
+                reason: BreakReason::Failure,
             },
-            10 => Recorded::Usage {
+            9 => Event::Usage {
                 totals: UsageTotals::default(),
             },
-            _ => rng
-                .pick(&[
-                    Recorded::Approved,
-                    Recorded::Rejected,
-                    Recorded::Success { ticks: 4 },
-                ])
-                .cloned()
-                .unwrap_or(Recorded::Approved),
+            _ => Event::Success { ticks: 4 },
         };
         events.push(event);
     }
@@ -327,25 +275,26 @@ impl Target for RecordingTarget {
             "a recording's header written again reads back the same",
             || format!("{:?} wrote {header:?}", rec.header),
         )?;
-        for (line, entry) in &rec.entries {
+        for (line, entry) in rec.entries.iter().take(DECODED_AT_MOST) {
             let written = serde_json::to_string(entry).ok();
             let back: Option<Entry> = written
                 .as_deref()
                 .and_then(|w| serde_json::from_str(w).ok());
+            let again = back.as_ref().and_then(|b| serde_json::to_string(b).ok());
             ensure(
-                back.as_ref() == Some(entry),
-                "a recording's entry written again reads back the same",
-                || format!("line {line}: {entry:?} wrote {written:?}"),
+                written.is_some() && again == written,
+                "a recording's entry written again reads back and writes the same",
+                || format!("line {line}: {entry:?} wrote {written:?}, then {again:?}"),
             )?;
         }
-        let Some(scene) = self
+        if let Some(scene) = self
             .scenes
             .iter()
             .find(|(rel, ..)| rec.header.scenario == Path::new(rel))
             .or_else(|| self.scenes.first())
-        else {
-            return Ok(());
-        };
-        self.decode(&rec, &scene.1)
+        {
+            self.resimulate(&rec, &scene.1);
+        }
+        Ok(())
     }
 }

@@ -13,7 +13,7 @@
 
 use std::collections::BTreeSet;
 
-use crate::bt::{Forced, ForcedStatuses, NodeId, Status, TickRecord, Tree, path_text};
+use crate::bt::{Forced, ForcedStatuses, NodeId, Status, TickRecord, Tree};
 use crate::planner::WorldLeaves;
 
 use super::super::types::{BreakReason, Event};
@@ -204,7 +204,6 @@ impl Engine {
             .tree
             .as_ref()
             .and_then(|t| t.path(node).ok())
-            .map(|p| path_text(&p))
             .unwrap_or_default();
         self.emit(Event::BreakpointHit {
             node,

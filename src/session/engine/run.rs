@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use crate::bt::{Outcome as TickOutcome, TickRecord, Ticker, path_text};
+use crate::bt::{Outcome as TickOutcome, TickRecord, Ticker};
 use crate::domain::Condition;
 use crate::planner::WorldLeaves;
 use crate::world::cell::snapshot::MotionView;
@@ -161,7 +161,6 @@ impl Engine {
             .tree
             .as_ref()
             .and_then(|t| t.path(failure.node).ok())
-            .map(|p| path_text(&p))
             .unwrap_or_default();
         self.emit(Event::ActionFailed {
             action: failure.action.clone(),

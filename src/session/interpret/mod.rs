@@ -30,6 +30,7 @@ use crate::reading::parts::split;
 use crate::scenario::Scenario;
 use crate::world::World;
 
+use super::Question;
 use super::repair::ask::ask;
 use super::types::{Event, Options, SessionError};
 use goal_checks::GoalProblem;
@@ -237,11 +238,7 @@ impl Drawer<'_> {
         emit: &mut (dyn FnMut(&Event) + Send),
     ) -> Result<ChatReply, SessionError> {
         emit(&Event::Asking {
-            what: if draw == 0 {
-                "the goal of the instruction".into()
-            } else {
-                format!("another candidate goal ({} of {draws})", draw + 1)
-            },
+            what: Question::Goal { draw, draws },
         });
         let mut opts = self.options.clone();
         let seed = if draw > 0 {

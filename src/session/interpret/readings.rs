@@ -17,7 +17,7 @@ const FIRST_ACTIONS: usize = 3;
 const RUN_TICKS: u64 = 400;
 
 /// One reading of an instruction, as a person chooses it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Reading {
     pub goal: Formula,
     /// The goal in words, from the predicates' descriptions.

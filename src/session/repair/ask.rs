@@ -11,7 +11,7 @@ use crate::llm::reply::{self, ReplyError};
 use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
-use super::super::types::{Event, Options, Proposal, SessionError};
+use super::super::types::{Event, Options, Proposal, Question, SessionError};
 use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::value_bounds::Bounds;
@@ -338,7 +338,9 @@ pub(crate) async fn ask_conditions(
     };
     let choices = list.as_ref().map(|l| l.fixes.clone()).unwrap_or_default();
     emit(&Event::Asking {
-        what: format!("missing preconditions of {action}!"),
+        what: Question::Preconditions {
+            action: action.clone(),
+        },
     });
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
     let messages = ctx.resolve(&options.templates, action, error, &tried_lines, &choices)?;
@@ -393,7 +395,10 @@ pub(crate) async fn ask_value(
         ..
     } = *failed;
     emit(&Event::Asking {
-        what: format!("a value for {} of {action}!", param.name),
+        what: Question::Value {
+            param: param.name.clone(),
+            action: action.clone(),
+        },
     });
     // What the world said of the values tried so far bounds the next ones.
     let mut bounds = Bounds::declared(param);

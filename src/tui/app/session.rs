@@ -60,7 +60,7 @@ impl App {
             Event::Asking { what } => {
                 self.status.awaiting = Some(&strings::AWAITING_MODEL);
                 self.llm.error = None;
-                self.llm.asking = Some(what);
+                self.llm.asking = Some(what.to_string());
             }
             Event::Replied { attribution, .. } => {
                 self.llm.asking = None;
@@ -350,7 +350,8 @@ impl App {
                 reason,
             } => {
                 let leaf = self.tree.label(node, &self.theme);
-                let text = strings::stopped_at(reason, &leaf, &node_path, tick);
+                let text =
+                    strings::stopped_at(reason, &leaf, &crate::bt::path_text(&node_path), tick);
                 self.tree.set_stopped(node);
                 self.status.ending = Some(Ending::Stopped);
                 self.llm.log(text.clone());

@@ -111,7 +111,7 @@ pub struct TickResult {
 }
 
 /// Why a tree cannot be compiled for model checking.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error, serde::Serialize, serde::Deserialize)]
 pub enum ModelError {
     #[error(
         "action {call}! at node {path} names no skill of the scenario, so its effects are unknown"

@@ -125,7 +125,7 @@ pub struct ArmPathView {
 
 /// The last motion asked of the arms: which arm, what finding it took, and its length or
 /// what blocked it.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MotionView {
     pub arm: String,
     /// Joint-space length (radians) of the path; none when the arm found no path.
