@@ -6,6 +6,7 @@
 //! unattended, policies and the knowledge kept from approved fixes. Front ends (CLI, TUI)
 //! show the events; nothing here prints or reads a terminal.
 
+mod call;
 pub mod engine;
 pub mod interpret;
 pub mod knowledge;
@@ -21,17 +22,16 @@ pub use crate::planner::RunLimits;
 pub use crate::world::missing_description;
 pub use engine::{Command, Engine, EngineHandle, Setup};
 pub use interpret::goal_checks::check_goal;
-pub use interpret::readings::Reading;
 pub use interpret::{Interpretation, interpret};
 pub use knowledge::{KeptRule, Knowledge, KnowledgeError, Refusal};
 pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use repair::ask::missing_value;
 pub use repair::edit::{Edit, EditError, parse_edit, vocabulary_words};
-pub use repair::evidence::Evidence;
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{
-    BreakReason, Ending, Event, NoModel, Options, Proposal, Question, Resolved, SessionError, Steps,
+    BreakReason, Ending, Event, Evidence, NoModel, Options, Proposal, Question, Reading, Resolved,
+    SessionError, Steps,
 };
 
 /// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),

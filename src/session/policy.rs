@@ -30,6 +30,8 @@ use crate::domain::Domain;
 use crate::goal::Formula;
 use crate::planner;
 
+pub use super::types::{PolicyError, PolicyTreeError};
+
 /// How a fix got into the tree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Approval {
@@ -80,29 +82,6 @@ pub struct Policy {
     pub saved_at: String,
     pub fixes: Vec<Fix>,
     pub tree: Tree,
-}
-
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PolicyError {
-    #[error("cannot read policy {path}: {detail}")]
-    Read { path: String, detail: String },
-    #[error("policy {path}: {error}")]
-    Invalid {
-        path: String,
-        error: Box<PolicyTreeError>,
-    },
-    #[error("cannot write policy {path}: {detail}")]
-    Write { path: String, detail: String },
-}
-
-/// Why a policy's tree cannot be used: its text (with the position), or a leaf the domain
-/// does not know (with the node's path).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum PolicyTreeError {
-    #[error(transparent)]
-    Text(#[from] bt::ParseError),
-    #[error(transparent)]
-    Check(#[from] planner::TreeCheckError),
 }
 
 /// Where policies live.

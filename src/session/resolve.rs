@@ -16,9 +16,8 @@ use crate::llm::LanguageModel;
 use crate::scenario::Scenario;
 
 use super::engine::{Command, Engine, Setup};
-use super::interpret::readings::Reading;
 use super::policy::PolicyStore;
-use super::types::{Ending, Event, Options, Proposal, Resolved, SessionError};
+use super::types::{Ending, Event, Options, Proposal, Reading, Resolved, SessionError};
 
 /// The whole loop for `scenario`: `instruction` (else the scenario's) → goal → tree → success.
 pub async fn resolve(

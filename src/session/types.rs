@@ -27,6 +27,55 @@ pub enum NoModel {
     Unavailable(String),
 }
 
+/// The evidence shown with a proposal, before the model's reasoning.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Evidence {
+    /// What betr found, one finding a line, the failure first.
+    pub findings: Vec<String>,
+    /// The objects the failure involves: the action's, those its error names, those
+    /// whose facts stood in the way, and those the change names.
+    pub objects: Vec<String>,
+    /// Why the model's reasoning is not to be taken as the reason, when it is not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub doubt: Option<String>,
+}
+
+/// One reading of an instruction, as a person chooses it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Reading {
+    pub goal: Formula,
+    /// The goal in words, from the predicates' descriptions.
+    pub words: String,
+    /// The first actions the robot would take, in order.
+    pub first_actions: Vec<String>,
+    /// Every action of the plan's run in simulation (what makes two readings one).
+    pub(crate) actions: Vec<String>,
+}
+
+/// Why a policy cannot be read, used or written.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PolicyError {
+    #[error("cannot read policy {path}: {detail}")]
+    Read { path: String, detail: String },
+    #[error("policy {path}: {error}")]
+    Invalid {
+        path: String,
+        error: Box<PolicyTreeError>,
+    },
+    #[error("cannot write policy {path}: {detail}")]
+    Write { path: String, detail: String },
+}
+
+/// Why a policy's tree cannot be used: its text (with the position), or a leaf the domain
+/// does not know (with the node's path).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PolicyTreeError {
+    #[error(transparent)]
+    Text(#[from] crate::bt::ParseError),
+    #[error(transparent)]
+    Check(#[from] crate::planner::TreeCheckError),
+}
+
 /// How the loop asks and how long it keeps trying.
 #[derive(Debug, Clone)]
 pub struct Options {
@@ -294,7 +343,7 @@ pub enum Event {
     /// (`Command::ChooseReading`), best first, before anything runs.
     Readings {
         instruction: String,
-        readings: Vec<super::interpret::readings::Reading>,
+        readings: Vec<Reading>,
         doubt: Option<String>,
     },
     /// An action failed in simulation; `node_path` is the node's path (child indices
@@ -314,7 +363,7 @@ pub enum Event {
         author: String,
         /// What betr itself found about the failure and the change, shown first; `None`
         /// when the change was not asked of a model (a person's edit).
-        evidence: Option<Box<super::repair::evidence::Evidence>>,
+        evidence: Option<Box<Evidence>>,
     },
     Approved,
     Rejected,
@@ -532,7 +581,7 @@ pub enum SessionError {
     #[error("no usable goal after {attempts} call(s); last reply: {last}")]
     NoGoal { attempts: usize, last: ReplyError },
     #[error("{0}")]
-    Policy(#[from] super::policy::PolicyError),
+    Policy(#[from] PolicyError),
     #[error(transparent)]
     TreeFile(Box<crate::interop::TreeFileError>),
     #[error("the session stopped before the loop ended")]

@@ -291,3 +291,101 @@ fn the_lab_modules_are_declared_behind_the_lab_feature() {
         );
     }
 }
+
+/// Which of the session's own modules (its rooms and files: `engine`, `interpret`,
+/// `repair`, `types`, …) each one's product code names, by `crate::session::X` or by as
+/// many `super::` as lead back to the session. `session/mod.rs`, which declares them all,
+/// is left out.
+fn session_dependencies(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let session = src.join("session");
+    let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for file in rust_files(&session) {
+        let Ok(rel) = file.strip_prefix(&session) else {
+            continue;
+        };
+        let mut path: Vec<String> = rel
+            .iter()
+            .map(|c| c.to_string_lossy().trim_end_matches(".rs").to_string())
+            .collect();
+        if path.last().is_some_and(|l| l == "mod") {
+            path.pop();
+        }
+        let Some(from) = path.first().cloned() else {
+            continue;
+        };
+        let code = product_code(&file);
+        let entry = graph.entry(from.clone()).or_default();
+        for line in code_lines(&code) {
+            for name in session_names(line, path.len()) {
+                if name != from {
+                    entry.insert(name);
+                }
+            }
+        }
+    }
+    let modules: BTreeSet<String> = graph.keys().cloned().collect();
+    for deps in graph.values_mut() {
+        deps.retain(|d| modules.contains(d));
+    }
+    graph
+}
+
+/// The session modules `line` names from a file `depth` modules below the session.
+fn session_names(line: &str, depth: usize) -> Vec<String> {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut names = Vec::new();
+    for (at, _) in line.match_indices("crate::session::") {
+        names.push(ident(&line[at + "crate::session::".len()..]));
+    }
+    let ups = "super::".repeat(depth);
+    for (at, _) in line.match_indices(&ups) {
+        let before = &line[..at];
+        let rest = &line[at + ups.len()..];
+        // `super::super::x` seen from one level deeper is not this many `super::`.
+        if before.ends_with("super::") || before.ends_with(|c: char| c.is_alphanumeric()) {
+            continue;
+        }
+        if rest.starts_with("super::") {
+            continue;
+        }
+        if let Some(group) = rest.strip_prefix('{') {
+            let group = group.split('}').next().unwrap_or_default();
+            names.extend(group.split(',').map(|p| ident(p.trim())));
+        } else {
+            names.push(ident(rest));
+        }
+    }
+    names
+}
+
+#[test]
+fn the_session_rooms_depend_one_way() {
+    let graph = session_dependencies(&src());
+    for room in ["engine", "interpret", "repair", "types"] {
+        assert!(graph.contains_key(room), "no session module {room}: {graph:?}");
+    }
+    assert!(
+        graph["engine"].contains("repair") && graph["engine"].contains("interpret"),
+        "the reader misses the engine's imports: {graph:?}"
+    );
+    let cycles: Vec<String> = graph
+        .keys()
+        .filter_map(|m| cycle_from(&graph, m))
+        .map(|c| c.join(" → "))
+        .collect();
+    assert!(cycles.is_empty(), "import cycles inside the session: {cycles:#?}");
+    // The vocabulary is plain data: it names no room of the session.
+    let types = &graph["types"];
+    for room in ["engine", "interpret", "repair", "policy", "knowledge", "resolve"] {
+        assert!(!types.contains(room), "session/types.rs imports {room}: {types:?}");
+    }
+    // Reading an instruction and repairing a failure are separate jobs.
+    assert!(
+        !graph["interpret"].contains("repair") && !graph["repair"].contains("interpret"),
+        "interpret and repair import each other: {graph:?}"
+    );
+}

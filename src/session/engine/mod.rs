@@ -2,16 +2,19 @@
 //! policy, headless. Front ends send [`Command`]s and render the [`Event`]s it emits; the
 //! TUI, `betr resolve` and the tests drive the same code.
 //!
-//! The engine owns the scenario, the goal, the tree, a planning world (the planner ticks
-//! the tree in forks of it), an execution world with its `Ticker` (what "tick" and "run"
-//! advance), the language model, the pending proposal, the undo stack (the tree before
-//! each applied change) and the policy store.
+//! What the engine is doing is one [`phase::Phase`] (idle, reading an instruction,
+//! choosing a reading, ready, running, failed, asking about a failure, a proposal waiting,
+//! a change being checked, a change that fails its check), holding the data of that phase
+//! alone; `handle` says what each command does in each phase. Beside the phase: the task
+//! (goal, tree, undo history, fixes), the run (planning and execution worlds, ticker,
+//! debugger, facts), the settings, and the knowledge kept from approved fixes.
 //!
 //! Model calls run as tokio tasks whose results come back as internal messages: the engine
-//! keeps answering commands (ticks included) while a call is under way, and a call whose
-//! answer is no longer wanted (the tree was re-planned, undone or reset) is aborted and
-//! its late answer ignored. Nothing a model proposes changes the tree until it is
-//! approved (by a person, or by `auto_approve`).
+//! keeps answering commands while a call is under way, and leaving the phase that started
+//! a call aborts it, so its late answer finds no phase waiting for it. Reading an
+//! instruction (`session::interpret`) and asking about a failure (`session::repair`) run
+//! there; the engine only starts them and takes their answers. Nothing a model proposes
+//! changes the tree until it is approved (by a person, or by `auto_approve`).
 
 mod changes;
 mod checks;

@@ -3,8 +3,7 @@
 //! a change). Leaving a phase drops its data: a call it started is aborted, so its late
 //! answer finds no phase waiting for it.
 
-use crate::session::interpret::readings::Reading;
-use crate::session::types::{Event, Proposal};
+use crate::session::types::{Event, Proposal, Reading};
 
 use super::Engine;
 

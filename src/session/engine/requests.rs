@@ -12,9 +12,8 @@ use crate::verify::Report;
 use super::super::interpret::{Interpretation, interpret};
 use super::super::policy::Approval;
 use super::super::repair::ask::{Asked, Tried};
-use super::super::repair::evidence::Evidence;
 use super::super::repair::question::{Answer, Question};
-use super::super::types::{Event, SessionError};
+use super::super::types::{Event, Evidence, SessionError};
 use super::Engine;
 use super::phase::{Call, Failure, Pending, Phase};
 

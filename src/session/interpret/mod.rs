@@ -31,7 +31,7 @@ use crate::scenario::Scenario;
 use crate::world::World;
 
 use super::Question;
-use super::repair::ask::ask;
+use super::call::ask;
 use super::types::{Event, Options, SessionError};
 use goal_checks::GoalProblem;
 use judge::{Candidate, Judge};

@@ -10,23 +10,13 @@ use crate::planner::{Outcome, Planner, RunEnd, run_tree};
 use crate::scenario::Scenario;
 use crate::world::World;
 
+use super::super::types::Reading;
+
 /// How many actions of a reading's plan are shown.
 const FIRST_ACTIONS: usize = 3;
 
 /// Ticks a reading's plan is run for to find its actions.
 const RUN_TICKS: u64 = 400;
-
-/// One reading of an instruction, as a person chooses it.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Reading {
-    pub goal: Formula,
-    /// The goal in words, from the predicates' descriptions.
-    pub words: String,
-    /// The first actions the robot would take, in order.
-    pub first_actions: Vec<String>,
-    /// Every action of the plan's run in simulation (what makes two readings one).
-    actions: Vec<String>,
-}
 
 /// The readings among `goals` (best first) that the planner can achieve from `world`,
 /// without those whose plan runs the same actions as an earlier one's.

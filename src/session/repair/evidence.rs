@@ -10,23 +10,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::domain::{ANY_OBJECT, Atom, Condition, Object};
 
-use super::super::types::Proposal;
+use super::super::types::{Evidence, Proposal};
 use super::ask::Tried;
 use super::screen::{FailureAt, Verdict};
 use super::shortlist::Shortlist;
-
-/// The evidence shown with a proposal, before the model's reasoning.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Evidence {
-    /// What betr found, one finding a line, the failure first.
-    pub findings: Vec<String>,
-    /// The objects the failure involves: the action's, those its error names, those
-    /// whose facts stood in the way, and those the change names.
-    pub objects: Vec<String>,
-    /// Why the model's reasoning is not to be taken as the reason, when it is not.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub doubt: Option<String>,
-}
 
 /// What went into a question about a failure and what came out of it.
 pub struct Found<'a> {

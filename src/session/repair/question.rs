@@ -11,9 +11,9 @@ use crate::llm::prompt::Context;
 use crate::scenario::Scenario;
 use crate::world::World;
 
-use super::super::types::{Event, Options, SessionError};
+use super::super::types::{Event, Evidence, Options, SessionError};
 use super::ask::{Asked, FailedAction, Tried, ask_conditions, ask_value, missing_value};
-use super::evidence::{Evidence, Found};
+use super::evidence::Found;
 use super::screen::{FailureAt, Screen};
 
 /// Everything the question about one failure needs, owned, so it can be asked off the
