@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{Entry, FORMAT, Header, RecordError, VERSION};
+use crate::session::Event;
 
 /// A recording being written.
 pub struct Recorder {
@@ -136,6 +137,11 @@ pub fn parse(path: &Path, text: &str) -> Result<Recording, RecordError> {
             });
         }
     };
+    check_nodes(&read.items).map_err(|(line, reason)| RecordError::Line {
+        path: path.to_path_buf(),
+        line,
+        reason,
+    })?;
     Ok(Recording {
         path: path.to_path_buf(),
         header,
@@ -144,10 +150,77 @@ pub fn parse(path: &Path, text: &str) -> Result<Recording, RecordError> {
     })
 }
 
+/// Every node an event names is a node of the tree before it, and every tick has a
+/// status for each of its slots: a file edited by hand, or damaged, is refused at the
+/// line that breaks this rather than shown with statuses on the wrong nodes.
+fn check_nodes(entries: &[(usize, Entry)]) -> Result<(), (usize, String)> {
+    let mut tree: Option<&crate::bt::Tree> = None;
+    for (line, entry) in entries {
+        let Entry::Event { event, .. } = entry else {
+            continue;
+        };
+        if let Event::TreeChanged { tree: t, .. } = event {
+            tree = Some(t);
+        }
+        let named = named_nodes(event);
+        if named.is_empty() && !matches!(event, Event::Ticked { .. }) {
+            continue;
+        }
+        let Some(tree) = tree else {
+            return Err((*line, "an event that names nodes before any tree".into()));
+        };
+        if let Event::Ticked { record } = event
+            && record.statuses.len() != tree.capacity()
+        {
+            return Err((
+                *line,
+                format!(
+                    "{} statuses for a tree of {} slots",
+                    record.statuses.len(),
+                    tree.capacity()
+                ),
+            ));
+        }
+        if let Some(id) = named.into_iter().find(|id| !tree.contains(*id)) {
+            return Err((*line, format!("node {id} is not in the tree")));
+        }
+    }
+    Ok(())
+}
+
+/// The nodes `event` names (a tick's halted nodes may be removed ones, and are not).
+fn named_nodes(event: &Event) -> Vec<crate::bt::NodeId> {
+    use crate::session::Proposal;
+    match event {
+        Event::TreeChanged {
+            new_nodes, learned, ..
+        } => new_nodes
+            .iter()
+            .copied()
+            .chain(learned.iter().map(|(id, _)| *id))
+            .collect(),
+        Event::Ticked { record } => record
+            .visited
+            .iter()
+            .chain(&record.completed)
+            .chain(&record.forced)
+            .copied()
+            .chain(record.failures.iter().map(|(id, _)| *id))
+            .collect(),
+        Event::ActionFailed { node, .. } | Event::BreakpointHit { node, .. } => vec![*node],
+        Event::Proposal {
+            proposal: Proposal::Conditions { node, .. },
+            ..
+        } => vec![*node],
+        Event::Forced { forced } => forced.iter().map(|(id, _)| *id).collect(),
+        Event::Breakpoints { nodes, .. } => nodes.clone(),
+        _ => Vec::new(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::session::Event;
 
     fn temp(name: &str) -> PathBuf {
         std::env::temp_dir().join(format!("betr-record-{}-{name}", std::process::id()))
@@ -213,6 +286,33 @@ mod tests {
             .unwrap();
         let e = read(&path).unwrap_err().to_string();
         assert!(e.contains("line 2"), "{e}");
+    }
+
+    #[test]
+    fn an_event_naming_a_node_the_tree_lacks_is_an_error_naming_its_line() {
+        let path = temp("nodes.jsonl");
+        let mut r = Recorder::create(&path, Path::new("s.toml"), "S", None).unwrap();
+        let tree = crate::bt::parse("sequence\n  Sweep!\n").unwrap();
+        r.write(&Entry::Event {
+            ms: 1,
+            event: Event::TreeChanged {
+                tree: std::sync::Arc::new(tree),
+                new_nodes: Vec::new(),
+                learned: Vec::new(),
+                why: "planned".into(),
+            },
+        })
+        .unwrap();
+        r.write(&Entry::Event {
+            ms: 2,
+            event: Event::Breakpoints {
+                nodes: vec![crate::bt::NodeId(7)],
+                on_failure: false,
+            },
+        })
+        .unwrap();
+        let e = read(&path).unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("#7"), "{e}");
     }
 
     #[test]

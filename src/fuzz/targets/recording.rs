@@ -110,7 +110,6 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
         return serde_json::to_string(&header).unwrap_or_default();
     };
     let order = tree.preorder();
-    let any = |rng: &mut Rng| NodeId(rng.below(tree.capacity() + 1) as u32);
     let (node, action) = order
         .iter()
         .find_map(|id| match tree.kind(*id) {
@@ -129,12 +128,6 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
         }),
         _ => None,
     });
-    let statuses = [
-        Status::Idle,
-        Status::Running,
-        Status::Success,
-        Status::Failure,
-    ];
     let mut events = vec![Event::TreeChanged {
         tree: Arc::new(tree.clone()),
         new_nodes: order.clone(),
@@ -149,65 +142,14 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
             author: "model".into(),
         });
     }
+    let near = Near {
+        tree: &tree,
+        node,
+        action: &action,
+        fact: fact.as_ref(),
+    };
     for _ in 0..1 + rng.small(6) {
-        let event = match rng.below(11) {
-            0..=2 => Event::Ticked {
-                record: Arc::new(TickRecord {
-                    tick: rng.below(100) as u64,
-                    root: bt::Outcome::Running,
-                    statuses: (0..tree.capacity())
-                        .map(|_| *rng.pick(&statuses).unwrap_or(&Status::Idle))
-                        .collect(),
-                    visited: (0..rng.small(order.len())).map(|_| any(rng)).collect(),
-                    halted: vec![any(rng)],
-                    failures: vec![(node, "No collision free path found".into())],
-                    completed: vec![],
-                    forced: vec![],
-                }),
-            },
-            3 => Event::ActionFailed {
-                action: action.clone(),
-                node,
-                node_path: tree.path(node).unwrap_or_default(),
-                error: "it failed".into(),
-            },
-            4 => Event::Proposal {
-                proposal: Proposal::Conditions {
-                    action: action.clone(),
-                    node,
-                    conditions: fact.iter().cloned().collect(),
-                },
-                reasoning: Some((0..rng.small(20)).map(|_| random_char(rng)).collect()),
-                author: "model".into(),
-                evidence: Some(Box::new(crate::session::Evidence {
-                    findings: vec![(0..rng.small(20)).map(|_| random_char(rng)).collect()],
-                    objects: vec!["egg".into()],
-                    doubt: None,
-                })),
-            },
-            5 => Event::WorldChanged {
-                facts: fact.iter().cloned().collect(),
-                reset: rng.chance(50),
-            },
-            6 => Event::Forced {
-                forced: vec![(any(rng), bt::Forced::Failure)],
-            },
-            7 => Event::Breakpoints {
-                nodes: vec![any(rng)],
-                on_failure: rng.chance(50),
-            },
-            8 => Event::BreakpointHit {
-                node,
-                node_path: tree.path(node).unwrap_or_default(),
-                tick: 3,
-                reason: BreakReason::Failure,
-            },
-            9 => Event::Usage {
-                totals: UsageTotals::default(),
-            },
-            _ => Event::Success { ticks: 4 },
-        };
-        events.push(event);
+        events.push(random_event(rng, &near));
     }
     let mut lines = vec![serde_json::to_string(&header).unwrap_or_default()];
     for (ms, event) in events.into_iter().enumerate() {
@@ -229,6 +171,86 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
         text.push('\n');
     }
     text
+}
+
+/// What the random events of a recording name: its tree, an action of it and a fact.
+struct Near<'a> {
+    tree: &'a bt::Tree,
+    node: NodeId,
+    action: &'a crate::domain::ActionCall,
+    fact: Option<&'a Condition>,
+}
+
+/// One event about `near`, with random values where the format allows any (node ids
+/// past the tree included).
+fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
+    let statuses = [
+        Status::Idle,
+        Status::Running,
+        Status::Success,
+        Status::Failure,
+    ];
+    let (tree, node) = (near.tree, near.node);
+    let any = |rng: &mut Rng| NodeId(rng.below(tree.capacity() + 1) as u32);
+    let action = near.action;
+    let fact = near.fact;
+    match rng.below(11) {
+        0..=2 => Event::Ticked {
+            record: Arc::new(TickRecord {
+                tick: rng.below(100) as u64,
+                root: bt::Outcome::Running,
+                statuses: (0..tree.capacity())
+                    .map(|_| *rng.pick(&statuses).unwrap_or(&Status::Idle))
+                    .collect(),
+                visited: (0..rng.small(tree.len())).map(|_| any(rng)).collect(),
+                halted: vec![any(rng)],
+                failures: vec![(node, "No collision free path found".into())],
+                completed: vec![],
+                forced: vec![],
+            }),
+        },
+        3 => Event::ActionFailed {
+            action: action.clone(),
+            node,
+            node_path: tree.path(node).unwrap_or_default(),
+            error: "it failed".into(),
+        },
+        4 => Event::Proposal {
+            proposal: Proposal::Conditions {
+                action: action.clone(),
+                node,
+                conditions: fact.into_iter().cloned().collect(),
+            },
+            reasoning: Some((0..rng.small(20)).map(|_| random_char(rng)).collect()),
+            author: "model".into(),
+            evidence: Some(Box::new(crate::session::Evidence {
+                findings: vec![(0..rng.small(20)).map(|_| random_char(rng)).collect()],
+                objects: vec!["egg".into()],
+                doubt: None,
+            })),
+        },
+        5 => Event::WorldChanged {
+            facts: fact.into_iter().cloned().collect(),
+            reset: rng.chance(50),
+        },
+        6 => Event::Forced {
+            forced: vec![(any(rng), bt::Forced::Failure)],
+        },
+        7 => Event::Breakpoints {
+            nodes: vec![any(rng)],
+            on_failure: rng.chance(50),
+        },
+        8 => Event::BreakpointHit {
+            node,
+            node_path: tree.path(node).unwrap_or_default(),
+            tick: 3,
+            reason: BreakReason::Failure,
+        },
+        9 => Event::Usage {
+            totals: UsageTotals::default(),
+        },
+        _ => Event::Success { ticks: 4 },
+    }
 }
 
 impl Target for RecordingTarget {

@@ -6,9 +6,9 @@
 
 use crate::bt::NodeId;
 use crate::domain::{ActionCall, Condition, ValueParam};
-use crate::llm::prompt::{self, Context};
+use crate::llm::prompt::Context;
 use crate::llm::reply::{self, ReplyError};
-use crate::llm::{ChatReply, LanguageModel, Message, OutputConstraint, grammar, schema};
+use crate::llm::{LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
 use super::super::call::ask;

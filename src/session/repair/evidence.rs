@@ -6,8 +6,6 @@
 //! objects, or blames objects while the simulation found others in the way, is doubtful
 //! and never shown as the reason.
 
-use serde::{Deserialize, Serialize};
-
 use crate::domain::{ANY_OBJECT, Atom, Condition, Object};
 
 use super::super::types::{Evidence, Proposal};
