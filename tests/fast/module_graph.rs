@@ -366,7 +366,10 @@ fn session_names(line: &str, depth: usize) -> Vec<String> {
 fn the_session_rooms_depend_one_way() {
     let graph = session_dependencies(&src());
     for room in ["engine", "interpret", "repair", "types"] {
-        assert!(graph.contains_key(room), "no session module {room}: {graph:?}");
+        assert!(
+            graph.contains_key(room),
+            "no session module {room}: {graph:?}"
+        );
     }
     assert!(
         graph["engine"].contains("repair") && graph["engine"].contains("interpret"),
@@ -377,11 +380,24 @@ fn the_session_rooms_depend_one_way() {
         .filter_map(|m| cycle_from(&graph, m))
         .map(|c| c.join(" → "))
         .collect();
-    assert!(cycles.is_empty(), "import cycles inside the session: {cycles:#?}");
+    assert!(
+        cycles.is_empty(),
+        "import cycles inside the session: {cycles:#?}"
+    );
     // The vocabulary is plain data: it names no room of the session.
     let types = &graph["types"];
-    for room in ["engine", "interpret", "repair", "policy", "knowledge", "resolve"] {
-        assert!(!types.contains(room), "session/types.rs imports {room}: {types:?}");
+    for room in [
+        "engine",
+        "interpret",
+        "repair",
+        "policy",
+        "knowledge",
+        "resolve",
+    ] {
+        assert!(
+            !types.contains(room),
+            "session/types.rs imports {room}: {types:?}"
+        );
     }
     // Reading an instruction and repairing a failure are separate jobs.
     assert!(
