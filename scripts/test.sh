@@ -9,7 +9,9 @@
 # The tests need a Rust toolchain, the goal dataset in ../shared, and a few Debian
 # packages that scripts/setup.sh installs when missing. Tests that run the embedded LLM or
 # speech-to-text fetch their models into the cache on first use.
-# Usage: bash scripts/test.sh [fast|slow]   (no argument: the fast tier, then the slow)
+# Usage: bash scripts/test.sh [fast | slow [MODULE...]]
+#   no argument: the fast tier, then the slow; `slow bench_cmd viz_rrd`: those modules of
+#   the slow tier only (a single test: cargo test --test slow -- NAME).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,10 +19,15 @@ tier="${1:-all}"
 case "$tier" in
   fast | slow | all) ;;
   *)
-    echo "usage: bash scripts/test.sh [fast|slow]  (no argument: both, the fast tier first)" >&2
+    echo "usage: bash scripts/test.sh [fast | slow [MODULE...]]  (no argument: both, the fast tier first)" >&2
     exit 2
     ;;
 esac
+[ $# -gt 0 ] && shift
+if [ $# -gt 0 ] && [ "$tier" != slow ]; then
+  echo "error: only the slow tier takes module names" >&2
+  exit 2
+fi
 
 if [ ! -d ../shared/datasets/llm-obtea ]; then
   echo "error: ../shared/datasets/llm-obtea is missing; the tests read the goal dataset from there" >&2
@@ -58,19 +65,40 @@ fast() {
 # venvs, and the tmux suites, the model's threads and the kill tests' timings do not
 # compete with another module's. Every module runs; the failed ones are listed at the end.
 slow() {
-  cargo test --locked --test slow --no-run
+  # Built once; the binary is then run by itself, from the crate root as cargo runs it, so
+  # the modules do not each wait for cargo's lock on the target directory.
+  local bin
+  bin=$(cargo test --locked --test slow --no-run --message-format=json |
+    python3 -c 'import json, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m.get("reason") == "compiler-artifact" and m["target"]["name"] == "slow" and m.get("executable"):
+        print(m["executable"])')
+  if [ ! -x "$bin" ]; then
+    echo "error: cargo built no slow test binary" >&2
+    return 1
+  fi
   local list modules failed=() module names
-  list=$(cargo test --locked --test slow -q -- --list --format terse | sed -n 's/: test$//p')
+  list=$("$bin" --list --format terse | sed -n 's/: test$//p')
   if [ -z "$list" ]; then
     echo "error: the slow test binary lists no tests" >&2
     return 1
   fi
   modules=$(printf '%s\n' "$list" | cut -d: -f1 | sort -u)
+  if [ $# -gt 0 ]; then
+    for module in "$@"; do
+      if ! printf '%s\n' "$modules" | grep -qx "$module"; then
+        echo "error: the slow tier has no module $module; it has: $(echo $modules)" >&2
+        return 2
+      fi
+    done
+    modules="$*"
+  fi
   for module in $modules; do
     mapfile -t names < <(printf '%s\n' "$list" | grep "^${module}::")
     echo "=== slow: $module (${#names[@]} tests)" >&2
     local start=$SECONDS
-    if ! cargo test --locked --test slow -q -- --exact "${names[@]}"; then
+    if ! "$bin" --exact "${names[@]}"; then
       failed+=("$module")
     fi
     echo "=== slow: $module took $((SECONDS - start)) s" >&2
@@ -83,7 +111,7 @@ slow() {
 
 case "$tier" in
   fast) fast ;;
-  slow) slow ;;
+  slow) slow "$@" ;;
   all)
     fast
     slow
