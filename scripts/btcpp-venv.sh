@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs BehaviorTree.CPP's Python bindings (`behaviortreepy` from the package index,
 # bindings of the released C++ library) into a virtual environment under target/, once.
-# tests/btcpp_runs.rs runs the exported trees in it through scripts/btcpp_driver.py.
+# tests/slow/btcpp_runs.rs runs the exported trees in it through scripts/btcpp_driver.py.
 #   bash scripts/btcpp-venv.sh [VENV]     VENV defaults to $CARGO_TARGET_DIR/btcpp-venv
 # Prints the venv's python on success. Safe to run again and from several processes at
 # once: the install runs under a lock and does nothing when the right version is there.

@@ -105,7 +105,7 @@ fn params_records_values_and_the_worlds_verdicts() {
     let dir = tmp("eval-params");
     // For the egg, a first value that breaks it, then a corrected one when the prompt
     // carries the world's complaint; the other scenarios answer from their fixture files.
-    let note = format!("{}: tests/eval_cmds.rs", fixtures::SOURCE);
+    let note = format!("{}: tests/fast/eval_cmds.rs", fixtures::SOURCE);
     let mut replies = vec![
         FixtureReply {
             seed: None,
@@ -176,7 +176,7 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
     // The egg: too much force first; told so, a value still above the limit the world
     // stated (turned away untried), then one too little; a value midway is then tried
     // by betr. The other scenarios answer from their fixture files.
-    let note = format!("{}: tests/eval_sessions.rs", fixtures::SOURCE);
+    let note = format!("{}: tests/fast/eval_sessions.rs", fixtures::SOURCE);
     let reply = |when: &[&str], value: &str| FixtureReply {
         seed: None,
         when: when.iter().map(|w| (*w).to_string()).collect(),

@@ -39,7 +39,7 @@ fn resolvable_scenarios() -> Vec<PathBuf> {
     all.into_iter()
         .filter(|p| is_param(p) || Scenario::load(p).is_ok_and(|s| !s.expected_fix.is_empty()))
         // A failure only the real arms produce needs the robot's description, which the
-        // isolated home these commands run in does not have (tests/cell_arms.rs covers
+        // isolated home these commands run in does not have (tests/slow/cell_arms.rs covers
         // those scenarios in the engine).
         .filter(|p| is_param(p) || !fails_only_with_the_arms(p))
         .collect()

@@ -329,7 +329,7 @@ fn btcpp_ticks_every_scenario_tree_as_betr_does() {
         trees += 1;
     }
     eprintln!("{trees} trees, {ticks} ticks compared, {halts} halts; last ticks: {outcomes:?}");
-    // 31 scenarios with a goal, 19 of them with an expected fix (as tests/interop.rs
+    // 31 scenarios with a goal, 19 of them with an expected fix (as tests/fast/interop.rs
     // counts them).
     assert_eq!(trees, 50, "{outcomes:?}");
     // 24 of the planned trees meet a failure in their scenario's world and 7 succeed (the
