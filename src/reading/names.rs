@@ -6,7 +6,7 @@
 use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
-use super::english::{is_generic, is_phrasing, offers_choice};
+use super::english::{is_generic, is_phrasing};
 use super::kinds::asked_of_every;
 use super::placement::named_in;
 use super::request::Request;
@@ -273,32 +273,6 @@ fn alternatives(goal: &Formula, negated: bool) -> usize {
             inner + if offers { items.len() - 1 } else { 0 }
         }
     }
-}
-
-/// How many choices a request offers: each "or" (and "if not", "otherwise", ...), and each
-/// comma of a list that ends in "or" ("coffee, cake, or tea"). [`Request::new`] reads
-/// them once.
-pub(super) fn choices_offered(request: &str) -> usize {
-    let lower = request.to_lowercase();
-    let mut choices = lower.matches("if not").count();
-    for part in lower.split(['.', ';', ':', '!', '?']) {
-        let words: Vec<&str> = part
-            .split(|c: char| !c.is_alphanumeric() && c != ',')
-            .filter(|w| !w.is_empty())
-            .collect();
-        let mut commas_since_choice = 0;
-        for w in words {
-            let word = w.trim_end_matches(',');
-            if offers_choice(word) {
-                choices += 1 + commas_since_choice;
-                commas_since_choice = 0;
-            }
-            if w.ends_with(',') {
-                commas_since_choice += 1;
-            }
-        }
-    }
-    choices
 }
 
 /// Why `goal` offers more alternatives than `request` does, if it does: "a banana or an

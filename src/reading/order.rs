@@ -9,8 +9,8 @@ use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
 use super::english::TOWARDS;
-use super::placement::PLACE_WITHIN;
 use super::request::Request;
+use super::request::sent::PLACE_WITHIN;
 
 /// The pairs (first, second) the request relates: the first named, then within a few
 /// words a word that sends it, then the second.

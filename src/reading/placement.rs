@@ -4,24 +4,16 @@
 //! robot there) has not put the dessert anywhere. The relating conditions are the scene's
 //! predicates of two arguments whose slots take the item and the place.
 
-use crate::domain::{Atom, Object, Predicate, Vocabulary};
+use crate::domain::{Atom, Object};
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
-use super::english::{MOVING_VERBS, SOURCES, TOWARDS};
-use super::polarity::find_phrase;
-use super::request::{Mention, Request};
-use super::words::{same_word, terms};
-
-/// How far after such a word the place's name may start ("to the third table").
-pub(super) const PLACE_WITHIN: usize = 3;
-
-/// An item the request sends to a place.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sent {
-    pub item: String,
-    pub place: String,
-}
+use super::english::SOURCES;
+use super::request::Request;
+use super::request::asked::find_phrase;
+use super::request::mentions::mentions;
+use super::request::sent::{PLACE_WITHIN, Sent, relating};
+use super::words::terms;
 
 /// The first item the request sends to a place that `goal` has in a condition but never
 /// in one with that place, if any.
@@ -250,87 +242,6 @@ fn placed(f: &Formula, place: &str, relation: &str) -> Formula {
     }
 }
 
-/// The predicates of two arguments that take an item and a place.
-pub(super) fn relating(vocabulary: &Vocabulary) -> Vec<&Predicate> {
-    vocabulary
-        .predicates
-        .iter()
-        .filter(|p| p.arg_types.len() == 2)
-        .collect()
-}
-
-/// The items the request sends to a place, each with its place: an item named before
-/// "to"/"at"/"on" and a place named right after, in one clause, with no verb of the
-/// robot's own moving between them; items named after an earlier place go to the next.
-/// Items and places are the objects the scene's relating predicates take.
-/// [`Request::sent`] keeps them.
-pub(super) fn sent(request: &Request) -> Vec<Sent> {
-    let vocabulary = request.vocabulary;
-    let relating = relating(vocabulary);
-    let fits = |o: &Object, slot: usize| {
-        relating
-            .iter()
-            .any(|p| p.arg_types.get(slot).is_some_and(|t| o.fits(t)))
-    };
-    let items: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 0)).collect();
-    let places: Vec<&Object> = vocabulary.objects.iter().filter(|o| fits(o, 1)).collect();
-    let mut out: Vec<Sent> = Vec::new();
-    for words in &request.clauses {
-        let place_spans = mentions(words, &places, &[]);
-        let covered: Vec<usize> = place_spans
-            .iter()
-            .flat_map(|(at, len, _)| *at..at + len)
-            .collect();
-        let item_spans = mentions(words, &items, &covered);
-        let mut waiting: Vec<String> = Vec::new();
-        let mut sent_unnamed = false;
-        for (at, word) in words.iter().enumerate() {
-            if MOVING_VERBS.iter().any(|m| same_word(m, word)) {
-                waiting.clear();
-                sent_unnamed = false;
-            }
-            if let Some((_, _, item)) = item_spans.iter().find(|(start, _, _)| *start == at)
-                && !waiting.contains(item)
-            {
-                // Items sent somewhere no name says ("coffee to the table by the door")
-                // are not sent to the place of the next item ("and water to table 2");
-                // with no item between ("coffee to me at table 2"), they are.
-                if std::mem::take(&mut sent_unnamed) {
-                    waiting.clear();
-                }
-                waiting.push(item.clone());
-            }
-            if !TOWARDS.contains(&word.as_str()) || waiting.is_empty() {
-                continue;
-            }
-            let place = place_spans
-                .iter()
-                .find(|(start, _, _)| *start > at && *start <= at + PLACE_WITHIN);
-            let Some((start, _, place)) = place else {
-                sent_unnamed = true;
-                continue;
-            };
-            // "In from the cold frame": the place the item comes from; where it goes is
-            // said next.
-            if words[at + 1..*start]
-                .iter()
-                .any(|w| SOURCES.contains(&w.as_str()))
-            {
-                continue;
-            }
-            for item in waiting.drain(..) {
-                if item != *place {
-                    out.push(Sent {
-                        item,
-                        place: place.clone(),
-                    });
-                }
-            }
-        }
-    }
-    out
-}
-
 /// The names of the scene's objects the request says things come from ("from the cold
 /// frame").
 fn sources(request: &Request) -> Vec<String> {
@@ -353,99 +264,6 @@ pub(super) fn named_in(request: &Request, objects: &[&Object]) -> Vec<String> {
         .into_iter()
         .map(|(_, _, name)| name)
         .collect()
-}
-
-/// Where `words` name one of `objects` by its name's words in a row or by what it is
-/// called, the longest name first, skipping the positions in `taken`: (start, length,
-/// object). A name of several words also names its object with the words spread over a
-/// short stretch, in any order ("table 6 by the window" for window table 6), once no
-/// name has them in a row. A name with a word beside it from a longer name of another
-/// object that shares its words ("the other bar", where the other bar counter is another
-/// place than the bar) names neither.
-pub(super) fn mentions(words: &[String], objects: &[&Object], taken: &[usize]) -> Vec<Mention> {
-    let mut phrases: Vec<(Vec<String>, &str)> = objects
-        .iter()
-        .flat_map(|o| {
-            std::iter::once(&o.name)
-                .chain(&o.called)
-                .map(move |p| (terms(p), o.name.as_str()))
-        })
-        .filter(|(t, _)| !t.is_empty())
-        .collect();
-    phrases.sort_by_key(|(t, _)| std::cmp::Reverse(t.len()));
-    let mut used: Vec<usize> = taken.to_vec();
-    let mut out = Vec::new();
-    for spread in [false, true] {
-        for (phrase, name) in &phrases {
-            if spread && phrase.len() < 2 {
-                continue;
-            }
-            let mut start = 0;
-            while start < words.len() {
-                let Some(end) = named_at(words, phrase, start, spread, &used) else {
-                    start += 1;
-                    continue;
-                };
-                let span = start..end;
-                used.extend(span.clone());
-                let beside: Vec<&String> = [span.start.checked_sub(1), Some(span.end)]
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|i| words.get(i))
-                    .collect();
-                let other_longer = phrases.iter().any(|(other, other_name)| {
-                    other_name != name
-                        && other.len() > phrase.len()
-                        && phrase.iter().all(|p| other.contains(p))
-                        && beside.iter().any(|b| other.iter().any(|o| same_word(o, b)))
-                });
-                if !other_longer {
-                    out.push((start, end - start, name.to_string()));
-                }
-                start = end;
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
-/// How many more words a name's words may be spread over than it has.
-const SPREAD: usize = 2;
-
-/// Where a mention of `phrase` starting at `start` ends: its words in a row or, when
-/// `spread`, each of them once within the name's length and [`SPREAD`] words, beginning
-/// with one of them; none of the words on the way in `used`.
-fn named_at(
-    words: &[String],
-    phrase: &[String],
-    start: usize,
-    spread: bool,
-    used: &[usize],
-) -> Option<usize> {
-    if !spread {
-        let end = start + phrase.len();
-        let row = words.get(start..end)?;
-        let fits = phrase.iter().zip(row).all(|(p, w)| same_word(p, w));
-        return (fits && !(start..end).any(|i| used.contains(&i))).then_some(end);
-    }
-    if !phrase.iter().any(|p| same_word(p, &words[start])) {
-        return None;
-    }
-    let mut left: Vec<&String> = phrase.iter().collect();
-    let stretch = words.len().min(start + phrase.len() + SPREAD);
-    for (i, word) in words.iter().enumerate().take(stretch).skip(start) {
-        if used.contains(&i) {
-            return None;
-        }
-        if let Some(k) = left.iter().position(|p| same_word(p, word)) {
-            left.remove(k);
-            if left.is_empty() {
-                return Some(i + 1);
-            }
-        }
-    }
-    None
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
 use super::*;
-use crate::domain::{Object, StateWords};
+use crate::domain::{Object, Predicate, StateWords, Vocabulary};
 
 fn object(name: &str, kind: &str, called: &[&str]) -> Object {
     Object {
@@ -176,22 +176,6 @@ fn the_scenes_own_worked_examples_are_read_the_way_round_they_ask() {
             example.instruction
         );
     });
-}
-
-#[test]
-fn words_that_only_announce_a_number_are_left_out() {
-    assert_eq!(
-        without_numbering("Go to table No. 6 now"),
-        "Go to table 6 now"
-    );
-    assert_eq!(
-        without_numbering("table number one, please"),
-        "table one, please"
-    );
-    assert_eq!(
-        without_numbering("No juice, no. Bar nr 2"),
-        "No juice, no. Bar 2"
-    );
 }
 
 fn with_asked(goal: &str, request: &str) -> Option<String> {

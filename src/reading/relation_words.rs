@@ -8,9 +8,11 @@ use crate::domain::{Atom, Object, Predicate};
 use crate::goal::Formula;
 use crate::goal::rewrite::map_atoms;
 
-use super::placement::{PLACE_WITHIN, Sent, mentions, put_sent, relating};
-use super::polarity::find_phrase;
+use super::placement::put_sent;
 use super::request::Request;
+use super::request::asked::find_phrase;
+use super::request::mentions::mentions;
+use super::request::sent::{PLACE_WITHIN, Sent, relating};
 use super::words::every_term;
 
 /// `goal` with each condition relating two objects by a predicate other than the one the

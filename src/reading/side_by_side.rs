@@ -9,8 +9,9 @@ use crate::goal::Formula;
 use crate::goal::rewrite::undo_each;
 
 use super::english::may_precede_thing;
-use super::placement::{mentions, named_in};
+use super::placement::named_in;
 use super::request::Request;
+use super::request::mentions::mentions;
 
 /// Two things named side by side, one of which the goal leaves out.
 #[derive(Debug, Clone, PartialEq)]

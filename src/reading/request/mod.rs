@@ -3,18 +3,32 @@
 //! (computed on first use, then kept) the scene's objects it mentions, what it asks for
 //! in the scene's words and the kinds it asks for every object of. Every reader of a request takes this value, so no reader
 //! splits the text again.
+//!
+//! What a request is read into is computed here, and the readers import it from here:
+//! its clauses, negation scopes and choices ([`mod@clauses`]), where its words name the
+//! scene's objects ([`mod@mentions`]), what it asks for one way in each negation scope
+//! ([`mod@asked`]), the items it sends to a place ([`mod@sent`]) and the kinds it asks for
+//! every object of ([`mod@every_of_kind`]).
 
 use std::sync::OnceLock;
 
 use crate::domain::{Atom, Object, Vocabulary};
 use crate::scenario::{Convention, Scenario};
 
-use super::kinds::{EveryOfKind, every_of_kind_in};
 use super::lexicon::Lexicon;
-use super::names::choices_offered;
-use super::placement::{Sent, mentions, sent};
-use super::polarity::{Asked, asked_in_sentences, clauses, without_numbering};
 use super::words::{every_term, terms};
+
+pub mod asked;
+pub mod clauses;
+pub mod every_of_kind;
+pub mod mentions;
+pub mod sent;
+
+use asked::{Asked, asked_in_sentences};
+use clauses::{choices_offered, clauses, without_numbering};
+use every_of_kind::{EveryOfKind, every_of_kind_in};
+use mentions::mentions;
+use sent::{Sent, relating, sent};
 
 /// Where a run of words names one of the scene's objects: (first word, how many words,
 /// the object's name).
@@ -137,13 +151,13 @@ impl<'a> Request<'a> {
     }
 
     /// The conditions the request asks for one way in the scene's words
-    /// ([`super::polarity`]).
+    /// ([`mod@asked`]).
     pub(super) fn asked(&self) -> &[Asked] {
         self.asked.get_or_init(|| asked_in_sentences(self))
     }
 
     /// The conditions about one object the request asks for one way in the scene's words,
-    /// each with whether it is asked to hold ([`super::polarity`]: the words the scene
+    /// each with whether it is asked to hold ([`mod@asked`]: the words the scene
     /// lists for the condition and its opposite, turned by the negations before them; "both
     /// rooms" asks it of each).
     pub fn asked_of_one_object(&self) -> Vec<(Atom, bool)> {
@@ -164,7 +178,7 @@ impl<'a> Request<'a> {
     /// relation of an item and a place that puts it there; none in a scene with no such
     /// relation or several (which one a request means is not read here).
     pub fn sent_by_the_relation(&self) -> Vec<Atom> {
-        let relating = super::placement::relating(self.vocabulary);
+        let relating = relating(self.vocabulary);
         let [relation] = relating.as_slice() else {
             return Vec::new();
         };
@@ -175,12 +189,12 @@ impl<'a> Request<'a> {
             .collect()
     }
 
-    /// The items the request sends to a place ([`super::placement`]).
+    /// The items the request sends to a place ([`mod@sent`]).
     pub(super) fn sent(&self) -> &[Sent] {
         self.sent.get_or_init(|| sent(self))
     }
 
-    /// The kinds it asks for every object of ("both vents"; [`super::kinds`]).
+    /// The kinds it asks for every object of ("both vents"; [`mod@every_of_kind`]).
     pub fn every_of_kind(&self) -> &[EveryOfKind] {
         self.every_of_kind
             .get_or_init(|| every_of_kind_in(&self.unnumbered_words, self.vocabulary, self.lexicon))
