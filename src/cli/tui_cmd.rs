@@ -101,29 +101,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // leaves the workbench usable without it and says why.
     let (arrival_report, arrivals) = tokio::sync::mpsc::unbounded_channel();
     let offline = args.offline;
-    let mut wanted_model = None;
-    let model = match llm_cmds::local_model_to_fetch(&settings) {
-        Some(spec) if offline => Err(NoModel::Unavailable(format!(
-            "the model {} is not in the cache and --offline fetches nothing (`betr model fetch` fetches it)",
-            spec.name
-        ))),
-        Some(spec) => {
-            let arriving = Arc::new(ArrivingModel::new(
-                spec.name,
-                true,
-                false,
-                &format!("the model {} is not fetched yet", spec.name),
-            ));
-            wanted_model = Some(super::background_fetch::WantedModel {
-                spec,
-                settings: settings.clone(),
-                ledger: ledger.clone(),
-                arriving: arriving.clone(),
-            });
-            Ok(arriving as Arc<dyn LanguageModel>)
-        }
-        None => ready_model(&settings, &ledger, &var),
-    };
+    let (model, wanted_model) = workbench_model(&settings, &ledger, offline, &var);
     let robot = betr::session::missing_description(&scenario).filter(|_| !offline);
     let background = if robot.is_some() || wanted_model.is_some() {
         Some(super::background_fetch::start(
@@ -224,8 +202,55 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     if let Some(fetch) = background {
         fetch.cancel();
     }
-    let summary = ran?;
-    // Where what the session made went, now the terminal is the shell's again.
+    report_session(&ran?, args, &mut tap);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The workbench's model: one being fetched (it answers once it has arrived, and the
+/// fetch to start is returned), or the configured one ready now, or why there is none.
+fn workbench_model(
+    settings: &betr::llm::config::Settings,
+    ledger: &Ledger,
+    offline: bool,
+    var: &dyn Fn(&str) -> Option<String>,
+) -> (
+    Result<Arc<dyn LanguageModel>, NoModel>,
+    Option<super::background_fetch::WantedModel>,
+) {
+    match llm_cmds::local_model_to_fetch(settings) {
+        Some(spec) if offline => (
+            Err(NoModel::Unavailable(format!(
+                "the model {} is not in the cache and --offline fetches nothing (`betr model fetch` fetches it)",
+                spec.name
+            ))),
+            None,
+        ),
+        Some(spec) => {
+            let arriving = Arc::new(ArrivingModel::new(
+                spec.name,
+                true,
+                false,
+                &format!("the model {} is not fetched yet", spec.name),
+            ));
+            let wanted = super::background_fetch::WantedModel {
+                spec,
+                settings: settings.clone(),
+                ledger: ledger.clone(),
+                arriving: arriving.clone(),
+            };
+            (Ok(arriving as Arc<dyn LanguageModel>), Some(wanted))
+        }
+        None => (ready_model(settings, ledger, var), None),
+    }
+}
+
+/// Where what the session made went, now the terminal is the shell's again; the web
+/// viewer started for the workbench goes with it.
+fn report_session(
+    summary: &betr::tui::Summary,
+    args: &TuiArgs,
+    tap: &mut super::viz_flags::SessionTap,
+) {
     for path in &summary.policies {
         outln!("policy saved: {}", path.display());
     }
@@ -244,12 +269,10 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     if let Some(path) = &args.viz.rrd {
         outln!("3D view (.rrd): {}", path.display());
     }
-    // The web viewer started for the workbench goes with it.
     if let Some(mut server) = tap.viz.as_mut().and_then(betr::viz::Viz::take_web_server) {
         server.stop();
         outln!("3D view: the web viewer was stopped");
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// The configured model when nothing needs fetching: a server's client, or the embedded
