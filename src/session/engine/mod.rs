@@ -343,8 +343,9 @@ impl Engine {
                 | Phase::Proposed(_)),
                 Command::Tick | Command::Run,
             ) => {
-                let message = phase.why_not_ticked();
-                self.notice(message);
+                if let Some(message) = phase.why_not_ticked() {
+                    self.notice(message);
+                }
             }
             (Phase::Reading { .. } | Phase::Choosing { .. }, Command::Run) => self.notice(
                 "not run: the tree is replaced when the instruction is read; step it with a tick meanwhile",

@@ -104,24 +104,23 @@ impl Phase {
         }
     }
 
-    /// Why the tree is not ticked in this phase: ticking a tree that waits for a change
-    /// would only fail again.
-    pub(super) fn why_not_ticked(&self) -> String {
-        let (subject, what) = match self {
-            Phase::Checking { .. } => ("the changed tree", "the verification of the change"),
-            Phase::Violated { .. } => (
-                "the changed tree",
-                "approval of the change that fails verification (approve again, reject, or undo)",
-            ),
-            Phase::Proposed(_) => ("the failure", "approval of the proposal"),
-            Phase::Asking { .. } => ("the failure", "the model's proposal"),
-            _ => return String::new(),
-        };
-        if subject == "the failure" {
-            format!("not ticked: {subject} waits for {what}; the failed tree would only fail again")
-        } else {
-            format!("not ticked: {subject} waits for {what}")
-        }
+    /// Why the tree is not ticked in this phase, if it is not: ticking a tree that waits
+    /// for a change would only fail again.
+    pub(super) fn why_not_ticked(&self) -> Option<String> {
+        const FAILED: &str = "the failed tree would only fail again";
+        Some(match self {
+            Phase::Checking { .. } => {
+                "not ticked: the changed tree waits for the verification of the change".into()
+            }
+            Phase::Violated { .. } => "not ticked: the changed tree waits for approval of the change that fails verification (approve again, reject, or undo)".into(),
+            Phase::Proposed(_) => {
+                format!("not ticked: the failure waits for approval of the proposal; {FAILED}")
+            }
+            Phase::Asking { .. } => {
+                format!("not ticked: the failure waits for the model's proposal; {FAILED}")
+            }
+            _ => return None,
+        })
     }
 }
 
