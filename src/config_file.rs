@@ -25,7 +25,7 @@ pub struct FileConfig {
 
 impl FileConfig {
     pub fn read(path: &Path) -> Result<FileConfig, ConfigFileError> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::store::read_text(path, crate::store::SMALL_FILE_BYTES)
             .map_err(|e| ConfigFileError(format!("cannot read {}: {e}", path.display())))?;
         let file: FileConfig = toml::from_str(&text)
             .map_err(|e| ConfigFileError(format!("{}: {e}", path.display())))?;

@@ -103,7 +103,8 @@ impl std::fmt::Debug for Secret {
     }
 }
 
-/// `text` with every occurrence of `secret` replaced (an empty secret changes nothing).
+/// `text` with every occurrence of `secret` replaced (an empty secret changes nothing),
+/// for what betr writes: messages and logs, never a reply it reads.
 pub fn redact(text: &str, secret: Option<&str>) -> String {
     match secret {
         Some(key) if !key.is_empty() => text.replace(key, "<redacted>"),
@@ -156,8 +157,9 @@ pub async fn read_body(mut response: reqwest::Response, limit: usize) -> Result<
 }
 
 /// `text` safe to show on a terminal: control characters other than newline and tab
-/// (escape sequences, carriage returns, bells) written out as `\u{1b}` instead of
-/// reaching the terminal raw.
+/// (escape sequences, carriage returns, bells) and the marks that reorder text (U+202E
+/// and the other bidirectional controls) written out as `\u{1b}` instead of reaching the
+/// terminal raw.
 pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
     if !text.chars().any(hidden) {
         return std::borrow::Cow::Borrowed(text);
@@ -173,9 +175,11 @@ pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
     std::borrow::Cow::Owned(out)
 }
 
-/// A character a terminal would act on rather than show.
+/// A character a terminal would act on rather than show, or one that makes the text
+/// around it show in another order than it is read (embeddings, overrides, isolates).
 fn hidden(c: char) -> bool {
-    c.is_control() && c != '\n' && c != '\t'
+    (c.is_control() && c != '\n' && c != '\t')
+        || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
 }
 
 /// At most 300 characters of `text`, trimmed and printable; `(empty body)` for nothing.
@@ -234,5 +238,7 @@ mod printable_tests {
             "\\u{1b}[2Jgone\\u{d}back\\u{7}"
         );
         assert!(!excerpt("\u{1b}]0;title\u{7}").contains('\u{1b}'));
+        assert_eq!(printable("abc\u{202e}def"), "abc\\u{202e}def");
+        assert_eq!(printable("tree ├─ ✓ ü"), "tree ├─ ✓ ü");
     }
 }

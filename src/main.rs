@@ -1,5 +1,6 @@
 //! The `betr` command line. Exit status: 0 when the tree succeeds, 1 when it fails in the
-//! world, 2 for bad input (with the reason on stderr).
+//! world, 2 for bad input or a result that could not be written, standard output included
+//! (with the reason on stderr).
 #![forbid(unsafe_code)]
 
 mod cli;
@@ -42,10 +43,19 @@ fn main() -> ExitCode {
             .with_writer(std::io::stderr)
             .init();
     }
-    match cli::run(args) {
+    let code = match cli::run(args) {
         Ok(code) => code,
         Err(e) => {
             cli::out::stderr(format_args!("error: {e:#}\n"));
+            return ExitCode::from(2);
+        }
+    };
+    // What was printed is part of the result: a redirection that could not take it all
+    // is a failed command.
+    match cli::out::finish() {
+        Ok(()) => code,
+        Err(e) => {
+            cli::out::stderr(format_args!("error: {e}\n"));
             ExitCode::from(2)
         }
     }

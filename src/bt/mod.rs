@@ -22,5 +22,10 @@ pub use action::ActionStep;
 pub use render::{ASCII, Glyphs, UNICODE, render};
 pub use status::{Forced, Outcome, Status};
 pub use text::{ParseError, parse, to_text};
+
+/// The deepest nesting a tree read from outside may have (the root at depth 0). Ticking,
+/// verifying and drawing a tree recurse once per level, so a deeper one would overflow the
+/// stack; trees people write and the planner grows are tens of levels deep.
+pub const MAX_DEPTH: usize = 256;
 pub use tick::{ForcedStatuses, Leaves, TickRecord, Ticker};
 pub use tree::{NodeId, NodeKind, Tree, TreeError, path_text};

@@ -88,6 +88,13 @@ pub fn parse(text: &str) -> Result<Tree, ParseError> {
             ));
         }
         let depth = indent / 2;
+        if depth > super::MAX_DEPTH {
+            return Err(err(
+                indent,
+                &format!("at most {} levels of nesting", super::MAX_DEPTH),
+                format!("level {depth}"),
+            ));
+        }
         let kind =
             parse_node(raw, indent).map_err(|(at, expected, found)| err(at, &expected, found))?;
         if tree.is_some() && depth == 0 {

@@ -233,3 +233,24 @@ proptest! {
         prop_assert_eq!(to_text(&back), text);
     }
 }
+
+/// A tree `levels` sequences deep with one condition at the bottom.
+fn nested(levels: usize) -> String {
+    let mut text = String::new();
+    for depth in 0..levels {
+        text.push_str(&"  ".repeat(depth));
+        text.push_str("sequence\n");
+    }
+    text.push_str(&"  ".repeat(levels));
+    text.push_str("Done?\n");
+    text
+}
+
+#[test]
+fn nesting_deeper_than_the_limit_is_refused_at_its_line() {
+    // The condition sits at depth MAX_DEPTH: allowed.
+    assert!(parse(&nested(crate::bt::MAX_DEPTH)).is_ok());
+    let e = parse(&nested(crate::bt::MAX_DEPTH + 1)).unwrap_err();
+    assert_eq!(e.line, crate::bt::MAX_DEPTH + 2);
+    assert!(e.expected.contains("levels of nesting"), "{e:?}");
+}

@@ -61,7 +61,7 @@ pub fn export(
         let tree = Arc::unwrap_or_clone(session.tree()?);
         (path, tree, Vec::new())
     } else {
-        let text = std::fs::read_to_string(source)
+        let text = betr::store::read_text(source, betr::store::TREE_FILE_BYTES)
             .with_context(|| format!("reading tree file {}", source.display()))?;
         let scenario_path = match (scenario_arg, policy::scenario_of(&text)) {
             (Some(s), _) => super::find_scenario(s)?,

@@ -104,12 +104,21 @@ pub fn ensure(name: Option<&str>) -> Result<std::path::PathBuf> {
 }
 
 /// Fetch something into the cache with a progress bar on the terminal, saying first what
-/// and how big, and at the end where it went.
+/// and how big, and at the end where it went; with `--offline` (or `BETR_OFFLINE`),
+/// nothing is fetched and the command fails saying what is missing.
 fn fetch_once(
     description: &str,
     size: u64,
     fetch: impl FnOnce(&mut TerminalProgress) -> Result<std::path::PathBuf, model::FetchError>,
 ) -> Result<std::path::PathBuf> {
+    if super::offline() {
+        anyhow::bail!(
+            "{description} ({:.0} MB) is not in {} and --offline (or BETR_OFFLINE) fetches nothing; \
+             `betr model fetch` fetches it where the network can be reached",
+            size as f64 / 1e6,
+            model::cache_dir().display()
+        );
+    }
     errln!(
         "Fetching {} ({:.0} MB) into {} — once only",
         description,

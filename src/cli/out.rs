@@ -1,17 +1,22 @@
 //! Standard output and error of the commands. A reader that goes away early
 //! (`betr plan S | head -1`) ends the printing, never the command: what is left to print is
 //! dropped, the command finishes its work (saves included) and exits with the status it
-//! would have had. `outln!`, `out!` and `errln!` stand for `println!`, `print!` and
+//! would have had. Any other failure to write standard output (a full disk behind a
+//! redirection) makes the command fail at its end (`finish`), so nobody takes a cut file
+//! for a whole one. `outln!`, `out!` and `errln!` stand for `println!`, `print!` and
 //! `eprintln!`, which panic when the stream is closed.
 
 use std::fmt;
 use std::io::{self, Write};
+use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Set once standard output could not be written: nothing more is tried.
 static STDOUT_GONE: AtomicBool = AtomicBool::new(false);
 /// The same for standard error.
 static STDERR_GONE: AtomicBool = AtomicBool::new(false);
+/// Why standard output could not be written, unless its reader went away.
+static STDOUT_FAILED: OnceLock<String> = OnceLock::new();
 
 /// `println!` that stops printing, quietly, once standard output is closed.
 macro_rules! outln {
@@ -39,41 +44,71 @@ macro_rules! errln {
 
 /// Write to standard output unless it has gone.
 pub fn stdout(args: fmt::Arguments) {
-    put(&STDOUT_GONE, &mut io::stdout().lock(), args);
+    if !STDOUT_GONE.load(Ordering::Relaxed)
+        && let Err(e) = io::stdout().lock().write_all(shown(args).as_bytes())
+    {
+        stdout_failed(&e);
+    }
 }
 
 /// Write to standard error unless it has gone.
 pub fn stderr(args: fmt::Arguments) {
-    put(&STDERR_GONE, &mut io::stderr().lock(), args);
+    if !STDERR_GONE.load(Ordering::Relaxed)
+        && io::stderr()
+            .lock()
+            .write_all(shown(args).as_bytes())
+            .is_err()
+    {
+        // Nowhere left to say it.
+        STDERR_GONE.store(true, Ordering::Relaxed);
+    }
 }
 
-fn put(gone: &AtomicBool, stream: &mut impl Write, args: fmt::Arguments) {
-    if gone.load(Ordering::Relaxed) {
-        return;
-    }
-    if let Err(e) = stream.write_fmt(args) {
-        closed(gone, &e);
+/// What is printed, with the escape sequences and reordering marks that text from outside
+/// (a scenario's names, a model's reply, a file's line in an error) may carry written out,
+/// so they show instead of acting on the terminal. betr's own output has none.
+fn shown(args: fmt::Arguments) -> String {
+    let text = args.to_string();
+    match betr::http_text::printable(&text) {
+        std::borrow::Cow::Borrowed(_) => text,
+        std::borrow::Cow::Owned(safe) => safe,
     }
 }
 
-/// A stream that failed is left alone from now on; anything but a reader that went away
-/// (a full disk behind a redirection) is said in the log.
-fn closed(gone: &AtomicBool, error: &io::Error) {
-    if !gone.swap(true, Ordering::Relaxed) && error.kind() != io::ErrorKind::BrokenPipe {
-        tracing::warn!(%error, "standard output or error cannot be written; printing stops");
+/// Standard output is left alone from now on; a failure other than a reader that went
+/// away is kept for `finish`.
+fn stdout_failed(error: &io::Error) {
+    if !STDOUT_GONE.swap(true, Ordering::Relaxed) && error.kind() != io::ErrorKind::BrokenPipe {
+        tracing::warn!(%error, "standard output cannot be written; printing stops");
+        let _ = STDOUT_FAILED.set(error.to_string());
+    }
+}
+
+/// At the end of a command: what is left of standard output written out, and an error if
+/// any of it could not be written for a reason other than its reader going away.
+pub fn finish() -> Result<(), String> {
+    flush();
+    match STDOUT_FAILED.get() {
+        Some(e) => Err(format!("standard output could not be written: {e}")),
+        None => Ok(()),
     }
 }
 
 /// Standard output as an `io::Write` for code that writes reports: once it has gone,
-/// every write succeeds without writing, so a report's writer never fails the command.
+/// every write succeeds without writing, so a report's writer never stops midway (the
+/// command fails at its end instead, `finish`).
 pub struct Stdout;
 
 impl Write for Stdout {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        // Formatting writes whole `str` pieces, so a piece is text unless it was bytes.
+        let text = String::from_utf8_lossy(buf);
         if !STDOUT_GONE.load(Ordering::Relaxed)
-            && let Err(e) = io::stdout().lock().write_all(buf)
+            && let Err(e) = io::stdout()
+                .lock()
+                .write_all(betr::http_text::printable(&text).as_bytes())
         {
-            closed(&STDOUT_GONE, &e);
+            stdout_failed(&e);
         }
         Ok(buf.len())
     }
@@ -82,7 +117,7 @@ impl Write for Stdout {
         if !STDOUT_GONE.load(Ordering::Relaxed)
             && let Err(e) = io::stdout().lock().flush()
         {
-            closed(&STDOUT_GONE, &e);
+            stdout_failed(&e);
         }
         Ok(())
     }

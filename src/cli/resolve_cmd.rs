@@ -504,9 +504,10 @@ fn print_event_line(event: &Event) {
 
 fn print_usage(model: &Arc<Metered<Box<dyn LanguageModel>>>) {
     let ledger = model.ledger();
-    let log = ledger
-        .log_path()
-        .map(|p| format!("; logged to {}", p.display()))
-        .unwrap_or_default();
+    let log = match (ledger.log_path(), ledger.log_error()) {
+        (Some(p), Some(e)) => format!("; NOT logged to {}: {e}", p.display()),
+        (Some(p), None) => format!("; logged to {}", p.display()),
+        (None, _) => String::new(),
+    };
     outln!("LLM usage: {}{log}", ledger.totals());
 }

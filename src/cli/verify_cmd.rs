@@ -114,7 +114,7 @@ fn load_or_plan(
 ) -> Result<String> {
     Ok(match tree {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
+            let text = betr::store::read_text(path, betr::store::TREE_FILE_BYTES)
                 .with_context(|| format!("reading tree file {}", path.display()))?;
             session.load(path.clone(), false)?;
             origin_of_file(path, TreeFormat::of(path, &text), &text, scenario)

@@ -1,6 +1,7 @@
 //! Minimal disjunctive normal form.
 
 use std::collections::BTreeSet;
+use std::convert::Infallible;
 use std::fmt;
 
 use super::Formula;
@@ -11,6 +12,62 @@ use crate::domain::{Atom, Condition};
 /// Up to this many distinct atoms, [`Formula::to_dnf`] minimises exactly; beyond it, it
 /// only drops contradictory conjunctions, duplicate literals and absorbed conjunctions.
 pub const EXACT_ATOM_LIMIT: usize = 12;
+
+/// The most alternatives (conjunctions of the DNF) a goal from outside may have: its `|`
+/// choices multiply out (`(A | B) & (C | D)` has four), so a line of sixteen either/or
+/// choices has 65,536, each a branch of the tree. A goal with more is refused when it is
+/// read ([`Formula::parse`]).
+pub const MAX_ALTERNATIVES: usize = 1024;
+
+/// A goal whose DNF has more than [`MAX_ALTERNATIVES`] conjunctions.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "more than {limit} alternatives when its '|' choices are multiplied out (betr plans at most {limit})"
+)]
+pub struct TooManyAlternatives {
+    pub limit: usize,
+}
+
+/// How many conjunctions distributing may hold.
+trait Budget {
+    type Error;
+    fn check(&self, conjunctions: usize) -> Result<(), Self::Error>;
+}
+
+/// No bound: for formulas already checked.
+struct Unbounded;
+
+impl Budget for Unbounded {
+    type Error = Infallible;
+    fn check(&self, _: usize) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// At most this many conjunctions after absorption, and (so absorbing stays cheap) at most
+/// sixteen times as many before it.
+struct Alternatives(usize);
+
+impl Budget for Alternatives {
+    type Error = TooManyAlternatives;
+    fn check(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
+        if conjunctions > self.0.saturating_mul(16) {
+            Err(TooManyAlternatives { limit: self.0 })
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl Alternatives {
+    fn check_absorbed(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
+        if conjunctions > self.0 {
+            Err(TooManyAlternatives { limit: self.0 })
+        } else {
+            Ok(())
+        }
+    }
+}
 
 /// A disjunction of conjunctions of literals. `Dnf(vec![])` is false; a DNF with an empty
 /// conjunction, such as `Dnf(vec![vec![]])`, is true.
@@ -41,27 +98,53 @@ impl Formula {
         let atoms = self.atoms_in_order();
         let index = index_of(&atoms);
         let ix = Ix::compile(self, &index);
-        let mut conjunctions = if atoms.len() <= EXACT_ATOM_LIMIT {
+        let conjunctions = if atoms.len() <= EXACT_ATOM_LIMIT {
             exact(&ix, &atoms)
         } else {
-            distribute(&ix, false)
+            match distribute(&ix, false, &Unbounded) {
+                Ok(c) => c,
+                Err(never) => match never {},
+            }
         };
-        for c in &mut conjunctions {
-            c.sort_unstable();
-        }
-        conjunctions.sort();
-        Dnf(conjunctions
-            .into_iter()
-            .map(|c| {
-                c.into_iter()
-                    .map(|(i, negated)| Condition {
-                        atom: atoms[i].clone(),
-                        negated,
-                    })
-                    .collect()
-            })
-            .collect())
+        named(conjunctions, &atoms)
     }
+
+    /// [`Formula::to_dnf`], unless the DNF has more than `limit` conjunctions, found without
+    /// writing them all out (distributing gives up as soon as it holds too many).
+    pub fn to_dnf_within(&self, limit: usize) -> Result<Dnf, TooManyAlternatives> {
+        self.check_alternatives(limit)?;
+        let dnf = self.to_dnf();
+        Alternatives(limit).check_absorbed(dnf.0.len())?;
+        Ok(dnf)
+    }
+
+    /// Whether the formula's conjunctions, distributed and absorbed, number at most
+    /// `limit` (the minimal DNF has at most as many).
+    pub fn check_alternatives(&self, limit: usize) -> Result<(), TooManyAlternatives> {
+        let atoms = self.atoms_in_order();
+        let ix = Ix::compile(self, &index_of(&atoms));
+        let budget = Alternatives(limit);
+        budget.check_absorbed(distribute(&ix, false, &budget)?.len())
+    }
+}
+
+/// Conjunctions of literals by index as conditions on `atoms`, in the canonical order.
+fn named(mut conjunctions: Vec<Vec<Lit>>, atoms: &[Atom]) -> Dnf {
+    for c in &mut conjunctions {
+        c.sort_unstable();
+    }
+    conjunctions.sort();
+    Dnf(conjunctions
+        .into_iter()
+        .map(|c| {
+            c.into_iter()
+                .map(|(i, negated)| Condition {
+                    atom: atoms[i].clone(),
+                    negated,
+                })
+                .collect()
+        })
+        .collect())
 }
 
 fn exact(ix: &Ix, atoms: &[Atom]) -> Vec<Vec<Lit>> {
@@ -84,16 +167,18 @@ fn exact(ix: &Ix, atoms: &[Atom]) -> Vec<Vec<Lit>> {
         .collect()
 }
 
-/// DNF of `ix` (of its negation when `negated`), with each step absorbed.
-fn distribute(ix: &Ix, negated: bool) -> Vec<Vec<Lit>> {
+/// DNF of `ix` (of its negation when `negated`), with each step absorbed; `budget` is
+/// asked at every step whether the conjunctions held so far may grow on.
+fn distribute<B: Budget>(ix: &Ix, negated: bool, budget: &B) -> Result<Vec<Vec<Lit>>, B::Error> {
     match ix {
-        Ix::Var(i) => vec![vec![(*i, negated)]],
-        Ix::Not(x) => distribute(x, !negated),
+        Ix::Var(i) => Ok(vec![vec![(*i, negated)]]),
+        Ix::Not(x) => distribute(x, !negated, budget),
         Ix::And(v) | Ix::Or(v) if matches!(ix, Ix::And(_)) != negated => {
             // A conjunction (or a negated disjunction): the product of the parts.
             let mut acc: Vec<Vec<Lit>> = vec![Vec::new()];
             for part in v {
-                let part = distribute(part, negated);
+                let part = distribute(part, negated, budget)?;
+                budget.check(acc.len().saturating_mul(part.len()))?;
                 let mut next = Vec::with_capacity(acc.len() * part.len());
                 for a in &acc {
                     for b in &part {
@@ -104,9 +189,16 @@ fn distribute(ix: &Ix, negated: bool) -> Vec<Vec<Lit>> {
                 }
                 acc = absorb(next);
             }
-            acc
+            Ok(acc)
         }
-        Ix::And(v) | Ix::Or(v) => absorb(v.iter().flat_map(|x| distribute(x, negated)).collect()),
+        Ix::And(v) | Ix::Or(v) => {
+            let mut all = Vec::new();
+            for x in v {
+                all.extend(distribute(x, negated, budget)?);
+                budget.check(all.len())?;
+            }
+            Ok(absorb(all))
+        }
     }
 }
 
@@ -291,5 +383,38 @@ mod tests {
             };
             assert_eq!(d.eval(&t), f.eval(&t));
         }
+    }
+
+    /// `n` either/or choices joined by `&`: 2^n alternatives.
+    fn choices(n: usize) -> String {
+        (0..n)
+            .map(|i| format!("(A{i} | B{i})"))
+            .collect::<Vec<_>>()
+            .join(" & ")
+    }
+
+    #[test]
+    fn goals_with_too_many_alternatives_are_refused_when_read() {
+        // 2^10 = 1024: the most there may be.
+        let ten = Formula::parse(&choices(10)).unwrap();
+        assert_eq!(ten.to_dnf().0.len(), MAX_ALTERNATIVES);
+        // 2^16: refused (distributing gives up at 2^11, before writing them all out).
+        let e = Formula::parse(&choices(16)).unwrap_err();
+        assert!(e.expected.contains("at most 1024 alternatives"), "{e}");
+        // Repeated choices absorb: not refused however many.
+        let same = vec!["(A | B)"; 40].join(" & ");
+        assert_eq!(dnf(&same), "A | B");
+        // A negation that multiplies out is bounded too.
+        let ors = (0..16)
+            .map(|i| format!("A{i} & B{i}"))
+            .collect::<Vec<_>>()
+            .join(" | ");
+        let f = Formula::parse(&ors).unwrap();
+        assert_eq!(
+            Formula::Not(Box::new(f)).to_dnf_within(MAX_ALTERNATIVES),
+            Err(TooManyAlternatives {
+                limit: MAX_ALTERNATIVES
+            })
+        );
     }
 }

@@ -23,7 +23,7 @@ mod qm;
 pub mod rewrite;
 mod truth;
 
-pub use dnf::{Dnf, EXACT_ATOM_LIMIT};
+pub use dnf::{Dnf, EXACT_ATOM_LIMIT, MAX_ALTERNATIVES, TooManyAlternatives};
 pub use equiv::{EQUIV_ATOM_LIMIT, TooManyAtoms, equivalent, same_dnf};
 pub use formula::Formula;
 

@@ -48,7 +48,15 @@ pub(super) fn parse(text: &str) -> Result<Formula, GoalError> {
     let formula = p.or(After::Start)?;
     p.skip_ws();
     match p.peek() {
-        None => Ok(formula),
+        None => match formula.check_alternatives(super::MAX_ALTERNATIVES) {
+            Ok(()) => Ok(formula),
+            Err(e) => Err(GoalError::new(
+                text,
+                0,
+                format!("a goal of at most {} alternatives", e.limit),
+                "more (its '|' choices multiply out)",
+            )),
+        },
         Some(')') => Err(p.error(
             p.pos,
             "'&', '|' or end of goal (this ')' has no matching '(')",

@@ -15,8 +15,7 @@ use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::action::parse_value;
 use crate::domain::{ActionCall, Atom, Condition, Domain, Value};
 
-/// Deeper nesting than this is refused (the reader recurses).
-const MAX_DEPTH: usize = 256;
+use crate::bt::MAX_DEPTH;
 
 /// Attributes any node may carry that change nothing in betr.
 const IGNORED_ATTRIBUTES: [&str; 2] = ["name", "_description"];

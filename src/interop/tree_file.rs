@@ -64,9 +64,11 @@ pub enum TreeFileError {
 /// Read a tree file and check it against `domain`.
 pub fn load_tree_file(path: &Path, domain: &Domain) -> Result<LoadedTree, TreeFileError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| TreeFileError::Read {
-        path: name.clone(),
-        detail: e.to_string(),
+    let text = crate::store::read_text(path, crate::store::TREE_FILE_BYTES).map_err(|e| {
+        TreeFileError::Read {
+            path: name.clone(),
+            detail: e.to_string(),
+        }
     })?;
     read_tree(&text, TreeFormat::of(path, &text), domain, &name)
 }

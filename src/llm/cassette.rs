@@ -93,13 +93,31 @@ pub struct Recorder<M> {
 }
 
 impl<M: LanguageModel> Recorder<M> {
-    pub fn new(inner: M, path: impl Into<PathBuf>) -> Self {
-        Recorder {
+    /// A recorder appending to `path`, which is opened for appending (made, empty, when
+    /// missing) before any model is asked: a cassette that cannot be written is an error
+    /// now, not after a call that was paid for.
+    pub fn new(inner: M, path: impl Into<PathBuf>) -> Result<Self, LlmError> {
+        let path = path.into();
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| LlmError::Cassette {
+                path: path.display().to_string(),
+                detail: e.to_string(),
+            })?;
+        }
+        std::fs::File::options()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(|e| LlmError::Cassette {
+                path: path.display().to_string(),
+                detail: format!("cannot be written: {e}"),
+            })?;
+        Ok(Recorder {
             inner,
-            path: path.into(),
+            path,
             lock: std::sync::Mutex::new(()),
             known: HashMap::new(),
-        }
+        })
     }
 
     /// A recorder that answers what the cassette already holds for `inner`'s model from
@@ -112,7 +130,7 @@ impl<M: LanguageModel> Recorder<M> {
             path: path.display().to_string(),
             detail,
         };
-        let text = match std::fs::read_to_string(&path) {
+        let text = match crate::store::read_text(&path, crate::store::LOG_FILE_BYTES) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
             Err(e) => return Err(err(e.to_string())),
@@ -125,7 +143,7 @@ impl<M: LanguageModel> Recorder<M> {
             .filter(|e| e.model == model)
             .map(|e| (e.prompt_hash.clone(), e))
             .collect();
-        let mut recorder = Recorder::new(inner, path);
+        let mut recorder = Recorder::new(inner, path)?;
         recorder.known = known;
         Ok(recorder)
     }
@@ -178,9 +196,11 @@ impl Replay {
     /// Read a cassette. `model` selects the recordings of that model; without it, the
     /// cassette must hold exactly one model.
     pub fn open(path: &Path, model: Option<&str>, structured: bool) -> Result<Replay, LlmError> {
-        let text = std::fs::read_to_string(path).map_err(|e| LlmError::Cassette {
-            path: path.display().to_string(),
-            detail: e.to_string(),
+        let text = crate::store::read_text(path, crate::store::LOG_FILE_BYTES).map_err(|e| {
+            LlmError::Cassette {
+                path: path.display().to_string(),
+                detail: e.to_string(),
+            }
         })?;
         Self::from_text(path, &text, model, structured)
     }
@@ -332,7 +352,7 @@ mod tests {
         let _ = std::fs::remove_file(&path);
         let a = ChatRequest::new(vec![Message::user("goal please")]);
         let b = ChatRequest::new(vec![Message::user("other")]);
-        let rec = Recorder::new(Echo, &path);
+        let rec = Recorder::new(Echo, &path).unwrap();
         assert_eq!(block(rec.chat(&a)).unwrap().text, "GOAL PLEASE");
         let replay = Replay::open(&path, None, false).unwrap();
         assert_eq!(replay.model(), "echo-1");
@@ -366,7 +386,7 @@ mod tests {
         let _ = std::fs::remove_file(&path);
         let a = ChatRequest::new(vec![Message::user("goal please")]);
         let b = ChatRequest::new(vec![Message::user("other")]);
-        block(Recorder::new(Echo, &path).chat(&a)).unwrap();
+        block(Recorder::new(Echo, &path).unwrap().chat(&a)).unwrap();
         let live = Recorder::reusing(Counting(Default::default()), &path).unwrap();
         let reused = block(live.chat(&a)).unwrap();
         assert_eq!(

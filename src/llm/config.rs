@@ -372,7 +372,7 @@ impl Settings {
     ) -> Result<Box<dyn LanguageModel>, LlmError> {
         Ok(match &self.cassette {
             Some(path) if self.reuse_cassette => Box::new(Recorder::reusing(live, path)?),
-            Some(path) => Box::new(Recorder::new(live, path)),
+            Some(path) => Box::new(Recorder::new(live, path)?),
             None => Box::new(live),
         })
     }

@@ -2,11 +2,15 @@ use super::*;
 use crate::llm::Message;
 
 fn client(structured: bool) -> OpenAiClient {
+    client_with_key(structured, "sk-secret")
+}
+
+fn client_with_key(structured: bool, key: &str) -> OpenAiClient {
     OpenAiClient::new(OpenAiSettings {
         base_url: "http://127.0.0.1:9/v1/".into(),
         model: "m".into(),
         api_key_env: Some("K".into()),
-        api_key: Some(ApiKey::new("sk-secret")),
+        api_key: Some(ApiKey::new(key)),
         auth_header: AuthHeader::Bearer,
         timeout: Duration::from_secs(1),
         connect_timeout: Duration::from_secs(1),
@@ -66,5 +70,21 @@ fn replies_are_checked() {
     assert_eq!(
         (r.text.as_str(), r.usage.prompt_tokens, r.model.as_str()),
         ("Goal: A", 3, "m")
+    );
+}
+
+/// What the model wrote is read as written, whatever the key: a placeholder key such as
+/// `test` takes no word out of a reply (the key stays out of the messages betr writes).
+#[test]
+fn replies_are_read_as_the_model_wrote_them_whatever_the_key() {
+    let reply = r#"{"choices":[{"message":{"content":"Goal: \"test tube\" in rack & x"}}]}"#;
+    for key in ["test", "x", "sk-secret"] {
+        let c = client_with_key(false, key);
+        let r = c.parse_reply(reply, Duration::ZERO).unwrap();
+        assert_eq!(r.text, r#"Goal: "test tube" in rack & x"#, "key {key:?}");
+    }
+    assert_eq!(
+        client_with_key(false, "test").detail(r#"{"error":{"message":"bad key test"}}"#),
+        "bad key <redacted>"
     );
 }

@@ -97,9 +97,11 @@ impl Templates {
     pub fn from_dir(dir: &Path) -> Result<Templates, PromptError> {
         let read = |name: &str| {
             let path = dir.join(name);
-            std::fs::read_to_string(&path).map_err(|e| PromptError::Read {
-                path: path.display().to_string(),
-                detail: e.to_string(),
+            crate::store::read_text(&path, crate::store::SMALL_FILE_BYTES).map_err(|e| {
+                PromptError::Read {
+                    path: path.display().to_string(),
+                    detail: e.to_string(),
+                }
             })
         };
         Ok(Templates {

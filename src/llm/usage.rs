@@ -105,6 +105,8 @@ pub fn default_log_path() -> Option<PathBuf> {
 pub struct Ledger {
     records: Arc<Mutex<Vec<UsageRecord>>>,
     log: Option<PathBuf>,
+    /// The first error appending to the log gave, if one did.
+    log_error: Arc<Mutex<Option<String>>>,
 }
 
 impl Ledger {
@@ -113,11 +115,17 @@ impl Ledger {
         Ledger {
             records: Arc::default(),
             log,
+            log_error: Arc::default(),
         }
     }
 
     pub fn log_path(&self) -> Option<&Path> {
         self.log.as_deref()
+    }
+
+    /// Why a record could not be appended to the log (the first time one could not).
+    pub fn log_error(&self) -> Option<String> {
+        self.log_error.lock().ok().and_then(|e| e.clone())
     }
 
     pub fn records(&self) -> Vec<UsageRecord> {
@@ -135,6 +143,9 @@ impl Ledger {
             && let Err(e) = append_line(path, &record)
         {
             tracing::warn!(path = %path.display(), error = %e, "cannot append to the usage log");
+            if let Ok(mut first) = self.log_error.lock() {
+                first.get_or_insert_with(|| e.to_string());
+            }
         }
         if let Ok(mut r) = self.records.lock() {
             r.push(record);
@@ -298,6 +309,13 @@ mod tests {
         assert_eq!(totals.calls, 2);
         assert!((totals.price_usd - 3.5).abs() < 1e-9);
         assert_eq!(std::fs::read_to_string(&log).unwrap().lines().count(), 2);
+        assert_eq!(m.ledger().log_error(), None);
+
+        // A log that cannot be written (its directory is a file) is said, not claimed.
+        let blocked = Ledger::new(Some(log.join("u.jsonl")));
+        blocked.add(m.record_for(&replayed));
+        assert!(blocked.log_error().is_some());
+        assert_eq!(blocked.totals().calls, 1, "the call is still counted");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -94,9 +94,11 @@ pub struct Recording {
 /// Read the recording at `path`; a line that is not an entry is an error naming it,
 /// except a partial last line (no newline), which is left out and reported in `cut_at`.
 pub fn read(path: &Path) -> Result<Recording, RecordError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RecordError::Io {
-        path: path.to_path_buf(),
-        source,
+    let text = crate::store::read_text(path, crate::store::LOG_FILE_BYTES).map_err(|source| {
+        RecordError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     parse(path, &text)
 }

@@ -121,11 +121,13 @@ impl GoalTextError {
 
 impl SourceFile {
     pub fn read(path: &Path) -> Result<SourceFile, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-            file: path.to_path_buf(),
-            line: 0,
-            column: 0,
-            message: format!("cannot read scenario file: {e}"),
+        let text = crate::store::read_text(path, crate::store::SMALL_FILE_BYTES).map_err(|e| {
+            ScenarioError {
+                file: path.to_path_buf(),
+                line: 0,
+                column: 0,
+                message: format!("cannot read scenario file: {e}"),
+            }
         })?;
         Ok(SourceFile {
             path: path.to_path_buf(),

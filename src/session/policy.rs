@@ -191,9 +191,11 @@ fn header_value<'t>(text: &'t str, key: &str) -> Option<&'t str> {
 
 /// Read a policy and check its tree against `domain`.
 pub fn load(path: &Path, domain: &Domain) -> Result<Policy, PolicyError> {
-    let text = std::fs::read_to_string(path).map_err(|e| PolicyError::Read {
-        path: path.display().to_string(),
-        detail: e.to_string(),
+    let text = crate::store::read_text(path, crate::store::TREE_FILE_BYTES).map_err(|e| {
+        PolicyError::Read {
+            path: path.display().to_string(),
+            detail: e.to_string(),
+        }
     })?;
     parse(&text, domain).map_err(|error| PolicyError::Invalid {
         path: path.display().to_string(),

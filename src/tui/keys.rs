@@ -401,7 +401,7 @@ impl KeyBindings {
     /// The bindings from `path` when it exists, else the defaults; with the reason a file
     /// was not used.
     pub fn load(path: &Path) -> (KeyBindings, Option<String>) {
-        match std::fs::read_to_string(path) {
+        match crate::store::read_text(path, crate::store::SMALL_FILE_BYTES) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => (KeyBindings::default(), None),
             Err(e) => (
                 KeyBindings::default(),

@@ -183,3 +183,59 @@ fn prompts_and_errors_never_grow_with_a_long_reply() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A tree file nested thousands of levels deep (6 MB of text) is refused when it is read,
+/// naming the line, where `verify` and `repair` used to overflow the stack.
+#[test]
+fn a_tree_nested_too_deep_is_refused_not_a_stack_overflow() {
+    let dir = tmp("bounds-deep-tree");
+    let mut tree = String::new();
+    let levels = 2_400;
+    for depth in 0..levels {
+        tree.push_str(&"  ".repeat(depth));
+        tree.push_str("sequence\n");
+    }
+    tree.push_str(&"  ".repeat(levels));
+    tree.push_str("\"red cube\" on \"blue cube\"?\n");
+    std::fs::write(dir.join("deep.bt"), &tree).unwrap();
+    let scenario = fixtures::root()
+        .join("scenarios/cell/red_on_blue.toml")
+        .to_string_lossy()
+        .into_owned();
+    for args in [
+        vec!["verify", &scenario[..], "--tree", "deep.bt"],
+        vec![
+            "repair",
+            &scenario,
+            "--tree",
+            "deep.bt",
+            "--add",
+            "~\"any object\" on \"blue cube\"",
+        ],
+    ] {
+        let out = betr(&dir, &args);
+        let log = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {log}");
+        assert!(
+            log.contains("deep.bt:") && log.contains("levels of nesting"),
+            "{args:?}: {log}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A scenario that extends a device without end (`/dev/zero`) is read only up to the
+/// limit for a scenario file, and refused naming it, not read until memory runs out.
+#[test]
+fn a_scenario_extending_a_file_without_end_is_refused_at_the_limit() {
+    let dir = tmp("bounds-endless-base");
+    std::fs::write(dir.join("s.toml"), "extends = \"/dev/zero\"\n").unwrap();
+    let out = betr(&dir, &["plan", "s.toml"]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("/dev/zero") && log.contains("larger than 4 MiB"),
+        "{log}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

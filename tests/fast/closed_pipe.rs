@@ -208,3 +208,95 @@ fn a_save_path_that_cannot_be_written_is_refused_before_any_work() {
     assert_eq!(server.received().len(), 0, "no model call");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Standard output on a full disk (`/dev/full` fails every write with "no space"): the
+/// command fails, naming standard output, instead of exiting 0 with an empty file.
+#[test]
+fn output_that_cannot_be_written_fails_the_command() {
+    let s = scenario();
+    let dir = tmp("pipe-full-disk");
+    for args in [
+        vec!["plan", &s[..]],
+        vec!["export", &s, "--format", "btcpp"],
+    ] {
+        let full = std::fs::File::options()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = command(&dir, &args)
+            .stdout(Stdio::from(full))
+            .stderr(Stdio::piped())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}:\n{stderr}");
+        assert!(
+            stderr.contains("standard output could not be written"),
+            "{args:?}:\n{stderr}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `export --out` to a FIFO someone reads: the reader gets the whole tree and the FIFO is
+/// still a FIFO (it was never replaced by a regular file).
+#[test]
+fn an_export_to_a_fifo_is_written_through() {
+    use std::os::unix::fs::FileTypeExt;
+    let s = scenario();
+    let dir = tmp("pipe-fifo");
+    let fifo = dir.join("tree.xml");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read_to_string(fifo).unwrap())
+    };
+    let out = read_whole(
+        &dir,
+        &["export", &s, "--format", "btcpp", "--out", "tree.xml"],
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let xml = reader.join().unwrap();
+    assert!(
+        xml.contains("<root") && xml.trim_end().ends_with("</root>"),
+        "{xml}"
+    );
+    assert!(
+        std::fs::symlink_metadata(&fifo)
+            .unwrap()
+            .file_type()
+            .is_fifo()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Text from outside (here a scenario's name) reaches the terminal with its escape
+/// sequences and reordering marks written out, never raw.
+#[test]
+fn escape_sequences_and_reordering_marks_from_a_scenario_are_written_out() {
+    let dir = tmp("pipe-controls");
+    let base = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    std::fs::write(
+        dir.join("evil.toml"),
+        format!(
+            "extends = {:?}\n[scenario]\nname = \"Evil \\u001b[2J \\u202e eman\"\n",
+            base.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    let out = read_whole(&dir, &["plan", "evil.toml"]);
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{all}");
+    assert!(all.contains("Evil \\u{1b}[2J \\u{202e} eman"), "{all}");
+    assert!(
+        !all.contains('\u{1b}') && !all.contains('\u{202e}'),
+        "{all}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

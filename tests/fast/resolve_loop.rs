@@ -383,3 +383,40 @@ fn every_spread_case_that_fails_is_named() {
     assert!(told.contains("case 2: 2 is even"), "{told}");
     assert!(told.contains("case 4: 4 is even"), "{told}");
 }
+
+/// A cassette that cannot be written is refused before the model is asked: no call is
+/// paid for whose reply could not be kept.
+#[test]
+fn a_cassette_that_cannot_be_written_is_refused_before_any_call() {
+    let dir = tmp("cassette-unwritable");
+    std::fs::write(dir.join("a-file"), "").unwrap();
+    let scenario = fixtures::root().join("scenarios/cafe/sweep.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let base = server.base_url();
+    let out = betr(
+        &dir,
+        &[
+            "resolve",
+            &scenario_s,
+            "--yes",
+            "--base-url",
+            &base,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            KEY_VAR,
+            "--cassette",
+            "a-file/c.jsonl",
+        ],
+    );
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(log.contains("a-file/c.jsonl"), "{log}");
+    assert!(
+        server.received().is_empty(),
+        "{} calls were sent",
+        server.received().len()
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -64,3 +64,35 @@ fn the_goal_dataset_beside_the_repository_is_asked_for_clearly_elsewhere() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Offline (`BETR_OFFLINE=1` or `--offline`), a command that needs the embedded model it
+/// does not have fails saying so, and starts no download.
+#[test]
+fn offline_the_commands_that_read_with_the_embedded_model_fetch_nothing() {
+    let dir = tmp("anywhere-offline");
+    let scenario = support::fixtures::root()
+        .join("scenarios/cell/red_on_blue.toml")
+        .to_string_lossy()
+        .into_owned();
+    for (args, offline) in [
+        (vec!["interpret", &scenario[..]], "1"),
+        (vec!["resolve", &scenario, "--yes"], "1"),
+        (vec!["--offline", "interpret", &scenario], "0"),
+        (vec!["--offline", "model", "fetch"], "0"),
+    ] {
+        let out = support::cli::betr_with(&dir, &args, &[("BETR_OFFLINE", offline)]);
+        let text = support::cli::text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {text}");
+        assert!(
+            text.contains("--offline (or BETR_OFFLINE) fetches nothing"),
+            "{args:?}: {text}"
+        );
+        assert!(!text.contains("Fetching"), "{args:?}: {text}");
+        assert!(
+            !dir.join("cache/betr/models").exists()
+                || support::cli::files_under(&dir.join("cache/betr/models")).is_empty(),
+            "{args:?} left files in the cache"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

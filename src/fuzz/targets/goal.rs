@@ -3,7 +3,7 @@
 //!
 //! Properties: a parsed formula prints and reads back to the same formula (and, when it
 //! has few atoms, an equivalent one with the same minimal DNF, whose formula is equivalent
-//! too); an error's byte offset lies in the text on a character boundary and its column
+//! too, of at most `MAX_ALTERNATIVES` conjunctions); an error's byte offset lies in the text on a character boundary and its column
 //! counts the characters before it; `parse_goal` agrees with `Formula::parse` and accepts
 //! only atoms of the vocabulary; a parsed condition prints and reads back the same.
 
@@ -15,7 +15,7 @@ use super::{
 };
 use crate::domain::{Atom, Condition};
 use crate::fuzz::Corpus;
-use crate::goal::{Formula, equivalent, same_dnf};
+use crate::goal::{Formula, MAX_ALTERNATIVES, equivalent, same_dnf};
 use crate::scenario::{GoalTextError, Scenario};
 
 /// Formulas with more atoms are not compared by truth table (it doubles per atom).
@@ -77,6 +77,11 @@ impl GoalTarget {
                         same_dnf(&f, &dnf.to_formula()),
                         "a goal's minimal DNF is its own minimal DNF",
                         || format!("{printed} has the DNF {dnf}"),
+                    )?;
+                    ensure(
+                        dnf.0.len() <= MAX_ALTERNATIVES,
+                        "a goal read has at most MAX_ALTERNATIVES alternatives",
+                        || format!("{printed} has {} alternatives", dnf.0.len()),
                     )?;
                 }
                 Ok(())
@@ -176,6 +181,17 @@ impl Target for GoalTarget {
             };
             let inner = random_formula(rng, &self.atoms, 2).to_string();
             return format!("{}{inner}{}", open.repeat(depth), close.repeat(depth)).into_bytes();
+        }
+        if !self.atoms.is_empty() && rng.chance(10) {
+            // Either/or choices joined by '&', around the limit of alternatives (2^10):
+            // their DNF doubles with each one.
+            let choices: Vec<String> = (0..rng.between(8, 24))
+                .map(|_| {
+                    let mut pick = || self.atoms[rng.below(self.atoms.len())].to_string();
+                    format!("({} | {})", pick(), pick())
+                })
+                .collect();
+            return choices.join(" & ").into_bytes();
         }
         let depth = rng.small(6);
         let f = random_formula(rng, &self.atoms, depth);

@@ -168,6 +168,14 @@ impl Target for ScenarioTarget {
             };
             return format!("x = {}1{}\n", open.repeat(depth), close.repeat(depth)).into_bytes();
         }
+        if rng.chance(2) {
+            // A base without end, or one that is not text: read only up to the limit.
+            let base = rng
+                .pick(&["/dev/zero", "/dev/urandom"])
+                .copied()
+                .unwrap_or("/dev/zero");
+            return format!("extends = {base:?}\n[scenario]\nname = \"x\"\n").into_bytes();
+        }
         let Some((text, atoms)) = rng.pick(&self.scenes) else {
             return Vec::new();
         };

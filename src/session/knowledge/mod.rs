@@ -159,7 +159,7 @@ impl Knowledge {
 
     /// Read the file; a missing file is no knowledge yet.
     pub fn open(path: &Path) -> Result<Knowledge, KnowledgeError> {
-        let text = match std::fs::read_to_string(path) {
+        let text = match crate::store::read_text(path, crate::store::SMALL_FILE_BYTES) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 return Ok(Knowledge {
