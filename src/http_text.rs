@@ -1,9 +1,22 @@
 //! Text from HTTP servers made safe to show: the error message an OpenAI-style server
 //! sends, shortened, with a secret removed; and the secret itself, an API key that never
 //! prints. Shared by the chat and the transcription clients (which otherwise know nothing
-//! of each other).
+//! of each other). Every secret made is also kept out of what betr writes — files, logs,
+//! the command line's output — by [`without_secrets`], while what betr reads (a model's
+//! reply) is left as it came.
+
+use std::borrow::Cow;
+use std::sync::RwLock;
 
 use serde_json::Value as Json;
+
+/// Secrets shorter than this are placeholders (`x`, `test`, for a server that checks
+/// nothing), and taking them out of what betr writes would take letters out of its
+/// words and JSON: they are kept out of messages only ([`redact`]).
+pub const SHORTEST_SECRET: usize = 8;
+
+/// The secrets of this process, kept out of everything it writes.
+static SECRETS: RwLock<Vec<String>> = RwLock::new(Vec::new());
 
 /// An API key: shown as `<redacted>` by `Debug`, read only where it is sent.
 #[derive(Clone)]
@@ -11,7 +24,14 @@ pub struct Secret(String);
 
 impl Secret {
     pub fn new(key: impl Into<String>) -> Self {
-        Secret(key.into())
+        let key = key.into();
+        if key.chars().count() >= SHORTEST_SECRET
+            && let Ok(mut secrets) = SECRETS.write()
+            && !secrets.contains(&key)
+        {
+            secrets.push(key.clone());
+        }
+        Secret(key)
     }
 
     /// The key itself, for the authorization header and for removing it from texts.
@@ -109,6 +129,40 @@ pub fn redact(text: &str, secret: Option<&str>) -> String {
     match secret {
         Some(key) if !key.is_empty() => text.replace(key, "<redacted>"),
         _ => text.to_string(),
+    }
+}
+
+/// `text` with every secret this process made (of at least [`SHORTEST_SECRET`]
+/// characters) replaced: for what betr writes to files, logs and the terminal.
+pub fn without_secrets(text: &str) -> Cow<'_, str> {
+    let Ok(secrets) = SECRETS.read() else {
+        return Cow::Borrowed(text);
+    };
+    if !secrets.iter().any(|k| text.contains(k.as_str())) {
+        return Cow::Borrowed(text);
+    }
+    let mut out = text.to_string();
+    for key in secrets.iter() {
+        out = out.replace(key.as_str(), "<redacted>");
+    }
+    Cow::Owned(out)
+}
+
+/// A writer that keeps the process's secrets out of what it writes (the log's). Each
+/// write is taken as text on its own: the log writes an event in one piece.
+pub struct WithoutSecrets<W>(pub W);
+
+impl<W: std::io::Write> std::io::Write for WithoutSecrets<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        match std::str::from_utf8(buf).map(without_secrets) {
+            Ok(Cow::Owned(text)) => self.0.write_all(text.as_bytes())?,
+            _ => self.0.write_all(buf)?,
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
     }
 }
 
@@ -239,6 +293,17 @@ mod printable_tests {
         );
         assert!(!excerpt("\u{1b}]0;title\u{7}").contains('\u{1b}'));
         assert_eq!(printable("abc\u{202e}def"), "abc\\u{202e}def");
+
+        // What betr writes never carries a secret it made; a placeholder key is no secret.
+        let _key = Secret::new("sk-printable-test-key");
+        let _placeholder = Secret::new("test");
+        assert_eq!(
+            without_secrets("key sk-printable-test-key, test tube"),
+            "key <redacted>, test tube"
+        );
+        let mut log = WithoutSecrets(Vec::new());
+        std::io::Write::write_all(&mut log, b"sent sk-printable-test-key").unwrap();
+        assert_eq!(log.0, b"sent <redacted>");
         assert_eq!(printable("tree ├─ ✓ ü"), "tree ├─ ✓ ü");
     }
 }

@@ -7,6 +7,7 @@ mod cli;
 
 use std::process::ExitCode;
 
+use betr::http_text::WithoutSecrets;
 use clap::Parser;
 
 fn main() -> ExitCode {
@@ -32,7 +33,9 @@ fn main() -> ExitCode {
             .with_env_filter(filter)
             .with_ansi(false);
         match file {
-            Some(f) => builder.with_writer(std::sync::Mutex::new(f)).init(),
+            Some(f) => builder
+                .with_writer(std::sync::Mutex::new(WithoutSecrets(f)))
+                .init(),
             None => builder.with_writer(std::io::sink).init(),
         }
     } else {
@@ -40,7 +43,7 @@ fn main() -> ExitCode {
         tracing_subscriber::fmt()
             .with_env_filter(filter)
             .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
-            .with_writer(std::io::stderr)
+            .with_writer(|| WithoutSecrets(std::io::stderr()))
             .init();
     }
     let code = match cli::run(args) {

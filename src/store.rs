@@ -59,13 +59,19 @@ fn file_name(path: &Path) -> String {
         .unwrap_or_else(|| "betr".into())
 }
 
-/// Write `bytes` to `path` so that no reader sees half of them. A regular file, or a path
+/// Write `bytes` to `path` so that no reader sees half of them (and no secret betr holds,
+/// `http_text::without_secrets`). A regular file, or a path
 /// where nothing is yet, is replaced atomically: after a crash it holds either its old
 /// content or the new one, never a mix or nothing. A symbolic link is followed, and what it
 /// points to is written by the same rules (the link stays). A device, FIFO or socket
 /// (`/dev/null`, a pipe someone reads) is written through, never replaced. A directory is
 /// refused.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let text = std::str::from_utf8(bytes).map(crate::http_text::without_secrets);
+    let bytes = match &text {
+        Ok(text) => text.as_bytes(),
+        Err(_) => bytes,
+    };
     let target = follow_links(path)?;
     match fs::metadata(&target) {
         Ok(m) if m.is_dir() => Err(std::io::Error::new(
@@ -229,6 +235,7 @@ pub fn append_line(path: &Path, line: &str) -> std::io::Result<()> {
         );
         file.set_len(whole)?;
     }
+    let line = crate::http_text::without_secrets(line);
     let mut bytes = Vec::with_capacity(line.len() + 1);
     bytes.extend_from_slice(line.as_bytes());
     bytes.push(b'\n');

@@ -66,13 +66,11 @@ pub fn stderr(args: fmt::Arguments) {
 
 /// What is printed, with the escape sequences and reordering marks that text from outside
 /// (a scenario's names, a model's reply, a file's line in an error) may carry written out,
-/// so they show instead of acting on the terminal. betr's own output has none.
+/// so they show instead of acting on the terminal (betr's own output has none), and
+/// without the secrets betr holds.
 fn shown(args: fmt::Arguments) -> String {
     let text = args.to_string();
-    match betr::http_text::printable(&text) {
-        std::borrow::Cow::Borrowed(_) => text,
-        std::borrow::Cow::Owned(safe) => safe,
-    }
+    betr::http_text::printable(&betr::http_text::without_secrets(&text)).into_owned()
 }
 
 /// Standard output is left alone from now on; a failure other than a reader that went
@@ -104,9 +102,9 @@ impl Write for Stdout {
         // Formatting writes whole `str` pieces, so a piece is text unless it was bytes.
         let text = String::from_utf8_lossy(buf);
         if !STDOUT_GONE.load(Ordering::Relaxed)
-            && let Err(e) = io::stdout()
-                .lock()
-                .write_all(betr::http_text::printable(&text).as_bytes())
+            && let Err(e) = io::stdout().lock().write_all(
+                betr::http_text::printable(&betr::http_text::without_secrets(&text)).as_bytes(),
+            )
         {
             stdout_failed(&e);
         }

@@ -63,11 +63,12 @@ impl Recorder {
     }
 
     fn line(&mut self, value: &impl serde::Serialize) -> Result<(), RecordError> {
-        let mut text = serde_json::to_string(value).map_err(|e| RecordError::Line {
+        let json = serde_json::to_string(value).map_err(|e| RecordError::Line {
             path: self.path.clone(),
             line: 0,
             reason: format!("cannot be written as JSON: {e}"),
         })?;
+        let mut text = crate::http_text::without_secrets(&json).into_owned();
         text.push('\n');
         // One write per entry: a crash leaves whole entries and at most one partial line.
         self.file

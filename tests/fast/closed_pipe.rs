@@ -285,7 +285,8 @@ fn escape_sequences_and_reordering_marks_from_a_scenario_are_written_out() {
     std::fs::write(
         dir.join("evil.toml"),
         format!(
-            "extends = {:?}\n[scenario]\nname = \"Evil \\u001b[2J \\u202e eman\"\n",
+            "extends = {:?}\n[scenario]\nname = \"Evil \\u001b[2J \\u202e eman\"\n\
+             goal = '\"red cube\" on \"blue cube\"'\n",
             base.to_string_lossy()
         ),
     )
