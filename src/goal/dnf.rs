@@ -28,10 +28,12 @@ pub struct TooManyAlternatives {
     pub limit: usize,
 }
 
-/// How many conjunctions distributing may hold.
+/// How many conjunctions distributing may hold: after each step is absorbed, and (so that
+/// absorbing, which compares each conjunction with those kept, stays cheap) before.
 trait Budget {
     type Error;
-    fn check(&self, conjunctions: usize) -> Result<(), Self::Error>;
+    fn absorbed(&self, conjunctions: usize) -> Result<(), Self::Error>;
+    fn raw(&self, conjunctions: usize) -> Result<(), Self::Error>;
 }
 
 /// No bound: for formulas already checked.
@@ -39,19 +41,20 @@ struct Unbounded;
 
 impl Budget for Unbounded {
     type Error = Infallible;
-    fn check(&self, _: usize) -> Result<(), Infallible> {
+    fn absorbed(&self, _: usize) -> Result<(), Infallible> {
+        Ok(())
+    }
+    fn raw(&self, _: usize) -> Result<(), Infallible> {
         Ok(())
     }
 }
 
-/// At most this many conjunctions after absorption, and (so absorbing stays cheap) at most
-/// sixteen times as many before it.
+/// At most this many conjunctions after each absorbed step, and four times as many before.
 struct Alternatives(usize);
 
-impl Budget for Alternatives {
-    type Error = TooManyAlternatives;
-    fn check(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
-        if conjunctions > self.0.saturating_mul(16) {
+impl Alternatives {
+    fn within(&self, conjunctions: usize, limit: usize) -> Result<(), TooManyAlternatives> {
+        if conjunctions > limit {
             Err(TooManyAlternatives { limit: self.0 })
         } else {
             Ok(())
@@ -59,13 +62,13 @@ impl Budget for Alternatives {
     }
 }
 
-impl Alternatives {
-    fn check_absorbed(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
-        if conjunctions > self.0 {
-            Err(TooManyAlternatives { limit: self.0 })
-        } else {
-            Ok(())
-        }
+impl Budget for Alternatives {
+    type Error = TooManyAlternatives;
+    fn absorbed(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
+        self.within(conjunctions, self.0)
+    }
+    fn raw(&self, conjunctions: usize) -> Result<(), TooManyAlternatives> {
+        self.within(conjunctions, self.0.saturating_mul(4))
     }
 }
 
@@ -114,7 +117,7 @@ impl Formula {
     pub fn to_dnf_within(&self, limit: usize) -> Result<Dnf, TooManyAlternatives> {
         self.check_alternatives(limit)?;
         let dnf = self.to_dnf();
-        Alternatives(limit).check_absorbed(dnf.0.len())?;
+        Alternatives(limit).absorbed(dnf.0.len())?;
         Ok(dnf)
     }
 
@@ -123,8 +126,7 @@ impl Formula {
     pub fn check_alternatives(&self, limit: usize) -> Result<(), TooManyAlternatives> {
         let atoms = self.atoms_in_order();
         let ix = Ix::compile(self, &index_of(&atoms));
-        let budget = Alternatives(limit);
-        budget.check_absorbed(distribute(&ix, false, &budget)?.len())
+        distribute(&ix, false, &Alternatives(limit)).map(drop)
     }
 }
 
@@ -178,7 +180,7 @@ fn distribute<B: Budget>(ix: &Ix, negated: bool, budget: &B) -> Result<Vec<Vec<L
             let mut acc: Vec<Vec<Lit>> = vec![Vec::new()];
             for part in v {
                 let part = distribute(part, negated, budget)?;
-                budget.check(acc.len().saturating_mul(part.len()))?;
+                budget.raw(acc.len().saturating_mul(part.len()))?;
                 let mut next = Vec::with_capacity(acc.len() * part.len());
                 for a in &acc {
                     for b in &part {
@@ -188,6 +190,7 @@ fn distribute<B: Budget>(ix: &Ix, negated: bool, budget: &B) -> Result<Vec<Vec<L
                     }
                 }
                 acc = absorb(next);
+                budget.absorbed(acc.len())?;
             }
             Ok(acc)
         }
@@ -195,9 +198,11 @@ fn distribute<B: Budget>(ix: &Ix, negated: bool, budget: &B) -> Result<Vec<Vec<L
             let mut all = Vec::new();
             for x in v {
                 all.extend(distribute(x, negated, budget)?);
-                budget.check(all.len())?;
+                budget.raw(all.len())?;
             }
-            Ok(absorb(all))
+            let all = absorb(all);
+            budget.absorbed(all.len())?;
+            Ok(all)
         }
     }
 }

@@ -1,9 +1,9 @@
 //! The resolve loop, headless, as a client of the session [`Engine`]: submit the
 //! instruction (the model reads it as a goal), let the engine plan, run the tree in the
 //! execution world; when an action fails the engine asks the model for the missing
-//! preconditions (or parameter value), this loop asks `approve` and sends Approve or
-//! Reject, and runs again after each change, until the tree succeeds, the rounds run out,
-//! or a proposal is rejected.
+//! preconditions (or parameter value), this loop asks `approve` and sends Approve (or
+//! stops at a "no"), and runs again after each change, until the tree succeeds, the
+//! rounds run out, or a proposal is rejected.
 //!
 //! Every event of the engine goes to `emit`; the loop never prints. A proposal that does
 //! not change the failure is reported and undone by the engine, so the tree only ever
@@ -128,13 +128,15 @@ pub async fn resolve_with_scenes(
             Event::Proposal {
                 proposal, author, ..
             } => {
-                let yes = approve(&proposal);
+                if !approve(&proposal) {
+                    // The loop ends at a "no" here, before the engine would put the
+                    // question to the model again (as the workbench does after a
+                    // rejection): no call is sent that nobody will read.
+                    emit(&Event::Rejected);
+                    break Ending::Rejected;
+                }
                 offered = Some((proposal.clone(), author.clone()));
-                engine.send(if yes {
-                    Command::Approve
-                } else {
-                    Command::Reject
-                });
+                engine.send(Command::Approve);
             }
             Event::Repaired { .. } => {
                 repairs += 1;

@@ -239,3 +239,41 @@ fn a_scenario_extending_a_file_without_end_is_refused_at_the_limit() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A goal of twelve either/or choices (4,096 alternatives once multiplied out) is refused
+/// when read, naming the limit, instead of planning for minutes; repeated choices absorb
+/// and are planned.
+#[test]
+fn a_goal_with_too_many_alternatives_is_refused_when_read() {
+    let dir = tmp("bounds-alternatives");
+    let scenario = fixtures::root()
+        .join("scenarios/cafe/cafe.toml")
+        .to_string_lossy()
+        .into_owned();
+    let same = vec!["(On_Chips_Table1 | On_Milk_Table1)"; 16].join(" & ");
+    let out = betr(&dir, &["plan", &scenario, "--goal", &same]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let places = [
+        "Table1",
+        "Table2",
+        "Table3",
+        "WindowTable4",
+        "WindowTable5",
+        "WindowTable6",
+        "QuietTable7",
+        "QuietTable8",
+        "QuietTable9",
+        "ReadingNook",
+        "Bar",
+        "Bar2",
+    ];
+    let different: Vec<String> = places
+        .iter()
+        .map(|p| format!("(On_Chips_{p} | On_Milk_{p})"))
+        .collect();
+    let out = betr(&dir, &["plan", &scenario, "--goal", &different.join(" & ")]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(log.contains("at most 1024 alternatives"), "{log}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -420,3 +420,31 @@ fn a_cassette_that_cannot_be_written_is_refused_before_any_call() {
     );
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A person who answers "no" to the proposal ends the loop: the model is not asked again
+/// (the one question about the failure is the last call the server sees).
+#[test]
+fn a_rejected_proposal_ends_the_loop_without_another_call() {
+    use std::io::Write;
+    let dir = tmp("reject-no-call");
+    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let base = server.base_url();
+    let mut args = vec!["resolve", &scenario_s[..], "--stated-goal"];
+    args.extend(support::cli::openai_flags(&base));
+    let mut child = support::cli::command(&dir, &args)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(b"n\n").unwrap();
+    let out = child.wait_with_output().unwrap();
+    let log = text(&out);
+    assert!(log.contains("Not approved; stopping."), "{log}");
+    assert_eq!(out.status.code(), Some(1), "{log}");
+    // The stated goal needs no reading: the only call is the question about the failure.
+    assert_eq!(server.received().len(), 1, "{log}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -182,10 +182,10 @@ impl Target for GoalTarget {
             let inner = random_formula(rng, &self.atoms, 2).to_string();
             return format!("{}{inner}{}", open.repeat(depth), close.repeat(depth)).into_bytes();
         }
-        if !self.atoms.is_empty() && rng.chance(10) {
+        if !self.atoms.is_empty() && rng.chance(4) {
             // Either/or choices joined by '&', around the limit of alternatives (2^10):
             // their DNF doubles with each one.
-            let choices: Vec<String> = (0..rng.between(8, 24))
+            let choices: Vec<String> = (0..rng.between(8, 16))
                 .map(|_| {
                     let mut pick = || self.atoms[rng.below(self.atoms.len())].to_string();
                     format!("({} | {})", pick(), pick())
