@@ -29,7 +29,11 @@ fn fetch_command(dir: &Path, bin: &Path, cache: &Path) -> std::process::Command 
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    command.env("PATH", path).env("BETR_MODEL_DIR", cache);
+    // A fetch asked for by name fetches (`command` runs offline otherwise).
+    command
+        .env("PATH", path)
+        .env("BETR_MODEL_DIR", cache)
+        .env("BETR_OFFLINE", "0");
     command
 }
 

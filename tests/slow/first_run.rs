@@ -352,6 +352,7 @@ fn model_fetch_robot_installs_the_description_and_refuses_an_unknown_name() {
         ("BETR_MODEL_DIR", cache.to_str().unwrap()),
         ("PIP_CACHE_DIR", pip_cache.to_str().unwrap()),
         ("PIP_DISABLE_PIP_VERSION_CHECK", "1"),
+        ("BETR_OFFLINE", "0"),
     ];
     let unknown = support::cli::betr_with(&dir, &["model", "fetch", "--robot", "nao"], &env);
     assert_eq!(
