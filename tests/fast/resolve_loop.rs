@@ -394,22 +394,9 @@ fn a_cassette_that_cannot_be_written_is_refused_before_any_call() {
     let scenario_s = scenario.to_string_lossy().to_string();
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let base = server.base_url();
-    let out = betr(
-        &dir,
-        &[
-            "resolve",
-            &scenario_s,
-            "--yes",
-            "--base-url",
-            &base,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
-            "--cassette",
-            "a-file/c.jsonl",
-        ],
-    );
+    let mut args = resolve_yes(&scenario_s, &base);
+    args.extend(["--cassette", "a-file/c.jsonl"]);
+    let out = betr(&dir, &args);
     let log = text(&out);
     assert_eq!(out.status.code(), Some(2), "{log}");
     assert!(log.contains("a-file/c.jsonl"), "{log}");
