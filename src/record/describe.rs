@@ -18,6 +18,7 @@ pub fn describe(event: &Event) -> Vec<String> {
             goal,
             reasoning,
             matches_expected,
+            first_answer,
             ..
         } => {
             let check = match matches_expected {
@@ -30,6 +31,12 @@ pub fn describe(event: &Event) -> Vec<String> {
                 .map(|r| format!("Reasoning: {r}"))
                 .collect();
             lines.push(format!("Goal: {goal}{check}"));
+            if let Some(first) = first_answer {
+                lines.push(format!(
+                    "  (the model answered {first} first; this goal is the one the \
+                     request's words and the checks kept)"
+                ));
+            }
             lines
         }
         Event::Proposal {
@@ -225,6 +232,7 @@ mod tests {
             reasoning: Some("because".into()),
             matches_expected: Some(true),
             author: "model".into(),
+            first_answer: None,
         };
         assert_eq!(
             describe(&event),

@@ -273,6 +273,7 @@ impl Decoder {
                     .map_err(|e| refused(format!("the goal {goal:?}: {e}")))?,
                 reasoning: reasoning.clone(),
                 matches_expected: *matches_expected,
+                first_answer: None,
             },
             Recorded::ActionFailed {
                 action,

@@ -337,6 +337,11 @@ pub enum Event {
         /// Where the goal came from: `model` (the reply's attribution says which), a
         /// person, a policy file, the scenario file.
         author: String,
+        /// The model's first answer when the goal kept is another one (a relation it had
+        /// the other way round turned back, a part no word asks for taken out, another
+        /// candidate voted for): said, so that no change to what the model wrote is silent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        first_answer: Option<Formula>,
     },
     /// The instruction has more than one reading that would make the robot do different
     /// things, or one the checks doubt (`doubt`, why): the person chooses one

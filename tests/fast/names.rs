@@ -169,6 +169,11 @@ fn a_goal_with_its_objects_the_other_way_round_is_turned_round_before_it_runs() 
         !log.contains("Goal: \"green cube\" on \"blue cube\""),
         "the reversed goal is never worked on:\n{log}"
     );
+    // ... and the person is told it was turned round.
+    assert!(
+        log.contains("the model answered \"green cube\" on \"blue cube\" first"),
+        "{log}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -140,6 +140,7 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
             reasoning: Some("because".into()),
             matches_expected: Some(true),
             author: "model".into(),
+            first_answer: None,
         });
     }
     let near = Near {

@@ -47,6 +47,7 @@ impl Engine {
             reasoning: None,
             matches_expected,
             author: author.to_string(),
+            first_answer: None,
         });
         self.task.goal = Some(Goal {
             formula: goal,
@@ -161,6 +162,7 @@ impl Engine {
             reasoning: None,
             matches_expected: None,
             author: format!("policy {}", path.display()),
+            first_answer: None,
         });
         Some(goal)
     }

@@ -122,9 +122,15 @@ pub(super) fn example_pool<'a>(
         .unwrap_or(&scenario.examples)
 }
 
-/// Tell the front end the goal chosen, and the doubt raised about it.
+/// Tell the front end the goal chosen (with the model's first answer when it was another),
+/// and the doubt raised about it.
 fn announce(scenario: &Scenario, found: &Interpretation, emit: &mut (dyn FnMut(&Event) + Send)) {
-    emit_goal(scenario, &found.answer, emit);
+    let chosen = &found.answer.goal;
+    let first = found
+        .first
+        .as_ref()
+        .filter(|first| !goal::equivalent(first, chosen).unwrap_or(*first == chosen));
+    emit_goal(scenario, &found.answer, first, emit);
     if let Some(why) = &found.doubt {
         emit(&Event::Notice {
             message: format!("check the goal before it runs: {why}"),
@@ -416,7 +422,12 @@ fn in_asked_order(
     answer
 }
 
-fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Event) + Send)) {
+fn emit_goal(
+    scenario: &Scenario,
+    answer: &GoalAnswer,
+    first_answer: Option<&Formula>,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) {
     let matches_expected = scenario
         .goal
         .as_ref()
@@ -426,6 +437,7 @@ fn emit_goal(scenario: &Scenario, answer: &GoalAnswer, emit: &mut (dyn FnMut(&Ev
         reasoning: answer.reasoning.clone(),
         matches_expected,
         author: "model".into(),
+        first_answer: first_answer.cloned(),
     });
 }
 
