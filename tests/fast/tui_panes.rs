@@ -364,3 +364,25 @@ fn a_click_focuses_a_pane_and_the_wheel_scrolls_the_one_under_it() {
         assert_eq!(b.app.focus, Pane::Tree);
     });
 }
+
+/// A goal kept other than the model's first answer (here turned round) says so in the
+/// log pane, with both goals.
+#[test]
+fn a_goal_other_than_the_first_answer_is_said_in_the_log() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        let goal = |text: &str| betr::goal::Formula::parse(text).unwrap();
+        b.app.on_session(Event::Goal {
+            goal: goal("\"blue cube\" on \"green cube\""),
+            reasoning: None,
+            matches_expected: None,
+            author: "model".into(),
+            first_answer: Some(goal("\"green cube\" on \"blue cube\"")),
+        });
+        let screen = b.screen(160, 50);
+        assert!(
+            screen.contains("the model answered \"green cube\" on \"blue cube\" first"),
+            "{screen}"
+        );
+    });
+}

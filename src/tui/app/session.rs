@@ -76,9 +76,16 @@ impl App {
                 goal,
                 reasoning,
                 author,
+                first_answer,
                 ..
             } => {
                 self.status.awaiting = None;
+                if let Some(first) = first_answer {
+                    self.llm.log(format!(
+                        "the model answered {first} first; the goal kept is {goal}, which the \
+                         request's words and the checks agree with"
+                    ));
+                }
                 self.llm.goal = Some(goal.to_string());
                 // A model's goal names the model that answered.
                 let by = match (author.as_str(), &self.llm.replied_by) {
