@@ -54,12 +54,15 @@ fn main() -> ExitCode {
         }
     };
     // What was printed is part of the result: a redirection that could not take it all
-    // is a failed command.
-    match cli::out::finish() {
-        Ok(()) => code,
-        Err(e) => {
-            cli::out::stderr(format_args!("error: {e}\n"));
-            ExitCode::from(2)
-        }
+    // is a failed command, and so is a file a writer could not write midway.
+    let mut failed = false;
+    if let Err(e) = cli::out::finish() {
+        cli::out::stderr(format_args!("error: {e}\n"));
+        failed = true;
     }
+    for unwritten in betr::store::unwritten() {
+        cli::out::stderr(format_args!("error: could not write {unwritten}\n"));
+        failed = true;
+    }
+    if failed { ExitCode::from(2) } else { code }
 }

@@ -167,6 +167,31 @@ fn process_alive(pid: i32) -> bool {
     }
 }
 
+/// Files a writer could not write without failing the work it was part of (a cassette's
+/// entry after a call that was paid for, a usage record), each with why.
+static UNWRITTEN: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// Keep, for the end of the command, that `path` could not be written: the work goes on
+/// (the reply is used, the tree is saved) and the command then fails naming the file.
+pub fn note_unwritten(path: &Path, error: &dyn std::fmt::Display) {
+    if let Ok(mut unwritten) = UNWRITTEN.lock() {
+        unwritten.push(format!("{}: {error}", path.display()));
+    }
+}
+
+/// What [`note_unwritten`] kept, each once, in the order it came.
+pub fn unwritten() -> Vec<String> {
+    let mut seen = Vec::new();
+    if let Ok(unwritten) = UNWRITTEN.lock() {
+        for u in unwritten.iter() {
+            if !seen.contains(u) {
+                seen.push(u.clone());
+            }
+        }
+    }
+    seen
+}
+
 /// The most betr reads of a file a person writes or points it to: scenarios, settings,
 /// prompts, learned rules.
 pub const SMALL_FILE_BYTES: u64 = 4 << 20;

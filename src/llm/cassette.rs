@@ -165,7 +165,16 @@ impl<M: LanguageModel> Recorder<M> {
             recorded_unix: super::usage::unix_now(),
             ranked: reply.ranked.clone(),
         };
-        self.append(&entry)?;
+        // The call is paid for and its reply is used: a cassette that cannot take it (a
+        // full disk) fails the command at its end, naming the file, not the work now.
+        if let Err(e) = self.append(&entry) {
+            tracing::error!(path = %self.path.display(), error = %e, "cannot append to the cassette");
+            let why = match e {
+                LlmError::Cassette { detail, .. } => detail,
+                other => other.to_string(),
+            };
+            crate::store::note_unwritten(&self.path, &why);
+        }
         Ok(reply)
     }
 

@@ -146,6 +146,7 @@ impl Ledger {
             if let Ok(mut first) = self.log_error.lock() {
                 first.get_or_insert_with(|| e.to_string());
             }
+            crate::store::note_unwritten(path, &e);
         }
         if let Ok(mut r) = self.records.lock() {
             r.push(record);

@@ -435,3 +435,26 @@ fn a_rejected_proposal_ends_the_loop_without_another_call() {
     assert_eq!(server.received().len(), 1, "{log}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A cassette on a full disk (`/dev/full` refuses every write with "no space") loses
+/// nothing else: the loop goes on, the tree that succeeded is saved, and the command then
+/// fails naming the cassette.
+#[test]
+fn a_cassette_on_a_full_disk_keeps_the_tree_and_fails_the_command_at_its_end() {
+    let dir = tmp("cassette-full");
+    let scenario = fixtures::root().join("scenarios/cafe/sweep.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let base = server.base_url();
+    let mut args = resolve_yes(&scenario_s, &base);
+    args.extend(["--cassette", "/dev/full", "--save", "kept.bt"]);
+    let out = betr(&dir, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(log.contains("could not write /dev/full"), "{log}");
+    assert!(
+        std::fs::read_to_string(dir.join("kept.bt")).is_ok_and(|t| !t.is_empty()),
+        "{log}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
