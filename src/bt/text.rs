@@ -72,29 +72,8 @@ pub fn parse(text: &str) -> Result<Tree, ParseError> {
             continue;
         }
         let err = |at: usize, expected: &str, found: String| error(line, raw, at, expected, found);
-        let indent = raw.len() - raw.trim_start_matches(' ').len();
-        if raw[indent..].starts_with(char::is_whitespace) {
-            return Err(err(
-                indent,
-                "indentation made of spaces",
-                "a tab or other blank".into(),
-            ));
-        }
-        if indent % 2 != 0 {
-            return Err(err(
-                indent,
-                "indentation of two spaces per level",
-                format!("{indent} spaces"),
-            ));
-        }
-        let depth = indent / 2;
-        if depth > super::MAX_DEPTH {
-            return Err(err(
-                indent,
-                &format!("at most {} levels of nesting", super::MAX_DEPTH),
-                format!("level {depth}"),
-            ));
-        }
+        let (indent, depth) =
+            indentation(raw).map_err(|(at, expected, found)| err(at, &expected, found))?;
         let kind =
             parse_node(raw, indent).map_err(|(at, expected, found)| err(at, &expected, found))?;
         if tree.is_some() && depth == 0 {
@@ -189,6 +168,35 @@ fn error(line: usize, raw: &str, at: usize, expected: &str, found: String) -> Pa
 }
 
 type NodeError = (usize, String, String);
+
+/// A line's indentation in spaces and the depth it stands for: two spaces per level, no
+/// tabs, at most [`super::MAX_DEPTH`] levels.
+fn indentation(raw: &str) -> Result<(usize, usize), NodeError> {
+    let indent = raw.len() - raw.trim_start_matches(' ').len();
+    if raw[indent..].starts_with(char::is_whitespace) {
+        return Err((
+            indent,
+            "indentation made of spaces".into(),
+            "a tab or other blank".into(),
+        ));
+    }
+    if indent % 2 != 0 {
+        return Err((
+            indent,
+            "indentation of two spaces per level".into(),
+            format!("{indent} spaces"),
+        ));
+    }
+    let depth = indent / 2;
+    if depth > super::MAX_DEPTH {
+        return Err((
+            indent,
+            format!("at most {} levels of nesting", super::MAX_DEPTH),
+            format!("level {depth}"),
+        ));
+    }
+    Ok((indent, depth))
+}
 
 /// Read the node written at byte `start` of `raw`; errors carry a byte offset.
 fn parse_node(raw: &str, start: usize) -> Result<NodeKind, NodeError> {
