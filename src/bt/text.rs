@@ -180,7 +180,7 @@ fn indentation(raw: &str) -> Result<(usize, usize), NodeError> {
             "a tab or other blank".into(),
         ));
     }
-    if indent % 2 != 0 {
+    if !indent.is_multiple_of(2) {
         return Err((
             indent,
             "indentation of two spaces per level".into(),
