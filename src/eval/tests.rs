@@ -283,3 +283,31 @@ fn a_case_past_the_context_window_fails_alone() {
     );
     std::fs::remove_dir_all(&dir).expect("cleanup");
 }
+
+/// The right goal of every request of every set of the suite, against the check that an
+/// object was guessed for one the scene lacks: a right goal doubted would cost the person
+/// a question for nothing, on domains the check was not written for as much as on the cell.
+#[test]
+fn no_right_goal_of_the_suite_is_taken_for_a_guessed_object() {
+    use crate::reading::{Request, lexicon::Lexicon, names::guessed_for_unknown};
+    // The suite's paths are read from the repository's top folder, where cargo runs the
+    // unit tests.
+    let sets = super::suite::load(Path::new("docs/eval-suite.toml")).expect("the suite");
+    let (mut read, mut doubted) = (0, Vec::new());
+    for set in &sets {
+        for (scene, case) in &set.cases {
+            let scene = &set.scenes[*scene];
+            let lexicon = Lexicon::new(&scene.domain.vocabulary, &scene.examples);
+            let request = Request::new(&case.instruction, scene, &lexicon);
+            let gold = scene
+                .parse_goal(&case.gold)
+                .expect("a right goal in the scene");
+            read += 1;
+            if let Some(why) = guessed_for_unknown(&gold, &request) {
+                doubted.push(format!("{}: {:?}: {why}", set.name, case.instruction));
+            }
+        }
+    }
+    assert!(read > 250, "{read} requests read");
+    assert!(doubted.is_empty(), "{}", doubted.join("\n"));
+}

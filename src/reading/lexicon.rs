@@ -80,6 +80,13 @@ impl Lexicon {
         self.whole_names.iter().any(|w| same_word(w, word))
     }
 
+    /// Whether some predicate or object of the scene answers to `word`.
+    pub fn knows(&self, word: &str) -> bool {
+        self.words
+            .values()
+            .any(|list| list.iter().any(|w| same_word(w, word)))
+    }
+
     /// The words `symbol` answers to (none for a name the scene does not have).
     pub fn words(&self, symbol: &str) -> &[String] {
         self.words.get(symbol).map_or(&[], Vec::as_slice)

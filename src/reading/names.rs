@@ -6,7 +6,7 @@
 use crate::goal::Formula;
 use crate::goal::rewrite::rename;
 
-use super::english::{is_generic, is_phrasing};
+use super::english::{ARTICLES, is_generic, is_phrasing};
 use super::kinds::asked_of_every;
 use super::placement::named_in;
 use super::request::Request;
@@ -147,6 +147,71 @@ fn of_a_kind_with<'a>(
             .filter(|o| o.types.iter().any(|t| kinds.contains(t)))
             .collect(),
     )
+}
+
+/// An object of `goal` guessed for one the scene lacks: the request says "the purple cube",
+/// no symbol of the scene answers to "purple", several of its objects answer to "cube", and
+/// the goal's cube is one whose own distinguishing words the request never says ("blue
+/// cube"). The model chose among the cubes by itself; a person settles which, if any, was
+/// meant. Only a word right after an article is read as naming which object ("grab cubes"
+/// names no particular one), and an unsaid word with the modifier's first letter may be its
+/// abbreviation (so "the pink cube" read as a "purple cube" passes). Returns why, in words.
+pub fn guessed_for_unknown(goal: &Formula, request: &Request) -> Option<String> {
+    let words = &request.unnumbered_words;
+    let in_goal: Vec<String> = goal
+        .atoms()
+        .into_iter()
+        .flat_map(|a| a.args)
+        .filter(|arg| !is_placeholder(arg))
+        .collect();
+    words.windows(3).find_map(|w| {
+        let [article, modifier, noun] = [&w[0], &w[1], &w[2]];
+        if !ARTICLES.contains(&article.as_str())
+            || is_generic(modifier)
+            || is_number(modifier)
+            || request.lexicon.knows(modifier)
+            || !request.lexicon.names_an_object(noun)
+        {
+            return None;
+        }
+        let answering = |object: &str| {
+            request
+                .lexicon
+                .words(object)
+                .iter()
+                .any(|x| same_word(x, noun))
+        };
+        let of_the_noun = request
+            .vocabulary
+            .objects
+            .iter()
+            .filter(|o| answering(&o.name))
+            .count();
+        if of_the_noun < 2 {
+            return None;
+        }
+        let said = |x: &String| request.terms.iter().any(|t| same_word(t, x));
+        // A word the request leaves unsaid that may shorten the modifier ("AD" of `ADMilk`
+        // for "almond milk") does not make the object a guess.
+        let shortens = |x: &String| x.chars().next() == modifier.chars().next();
+        in_goal
+            .iter()
+            .find(|object| {
+                let unsaid: Vec<&String> = request
+                    .lexicon
+                    .words(object)
+                    .iter()
+                    .filter(|x| !said(x))
+                    .collect();
+                answering(object) && !unsaid.is_empty() && !unsaid.into_iter().any(shortens)
+            })
+            .map(|object| {
+                format!(
+                    "the request says \"{modifier} {noun}\", and no object of the scene is \
+                     {modifier}: the goal puts \"{object}\" in its place"
+                )
+            })
+    })
 }
 
 /// The first object of `atoms` that no word of `request` names.

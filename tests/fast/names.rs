@@ -65,6 +65,47 @@ fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The model answering with another object for the one the request names ("blue cube" for
+/// "the purple cube", which the scene lacks) is a substitution nobody asked for: never run
+/// unattended, never saved.
+#[test]
+fn a_substituted_object_is_never_run_by_yes() {
+    let server = FakeServer::start(
+        vec![],
+        Behavior::Reply("Goal: \"blue cube\" on \"green cube\"".into()),
+    );
+    let dir = tmp("names-substituted");
+    let before = "sequence\n  \"red cube\" on \"blue cube\"?\n";
+    std::fs::write(dir.join("saved.bt"), before).unwrap();
+    let mut args: Vec<String> = [
+        "resolve",
+        &scenario("scenarios/cell/red_on_blue.toml"),
+        "--instruction",
+        "Put the purple cube on the green cube",
+        "--yes",
+        "--save",
+        "saved.bt",
+    ]
+    .map(str::to_string)
+    .to_vec();
+    args.extend(model_flags(&server.base_url()));
+    let out = run(&dir, &args);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(3), "not approved: {log}");
+    assert!(log.contains("doubtful"), "{log}");
+    assert!(
+        log.contains("\"purple cube\"") && log.contains("puts \"blue cube\" in its place"),
+        "{log}"
+    );
+    assert!(!log.contains("SUCCESS"), "never run:\n{log}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("saved.bt")).unwrap(),
+        before,
+        "the saved policy is kept"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_typed_goal_with_an_unknown_predicate_is_refused_without_a_model_call() {
     let server = FakeServer::start(vec![], Behavior::Reply("Goal: On_Coffee_Table1".into()));

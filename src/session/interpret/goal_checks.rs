@@ -11,7 +11,7 @@ use crate::goal::Formula;
 use crate::planner::{Outcome, Planner};
 use crate::reading::Request;
 use crate::reading::names::{
-    copied_from_example, more_alternatives_than_asked, unasked, unnamed_object,
+    copied_from_example, guessed_for_unknown, more_alternatives_than_asked, unasked, unnamed_object,
 };
 use crate::scenario::Scenario;
 use crate::world::World;
@@ -147,7 +147,8 @@ pub(super) fn assess(
                  never mentions; the request asks for a change"
             )))
         }
-        checked => copied_from_example(goal, shown, request)
+        checked => guessed_for_unknown(goal, request)
+            .or_else(|| copied_from_example(goal, shown, request))
             .map(doubt)
             .or_else(|| {
                 let extra = unasked(goal, request);

@@ -4,7 +4,7 @@ use super::*;
 use crate::goal::Formula;
 use crate::reading::Lexicon;
 use crate::reading::names::{
-    factored, swapped_back, swapped_object, without_copied, without_unasked,
+    factored, guessed_for_unknown, swapped_back, swapped_object, without_copied, without_unasked,
 };
 use crate::reading::words::same_word;
 use std::path::Path;
@@ -354,4 +354,51 @@ fn alternatives_claim_each_word_once_per_condition() {
         .parse_goal("Active_AC & (On_Chips_Table1 | On_NFCJuice_Table2)")
         .expect("parses");
     assert!(unasked(&asked, &Request::new(request, &s, &lexicon)).is_empty());
+}
+
+#[test]
+fn an_object_the_scene_lacks_answered_with_another_of_its_kind_is_a_guess() {
+    let scenario = Scenario::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml"),
+    )
+    .expect("cell scenario");
+    let lexicon = Lexicon::new(&scenario.domain.vocabulary, &scenario.examples);
+    let guessed = |request: &str, goal: &str| {
+        guessed_for_unknown(
+            &scenario.parse_goal(goal).expect("parses"),
+            &Request::new(request, &scenario, &lexicon),
+        )
+    };
+    let why = guessed(
+        "Put the purple cube on the green cube",
+        r#""blue cube" on "green cube""#,
+    )
+    .expect("a guess");
+    assert!(
+        why.contains("\"purple cube\"") && why.contains("\"blue cube\""),
+        "{why}"
+    );
+    // Named in full, or named by a word the scene knows: no guess.
+    assert_eq!(
+        guessed(
+            "Put the blue cube on the green cube",
+            r#""blue cube" on "green cube""#
+        ),
+        None
+    );
+    assert_eq!(
+        guessed(
+            "Put the cube on the green cube",
+            r#""blue cube" on "green cube""#
+        ),
+        None
+    );
+    // A word not after an article says no particular object.
+    assert_eq!(
+        guessed(
+            "Stack purple cubes on the green cube",
+            r#""blue cube" on "green cube""#
+        ),
+        None
+    );
 }
