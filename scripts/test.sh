@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Every test of betr, in two tiers (docs/BUILD.md, "Tests"):
-#   fast  the library's and the binary's unit tests, the fast test binary (tests/fast: the
-#         fake and scripted models, fixtures, snapshots, fuzz seeds, short commands of the
-#         binary) and the doc tests; no language or speech model, no tmux, no Python
+#   fast  the library's unit tests, the fast test binary (tests/fast: the fake and
+#         scripted models, fixtures, snapshots, fuzz seeds, the binary's commands) and the
+#         doc tests; no language or speech model, no tmux, no Python
 #         environment, no killed child process. Run it after every change.
 #   slow  the slow test binary (tests/slow: the real language model and Whisper, the tmux
 #         suites, the pip anchors, the kill tests, the arms end to end), a module at a time.
@@ -56,7 +56,7 @@ if [ -n "$free_kb" ] && [ "$free_kb" -lt $((12 * 1024 * 1024)) ]; then
 fi
 
 fast() {
-  cargo test --locked --lib --bins --test fast
+  cargo test --locked --lib --test fast
   cargo test --locked --doc
 }
 

@@ -179,7 +179,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // pressed), not the workbench.
     let no_flags = super::voice_cmd::SttFlags::default();
     let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &no_flags)
-        .map(super::voice_cmd::workbench_loader)
+        .map(betr::tui::dictation::loader_of)
         .map_err(|e| betr::tui::dictation::DictationError::Settings {
             reason: format!("{e:#}"),
         });

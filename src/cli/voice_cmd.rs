@@ -5,15 +5,12 @@
 use std::io::BufRead;
 use std::path::Path;
 use std::process::ExitCode;
-use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{Result, bail};
 use clap::Args;
 
 use betr::config_file::FileConfig;
-use betr::model::Progress;
-use betr::tui::dictation::{DictationError, SttLoader};
 use betr::voice::{self, Audio16k, SpeechToText, SttBackend, SttLayer, SttSettings, Transcript};
 
 /// Speech-to-text flags. Each overrides the matching `BETR_STT*` variable, which overrides
@@ -76,58 +73,6 @@ pub fn settings(config: Option<&Path>, flags: &SttFlags) -> Result<SttSettings> 
 pub struct Loaded {
     pub stt: Box<dyn SpeechToText>,
     pub load_time: Option<Duration>,
-}
-
-/// The workbench's push-to-talk model: built on first use, the embedded model fetched
-/// first when it is not in the cache, with progress reported as short lines (the screen
-/// is up, so nothing is printed).
-pub fn workbench_loader(settings: SttSettings) -> SttLoader {
-    Arc::new(move |report: &mut dyn FnMut(&str)| {
-        if settings.backend == SttBackend::Local
-            && let Some(spec) = betr::model::find_stt(&settings.model)
-            && !spec.is_present()
-        {
-            report(&format!(
-                "fetching {} ({:.0} MB, once only)",
-                spec.name,
-                spec.size() as f64 / 1e6
-            ));
-            let mut progress = ReportedProgress {
-                name: spec.name,
-                report: &mut *report,
-                percent: None,
-            };
-            betr::model::fetch_dir(spec, &betr::model::cache_dir(), "python3", &mut progress)?;
-        }
-        if settings.backend == SttBackend::Local {
-            report(&format!("loading {}", settings.model));
-        }
-        settings
-            .build(&|k| std::env::var(k).ok())
-            .map(Arc::from)
-            .map_err(DictationError::from)
-    })
-}
-
-/// A fetch's progress as "fetching NAME: 42%" lines, one per percent.
-struct ReportedProgress<'a> {
-    name: &'static str,
-    report: &'a mut dyn FnMut(&str),
-    percent: Option<u64>,
-}
-
-impl Progress for ReportedProgress<'_> {
-    fn stage(&mut self, message: &str) {
-        (self.report)(&format!("{}: {message}", self.name));
-    }
-
-    fn bytes(&mut self, done: u64, total: u64) {
-        let percent = (done * 100).checked_div(total).unwrap_or(0);
-        if self.percent != Some(percent) {
-            self.percent = Some(percent);
-            (self.report)(&format!("fetching {}: {percent}%", self.name));
-        }
-    }
 }
 
 /// Build the backend; the embedded model is fetched first if it is not in the cache.
@@ -225,93 +170,5 @@ pub fn confirm(transcript: &str, answer: &str) -> Result<String> {
         "" | "y" | "Y" | "yes" => Ok(transcript.to_string()),
         "n" | "N" | "no" => bail!("cancelled: the transcript was not used"),
         corrected => Ok(corrected.to_string()),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_command_line_definition_is_valid() {
-        use clap::CommandFactory;
-        crate::cli::Cli::command().debug_assert();
-    }
-
-    #[test]
-    fn fetch_progress_is_one_line_per_percent() {
-        let mut lines = Vec::new();
-        let mut report = |l: &str| lines.push(l.to_string());
-        let mut progress = ReportedProgress {
-            name: "whisper-tiny.en",
-            report: &mut report,
-            percent: None,
-        };
-        progress.stage("downloading part 1 of 1");
-        for done in [0, 10, 11, 500, 999, 1000] {
-            progress.bytes(done, 1000);
-        }
-        progress.bytes(5, 0);
-        assert_eq!(
-            lines,
-            [
-                "whisper-tiny.en: downloading part 1 of 1",
-                "fetching whisper-tiny.en: 0%",
-                "fetching whisper-tiny.en: 1%",
-                "fetching whisper-tiny.en: 50%",
-                "fetching whisper-tiny.en: 99%",
-                "fetching whisper-tiny.en: 100%",
-                "fetching whisper-tiny.en: 0%",
-            ]
-        );
-    }
-
-    #[test]
-    fn the_workbench_loader_builds_the_configured_backend() {
-        let settings = SttSettings::resolve(
-            None,
-            SttLayer::default(),
-            SttLayer {
-                backend: Some(SttBackend::Openai),
-                base_url: Some("http://127.0.0.1:9/v1".into()),
-                model: Some("whisper-large".into()),
-                ..SttLayer::default()
-            },
-        )
-        .unwrap();
-        let mut lines = Vec::new();
-        let stt = workbench_loader(settings)(&mut |l: &str| lines.push(l.to_string())).unwrap();
-        assert_eq!(stt.describe(), "whisper-large at http://127.0.0.1:9/v1");
-        assert!(lines.is_empty(), "nothing to fetch or load: {lines:?}");
-        // An unknown embedded model is an error naming the known ones, not a fetch.
-        let settings = SttSettings::resolve(
-            None,
-            SttLayer::default(),
-            SttLayer {
-                model: Some("whisper-huge".into()),
-                ..SttLayer::default()
-            },
-        )
-        .unwrap();
-        let e = workbench_loader(settings)(&mut |_: &str| {})
-            .err()
-            .unwrap()
-            .to_string();
-        assert!(
-            e.contains("whisper-huge") && e.contains("whisper-tiny.en"),
-            "{e}"
-        );
-    }
-
-    #[test]
-    fn the_user_confirms_corrects_or_cancels() {
-        let t = "Put the blue cube on the green cube.";
-        assert_eq!(confirm(t, "\n").unwrap(), t);
-        assert_eq!(confirm(t, "yes\n").unwrap(), t);
-        assert_eq!(
-            confirm(t, "Put the red cube on the green cube\n").unwrap(),
-            "Put the red cube on the green cube"
-        );
-        assert!(confirm(t, "n\n").is_err());
     }
 }

@@ -16,7 +16,10 @@ use std::time::Duration;
 use tokio::sync::OnceCell;
 use tokio::sync::mpsc::{UnboundedReceiver, unbounded_channel};
 
-use crate::voice::{self, Audio16k, Level, Recorder, SpeechToText, Transcript, VoiceError};
+use crate::model::Progress;
+use crate::voice::{
+    self, Audio16k, Level, Recorder, SpeechToText, SttBackend, SttSettings, Transcript, VoiceError,
+};
 
 /// What the app asks of the service.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -174,6 +177,58 @@ pub enum DictationError {
 pub type SttLoader = Arc<
     dyn Fn(&mut dyn FnMut(&str)) -> Result<Arc<dyn SpeechToText>, DictationError> + Send + Sync,
 >;
+
+/// The workbench's push-to-talk model: built on first use, the embedded model fetched
+/// first when it is not in the cache, with progress reported as short lines (the screen
+/// is up, so nothing is printed).
+pub fn loader_of(settings: SttSettings) -> SttLoader {
+    Arc::new(move |report: &mut dyn FnMut(&str)| {
+        if settings.backend == SttBackend::Local
+            && let Some(spec) = crate::model::find_stt(&settings.model)
+            && !spec.is_present()
+        {
+            report(&format!(
+                "fetching {} ({:.0} MB, once only)",
+                spec.name,
+                spec.size() as f64 / 1e6
+            ));
+            let mut progress = ReportedProgress {
+                name: spec.name,
+                report: &mut *report,
+                percent: None,
+            };
+            crate::model::fetch_dir(spec, &crate::model::cache_dir(), "python3", &mut progress)?;
+        }
+        if settings.backend == SttBackend::Local {
+            report(&format!("loading {}", settings.model));
+        }
+        settings
+            .build(&|k| std::env::var(k).ok())
+            .map(Arc::from)
+            .map_err(DictationError::from)
+    })
+}
+
+/// A fetch's progress as "fetching NAME: 42%" lines, one per percent.
+struct ReportedProgress<'a> {
+    name: &'static str,
+    report: &'a mut dyn FnMut(&str),
+    percent: Option<u64>,
+}
+
+impl Progress for ReportedProgress<'_> {
+    fn stage(&mut self, message: &str) {
+        (self.report)(&format!("{}: {message}", self.name));
+    }
+
+    fn bytes(&mut self, done: u64, total: u64) {
+        let percent = (done * 100).checked_div(total).unwrap_or(0);
+        if self.percent != Some(percent) {
+            self.percent = Some(percent);
+            (self.report)(&format!("fetching {}: {percent}%", self.name));
+        }
+    }
+}
 
 /// Owns the recording in progress and the speech-to-text model.
 pub struct DictationService {

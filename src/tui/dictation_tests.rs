@@ -344,3 +344,69 @@ fn a_wav_file_plays_as_the_microphone() {
     assert!(e.to_string().contains("missing.wav"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn fetch_progress_is_one_line_per_percent() {
+    let mut lines = Vec::new();
+    let mut report = |l: &str| lines.push(l.to_string());
+    let mut progress = ReportedProgress {
+        name: "whisper-tiny.en",
+        report: &mut report,
+        percent: None,
+    };
+    progress.stage("downloading part 1 of 1");
+    for done in [0, 10, 11, 500, 999, 1000] {
+        progress.bytes(done, 1000);
+    }
+    progress.bytes(5, 0);
+    assert_eq!(
+        lines,
+        [
+            "whisper-tiny.en: downloading part 1 of 1",
+            "fetching whisper-tiny.en: 0%",
+            "fetching whisper-tiny.en: 1%",
+            "fetching whisper-tiny.en: 50%",
+            "fetching whisper-tiny.en: 99%",
+            "fetching whisper-tiny.en: 100%",
+            "fetching whisper-tiny.en: 0%",
+        ]
+    );
+}
+
+#[test]
+fn the_settings_loader_builds_the_configured_backend() {
+    use crate::voice::SttLayer;
+    let settings = SttSettings::resolve(
+        None,
+        SttLayer::default(),
+        SttLayer {
+            backend: Some(SttBackend::Openai),
+            base_url: Some("http://127.0.0.1:9/v1".into()),
+            model: Some("whisper-large".into()),
+            ..SttLayer::default()
+        },
+    )
+    .expect("remote settings");
+    let mut lines = Vec::new();
+    let stt = loader_of(settings)(&mut |l: &str| lines.push(l.to_string())).expect("a backend");
+    assert_eq!(stt.describe(), "whisper-large at http://127.0.0.1:9/v1");
+    assert!(lines.is_empty(), "nothing to fetch or load: {lines:?}");
+    // An unknown embedded model is an error naming the known ones, not a fetch.
+    let settings = SttSettings::resolve(
+        None,
+        SttLayer::default(),
+        SttLayer {
+            model: Some("whisper-huge".into()),
+            ..SttLayer::default()
+        },
+    )
+    .expect("local settings");
+    let e = loader_of(settings)(&mut |_: &str| {})
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("whisper-huge") && e.contains("whisper-tiny.en"),
+        "{e}"
+    );
+}

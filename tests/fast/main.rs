@@ -15,6 +15,7 @@ mod cafe_goals;
 mod cafe_scenarios;
 mod cell_scenarios;
 mod closed_pipe;
+mod command_line;
 mod engine;
 mod engine_dead_ends;
 mod engine_debugger;

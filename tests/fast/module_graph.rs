@@ -405,3 +405,22 @@ fn the_session_rooms_depend_one_way() {
         "interpret and repair import each other: {graph:?}"
     );
 }
+
+/// The test command builds no unit-test harness of the binary (a second compile of the
+/// whole command line at the test profile's optimisation): what the binary does is tested
+/// by running it, and what can be tested alone lives in the library.
+#[test]
+fn the_binary_has_no_unit_tests() {
+    let main = src().join("main.rs");
+    let mut files = rust_files(&src().join("cli"));
+    files.push(main);
+    let with_tests: Vec<String> = files
+        .iter()
+        .filter(|f| {
+            let text = std::fs::read_to_string(f).unwrap();
+            text.contains("#[test]") || text.contains("#[cfg(test)]")
+        })
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(with_tests.is_empty(), "{with_tests:?}");
+}

@@ -6,11 +6,13 @@
 
 use crate::support;
 
+use std::io::Write;
+use std::process::Stdio;
 use std::time::Duration;
 
 use betr::voice::openai_stt::{OpenAiStt, OpenAiSttSettings, SttKey};
 use betr::voice::{Audio16k, VoiceError, transcribe};
-use support::cli::{KEY, KEY_VAR, betr, text, tmp};
+use support::cli::{KEY, KEY_VAR, betr, command, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures;
 
@@ -243,6 +245,45 @@ fn the_cli_transcribes_and_dictates_through_a_server() {
         "{t}"
     );
     assert!(t.contains("(equivalent to the scenario's goal)"), "{t}");
+
+    // On a terminal the person confirms with Enter, corrects by typing, or cancels.
+    args.pop();
+    let answered = |answer: &str| {
+        let mut child = command(&dir, &args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(answer.as_bytes())
+            .unwrap();
+        child.wait_with_output().unwrap()
+    };
+    let confirmed = answered("\n");
+    assert!(
+        text(&confirmed).contains("Instruction: Put the blue cube on the green cube."),
+        "{}",
+        text(&confirmed)
+    );
+    let corrected = answered("Put the red cube on the green cube\n");
+    assert!(
+        text(&corrected).contains("Instruction: Put the red cube on the green cube"),
+        "{}",
+        text(&corrected)
+    );
+    let calls = llm.received().len();
+    let cancelled = answered("n\n");
+    assert_eq!(cancelled.status.code(), Some(2), "{}", text(&cancelled));
+    assert!(
+        text(&cancelled).contains("cancelled"),
+        "{}",
+        text(&cancelled)
+    );
+    assert_eq!(llm.received().len(), calls, "no model call after a cancel");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,0 +1,46 @@
+//! The command line's definition, checked through the binary: every command's help,
+//! down to the subcommands of subcommands, is built by clap, whose debug builds assert
+//! the definition (conflicting names, a default outside its values, a missing value
+//! name) as each command is built. The binary has no unit tests of its own, so this is
+//! where the definition is checked.
+
+#![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
+
+use crate::support;
+
+use support::cli::{betr, text, tmp};
+
+/// The subcommands a help text lists under "Commands:" (clap's `help` left out).
+fn subcommands(help: &str) -> Vec<String> {
+    help.lines()
+        .skip_while(|l| l.trim() != "Commands:")
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|name| *name != "help")
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn every_command_and_subcommand_builds_its_help() {
+    let dir = tmp("command-line");
+    let mut pending: Vec<Vec<String>> = vec![Vec::new()];
+    let mut seen = 0;
+    while let Some(path) = pending.pop() {
+        let mut args: Vec<&str> = path.iter().map(String::as_str).collect();
+        args.push("--help");
+        let out = betr(&dir, &args);
+        let help = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", text(&out));
+        assert!(help.contains("Usage: betr"), "{args:?}: {help}");
+        seen += 1;
+        for sub in subcommands(&help) {
+            let mut deeper = path.clone();
+            deeper.push(sub);
+            pending.push(deeper);
+        }
+    }
+    // betr, its commands, and the subcommands of eval, knowledge and model.
+    assert!(seen > 20, "{seen} helps built");
+}
