@@ -272,12 +272,18 @@ impl Driver {
                         reason,
                     };
                 }
-                Event::ChangeViolates { report } => {
+                Event::ChangeViolates { report, inherited } => {
                     // A change written on the command line is the person's own: it is run
                     // with the finding in view rather than refused.
                     errln!(
                         "note: the changed tree fails verification in the model; it runs as written"
                     );
+                    if !inherited.is_empty() {
+                        errln!(
+                            "note: {}",
+                            betr::record::describe::not_the_change(&inherited)
+                        );
+                    }
                     let mut err = std::io::stderr();
                     if let Err(e) = super::verify_cmd::write_report(&mut err, &report, false) {
                         tracing::warn!("cannot write the report to stderr: {e}");

@@ -478,10 +478,13 @@ fn print_event_line(event: &Event) {
         | Event::DidNotHelp { .. }
         | Event::Error { .. } => "",
         Event::Rejected => return outln!("Not approved; stopping."),
-        Event::ChangeViolates { report } => {
+        Event::ChangeViolates { report, inherited } => {
             outln!(
                 "\n✕ The approved change fails verification in the model; it is rejected and undone, not run (counterexample on stderr)"
             );
+            if !inherited.is_empty() {
+                outln!("  {}", betr::record::describe::not_the_change(inherited));
+            }
             let mut err = std::io::stderr();
             if let Err(e) = super::verify_cmd::write_report(&mut err, report, false) {
                 tracing::warn!("cannot write the report to stderr: {e}");

@@ -136,9 +136,13 @@ fn about_the_tree(event: &Event) -> Option<String> {
         } => crate::session::interpret::readings::summary(readings, doubt.as_deref()),
         Event::Verified { report, origin } if report.holds() => format!("verified ({origin})"),
         Event::Verified { origin, .. } => format!("NOT verified ({origin})"),
-        Event::ChangeViolates { .. } => {
+        Event::ChangeViolates { inherited, .. } if inherited.is_empty() => {
             "✕ the approved change fails verification in the model".into()
         }
+        Event::ChangeViolates { inherited, .. } => format!(
+            "✕ the approved change fails verification in the model; {}",
+            not_the_change(inherited)
+        ),
         Event::PolicySaved { path, fixes } => {
             format!("policy saved to {} ({fixes} fix(es))", path.display())
         }
@@ -182,6 +186,14 @@ fn about_the_tree(event: &Event) -> Option<String> {
 }
 
 /// A replayed step in words: a command as `> command`, an event as [`describe`] says it.
+/// Beside a changed tree's failures: those the tree before the change has too.
+pub fn not_the_change(inherited: &[String]) -> String {
+    format!(
+        "not the change's doing (the tree before it fails these too): {}",
+        inherited.join("; ")
+    )
+}
+
 pub fn describe_step(step: &Step) -> Vec<String> {
     match step {
         Step::Command(text) => vec![format!("> {text}")],

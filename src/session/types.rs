@@ -490,6 +490,10 @@ pub enum Event {
     /// undoes it.
     ChangeViolates {
         report: Arc<Report>,
+        /// The report's failures the tree before the change has too: the tree's (or the
+        /// property's), not the change's.
+        #[serde(default)]
+        inherited: Vec<String>,
     },
     PolicySaved {
         path: PathBuf,

@@ -72,6 +72,14 @@ pub struct Finding {
     pub hint: String,
 }
 
+impl Finding {
+    /// The finding without where in the tree it is (a change moves nodes): its rule and
+    /// message, as [`Report::failures`] lists it.
+    pub fn key(&self) -> String {
+        format!("[{}] {}", self.rule.name(), self.message)
+    }
+}
+
 impl std::fmt::Display for Finding {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -155,6 +163,42 @@ impl Report {
                 .model
                 .as_ref()
                 .is_ok_and(|m| m.properties.iter().all(|p| p.verdict.holds()))
+    }
+
+    /// What fails, one line each: a structural finding, a property violated or left
+    /// undecided by the state bound, or a tree that could not be model checked.
+    pub fn failures(&self) -> Vec<String> {
+        let mut out: Vec<String> = self.findings.iter().map(Finding::key).collect();
+        match &self.model {
+            Err(e) => out.push(format!("not model checked: {e}")),
+            Ok(m) => out.extend(
+                m.properties
+                    .iter()
+                    .filter(|p| !p.verdict.holds())
+                    .map(|p| p.name.clone()),
+            ),
+        }
+        out
+    }
+
+    /// Of this report's failures, those `before` has too: what a changed tree inherits
+    /// from the tree it was changed from, not what the change did.
+    pub fn failures_shared_with(&self, before: &Report) -> Vec<String> {
+        let earlier = before.failures();
+        self.failures()
+            .into_iter()
+            .filter(|f| earlier.contains(f))
+            .collect()
+    }
+
+    /// Whether `failure` (one of [`Report::failures`]) is a violated property of the
+    /// scenario's own, not one of the checks every tree gets.
+    pub fn is_declared_property(&self, failure: &str) -> bool {
+        self.model.as_ref().is_ok_and(|m| {
+            m.properties
+                .iter()
+                .any(|p| matches!(p.kind, PropertyKind::User(_)) && p.name == failure)
+        })
     }
 
     /// The result for one property kind, if it was checked.

@@ -26,13 +26,12 @@ fn run(dir: &std::path::Path, args: &[String]) -> Output {
     betr(dir, &args)
 }
 
-#[test]
-fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
-    let server = FakeServer::start(
-        vec![],
-        Behavior::Reply("Goal: \"purple cube\" on \"green cube\"".into()),
-    );
-    let dir = tmp("names-purple");
+/// `resolve --yes` of "Put the purple cube on the green cube" (the scene has no purple
+/// cube) with the model replying `reply`, over a saved policy: the exit code and the log,
+/// once the policy is checked to be kept as it was.
+fn purple_cube_resolved(name: &str, reply: &str) -> (Option<i32>, String) {
+    let server = FakeServer::start(vec![], Behavior::Reply(reply.into()));
+    let dir = tmp(name);
     let before = "sequence\n  \"red cube\" on \"blue cube\"?\n";
     std::fs::write(dir.join("saved.bt"), before).unwrap();
     let mut args: Vec<String> = [
@@ -49,7 +48,20 @@ fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
     args.extend(model_flags(&server.base_url()));
     let out = run(&dir, &args);
     let log = text(&out);
-    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("saved.bt")).unwrap(),
+        before,
+        "the saved policy is kept: {log}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    (out.status.code(), log)
+}
+
+#[test]
+fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
+    let (code, log) =
+        purple_cube_resolved("names-purple", "Goal: \"purple cube\" on \"green cube\"");
+    assert_eq!(code, Some(2), "{log}");
     assert!(log.contains("\"purple cube\""), "{log}");
     assert!(log.contains("is not in the scene"), "{log}");
     assert!(log.contains("did you mean \"blue cube\""), "{log}");
@@ -57,12 +69,6 @@ fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
         !log.contains("Goal: \"blue cube\""),
         "never used instead:\n{log}"
     );
-    assert_eq!(
-        std::fs::read_to_string(dir.join("saved.bt")).unwrap(),
-        before,
-        "the saved policy is kept"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The model answering with another object for the one the request names ("blue cube" for
@@ -70,40 +76,15 @@ fn an_object_the_scene_lacks_is_refused_not_replaced_and_the_policy_kept() {
 /// unattended, never saved.
 #[test]
 fn a_substituted_object_is_never_run_by_yes() {
-    let server = FakeServer::start(
-        vec![],
-        Behavior::Reply("Goal: \"blue cube\" on \"green cube\"".into()),
-    );
-    let dir = tmp("names-substituted");
-    let before = "sequence\n  \"red cube\" on \"blue cube\"?\n";
-    std::fs::write(dir.join("saved.bt"), before).unwrap();
-    let mut args: Vec<String> = [
-        "resolve",
-        &scenario("scenarios/cell/red_on_blue.toml"),
-        "--instruction",
-        "Put the purple cube on the green cube",
-        "--yes",
-        "--save",
-        "saved.bt",
-    ]
-    .map(str::to_string)
-    .to_vec();
-    args.extend(model_flags(&server.base_url()));
-    let out = run(&dir, &args);
-    let log = text(&out);
-    assert_eq!(out.status.code(), Some(3), "not approved: {log}");
+    let (code, log) =
+        purple_cube_resolved("names-substituted", "Goal: \"blue cube\" on \"green cube\"");
+    assert_eq!(code, Some(3), "not approved: {log}");
     assert!(log.contains("doubtful"), "{log}");
     assert!(
         log.contains("\"purple cube\"") && log.contains("puts \"blue cube\" in its place"),
         "{log}"
     );
     assert!(!log.contains("SUCCESS"), "never run:\n{log}");
-    assert_eq!(
-        std::fs::read_to_string(dir.join("saved.bt")).unwrap(),
-        before,
-        "the saved policy is kept"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -81,8 +81,12 @@ impl Checks {
 
 /// What failed in a report, in one line: the first finding or violated property, with the
 /// counterexample's last words.
-fn violation_summary(report: &Report) -> String {
-    if let Some(f) = report.findings.first() {
+fn violation_summary(report: &Report, inherited: &[String]) -> String {
+    if let Some(f) = report
+        .findings
+        .iter()
+        .find(|f| !inherited.contains(&f.key()))
+    {
         return f.to_string();
     }
     let Ok(model) = &report.model else {
@@ -91,7 +95,7 @@ fn violation_summary(report: &Report) -> String {
     model
         .properties
         .iter()
-        .find(|p| !p.verdict.holds())
+        .find(|p| !p.verdict.holds() && !inherited.contains(&p.name))
         .map_or_else(
             || "it could not be checked".to_string(),
             |p| match &p.verdict {
@@ -104,6 +108,33 @@ fn violation_summary(report: &Report) -> String {
 }
 
 impl Engine {
+    /// What a change that breaks nothing is told with: what the tree before it fails too,
+    /// and, for a property of the scenario's, that it was declared with the scenario's own
+    /// goal when the goal worked on is another.
+    fn inherited_notice(&self, report: &Report, inherited: &[String]) -> String {
+        let declared_goal = self.settings.scenario.goal.as_ref();
+        let other_goal = match (declared_goal, &self.task.goal) {
+            (Some(declared), Some(goal)) => !crate::goal::equivalent(declared, &goal.formula)
+                .unwrap_or(declared == &goal.formula),
+            _ => false,
+        };
+        let described: Vec<String> = inherited
+            .iter()
+            .map(|failure| {
+                if other_goal && report.is_declared_property(failure) {
+                    format!("{failure} (declared for the scenario's goal; this goal differs)")
+                } else {
+                    failure.clone()
+                }
+            })
+            .collect();
+        format!(
+            "the change breaks nothing: the tree fails verification without it in the same way, \
+             not because of it: {}",
+            described.join("; ")
+        )
+    }
+
     /// Where the current tree came from, for the verification report.
     fn origin(&self) -> String {
         match (&self.task.origin, self.task.fixes.len()) {
@@ -186,7 +217,7 @@ impl Engine {
         });
         self.calls.verifications += 1;
         self.notice("verifying the tree …");
-        self.spawn_check(tree, checks, None, origin);
+        self.spawn_check(tree, None, checks, None, origin);
     }
 
     /// Write the model `checks` would check as Promela; its LTL claims' names.
@@ -227,26 +258,50 @@ impl Engine {
         self.notice("verifying the changed tree in the model before it runs …");
         let origin = self.origin();
         let checks = Checks::of(config, &VerifyRequest::default());
-        self.spawn_check(tree, checks, Some(id), origin);
+        // The tree before the change is checked the same way, so that what it fails too is
+        // told apart from what the change did.
+        let before = self.task.undo.last().map(|entry| entry.tree.clone());
+        self.spawn_check(tree, before, checks, Some(id), origin);
     }
 
-    fn spawn_check(&self, tree: Tree, checks: Checks, gate: Option<u64>, origin: String) {
+    fn spawn_check(
+        &self,
+        tree: Tree,
+        before: Option<Tree>,
+        checks: Checks,
+        gate: Option<u64>,
+        origin: String,
+    ) {
         let scenario = self.settings.scenario.clone();
         let initial = self.run.planning.facts();
         let tx = self.internal_tx.clone();
         tokio::task::spawn_blocking(move || {
-            let input = checks.input(&scenario.domain, &tree, &initial);
-            let report = Arc::new(verify::verify(&input));
+            let check = |tree: &Tree| {
+                Arc::new(verify::verify(&checks.input(
+                    &scenario.domain,
+                    tree,
+                    &initial,
+                )))
+            };
+            let report = check(&tree);
+            let before = before.filter(|_| !report.holds()).map(|tree| check(&tree));
             let _ = tx.send(Internal::Verified {
                 report,
                 origin,
                 gate,
+                before,
             });
         });
     }
 
     /// A verification finished: a report for the person, or the verdict on a change.
-    pub(super) fn on_verified(&mut self, report: Arc<Report>, origin: String, gate: Option<u64>) {
+    pub(super) fn on_verified(
+        &mut self,
+        report: Arc<Report>,
+        origin: String,
+        gate: Option<u64>,
+        before: Option<Arc<Report>>,
+    ) {
         let Some(id) = gate else {
             self.calls.verifications = self.calls.verifications.saturating_sub(1);
             return self.emit(Event::Verified { report, origin });
@@ -263,18 +318,31 @@ impl Engine {
             return;
         }
         let (run_after, change) = (*run_after, change.clone());
-        if report.holds() {
+        let inherited = before
+            .map(|before| report.failures_shared_with(&before))
+            .unwrap_or_default();
+        let caused: Vec<String> = report
+            .failures()
+            .into_iter()
+            .filter(|f| !inherited.contains(f))
+            .collect();
+        if caused.is_empty() {
             self.enter(Phase::Ready);
-            self.notice("the changed tree verifies in the model");
+            if inherited.is_empty() {
+                self.notice("the changed tree verifies in the model");
+            } else {
+                let message = self.inherited_notice(&report, &inherited);
+                self.notice(message);
+            }
             if run_after {
                 self.start_running();
             }
         } else {
             self.enter(Phase::Violated {
-                summary: violation_summary(&report),
+                summary: violation_summary(&report, &inherited),
                 change,
             });
-            self.emit(Event::ChangeViolates { report });
+            self.emit(Event::ChangeViolates { report, inherited });
             self.notice(
                 "the changed tree fails verification: it does not run until the change is approved again with the counterexample in view, rejected (the model is told why), or undone",
             );

@@ -36,6 +36,8 @@ pub(crate) enum Internal {
         origin: String,
         /// The check of an applied change this answers, if it is one.
         gate: Option<u64>,
+        /// The same checks of the tree before that change, when there was one.
+        before: Option<Arc<Report>>,
     },
 }
 
@@ -174,7 +176,8 @@ impl Engine {
                 report,
                 origin,
                 gate,
-            } => self.on_verified(report, origin, gate),
+                before,
+            } => self.on_verified(report, origin, gate, before),
             Internal::Goal {
                 id,
                 instruction,

@@ -13,6 +13,7 @@ use crate::scenario::Scenario;
 
 use super::super::call::ask;
 use super::super::types::{Event, Options, Proposal, Question, SessionError};
+use super::evidence::breaking_text;
 use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{Shortlist, shortlist, without_implied};
 use super::value_bounds::Bounds;
@@ -252,11 +253,12 @@ fn shortlist_notice(list: &Shortlist, refused: usize) -> String {
         .map(|o| format!("\"{o}\""))
         .collect::<Vec<_>>()
         .join(", ");
-    let left_out = if refused > 0 {
+    let mut left_out = if refused > 0 {
         format!(" ({refused} refused before, left out)")
     } else {
         String::new()
     };
+    left_out.push_str(&breaking_text(list));
     if list.fixes.is_empty() {
         return format!(
             "tried {} condition(s) about {about} in simulation: none fixes the failure alone{left_out}; the model names the condition itself",
@@ -293,8 +295,14 @@ pub(crate) async fn ask_conditions(
         // grammar that allows only the shortlist, so it would choose it again.
         let before = list.fixes.len();
         list.fixes.retain(|c| !refused_alone(tried, c));
+        let refused = before - list.fixes.len();
+        // A fix that breaks a property the scenario declares would fail the changed
+        // tree's check after approval: left out before anyone is asked, and said.
+        list.breaking = screen.breaking(&list.fixes);
+        let breaking = list.breaking.clone();
+        list.fixes.retain(|c| !breaking.iter().any(|(b, _)| b == c));
         emit(&Event::Notice {
-            message: shortlist_notice(&list, before - list.fixes.len()),
+            message: shortlist_notice(&list, refused),
         });
         Some(list)
     } else {

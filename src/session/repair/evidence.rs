@@ -92,21 +92,32 @@ fn verdict_text(v: Verdict) -> &'static str {
     }
 }
 
+/// The fixes left out of a shortlist for breaking a declared property, as a clause to
+/// append (empty when none was).
+pub(super) fn breaking_text(list: &Shortlist) -> String {
+    list.breaking
+        .iter()
+        .map(|(condition, property)| format!(" ({condition} left out: it breaks {property})"))
+        .collect()
+}
+
 fn shortlist_finding(list: &Shortlist) -> String {
     let about: Vec<String> = list.objects.iter().map(|o| format!("\"{o}\"")).collect();
     let about = about.join(", ");
     if list.fixes.is_empty() {
         return format!(
-            "tried {} condition(s) about {about} in simulation: none fixes the failure alone",
-            list.tried
+            "tried {} condition(s) about {about} in simulation: none fixes the failure alone{}",
+            list.tried,
+            breaking_text(list)
         );
     }
     let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
     format!(
-        "tried {} condition(s) about {about} in simulation: {} fix the failure ({})",
+        "tried {} condition(s) about {about} in simulation: {} fix the failure ({}){}",
         list.tried,
         list.fixes.len(),
-        fixes.join(", ")
+        fixes.join(", "),
+        breaking_text(list)
     )
 }
 
@@ -259,6 +270,7 @@ mod tests {
             fixes: fixes.clone(),
             tried: 19,
             objects: vec!["blue cube".into()],
+            breaking: Vec::new(),
         };
         let proposal = Proposal::Conditions {
             action: failure.action.clone(),

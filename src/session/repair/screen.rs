@@ -7,6 +7,7 @@
 use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::{ActionCall, Condition};
 use crate::planner::{Outcome, Plan, Planner, RepairError, run_tree, set_value};
+use crate::verify::{self, Limits, VerifyConfig, VerifyInput};
 use crate::world::World;
 
 use super::super::types::Proposal;
@@ -163,6 +164,56 @@ impl Screen {
             },
         );
         completed
+    }
+
+    /// The conditions of `fixes` after which the tree breaks a property the scenario
+    /// declares that the tree as it is keeps, each with that property: a fix that makes
+    /// the robot do what the scenario forbids is not offered. Verified in the planner's
+    /// model, as an approved change is; nothing to check when the scenario declares no
+    /// property (or its checks cannot be read: the change's own check says why).
+    pub fn breaking(&self, fixes: &[Condition]) -> Vec<(Condition, String)> {
+        let Ok(config) = VerifyConfig::from_scenario(&self.scenario) else {
+            return Vec::new();
+        };
+        if config.properties.is_empty() {
+            return Vec::new();
+        }
+        let initial = self.world.facts();
+        let broken = |tree: &Tree| {
+            let report = verify::verify(&VerifyInput {
+                domain: &self.scenario.domain,
+                tree,
+                initial: &initial,
+                disturbances: &config.disturbances,
+                properties: &config.properties,
+                limits: Limits {
+                    action_failures: config.action_failures,
+                    ..Limits::default()
+                },
+            });
+            report
+                .failures()
+                .into_iter()
+                .filter(|f| report.is_declared_property(f))
+                .collect::<Vec<String>>()
+        };
+        let before = broken(&self.tree);
+        fixes
+            .iter()
+            .filter_map(|condition| {
+                let plan = self
+                    .replan(&Proposal::Conditions {
+                        action: self.failure.action.clone(),
+                        node: self.failure.node,
+                        conditions: vec![condition.clone()],
+                    })
+                    .ok()?;
+                broken(&plan.tree)
+                    .into_iter()
+                    .find(|f| !before.contains(f))
+                    .map(|f| (condition.clone(), f))
+            })
+            .collect()
     }
 
     /// As [`Screen::check`], saying whether the whole tree then succeeds.

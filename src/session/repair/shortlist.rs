@@ -21,6 +21,9 @@ pub struct Shortlist {
     pub tried: usize,
     /// The objects the conditions were about.
     pub objects: Vec<String>,
+    /// Fixes left out because the tree with them breaks a property the scenario declares,
+    /// each with that property ([`super::screen::Screen::breaking`]).
+    pub breaking: Vec<(Condition, String)>,
 }
 
 /// Bound on the conditions tried in each pass, so a huge scene stays quick to screen.
@@ -65,6 +68,7 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
         fixes: found.fixes,
         tried,
         objects,
+        breaking: Vec::new(),
     }
 }
 
@@ -144,6 +148,7 @@ fn screen_all(
         fixes: without_indirect(screen, succeeding),
         tried,
         objects: objects.to_vec(),
+        breaking: Vec::new(),
     }
 }
 

@@ -246,9 +246,12 @@ impl App {
                 self.llm
                     .log(if holds { "verified" } else { "NOT verified" });
             }
-            Event::ChangeViolates { report } => {
+            Event::ChangeViolates { report, inherited } => {
                 self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
                 let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
+                if !inherited.is_empty() {
+                    lines.push(crate::record::describe::not_the_change(&inherited));
+                }
                 lines.extend(report_lines(&report, &self.theme));
                 self.overlay = Some(Overlay::Report {
                     title: strings::VIOLATION_TITLE,
