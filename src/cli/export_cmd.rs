@@ -45,9 +45,11 @@ pub fn export(
         knowledge.apply(&mut scenario)?;
         Ok(scenario)
     };
+    // A scenario file, or a scenario's name (`cell/red_on_blue`) where no tree file is.
     let is_scenario = source
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        || (!source.exists() && super::find_scenario(source).is_ok());
     let (scenario_path, tree, new_nodes) = if is_scenario {
         let path = super::find_scenario(source)?;
         let scenario = load(&path)?;

@@ -46,12 +46,18 @@ use betr::scenario::Scenario;
 #[command(
     name = "betr",
     version,
-    about = "Instruction → goal → behavior tree, repaired when the world disagrees"
+    about = "Instruction → goal → behavior tree, repaired when the world disagrees",
+    override_usage = "betr [SCENARIO] [WORKBENCH OPTIONS]\n       betr <COMMAND> [ARGS]",
+    args_conflicts_with_subcommands = true
 )]
 pub struct Cli {
-    /// What to do (none: the workbench on scenario 1, as `betr tui`).
+    /// What to do (none: the workbench, as `betr tui` with the same arguments).
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// Without a command: the workbench's scenario and options (`betr cafe/no_coffee
+    /// --viewer web` is `betr tui cafe/no_coffee --viewer web`).
+    #[command(flatten)]
+    pub workbench: tui_cmd::TuiArgs,
     /// Print trees with ASCII symbols instead of Unicode.
     #[arg(long, global = true)]
     pub ascii: bool,
@@ -84,8 +90,8 @@ pub enum Command {
     /// Write a tree as BehaviorTree.CPP v4 XML (for BT.CPP and Groot2) or Graphviz DOT
     /// (statuses of the last tick of a run as colours, the last fix's nodes marked).
     Export {
-        /// A scenario file (its planned tree) or a tree file (betr text, a saved policy,
-        /// or BT.CPP XML).
+        /// A scenario, as a file or a name like the other commands take (its planned
+        /// tree), or a tree file (betr text, a saved policy, or BT.CPP XML).
         source: PathBuf,
         #[arg(long, value_enum)]
         format: export_cmd::Format,
@@ -173,8 +179,11 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
     let Some(command) = cli.command else {
         let args = tui_cmd::TuiArgs {
             offline,
-            ..Default::default()
+            ..cli.workbench
         };
+        if let Some(scenario) = &args.scenario {
+            scenario_or_command(scenario)?;
+        }
         return tui_cmd::tui(&args, cli.ascii);
     };
     // Every engine a one-shot command starts reads it (`engine_driver::Driver::start`).
@@ -242,6 +251,26 @@ pub fn offline_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
     match betr::bounds::switch_value(&value) {
         Some(on) => Ok(on),
         None => bail!("BETR_OFFLINE={value:?} is not true or false"),
+    }
+}
+
+/// The first word of a bare `betr WORD` is a scenario; one that names no scenario but is
+/// close to a command's name was most likely that command mistyped (`betr tiu`).
+fn scenario_or_command(word: &Path) -> Result<()> {
+    let Err(not_found) = find_scenario(word) else {
+        return Ok(());
+    };
+    let typed = word.to_string_lossy();
+    let commands = <Cli as clap::CommandFactory>::command();
+    let names = commands
+        .get_subcommands()
+        .filter(|c| !c.is_hide_set())
+        .map(|c| c.get_name());
+    match betr::domain::names::nearest(&typed, names, 0.6).first() {
+        Some(command) => bail!(
+            "{not_found}\n  no scenario or command is called {typed:?}; did you mean the command `betr {command}`?"
+        ),
+        None => Err(not_found),
     }
 }
 

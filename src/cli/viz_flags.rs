@@ -15,9 +15,10 @@ pub struct VizFlags {
     /// Stream the cell, the tree and the events to the rerun viewer: `connect` (a running
     /// viewer at rerun+http://127.0.0.1:9876/proxy), `connect=URL`, `spawn` (start the
     /// `rerun` program's native viewer; needs a display), or `web` (start `rerun
-    /// --serve-web` and print the address to open in a browser). `rerun` comes with
+    /// --serve-web`, listening on this machine only, and print the address to open in a
+    /// browser; `web=0.0.0.0`: on every interface, reachable from other machines). `rerun` comes with
     /// `pip install rerun-sdk==0.36.*`.
-    #[arg(long, value_name = "connect[=URL]|spawn|web")]
+    #[arg(long, value_name = "connect[=URL]|spawn|web[=0.0.0.0]")]
     pub viewer: Option<Viewer>,
     /// Save a rerun recording of the session to FILE (.rrd).
     #[arg(long, value_name = "FILE")]
@@ -50,8 +51,12 @@ impl VizFlags {
         if let Some(moved) = viz.as_ref().and_then(Viz::web_moved) {
             errln!("3D view: {moved}");
         }
+        if let Some(exposed) = viz.as_ref().and_then(Viz::web_exposed) {
+            errln!("warning: 3D view: {exposed}");
+        }
+        // The address on a line of its own, to copy whole.
         if let Some(url) = viz.as_ref().and_then(Viz::web_url) {
-            errln!("3D view: open {url}");
+            errln!("3D view: open this address in a browser:\n{url}");
         }
         if web_viewer == ViewerLife::OutlivesCommand
             && let Some(server) = viz.as_mut().and_then(Viz::take_web_server)

@@ -144,7 +144,8 @@ pub async fn run(
     let mut app = App::new(scenario, info, keys, theme);
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     if let Some(page) = tap.as_ref().and_then(|t| t.viewer_page()) {
-        app.llm.log(strings::viewer_page(&page));
+        app.llm.log(strings::VIEWER_PAGE);
+        app.llm.log(page);
     }
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let queue = event_loop::Queue::new();

@@ -151,10 +151,9 @@ pub fn facts_heading(shown: usize, total: usize, filter: Option<&str>) -> String
 }
 
 /// Over the fact table scrolled down.
-/// The first line of the log when a web viewer shows the session.
-pub fn viewer_page(page: &str) -> String {
-    format!("3D view: open {page}")
-}
+/// The first line of the log when a web viewer shows the session; the address follows
+/// on a line of its own, to copy whole.
+pub const VIEWER_PAGE: &str = "3D view: open this address in a browser:";
 
 /// Under a proposal cut to fit: which of its rows are shown.
 pub fn rows_of(first: usize, last: usize, total: usize) -> String {

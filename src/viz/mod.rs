@@ -62,9 +62,10 @@ pub enum Viewer {
     Connect(Option<String>),
     /// Start the `rerun` program's native viewer, then stream to it.
     Spawn,
-    /// Start the `rerun` program as a web viewer (`rerun --serve-web`), stream to it, and
-    /// say the address to open in a browser.
-    Web,
+    /// Start the `rerun` program as a web viewer (`rerun --serve-web`) listening on this
+    /// address (`web`: 127.0.0.1, this machine only; `web=0.0.0.0`: every interface),
+    /// stream to it, and say the address to open in a browser.
+    Web(std::net::IpAddr),
 }
 
 impl std::str::FromStr for Viewer {
@@ -73,7 +74,13 @@ impl std::str::FromStr for Viewer {
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s.split_once('=') {
             None if s == "spawn" => Ok(Viewer::Spawn),
-            None if s == "web" => Ok(Viewer::Web),
+            None if s == "web" => Ok(Viewer::Web(std::net::Ipv4Addr::LOCALHOST.into())),
+            // This machine, or every interface: the viewer is then still reached here at
+            // 127.0.0.1, which is where betr streams to.
+            Some(("web", address)) => match address.parse::<std::net::IpAddr>() {
+                Ok(ip) if ip.is_loopback() || ip.is_unspecified() => Ok(Viewer::Web(ip)),
+                _ => Err(VizError::BadViewer(s.to_string())),
+            },
             None if s == "connect" => Ok(Viewer::Connect(None)),
             Some(("connect", url)) if !url.is_empty() => Ok(Viewer::Connect(Some(url.into()))),
             _ => Err(VizError::BadViewer(s.to_string())),
@@ -100,7 +107,9 @@ impl Sinks {
 
 #[derive(Debug, thiserror::Error)]
 pub enum VizError {
-    #[error("--viewer {0:?}: expected `connect`, `connect=URL`, `spawn` or `web`")]
+    #[error(
+        "--viewer {0:?}: expected `connect`, `connect=URL`, `spawn`, `web` (this machine only) or `web=0.0.0.0` (every interface)"
+    )]
     BadViewer(String),
     #[error("cannot write the recording {path}: {message}")]
     Rrd { path: PathBuf, message: String },
@@ -153,6 +162,9 @@ pub struct Viz {
     web_url: Option<String>,
     /// Why the web viewer is not on the usual ports, when it is not.
     web_moved: Option<String>,
+    /// That the web viewer can be reached from other machines, when it listens beyond
+    /// this one.
+    web_exposed: Option<String>,
     /// An `.rrd` file is written: flushed whenever the session comes to rest, so a
     /// session killed while it waits (for the model, for a person) leaves a file that
     /// holds everything up to there.
@@ -193,6 +205,7 @@ impl Viz {
         }
         let mut web_url = None;
         let mut web_moved = None;
+        let mut web_exposed = None;
         let mut web_server = None;
         let url = match &sinks.viewer {
             Some(Viewer::Connect(url)) => Some(url.clone().unwrap_or_else(|| DEFAULT_URL.into())),
@@ -203,18 +216,21 @@ impl Viz {
                     None
                 }
             },
-            Some(Viewer::Web) => match viewer::start_web(OsStr::new("rerun"), sinks.web_viewer) {
-                Ok(web) => {
-                    web_url = Some(web.open);
-                    web_moved = web.moved;
-                    web_server = web.server;
-                    Some(web.grpc)
+            Some(Viewer::Web(address)) => {
+                match viewer::start_web(OsStr::new("rerun"), sinks.web_viewer, *address) {
+                    Ok(web) => {
+                        web_url = Some(web.open);
+                        web_moved = web.moved;
+                        web_exposed = web.exposed;
+                        web_server = web.server;
+                        Some(web.grpc)
+                    }
+                    Err(why) => {
+                        notice = Some(format!("{NOT_CONNECTED}: {why}"));
+                        None
+                    }
                 }
-                Err(why) => {
-                    notice = Some(format!("{NOT_CONNECTED}: {why}"));
-                    None
-                }
-            },
+            }
             None => None,
         };
         if let Some(url) = url {
@@ -235,6 +251,7 @@ impl Viz {
         viz.notice = notice;
         viz.web_url = web_url;
         viz.web_moved = web_moved;
+        viz.web_exposed = web_exposed;
         viz.web_server = web_server;
         viz.file = sinks.rrd.is_some();
         viz.meshes = sinks.meshes;
@@ -262,6 +279,7 @@ impl Viz {
             notice: None,
             web_url: None,
             web_moved: None,
+            web_exposed: None,
             file: false,
             web_server: None,
         }
@@ -275,6 +293,11 @@ impl Viz {
     /// Why the web viewer is not on the usual ports, when it is not.
     pub fn web_moved(&self) -> Option<&str> {
         self.web_moved.as_deref()
+    }
+
+    /// That the web viewer can be reached from other machines, when it can.
+    pub fn web_exposed(&self) -> Option<&str> {
+        self.web_exposed.as_deref()
     }
 
     /// The web viewer started for this session, to leave running or to stop; none when

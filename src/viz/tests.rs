@@ -226,7 +226,17 @@ fn colours_come_from_the_names_and_shapes_from_the_parts() {
 #[test]
 fn viewer_flags_parse() {
     assert_eq!("spawn".parse::<Viewer>().unwrap(), Viewer::Spawn);
-    assert_eq!("web".parse::<Viewer>().unwrap(), Viewer::Web);
+    let localhost: std::net::IpAddr = std::net::Ipv4Addr::LOCALHOST.into();
+    assert_eq!("web".parse::<Viewer>().unwrap(), Viewer::Web(localhost));
+    assert_eq!(
+        "web=0.0.0.0".parse::<Viewer>().unwrap(),
+        Viewer::Web(std::net::Ipv4Addr::UNSPECIFIED.into())
+    );
+    // Only this machine or every interface: betr streams to the viewer at 127.0.0.1.
+    for refused in ["web=", "web=10.1.2.3", "web=somewhere"] {
+        let e = refused.parse::<Viewer>().unwrap_err().to_string();
+        assert!(e.contains(refused) && e.contains("web=0.0.0.0"), "{e}");
+    }
     assert_eq!(
         viewer::web_page(DEFAULT_URL, WEB_PORT),
         "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
@@ -421,9 +431,14 @@ fn the_web_viewer_moves_off_ports_that_are_taken() {
 /// ports tried and how to use a viewer started by hand; one that is not there is said.
 #[test]
 fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
-    let error = viewer::start_web(std::ffi::OsStr::new("false"), ViewerLife::StopsWithSession)
-        .err()
-        .unwrap();
+    let localhost = std::net::Ipv4Addr::LOCALHOST.into();
+    let error = viewer::start_web(
+        std::ffi::OsStr::new("false"),
+        ViewerLife::StopsWithSession,
+        localhost,
+    )
+    .err()
+    .unwrap();
     let said = error.to_string();
     assert!(
         matches!(error, viewer::ViewerError::Stopped { attempts: 3, .. }),
@@ -434,6 +449,7 @@ fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
     let missing = viewer::start_web(
         std::ffi::OsStr::new("/nonexistent/rerun"),
         ViewerLife::StopsWithSession,
+        localhost,
     )
     .err()
     .unwrap();

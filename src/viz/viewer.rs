@@ -15,7 +15,7 @@
 
 use std::ffi::OsStr;
 use std::io::ErrorKind;
-use std::net::TcpListener;
+use std::net::{IpAddr, TcpListener};
 use std::os::unix::process::CommandExt;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
@@ -107,6 +107,8 @@ pub struct WebViewer {
     pub open: String,
     /// Why it is not on the usual ports, when it is not.
     pub moved: Option<String>,
+    /// That other machines can reach it, when it listens beyond this one.
+    pub exposed: Option<String>,
     pub server: Option<WebServer>,
 }
 
@@ -259,13 +261,18 @@ pub fn web_page(grpc: &str, web_port: u16) -> String {
 
 /// A web viewer to stream to: for a one-shot command one listening on the usual ports
 /// when there is one; otherwise `program --serve-web` started and listening.
-pub(super) fn start_web(program: &OsStr, life: ViewerLife) -> Result<WebViewer, ViewerError> {
+pub(super) fn start_web(
+    program: &OsStr,
+    life: ViewerLife,
+    address: IpAddr,
+) -> Result<WebViewer, ViewerError> {
     let usual_page = format!("http://127.0.0.1:{WEB_PORT}/");
     if life == ViewerLife::OutlivesCommand && listening(DEFAULT_URL) && listening(&usual_page) {
         return Ok(WebViewer {
             grpc: DEFAULT_URL.to_string(),
             open: web_page(DEFAULT_URL, WEB_PORT),
             moved: None,
+            exposed: None,
             server: None,
         });
     }
@@ -273,7 +280,11 @@ pub(super) fn start_web(program: &OsStr, life: ViewerLife) -> Result<WebViewer, 
     loop {
         attempt += 1;
         let (grpc, web) = free_ports()?;
-        match serve(program, grpc, web, life == ViewerLife::OutlivesCommand) {
+        match serve(
+            program,
+            (address, grpc, web),
+            life == ViewerLife::OutlivesCommand,
+        ) {
             Err(ViewerError::Stopped { status, .. }) if attempt < START_ATTEMPTS => {
                 tracing::info!(%status, grpc, web, "the web viewer stopped at once: new ports");
             }
@@ -299,10 +310,18 @@ pub(super) fn start_web(program: &OsStr, life: ViewerLife) -> Result<WebViewer, 
                         taken.join(" and ")
                     )
                 });
+                let exposed = (!address.is_loopback()).then(|| {
+                    format!(
+                        "the web viewer listens on {address}: anyone who reaches this machine on \
+                         ports {grpc} and {web} can watch the session (`--viewer web` keeps it \
+                         to this machine)"
+                    )
+                });
                 return Ok(WebViewer {
                     open: web_page(&url, web),
                     grpc: url,
                     moved,
+                    exposed,
                     server: Some(server),
                 });
             }
@@ -310,11 +329,17 @@ pub(super) fn start_web(program: &OsStr, life: ViewerLife) -> Result<WebViewer, 
     }
 }
 
-/// `program --serve-web` on these ports (`own_group`: in a process group of its own),
-/// once it listens on both.
-fn serve(program: &OsStr, grpc: u16, web: u16, own_group: bool) -> Result<WebServer, ViewerError> {
+/// `program --serve-web` on this address and these ports (`own_group`: in a process
+/// group of its own), once it listens on both.
+fn serve(
+    program: &OsStr,
+    (address, grpc, web): (IpAddr, u16, u16),
+    own_group: bool,
+) -> Result<WebServer, ViewerError> {
     let mut command = Command::new(program);
     command
+        .arg("--bind")
+        .arg(address.to_string())
         .args(["--serve-web", "--port"])
         .arg(grpc.to_string())
         .arg("--web-viewer-port")

@@ -44,3 +44,42 @@ fn every_command_and_subcommand_builds_its_help() {
     // betr, its commands, and the subcommands of eval, knowledge and model.
     assert!(seen > 20, "{seen} helps built");
 }
+
+/// A first word that is neither a command nor a scenario, but close to a command's name,
+/// is answered with that command; one close to nothing names only the scenario it could
+/// not find.
+#[test]
+fn a_mistyped_command_gets_the_command_it_was_likely_meant_as() {
+    let dir = tmp("command-line-typo");
+    let out = betr(&dir, &["tiu"]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("did you mean the command `betr tui`?"),
+        "{log}"
+    );
+    let out = betr(&dir, &["verfy"]);
+    assert!(text(&out).contains("`betr verify`"), "{}", text(&out));
+    let out = betr(&dir, &["zzzzzz"]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("zzzzzz") && !log.contains("did you mean the command"),
+        "{log}"
+    );
+}
+
+/// `export` takes a scenario by its name, as the other commands do.
+#[test]
+fn export_takes_a_scenario_by_name() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_betr"))
+        .args(["export", "cell/red_on_blue", "--format", "btcpp"])
+        .current_dir(support::fixtures::root())
+        .env("BETR_OFFLINE", "1")
+        .env("XDG_CACHE_HOME", tmp("command-line-export").join("cache"))
+        .output()
+        .unwrap();
+    let xml = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    assert!(xml.contains("<root BTCPP_format=\"4\""), "{xml}");
+}

@@ -561,3 +561,29 @@ fn replay_position(screen: &str) -> (usize, usize) {
     let (p, n) = field.split_once('/').unwrap();
     (p.parse().unwrap(), n.parse().unwrap())
 }
+
+/// `betr SCENARIO [workbench options]` without a command is the workbench, a scenario
+/// given by its name as every command takes it.
+#[test]
+fn bare_betr_with_a_scenario_name_opens_the_workbench_on_it() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-bare");
+    let command = format!(
+        "cd {repo} && {isolated} {key_var}={key} {bin} cafe/no_coffee --backend openai \
+         --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies}; \
+         echo \"betr exited with status $?\"; sleep 60",
+        repo = quote(&fixtures::root()),
+        isolated = support::tmux::isolated_env(&dir),
+        key_var = KEY_VAR,
+        key = KEY,
+        bin = quote(Path::new(env!("CARGO_BIN_EXE_betr"))),
+        url = server.base_url(),
+        policies = quote(&dir.join("policies")),
+    );
+    let tmux = Tmux::start(&command);
+    tmux.wait_for(&["Behavior tree", "no_coffee", "openai fake-model"], 20);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -532,7 +532,7 @@ fn the_viewer_flags_say_what_they_started_or_why_not() {
     let _ = viewer.wait();
     assert!(
         said.contains(
-            "3D view: open http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
+            "3D view: open this address in a browser:\nhttp://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy\n"
         ),
         "{said}"
     );

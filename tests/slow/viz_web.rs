@@ -133,6 +133,29 @@ fn still_running(viewers: &BTreeSet<Served>) -> Vec<u32> {
     }
 }
 
+/// The local addresses of the sockets listening on `port`, as /proc/net/tcp and tcp6 list
+/// them (hex: `0100007F` is 127.0.0.1, `00000000` every interface).
+fn listening_addresses(port: u16) -> Vec<String> {
+    let mut out = Vec::new();
+    for table in ["/proc/net/tcp", "/proc/net/tcp6"] {
+        let Ok(text) = std::fs::read_to_string(table) else {
+            continue;
+        };
+        for line in text.lines().skip(1) {
+            let fields: Vec<&str> = line.split_whitespace().collect();
+            // local address, then remote address, then the state (0A: listening).
+            if let [_, local, _, state, ..] = fields.as_slice()
+                && *state == "0A"
+                && let Some((address, hex_port)) = local.rsplit_once(':')
+                && u16::from_str_radix(hex_port, 16) == Ok(port)
+            {
+                out.push(address.to_string());
+            }
+        }
+    }
+    out
+}
+
 /// The status line of the page the web viewer serves on `port`.
 fn page_status(port: u16) -> String {
     let mut page = String::new();
@@ -183,6 +206,12 @@ fn two_workbenches_each_have_a_web_viewer_and_quitting_stops_its_own() {
     // The launcher and the viewer's binary it runs.
     assert!(first_viewers.len() >= 2, "{first_viewers:?}");
     first.wait_for(&[&format!("http://127.0.0.1:{first_port}/?url=")], 10);
+    // Reachable from this machine only.
+    let addresses = listening_addresses(first_port);
+    assert!(
+        !addresses.is_empty() && addresses.iter().all(|a| a == "0100007F"),
+        "the page listens on {addresses:?}"
+    );
 
     let (_second_dir, second) = workbench("viz-web-second", &server);
     second.wait_for(&["Behavior tree", "3D view: open", "http://127.0.0.1:"], 60);
@@ -242,15 +271,17 @@ fn a_one_shot_commands_web_viewer_stays_and_says_how_to_stop_it() {
             "no viewer started and none was there: {said}"
         );
         assert!(
-            said.contains("3D view: open http://127.0.0.1:9090/"),
+            said.contains("3D view: open this address in a browser:\nhttp://127.0.0.1:9090/"),
             "{said}"
         );
         return;
     };
     let group: i32 = stop.parse().unwrap();
+    // The address is on the line after the one that announces it.
     let url = said
         .lines()
-        .find_map(|l| l.strip_prefix("3D view: open "))
+        .skip_while(|l| *l != "3D view: open this address in a browser:")
+        .nth(1)
         .unwrap();
     let port: u16 = url
         .trim_start_matches("http://127.0.0.1:")
