@@ -74,6 +74,7 @@ pub fn command_text(command: &Command) -> String {
         Command::Pause => "pause".into(),
         Command::Approve => "approve".into(),
         Command::Reject => "reject".into(),
+        Command::Cancel => "cancel the model call".into(),
         Command::Edit(edit) => format!("edit {edit}"),
         Command::SetValue(setting) => format!("set {}", setting.text),
         Command::Undo => "undo".into(),

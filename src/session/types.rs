@@ -306,6 +306,8 @@ pub enum Event {
     Asking {
         what: Question,
     },
+    /// The person stopped the model call under way; no answer comes.
+    CallCancelled,
     /// A reply came back: who answered, its tokens and latency.
     Replied {
         attribution: String,

@@ -332,6 +332,7 @@ impl App {
             Action::Plan => Command::Plan,
             Action::Approve => Command::Approve,
             Action::Reject => Command::Reject,
+            Action::Cancel => Command::Cancel,
             Action::Undo => {
                 self.llm.offer = None;
                 self.summary.unsaved_fixes = self.summary.unsaved_fixes.saturating_sub(1);

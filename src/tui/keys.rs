@@ -23,6 +23,8 @@ pub enum Action {
     Dictate,
     Approve,
     Reject,
+    /// Stop the model call under way.
+    Cancel,
     Edit,
     Undo,
     Verify,
@@ -303,6 +305,7 @@ bindings! {
     dictate: Dictate = Key::plain('d'), Workbench;
     approve: Approve = Key::plain('a'), Workbench;
     reject: Reject = Key::plain('x'), Workbench;
+    cancel: Cancel = Key::code(KeyCode::Esc), Workbench;
     edit: Edit = Key::plain('e'), Workbench;
     undo: Undo = Key::plain('u'), Workbench;
     verify: Verify = Key::plain('v'), Workbench;

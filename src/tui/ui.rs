@@ -7,6 +7,7 @@ use ratatui::layout::{Constraint, Layout};
 
 use super::app::{App, Overlay};
 use super::components::help::{draw_help, draw_readings, draw_report};
+use super::components::llm_pane::PaneHints;
 use super::keys::{Action, KeyMode};
 use super::strings;
 
@@ -53,7 +54,16 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     };
     let help_key = key(Action::Help);
     app.tree.draw(frame, tree_area, &theme);
-    app.llm.draw(frame, llm_area, &theme, &hint);
+    let cancel = (app.mode == KeyMode::Workbench).then(|| key(Action::Cancel));
+    app.llm.draw(
+        frame,
+        llm_area,
+        &theme,
+        &PaneHints {
+            proposal: &hint,
+            cancel: cancel.as_deref(),
+        },
+    );
     app.world.draw(frame, world_area, &theme);
     if app.dictation.is_shown() && !app.input.is_open() {
         app.dictation

@@ -224,6 +224,54 @@ fn a_slow_model_call_does_not_block_ticks() {
     });
 }
 
+/// A question to a slow model is cancelled: no answer is waited for, the failure is left
+/// to the person, whose fix is taken as when no model was asked; a second cancel has
+/// nothing to cancel.
+#[test]
+fn a_question_to_the_model_is_cancelled_and_the_person_writes_the_fix() {
+    rt().block_on(async {
+        let mut s = Session::start(setup(
+            Ok(Arc::new(model(Duration::from_secs(600)))),
+            None,
+        ));
+        s.send(Command::Submit("\"blue cube\" on \"green cube\"".into()));
+        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        s.until("the question", |e| matches!(e, Event::Asking { .. }))
+            .await;
+        s.send(Command::Cancel);
+        let got = s
+            .until("the cancel", |e| {
+                matches!(e, Event::Notice { message } if message.starts_with("the question was cancelled"))
+            })
+            .await;
+        assert!(
+            got.iter().any(|e| matches!(e, Event::CallCancelled)),
+            "{got:#?}"
+        );
+        s.send(Command::Cancel);
+        let got = s
+            .until("nothing to cancel", |e| matches!(e, Event::Error { .. }))
+            .await;
+        assert!(
+            format!("{:?}", got.last()).contains("nothing to cancel"),
+            "{got:#?}"
+        );
+        s.send(edit(FIX).unwrap());
+        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
+            .await;
+        s.send(Command::Run);
+        let got = s
+            .until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        assert!(
+            !got.iter().any(|e| matches!(e, Event::Proposal { .. })),
+            "a late answer was taken: {got:#?}"
+        );
+    });
+}
+
 #[test]
 fn a_saved_policy_needs_no_model_call_next_time() {
     let dir = std::env::temp_dir().join(format!("betr-engine-policy-{}", std::process::id()));

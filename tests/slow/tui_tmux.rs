@@ -624,3 +624,35 @@ fn a_property_the_tree_broke_already_does_not_hold_the_approved_fix() {
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A slow model's question shows how long it has waited and the key that cancels it;
+/// `Esc` cancels it, and the person's own fix then resolves the failure.
+#[test]
+fn a_person_cancels_a_slow_question_and_writes_the_fix() {
+    let server = FakeServer::start(
+        vec![],
+        Behavior::Slow(Duration::from_secs(600), "never read".into()),
+    );
+    let dir = tmp("tmux-cancel");
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", ""));
+    tmux.wait_for(&["Behavior tree", "red_on_blue"], 20);
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("\"blue cube\" on \"green cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["grasp \"blue cube\"!"], 20);
+    tmux.keys(&["r"]);
+    tmux.wait_for(&["asking the model for", "esc cancels"], 30);
+    tmux.wait_for(&[" 2 s · esc cancels"], 10);
+    tmux.keys(&["Escape"]);
+    let screen = tmux.wait_for(&["the question was cancelled"], 10);
+    assert!(!screen.contains("esc cancels"), "{screen}");
+    tmux.keys(&["e"]);
+    tmux.text("~\"any object\" on \"blue cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
+    tmux.keys(&["r"]);
+    tmux.wait_for(&["SUCCESS"], 30);
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -139,6 +139,10 @@ pub enum Command {
     Approve,
     /// Drop the pending proposal.
     Reject,
+    /// Stop the model call under way: a question about a failure leaves the failure to
+    /// the person (write the fix, or tick to ask again); a reading leaves the tree as it
+    /// was.
+    Cancel,
     /// Conditions (`A & ~B`) or a value (`5 N`) a person wrote for the pending proposal or
     /// the current failure, read by [`super::parse_edit`]; checked against what is pending,
     /// then applied.
@@ -364,6 +368,21 @@ impl Engine {
             (Phase::Proposed(_), Command::Reject) => self.reject(),
             (Phase::Violated { .. }, Command::Reject) => self.reject_violation(),
             (_, Command::Reject) => self.error("no proposal to reject"),
+            (Phase::Asking { failure, .. }, Command::Cancel) => {
+                let failure = failure.clone();
+                self.enter(Phase::Failed { failure });
+                self.emit(Event::CallCancelled);
+                self.notice(
+                    "the question was cancelled: write the fix yourself (the shortlist above says what fixes the failure in simulation), or step to ask again",
+                );
+            }
+            (Phase::Reading { .. }, Command::Cancel) => {
+                let settled = self.settled();
+                self.enter(settled);
+                self.emit(Event::CallCancelled);
+                self.notice("the reading was cancelled: the tree is as it was");
+            }
+            (_, Command::Cancel) => self.error("nothing to cancel: no model call is under way"),
             (Phase::Proposed(_) | Phase::Failed { .. } | Phase::Asking { .. }, Command::Edit(e)) => {
                 self.edit(e);
             }

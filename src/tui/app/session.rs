@@ -14,6 +14,7 @@ impl App {
     pub fn on_session(&mut self, event: Event) {
         match event {
             e @ (Event::Asking { .. }
+            | Event::CallCancelled
             | Event::Replied { .. }
             | Event::InvalidReply { .. }
             | Event::CandidateRejected { .. }
@@ -61,6 +62,11 @@ impl App {
                 self.status.awaiting = Some(&strings::AWAITING_MODEL);
                 self.llm.error = None;
                 self.llm.asking = Some(what.to_string());
+                self.llm.asking_since = Some(std::time::Instant::now());
+            }
+            Event::CallCancelled => {
+                self.status.awaiting = None;
+                self.llm.asking = None;
             }
             Event::Replied { attribution, .. } => {
                 self.llm.asking = None;

@@ -22,6 +22,15 @@ use super::super::theme::Theme;
 const LOG_LINES: usize = 200;
 const SPINNER: [&str; 4] = ["|", "/", "-", "\\"];
 
+/// The keys the pane names, as they are bound.
+pub struct PaneHints<'a> {
+    /// Under a proposal: approve, reject, edit, whole.
+    pub proposal: &'a str,
+    /// Beside a question under way: the key that cancels it (none in a replay, where
+    /// nothing is under way and no time passes).
+    pub cancel: Option<&'a str>,
+}
+
 /// A proposal as the pane shows it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProposalView {
@@ -104,6 +113,8 @@ impl ProposalView {
 #[derive(Default)]
 pub struct LlmPane {
     pub asking: Option<String>,
+    /// When the question under way was asked.
+    pub asking_since: Option<std::time::Instant>,
     /// Who answered the last model call (`model qwen…`, a fixture).
     pub replied_by: Option<String>,
     pub goal: Option<String>,
@@ -208,16 +219,22 @@ impl LlmPane {
         self.spin = (self.spin + 1) % SPINNER.len();
     }
 
-    pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, keys_hint: &str) {
+    pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, hints: &PaneHints) {
         let mut lines: Vec<Line> = Vec::new();
         if let Some(what) = &self.asking {
+            let live = match (hints.cancel, self.asking_since) {
+                (Some(key), Some(since)) => {
+                    format!(" {} s · {key} cancels", since.elapsed().as_secs())
+                }
+                _ => String::new(),
+            };
             lines.push(Line::from(Span::styled(
-                format!("{} {} {what} …", SPINNER[self.spin], strings::ASKING),
+                format!("{} {} {what} …{live}", SPINNER[self.spin], strings::ASKING),
                 theme.running,
             )));
         }
         match &self.proposal {
-            Some(p) => proposal_lines(p, theme, keys_hint, &mut lines),
+            Some(p) => proposal_lines(p, theme, hints.proposal, &mut lines),
             None => match &self.offer {
                 Some(offer) => lines.push(Line::from(Span::styled(offer.clone(), theme.proposal))),
                 None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
@@ -280,7 +297,7 @@ impl LlmPane {
                     strings::proposed_title(&p.lines.join(" & ")),
                     theme.proposal,
                 ))
-                .title_bottom(Span::styled(format!(" {keys_hint} "), theme.key));
+                .title_bottom(Span::styled(format!(" {} ", hints.proposal), theme.key));
         }
         let inner = block.inner(area);
         frame.render_widget(block, area);
@@ -421,11 +438,40 @@ mod tests {
     use ratatui::backend::TestBackend;
 
     fn screen(pane: &LlmPane) -> String {
-        let mut terminal = Terminal::new(TestBackend::new(40, 12)).unwrap();
+        screen_with(pane, 40, 12, None)
+    }
+
+    fn screen_with(pane: &LlmPane, width: u16, height: u16, cancel: Option<&str>) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
+        let hints = PaneHints {
+            proposal: "a approve",
+            cancel,
+        };
         terminal
-            .draw(|f| pane.draw(f, f.area(), &Theme::default(), ""))
+            .draw(|f| pane.draw(f, f.area(), &Theme::default(), &hints))
             .unwrap();
         terminal.backend().to_string()
+    }
+
+    /// A question under way says how long it has waited and the key that cancels it;
+    /// a replayed one neither (nothing is under way there).
+    #[test]
+    fn a_question_under_way_shows_its_wait_and_its_cancel_key() {
+        let pane = LlmPane {
+            asking: Some("the missing precondition".into()),
+            asking_since: std::time::Instant::now().checked_sub(std::time::Duration::from_secs(7)),
+            ..LlmPane::default()
+        };
+        let live = screen_with(&pane, 80, 6, Some("esc"));
+        assert!(
+            live.contains("the missing precondition … 7 s · esc cancels"),
+            "{live}"
+        );
+        let replayed = screen_with(&pane, 80, 6, None);
+        assert!(
+            replayed.contains("the missing precondition …") && !replayed.contains("cancels"),
+            "{replayed}"
+        );
     }
 
     /// Scenario 1's proposal with the reasoning a small model gave for it, which blames
@@ -472,11 +518,7 @@ mod tests {
     }
 
     fn screen_of(pane: &LlmPane, width: u16, height: u16) -> String {
-        let mut terminal = Terminal::new(TestBackend::new(width, height)).unwrap();
-        terminal
-            .draw(|f| pane.draw(f, f.area(), &Theme::default(), "a approve"))
-            .unwrap();
-        terminal.backend().to_string()
+        screen_with(pane, width, height, None)
     }
 
     #[test]
