@@ -8,10 +8,9 @@ mod cli;
 use std::process::ExitCode;
 
 use betr::http_text::WithoutSecrets;
-use clap::Parser;
 
 fn main() -> ExitCode {
-    let args = cli::Cli::parse();
+    let args = cli::Cli::parse_checked();
     let filter =
         tracing_subscriber::EnvFilter::try_from_env("BETR_LOG").unwrap_or_else(|_| "warn".into());
     let workbench = match &args.command {

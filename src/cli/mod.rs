@@ -48,7 +48,7 @@ use betr::scenario::Scenario;
     version,
     about = "Instruction → goal → behavior tree, repaired when the world disagrees",
     override_usage = "betr [SCENARIO] [WORKBENCH OPTIONS]\n       betr <COMMAND> [ARGS]",
-    args_conflicts_with_subcommands = true
+    subcommand_precedence_over_arg = true
 )]
 pub struct Cli {
     /// What to do (none: the workbench, as `betr tui` with the same arguments).
@@ -251,6 +251,44 @@ pub fn offline_from_env(var: &dyn Fn(&str) -> Option<String>) -> Result<bool> {
     match betr::bounds::switch_value(&value) {
         Some(on) => Ok(on),
         None => bail!("BETR_OFFLINE={value:?} is not true or false"),
+    }
+}
+
+impl Cli {
+    /// The command line, parsed; workbench options given before a command are refused
+    /// rather than ignored (`betr --viewer web plan S`: the option belongs after
+    /// `betr tui`, or to a command that takes it, after the command).
+    pub fn parse_checked() -> Cli {
+        use clap::{CommandFactory, FromArgMatches, parser::ValueSource};
+        let mut command = Cli::command();
+        let matches = command.get_matches_mut();
+        if let Some((name, _)) = matches.subcommand() {
+            let given: Vec<String> = command
+                .get_arguments()
+                .filter(|a| !a.is_global_set())
+                .filter(|a| {
+                    matches.value_source(a.get_id().as_str()) == Some(ValueSource::CommandLine)
+                })
+                .map(|a| match a.get_long() {
+                    Some(long) => format!("--{long}"),
+                    None => a.get_id().to_string().to_uppercase(),
+                })
+                .collect();
+            if !given.is_empty() {
+                command
+                    .error(
+                        clap::error::ErrorKind::ArgumentConflict,
+                        format!(
+                            "{} before the command `{name}`: options before a command are the \
+                             workbench's (`betr [SCENARIO] [OPTIONS]`); a command's own options \
+                             go after it",
+                            given.join(", ")
+                        ),
+                    )
+                    .exit();
+            }
+        }
+        Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
     }
 }
 

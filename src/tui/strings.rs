@@ -287,9 +287,7 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         Dictate => "dictate an instruction (again: stop; Esc: discard)",
         Approve => "approve the proposal",
         Reject => "reject the proposal",
-        Cancel => {
-            "cancel the question to the model under way (then write the fix, or step to ask again)"
-        }
+        Cancel => "cancel the model call under way",
         Edit => "edit the proposal (or type conditions yourself)",
         Undo => "undo the last expansion",
         Verify => "verify the tree",

@@ -83,3 +83,23 @@ fn export_takes_a_scenario_by_name() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out));
     assert!(xml.contains("<root BTCPP_format=\"4\""), "{xml}");
 }
+
+/// Options before a command are the workbench's: given with a command they are refused,
+/// naming them, instead of ignored; the global flags are taken anywhere.
+#[test]
+fn workbench_options_before_a_command_are_refused_not_ignored() {
+    let dir = tmp("command-line-before");
+    let scenario = support::fixtures::root()
+        .join("scenarios/cell/red_on_blue.toml")
+        .to_string_lossy()
+        .into_owned();
+    let out = betr(&dir, &["--viewer", "web", "plan", &scenario]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(log.contains("--viewer before the command `plan`"), "{log}");
+    // Planned (and predicted to fail in simulation: exit 1), the flag taken.
+    let out = betr(&dir, &["--ascii", "plan", &scenario]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{log}");
+    assert!(log.contains("Planned in") && !log.contains('▸'), "{log}");
+}
