@@ -95,7 +95,13 @@ fn node_line(
     let failing = marks.failing == Some(node);
     let label = node_label(tree, node, theme);
     let mut spans = vec![
-        Span::styled(if new { strings::NEW_MARK } else { " " }, theme.new_node),
+        // Only a new node's column is coloured: a styled blank would put a block of the
+        // new-node colour at the start of every row.
+        if new {
+            Span::styled(strings::NEW_MARK, theme.new_node)
+        } else {
+            Span::raw(" ")
+        },
         Span::styled(
             format!("[{}] ", theme.glyphs.status(status)),
             theme.status(status),

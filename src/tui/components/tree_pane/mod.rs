@@ -544,6 +544,35 @@ mod tests {
         insta::assert_snapshot!("searched_300_nodes_80x24", terminal.backend().to_string());
     }
 
+    /// The new-node colour marks the rows of new nodes only.
+    #[test]
+    fn only_the_new_nodes_rows_carry_the_new_node_colour() {
+        let tree = Arc::new(big(13));
+        let theme = Theme::default();
+        let mut pane = TreePane::default();
+        pane.set_tree(tree.clone(), Vec::new(), Vec::new());
+        pane.search("thing 4", true, &theme).unwrap();
+        let new = pane.selected().unwrap();
+        pane.set_tree(tree, vec![new], Vec::new());
+        let mut terminal = Terminal::new(TestBackend::new(60, 20)).unwrap();
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        let buffer = terminal.backend().buffer();
+        let coloured = |y: u16| {
+            (0..buffer.area.width).any(|x| buffer[(x, y)].bg == theme.new_node.bg.unwrap())
+        };
+        let text = |y: u16| -> String {
+            (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol())
+                .collect()
+        };
+        let marked: Vec<String> = (0..buffer.area.height)
+            .filter(|y| coloured(*y))
+            .map(text)
+            .collect();
+        assert_eq!(marked.len(), 1, "{marked:#?}");
+        assert!(marked[0].contains("thing 4"), "{marked:#?}");
+    }
+
     #[test]
     fn five_thousand_nodes_render() {
         // How fast is measured by `cargo bench --bench tree_render`; here only that a large tree draws,
