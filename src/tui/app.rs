@@ -277,8 +277,12 @@ impl App {
         }
         if let Some(Overlay::ConfirmQuit(_)) = &self.overlay {
             self.overlay = None;
-            if self.keys.action_in(self.mode, &key) == Some(Action::Quit) {
-                self.queue.push(AppEvent::Quit);
+            // The question names the save key for the unsaved fixes: it saves them, and
+            // the person quits after (any other key stays).
+            match self.keys.action_in(self.mode, &key) {
+                Some(Action::Quit) => self.queue.push(AppEvent::Quit),
+                Some(Action::Save) => self.on_action(Action::Save),
+                _ => {}
             }
             return;
         }

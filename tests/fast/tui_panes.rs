@@ -386,3 +386,27 @@ fn a_goal_other_than_the_first_answer_is_said_in_the_log() {
         );
     });
 }
+
+/// The quit question names the save key for the fixes not saved: that key saves them
+/// (and closes the question) instead of only closing it.
+#[test]
+fn the_quit_question_saves_with_the_key_it_names() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.step_to_failure().await;
+        b.key(KeyCode::Char('a'));
+        b.until(|e| matches!(e, Event::Repaired { .. })).await;
+        b.key(KeyCode::Char('q'));
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("(s saves them)"), "{screen}");
+        b.key(KeyCode::Char('s'));
+        assert!(
+            b.sent
+                .iter()
+                .any(|c| matches!(c, betr::session::Command::SavePolicy)),
+            "{:?}",
+            b.sent
+        );
+        assert!(!b.screen(120, 40).contains("again to quit"));
+    });
+}
