@@ -28,6 +28,7 @@ pub mod http_text;
 pub mod interop;
 pub mod llm;
 pub mod model;
+pub mod monitor;
 pub mod motion;
 pub mod planner;
 pub mod reading;

@@ -16,6 +16,7 @@ fn main() -> ExitCode {
     let workbench = match &args.command {
         None | Some(cli::Command::Tui(_)) => true,
         Some(cli::Command::Replay(r)) => !r.print && r.to_rrd.is_none(),
+        Some(cli::Command::Monitor(m)) => !m.print,
         _ => false,
     };
     if workbench {

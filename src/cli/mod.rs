@@ -8,6 +8,7 @@ mod export_cmd;
 mod knowledge_cmd;
 mod llm_cmds;
 mod model_cmd;
+mod monitor_cmd;
 mod policy_cmd;
 mod replay_cmd;
 mod resolve_cmd;
@@ -104,6 +105,9 @@ pub enum Command {
         #[command(flatten)]
         knowledge: knowledge_cmd::KnowledgeFlags,
     },
+    /// Watch a BehaviorTree.CPP process live over Groot2's protocol: its tree with every
+    /// node's status (or --print: one line per status change).
+    Monitor(monitor_cmd::MonitorArgs),
     /// Open a recorded session (--record FILE) in the workbench, read-only, to step through
     /// forward and back without the model; print it as text (--print), or convert it into a
     /// rerun recording (--to-rrd).
@@ -227,6 +231,7 @@ pub fn run(cli: Cli) -> Result<ExitCode> {
         } => tree_cmds::plan(&load_with(&scenario, &knowledge)?, goal.as_deref(), glyphs),
         Command::Run(args) => tree_cmds::run_command(&args, glyphs),
         Command::Replay(args) => replay_cmd::replay(&args, cli.ascii),
+        Command::Monitor(args) => monitor_cmd::monitor(&args, cli.ascii),
         Command::Repair(args) => tree_cmds::repair_command(&args, glyphs),
         Command::Verify(args) => verify_cmd::command(&args, cli.ascii),
     }

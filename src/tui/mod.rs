@@ -17,6 +17,7 @@ pub mod components;
 pub mod dictation;
 pub mod event_loop;
 pub mod keys;
+pub mod monitor;
 pub mod replay;
 pub mod stderr;
 pub mod strings;

@@ -33,6 +33,7 @@ mod knowledge_shared;
 mod llm_client;
 mod llm_faults;
 mod module_graph;
+mod monitor_errors;
 mod names;
 mod recording;
 mod resolve_loop;

@@ -14,7 +14,7 @@
 use crate::support;
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use betr::bt::{
@@ -29,30 +29,6 @@ use serde_json::{Value as Json, json};
 use support::cli::{betr, text, tmp};
 use support::spread;
 use support::verify::{planned, repaired, root, scenario_files};
-
-/// The venv's python, installed through the script when missing; a failed install fails
-/// the test with the script's reason.
-fn btcpp_python() -> PathBuf {
-    let target = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf();
-    let venv = target.join("btcpp-venv");
-    let out = Command::new("bash")
-        .arg(root().join("scripts/btcpp-venv.sh"))
-        .arg(&venv)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "scripts/btcpp-venv.sh could not install behaviortreepy into {}: {}",
-        venv.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let python = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
-    assert!(python.exists(), "{}", python.display());
-    python
-}
 
 /// A leaf as the driver names it: its BT.CPP node ID and its ports in the model's order.
 fn condition_key(domain: &Domain, condition: &Condition) -> String {
@@ -283,7 +259,7 @@ fn compare(name: &str, report: &Json, expected: &[(String, Statuses)], xml: &str
 
 #[test]
 fn btcpp_ticks_every_scenario_tree_as_betr_does() {
-    let python = btcpp_python();
+    let python = support::btcpp::python();
     let dir = tmp("btcpp-runs");
     // Each scenario's trees are exported, run in BT.CPP and compared on their own, so the
     // scenarios run on every core; per tree: what it is, its last outcome, ticks, halts.
@@ -342,7 +318,7 @@ fn btcpp_ticks_every_scenario_tree_as_betr_does() {
 
 #[test]
 fn the_betr_export_command_writes_what_btcpp_loads() {
-    let python = btcpp_python();
+    let python = support::btcpp::python();
     let dir = tmp("btcpp-export-cmd");
     let scenario = root().join("scenarios/cell/red_on_blue.toml");
     let out = betr(
@@ -368,7 +344,7 @@ fn the_betr_export_command_writes_what_btcpp_loads() {
 
 #[test]
 fn a_leaf_the_script_does_not_answer_is_a_problem_the_driver_reports() {
-    let python = btcpp_python();
+    let python = support::btcpp::python();
     let dir = tmp("btcpp-driver-problem");
     let s = Scenario::load(&root().join("scenarios/cell/red_on_blue.toml")).unwrap();
     let tree = planned(&s).unwrap();
@@ -393,7 +369,7 @@ fn a_leaf_the_script_does_not_answer_is_a_problem_the_driver_reports() {
 
 #[test]
 fn a_guard_that_stops_holding_halts_the_running_action_in_btcpp_as_in_betr() {
-    let python = btcpp_python();
+    let python = support::btcpp::python();
     let dir = tmp("btcpp-halt");
     let s = Scenario::load(&root().join("scenarios/cafe/cafe.toml")).unwrap();
     let tree = planned(&s).unwrap();

@@ -15,6 +15,7 @@ mod eval_cmds;
 mod fetch_kill;
 mod first_run;
 mod local_model;
+mod monitor_btcpp;
 mod motion_anchor;
 mod policy_kill;
 mod recording;

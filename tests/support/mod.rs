@@ -4,6 +4,7 @@
 #![allow(clippy::unwrap_used)] // test helpers: a failure is a failed test
 
 pub mod bench;
+pub mod btcpp;
 pub mod check;
 pub mod cli;
 pub mod embedded;

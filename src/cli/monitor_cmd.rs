@@ -1,0 +1,154 @@
+//! `betr monitor [HOST:PORT]`: a BehaviorTree.CPP process watched live over Groot2's
+//! protocol, in a screen of its tree with every node's status, or (`--print`) one line per
+//! status change for scripts and terminals without a screen.
+
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Result, bail};
+use tokio::sync::mpsc;
+
+use betr::http_text::printable;
+use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, watch};
+
+/// What `betr monitor` is asked.
+#[derive(clap::Args)]
+pub struct MonitorArgs {
+    /// The publisher's address: HOST, HOST:PORT or :PORT (BT.CPP's Groot2Publisher
+    /// listens on 1667 unless told otherwise).
+    #[arg(default_value = "127.0.0.1:1667", value_name = "HOST:PORT")]
+    pub address: String,
+    /// Print one line per status change (time, node path, name, old → new) instead of
+    /// opening the screen.
+    #[arg(long)]
+    pub print: bool,
+    /// Stop after this many seconds (a fraction allowed); without it, watch until stopped.
+    #[arg(long = "for", value_name = "SECONDS", value_parser = seconds)]
+    pub duration: Option<Duration>,
+}
+
+fn seconds(text: &str) -> Result<Duration, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if s > 0.0 && s <= 1e7 => Ok(Duration::from_secs_f64(s)),
+        _ => Err(format!(
+            "{text:?} is not a number of seconds above 0 (at most 10000000)"
+        )),
+    }
+}
+
+pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
+    let address = Address::parse(&args.address)?;
+    if args.print {
+        return super::runtime()?.block_on(print(address, args.duration, ascii));
+    }
+    use std::io::IsTerminal as _;
+    if !std::io::stdout().is_terminal() {
+        bail!(
+            "standard output is not a terminal, and the monitor opens a screen; --print prints the status changes as text"
+        );
+    }
+    betr::tui::monitor::run(
+        address,
+        args.duration,
+        ascii,
+        super::tui_cmd::log_path().as_deref(),
+    )?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Prints what the watch reports until `duration` has passed (or forever); an error when
+/// no publisher ever answered.
+async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Result<ExitCode> {
+    let (events, mut received) = mpsc::channel(256);
+    let watcher = tokio::spawn(watch(address.clone(), WatchTiming::default(), events));
+    let deadline = duration.map(|d| tokio::time::Instant::now() + d);
+    let mut printer = Printer {
+        live: None,
+        since: Duration::ZERO,
+        arrow: if ascii { "->" } else { "→" },
+        last_wait: None,
+    };
+    loop {
+        let event = match deadline {
+            Some(at) => match tokio::time::timeout_at(at, received.recv()).await {
+                Ok(event) => event,
+                Err(_) => break,
+            },
+            None => received.recv().await,
+        };
+        let Some(event) = event else { break };
+        printer.on(event);
+    }
+    watcher.abort();
+    if printer.live.is_none() {
+        let waited = duration.map_or(String::new(), |d| format!(" for {} s", d.as_secs_f64()));
+        match printer.last_wait {
+            Some(reason) => bail!("{reason} (tried{waited})"),
+            None => bail!("no Groot2 publisher answered at {address}{waited}"),
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The lines `--print` writes: `#` lines about the connection and the tree, then one line
+/// per status change.
+struct Printer {
+    live: Option<LiveTree>,
+    since: Duration,
+    arrow: &'static str,
+    last_wait: Option<String>,
+}
+
+impl Printer {
+    fn on(&mut self, event: WatchEvent) {
+        match event {
+            WatchEvent::Connected {
+                address,
+                tree,
+                statuses,
+                since,
+            } => {
+                outln!(
+                    "# watching {address}: tree {}, {} nodes",
+                    printable(&tree.main),
+                    tree.nodes.len()
+                );
+                let live = LiveTree::new(*tree, &statuses);
+                for (node, status) in live.tree.nodes.iter().zip(&live.statuses) {
+                    outln!(
+                        "# {:<10} {}{}  {}",
+                        node.path,
+                        "  ".repeat(node.depth),
+                        live.tree.describe(node),
+                        status.name()
+                    );
+                }
+                self.live = Some(live);
+                self.since = since;
+            }
+            WatchEvent::Changes(transitions) => {
+                let Some(live) = self.live.as_mut() else {
+                    return;
+                };
+                for transition in transitions {
+                    let Some(change) = live.apply(transition) else {
+                        outln!(
+                            "# a status change of node {}, which the tree does not have",
+                            transition.uid
+                        );
+                        continue;
+                    };
+                    outln!("{}", live.describe_change(self.since, &change, self.arrow));
+                }
+            }
+            WatchEvent::Restarted => {
+                outln!("# the publisher runs a new tree (restarted): reading it again");
+            }
+            WatchEvent::Lost(reason) => outln!("# {reason}; trying again"),
+            WatchEvent::Waiting(reason) => {
+                outln!("# {reason}; trying again");
+                self.last_wait = Some(reason);
+            }
+        }
+    }
+}

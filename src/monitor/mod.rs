@@ -1,0 +1,207 @@
+//! Watching a BehaviorTree.CPP process live over Groot2's monitor protocol: `protocol` is
+//! the wire format, `tree` the tree the publisher describes, `client` one connection, and
+//! [`watch`] the loop that follows a publisher — connecting, reading its tree, asking it to
+//! keep every status change and collecting them — through restarts and lost connections,
+//! as [`WatchEvent`]s for a front end (`betr monitor --print`, the monitor screen).
+
+pub mod client;
+pub mod protocol;
+pub mod tree;
+
+use std::time::Duration;
+
+use tokio::sync::mpsc;
+
+pub use client::{Address, AddressError, ClientError, DEFAULT_PORT, Publisher, TreeId};
+pub use protocol::{NodeStatus, Transition};
+pub use tree::{NodeKind, WatchedNode, WatchedTree};
+
+/// How the watch talks to the publisher.
+#[derive(Clone, Copy, Debug)]
+pub struct WatchTiming {
+    /// Between two requests for the status changes.
+    pub poll: Duration,
+    /// For connecting and for each reply.
+    pub timeout: Duration,
+    /// Between two tries to connect after a failure.
+    pub retry: Duration,
+}
+
+impl Default for WatchTiming {
+    fn default() -> Self {
+        WatchTiming {
+            poll: Duration::from_millis(10),
+            timeout: Duration::from_secs(2),
+            retry: Duration::from_millis(500),
+        }
+    }
+}
+
+/// What the watch reports, in order.
+#[derive(Debug)]
+pub enum WatchEvent {
+    /// Connected (again) and read the tree: every node's status now, and the moment the
+    /// publisher started keeping status changes, as time since the watch began.
+    Connected {
+        address: Address,
+        tree: Box<WatchedTree>,
+        statuses: Vec<(u16, NodeStatus)>,
+        since: Duration,
+    },
+    /// Status changes, each timed from the `since` of the last `Connected`.
+    Changes(Vec<Transition>),
+    /// The publisher now runs another tree (the robot restarted); its tree is read again.
+    Restarted,
+    /// The connection broke, or a reply was not Groot2's; the watch tries again.
+    Lost(String),
+    /// Not connected: why, as the last try said. Sent when the reason changes.
+    Waiting(String),
+}
+
+/// Follows the publisher at `address` until the receiver is dropped.
+pub async fn watch(address: Address, timing: WatchTiming, events: mpsc::Sender<WatchEvent>) {
+    let began = tokio::time::Instant::now();
+    let mut last_wait: Option<String> = None;
+    loop {
+        let outcome = follow(&address, timing, began, &events).await;
+        if events.is_closed() {
+            return;
+        }
+        let event = match outcome {
+            Ok(Ended::Restarted) => WatchEvent::Restarted,
+            Ok(Ended::Closed) => return,
+            Err(Failure::BeforeConnecting(e)) => {
+                let reason = e.to_string();
+                if last_wait.as_ref() != Some(&reason) {
+                    last_wait = Some(reason.clone());
+                    if events.send(WatchEvent::Waiting(reason)).await.is_err() {
+                        return;
+                    }
+                }
+                tokio::time::sleep(timing.retry).await;
+                continue;
+            }
+            Err(Failure::AfterConnecting(e)) => WatchEvent::Lost(e.to_string()),
+        };
+        last_wait = None;
+        if events.send(event).await.is_err() {
+            return;
+        }
+    }
+}
+
+enum Ended {
+    Restarted,
+    Closed,
+}
+
+enum Failure {
+    BeforeConnecting(ClientError),
+    AfterConnecting(ClientError),
+}
+
+/// One connection's life: connect, read the tree, start recording, collect changes until
+/// the tree changes or the connection fails.
+async fn follow(
+    address: &Address,
+    timing: WatchTiming,
+    began: tokio::time::Instant,
+    events: &mpsc::Sender<WatchEvent>,
+) -> Result<Ended, Failure> {
+    let before = Failure::BeforeConnecting;
+    let mut publisher = Publisher::connect(address, timing.timeout)
+        .await
+        .map_err(before)?;
+    let (tree_id, tree) = publisher.tree().await.map_err(before)?;
+    let since = began.elapsed();
+    let after = Failure::AfterConnecting;
+    publisher.start_recording().await.map_err(after)?;
+    let (_, statuses) = publisher.statuses().await.map_err(after)?;
+    let connected = WatchEvent::Connected {
+        address: address.clone(),
+        tree: Box::new(tree),
+        statuses,
+        since,
+    };
+    if events.send(connected).await.is_err() {
+        return Ok(Ended::Closed);
+    }
+    loop {
+        tokio::time::sleep(timing.poll).await;
+        let (id, changes) = publisher.transitions().await.map_err(after)?;
+        if id != tree_id {
+            return Ok(Ended::Restarted);
+        }
+        if !changes.is_empty() && events.send(WatchEvent::Changes(changes)).await.is_err() {
+            return Ok(Ended::Closed);
+        }
+    }
+}
+
+/// A watched tree with every node's status, kept up to date from the watch's events.
+#[derive(Clone, Debug)]
+pub struct LiveTree {
+    pub tree: WatchedTree,
+    pub statuses: Vec<NodeStatus>,
+}
+
+/// One node's status change, resolved to the node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Change {
+    pub micros: u64,
+    pub index: usize,
+    pub old: NodeStatus,
+    pub new: NodeStatus,
+}
+
+impl LiveTree {
+    pub fn new(tree: WatchedTree, statuses: &[(u16, NodeStatus)]) -> LiveTree {
+        let mut live = LiveTree {
+            statuses: vec![NodeStatus::Idle; tree.nodes.len()],
+            tree,
+        };
+        for &(uid, status) in statuses {
+            if let Some(i) = live.tree.index_of(uid) {
+                live.statuses[i] = status;
+            }
+        }
+        live
+    }
+
+    /// Applies a status change; `None` for a node the tree does not have.
+    pub fn apply(&mut self, transition: Transition) -> Option<Change> {
+        let index = self.tree.index_of(transition.uid)?;
+        let old = std::mem::replace(&mut self.statuses[index], transition.status);
+        Some(Change {
+            micros: transition.micros,
+            index,
+            old,
+            new: transition.status,
+        })
+    }
+}
+
+impl LiveTree {
+    /// The node the tree is busy in: the deepest running node (the last running one in
+    /// depth-first order lies on the running path's end).
+    pub fn busy(&self) -> Option<usize> {
+        self.statuses
+            .iter()
+            .rposition(|s| *s == NodeStatus::Running)
+    }
+
+    /// A status change as one line: the time since the watch began, the node's path and
+    /// name, the old and the new status.
+    pub fn describe_change(&self, since: Duration, change: &Change, arrow: &str) -> String {
+        let node = &self.tree.nodes[change.index];
+        let time = since + Duration::from_micros(change.micros);
+        format!(
+            "{:>10.3}  {}  {}  {} {arrow} {}",
+            time.as_secs_f64(),
+            node.path,
+            crate::http_text::printable(&node.name),
+            change.old.name(),
+            change.new.name()
+        )
+    }
+}

@@ -1,0 +1,331 @@
+//! Groot2's monitor protocol as BehaviorTree.CPP 4 speaks it
+//! (`loggers/groot2_protocol.h`): ZeroMQ request–reply, each request a 6-byte header
+//! (protocol id, request type, a request id) and an optional body, each reply a 22-byte
+//! header (the request's header echoed and the tree's 16-byte id) and a payload, or the two
+//! frames `error`, message. Numbers are little-endian, as the publisher writes its native
+//! integers on the platforms BT.CPP runs on.
+
+use thiserror::Error;
+
+/// The protocol version this module speaks (BT.CPP 4's `kProtocolID`).
+pub const PROTOCOL_ID: u8 = 2;
+const REQUEST_HEADER: usize = 6;
+const REPLY_HEADER: usize = REQUEST_HEADER + 16;
+
+/// What a request asks the publisher.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RequestKind {
+    /// The whole tree as XML, with each node's `_uid`.
+    FullTree,
+    /// Every node's current status.
+    Status,
+    /// Start (body `start`) or stop (`stop`) keeping every status change.
+    ToggleRecording,
+    /// The status changes kept since the last such request.
+    Transitions,
+}
+
+impl RequestKind {
+    fn byte(self) -> u8 {
+        match self {
+            RequestKind::FullTree => b'T',
+            RequestKind::Status => b'S',
+            RequestKind::ToggleRecording => b'r',
+            RequestKind::Transitions => b't',
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            RequestKind::FullTree => "full tree",
+            RequestKind::Status => "status",
+            RequestKind::ToggleRecording => "toggle recording",
+            RequestKind::Transitions => "transitions",
+        }
+    }
+}
+
+/// A node's status as the publisher reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum NodeStatus {
+    Idle,
+    Running,
+    Success,
+    Failure,
+    Skipped,
+}
+
+impl NodeStatus {
+    /// BT.CPP's `NodeStatus` value; the status buffer's 10 + status ("idle, after
+    /// success") is idle.
+    fn from_byte(byte: u8) -> Option<NodeStatus> {
+        Some(match byte {
+            0 | 11..=13 => NodeStatus::Idle,
+            1 => NodeStatus::Running,
+            2 => NodeStatus::Success,
+            3 => NodeStatus::Failure,
+            4 => NodeStatus::Skipped,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeStatus::Idle => "IDLE",
+            NodeStatus::Running => "RUNNING",
+            NodeStatus::Success => "SUCCESS",
+            NodeStatus::Failure => "FAILURE",
+            NodeStatus::Skipped => "SKIPPED",
+        }
+    }
+}
+
+/// A reply that is not what the protocol promises, or the publisher's own error.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum ProtocolError {
+    #[error("the reply to a {request} request is not Groot2's: {what}")]
+    NotGroot2 { request: &'static str, what: String },
+    #[error(
+        "the publisher speaks Groot2 protocol version {got}; betr speaks version {PROTOCOL_ID} (BehaviorTree.CPP 4)"
+    )]
+    Version { got: u8 },
+    #[error("the publisher refused a {request} request: {message}")]
+    Refused {
+        request: &'static str,
+        message: String,
+    },
+    #[error("the {what} payload is {len} bytes, not a whole number of {unit}-byte entries")]
+    Ragged {
+        what: &'static str,
+        len: usize,
+        unit: usize,
+    },
+    #[error("node {uid}'s status byte is {byte}, which is no BehaviorTree.CPP status")]
+    Status { uid: u16, byte: u8 },
+}
+
+/// One request: its kind, its id (echoed in the reply) and its frames.
+#[derive(Clone, Debug)]
+pub struct Request {
+    pub kind: RequestKind,
+    pub id: u32,
+    pub body: Option<Vec<u8>>,
+}
+
+impl Request {
+    pub fn new(kind: RequestKind, id: u32) -> Request {
+        Request {
+            kind,
+            id,
+            body: None,
+        }
+    }
+
+    pub fn with_body(mut self, body: &[u8]) -> Request {
+        self.body = Some(body.to_vec());
+        self
+    }
+
+    /// The request's frames: the header, then the body if any.
+    pub fn frames(&self) -> Vec<Vec<u8>> {
+        let mut header = Vec::with_capacity(REQUEST_HEADER);
+        header.push(PROTOCOL_ID);
+        header.push(self.kind.byte());
+        header.extend_from_slice(&self.id.to_le_bytes());
+        let mut frames = vec![header];
+        frames.extend(self.body.clone());
+        frames
+    }
+
+    /// The reply's payload and the tree id, checked against this request.
+    pub fn read_reply<'a>(&self, frames: &'a [&'a [u8]]) -> Result<Reply<'a>, ProtocolError> {
+        let request = self.kind.name();
+        let Some(first) = frames.first() else {
+            return Err(ProtocolError::NotGroot2 {
+                request,
+                what: "it has no frames".into(),
+            });
+        };
+        if *first == b"error" {
+            let message = frames
+                .get(1)
+                .map(|m| crate::http_text::printable(&String::from_utf8_lossy(m)).into_owned())
+                .unwrap_or_default();
+            return Err(ProtocolError::Refused { request, message });
+        }
+        if first.len() != REPLY_HEADER {
+            return Err(ProtocolError::NotGroot2 {
+                request,
+                what: format!(
+                    "its first frame is {} bytes, where Groot2's reply header is {REPLY_HEADER}",
+                    first.len()
+                ),
+            });
+        }
+        if first[0] != PROTOCOL_ID {
+            return Err(ProtocolError::Version { got: first[0] });
+        }
+        let id = u32::from_le_bytes([first[2], first[3], first[4], first[5]]);
+        if first[1] != self.kind.byte() || id != self.id {
+            return Err(ProtocolError::NotGroot2 {
+                request,
+                what: format!(
+                    "it answers request {id} of type {:?}, not request {} of type {:?}",
+                    char::from(first[1]),
+                    self.id,
+                    char::from(self.kind.byte())
+                ),
+            });
+        }
+        let mut tree_id = [0u8; 16];
+        tree_id.copy_from_slice(&first[REQUEST_HEADER..]);
+        Ok(Reply {
+            tree_id,
+            payload: frames.get(1).copied(),
+        })
+    }
+}
+
+/// A checked reply.
+#[derive(Debug)]
+pub struct Reply<'a> {
+    /// The publisher's tree: a new id means a new tree (the robot restarted).
+    pub tree_id: [u8; 16],
+    pub payload: Option<&'a [u8]>,
+}
+
+/// The status buffer: (node uid, status) for every node.
+pub fn read_statuses(payload: &[u8]) -> Result<Vec<(u16, NodeStatus)>, ProtocolError> {
+    entries(payload, "status", 3)?
+        .map(|entry| {
+            let uid = u16::from_le_bytes([entry[0], entry[1]]);
+            NodeStatus::from_byte(entry[2])
+                .map(|status| (uid, status))
+                .ok_or(ProtocolError::Status {
+                    uid,
+                    byte: entry[2],
+                })
+        })
+        .collect()
+}
+
+/// One status change the publisher kept while recording.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Transition {
+    /// Microseconds since the recording started.
+    pub micros: u64,
+    pub uid: u16,
+    pub status: NodeStatus,
+}
+
+/// The transitions payload: 6 bytes of time, the node's uid, its new status.
+pub fn read_transitions(payload: &[u8]) -> Result<Vec<Transition>, ProtocolError> {
+    entries(payload, "transitions", 9)?
+        .map(|entry| {
+            let mut time = [0u8; 8];
+            time[..6].copy_from_slice(&entry[..6]);
+            let uid = u16::from_le_bytes([entry[6], entry[7]]);
+            let status = NodeStatus::from_byte(entry[8]).ok_or(ProtocolError::Status {
+                uid,
+                byte: entry[8],
+            })?;
+            Ok(Transition {
+                micros: u64::from_le_bytes(time),
+                uid,
+                status,
+            })
+        })
+        .collect()
+}
+
+fn entries<'a>(
+    payload: &'a [u8],
+    what: &'static str,
+    unit: usize,
+) -> Result<std::slice::ChunksExact<'a, u8>, ProtocolError> {
+    if !payload.len().is_multiple_of(unit) {
+        return Err(ProtocolError::Ragged {
+            what,
+            len: payload.len(),
+            unit,
+        });
+    }
+    Ok(payload.chunks_exact(unit))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reply_header(kind: u8, id: u32, protocol: u8) -> Vec<u8> {
+        let mut h = vec![protocol, kind];
+        h.extend_from_slice(&id.to_le_bytes());
+        h.extend_from_slice(&[7; 16]);
+        h
+    }
+
+    #[test]
+    fn a_request_is_the_header_then_its_body() {
+        let r = Request::new(RequestKind::ToggleRecording, 0x0403_0201).with_body(b"start");
+        assert_eq!(
+            r.frames(),
+            vec![vec![2, b'r', 1, 2, 3, 4], b"start".to_vec()]
+        );
+        assert_eq!(Request::new(RequestKind::Status, 9).frames().len(), 1);
+    }
+
+    #[test]
+    fn a_reply_is_checked_against_its_request() {
+        let r = Request::new(RequestKind::Status, 77);
+        let header = reply_header(b'S', 77, 2);
+        let frames: Vec<&[u8]> = vec![&header, &[1, 0, 2]];
+        let reply = r.read_reply(&frames).expect("a right reply");
+        assert_eq!(reply.tree_id, [7; 16]);
+        assert_eq!(reply.payload, Some(&[1u8, 0, 2][..]));
+
+        let other = reply_header(b'S', 78, 2);
+        let err = r.read_reply(&[&other]).unwrap_err();
+        assert!(err.to_string().contains("request 78"), "{err}");
+        let v3 = reply_header(b'S', 77, 3);
+        assert_eq!(
+            r.read_reply(&[&v3]).unwrap_err(),
+            ProtocolError::Version { got: 3 }
+        );
+        let short: &[u8] = b"HTTP/1.1 400";
+        let err = r.read_reply(&[short]).unwrap_err();
+        assert!(err.to_string().contains("12 bytes"), "{err}");
+        let refused = r
+            .read_reply(&[b"error", b"Request not recognized\x1b[2J"])
+            .unwrap_err();
+        assert_eq!(
+            refused.to_string(),
+            "the publisher refused a status request: Request not recognized\\u{1b}[2J"
+        );
+    }
+
+    #[test]
+    fn statuses_and_transitions_are_read_whole_or_refused() {
+        assert_eq!(
+            read_statuses(&[1, 0, 1, 2, 0, 12]).unwrap(),
+            vec![(1, NodeStatus::Running), (2, NodeStatus::Idle)]
+        );
+        assert!(matches!(
+            read_statuses(&[1, 0]),
+            Err(ProtocolError::Ragged { len: 2, .. })
+        ));
+        assert_eq!(
+            read_statuses(&[5, 0, 9]).unwrap_err(),
+            ProtocolError::Status { uid: 5, byte: 9 }
+        );
+        let t = read_transitions(&[0x10, 0x27, 0, 0, 0, 0, 3, 0, 3]).unwrap();
+        assert_eq!(
+            t,
+            vec![Transition {
+                micros: 10_000,
+                uid: 3,
+                status: NodeStatus::Failure
+            }]
+        );
+        assert!(read_transitions(&[0; 10]).is_err());
+    }
+}

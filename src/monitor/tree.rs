@@ -1,0 +1,378 @@
+//! The tree a Groot2 publisher describes (`FULLTREE`): BehaviorTree.CPP's XML with each
+//! node's `_uid`, the main tree first, each SubTree instance as its own `<BehaviorTree>`
+//! named by `_fullpath`, and the `<TreeNodesModel>` saying each node ID's kind. Read into a
+//! tree of every node as written — whatever its kind, with its ports — and each SubTree
+//! instance hung under its SubTree node, so a tree of any BT.CPP 4 node kinds is shown
+//! whole.
+
+use std::collections::HashMap;
+
+use thiserror::Error;
+
+/// The largest tree description read: BT.CPP numbers nodes with 16 bits, and a tree of
+/// 65,535 nodes with long ports stays well under this.
+pub const MAX_TREE_BYTES: usize = 32 << 20;
+
+/// A node's kind, from the publisher's `<TreeNodesModel>`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeKind {
+    Action,
+    Condition,
+    Control,
+    Decorator,
+    SubTree,
+    /// An ID the model does not describe.
+    Unknown,
+}
+
+impl NodeKind {
+    fn of_model_tag(tag: &str) -> Option<NodeKind> {
+        Some(match tag {
+            "Action" => NodeKind::Action,
+            "Condition" => NodeKind::Condition,
+            "Control" => NodeKind::Control,
+            "Decorator" => NodeKind::Decorator,
+            "SubTree" => NodeKind::SubTree,
+            _ => return None,
+        })
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeKind::Action => "Action",
+            NodeKind::Condition => "Condition",
+            NodeKind::Control => "Control",
+            NodeKind::Decorator => "Decorator",
+            NodeKind::SubTree => "SubTree",
+            NodeKind::Unknown => "node",
+        }
+    }
+}
+
+/// One node as the publisher wrote it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WatchedNode {
+    pub uid: u16,
+    pub kind: NodeKind,
+    /// The registration ID (the element's name: `Fallback`, `OpenDoor`, `SubTree`).
+    pub id: String,
+    /// The instance's name (a SubTree's is the ID of the tree it runs).
+    pub name: String,
+    /// Its ports and other attributes as written (`{goal}` is a blackboard entry).
+    pub ports: Vec<(String, String)>,
+    pub children: Vec<usize>,
+    pub parent: Option<usize>,
+    /// Where it sits: `root`, then child indices from the root (`0`, `0.1`), as betr
+    /// names nodes everywhere.
+    pub path: String,
+    pub depth: usize,
+}
+
+/// A watched tree: its nodes in depth-first order (index 0 the root).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WatchedTree {
+    /// The main tree's ID.
+    pub main: String,
+    pub nodes: Vec<WatchedNode>,
+    by_uid: HashMap<u16, usize>,
+}
+
+/// A tree description that cannot be shown, with where.
+#[derive(Debug, Error, PartialEq, Eq)]
+pub enum TreeError {
+    #[error("the tree description is {len} bytes; betr reads at most {MAX_TREE_BYTES}")]
+    TooLarge { len: usize },
+    #[error("the tree description is not XML: {0}")]
+    Xml(String),
+    #[error("the tree description has no <BehaviorTree> with a root node")]
+    NoTree,
+    #[error("line {line}: <{element}> has no _uid, or one that is not a number from 0 to 65535")]
+    Uid { line: u32, element: String },
+    #[error("line {line}: <{element}> has the _uid {uid} of another node")]
+    SameUid {
+        line: u32,
+        element: String,
+        uid: u16,
+    },
+}
+
+impl WatchedTree {
+    /// Reads the publisher's description.
+    pub fn parse(xml: &[u8]) -> Result<WatchedTree, TreeError> {
+        if xml.len() > MAX_TREE_BYTES {
+            return Err(TreeError::TooLarge { len: xml.len() });
+        }
+        let text = std::str::from_utf8(xml).map_err(|e| TreeError::Xml(e.to_string()))?;
+        let doc = roxmltree::Document::parse(text).map_err(|e| TreeError::Xml(e.to_string()))?;
+        let kinds = model_kinds(&doc);
+        let trees: Vec<roxmltree::Node> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("BehaviorTree"))
+            .collect();
+        let main = trees.first().ok_or(TreeError::NoTree)?;
+        let instances: HashMap<&str, roxmltree::Node> = trees
+            .iter()
+            .skip(1)
+            .filter_map(|t| Some((t.attribute("_fullpath")?, *t)))
+            .collect();
+        let root = main
+            .children()
+            .find(|n| n.is_element())
+            .ok_or(TreeError::NoTree)?;
+        let mut tree = WatchedTree {
+            main: main.attribute("ID").unwrap_or_default().to_string(),
+            nodes: Vec::new(),
+            by_uid: HashMap::new(),
+        };
+        // Depth first without recursion, so a deep description cannot exhaust the stack:
+        // (element, parent index, path).
+        let mut stack = vec![(root, None::<usize>, "root".to_string())];
+        while let Some((element, parent, path)) = stack.pop() {
+            let index = tree.add(&doc, element, &kinds, path.clone(), parent)?;
+            let children: Vec<roxmltree::Node> =
+                if tree.nodes[index].kind == NodeKind::SubTree || element.has_tag_name("SubTree") {
+                    element
+                        .attribute("_fullpath")
+                        .and_then(|p| instance_of(&instances, p))
+                        .and_then(|t| t.children().find(|n| n.is_element()))
+                        .into_iter()
+                        .collect()
+                } else {
+                    element.children().filter(|n| n.is_element()).collect()
+                };
+            for (i, child) in children.into_iter().enumerate().rev() {
+                let child_path = if path == "root" {
+                    i.to_string()
+                } else {
+                    format!("{path}.{i}")
+                };
+                stack.push((child, Some(index), child_path));
+            }
+        }
+        Ok(tree)
+    }
+
+    fn add(
+        &mut self,
+        doc: &roxmltree::Document,
+        element: roxmltree::Node,
+        kinds: &HashMap<String, NodeKind>,
+        path: String,
+        parent: Option<usize>,
+    ) -> Result<usize, TreeError> {
+        let tag = element.tag_name().name().to_string();
+        let line = doc.text_pos_at(element.range().start).row;
+        let uid = element
+            .attribute("_uid")
+            .and_then(|u| u.parse::<u16>().ok())
+            .ok_or_else(|| TreeError::Uid {
+                line,
+                element: tag.clone(),
+            })?;
+        let index = self.nodes.len();
+        if self.by_uid.insert(uid, index).is_some() {
+            return Err(TreeError::SameUid {
+                line,
+                element: tag,
+                uid,
+            });
+        }
+        let kind = kinds.get(&tag).copied().unwrap_or(if tag == "SubTree" {
+            NodeKind::SubTree
+        } else {
+            NodeKind::Unknown
+        });
+        let name = element
+            .attribute("name")
+            .or_else(|| element.attribute("ID"))
+            .unwrap_or(&tag)
+            .to_string();
+        let ports = element
+            .attributes()
+            .filter(|a| !matches!(a.name(), "name" | "_uid" | "_fullpath"))
+            .filter(|a| !(kind == NodeKind::SubTree && a.name() == "ID"))
+            .map(|a| (a.name().to_string(), a.value().to_string()))
+            .collect();
+        let depth = parent.map_or(0, |p| self.nodes[p].depth + 1);
+        self.nodes.push(WatchedNode {
+            uid,
+            kind,
+            id: tag,
+            name,
+            ports,
+            children: Vec::new(),
+            parent,
+            path,
+            depth,
+        });
+        if let Some(p) = parent {
+            self.nodes[p].children.push(index);
+        }
+        Ok(index)
+    }
+
+    /// The node the publisher numbers `uid`.
+    pub fn by_uid(&self, uid: u16) -> Option<&WatchedNode> {
+        self.by_uid.get(&uid).map(|&i| &self.nodes[i])
+    }
+
+    /// The index of the node the publisher numbers `uid`.
+    pub fn index_of(&self, uid: u16) -> Option<usize> {
+        self.by_uid.get(&uid).copied()
+    }
+
+    /// The uids from the root down to node `index`, itself included.
+    pub fn uid_path(&self, index: usize) -> Vec<u16> {
+        let mut path = Vec::with_capacity(self.nodes[index].depth + 1);
+        let mut at = Some(index);
+        while let Some(i) = at {
+            path.push(self.nodes[i].uid);
+            at = self.nodes[i].parent;
+        }
+        path.reverse();
+        path
+    }
+
+    /// One line for a node: its ID, its name when it has its own, its kind and ports.
+    pub fn describe(&self, node: &WatchedNode) -> String {
+        let mut line = node.id.clone();
+        if node.name != node.id {
+            line.push_str(&format!(" {:?}", node.name));
+        }
+        if node.kind != NodeKind::Unknown && node.kind.name() != node.id {
+            line.push_str(&format!(" ({})", node.kind.name()));
+        }
+        for (port, value) in &node.ports {
+            line.push_str(&format!(" {port}={value:?}"));
+        }
+        crate::http_text::printable(&line).into_owned()
+    }
+}
+
+/// The `<BehaviorTree>` a SubTree node runs: the one whose `_fullpath` is the node's, or
+/// the node's without the `::UID` that BT.CPP 4 appends to a node's path
+/// (`<SubTree _fullpath="Work::5">` runs `<BehaviorTree _fullpath="Work">`).
+fn instance_of<'a, 'input>(
+    instances: &HashMap<&str, roxmltree::Node<'a, 'input>>,
+    path: &str,
+) -> Option<roxmltree::Node<'a, 'input>> {
+    instances.get(path).copied().or_else(|| {
+        let (instance, uid) = path.rsplit_once("::")?;
+        uid.bytes().all(|b| b.is_ascii_digit()).then_some(())?;
+        instances.get(instance).copied()
+    })
+}
+
+/// Each node ID's kind, from `<TreeNodesModel>`.
+fn model_kinds(doc: &roxmltree::Document) -> HashMap<String, NodeKind> {
+    doc.descendants()
+        .filter(|n| n.has_tag_name("TreeNodesModel"))
+        .flat_map(|m| m.children().filter(|n| n.is_element()))
+        .filter_map(|entry| {
+            let kind = NodeKind::of_model_tag(entry.tag_name().name())?;
+            Some((entry.attribute("ID")?.to_string(), kind))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// What BT.CPP 4's `WriteTreeToXML(tree, true, true)` writes for a main tree with a
+    /// SubTree (the shape the publisher sends: the SubTree node's path ends in its uid,
+    /// its tree's does not).
+    const FULLTREE: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<root BTCPP_format="4">
+    <BehaviorTree ID="MainTree" _fullpath="">
+        <Fallback name="root" _uid="1">
+            <Inverter name="not_open" _uid="2">
+                <IsDoorOpen name="open" _uid="3"/>
+            </Inverter>
+            <SubTree ID="Walk" _fullpath="walk::4" _uid="4" target="{goal}"/>
+        </Fallback>
+    </BehaviorTree>
+    <BehaviorTree ID="Walk" _fullpath="walk">
+        <RetryUntilSuccessful name="retry" _uid="5" num_attempts="3">
+            <Move name="move" _uid="6" target="{target}"/>
+        </RetryUntilSuccessful>
+    </BehaviorTree>
+    <TreeNodesModel>
+        <Condition ID="IsDoorOpen"/>
+        <Action ID="Move"><input_port name="target"/></Action>
+        <Control ID="Fallback"/>
+        <Decorator ID="Inverter"/>
+        <Decorator ID="RetryUntilSuccessful"><input_port name="num_attempts"/></Decorator>
+        <SubTree ID="SubTree"/>
+    </TreeNodesModel>
+</root>"#;
+
+    #[test]
+    fn a_publisher_tree_is_read_whole_with_its_subtree_hung_under_it() {
+        let tree = WatchedTree::parse(FULLTREE.as_bytes()).expect("reads");
+        assert_eq!(tree.main, "MainTree");
+        let lines: Vec<String> = tree
+            .nodes
+            .iter()
+            .map(|n| format!("{} {}", n.path, tree.describe(n)))
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                "root Fallback \"root\" (Control)",
+                "0 Inverter \"not_open\" (Decorator)",
+                "0.0 IsDoorOpen \"open\" (Condition)",
+                "1 SubTree \"Walk\" target=\"{goal}\"",
+                "1.0 RetryUntilSuccessful \"retry\" (Decorator) num_attempts=\"3\"",
+                "1.0.0 Move \"move\" (Action) target=\"{target}\"",
+            ]
+        );
+        assert_eq!(tree.by_uid(6).map(|n| n.depth), Some(3));
+        assert_eq!(tree.uid_path(5), vec![1, 4, 5, 6]);
+    }
+
+    #[test]
+    fn a_bad_description_is_refused_naming_the_line() {
+        let no_uid = FULLTREE.replace(r#" _uid="3""#, "");
+        assert_eq!(
+            WatchedTree::parse(no_uid.as_bytes()),
+            Err(TreeError::Uid {
+                line: 6,
+                element: "IsDoorOpen".into()
+            })
+        );
+        let twice = FULLTREE.replace(r#"_uid="6""#, r#"_uid="2""#);
+        assert!(matches!(
+            WatchedTree::parse(twice.as_bytes()),
+            Err(TreeError::SameUid { uid: 2, .. })
+        ));
+        assert!(matches!(
+            WatchedTree::parse(b"<root><BehaviorTree ID=\"x\">"),
+            Err(TreeError::Xml(_))
+        ));
+        assert_eq!(WatchedTree::parse(b"<root/>"), Err(TreeError::NoTree));
+        let huge = vec![b' '; MAX_TREE_BYTES + 1];
+        assert!(matches!(
+            WatchedTree::parse(&huge),
+            Err(TreeError::TooLarge { .. })
+        ));
+    }
+
+    #[test]
+    fn a_deep_tree_does_not_exhaust_the_stack() {
+        let depth = 5_000;
+        let mut xml = String::from("<root><BehaviorTree ID=\"deep\">");
+        for i in 0..depth {
+            xml.push_str(&format!("<Inverter _uid=\"{i}\">"));
+        }
+        for _ in 0..depth {
+            xml.push_str("</Inverter>");
+        }
+        xml.push_str("</BehaviorTree></root>");
+        // roxmltree refuses very deep documents itself; either way nothing overflows.
+        match WatchedTree::parse(xml.as_bytes()) {
+            Ok(tree) => assert_eq!(tree.nodes.len(), depth),
+            Err(e) => assert!(matches!(e, TreeError::Xml(_)), "{e}"),
+        }
+    }
+}

@@ -1,0 +1,267 @@
+//! The monitor screen (`betr monitor`): a BehaviorTree.CPP process's tree, live, as its
+//! Groot2 publisher reports it. The tree pane shows every node with its status, following
+//! the node the tree is busy in unless the person moves; the side pane the selected
+//! node's kind, ports (a `{name}` port is a blackboard entry) and the latest status
+//! changes; the status bar the connection. The screen only reads: nothing is sent to the
+//! robot but Groot2's read requests.
+
+mod view;
+
+use std::collections::VecDeque;
+use std::path::Path;
+use std::time::Duration;
+
+use crossterm::event::{Event as TermEvent, KeyCode, KeyEvent, KeyModifiers};
+use tokio::sync::mpsc;
+use tui_tree_widget::TreeState;
+
+use crate::bt::render::{ASCII, Glyphs, UNICODE};
+use crate::monitor::{Address, LiveTree, WatchEvent, WatchTiming, watch};
+
+use super::event_loop::{QueueEvent, spawn_input_reader};
+use super::theme::Theme;
+use super::{TerminalGuard, TuiError};
+
+/// How many status changes the side pane keeps.
+const RECENT: usize = 200;
+
+/// Where the connection stands.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Connection {
+    /// Never connected yet, or not since the last loss: the last try's reason.
+    Waiting(Option<String>),
+    Watching,
+    /// The connection broke; the tree shown is as it was last seen.
+    Lost(String),
+}
+
+/// What the screen shows and where the person is in it.
+pub struct MonitorScreen {
+    address: Address,
+    connection: Connection,
+    live: Option<LiveTree>,
+    /// When the publisher began keeping changes, since the watch began.
+    since: Duration,
+    state: TreeState<u16>,
+    /// The selection follows the node the tree is busy in.
+    follow: bool,
+    recent: VecDeque<String>,
+    changes: u64,
+    quit: bool,
+    glyphs: &'static Glyphs,
+    theme: Theme,
+}
+
+impl MonitorScreen {
+    pub fn new(address: Address, ascii: bool) -> MonitorScreen {
+        let glyphs = if ascii { &ASCII } else { &UNICODE };
+        MonitorScreen {
+            address,
+            connection: Connection::Waiting(None),
+            live: None,
+            since: Duration::ZERO,
+            state: TreeState::default(),
+            follow: true,
+            recent: VecDeque::new(),
+            changes: 0,
+            quit: false,
+            glyphs,
+            theme: Theme::new(glyphs),
+        }
+    }
+
+    pub fn should_quit(&self) -> bool {
+        self.quit
+    }
+
+    pub fn connection(&self) -> &Connection {
+        &self.connection
+    }
+
+    /// What the watch reported.
+    pub fn on_watch(&mut self, event: WatchEvent) {
+        match event {
+            WatchEvent::Connected {
+                tree,
+                statuses,
+                since,
+                ..
+            } => {
+                let live = LiveTree::new(*tree, &statuses);
+                // A new tree opens whole; the same tree again keeps the person's folds.
+                if self.live.as_ref().map(|l| &l.tree) != Some(&live.tree) {
+                    self.state = TreeState::default();
+                    for (i, node) in live.tree.nodes.iter().enumerate() {
+                        if !node.children.is_empty() {
+                            self.state.open(live.tree.uid_path(i));
+                        }
+                    }
+                }
+                self.live = Some(live);
+                self.since = since;
+                self.connection = Connection::Watching;
+                self.follow_busy();
+            }
+            WatchEvent::Changes(transitions) => {
+                let arrow = if self.glyphs.success.is_ascii() {
+                    "->"
+                } else {
+                    "→"
+                };
+                let Some(live) = self.live.as_mut() else {
+                    return;
+                };
+                for transition in transitions {
+                    if let Some(change) = live.apply(transition) {
+                        self.changes += 1;
+                        if self.recent.len() == RECENT {
+                            self.recent.pop_front();
+                        }
+                        self.recent.push_back(
+                            live.describe_change(self.since, &change, arrow)
+                                .trim_start()
+                                .to_string(),
+                        );
+                    }
+                }
+                self.follow_busy();
+            }
+            WatchEvent::Restarted => self.connection = Connection::Waiting(None),
+            WatchEvent::Lost(reason) => self.connection = Connection::Lost(reason),
+            WatchEvent::Waiting(reason) => {
+                if !matches!(self.connection, Connection::Lost(_)) {
+                    self.connection = Connection::Waiting(Some(reason));
+                }
+            }
+        }
+    }
+
+    /// Selects the node the tree is busy in, its branch opened, when following.
+    fn follow_busy(&mut self) {
+        if !self.follow {
+            return;
+        }
+        let Some(live) = &self.live else { return };
+        if let Some(busy) = live.busy() {
+            let path = live.tree.uid_path(busy);
+            for depth in 1..path.len() {
+                self.state.open(path[..depth].to_vec());
+            }
+            self.state.select(path);
+        }
+    }
+
+    /// A key pressed.
+    pub fn on_key(&mut self, key: KeyEvent) {
+        let moved = match key.code {
+            KeyCode::Char('q') | KeyCode::Esc => {
+                self.quit = true;
+                return;
+            }
+            KeyCode::Char('c') if key.modifiers.contains(KeyModifiers::CONTROL) => {
+                self.quit = true;
+                return;
+            }
+            KeyCode::Char('f') => {
+                self.follow = !self.follow;
+                self.follow_busy();
+                return;
+            }
+            KeyCode::Up | KeyCode::Char('k') => self.state.key_up(),
+            KeyCode::Down | KeyCode::Char('j') => self.state.key_down(),
+            KeyCode::Left | KeyCode::Char('h') => self.state.key_left(),
+            KeyCode::Right | KeyCode::Char('l') => self.state.key_right(),
+            KeyCode::Home => self.state.select_first(),
+            KeyCode::End => self.state.select_last(),
+            KeyCode::Char('E') => {
+                if let Some(live) = &self.live {
+                    for (i, node) in live.tree.nodes.iter().enumerate() {
+                        if !node.children.is_empty() {
+                            self.state.open(live.tree.uid_path(i));
+                        }
+                    }
+                }
+                true
+            }
+            KeyCode::Char('C') => {
+                self.state.close_all();
+                self.state.select_first()
+            }
+            _ => false,
+        };
+        // Moving through the tree by hand stops following the robot.
+        if moved {
+            self.follow = false;
+        }
+    }
+
+    /// The selected node's index in the tree.
+    fn selected(&self) -> Option<usize> {
+        let live = self.live.as_ref()?;
+        live.tree.index_of(*self.state.selected().last()?)
+    }
+}
+
+/// Show the monitor until the person quits or `duration` has passed; standard error goes
+/// to `stderr_to` meanwhile.
+pub fn run(
+    address: Address,
+    duration: Option<Duration>,
+    ascii: bool,
+    stderr_to: Option<&Path>,
+) -> Result<(), TuiError> {
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()?;
+    runtime.block_on(async {
+        let (_guard, mut terminal) = TerminalGuard::enter(stderr_to)?;
+        let (events, mut watched) = mpsc::channel(256);
+        let watcher = tokio::spawn(watch(address.clone(), WatchTiming::default(), events));
+        let (keys, mut input) = mpsc::unbounded_channel();
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        spawn_input_reader(keys, stop.clone());
+        let mut screen = MonitorScreen::new(address, ascii);
+        let deadline = duration.map(|d| tokio::time::Instant::now() + d);
+        let result = loop {
+            if let Err(e) = terminal.draw(|f| view::draw(f, &mut screen)) {
+                break Err(TuiError::Terminal(e));
+            }
+            let ended = tokio::select! {
+                Some(event) = watched.recv() => {
+                    screen.on_watch(event);
+                    // Everything already arrived is shown in one drawing.
+                    while let Ok(event) = watched.try_recv() {
+                        screen.on_watch(event);
+                    }
+                    false
+                }
+                input = input.recv() => match input {
+                    Some(QueueEvent::Input(TermEvent::Key(key))) => {
+                        screen.on_key(key);
+                        false
+                    }
+                    Some(QueueEvent::InputEnded) | None => true,
+                    Some(_) => false,
+                },
+                _ = sleep_until(deadline) => true,
+            };
+            if ended || screen.should_quit() {
+                break Ok(());
+            }
+        };
+        stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        watcher.abort();
+        result
+    })
+}
+
+/// Waits until `deadline`, or for ever without one.
+async fn sleep_until(deadline: Option<tokio::time::Instant>) {
+    match deadline {
+        Some(at) => tokio::time::sleep_until(at).await,
+        None => std::future::pending().await,
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,107 @@
+use std::time::Duration;
+
+use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+use ratatui::Terminal;
+use ratatui::backend::TestBackend;
+
+use crate::monitor::{Address, NodeStatus, Transition, WatchEvent, WatchedTree};
+
+use super::{Connection, MonitorScreen, view};
+
+const TREE: &str = r#"<root BTCPP_format="4">
+  <BehaviorTree ID="Main" _fullpath="">
+    <Fallback name="serve" _uid="1">
+      <ReactiveSequence name="ready_then_work" _uid="2">
+        <Inverter name="not_blocked" _uid="3"><IsBlocked name="blocked" _uid="4"/></Inverter>
+        <SubTree ID="Work" _fullpath="Work::5" _uid="5"/>
+      </ReactiveSequence>
+      <Recover name="recover" _uid="8"/>
+    </Fallback>
+  </BehaviorTree>
+  <BehaviorTree ID="Work" _fullpath="Work">
+    <RetryUntilSuccessful name="retry" _uid="6" num_attempts="3">
+      <Grasp name="grasp" _uid="7" target="{cup}"/>
+    </RetryUntilSuccessful>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <Condition ID="IsBlocked"/><Action ID="Grasp"/><Action ID="Recover"/>
+    <Control ID="Fallback"/><Control ID="ReactiveSequence"/>
+    <Decorator ID="Inverter"/><Decorator ID="RetryUntilSuccessful"/>
+  </TreeNodesModel>
+</root>"#;
+
+fn connected() -> MonitorScreen {
+    let address = Address::parse(":1667").expect("an address");
+    let mut screen = MonitorScreen::new(address.clone(), false);
+    let tree = WatchedTree::parse(TREE.as_bytes()).expect("the tree reads");
+    screen.on_watch(WatchEvent::Connected {
+        address,
+        tree: Box::new(tree),
+        statuses: vec![],
+        since: Duration::from_millis(250),
+    });
+    screen
+}
+
+fn change(micros: u64, uid: u16, status: NodeStatus) -> Transition {
+    Transition {
+        micros,
+        uid,
+        status,
+    }
+}
+
+fn drawn(screen: &mut MonitorScreen) -> String {
+    let mut terminal = Terminal::new(TestBackend::new(110, 20)).expect("a test terminal");
+    terminal
+        .draw(|f| view::draw(f, screen))
+        .expect("the screen draws");
+    format!("{}", terminal.backend())
+}
+
+#[test]
+fn the_screen_follows_the_node_the_robot_is_busy_in() {
+    let mut screen = connected();
+    screen.on_watch(WatchEvent::Changes(vec![
+        change(1_000, 1, NodeStatus::Running),
+        change(1_100, 2, NodeStatus::Running),
+        change(1_200, 4, NodeStatus::Failure),
+        change(1_300, 3, NodeStatus::Success),
+        change(1_400, 5, NodeStatus::Running),
+        change(1_500, 6, NodeStatus::Running),
+        change(1_600, 7, NodeStatus::Running),
+    ]));
+    assert_eq!(screen.selected(), Some(6), "the grasp, deepest running");
+    insta::assert_snapshot!(drawn(&mut screen));
+
+    // Moving by hand stops following; `f` follows again.
+    screen.on_key(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE));
+    assert_eq!(screen.selected(), Some(5));
+    screen.on_watch(WatchEvent::Changes(vec![change(
+        2_000,
+        8,
+        NodeStatus::Running,
+    )]));
+    assert_eq!(screen.selected(), Some(5));
+    screen.on_key(KeyEvent::new(KeyCode::Char('f'), KeyModifiers::NONE));
+    assert_eq!(screen.selected(), Some(7), "the recovery, now last running");
+}
+
+#[test]
+fn a_lost_connection_is_shown_with_the_tree_as_last_seen() {
+    let mut screen = connected();
+    screen.on_watch(WatchEvent::Changes(vec![change(
+        10,
+        1,
+        NodeStatus::Running,
+    )]));
+    screen.on_watch(WatchEvent::Lost(
+        "the connection to 127.0.0.1:1667 was lost: timed out".into(),
+    ));
+    // A failed try afterwards does not hide that it was lost.
+    screen.on_watch(WatchEvent::Waiting("no Groot2 publisher answers".into()));
+    assert!(matches!(screen.connection(), Connection::Lost(_)));
+    let text = drawn(&mut screen);
+    assert!(text.contains("was lost: timed out; trying again"), "{text}");
+    assert!(text.contains("serve"), "{text}");
+}

@@ -1,0 +1,205 @@
+//! Drawing the monitor screen: the tree with statuses, the selected node, the latest
+//! changes and the connection.
+
+use ratatui::Frame;
+use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
+use tui_tree_widget::{Tree as TreeWidget, TreeItem};
+
+use crate::bt::Status;
+use crate::http_text::printable;
+use crate::monitor::{LiveTree, NodeKind, NodeStatus};
+
+use super::{Connection, MonitorScreen};
+
+pub fn draw(frame: &mut Frame, screen: &mut MonitorScreen) {
+    let [main, bar] =
+        Layout::vertical([Constraint::Min(3), Constraint::Length(1)]).areas(frame.area());
+    let [tree_area, side] =
+        Layout::horizontal([Constraint::Percentage(60), Constraint::Percentage(40)]).areas(main);
+    let [details, recent] =
+        Layout::vertical([Constraint::Percentage(45), Constraint::Percentage(55)]).areas(side);
+    draw_tree(frame, screen, tree_area);
+    draw_details(frame, screen, details);
+    draw_recent(frame, screen, recent);
+    draw_bar(frame, screen, bar);
+}
+
+fn block(screen: &MonitorScreen, title: String) -> Block<'static> {
+    Block::default()
+        .borders(Borders::ALL)
+        .border_style(screen.theme.border)
+        .title(Span::styled(title, screen.theme.title))
+}
+
+fn draw_tree(frame: &mut Frame, screen: &mut MonitorScreen, area: Rect) {
+    let Some(live) = &screen.live else {
+        let text = match &screen.connection {
+            Connection::Waiting(Some(reason)) => format!("{reason}\n\ntrying again…"),
+            _ => format!("connecting to {}…", screen.address),
+        };
+        let pane = Paragraph::new(text)
+            .wrap(Wrap { trim: false })
+            .block(block(screen, " tree ".into()));
+        frame.render_widget(pane, area);
+        return;
+    };
+    let items = items(live, screen);
+    let title = format!(" {} ", printable(&live.tree.main));
+    match TreeWidget::new(&items) {
+        Ok(widget) => {
+            let widget = widget
+                .block(block(screen, title))
+                .highlight_style(screen.theme.selected);
+            frame.render_stateful_widget(widget, area, &mut screen.state);
+        }
+        Err(e) => {
+            // Uids are unique in a read tree (`WatchedTree::parse` refuses repeats).
+            tracing::warn!(error = %e, "the watched tree's rows cannot be drawn");
+        }
+    }
+}
+
+/// The widget's rows, children before parents (no recursion: nodes are in depth-first
+/// order, so every node comes after its parent).
+fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>> {
+    let mut built: Vec<Option<TreeItem<'static, u16>>> = vec![None; live.tree.nodes.len()];
+    for (i, node) in live.tree.nodes.iter().enumerate().rev() {
+        let status = live.statuses[i];
+        let style = screen.theme.status(shown(status));
+        let line = Line::from(vec![
+            Span::styled(format!("[{}] ", mark(screen, status)), style),
+            Span::styled(live.tree.describe(node), style),
+        ]);
+        let children: Vec<TreeItem<'static, u16>> = node
+            .children
+            .iter()
+            .filter_map(|&c| built[c].take())
+            .collect();
+        let item = if children.is_empty() {
+            TreeItem::new_leaf(node.uid, line)
+        } else {
+            TreeItem::new(node.uid, line.clone(), children)
+                .unwrap_or_else(|_| TreeItem::new_leaf(node.uid, line))
+        };
+        built[i] = Some(item);
+    }
+    built
+        .first_mut()
+        .and_then(Option::take)
+        .into_iter()
+        .collect()
+}
+
+/// The workbench's colour for a BT.CPP status (a skipped node is drawn as idle).
+fn shown(status: NodeStatus) -> Status {
+    match status {
+        NodeStatus::Idle | NodeStatus::Skipped => Status::Idle,
+        NodeStatus::Running => Status::Running,
+        NodeStatus::Success => Status::Success,
+        NodeStatus::Failure => Status::Failure,
+    }
+}
+
+fn mark(screen: &MonitorScreen, status: NodeStatus) -> &'static str {
+    let g = screen.glyphs;
+    match status {
+        NodeStatus::Idle => " ",
+        NodeStatus::Skipped => g.idle,
+        NodeStatus::Running => g.running,
+        NodeStatus::Success => g.success,
+        NodeStatus::Failure => g.failure,
+    }
+}
+
+fn draw_details(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
+    let mut lines = Vec::new();
+    if let (Some(live), Some(i)) = (&screen.live, screen.selected()) {
+        let node = &live.tree.nodes[i];
+        let kind = match node.kind {
+            NodeKind::Unknown => "a node the publisher's model does not describe",
+            kind => kind.name(),
+        };
+        lines.push(Line::from(vec![
+            Span::styled(printable(&node.id).into_owned(), screen.theme.title),
+            Span::raw(format!("  {:?}", printable(&node.name))),
+        ]));
+        lines.push(Line::raw(format!(
+            "{kind} · path {} · uid {}",
+            node.path, node.uid
+        )));
+        lines.push(Line::from(vec![
+            Span::raw("status "),
+            Span::styled(
+                live.statuses[i].name(),
+                screen.theme.status(shown(live.statuses[i])),
+            ),
+        ]));
+        if node.ports.is_empty() {
+            lines.push(Line::styled("no ports", screen.theme.dim));
+        }
+        for (port, value) in &node.ports {
+            let entry = value
+                .strip_prefix('{')
+                .and_then(|v| v.strip_suffix('}'))
+                .map(|name| format!("  (blackboard entry {})", printable(name)))
+                .unwrap_or_default();
+            lines.push(Line::raw(format!(
+                "{} = {}{entry}",
+                printable(port),
+                printable(value)
+            )));
+        }
+    }
+    let pane = Paragraph::new(lines)
+        .wrap(Wrap { trim: false })
+        .block(block(screen, " node ".into()));
+    frame.render_widget(pane, area);
+}
+
+fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
+    let rows = usize::from(area.height.saturating_sub(2));
+    let skip = screen.recent.len().saturating_sub(rows);
+    let lines: Vec<Line> = screen
+        .recent
+        .iter()
+        .skip(skip)
+        .map(|l| Line::raw(l.clone()))
+        .collect();
+    let title = format!(" status changes ({}) ", screen.changes);
+    frame.render_widget(Paragraph::new(lines).block(block(screen, title)), area);
+}
+
+fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
+    let (text, style) = match &screen.connection {
+        Connection::Watching => {
+            let nodes = screen.live.as_ref().map_or(0, |l| l.tree.nodes.len());
+            let follow = if screen.follow {
+                "following"
+            } else {
+                "f: follow"
+            };
+            (
+                format!(
+                    " watching {} · {nodes} nodes · {follow} · ←→ fold · E/C open/close all · q quit",
+                    screen.address
+                ),
+                screen.theme.status_bar,
+            )
+        }
+        Connection::Lost(reason) => (
+            format!(" {reason}; trying again · q quit"),
+            screen.theme.error,
+        ),
+        Connection::Waiting(Some(reason)) => (
+            format!(" {reason}; trying again · q quit"),
+            screen.theme.error,
+        ),
+        Connection::Waiting(None) => (
+            format!(" connecting to {} · q quit", screen.address),
+            screen.theme.status_bar,
+        ),
+    };
+    frame.render_widget(Paragraph::new(Span::styled(text, style)), area);
+}

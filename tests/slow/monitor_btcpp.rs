@@ -1,0 +1,189 @@
+//! `betr monitor` watching the real BehaviorTree.CPP (through `behaviortreepy`, its Python
+//! bindings) under Groot2's publisher: a tree with Fallback, ReactiveSequence, Inverter,
+//! RetryUntilSuccessful and a SubTree ticked by scripts/btcpp_publisher.py, whose own
+//! StdCoutLogger says what happened.
+
+#![allow(clippy::unwrap_used)] // tests may panic on what they check
+use crate::support;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use support::btcpp::{Publisher, free_port_pair, python};
+use support::cli::{command, tmp};
+use support::tmux::{Tmux, isolated_env, quote};
+
+/// `betr monitor --print` started on `port` for `secs`, its lines arriving on a channel.
+fn print_monitor(dir: &std::path::Path, port: u16, secs: u32) -> (Child, mpsc::Receiver<String>) {
+    let mut child = command(
+        dir,
+        &[
+            "monitor",
+            "--print",
+            "--for",
+            &secs.to_string(),
+            &format!(":{port}"),
+        ],
+    )
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    let stdout = BufReader::new(child.stdout.take().unwrap());
+    let (lines, received) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in stdout.lines().map_while(Result::ok) {
+            if lines.send(line).is_err() {
+                return;
+            }
+        }
+    });
+    (child, received)
+}
+
+/// Lines until one starts with `prefix` (that one included); panics after 30 s.
+fn lines_until(received: &mpsc::Receiver<String>, prefix: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    loop {
+        let line = received
+            .recv_timeout(Duration::from_secs(30))
+            .unwrap_or_else(|e| {
+                panic!(
+                    "no line starting {prefix:?} ({e}); so far:\n{}",
+                    out.join("\n")
+                )
+            });
+        let done = line.starts_with(prefix);
+        out.push(line);
+        if done {
+            return out;
+        }
+    }
+}
+
+/// The status changes in `--print` lines: (name, old, new).
+fn changes(lines: &[String]) -> Vec<(String, String, String)> {
+    lines
+        .iter()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| {
+            let fields: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(fields.len(), 6, "a change line has 6 fields: {l}");
+            assert_eq!(fields[4], "→", "{l}");
+            (fields[2].into(), fields[3].into(), fields[5].into())
+        })
+        .collect()
+}
+
+#[test]
+fn print_reports_every_status_change_the_tree_made_in_order() {
+    let python = python();
+    let dir = tmp("monitor-print");
+    let port = free_port_pair();
+    let mut publisher = Publisher::start(&python, port, 6);
+    let (mut monitor, received) = print_monitor(&dir, port, 8);
+    let header = lines_until(&received, "# watching");
+    assert_eq!(
+        header.last().unwrap(),
+        &format!("# watching 127.0.0.1:{port}: tree Main, 8 nodes")
+    );
+    let tree = lines_until(&received, "# 1 ");
+    let shown: Vec<&str> = tree
+        .iter()
+        .map(|l| l.split_whitespace().nth(2).unwrap())
+        .collect();
+    assert_eq!(
+        shown,
+        [
+            "Fallback",
+            "ReactiveSequence",
+            "Inverter",
+            "IsBlocked",
+            "SubTree",
+            "RetryUntilSuccessful",
+            "Grasp",
+            "Recover"
+        ],
+        "the tree whole, the SubTree's tree under it:\n{}",
+        tree.join("\n")
+    );
+    publisher.go();
+    let seen = publisher.seen();
+    let status = monitor.wait().unwrap();
+    assert!(status.success(), "betr monitor: {status}");
+    let printed: Vec<String> = received.try_iter().collect();
+    let reported = changes(&printed);
+    assert!(seen.len() > 60, "six ticks change many statuses: {seen:?}");
+    assert_eq!(reported, seen, "betr's lines:\n{}", printed.join("\n"));
+    // Once the publisher is gone, that is said.
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("# the connection to") && l.contains("was lost")),
+        "{}",
+        printed.join("\n")
+    );
+}
+
+#[test]
+fn print_follows_a_robot_that_restarts() {
+    let python = python();
+    let dir = tmp("monitor-restart");
+    let port = free_port_pair();
+    let mut first = Publisher::start(&python, port, 2);
+    let (mut monitor, received) = print_monitor(&dir, port, 20);
+    lines_until(&received, "# watching");
+    first.go();
+    let first_seen = first.seen();
+    lines_until(&received, "# the connection to");
+    let mut second = Publisher::start(&python, port, 3);
+    let between = lines_until(&received, "# watching");
+    second.go();
+    let second_seen = second.seen();
+    monitor.kill().unwrap();
+    monitor.wait().unwrap();
+    let after: Vec<String> = received.try_iter().collect();
+    assert_eq!(changes(&after), second_seen, "{}", after.join("\n"));
+    assert!(changes(&between).len() <= first_seen.len());
+}
+
+#[test]
+fn the_screen_shows_the_running_tree_and_a_lost_robot() {
+    let python = python();
+    let dir = tmp("monitor-screen");
+    let port = free_port_pair();
+    let mut publisher = Publisher::start(&python, port, 0);
+    let tmux = Tmux::start(&format!(
+        "cd {} && {} {} monitor :{port}; echo monitor exited $?; sleep 30",
+        quote(&dir),
+        isolated_env(&dir),
+        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr")))
+    ));
+    tmux.wait_for(
+        &[
+            &format!("watching 127.0.0.1:{port}"),
+            "8 nodes",
+            "following",
+        ],
+        30,
+    );
+    publisher.go();
+    // The tree ticks: statuses and the changes pane move.
+    let wanted = [
+        "Grasp \"grasp\" (Action)",
+        "SubTree \"Work\"",
+        "IDLE → RUNNING",
+    ];
+    tmux.wait_until(&wanted, 30, |screen| {
+        wanted.iter().all(|w| screen.contains(w))
+            && screen.contains("status changes (")
+            && !screen.contains("status changes (0)")
+    });
+    publisher.stop();
+    drop(publisher);
+    tmux.wait_for(&["was lost", "trying again"], 30);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["monitor exited 0"], 10);
+}
