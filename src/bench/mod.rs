@@ -8,11 +8,13 @@
 //! one-shot command against a warm one (`cold`); and seeking in a long recording through
 //! the replay workbench's own seek (`replay`); the YuMi's forward kinematics against
 //! Pinocchio and its collision-free paths against OMPL with PyBullet (`motion`, not in the
-//! default set: it needs the robot's description in the cache). Nothing here is timed inside tests.
+//! default set: it needs the robot's description in the cache); `betr monitor` following a
+//! real BehaviorTree.CPP tree at 100 Hz (`monitor`, not in the default set). Nothing here is timed inside tests.
 
 pub mod cell_motion;
 pub mod cold;
 pub mod model;
+pub mod monitor;
 pub mod motion;
 pub mod pybullet;
 pub mod replay;

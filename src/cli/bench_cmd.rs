@@ -30,6 +30,9 @@ pub enum Part {
     /// against OMPL's RRTConnect with PyBullet's collision checks (same URDF, same
     /// solids); scenario 1 end to end with the real arms. Not part of the default set.
     Motion,
+    /// `betr monitor` following a ~500-node BehaviorTree.CPP tree ticked at 100 Hz under
+    /// Groot2's publisher (behaviortreepy); not part of the default set.
+    Monitor,
     /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
     /// not part of the default set.
     Llm,
@@ -111,6 +114,11 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 },
             )?),
             Part::Motion => motion_part(args)?,
+            Part::Monitor => bench::monitor::rows(&bench::monitor::run(
+                &bench::monitor::btcpp_python()?,
+                500,
+                if args.quick { 1.0 } else { 10.0 },
+            )?),
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {

@@ -9,7 +9,8 @@ use anyhow::{Result, bail};
 use tokio::sync::mpsc;
 
 use betr::http_text::printable;
-use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, watch};
+use betr::monitor::protocol::KEPT_CHANGES;
+use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch};
 
 /// What `betr monitor` is asked.
 #[derive(clap::Args)]
@@ -107,6 +108,7 @@ impl Printer {
                 tree,
                 statuses,
                 since,
+                ..
             } => {
                 outln!(
                     "# watching {address}: tree {}, {} nodes",
@@ -130,6 +132,11 @@ impl Printer {
                 let Some(live) = self.live.as_mut() else {
                     return;
                 };
+                if missed_some(&transitions) {
+                    outln!(
+                        "# the publisher kept only its last {KEPT_CHANGES} changes since the last read: some before these were missed"
+                    );
+                }
                 for transition in transitions {
                     let Some(change) = live.apply(transition) else {
                         outln!(

@@ -2,7 +2,7 @@
 //! within a time limit or the connection counts as lost (a REQ socket that missed its
 //! reply cannot ask again, so a lost connection is dropped and made anew).
 
-use std::time::Duration;
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use thiserror::Error;
 use zeromq::{ReqSocket, Socket as _, SocketOptions, SocketRecv as _, SocketSend as _, ZmqMessage};
@@ -227,12 +227,18 @@ impl Publisher {
         Ok((id, statuses))
     }
 
-    /// Asks the publisher to keep every status change from now on.
-    pub async fn start_recording(&mut self) -> Result<TreeId, ClientError> {
-        Ok(self
+    /// Asks the publisher to keep every status change from now on; the publisher's clock
+    /// at that moment, when it says (BT.CPP 4 answers with microseconds since the Unix
+    /// epoch, the clock its changes are timed by).
+    pub async fn start_recording(&mut self) -> Result<(TreeId, Option<SystemTime>), ClientError> {
+        let (id, payload) = self
             .ask(RequestKind::ToggleRecording, Some(b"start"))
-            .await?
-            .0)
+            .await?;
+        let started = payload
+            .and_then(|p| String::from_utf8(p).ok())
+            .and_then(|t| t.trim().parse::<u64>().ok())
+            .map(|micros| UNIX_EPOCH + Duration::from_micros(micros));
+        Ok((id, started))
     }
 
     /// The status changes since the last call (or since recording started).
@@ -253,8 +259,8 @@ impl Publisher {
 
 /// A request id to start from; the publisher only echoes it, so the clock will do.
 fn rand_id() -> u32 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
         .map_or(1, |d| d.subsec_nanos())
 }
 

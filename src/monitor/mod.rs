@@ -30,7 +30,7 @@ pub struct WatchTiming {
 impl Default for WatchTiming {
     fn default() -> Self {
         WatchTiming {
-            poll: Duration::from_millis(10),
+            poll: Duration::from_millis(5),
             timeout: Duration::from_secs(2),
             retry: Duration::from_millis(500),
         }
@@ -47,8 +47,12 @@ pub enum WatchEvent {
         tree: Box<WatchedTree>,
         statuses: Vec<(u16, NodeStatus)>,
         since: Duration,
+        /// The publisher's clock when it began keeping changes (their times count from
+        /// it), when it says.
+        started: Option<std::time::SystemTime>,
     },
-    /// Status changes, each timed from the `since` of the last `Connected`.
+    /// Status changes, each timed from the `since` of the last `Connected`. A batch of
+    /// [`protocol::KEPT_CHANGES`] may have lost older ones ([`missed_some`]).
     Changes(Vec<Transition>),
     /// The publisher now runs another tree (the robot restarted); its tree is read again.
     Restarted,
@@ -115,27 +119,43 @@ async fn follow(
     let (tree_id, tree) = publisher.tree().await.map_err(before)?;
     let since = began.elapsed();
     let after = Failure::AfterConnecting;
-    publisher.start_recording().await.map_err(after)?;
+    let (_, started) = publisher.start_recording().await.map_err(after)?;
     let (_, statuses) = publisher.statuses().await.map_err(after)?;
     let connected = WatchEvent::Connected {
         address: address.clone(),
         tree: Box::new(tree),
         statuses,
         since,
+        started,
     };
     if events.send(connected).await.is_err() {
         return Ok(Ended::Closed);
     }
+    // Polled on a fixed beat rather than a pause after each read, and read again at once
+    // when a read came back a quarter full: the publisher drops its oldest changes past
+    // `protocol::KEPT_CHANGES`.
+    let mut beat = tokio::time::interval(timing.poll);
+    beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut busy = false;
     loop {
-        tokio::time::sleep(timing.poll).await;
+        if !busy {
+            beat.tick().await;
+        }
         let (id, changes) = publisher.transitions().await.map_err(after)?;
         if id != tree_id {
             return Ok(Ended::Restarted);
         }
+        busy = changes.len() >= protocol::KEPT_CHANGES / 4;
         if !changes.is_empty() && events.send(WatchEvent::Changes(changes)).await.is_err() {
             return Ok(Ended::Closed);
         }
     }
+}
+
+/// Whether a batch of changes is as long as the publisher keeps, so older changes may
+/// have been dropped before betr read them.
+pub fn missed_some(batch: &[Transition]) -> bool {
+    batch.len() >= protocol::KEPT_CHANGES
 }
 
 /// A watched tree with every node's status, kept up to date from the watch's events.

@@ -7,6 +7,10 @@
 
 use thiserror::Error;
 
+/// The status changes a BT.CPP 4 publisher keeps between two reads; past that it drops
+/// the oldest.
+pub const KEPT_CHANGES: usize = 1000;
+
 /// The protocol version this module speaks (BT.CPP 4's `kProtocolID`).
 pub const PROTOCOL_ID: u8 = 2;
 const REQUEST_HEADER: usize = 6;

@@ -212,6 +212,45 @@ impl Report {
     }
 }
 
+/// What one verification checks: properties and disturbances, within bounds.
+#[derive(Debug, Clone)]
+pub struct Checks {
+    pub properties: Vec<NamedProperty>,
+    pub disturbances: Vec<Disturbance>,
+    pub limits: Limits,
+}
+
+impl Checks {
+    /// What the scenario declares, within the default bounds.
+    pub fn declared(config: VerifyConfig) -> Checks {
+        Checks {
+            limits: Limits {
+                action_failures: config.action_failures,
+                ..Limits::default()
+            },
+            properties: config.properties,
+            disturbances: config.disturbances,
+        }
+    }
+
+    /// These checks on `tree`, started from `initial`.
+    pub fn input<'a>(
+        &'a self,
+        domain: &'a Domain,
+        tree: &'a Tree,
+        initial: &'a [Condition],
+    ) -> VerifyInput<'a> {
+        VerifyInput {
+            domain,
+            tree,
+            initial,
+            disturbances: &self.disturbances,
+            properties: &self.properties,
+            limits: self.limits,
+        }
+    }
+}
+
 /// What to verify and how.
 pub struct VerifyInput<'a> {
     pub domain: &'a Domain,

@@ -10,9 +10,7 @@
 use std::sync::Arc;
 
 use crate::bt::{Tree, to_text};
-use crate::verify::{
-    self, Disturbance, Limits, NamedProperty, Report, VerifyConfig, VerifyInput, plan_in_model,
-};
+use crate::verify::{self, Checks, Limits, Report, VerifyConfig, plan_in_model};
 
 use super::super::planned::Prediction;
 use super::super::types::{Event, VerifyRequest, VerifyScope};
@@ -34,49 +32,19 @@ enum PromelaError {
     },
 }
 
-/// What one verification checks: the scenario's properties and disturbances with what
-/// the request added or left out, within its bounds.
-struct Checks {
-    properties: Vec<NamedProperty>,
-    disturbances: Vec<Disturbance>,
-    limits: Limits,
-}
-
-impl Checks {
-    fn of(config: VerifyConfig, request: &VerifyRequest) -> Checks {
-        let defaults = Limits::default();
-        let mut properties = config.properties;
-        properties.extend(request.properties.iter().cloned());
-        Checks {
-            properties,
-            disturbances: if request.no_disturbances {
-                Vec::new()
-            } else {
-                config.disturbances
-            },
-            limits: Limits {
-                max_states: request.max_states.unwrap_or(defaults.max_states),
-                max_ticks: request.max_ticks.unwrap_or(defaults.max_ticks),
-                action_failures: request.action_failures || config.action_failures,
-            },
-        }
+/// What a request asks checked: the scenario's properties and disturbances with what the
+/// request added or left out, within its bounds.
+fn requested(config: VerifyConfig, request: &VerifyRequest) -> Checks {
+    let mut checks = Checks::declared(config);
+    checks.properties.extend(request.properties.iter().cloned());
+    if request.no_disturbances {
+        checks.disturbances.clear();
     }
-
-    fn input<'a>(
-        &'a self,
-        domain: &'a crate::domain::Domain,
-        tree: &'a Tree,
-        initial: &'a [crate::domain::Condition],
-    ) -> VerifyInput<'a> {
-        VerifyInput {
-            domain,
-            tree,
-            initial,
-            disturbances: &self.disturbances,
-            properties: &self.properties,
-            limits: self.limits,
-        }
-    }
+    let defaults = Limits::default();
+    checks.limits.max_states = request.max_states.unwrap_or(defaults.max_states);
+    checks.limits.max_ticks = request.max_ticks.unwrap_or(defaults.max_ticks);
+    checks.limits.action_failures |= request.action_failures;
+    checks
 }
 
 /// What failed in a report, in one line: the first finding or violated property, with the
@@ -156,7 +124,7 @@ impl Engine {
             Err(e) => return self.error(format!("cannot verify: {e}")),
         };
         let left_out = request.no_disturbances && !config.disturbances.is_empty();
-        let checks = Checks::of(config, &request);
+        let checks = requested(config, &request);
         let fresh = self.run.last.is_none()
             && self.task.fixes.is_empty()
             && !matches!(self.task.origin, Origin::File(_));
@@ -257,7 +225,7 @@ impl Engine {
         });
         self.notice("verifying the changed tree in the model before it runs …");
         let origin = self.origin();
-        let checks = Checks::of(config, &VerifyRequest::default());
+        let checks = requested(config, &VerifyRequest::default());
         // The tree before the change is checked the same way, so that what it fails too is
         // told apart from what the change did.
         let before = self.task.undo.last().map(|entry| entry.tree.clone());

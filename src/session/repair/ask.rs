@@ -298,9 +298,7 @@ pub(crate) async fn ask_conditions(
         let refused = before - list.fixes.len();
         // A fix that breaks a property the scenario declares would fail the changed
         // tree's check after approval: left out before anyone is asked, and said.
-        list.breaking = screen.breaking(&list.fixes);
-        let breaking = list.breaking.clone();
-        list.fixes.retain(|c| !breaking.iter().any(|(b, _)| b == c));
+        list.leave_out_breaking(screen.breaking(&list.fixes));
         emit(&Event::Notice {
             message: shortlist_notice(&list, refused),
         });

@@ -7,7 +7,7 @@
 use crate::bt::{NodeId, NodeKind, Tree};
 use crate::domain::{ActionCall, Condition};
 use crate::planner::{Outcome, Plan, Planner, RepairError, run_tree, set_value};
-use crate::verify::{self, Limits, VerifyConfig, VerifyInput};
+use crate::verify::{self, Checks, VerifyConfig};
 use crate::world::World;
 
 use super::super::types::Proposal;
@@ -179,18 +179,9 @@ impl Screen {
             return Vec::new();
         }
         let initial = self.world.facts();
+        let checks = Checks::declared(config);
         let broken = |tree: &Tree| {
-            let report = verify::verify(&VerifyInput {
-                domain: &self.scenario.domain,
-                tree,
-                initial: &initial,
-                disturbances: &config.disturbances,
-                properties: &config.properties,
-                limits: Limits {
-                    action_failures: config.action_failures,
-                    ..Limits::default()
-                },
-            });
+            let report = verify::verify(&checks.input(&self.scenario.domain, tree, &initial));
             report
                 .failures()
                 .into_iter()

@@ -26,6 +26,15 @@ pub struct Shortlist {
     pub breaking: Vec<(Condition, String)>,
 }
 
+impl Shortlist {
+    /// Leaves out the fixes that break a declared property, keeping each with the
+    /// property it breaks.
+    pub fn leave_out_breaking(&mut self, breaking: Vec<(Condition, String)>) {
+        self.fixes.retain(|c| !breaking.iter().any(|(b, _)| b == c));
+        self.breaking = breaking;
+    }
+}
+
 /// Bound on the conditions tried in each pass, so a huge scene stays quick to screen.
 const MAX_TRIED: usize = 3000;
 

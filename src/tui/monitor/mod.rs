@@ -7,6 +7,8 @@
 
 mod view;
 
+pub use view::draw;
+
 use std::collections::VecDeque;
 use std::path::Path;
 use std::time::Duration;
@@ -16,11 +18,14 @@ use tokio::sync::mpsc;
 use tui_tree_widget::TreeState;
 
 use crate::bt::render::{ASCII, Glyphs, UNICODE};
-use crate::monitor::{Address, LiveTree, WatchEvent, WatchTiming, watch};
+use crate::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch};
 
 use super::event_loop::{QueueEvent, spawn_input_reader};
 use super::theme::Theme;
 use super::{TerminalGuard, TuiError};
+
+/// The shortest time between two drawings while changes stream in.
+const FRAME: Duration = Duration::from_millis(15);
 
 /// How many status changes the side pane keeps.
 const RECENT: usize = 200;
@@ -47,6 +52,8 @@ pub struct MonitorScreen {
     follow: bool,
     recent: VecDeque<String>,
     changes: u64,
+    /// Reads that came back as full as the publisher keeps: changes before them were lost.
+    missed: u64,
     quit: bool,
     glyphs: &'static Glyphs,
     theme: Theme,
@@ -64,6 +71,7 @@ impl MonitorScreen {
             follow: true,
             recent: VecDeque::new(),
             changes: 0,
+            missed: 0,
             quit: false,
             glyphs,
             theme: Theme::new(glyphs),
@@ -111,6 +119,9 @@ impl MonitorScreen {
                 let Some(live) = self.live.as_mut() else {
                     return;
                 };
+                if missed_some(&transitions) {
+                    self.missed += 1;
+                }
                 for transition in transitions {
                     if let Some(change) = live.apply(transition) {
                         self.changes += 1;
@@ -210,7 +221,10 @@ pub fn run(
     ascii: bool,
     stderr_to: Option<&Path>,
 ) -> Result<(), TuiError> {
-    let runtime = tokio::runtime::Builder::new_current_thread()
+    // The watch runs on a worker thread of its own, so drawing never delays a read (the
+    // publisher drops changes past the 1000 it keeps between two reads).
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(1)
         .enable_all()
         .build()?;
     runtime.block_on(async {
@@ -226,13 +240,10 @@ pub fn run(
             if let Err(e) = terminal.draw(|f| view::draw(f, &mut screen)) {
                 break Err(TuiError::Terminal(e));
             }
+            let last_draw = tokio::time::Instant::now();
             let ended = tokio::select! {
                 Some(event) = watched.recv() => {
-                    screen.on_watch(event);
-                    // Everything already arrived is shown in one drawing.
-                    while let Ok(event) = watched.try_recv() {
-                        screen.on_watch(event);
-                    }
+                    gather(&mut screen, event, &mut watched, last_draw, |_| {}).await;
                     false
                 }
                 input = input.recv() => match input {
@@ -253,6 +264,32 @@ pub fn run(
         watcher.abort();
         result
     })
+}
+
+/// Applies `first` and every event that arrives until a frame after `last_draw` (at
+/// once when that is past), so a stream of changes is drawn at most once a frame;
+/// `observe` sees each event before the screen does.
+pub async fn gather(
+    screen: &mut MonitorScreen,
+    first: WatchEvent,
+    watched: &mut mpsc::Receiver<WatchEvent>,
+    last_draw: tokio::time::Instant,
+    mut observe: impl FnMut(&WatchEvent),
+) {
+    observe(&first);
+    screen.on_watch(first);
+    let until = last_draw + FRAME;
+    if until > tokio::time::Instant::now() {
+        while let Ok(Some(event)) = tokio::time::timeout_at(until, watched.recv()).await {
+            observe(&event);
+            screen.on_watch(event);
+        }
+    } else {
+        while let Ok(event) = watched.try_recv() {
+            observe(&event);
+            screen.on_watch(event);
+        }
+    }
 }
 
 /// Waits until `deadline`, or for ever without one.

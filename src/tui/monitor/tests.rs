@@ -39,6 +39,7 @@ fn connected() -> MonitorScreen {
         tree: Box::new(tree),
         statuses: vec![],
         since: Duration::from_millis(250),
+        started: None,
     });
     screen
 }

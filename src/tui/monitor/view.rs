@@ -167,7 +167,14 @@ fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         .skip(skip)
         .map(|l| Line::raw(l.clone()))
         .collect();
-    let title = format!(" status changes ({}) ", screen.changes);
+    let title = if screen.missed == 0 {
+        format!(" status changes ({}) ", screen.changes)
+    } else {
+        format!(
+            " status changes ({}; some missed {} times: the publisher keeps 1000) ",
+            screen.changes, screen.missed
+        )
+    };
     frame.render_widget(Paragraph::new(lines).block(block(screen, title)), area);
 }
 
