@@ -229,6 +229,9 @@ impl<'a, 'i> Reader<'a, 'i> {
                 };
                 self.leaf(node, id, Some(tag))
             }
+            other if !self.names_a_leaf(other) && btcpp_builtin(other).is_some() => {
+                Err(self.error(node, &builtin_refusal(other)))
+            }
             // BT.CPP's compact form: the node ID as the element name.
             other => self.leaf(node, other, None),
         }
@@ -332,6 +335,12 @@ impl<'a, 'i> Reader<'a, 'i> {
             (None, Some(_)) => self.port(node, position),
             (_, None) | (Some(_), Some(_)) => self.port(node, name),
         }
+    }
+
+    /// Whether `id` names a predicate or a skill of the scenario (which then wins over a
+    /// BT.CPP built-in of the same name).
+    fn names_a_leaf(&self, id: &str) -> bool {
+        predicate_for_id(self.domain, id).is_some() || !skills_for_id(self.domain, id).is_empty()
     }
 
     /// A condition or an action: `id` names a predicate or a skill of the scenario.
@@ -501,6 +510,47 @@ impl<'a, 'i> Reader<'a, 'i> {
 }
 
 /// The first action in `read`'s subtree, if it has one (only actions can be running).
+/// The kind of a node BehaviorTree.CPP 4 registers itself that betr's engine does not run
+/// (Sequence, Fallback, their reactive forms, Inverter over a condition and SubTree are
+/// read above).
+fn btcpp_builtin(id: &str) -> Option<&'static str> {
+    Some(match id {
+        "AsyncFallback" | "AsyncSequence" | "SequenceWithMemory" | "SequenceStar" | "Parallel"
+        | "ParallelAll" | "IfThenElse" | "WhileDoElse" | "TryCatch" | "Switch2" | "Switch3"
+        | "Switch4" | "Switch5" | "Switch6" => "control node",
+        "RetryUntilSuccessful"
+        | "KeepRunningUntilFailure"
+        | "Repeat"
+        | "Timeout"
+        | "Delay"
+        | "RunOnce"
+        | "ForceSuccess"
+        | "ForceFailure"
+        | "Precondition"
+        | "LoopInt"
+        | "LoopBool"
+        | "LoopDouble"
+        | "LoopString"
+        | "SkipUnlessUpdated"
+        | "WaitValueUpdate" => "decorator",
+        "AlwaysSuccess" | "AlwaysFailure" | "Script" | "SetBlackboard" | "Sleep"
+        | "UnsetBlackboard" => "action",
+        "ScriptCondition" | "WasEntryUpdated" => "condition",
+        _ => return None,
+    })
+}
+
+/// Why a BT.CPP built-in is not read, and what would show or run the tree.
+fn builtin_refusal(id: &str) -> String {
+    format!(
+        "{id} is a BehaviorTree.CPP {} that betr's engine does not run (it runs Sequence, \
+         Fallback, their reactive forms, Inverter over a condition, and the scenario's \
+         skills and conditions); nothing of the tree is changed or dropped, so it is not \
+         read; `betr monitor` shows it whole while it runs in BehaviorTree.CPP",
+        btcpp_builtin(id).unwrap_or("node")
+    )
+}
+
 fn first_action(read: &Read) -> Option<String> {
     match &read.kind {
         NodeKind::Action(a) => Some(a.to_string()),

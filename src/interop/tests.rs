@@ -215,3 +215,64 @@ fn the_export_writes_compact_leaves_with_named_ports() {
         "{xml}"
     );
 }
+
+/// Every node kind BehaviorTree.CPP 4 ships that betr's engine does not run, written in
+/// BT.CPP's own style: each refused with its line and element, as the node it is.
+#[test]
+fn btcpp_built_ins_betr_cannot_run_are_refused_by_line_and_kind() {
+    let s = scenario("scenarios/cell/red_on_blue.toml");
+    let cases = [
+        (
+            "<Parallel success_count=\"1\"><AlwaysSuccess/></Parallel>",
+            "Parallel",
+            "control node",
+        ),
+        (
+            "<IfThenElse><AlwaysSuccess/><AlwaysSuccess/></IfThenElse>",
+            "IfThenElse",
+            "control node",
+        ),
+        (
+            "<Switch2 variable=\"{v}\" case_1=\"1\"><AlwaysSuccess/><AlwaysSuccess/><AlwaysSuccess/></Switch2>",
+            "Switch2",
+            "control node",
+        ),
+        (
+            "<RetryUntilSuccessful num_attempts=\"3\"><AlwaysSuccess/></RetryUntilSuccessful>",
+            "RetryUntilSuccessful",
+            "decorator",
+        ),
+        (
+            "<Timeout msec=\"100\"><AlwaysSuccess/></Timeout>",
+            "Timeout",
+            "decorator",
+        ),
+        (
+            "<Repeat num_cycles=\"2\"><AlwaysSuccess/></Repeat>",
+            "Repeat",
+            "decorator",
+        ),
+        ("<Script code=\"x:=1\"/>", "Script", "action"),
+        (
+            "<SetBlackboard value=\"1\" output_key=\"x\"/>",
+            "SetBlackboard",
+            "action",
+        ),
+        (
+            "<ScriptCondition code=\"x==1\"/>",
+            "ScriptCondition",
+            "condition",
+        ),
+    ];
+    for (xml, id, kind) in cases {
+        let e = import(&format!("<Sequence>\n{xml}\n</Sequence>"), &s).unwrap_err();
+        assert_eq!(e.line, 2, "{id}: {e}");
+        assert!(e.element.starts_with(&format!("<{id}")), "{id}: {e}");
+        assert!(
+            e.reason.starts_with(&format!(
+                "{id} is a BehaviorTree.CPP {kind} that betr's engine does not run"
+            )),
+            "{id}: {e}"
+        );
+    }
+}
