@@ -53,7 +53,11 @@ fn change(micros: u64, uid: u16, status: NodeStatus) -> Transition {
 }
 
 fn drawn(screen: &mut MonitorScreen) -> String {
-    let mut terminal = Terminal::new(TestBackend::new(110, 20)).expect("a test terminal");
+    drawn_at(screen, 110, 20)
+}
+
+fn drawn_at(screen: &mut MonitorScreen, width: u16, height: u16) -> String {
+    let mut terminal = Terminal::new(TestBackend::new(width, height)).expect("a test terminal");
     terminal
         .draw(|f| view::draw(f, screen))
         .expect("the screen draws");
@@ -105,4 +109,26 @@ fn a_lost_connection_is_shown_with_the_tree_as_last_seen() {
     let text = drawn(&mut screen);
     assert!(text.contains("was lost: timed out; trying again"), "{text}");
     assert!(text.contains("serve"), "{text}");
+}
+
+#[test]
+fn a_small_terminal_keeps_the_state_and_the_quit_key() {
+    let mut screen = connected();
+    screen.on_watch(WatchEvent::Changes(vec![change(
+        1_000,
+        1,
+        NodeStatus::Running,
+    )]));
+    insta::assert_snapshot!(drawn_at(&mut screen, 80, 24));
+    let mut screen = connected();
+    screen.on_watch(WatchEvent::Lost(
+        "the connection to 127.0.0.1:1667 was lost: Server disconnected".into(),
+    ));
+    let text = drawn_at(&mut screen, 80, 24);
+    let bar = text.lines().last().unwrap_or_default();
+    assert!(
+        bar.starts_with("\" the connection to 127.0.0.1:1667 was lost"),
+        "{bar}"
+    );
+    assert!(bar.ends_with("… · q quit\""), "{bar}");
 }

@@ -179,34 +179,52 @@ fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
 }
 
 fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
-    let (text, style) = match &screen.connection {
+    let ascii = screen.glyphs.success.is_ascii();
+    let dot = if ascii { " | " } else { " · " };
+    let (state, style) = match &screen.connection {
         Connection::Watching => {
             let nodes = screen.live.as_ref().map_or(0, |l| l.tree.nodes.len());
             let follow = if screen.follow {
                 "following"
             } else {
-                "f: follow"
+                "not following"
             };
             (
                 format!(
-                    " watching {} · {nodes} nodes · {follow} · ←→ fold · E/C open/close all · q quit",
+                    " watching {}{dot}{nodes} nodes{dot}{follow}",
                     screen.address
                 ),
                 screen.theme.status_bar,
             )
         }
-        Connection::Lost(reason) => (
-            format!(" {reason}; trying again · q quit"),
-            screen.theme.error,
-        ),
-        Connection::Waiting(Some(reason)) => (
-            format!(" {reason}; trying again · q quit"),
-            screen.theme.error,
-        ),
+        Connection::Lost(reason) | Connection::Waiting(Some(reason)) => {
+            (format!(" {reason}; trying again"), screen.theme.error)
+        }
         Connection::Waiting(None) => (
-            format!(" connecting to {} · q quit", screen.address),
+            format!(" connecting to {}", screen.address),
             screen.theme.status_bar,
         ),
+    };
+    // The keys after the state, fewer of them when the terminal is narrow; quitting is
+    // always said.
+    let fold = if ascii { "h/l fold" } else { "←→ fold" };
+    let keys = [
+        format!("{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}q quit"),
+        format!("{dot}f follow{dot}q quit"),
+        format!("{dot}q quit"),
+    ];
+    let width = usize::from(area.width);
+    let text = match keys
+        .iter()
+        .find(|k| state.chars().count() + k.chars().count() <= width)
+    {
+        Some(keys) => format!("{state}{keys}"),
+        // A long reason is cut rather than the way out.
+        None => {
+            let room = width.saturating_sub(keys[2].chars().count() + 1);
+            let cut: String = state.chars().take(room).collect();
+            format!("{cut}…{}", keys[2])
+        }
     };
     frame.render_widget(Paragraph::new(Span::styled(text, style)), area);
 }
