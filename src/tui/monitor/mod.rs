@@ -54,6 +54,12 @@ pub struct MonitorScreen {
     changes: u64,
     /// Reads that came back as full as the publisher keeps: changes before them were lost.
     missed: u64,
+    /// The search being typed after `/`.
+    typing: Option<String>,
+    /// The last search: its matches are marked, `n` goes to the next.
+    query: Option<String>,
+    /// A search that matched nothing, said until the next one.
+    not_found: Option<String>,
     quit: bool,
     glyphs: &'static Glyphs,
     theme: Theme,
@@ -72,6 +78,9 @@ impl MonitorScreen {
             recent: VecDeque::new(),
             changes: 0,
             missed: 0,
+            typing: None,
+            query: None,
+            not_found: None,
             quit: false,
             glyphs,
             theme: Theme::new(glyphs),
@@ -97,15 +106,12 @@ impl MonitorScreen {
             } => {
                 let live = LiveTree::new(*tree, &statuses);
                 // A new tree opens whole; the same tree again keeps the person's folds.
-                if self.live.as_ref().map(|l| &l.tree) != Some(&live.tree) {
-                    self.state = TreeState::default();
-                    for (i, node) in live.tree.nodes.iter().enumerate() {
-                        if !node.children.is_empty() {
-                            self.state.open(live.tree.uid_path(i));
-                        }
-                    }
-                }
+                let new_tree = self.live.as_ref().map(|l| &l.tree) != Some(&live.tree);
                 self.live = Some(live);
+                if new_tree {
+                    self.state = TreeState::default();
+                    self.open_all();
+                }
                 self.since = since;
                 self.connection = Connection::Watching;
                 self.follow_busy();
@@ -164,6 +170,24 @@ impl MonitorScreen {
 
     /// A key pressed.
     pub fn on_key(&mut self, key: KeyEvent) {
+        if let Some(typed) = self.typing.as_mut() {
+            match key.code {
+                KeyCode::Enter => {
+                    self.query = Some(std::mem::take(typed)).filter(|q| !q.trim().is_empty());
+                    self.typing = None;
+                    self.find_next();
+                }
+                KeyCode::Esc => self.typing = None,
+                KeyCode::Backspace => {
+                    typed.pop();
+                }
+                KeyCode::Char(c) if !key.modifiers.contains(KeyModifiers::CONTROL) => {
+                    typed.push(c);
+                }
+                _ => {}
+            }
+            return;
+        }
         let moved = match key.code {
             KeyCode::Char('q') | KeyCode::Esc => {
                 self.quit = true;
@@ -185,14 +209,16 @@ impl MonitorScreen {
             KeyCode::Home => self.state.select_first(),
             KeyCode::End => self.state.select_last(),
             KeyCode::Char('E') => {
-                if let Some(live) = &self.live {
-                    for (i, node) in live.tree.nodes.iter().enumerate() {
-                        if !node.children.is_empty() {
-                            self.state.open(live.tree.uid_path(i));
-                        }
-                    }
-                }
+                self.open_all();
                 true
+            }
+            KeyCode::Char('/') => {
+                self.typing = Some(String::new());
+                return;
+            }
+            KeyCode::Char('n') => {
+                self.find_next();
+                return;
             }
             KeyCode::Char('C') => {
                 self.state.close_all();
@@ -204,6 +230,55 @@ impl MonitorScreen {
         if moved {
             self.follow = false;
         }
+    }
+
+    /// Opens every branch.
+    fn open_all(&mut self) {
+        let Some(live) = &self.live else { return };
+        for (i, node) in live.tree.nodes.iter().enumerate() {
+            if !node.children.is_empty() {
+                self.state.open(live.tree.uid_path(i));
+            }
+        }
+    }
+
+    /// Whether node `index` matches the search (its ID, name or a port, any case).
+    fn matches(&self, index: usize) -> bool {
+        let (Some(live), Some(query)) = (&self.live, &self.query) else {
+            return false;
+        };
+        let query = query.to_lowercase();
+        let node = &live.tree.nodes[index];
+        [&node.id, &node.name]
+            .into_iter()
+            .chain(node.ports.iter().map(|(_, v)| v))
+            .any(|text| text.to_lowercase().contains(&query))
+    }
+
+    /// Selects the next node after the selection that matches the search (from the top
+    /// past the last), its branch opened; following stops.
+    fn find_next(&mut self) {
+        let Some(live) = &self.live else { return };
+        let count = live.tree.nodes.len();
+        let from = self.selected().map_or(0, |i| i + 1);
+        let Some(found) = (0..count)
+            .map(|k| (from + k) % count)
+            .find(|&i| self.matches(i))
+        else {
+            self.not_found = self.query.clone();
+            return;
+        };
+        self.not_found = None;
+        let path = self
+            .live
+            .as_ref()
+            .map(|l| l.tree.uid_path(found))
+            .unwrap_or_default();
+        for depth in 1..path.len() {
+            self.state.open(path[..depth].to_vec());
+        }
+        self.state.select(path);
+        self.follow = false;
     }
 
     /// The selected node's index in the tree.

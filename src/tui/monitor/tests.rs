@@ -132,3 +132,46 @@ fn a_small_terminal_keeps_the_state_and_the_quit_key() {
     );
     assert!(bar.ends_with("… · q quit\""), "{bar}");
 }
+
+#[test]
+fn a_search_marks_every_match_and_goes_from_one_to_the_next() {
+    let mut screen = connected();
+    let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
+    for c in ['/', 'G', 'R', 'A'] {
+        screen.on_key(key(c));
+    }
+    screen.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    assert_eq!(screen.selected(), Some(6), "Grasp, by its ID in any case");
+    assert!(screen.matches(6) && !screen.matches(5));
+    for c in "/{cup}".chars() {
+        screen.on_key(key(c));
+    }
+    screen.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    assert_eq!(screen.selected(), Some(6), "by a port's blackboard entry");
+    for c in "/o".chars() {
+        screen.on_key(key(c));
+    }
+    screen.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    assert_eq!(
+        screen.selected(),
+        Some(7),
+        "the next after the selection: Recover"
+    );
+    screen.on_key(key('n'));
+    assert_eq!(
+        screen.selected(),
+        Some(1),
+        "round past the end: ready_then_work"
+    );
+    for c in "/zebra".chars() {
+        screen.on_key(key(c));
+    }
+    screen.on_key(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE));
+    assert_eq!(
+        screen.selected(),
+        Some(1),
+        "nothing found: the selection stays"
+    );
+    let text = drawn(&mut screen);
+    assert!(text.contains("no node matches \"zebra\""), "{text}");
+}

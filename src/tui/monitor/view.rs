@@ -3,6 +3,7 @@
 
 use ratatui::Frame;
 use ratatui::layout::{Constraint, Layout, Rect};
+use ratatui::style::Modifier;
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use tui_tree_widget::{Tree as TreeWidget, TreeItem};
@@ -68,9 +69,14 @@ fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>>
     for (i, node) in live.tree.nodes.iter().enumerate().rev() {
         let status = live.statuses[i];
         let style = screen.theme.status(shown(status));
+        let label = if screen.matches(i) {
+            style.add_modifier(Modifier::UNDERLINED | Modifier::BOLD)
+        } else {
+            style
+        };
         let line = Line::from(vec![
             Span::styled(format!("[{}] ", mark(screen, status)), style),
-            Span::styled(live.tree.describe(node), style),
+            Span::styled(live.tree.describe(node), label),
         ]);
         let children: Vec<TreeItem<'static, u16>> = node
             .children
@@ -181,7 +187,15 @@ fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
 fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
     let ascii = screen.glyphs.success.is_ascii();
     let dot = if ascii { " | " } else { " · " };
-    let (state, style) = match &screen.connection {
+    if let Some(typed) = &screen.typing {
+        let text = format!(" find: {typed}_{dot}Enter find{dot}Esc cancel");
+        frame.render_widget(
+            Paragraph::new(Span::styled(text, screen.theme.status_bar)),
+            area,
+        );
+        return;
+    }
+    let (mut state, style) = match &screen.connection {
         Connection::Watching => {
             let nodes = screen.live.as_ref().map_or(0, |l| l.tree.nodes.len());
             let follow = if screen.follow {
@@ -205,11 +219,14 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
             screen.theme.status_bar,
         ),
     };
+    if let Some(query) = &screen.not_found {
+        state.push_str(&format!("{dot}no node matches {:?}", printable(query)));
+    }
     // The keys after the state, fewer of them when the terminal is narrow; quitting is
     // always said.
     let fold = if ascii { "h/l fold" } else { "←→ fold" };
     let keys = [
-        format!("{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}q quit"),
+        format!("{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}/ find{dot}q quit"),
         format!("{dot}f follow{dot}q quit"),
         format!("{dot}q quit"),
     ];
