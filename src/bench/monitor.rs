@@ -208,8 +208,9 @@ fn resident_kib() -> u64 {
         .map_or(0, |pages| pages * 4)
 }
 
-/// A port whose next port is free too (the publisher binds both).
-fn free_port_pair() -> Result<u16, BenchError> {
+/// A port free on every interface whose next port is free too (Groot2's publisher binds
+/// both).
+pub fn free_port_pair() -> Result<u16, BenchError> {
     for _ in 0..50 {
         let first = std::net::TcpListener::bind("0.0.0.0:0")?;
         let port = first.local_addr()?.port();

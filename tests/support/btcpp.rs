@@ -3,7 +3,6 @@
 //! a tree ticked under Groot2's publisher (scripts/btcpp_publisher.py) for the monitor.
 
 use std::io::{BufRead, BufReader, Write};
-use std::net::TcpListener;
 use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 
@@ -33,17 +32,9 @@ pub fn python() -> PathBuf {
     python
 }
 
-/// A port free on every interface whose next port is free too (Groot2's publisher binds
-/// both).
+/// A port free on every interface whose next port is free too (the benchmark's).
 pub fn free_port_pair() -> u16 {
-    for _ in 0..50 {
-        let first = TcpListener::bind("0.0.0.0:0").unwrap();
-        let port = first.local_addr().unwrap().port();
-        if port < u16::MAX && TcpListener::bind(("0.0.0.0", port + 1)).is_ok() {
-            return port;
-        }
-    }
-    panic!("no two free ports in a row");
+    betr::bench::monitor::free_port_pair().unwrap()
 }
 
 /// A BT.CPP tree published on a port, waiting for [`Publisher::go`] to tick.
