@@ -93,7 +93,14 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
         .map_err(|e| BenchError::Setup(e.to_string()))?;
     let (events, mut received) = mpsc::channel(256);
     let began = Instant::now();
-    let watcher = tokio::spawn(watch(address.clone(), WatchTiming::default(), events));
+    // The benchmark only watches: no commands.
+    let (_, no_commands) = mpsc::unbounded_channel();
+    let watcher = tokio::spawn(watch(
+        address.clone(),
+        WatchTiming::default(),
+        events,
+        no_commands,
+    ));
     let mut screen = MonitorScreen::new(address, false);
     // A test terminal cannot fail (its error type is `Infallible`).
     let Ok(mut terminal) = Terminal::new(TestBackend::new(160, 50));
@@ -156,7 +163,7 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
                 WatchEvent::Lost(reason) | WatchEvent::Waiting(reason) => {
                     failed.get_or_insert(reason.clone());
                 }
-                WatchEvent::Restarted => {}
+                WatchEvent::Restarted | WatchEvent::Stopped(_) | WatchEvent::Refused(_) => {}
             },
         )
         .await;

@@ -61,7 +61,14 @@ pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
 /// no publisher ever answered.
 async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Result<ExitCode> {
     let (events, mut received) = mpsc::channel(256);
-    let watcher = tokio::spawn(watch(address.clone(), WatchTiming::default(), events));
+    // `--print` only watches: no breakpoints are set.
+    let (_, no_commands) = mpsc::unbounded_channel();
+    let watcher = tokio::spawn(watch(
+        address.clone(),
+        WatchTiming::default(),
+        events,
+        no_commands,
+    ));
     let deadline = duration.map(|d| tokio::time::Instant::now() + d);
     let mut printer = Printer {
         live: None,
@@ -152,6 +159,9 @@ impl Printer {
                 outln!("# the publisher runs a new tree (restarted): reading it again");
             }
             WatchEvent::Lost(reason) => outln!("# {reason}; trying again"),
+            // Nothing sets breakpoints while printing; another client's stop is said.
+            WatchEvent::Stopped(uid) => outln!("# node {uid} stopped at a breakpoint"),
+            WatchEvent::Refused(reason) => outln!("# {reason}"),
             WatchEvent::Waiting(reason) => {
                 outln!("# {reason}; trying again");
                 self.last_wait = Some(reason);

@@ -5,7 +5,9 @@
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 use thiserror::Error;
-use zeromq::{ReqSocket, Socket as _, SocketOptions, SocketRecv as _, SocketSend as _, ZmqMessage};
+use zeromq::{
+    ReqSocket, Socket as _, SocketOptions, SocketRecv as _, SocketSend as _, SubSocket, ZmqMessage,
+};
 
 use super::protocol::{self, NodeStatus, ProtocolError, Request, RequestKind, Transition};
 use super::tree::{TreeError, WatchedTree};
@@ -241,6 +243,34 @@ impl Publisher {
         Ok((id, started))
     }
 
+    /// A request that changes the publisher's breakpoints (its reply carries nothing).
+    pub async fn command(
+        &mut self,
+        kind: RequestKind,
+        body: Option<&[u8]>,
+    ) -> Result<(), ClientError> {
+        self.ask(kind, body).await.map(|_| ())
+    }
+
+    /// The publisher's notifications: it says on its second port (its request port + 1)
+    /// when a node stops at a breakpoint.
+    pub async fn notifications(&self) -> Result<Notifications, ClientError> {
+        let address = Address {
+            host: self.address.host.clone(),
+            port: self.address.port.wrapping_add(1),
+        };
+        let mut options = SocketOptions::default();
+        options.connect_timeout(self.timeout);
+        let mut socket = SubSocket::with_options(options);
+        let failed = |e: zeromq::ZmqError| ClientError::Connect {
+            address: address.clone(),
+            reason: format!("the publisher's notification port: {e}"),
+        };
+        socket.connect(&address.endpoint()).await.map_err(failed)?;
+        socket.subscribe("").await.map_err(failed)?;
+        Ok(Notifications { address, socket })
+    }
+
     /// The status changes since the last call (or since recording started).
     pub async fn transitions(&mut self) -> Result<(TreeId, Vec<Transition>), ClientError> {
         let (id, payload) = self.ask_payload(RequestKind::Transitions, None).await?;
@@ -254,6 +284,28 @@ impl Publisher {
             address: self.address.clone(),
             source,
         }
+    }
+}
+
+/// The publisher's notifications of nodes stopped at a breakpoint.
+pub struct Notifications {
+    address: Address,
+    socket: SubSocket,
+}
+
+impl Notifications {
+    /// The next node stopped at a breakpoint.
+    pub async fn stopped(&mut self) -> Result<u16, ClientError> {
+        let message = self.socket.recv().await.map_err(|e| ClientError::Lost {
+            address: self.address.clone(),
+            reason: e.to_string(),
+        })?;
+        let frames = message.into_vec();
+        let slices: Vec<&[u8]> = frames.iter().map(|f| f.as_ref()).collect();
+        protocol::read_breakpoint_reached(&slices).map_err(|source| ClientError::Protocol {
+            address: self.address.clone(),
+            source,
+        })
     }
 }
 

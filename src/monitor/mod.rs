@@ -60,14 +60,60 @@ pub enum WatchEvent {
     Lost(String),
     /// Not connected: why, as the last try said. Sent when the reason changes.
     Waiting(String),
+    /// The node with this uid stopped at its breakpoint; the tree waits for a release.
+    Stopped(u16),
+    /// The publisher refused a breakpoint command: why.
+    Refused(String),
 }
 
-/// Follows the publisher at `address` until the receiver is dropped.
-pub async fn watch(address: Address, timing: WatchTiming, events: mpsc::Sender<WatchEvent>) {
+/// What a front end asks of the publisher while watching.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WatchCommand {
+    /// Stop before the node with this uid is ticked, every time.
+    Break(u16),
+    /// Take that breakpoint away.
+    Unbreak(u16),
+    /// Let the node stopped at its breakpoint go on: ticked as usual (`forced: None`) or
+    /// returning `forced` without being ticked.
+    Release {
+        uid: u16,
+        forced: Option<NodeStatus>,
+    },
+    /// Take every breakpoint away (before leaving: a breakpoint left behind would stop
+    /// the robot with no one watching).
+    ClearAll,
+}
+
+impl WatchCommand {
+    fn request(self) -> (protocol::RequestKind, Vec<u8>) {
+        use protocol::RequestKind;
+        match self {
+            WatchCommand::Break(uid) => (RequestKind::HookInsert, protocol::breakpoint_body(uid)),
+            WatchCommand::Unbreak(uid) => (
+                RequestKind::HookRemove,
+                protocol::breakpoint_removal_body(uid),
+            ),
+            WatchCommand::Release { uid, forced } => (
+                RequestKind::BreakpointUnlock,
+                protocol::release_body(uid, forced),
+            ),
+            WatchCommand::ClearAll => (RequestKind::RemoveAllHooks, Vec::new()),
+        }
+    }
+}
+
+/// Follows the publisher at `address` until the receiver is dropped, sending it
+/// `commands` as they come.
+pub async fn watch(
+    address: Address,
+    timing: WatchTiming,
+    events: mpsc::Sender<WatchEvent>,
+    mut commands: mpsc::UnboundedReceiver<WatchCommand>,
+) {
     let began = tokio::time::Instant::now();
     let mut last_wait: Option<String> = None;
     loop {
-        let outcome = follow(&address, timing, began, &events).await;
+        let outcome = follow(&address, timing, began, &events, &mut commands).await;
         if events.is_closed() {
             return;
         }
@@ -111,6 +157,7 @@ async fn follow(
     timing: WatchTiming,
     began: tokio::time::Instant,
     events: &mpsc::Sender<WatchEvent>,
+    commands: &mut mpsc::UnboundedReceiver<WatchCommand>,
 ) -> Result<Ended, Failure> {
     let before = Failure::BeforeConnecting;
     let mut publisher = Publisher::connect(address, timing.timeout)
@@ -119,6 +166,10 @@ async fn follow(
     let (tree_id, tree) = publisher.tree().await.map_err(before)?;
     let since = began.elapsed();
     let after = Failure::AfterConnecting;
+    // A new watch starts with no breakpoints, whatever an earlier one left.
+    let (clear, body) = WatchCommand::ClearAll.request();
+    publisher.command(clear, Some(&body)).await.map_err(after)?;
+    let mut notifications = publisher.notifications().await.map_err(after)?;
     let (_, started) = publisher.start_recording().await.map_err(after)?;
     let (_, statuses) = publisher.statuses().await.map_err(after)?;
     let connected = WatchEvent::Connected {
@@ -137,9 +188,34 @@ async fn follow(
     let mut beat = tokio::time::interval(timing.poll);
     beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     let mut busy = false;
+    let mut commanded = true;
     loop {
         if !busy {
-            beat.tick().await;
+            tokio::select! {
+                _ = beat.tick() => {}
+                command = commands.recv(), if commanded => {
+                    match command {
+                        Some(command) => {
+                            let (kind, body) = command.request();
+                            if let Err(e) = publisher.command(kind, Some(&body)).await {
+                                let refused = WatchEvent::Refused(e.to_string());
+                                if events.send(refused).await.is_err() {
+                                    return Ok(Ended::Closed);
+                                }
+                            }
+                        }
+                        None => commanded = false,
+                    }
+                    continue;
+                }
+                stopped = notifications.stopped() => {
+                    let uid = stopped.map_err(after)?;
+                    if events.send(WatchEvent::Stopped(uid)).await.is_err() {
+                        return Ok(Ended::Closed);
+                    }
+                    continue;
+                }
+            }
         }
         let (id, changes) = publisher.transitions().await.map_err(after)?;
         if id != tree_id {

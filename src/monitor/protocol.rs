@@ -27,6 +27,14 @@ pub enum RequestKind {
     ToggleRecording,
     /// The status changes kept since the last such request.
     Transitions,
+    /// Stop before a node is ticked (body: the hook as JSON).
+    HookInsert,
+    /// Take a stop away (body: the node and the position as JSON).
+    HookRemove,
+    /// Let a stopped node go on, or give it a status (body: JSON).
+    BreakpointUnlock,
+    /// Take every stop away.
+    RemoveAllHooks,
 }
 
 impl RequestKind {
@@ -36,6 +44,10 @@ impl RequestKind {
             RequestKind::Status => b'S',
             RequestKind::ToggleRecording => b'r',
             RequestKind::Transitions => b't',
+            RequestKind::HookInsert => b'I',
+            RequestKind::HookRemove => b'R',
+            RequestKind::BreakpointUnlock => b'U',
+            RequestKind::RemoveAllHooks => b'A',
         }
     }
 
@@ -45,6 +57,10 @@ impl RequestKind {
             RequestKind::Status => "status",
             RequestKind::ToggleRecording => "toggle recording",
             RequestKind::Transitions => "transitions",
+            RequestKind::HookInsert => "breakpoint",
+            RequestKind::HookRemove => "breakpoint removal",
+            RequestKind::BreakpointUnlock => "breakpoint release",
+            RequestKind::RemoveAllHooks => "remove all breakpoints",
         }
     }
 }
@@ -198,6 +214,75 @@ pub struct Reply<'a> {
     pub payload: Option<&'a [u8]>,
 }
 
+/// A breakpoint before node `uid` is ticked (an interactive pre-tick hook), as the
+/// publisher reads it.
+pub fn breakpoint_body(uid: u16) -> Vec<u8> {
+    serde_json::json!({
+        "enabled": true,
+        "uid": uid,
+        "mode": 0,
+        "once": false,
+        "desired_status": "SKIPPED",
+        "position": 0,
+    })
+    .to_string()
+    .into_bytes()
+}
+
+/// The breakpoint before node `uid`, to take away.
+pub fn breakpoint_removal_body(uid: u16) -> Vec<u8> {
+    serde_json::json!({"uid": uid, "position": 0})
+        .to_string()
+        .into_bytes()
+}
+
+/// Lets node `uid`, stopped at its breakpoint, go on: ticked as usual (`None`) or
+/// returning `forced` without being ticked.
+pub fn release_body(uid: u16, forced: Option<NodeStatus>) -> Vec<u8> {
+    let desired = match forced {
+        Some(NodeStatus::Success) => "SUCCESS",
+        Some(NodeStatus::Failure) => "FAILURE",
+        _ => "SKIPPED",
+    };
+    serde_json::json!({
+        "uid": uid,
+        "desired_status": desired,
+        "position": 0,
+        "remove_when_done": false,
+    })
+    .to_string()
+    .into_bytes()
+}
+
+/// The node a breakpoint notification (on the publisher's second port) says stopped: a
+/// request header of type `N`, then the node's uid in decimal.
+pub fn read_breakpoint_reached(frames: &[&[u8]]) -> Result<u16, ProtocolError> {
+    let request = "breakpoint notification";
+    let not_groot2 = |what: String| ProtocolError::NotGroot2 { request, what };
+    let [header, uid, ..] = frames else {
+        return Err(not_groot2(format!("it has {} frames, not 2", frames.len())));
+    };
+    if header.len() != REQUEST_HEADER || header[1] != b'N' {
+        return Err(not_groot2(format!(
+            "its header is {} bytes of type {:?}",
+            header.len(),
+            header.get(1).map(|b| char::from(*b))
+        )));
+    }
+    if header[0] != PROTOCOL_ID {
+        return Err(ProtocolError::Version { got: header[0] });
+    }
+    std::str::from_utf8(uid)
+        .ok()
+        .and_then(|t| t.trim().parse::<u16>().ok())
+        .ok_or_else(|| {
+            not_groot2(format!(
+                "its node {:?} is not a number",
+                String::from_utf8_lossy(uid)
+            ))
+        })
+}
+
 /// The status buffer: (node uid, status) for every node.
 pub fn read_statuses(payload: &[u8]) -> Result<Vec<(u16, NodeStatus)>, ProtocolError> {
     entries(payload, "status", 3)?
@@ -305,6 +390,30 @@ mod tests {
             refused.to_string(),
             "the publisher refused a status request: Request not recognized\\u{1b}[2J"
         );
+    }
+
+    #[test]
+    fn breakpoints_are_written_and_their_notifications_read_as_bt_cpp_does() {
+        let hook: serde_json::Value = serde_json::from_slice(&breakpoint_body(7)).expect("JSON");
+        assert_eq!(hook["uid"], 7);
+        assert_eq!(hook["mode"], 0, "interactive");
+        assert_eq!(hook["position"], 0, "before the tick");
+        let release: serde_json::Value =
+            serde_json::from_slice(&release_body(7, Some(NodeStatus::Failure))).expect("JSON");
+        assert_eq!(release["desired_status"], "FAILURE");
+        let go_on: serde_json::Value =
+            serde_json::from_slice(&release_body(7, None)).expect("JSON");
+        assert_eq!(go_on["desired_status"], "SKIPPED");
+        assert_eq!(
+            read_breakpoint_reached(&[&[2, b'N', 1, 0, 0, 0], b"12"]),
+            Ok(12)
+        );
+        assert_eq!(
+            read_breakpoint_reached(&[&[3, b'N', 1, 0, 0, 0], b"12"]),
+            Err(ProtocolError::Version { got: 3 })
+        );
+        assert!(read_breakpoint_reached(&[&[2, b'N', 1, 0, 0, 0], b"x"]).is_err());
+        assert!(read_breakpoint_reached(&[&[2, b'N', 1, 0, 0, 0]]).is_err());
     }
 
     #[test]

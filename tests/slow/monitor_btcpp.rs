@@ -187,3 +187,61 @@ fn the_screen_shows_the_running_tree_and_a_lost_robot() {
     tmux.keys(&["q"]);
     tmux.wait_for(&["monitor exited 0"], 10);
 }
+
+/// The number in the changes pane's title.
+fn changes_shown(screen: &str) -> u64 {
+    let at = screen.find("status changes (").expect("the changes pane") + "status changes (".len();
+    screen[at..]
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect::<String>()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn a_breakpoint_stops_the_real_tree_until_the_person_lets_it_go() {
+    let python = python();
+    let dir = tmp("monitor-breakpoint");
+    let port = free_port_pair();
+    let mut publisher = Publisher::start(&python, port, 0);
+    let tmux = Tmux::start(&format!(
+        "cd {} && {} {} monitor :{port}; echo monitor exited $?; sleep 30",
+        quote(&dir),
+        isolated_env(&dir),
+        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr")))
+    ));
+    tmux.wait_for(&[&format!("watching 127.0.0.1:{port}")], 30);
+    // Home, then down to the grasp (the seventh row), and a breakpoint before it.
+    tmux.keys(&["Home"]);
+    for _ in 0..6 {
+        tmux.keys(&["Down"]);
+    }
+    tmux.wait_for(&["Action · path 0.1.0.0"], 10);
+    tmux.keys(&["b"]);
+    tmux.wait_for(&["● [ ] Grasp"], 10);
+    publisher.go();
+    let stopped = tmux.wait_for(
+        &["stopped before Grasp \"grasp\" (Action)", "▶ [ ] Grasp"],
+        30,
+    );
+    // The tree waits: no change while stopped.
+    std::thread::sleep(Duration::from_millis(500));
+    let still = tmux.screen();
+    assert_eq!(changes_shown(&still), changes_shown(&stopped), "{still}");
+    assert!(still.contains("stopped before Grasp"), "{still}");
+    // Failed without being ticked: the tree goes on and stops at the next grasp.
+    tmux.keys(&["x"]);
+    tmux.wait_until(&["stopped again"], 30, |screen| {
+        screen.contains("stopped before Grasp") && changes_shown(screen) > changes_shown(&still)
+    });
+    // Taking the breakpoint away lets the tree run on.
+    tmux.keys(&["b"]);
+    let running = tmux.wait_until(&["running on"], 30, |screen| {
+        !screen.contains("stopped before") && changes_shown(screen) > changes_shown(&still) + 100
+    });
+    assert!(!running.contains("refused"), "{running}");
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["monitor exited 0"], 10);
+    publisher.stop();
+}

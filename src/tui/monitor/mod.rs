@@ -9,7 +9,7 @@ mod view;
 
 pub use view::draw;
 
-use std::collections::VecDeque;
+use std::collections::{HashSet, VecDeque};
 use std::path::Path;
 use std::time::Duration;
 
@@ -18,7 +18,9 @@ use tokio::sync::mpsc;
 use tui_tree_widget::TreeState;
 
 use crate::bt::render::{ASCII, Glyphs, UNICODE};
-use crate::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch};
+use crate::monitor::{
+    Address, LiveTree, NodeStatus, WatchCommand, WatchEvent, WatchTiming, missed_some, watch,
+};
 
 use super::event_loop::{QueueEvent, spawn_input_reader};
 use super::theme::Theme;
@@ -60,6 +62,14 @@ pub struct MonitorScreen {
     query: Option<String>,
     /// A search that matched nothing, said until the next one.
     not_found: Option<String>,
+    /// The nodes with a breakpoint before their tick.
+    breakpoints: HashSet<u16>,
+    /// The node stopped at its breakpoint, the tree waiting for the person.
+    stopped: Option<u16>,
+    /// What the publisher refused, said until the next key.
+    refused: Option<String>,
+    /// Commands for the publisher, taken by the terminal loop.
+    outbox: Vec<WatchCommand>,
     quit: bool,
     glyphs: &'static Glyphs,
     theme: Theme,
@@ -81,6 +91,10 @@ impl MonitorScreen {
             typing: None,
             query: None,
             not_found: None,
+            breakpoints: HashSet::new(),
+            stopped: None,
+            refused: None,
+            outbox: Vec::new(),
             quit: false,
             glyphs,
             theme: Theme::new(glyphs),
@@ -143,8 +157,20 @@ impl MonitorScreen {
                 }
                 self.follow_busy();
             }
-            WatchEvent::Restarted => self.connection = Connection::Waiting(None),
-            WatchEvent::Lost(reason) => self.connection = Connection::Lost(reason),
+            WatchEvent::Restarted => {
+                self.connection = Connection::Waiting(None);
+                self.stopped = None;
+            }
+            WatchEvent::Lost(reason) => {
+                self.connection = Connection::Lost(reason);
+                self.stopped = None;
+            }
+            WatchEvent::Stopped(uid) => {
+                self.stopped = Some(uid);
+                self.follow = false;
+                self.select_uid(uid);
+            }
+            WatchEvent::Refused(reason) => self.refused = Some(reason),
             WatchEvent::Waiting(reason) => {
                 if !matches!(self.connection, Connection::Lost(_)) {
                     self.connection = Connection::Waiting(Some(reason));
@@ -158,13 +184,57 @@ impl MonitorScreen {
         if !self.follow {
             return;
         }
+        let Some(busy) = self.live.as_ref().and_then(LiveTree::busy) else {
+            return;
+        };
+        self.select_index(busy);
+    }
+
+    /// Selects node `index`, its branch opened.
+    fn select_index(&mut self, index: usize) {
         let Some(live) = &self.live else { return };
-        if let Some(busy) = live.busy() {
-            let path = live.tree.uid_path(busy);
-            for depth in 1..path.len() {
-                self.state.open(path[..depth].to_vec());
+        let path = live.tree.uid_path(index);
+        for depth in 1..path.len() {
+            self.state.open(path[..depth].to_vec());
+        }
+        self.state.select(path);
+    }
+
+    /// Selects the node the publisher numbers `uid`.
+    fn select_uid(&mut self, uid: u16) {
+        if let Some(index) = self.live.as_ref().and_then(|l| l.tree.index_of(uid)) {
+            self.select_index(index);
+        }
+    }
+
+    /// The commands for the publisher since the last call.
+    pub fn take_commands(&mut self) -> Vec<WatchCommand> {
+        std::mem::take(&mut self.outbox)
+    }
+
+    /// Toggles the breakpoint before the selected node; taking away the one the tree is
+    /// stopped at lets it go on.
+    fn toggle_breakpoint(&mut self) {
+        let Some(index) = self.selected() else { return };
+        let Some(uid) = self.live.as_ref().map(|l| l.tree.nodes[index].uid) else {
+            return;
+        };
+        if self.breakpoints.remove(&uid) {
+            // Released first: the publisher no longer knows a node whose hook is gone.
+            if self.stopped == Some(uid) {
+                self.release(None);
             }
-            self.state.select(path);
+            self.outbox.push(WatchCommand::Unbreak(uid));
+        } else {
+            self.breakpoints.insert(uid);
+            self.outbox.push(WatchCommand::Break(uid));
+        }
+    }
+
+    /// Lets the stopped node go on: ticked, or returning `forced`.
+    fn release(&mut self, forced: Option<NodeStatus>) {
+        if let Some(uid) = self.stopped.take() {
+            self.outbox.push(WatchCommand::Release { uid, forced });
         }
     }
 
@@ -188,6 +258,7 @@ impl MonitorScreen {
             }
             return;
         }
+        self.refused = None;
         let moved = match key.code {
             KeyCode::Char('q') | KeyCode::Esc => {
                 self.quit = true;
@@ -218,6 +289,22 @@ impl MonitorScreen {
             }
             KeyCode::Char('n') => {
                 self.find_next();
+                return;
+            }
+            KeyCode::Char('b') => {
+                self.toggle_breakpoint();
+                return;
+            }
+            KeyCode::Char('c') if self.stopped.is_some() => {
+                self.release(None);
+                return;
+            }
+            KeyCode::Char('s') if self.stopped.is_some() => {
+                self.release(Some(NodeStatus::Success));
+                return;
+            }
+            KeyCode::Char('x') if self.stopped.is_some() => {
+                self.release(Some(NodeStatus::Failure));
                 return;
             }
             KeyCode::Char('C') => {
@@ -305,7 +392,13 @@ pub fn run(
     runtime.block_on(async {
         let (_guard, mut terminal) = TerminalGuard::enter(stderr_to)?;
         let (events, mut watched) = mpsc::channel(256);
-        let watcher = tokio::spawn(watch(address.clone(), WatchTiming::default(), events));
+        let (commands, to_publisher) = mpsc::unbounded_channel();
+        let watcher = tokio::spawn(watch(
+            address.clone(),
+            WatchTiming::default(),
+            events,
+            to_publisher,
+        ));
         let (keys, mut input) = mpsc::unbounded_channel();
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         spawn_input_reader(keys, stop.clone());
@@ -331,10 +424,18 @@ pub fn run(
                 },
                 _ = sleep_until(deadline) => true,
             };
+            for command in screen.take_commands() {
+                // The watch ends only after this loop does.
+                let _ = commands.send(command);
+            }
             if ended || screen.should_quit() {
                 break Ok(());
             }
         };
+        // No breakpoint is left to stop the robot with no one watching: the watch sends
+        // the clearing before it is stopped.
+        let _ = commands.send(WatchCommand::ClearAll);
+        tokio::time::sleep(Duration::from_millis(200)).await;
         stop.store(true, std::sync::atomic::Ordering::Relaxed);
         watcher.abort();
         result

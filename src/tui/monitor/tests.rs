@@ -175,3 +175,47 @@ fn a_search_marks_every_match_and_goes_from_one_to_the_next() {
     let text = drawn(&mut screen);
     assert!(text.contains("no node matches \"zebra\""), "{text}");
 }
+
+#[test]
+fn breakpoint_keys_become_commands_for_the_publisher() {
+    use crate::monitor::WatchCommand;
+    let mut screen = connected();
+    let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
+    // The widget moves through the rows it last drew.
+    drawn(&mut screen);
+    screen.on_key(KeyEvent::new(KeyCode::End, KeyModifiers::NONE));
+    screen.on_key(key('b'));
+    assert_eq!(
+        screen.take_commands(),
+        [WatchCommand::Break(8)],
+        "before Recover"
+    );
+    // `c`, `s` and `x` mean nothing until the tree stops.
+    screen.on_key(key('x'));
+    assert!(screen.take_commands().is_empty());
+    screen.on_watch(WatchEvent::Stopped(8));
+    assert_eq!(screen.selected(), Some(7));
+    screen.on_key(key('x'));
+    assert_eq!(
+        screen.take_commands(),
+        [WatchCommand::Release {
+            uid: 8,
+            forced: Some(NodeStatus::Failure)
+        }]
+    );
+    // Taking away the breakpoint the tree waits at releases it first.
+    screen.on_watch(WatchEvent::Stopped(8));
+    screen.on_key(key('b'));
+    assert_eq!(
+        screen.take_commands(),
+        [
+            WatchCommand::Release {
+                uid: 8,
+                forced: None
+            },
+            WatchCommand::Unbreak(8)
+        ]
+    );
+    let text = drawn(&mut screen);
+    assert!(!text.contains("stopped before"), "{text}");
+}

@@ -65,6 +65,7 @@ fn draw_tree(frame: &mut Frame, screen: &mut MonitorScreen, area: Rect) {
 /// The widget's rows, children before parents (no recursion: nodes are in depth-first
 /// order, so every node comes after its parent).
 fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>> {
+    let ascii = screen.glyphs.success.is_ascii();
     let mut built: Vec<Option<TreeItem<'static, u16>>> = vec![None; live.tree.nodes.len()];
     for (i, node) in live.tree.nodes.iter().enumerate().rev() {
         let status = live.statuses[i];
@@ -74,7 +75,15 @@ fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>>
         } else {
             style
         };
+        let stop = if screen.stopped == Some(node.uid) {
+            Span::styled(if ascii { "> " } else { "▶ " }, screen.theme.error)
+        } else if screen.breakpoints.contains(&node.uid) {
+            Span::styled(if ascii { "o " } else { "● " }, screen.theme.error)
+        } else {
+            Span::raw("")
+        };
         let line = Line::from(vec![
+            stop,
             Span::styled(format!("[{}] ", mark(screen, status)), style),
             Span::styled(live.tree.describe(node), label),
         ]);
@@ -195,6 +204,27 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         );
         return;
     }
+    let stopped = screen.stopped.and_then(|uid| {
+        let live = screen.live.as_ref()?;
+        Some(live.tree.describe(live.tree.by_uid(uid)?))
+    });
+    if let Some(node) = stopped {
+        let text = format!(
+            " stopped before {node}{dot}c go on{dot}s succeed it{dot}x fail it{dot}b remove the breakpoint"
+        );
+        frame.render_widget(
+            Paragraph::new(Span::styled(text, screen.theme.stopped)),
+            area,
+        );
+        return;
+    }
+    if let Some(reason) = &screen.refused {
+        frame.render_widget(
+            Paragraph::new(Span::styled(format!(" {reason}"), screen.theme.error)),
+            area,
+        );
+        return;
+    }
     let (mut state, style) = match &screen.connection {
         Connection::Watching => {
             let nodes = screen.live.as_ref().map_or(0, |l| l.tree.nodes.len());
@@ -226,7 +256,10 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
     // always said.
     let fold = if ascii { "h/l fold" } else { "←→ fold" };
     let keys = [
-        format!("{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}/ find{dot}q quit"),
+        format!(
+            "{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}/ find{dot}b breakpoint{dot}q quit"
+        ),
+        format!("{dot}f follow{dot}/ find{dot}b breakpoint{dot}q quit"),
         format!("{dot}f follow{dot}q quit"),
         format!("{dot}q quit"),
     ];
@@ -238,9 +271,9 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         Some(keys) => format!("{state}{keys}"),
         // A long reason is cut rather than the way out.
         None => {
-            let room = width.saturating_sub(keys[2].chars().count() + 1);
+            let room = width.saturating_sub(keys[3].chars().count() + 1);
             let cut: String = state.chars().take(room).collect();
-            format!("{cut}…{}", keys[2])
+            format!("{cut}…{}", keys[3])
         }
     };
     frame.render_widget(Paragraph::new(Span::styled(text, style)), area);
