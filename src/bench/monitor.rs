@@ -15,7 +15,7 @@ use ratatui::backend::TestBackend;
 use tokio::sync::mpsc;
 
 use super::{BenchError, Better, Row, Target};
-use crate::monitor::{Address, WatchEvent, WatchTiming, watch};
+use crate::monitor::{Address, WatchEvent, WatchTiming, watch_only};
 use crate::tui::monitor::{MonitorScreen, draw, gather};
 
 /// What one run measured.
@@ -93,14 +93,7 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
         .map_err(|e| BenchError::Setup(e.to_string()))?;
     let (events, mut received) = mpsc::channel(256);
     let began = Instant::now();
-    // The benchmark only watches: no commands.
-    let (_, no_commands) = mpsc::unbounded_channel();
-    let watcher = tokio::spawn(watch(
-        address.clone(),
-        WatchTiming::default(),
-        events,
-        no_commands,
-    ));
+    let watcher = tokio::spawn(watch_only(address.clone(), WatchTiming::default(), events));
     let mut screen = MonitorScreen::new(address, false);
     // A test terminal cannot fail (its error type is `Infallible`).
     let Ok(mut terminal) = Terminal::new(TestBackend::new(160, 50));

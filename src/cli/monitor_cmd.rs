@@ -10,7 +10,7 @@ use tokio::sync::mpsc;
 
 use betr::http_text::printable;
 use betr::monitor::protocol::KEPT_CHANGES;
-use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch};
+use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch_only};
 
 /// What `betr monitor` is asked.
 #[derive(clap::Args)]
@@ -61,14 +61,7 @@ pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
 /// no publisher ever answered.
 async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Result<ExitCode> {
     let (events, mut received) = mpsc::channel(256);
-    // `--print` only watches: no breakpoints are set.
-    let (_, no_commands) = mpsc::unbounded_channel();
-    let watcher = tokio::spawn(watch(
-        address.clone(),
-        WatchTiming::default(),
-        events,
-        no_commands,
-    ));
+    let watcher = tokio::spawn(watch_only(address.clone(), WatchTiming::default(), events));
     let deadline = duration.map(|d| tokio::time::Instant::now() + d);
     let mut printer = Printer {
         live: None,

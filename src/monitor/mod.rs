@@ -140,6 +140,12 @@ pub async fn watch(
     }
 }
 
+/// [`watch`] for a front end that only looks: no breakpoints are set.
+pub async fn watch_only(address: Address, timing: WatchTiming, events: mpsc::Sender<WatchEvent>) {
+    let (_, no_commands) = mpsc::unbounded_channel();
+    watch(address, timing, events, no_commands).await;
+}
+
 enum Ended {
     Restarted,
     Closed,

@@ -63,6 +63,16 @@ fn lines_until(received: &mpsc::Receiver<String>, prefix: &str) -> Vec<String> {
     }
 }
 
+/// `betr monitor :PORT` on the screen of a tmux of its own; says how it exited.
+fn monitor_in_tmux(dir: &std::path::Path, port: u16) -> Tmux {
+    Tmux::start(&format!(
+        "cd {} && {} {} monitor :{port}; echo monitor exited $?; sleep 30",
+        quote(dir),
+        isolated_env(dir),
+        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr")))
+    ))
+}
+
 /// The status changes in `--print` lines: (name, old, new).
 fn changes(lines: &[String]) -> Vec<(String, String, String)> {
     lines
@@ -155,12 +165,7 @@ fn the_screen_shows_the_running_tree_and_a_lost_robot() {
     let dir = tmp("monitor-screen");
     let port = free_port_pair();
     let mut publisher = Publisher::start(&python, port, 0);
-    let tmux = Tmux::start(&format!(
-        "cd {} && {} {} monitor :{port}; echo monitor exited $?; sleep 30",
-        quote(&dir),
-        isolated_env(&dir),
-        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr")))
-    ));
+    let tmux = monitor_in_tmux(&dir, port);
     tmux.wait_for(
         &[
             &format!("watching 127.0.0.1:{port}"),
@@ -205,12 +210,7 @@ fn a_breakpoint_stops_the_real_tree_until_the_person_lets_it_go() {
     let dir = tmp("monitor-breakpoint");
     let port = free_port_pair();
     let mut publisher = Publisher::start(&python, port, 0);
-    let tmux = Tmux::start(&format!(
-        "cd {} && {} {} monitor :{port}; echo monitor exited $?; sleep 30",
-        quote(&dir),
-        isolated_env(&dir),
-        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr")))
-    ));
+    let tmux = monitor_in_tmux(&dir, port);
     tmux.wait_for(&[&format!("watching 127.0.0.1:{port}")], 30);
     // Home, then down to the grasp (the seventh row), and a breakpoint before it.
     tmux.keys(&["Home"]);
