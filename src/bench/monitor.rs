@@ -108,10 +108,8 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
         publisher_ticks: 0,
         publisher_late: 0,
     };
-    let mut started = None;
-    let mut uids = std::collections::HashSet::new();
+    let mut frame = FrameTally::default();
     let mut ticking_since = None;
-    let mut failed = None;
     let mut last_draw = tokio::time::Instant::now();
     let deadline = tokio::time::Instant::now() + Duration::from_secs_f64(seconds + 30.0);
     loop {
@@ -122,60 +120,25 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
             ));
         };
         // The screen's own frame: the events of one frame gathered, then one drawing.
-        let mut times = Vec::new();
-        gather(
-            &mut screen,
-            first,
-            &mut received,
-            last_draw,
-            |event| match event {
-                WatchEvent::Connected {
-                    tree, started: at, ..
-                } => {
-                    run.nodes = tree.nodes.len();
-                    uids = tree.nodes.iter().map(|n| n.uid).collect();
-                    if started.is_some() {
-                        failed.get_or_insert("the publisher was connected twice".to_string());
-                    }
-                    started = *at;
-                }
-                WatchEvent::Changes(changes) => {
-                    run.largest_batch = run.largest_batch.max(changes.len());
-                    run.changes += changes.len() as u64;
-                    if let Some(at) = started {
-                        // Only the changes of nodes the tree has reach the screen (BT.CPP 4.8's
-                        // publisher can send an all-zero entry when a change races its read).
-                        times.extend(
-                            changes
-                                .iter()
-                                .filter(|c| uids.contains(&c.uid))
-                                .map(|c| at + Duration::from_micros(c.micros)),
-                        );
-                    }
-                }
-                WatchEvent::Lost(reason) | WatchEvent::Waiting(reason) => {
-                    failed.get_or_insert(reason.clone());
-                }
-                WatchEvent::Restarted | WatchEvent::Stopped(_) | WatchEvent::Refused(_) => {}
-            },
-        )
+        gather(&mut screen, first, &mut received, last_draw, |event| {
+            frame.observe(&mut run, event);
+        })
         .await;
-        if let Some(reason) = failed {
+        if let Some(reason) = frame.failed.take().or_else(|| {
+            frame
+                .started
+                .is_none()
+                .then(|| "the publisher did not say its clock".to_string())
+        }) {
             watcher.abort();
             return Err(BenchError::Setup(reason));
-        }
-        if started.is_none() {
-            watcher.abort();
-            return Err(BenchError::Setup(
-                "the publisher did not say its clock".into(),
-            ));
         }
         let Ok(_) = terminal.draw(|f| draw(f, &mut screen));
         last_draw = tokio::time::Instant::now();
         let drawn = SystemTime::now();
-        for t in &times {
+        for t in frame.times.drain(..) {
             run.latencies
-                .add(drawn.duration_since(*t).unwrap_or(Duration::ZERO));
+                .add(drawn.duration_since(t).unwrap_or(Duration::ZERO));
         }
         match ticking_since {
             None => {
@@ -198,6 +161,54 @@ async fn follow(port: u16, seconds: f64, go: &mut impl Write) -> Result<MonitorR
     run.rss_kib.1 = resident_kib();
     watcher.abort();
     Ok(run)
+}
+
+/// What the benchmark takes from the watch's events, frame by frame.
+#[derive(Default)]
+struct FrameTally {
+    /// The publisher's clock when it began keeping changes.
+    started: Option<SystemTime>,
+    /// The nodes the tree has.
+    uids: std::collections::HashSet<u16>,
+    /// When each change of this frame was made, by the publisher's clock.
+    times: Vec<SystemTime>,
+    failed: Option<String>,
+}
+
+impl FrameTally {
+    fn observe(&mut self, run: &mut MonitorRun, event: &WatchEvent) {
+        match event {
+            WatchEvent::Connected {
+                tree, started: at, ..
+            } => {
+                run.nodes = tree.nodes.len();
+                self.uids = tree.nodes.iter().map(|n| n.uid).collect();
+                if self.started.is_some() {
+                    self.failed
+                        .get_or_insert("the publisher was connected twice".to_string());
+                }
+                self.started = *at;
+            }
+            WatchEvent::Changes(changes) => {
+                run.largest_batch = run.largest_batch.max(changes.len());
+                run.changes += changes.len() as u64;
+                if let Some(at) = self.started {
+                    // Only the changes of nodes the tree has reach the screen (BT.CPP 4.8's
+                    // publisher can send an all-zero entry when a change races its read).
+                    self.times.extend(
+                        changes
+                            .iter()
+                            .filter(|c| self.uids.contains(&c.uid))
+                            .map(|c| at + Duration::from_micros(c.micros)),
+                    );
+                }
+            }
+            WatchEvent::Lost(reason) | WatchEvent::Waiting(reason) => {
+                self.failed.get_or_insert(reason.clone());
+            }
+            WatchEvent::Restarted | WatchEvent::Stopped(_) | WatchEvent::Refused(_) => {}
+        }
+    }
 }
 
 /// This process's resident memory in KiB (0 where /proc cannot tell).
