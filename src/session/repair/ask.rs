@@ -440,31 +440,43 @@ pub(crate) async fn ask_value(
         emit,
     )
     .await?;
-    // No value of the model's helped, and the world has refused values on both sides:
-    // one midway between them is tried too (in simulation, like any other).
-    if asked.chosen.is_none()
-        && let Some(midway) = bounds.midway()
-    {
-        let value = crate::domain::Value::Number {
-            value: midway,
-            unit: unit.to_string(),
-        };
-        let between = format!(
-            "Midway between the values the world refused on either side: it leaves only values {}.",
-            bounds.describe(unit).unwrap_or_default()
-        );
-        emit(&Event::Notice {
-            message: format!("no value of the model's helped; trying {value}, {between}"),
-        });
-        let midway = proposal(value);
-        match screen_one(screen, &mut bounds, (&midway, Some(MIDWAY)), emit) {
-            Ok(verdict) => {
-                asked.verdict = Some(verdict);
-                asked.chosen = Some((midway, Some(between)));
-                asked.author = Some(MIDWAY.to_string());
-            }
-            Err(why) => asked.rejected.push((midway, why.to_string())),
-        }
+    if asked.chosen.is_none() {
+        try_midway(&mut asked, &mut bounds, screen, unit, &proposal, emit);
     }
     Ok(asked)
+}
+
+/// No value of the model's helped, and the world has refused values on both sides: one
+/// midway between them is tried too (in simulation, like any other).
+fn try_midway(
+    asked: &mut Asked,
+    bounds: &mut Bounds,
+    screen: &mut Screen,
+    unit: &str,
+    proposal: &dyn Fn(crate::domain::Value) -> Proposal,
+    emit: &mut (dyn FnMut(&Event) + Send),
+) {
+    let Some(midway) = bounds.midway() else {
+        return;
+    };
+    let value = crate::domain::Value::Number {
+        value: midway,
+        unit: unit.to_string(),
+    };
+    let between = format!(
+        "Midway between the values the world refused on either side: it leaves only values {}.",
+        bounds.describe(unit).unwrap_or_default()
+    );
+    emit(&Event::Notice {
+        message: format!("no value of the model's helped; trying {value}, {between}"),
+    });
+    let midway = proposal(value);
+    match screen_one(screen, bounds, (&midway, Some(MIDWAY)), emit) {
+        Ok(verdict) => {
+            asked.verdict = Some(verdict);
+            asked.chosen = Some((midway, Some(between)));
+            asked.author = Some(MIDWAY.to_string());
+        }
+        Err(why) => asked.rejected.push((midway, why.to_string())),
+    }
 }
