@@ -1,16 +1,19 @@
 //! `betr monitor [HOST:PORT]`: a BehaviorTree.CPP process watched live over Groot2's
 //! protocol, in a screen of its tree with every node's status, or (`--print`) one line per
-//! status change for scripts and terminals without a screen.
+//! status change for scripts and terminals without a screen; `--record FILE` keeps what
+//! was watched for `betr replay`.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use anyhow::{Result, bail};
+use anyhow::{Context as _, Result, bail};
 use tokio::sync::mpsc;
 
 use betr::http_text::printable;
 use betr::monitor::protocol::KEPT_CHANGES;
 use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch_only};
+use betr::record::SessionRecorder;
 
 /// What `betr monitor` is asked.
 #[derive(clap::Args)]
@@ -26,6 +29,10 @@ pub struct MonitorArgs {
     /// Stop after this many seconds (a fraction allowed); without it, watch until stopped.
     #[arg(long = "for", value_name = "SECONDS", value_parser = seconds)]
     pub duration: Option<Duration>,
+    /// Record the watched run to FILE (the tree as the publisher describes it, every
+    /// status change, breakpoints), for `betr replay FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
 }
 
 fn seconds(text: &str) -> Result<Duration, String> {
@@ -39,36 +46,48 @@ fn seconds(text: &str) -> Result<Duration, String> {
 
 pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
     let address = Address::parse(&args.address)?;
-    if args.print {
-        return super::runtime()?.block_on(print(address, args.duration, ascii));
-    }
     use std::io::IsTerminal as _;
-    if !std::io::stdout().is_terminal() {
+    if !args.print && !std::io::stdout().is_terminal() {
         bail!(
             "standard output is not a terminal, and the monitor opens a screen; --print prints the status changes as text"
         );
     }
-    betr::tui::monitor::run(
-        address,
-        args.duration,
-        ascii,
-        super::tui_cmd::log_path().as_deref(),
-    )?;
+    let mut recorder = match &args.record {
+        Some(file) => Some(SessionRecorder::create_watched(file, &address).context("--record")?),
+        None => None,
+    };
+    if args.print {
+        super::runtime()?.block_on(print(address, args.duration, ascii, recorder.as_mut()))?;
+    } else {
+        betr::tui::monitor::run(
+            address,
+            args.duration,
+            ascii,
+            super::tui_cmd::log_path().as_deref(),
+            recorder.as_mut(),
+        )?;
+    }
+    if let Some(stopped) = recorder.as_ref().and_then(SessionRecorder::stopped) {
+        bail!("{stopped}");
+    }
+    if let Some(file) = &args.record {
+        errln!("Recorded to {}", file.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 
 /// Prints what the watch reports until `duration` has passed (or forever); an error when
 /// no publisher ever answered.
-async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Result<ExitCode> {
+async fn print(
+    address: Address,
+    duration: Option<Duration>,
+    ascii: bool,
+    mut recorder: Option<&mut SessionRecorder>,
+) -> Result<()> {
     let (events, mut received) = mpsc::channel(256);
     let watcher = tokio::spawn(watch_only(address.clone(), WatchTiming::default(), events));
     let deadline = duration.map(|d| tokio::time::Instant::now() + d);
-    let mut printer = Printer {
-        live: None,
-        since: Duration::ZERO,
-        arrow: if ascii { "->" } else { "→" },
-        last_wait: None,
-    };
+    let mut printer = Printer::new(ascii);
     loop {
         let event = match deadline {
             Some(at) => match tokio::time::timeout_at(at, received.recv()).await {
@@ -78,6 +97,9 @@ async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Res
             None => received.recv().await,
         };
         let Some(event) = event else { break };
+        if let Some(recorder) = recorder.as_deref_mut() {
+            recorder.watched(&event);
+        }
         printer.on(event);
     }
     watcher.abort();
@@ -88,12 +110,12 @@ async fn print(address: Address, duration: Option<Duration>, ascii: bool) -> Res
             None => bail!("no Groot2 publisher answered at {address}{waited}"),
         }
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
-/// The lines `--print` writes: `#` lines about the connection and the tree, then one line
-/// per status change.
-struct Printer {
+/// The lines `--print` writes (and `betr replay --print` of a watched run): `#` lines about
+/// the connection and the tree, then one line per status change.
+pub(super) struct Printer {
     live: Option<LiveTree>,
     since: Duration,
     arrow: &'static str,
@@ -101,7 +123,16 @@ struct Printer {
 }
 
 impl Printer {
-    fn on(&mut self, event: WatchEvent) {
+    pub(super) fn new(ascii: bool) -> Printer {
+        Printer {
+            live: None,
+            since: Duration::ZERO,
+            arrow: if ascii { "->" } else { "→" },
+            last_wait: None,
+        }
+    }
+
+    pub(super) fn on(&mut self, event: WatchEvent) {
         match event {
             WatchEvent::Connected {
                 address,

@@ -1,14 +1,16 @@
 //! `betr replay FILE`: a recorded session opened in the workbench, read-only, to step
 //! through forward and back without an engine or a model; `--print` tells it as text, one
 //! line per step; `--to-rrd OUT` converts it into a rerun recording with its tick
-//! timeline.
+//! timeline. A recording of a watched BehaviorTree.CPP process (`betr monitor --record`)
+//! opens on the monitor screen instead, `--print` tells it as the monitor's `--print`
+//! did, and `--to-rrd` puts its status changes on a `watch` timeline.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context as _, Result};
+use anyhow::{Context as _, Result, bail};
 
-use betr::record::{Replay, Resimulation, Step};
+use betr::record::{Replay, Resimulation, Source, Step, WatchedRun};
 use betr::session::Event;
 use betr::tui::replay::{Player, ReplayScreen};
 use betr::tui::{KeyBindings, Theme};
@@ -17,13 +19,14 @@ use betr::viz::{Sinks, Viz};
 /// What `betr replay` is asked.
 #[derive(clap::Args)]
 pub struct ReplayArgs {
-    /// A recording written with --record.
+    /// A recording written with --record (by a session, or by `betr monitor`).
     pub file: PathBuf,
     /// The scenario it was recorded on, when it is not where the recording says.
     #[arg(long)]
     pub scenario: Option<PathBuf>,
     /// Write it as a rerun recording (.rrd): the tree, every tick on the `tick` timeline,
-    /// the cell re-simulated after each tick, and the session's log.
+    /// the cell re-simulated after each tick, and the session's log (a watched process:
+    /// its tree and every status change on the `watch` timeline).
     #[arg(long, value_name = "OUT", conflicts_with = "print")]
     pub to_rrd: Option<PathBuf>,
     /// Print the steps as text (one line per step, a run of ticks on one line) instead of
@@ -36,7 +39,17 @@ pub struct ReplayArgs {
 }
 
 pub fn replay(args: &ReplayArgs, ascii: bool) -> Result<ExitCode> {
-    let replay = Replay::load(&args.file, args.scenario.as_deref())?;
+    let recording = betr::record::read(&args.file)?;
+    if let Source::Watched { .. } = recording.header.source {
+        if args.scenario.is_some() {
+            bail!(
+                "{}: a watched BehaviorTree.CPP process, recorded with no scenario; --scenario is for the recording of a session",
+                args.file.display()
+            );
+        }
+        return watched(WatchedRun::of(recording)?, args, ascii);
+    }
+    let replay = Replay::of(recording, args.scenario.as_deref())?;
     if let Some(out) = &args.to_rrd {
         cut_note(&args.file, &replay);
         return to_rrd(&replay, out);
@@ -58,6 +71,55 @@ fn cut_note(file: &Path, replay: &Replay) {
             betr::tui::strings::replay_cut(line)
         );
     }
+}
+
+/// A watched BehaviorTree.CPP process's recording: told as `betr monitor --print` told it,
+/// written as a rerun recording, or replayed on the monitor screen.
+fn watched(run: WatchedRun, args: &ReplayArgs, ascii: bool) -> Result<ExitCode> {
+    if let Some(line) = run.cut_at {
+        errln!(
+            "note: {}: {}",
+            args.file.display(),
+            betr::tui::strings::replay_cut(line)
+        );
+    }
+    if let Some(out) = &args.to_rrd {
+        return watched_to_rrd(&run, out);
+    }
+    if args.print {
+        outln!(
+            "# replay of {}: {} watched from {} with betr {}",
+            run.path.display(),
+            run.address,
+            run.header.started,
+            run.header.betr
+        );
+        let mut printer = super::monitor_cmd::Printer::new(ascii);
+        for event in run.events() {
+            printer.on(event.clone());
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    use std::io::IsTerminal as _;
+    if !std::io::stdout().is_terminal() {
+        bail!(
+            "{}: standard output is not a terminal, and the replay opens the monitor screen; --print prints the status changes as text",
+            args.file.display()
+        );
+    }
+    let player = betr::tui::monitor::WatchPlayer::at_first_tree(run, ascii);
+    betr::tui::monitor::replay(player, super::tui_cmd::log_path().as_deref())?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn watched_to_rrd(run: &WatchedRun, out: &Path) -> Result<ExitCode> {
+    let changes = betr::viz::watched::write(out, run.events())?;
+    errln!(
+        "Wrote {} ({changes} status changes on the `{}` timeline)",
+        out.display(),
+        betr::viz::watched::WATCH
+    );
+    Ok(ExitCode::SUCCESS)
 }
 
 /// The workbench on the recording, read-only, at its end.
@@ -102,7 +164,7 @@ fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
         ..Sinks::default()
     })?
     .context("--to-rrd: no recording was opened")?;
-    let mut cell = Resimulation::new(replay);
+    let mut cell = Resimulation::new(replay.scenario.clone(), replay.variant.clone());
     for (_, step) in &replay.steps {
         match step {
             Step::Command(text) => {
@@ -137,8 +199,8 @@ fn print_steps(replay: &Replay) {
     );
     outln!(
         "Scenario:  {} ({}), recorded {} with betr {}",
-        replay.header.name,
-        replay.header.scenario.display(),
+        replay.scenario.name,
+        replay.scenario_file.display(),
         replay.header.started,
         replay.header.betr
     );

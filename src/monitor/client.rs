@@ -13,7 +13,8 @@ use super::protocol::{self, NodeStatus, ProtocolError, Request, RequestKind, Tra
 use super::tree::{TreeError, WatchedTree};
 
 /// Where a publisher listens: a host and its request port (BT.CPP's default 1667).
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "String", into = "String")]
 pub struct Address {
     pub host: String,
     pub port: u16,
@@ -50,6 +51,19 @@ impl Address {
 
     fn endpoint(&self) -> String {
         format!("tcp://{}:{}", self.host, self.port)
+    }
+}
+
+impl TryFrom<String> for Address {
+    type Error = AddressError;
+    fn try_from(text: String) -> Result<Address, AddressError> {
+        Address::parse(&text)
+    }
+}
+
+impl From<Address> for String {
+    fn from(address: Address) -> String {
+        address.to_string()
     }
 }
 

@@ -37,8 +37,10 @@ impl Default for WatchTiming {
     }
 }
 
-/// What the watch reports, in order.
-#[derive(Debug)]
+/// What the watch reports, in order; a recording of a watched run is these, as serde
+/// writes them.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum WatchEvent {
     /// Connected (again) and read the tree: every node's status now, and the moment the
     /// publisher started keeping status changes, as time since the watch began.
@@ -67,7 +69,8 @@ pub enum WatchEvent {
 }
 
 /// What a front end asks of the publisher while watching.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum WatchCommand {
     /// Stop before the node with this uid is ticked, every time.
     Break(u16),
@@ -82,6 +85,22 @@ pub enum WatchCommand {
     /// Take every breakpoint away (before leaving: a breakpoint left behind would stop
     /// the robot with no one watching).
     ClearAll,
+}
+
+impl std::fmt::Display for WatchCommand {
+    /// In words, as a recording keeps it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            WatchCommand::Break(uid) => write!(f, "break before node {uid}"),
+            WatchCommand::Unbreak(uid) => write!(f, "no break before node {uid}"),
+            WatchCommand::Release { uid, forced: None } => write!(f, "let node {uid} go on"),
+            WatchCommand::Release {
+                uid,
+                forced: Some(status),
+            } => write!(f, "make node {uid} return {}", status.name()),
+            WatchCommand::ClearAll => f.write_str("clear every breakpoint"),
+        }
+    }
 }
 
 impl WatchCommand {

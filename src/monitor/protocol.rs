@@ -66,7 +66,7 @@ impl RequestKind {
 }
 
 /// A node's status as the publisher reports it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum NodeStatus {
     Idle,
     Running,
@@ -87,6 +87,17 @@ impl NodeStatus {
             4 => NodeStatus::Skipped,
             _ => return None,
         })
+    }
+
+    /// betr's status for it: a skipped node is shown as idle (it was not ticked).
+    pub fn as_status(self) -> crate::bt::Status {
+        use crate::bt::Status;
+        match self {
+            NodeStatus::Idle | NodeStatus::Skipped => Status::Idle,
+            NodeStatus::Running => Status::Running,
+            NodeStatus::Success => Status::Success,
+            NodeStatus::Failure => Status::Failure,
+        }
     }
 
     pub fn name(self) -> &'static str {
@@ -299,7 +310,7 @@ pub fn read_statuses(payload: &[u8]) -> Result<Vec<(u16, NodeStatus)>, ProtocolE
 }
 
 /// One status change the publisher kept while recording.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Transition {
     /// Microseconds since the recording started.
     pub micros: u64,

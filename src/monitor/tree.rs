@@ -14,7 +14,7 @@ use thiserror::Error;
 pub const MAX_TREE_BYTES: usize = 32 << 20;
 
 /// A node's kind, from the publisher's `<TreeNodesModel>`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum NodeKind {
     Action,
     Condition,
@@ -68,13 +68,36 @@ pub struct WatchedNode {
     pub depth: usize,
 }
 
-/// A watched tree: its nodes in depth-first order (index 0 the root).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A watched tree: its nodes in depth-first order (index 0 the root). Written to a
+/// recording as the publisher's description itself and read back through [`Self::parse`],
+/// so a recorded tree is checked as a received one is.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "Description", into = "Description")]
 pub struct WatchedTree {
     /// The main tree's ID.
     pub main: String,
     pub nodes: Vec<WatchedNode>,
     by_uid: HashMap<u16, usize>,
+    /// The description as the publisher sent it.
+    xml: String,
+}
+
+/// A tree as a recording holds it: the publisher's description.
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(transparent)]
+struct Description(String);
+
+impl TryFrom<Description> for WatchedTree {
+    type Error = TreeError;
+    fn try_from(description: Description) -> Result<WatchedTree, TreeError> {
+        WatchedTree::parse(description.0.as_bytes())
+    }
+}
+
+impl From<WatchedTree> for Description {
+    fn from(tree: WatchedTree) -> Description {
+        Description(tree.xml)
+    }
 }
 
 /// A tree description that cannot be shown, with where.
@@ -123,6 +146,7 @@ impl WatchedTree {
             main: main.attribute("ID").unwrap_or_default().to_string(),
             nodes: Vec::new(),
             by_uid: HashMap::new(),
+            xml: text.to_string(),
         };
         // Depth first without recursion, so a deep description cannot exhaust the stack:
         // (element, parent index, path).

@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::{Entry, FORMAT, Header, RecordError, VERSION};
+use super::{Entry, FORMAT, Header, RecordError, Source, VERSION};
 use crate::session::Event;
 
 /// A recording being written.
@@ -18,13 +18,23 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// Create (or replace) `path` and write the header.
+    /// Create (or replace) `path` and write the header of a session on `scenario`.
     pub fn create(
         path: &Path,
         scenario: &Path,
         name: &str,
         variant: Option<&str>,
     ) -> Result<Recorder, RecordError> {
+        let source = Source::Session {
+            scenario: scenario.to_path_buf(),
+            name: name.into(),
+            variant: variant.map(str::to_string),
+        };
+        Recorder::start(path, source)
+    }
+
+    /// Create (or replace) `path` and write the header of what `source` records.
+    pub fn start(path: &Path, source: Source) -> Result<Recorder, RecordError> {
         let io = |source| RecordError::Io {
             path: path.to_path_buf(),
             source,
@@ -38,9 +48,7 @@ impl Recorder {
         let header = Header {
             format: FORMAT.into(),
             version: VERSION,
-            scenario: scenario.to_path_buf(),
-            name: name.into(),
-            variant: variant.map(str::to_string),
+            source,
             betr: env!("CARGO_PKG_VERSION").into(),
             started: crate::session::policy::now_rfc3339(),
         };
@@ -244,7 +252,7 @@ mod tests {
         })
         .unwrap();
         let back = read(&path).unwrap();
-        assert_eq!(back.header.name, "S");
+        assert_eq!(back.header.scenario_name(), Some("S"));
         assert_eq!(back.entries.len(), 2);
         assert_eq!(back.entries[1].0, 3, "line numbers count the header");
         assert!(matches!(

@@ -4,6 +4,10 @@
 //! rejection, edit, undo and repair) and every command a front end sent, with times, so
 //! that it can be replayed without the model.
 //!
+//! A BehaviorTree.CPP process watched over Groot2's protocol (`betr monitor --record`)
+//! is recorded in the same file format: its header names the publisher instead of a
+//! scenario, and its entries are the watch's events (`watched.rs`).
+//!
 //! The file is JSON Lines, append-only: a header line, then one entry per line, each
 //! written whole and flushed as it happens, so a recording cut by a crash is readable up
 //! to its last whole line (`file.rs`). An event entry is the session's `Event` as serde
@@ -16,17 +20,20 @@ pub mod file;
 pub mod replay;
 pub mod session;
 pub mod v1;
+pub mod watched;
 
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+use crate::monitor::{Address, WatchEvent};
 use crate::session::Event;
 
 pub use describe::{brief, describe, describe_step, trace};
 pub use file::{Recorder, Recording, read};
 pub use replay::{Replay, ReplayError, Resimulation, Step};
 pub use session::SessionRecorder;
+pub use watched::WatchedRun;
 
 /// What the first line says the file is.
 pub const FORMAT: &str = "betr-recording";
@@ -38,15 +45,38 @@ pub const VERSION: u32 = 2;
 pub struct Header {
     pub format: String,
     pub version: u32,
-    /// The scenario file as the session named it.
-    pub scenario: PathBuf,
-    /// The scenario's name, to tell a wrong file apart when it is replayed.
-    pub name: String,
-    pub variant: Option<String>,
+    #[serde(flatten)]
+    pub source: Source,
     /// The betr version that wrote it.
     pub betr: String,
     /// When the session started (RFC 3339, UTC).
     pub started: String,
+}
+
+impl Header {
+    /// The name of the scenario a session ran on (none for a watched process).
+    pub fn scenario_name(&self) -> Option<&str> {
+        match &self.source {
+            Source::Session { name, .. } => Some(name),
+            Source::Watched { .. } => None,
+        }
+    }
+}
+
+/// What was recorded.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Source {
+    /// A session of betr's own on a scenario.
+    Session {
+        /// The scenario file as the session named it.
+        scenario: PathBuf,
+        /// The scenario's name, to tell a wrong file apart when it is replayed.
+        name: String,
+        variant: Option<String>,
+    },
+    /// A BehaviorTree.CPP process watched at this publisher's address.
+    Watched { watched: Address },
 }
 
 /// One line after the header.
@@ -57,13 +87,15 @@ pub enum Entry {
     Command { ms: u64, command: String },
     /// What the engine reported.
     Event { ms: u64, event: Event },
+    /// What the watch of a BehaviorTree.CPP process reported.
+    Watched { ms: u64, watched: WatchEvent },
 }
 
 impl Entry {
     /// Milliseconds since the session started.
     pub fn ms(&self) -> u64 {
         match self {
-            Entry::Command { ms, .. } | Entry::Event { ms, .. } => *ms,
+            Entry::Command { ms, .. } | Entry::Event { ms, .. } | Entry::Watched { ms, .. } => *ms,
         }
     }
 }

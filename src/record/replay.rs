@@ -11,7 +11,7 @@ use crate::scenario::{Scenario, ScenarioError};
 use crate::session::Event;
 use crate::world::{CellWorld, World};
 
-use super::{Entry, Header, RecordError};
+use super::{Entry, Header, RecordError, Source};
 
 /// One step of a replayed session.
 #[derive(Debug, Clone)]
@@ -25,6 +25,9 @@ pub enum Step {
 pub struct Replay {
     pub path: PathBuf,
     pub header: Header,
+    /// The scenario file as the recording names it.
+    pub scenario_file: PathBuf,
+    pub variant: Option<String>,
     pub scenario: Arc<Scenario>,
     /// The steps with their times (milliseconds since the session started).
     pub steps: Vec<(u64, Step)>,
@@ -38,6 +41,11 @@ pub struct Replay {
 pub enum ReplayError {
     #[error(transparent)]
     Record(#[from] RecordError),
+    #[error("{path}: a BehaviorTree.CPP process watched at {address}, not a session on a scenario")]
+    Watched {
+        path: PathBuf,
+        address: crate::monitor::Address,
+    },
     #[error("{path}: the recorded scenario {scenario}: {source}")]
     Scenario {
         path: PathBuf,
@@ -60,35 +68,57 @@ impl Replay {
     /// Read `path`; the scenario is the recorded one, or `scenario` when given (a
     /// recording made elsewhere).
     pub fn load(path: &Path, scenario: Option<&Path>) -> Result<Replay, ReplayError> {
-        let recording = super::read(path)?;
-        let scenario_path = scenario.map_or_else(
-            || recording.header.scenario.clone(),
-            std::path::Path::to_path_buf,
-        );
+        Replay::of(super::read(path)?, scenario)
+    }
+
+    /// A recording read back; the scenario is the recorded one, or `scenario` when given.
+    pub fn of(recording: super::Recording, scenario: Option<&Path>) -> Result<Replay, ReplayError> {
+        let (scenario_file, name, variant) = match &recording.header.source {
+            Source::Session {
+                scenario,
+                name,
+                variant,
+            } => (scenario.clone(), name.clone(), variant.clone()),
+            Source::Watched { watched } => {
+                return Err(ReplayError::Watched {
+                    path: recording.path.clone(),
+                    address: watched.clone(),
+                });
+            }
+        };
+        let mut steps = Vec::with_capacity(recording.entries.len());
+        for (line, entry) in recording.entries {
+            steps.push(match entry {
+                Entry::Command { ms, command } => (ms, Step::Command(command)),
+                Entry::Event { ms, event } => (ms, Step::Event(event)),
+                Entry::Watched { .. } => {
+                    return Err(ReplayError::Record(RecordError::Line {
+                        path: recording.path,
+                        line,
+                        reason: "a watched process's event in the recording of a session".into(),
+                    }));
+                }
+            });
+        }
+        let scenario_path = scenario.map_or_else(|| scenario_file.clone(), Path::to_path_buf);
         let loaded = Scenario::load(&scenario_path).map_err(|source| ReplayError::Scenario {
-            path: path.to_path_buf(),
+            path: recording.path.clone(),
             scenario: scenario_path.clone(),
             source,
         })?;
-        if loaded.name != recording.header.name {
+        if loaded.name != name {
             return Err(ReplayError::OtherScenario {
-                path: path.to_path_buf(),
+                path: recording.path.clone(),
                 scenario: scenario_path,
-                recorded: recording.header.name.clone(),
+                recorded: name,
                 found: loaded.name,
             });
         }
-        let steps = recording
-            .entries
-            .into_iter()
-            .map(|(_, entry)| match entry {
-                Entry::Command { ms, command } => (ms, Step::Command(command)),
-                Entry::Event { ms, event } => (ms, Step::Event(event)),
-            })
-            .collect();
         Ok(Replay {
-            path: path.to_path_buf(),
+            path: recording.path,
             header: recording.header,
+            scenario_file,
+            variant,
             scenario: Arc::new(loaded),
             steps,
             cut_at: recording.cut_at,
@@ -112,10 +142,10 @@ pub struct Resimulation {
 }
 
 impl Resimulation {
-    pub fn new(replay: &Replay) -> Resimulation {
+    pub fn new(scenario: Arc<Scenario>, variant: Option<String>) -> Resimulation {
         let mut sim = Resimulation {
-            scenario: replay.scenario.clone(),
-            variant: replay.header.variant.clone(),
+            scenario,
+            variant,
             world: None,
             ticker: Ticker::new(),
             tree: None,

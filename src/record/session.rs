@@ -1,13 +1,15 @@
 //! A session followed into a recording: every event the engine reports and every command a
-//! front end sends. A write that fails (a full disk) stops the recording, and what was
+//! front end sends; or a watched BehaviorTree.CPP process: every event the watch reports
+//! and every breakpoint command sent to it. A write that fails (a full disk) stops the recording, and what was
 //! written stays readable; `stopped` says why, and the one-shot commands end with it as
 //! an error, while the workbench shows it.
 
 use std::path::Path;
 
+use crate::monitor::{Address, WatchCommand, WatchEvent};
 use crate::session::{Command, Event};
 
-use super::{Entry, RecordError, Recorder};
+use super::{Entry, RecordError, Recorder, Source};
 
 pub struct SessionRecorder {
     recorder: Option<Recorder>,
@@ -27,6 +29,31 @@ impl SessionRecorder {
             recorder: Some(Recorder::create(path, scenario, name, variant)?),
             stopped: None,
         })
+    }
+
+    /// Start recording the publisher watched at `address` into `path` (replaced if it
+    /// exists).
+    pub fn create_watched(path: &Path, address: &Address) -> Result<SessionRecorder, RecordError> {
+        let source = Source::Watched {
+            watched: address.clone(),
+        };
+        Ok(SessionRecorder {
+            recorder: Some(Recorder::start(path, source)?),
+            stopped: None,
+        })
+    }
+
+    pub fn watched(&mut self, event: &WatchEvent) {
+        self.write(|ms| Entry::Watched {
+            ms,
+            watched: event.clone(),
+        });
+    }
+
+    /// A command sent to the watched publisher.
+    pub fn asked(&mut self, command: WatchCommand) {
+        let command = command.to_string();
+        self.write(|ms| Entry::Command { ms, command });
     }
 
     pub fn event(&mut self, event: &Event) {

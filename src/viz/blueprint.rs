@@ -25,17 +25,21 @@ pub const VIEW_GRAPH: &str = "tree";
 pub const VIEW_TEXT: &str = "tree (text)";
 pub const VIEW_LOG: &str = "events";
 
-/// The default layout. The graph view's forces are all off: the nodes stay where betr's
-/// tidy layout puts them (`tree::tidy_positions`) instead of being pushed apart. The
-/// blueprint and selection panels start collapsed, leaving the window to the views.
-pub fn default_blueprint() -> Blueprint {
-    let graph = GraphView::new(VIEW_GRAPH)
-        .with_origin(TREE_GRAPH)
+/// A graph view with every force off: the nodes stay where betr's tidy layout puts them.
+pub fn still_graph(name: &str) -> GraphView {
+    GraphView::new(name)
         .with_force_link(&ForceLink::new().with_enabled(false))
         .with_force_many_body(&ForceManyBody::new().with_enabled(false))
         .with_force_position(&ForcePosition::new().with_enabled(false))
         .with_force_collision_radius(&ForceCollisionRadius::new().with_enabled(false))
-        .with_force_center(&ForceCenter::new().with_enabled(false));
+        .with_force_center(&ForceCenter::new().with_enabled(false))
+}
+
+/// The default layout. The graph view's forces are all off: the nodes stay where betr's
+/// tidy layout puts them (`tree::tidy_positions`) instead of being pushed apart. The
+/// blueprint and selection panels start collapsed, leaving the window to the views.
+pub fn default_blueprint() -> Blueprint {
+    let graph = still_graph(VIEW_GRAPH).with_origin(TREE_GRAPH);
     let tree = Vertical::new([
         graph.into(),
         TextDocumentView::new(VIEW_TEXT)

@@ -21,6 +21,7 @@ pub mod scene;
 mod tests;
 pub mod tree;
 mod viewer;
+pub mod watched;
 
 pub use robot::RobotMeshes;
 pub use viewer::{GRPC_PORT, ViewerLife, WEB_PORT, WebServer};

@@ -56,59 +56,62 @@ fn graph_label(kind: &NodeKind, status: Status) -> String {
     }
 }
 
-/// Positions of the nodes of `order` (the tree's preorder) as a tidy tree: each leaf in
-/// its own slot, left to right, as wide as its label; each parent centred over its first
-/// and last child; one level per depth, the root on top (the graph view's y grows
-/// downwards).
+/// Positions of the nodes of `order` (the tree's preorder) as a tidy tree ([`tidy`]).
 pub fn tidy_positions(tree: &Tree, order: &[NodeId]) -> Vec<(f32, f32)> {
-    let mut x = std::collections::HashMap::new();
-    let mut cursor = 0.0_f32;
-    place(tree, tree.root(), &mut cursor, &mut x);
-    let depth = |id: NodeId| {
-        let mut d = 0;
-        let mut at = id;
-        while let Ok(Some(parent)) = tree.parent(at) {
-            d += 1;
-            at = parent;
-        }
-        d
-    };
-    order
+    let index: std::collections::HashMap<NodeId, usize> =
+        order.iter().enumerate().map(|(i, &id)| (id, i)).collect();
+    let nodes: Vec<(Vec<usize>, usize)> = order
         .iter()
         .map(|&id| {
+            let children = tree.children(id).unwrap_or_default();
+            let chars = tree.kind(id).map_or(0, |k| label(k).chars().count());
             (
-                x.get(&id).copied().unwrap_or_default(),
-                depth(id) as f32 * LEVEL,
+                children
+                    .iter()
+                    .filter_map(|c| index.get(c).copied())
+                    .collect(),
+                chars,
             )
         })
-        .collect()
+        .collect();
+    tidy(&nodes)
 }
 
-/// Places `id`'s subtree from `cursor` on, returning `id`'s x.
-fn place(
-    tree: &Tree,
-    id: NodeId,
-    cursor: &mut f32,
-    x: &mut std::collections::HashMap<NodeId, f32>,
-) -> f32 {
-    let children = tree.children(id).unwrap_or_default();
-    let at = if children.is_empty() {
-        let chars = tree.kind(id).map(|k| label(k).chars().count() + 2);
-        let width = (chars.unwrap_or_default() as f32 * CHAR_WIDTH + GAP).max(MIN_SLOT);
-        let at = *cursor + width / 2.0;
-        *cursor += width;
-        at
-    } else {
-        let placed: Vec<f32> = children
-            .iter()
-            .map(|&c| place(tree, c, cursor, x))
-            .collect();
-        let first = placed.first().copied().unwrap_or(*cursor);
-        let last = placed.last().copied().unwrap_or(*cursor);
-        (first + last) / 2.0
-    };
-    x.insert(id, at);
-    at
+/// Positions of a tree's nodes given in preorder (index 0 the root), each with its
+/// children's indices and its label's length: each leaf in its own slot, left to right,
+/// as wide as its label; each parent centred over its first and last child; one level
+/// per depth, the root on top (the graph view's y grows downwards). No recursion, so a
+/// deep tree cannot exhaust the stack.
+pub fn tidy(nodes: &[(Vec<usize>, usize)]) -> Vec<(f32, f32)> {
+    let mut depth = vec![0usize; nodes.len()];
+    let mut x = vec![0.0_f32; nodes.len()];
+    let mut cursor = 0.0_f32;
+    // Preorder meets the leaves left to right, and every parent before its children.
+    for (i, (children, chars)) in nodes.iter().enumerate() {
+        let below = depth[i] + 1;
+        for &c in children {
+            if let Some(d) = depth.get_mut(c) {
+                *d = below;
+            }
+        }
+        if children.is_empty() {
+            let width = ((chars + 2) as f32 * CHAR_WIDTH + GAP).max(MIN_SLOT);
+            x[i] = cursor + width / 2.0;
+            cursor += width;
+        }
+    }
+    // Reverse preorder places every child before its parent.
+    for (i, (children, _)) in nodes.iter().enumerate().rev() {
+        if let (Some(&first), Some(&last)) = (children.first(), children.last()) {
+            x[i] = (x.get(first).copied().unwrap_or_default()
+                + x.get(last).copied().unwrap_or_default())
+                / 2.0;
+        }
+    }
+    x.into_iter()
+        .zip(depth)
+        .map(|(x, d)| (x, d as f32 * LEVEL))
+        .collect()
 }
 
 /// Log the nodes (with colours and marks from `record`, grey without) at their tidy

@@ -93,7 +93,10 @@ fn a_disk_that_fills_during_a_recorded_repair_fails_it() {
     assert!(log.contains("No space left on device"), "{log}");
     // What was written before the disk filled reads back.
     let recording = betr::record::read(&dir.join("disk/r.jsonl")).unwrap();
-    assert_eq!(recording.header.name, "Red cube on the blue cube");
+    assert_eq!(
+        recording.header.scenario_name(),
+        Some("Red cube on the blue cube")
+    );
     drop(disk);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -52,7 +52,7 @@ fn a_resolve_session_is_recorded_and_replayed_without_the_model() {
     }
     // No server from here on.
     let replay = Replay::load(&record, None).unwrap();
-    assert_eq!(replay.header.name, "Red cube on the blue cube");
+    assert_eq!(replay.scenario.name, "Red cube on the blue cube");
     assert_eq!(replay.cut_at, None);
     let events: Vec<&Event> = replay
         .steps
@@ -241,7 +241,7 @@ fn a_version_1_recording_still_loads_replays_and_writes_again() {
         // Written again, it is a recording of the current version that tells the same.
         let new = dir.join(name);
         let mut recorder =
-            SessionRecorder::create(&new, &scenario, &replay.header.name, None).unwrap();
+            SessionRecorder::create(&new, &scenario, &replay.scenario.name, None).unwrap();
         for (_, step) in &replay.steps {
             if let Step::Event(e) = step {
                 recorder.event(e);

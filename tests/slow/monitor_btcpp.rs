@@ -15,22 +15,22 @@ use support::btcpp::{Publisher, free_port_pair, python};
 use support::cli::{command, tmp};
 use support::tmux::{Tmux, isolated_env, quote};
 
-/// `betr monitor --print` started on `port` for `secs`, its lines arriving on a channel.
-fn print_monitor(dir: &std::path::Path, port: u16, secs: u32) -> (Child, mpsc::Receiver<String>) {
-    let mut child = command(
-        dir,
-        &[
-            "monitor",
-            "--print",
-            "--for",
-            &secs.to_string(),
-            &format!(":{port}"),
-        ],
-    )
-    .stdout(Stdio::piped())
-    .stderr(Stdio::piped())
-    .spawn()
-    .unwrap();
+/// `betr monitor --print` started on `port` for `secs` (with `more` arguments), its lines
+/// arriving on a channel.
+fn print_monitor(
+    dir: &std::path::Path,
+    port: u16,
+    secs: u32,
+    more: &[&str],
+) -> (Child, mpsc::Receiver<String>) {
+    let (secs, address) = (secs.to_string(), format!(":{port}"));
+    let mut args = vec!["monitor", "--print", "--for", &secs, &address];
+    args.extend_from_slice(more);
+    let mut child = command(dir, &args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
     let stdout = BufReader::new(child.stdout.take().unwrap());
     let (lines, received) = mpsc::channel();
     std::thread::spawn(move || {
@@ -93,7 +93,8 @@ fn print_reports_every_status_change_the_tree_made_in_order() {
     let dir = tmp("monitor-print");
     let port = free_port_pair();
     let mut publisher = Publisher::start(&python, port, 6);
-    let (mut monitor, received) = print_monitor(&dir, port, 8);
+    let record = dir.join("watched.jsonl");
+    let (mut monitor, received) = print_monitor(&dir, port, 8, &["--record", "watched.jsonl"]);
     let header = lines_until(&received, "# watching");
     assert_eq!(
         header.last().unwrap(),
@@ -127,6 +128,8 @@ fn print_reports_every_status_change_the_tree_made_in_order() {
     let reported = changes(&printed);
     assert!(seen.len() > 60, "six ticks change many statuses: {seen:?}");
     assert_eq!(reported, seen, "betr's lines:\n{}", printed.join("\n"));
+    let live: Vec<String> = [header, tree, printed.clone()].concat();
+    replays_as_watched(&dir, &record, &live, seen.len());
     // Once the publisher is gone, that is said.
     assert!(
         printed
@@ -137,13 +140,75 @@ fn print_reports_every_status_change_the_tree_made_in_order() {
     );
 }
 
+/// The recording of a watched run: `betr replay --print` tells what `betr monitor
+/// --print` told, `--to-rrd` writes a recording the viewer's own CLI accepts, and the
+/// replay screen steps through it.
+fn replays_as_watched(
+    dir: &std::path::Path,
+    record: &std::path::Path,
+    live: &[String],
+    seen: usize,
+) {
+    let file = record.to_str().unwrap();
+    let out = command(dir, &["replay", file, "--print"]).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let told = String::from_utf8(out.stdout).unwrap();
+    let mut told: Vec<&str> = told.lines().collect();
+    assert!(told.remove(0).starts_with("# replay of "), "{told:?}");
+    assert_eq!(told, live, "the replay tells what the watch printed");
+
+    let rrd = dir.join("watched.rrd");
+    let out = command(dir, &["replay", file, "--to-rrd", rrd.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{said}");
+    assert!(said.contains(&format!("({seen} status changes")), "{said}");
+    let verify = std::process::Command::new(support::rerun::rerun_cli())
+        .args(["rrd", "verify"])
+        .arg(&rrd)
+        .output()
+        .unwrap();
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify: {}",
+        String::from_utf8_lossy(&verify.stderr)
+    );
+
+    let tmux = Tmux::start(&format!(
+        "cd {} && {} {} replay {}; echo replay exited $?; sleep 30",
+        quote(dir),
+        isolated_env(dir),
+        quote(std::path::Path::new(env!("CARGO_BIN_EXE_betr"))),
+        quote(record)
+    ));
+    tmux.wait_for(
+        &[
+            "replay watched.jsonl",
+            &format!("change 0/{seen}"),
+            "paused",
+        ],
+        30,
+    );
+    tmux.keys(&[".", ".", "."]);
+    tmux.wait_for(&[&format!("change 3/{seen}"), "IDLE → RUNNING"], 10);
+    tmux.keys(&["G"]);
+    tmux.wait_for(&[&format!("change {seen}/{seen}"), "at the end"], 10);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["replay exited 0"], 10);
+}
+
 #[test]
 fn print_follows_a_robot_that_restarts() {
     let python = python();
     let dir = tmp("monitor-restart");
     let port = free_port_pair();
     let mut first = Publisher::start(&python, port, 2);
-    let (mut monitor, received) = print_monitor(&dir, port, 20);
+    let (mut monitor, received) = print_monitor(&dir, port, 20, &[]);
     lines_until(&received, "# watching");
     first.go();
     let first_seen = first.seen();

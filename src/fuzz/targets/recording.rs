@@ -16,7 +16,7 @@ use crate::domain::Condition;
 use crate::fuzz::Corpus;
 use crate::fuzz::mutate::random_char;
 use crate::llm::usage::UsageTotals;
-use crate::record::{Entry, FORMAT, Header, RecordError, Replay, Resimulation, VERSION};
+use crate::record::{Entry, FORMAT, Header, RecordError, Resimulation, Source, VERSION};
 use crate::scenario::Scenario;
 use crate::session::{BreakReason, Event, Proposal};
 
@@ -77,14 +77,11 @@ impl RecordingTarget {
         if scenario.world_kind != "symbolic" {
             return;
         }
-        let replay = Replay {
-            path: PathBuf::from("fuzz.jsonl"),
-            header: rec.header.clone(),
-            scenario: scenario.clone(),
-            steps: Vec::new(),
-            cut_at: None,
+        let variant = match &rec.header.source {
+            Source::Session { variant, .. } => variant.clone(),
+            Source::Watched { .. } => return,
         };
-        let mut sim = Resimulation::new(&replay);
+        let mut sim = Resimulation::new(scenario.clone(), variant);
         for (_, entry) in rec.entries.iter().take(DECODED_AT_MOST) {
             if let Entry::Event { event, .. } = entry {
                 let _ = sim.follow(event);
@@ -100,9 +97,11 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
     let header = Header {
         format: FORMAT.into(),
         version: VERSION,
-        scenario: PathBuf::from(rel),
-        name: scenario.name.clone(),
-        variant: None,
+        source: Source::Session {
+            scenario: PathBuf::from(rel),
+            name: scenario.name.clone(),
+            variant: None,
+        },
         betr: "0.1.0".into(),
         started: "2026-05-01T09:30:00Z".into(),
     };
@@ -313,7 +312,9 @@ impl Target for RecordingTarget {
         if let Some(scene) = self
             .scenes
             .iter()
-            .find(|(rel, ..)| rec.header.scenario == Path::new(rel))
+            .find(|(rel, ..)| {
+                matches!(&rec.header.source, Source::Session { scenario, .. } if scenario == Path::new(rel))
+            })
             .or_else(|| self.scenes.first())
         {
             self.resimulate(&rec, &scene.1);

@@ -5,8 +5,10 @@
 //! changes; the status bar the connection. The screen only reads: nothing is sent to the
 //! robot but Groot2's read requests.
 
+mod replay;
 mod view;
 
+pub use replay::{WatchPlayer, run as replay};
 pub use view::draw;
 
 use std::collections::{HashSet, VecDeque};
@@ -19,8 +21,11 @@ use tui_tree_widget::TreeState;
 
 use crate::bt::render::{ASCII, Glyphs, UNICODE};
 use crate::monitor::{
-    Address, LiveTree, NodeStatus, WatchCommand, WatchEvent, WatchTiming, missed_some, watch,
+    Address, Change, LiveTree, NodeStatus, Transition, WatchCommand, WatchEvent, WatchTiming,
+    missed_some, watch,
 };
+
+use crate::record::SessionRecorder;
 
 use super::event_loop::{QueueEvent, spawn_input_reader};
 use super::theme::Theme;
@@ -52,7 +57,9 @@ pub struct MonitorScreen {
     state: TreeState<u16>,
     /// The selection follows the node the tree is busy in.
     follow: bool,
-    recent: VecDeque<String>,
+    /// The latest status changes of the tree shown, each with the `since` of its
+    /// connection.
+    recent: VecDeque<(Duration, Change)>,
     changes: u64,
     /// Reads that came back as full as the publisher keeps: changes before them were lost.
     missed: u64,
@@ -66,8 +73,12 @@ pub struct MonitorScreen {
     breakpoints: HashSet<u16>,
     /// The node stopped at its breakpoint, the tree waiting for the person.
     stopped: Option<u16>,
-    /// What the publisher refused, said until the next key.
-    refused: Option<String>,
+    /// What the publisher refused, or why the recording stopped: said until the next key.
+    said: Option<String>,
+    /// Breakpoints can be set and released (not in a replay).
+    controls: bool,
+    /// In a replay: where it stands, said in the status bar instead of the connection.
+    playback: Option<String>,
     /// Commands for the publisher, taken by the terminal loop.
     outbox: Vec<WatchCommand>,
     quit: bool,
@@ -93,7 +104,9 @@ impl MonitorScreen {
             not_found: None,
             breakpoints: HashSet::new(),
             stopped: None,
-            refused: None,
+            said: None,
+            controls: true,
+            playback: None,
             outbox: Vec::new(),
             quit: false,
             glyphs,
@@ -124,6 +137,7 @@ impl MonitorScreen {
                 self.live = Some(live);
                 if new_tree {
                     self.state = TreeState::default();
+                    self.recent.clear();
                     self.open_all();
                 }
                 self.since = since;
@@ -131,29 +145,11 @@ impl MonitorScreen {
                 self.follow_busy();
             }
             WatchEvent::Changes(transitions) => {
-                let arrow = if self.glyphs.success.is_ascii() {
-                    "->"
-                } else {
-                    "→"
-                };
-                let Some(live) = self.live.as_mut() else {
-                    return;
-                };
                 if missed_some(&transitions) {
                     self.missed += 1;
                 }
                 for transition in transitions {
-                    if let Some(change) = live.apply(transition) {
-                        self.changes += 1;
-                        if self.recent.len() == RECENT {
-                            self.recent.pop_front();
-                        }
-                        self.recent.push_back(
-                            live.describe_change(self.since, &change, arrow)
-                                .trim_start()
-                                .to_string(),
-                        );
-                    }
+                    self.apply(transition);
                 }
                 self.follow_busy();
             }
@@ -170,13 +166,41 @@ impl MonitorScreen {
                 self.follow = false;
                 self.select_uid(uid);
             }
-            WatchEvent::Refused(reason) => self.refused = Some(reason),
+            WatchEvent::Refused(reason) => self.said = Some(reason),
             WatchEvent::Waiting(reason) => {
                 if !matches!(self.connection, Connection::Lost(_)) {
                     self.connection = Connection::Waiting(Some(reason));
                 }
             }
         }
+    }
+
+    /// One status change, kept among the latest.
+    fn apply(&mut self, transition: Transition) {
+        let Some(change) = self.live.as_mut().and_then(|l| l.apply(transition)) else {
+            return;
+        };
+        self.changes += 1;
+        if self.recent.len() == RECENT {
+            self.recent.pop_front();
+        }
+        self.recent.push_back((self.since, change));
+    }
+
+    /// Back to before anything was watched, but for the tree, which stays until the next
+    /// one is compared with it (so a replay stepping back keeps the person's folds).
+    fn rewind(&mut self) {
+        self.connection = Connection::Waiting(None);
+        self.since = Duration::ZERO;
+        self.recent.clear();
+        self.changes = 0;
+        self.missed = 0;
+        self.stopped = None;
+    }
+
+    /// Says `text` in the status bar until the next key.
+    pub fn say(&mut self, text: String) {
+        self.said = Some(text);
     }
 
     /// Selects the node the tree is busy in, its branch opened, when following.
@@ -258,7 +282,7 @@ impl MonitorScreen {
             }
             return;
         }
-        self.refused = None;
+        self.said = None;
         let moved = match key.code {
             KeyCode::Char('q') | KeyCode::Esc => {
                 self.quit = true;
@@ -291,19 +315,19 @@ impl MonitorScreen {
                 self.find_next();
                 return;
             }
-            KeyCode::Char('b') => {
+            KeyCode::Char('b') if self.controls => {
                 self.toggle_breakpoint();
                 return;
             }
-            KeyCode::Char('c') if self.stopped.is_some() => {
+            KeyCode::Char('c') if self.controls && self.stopped.is_some() => {
                 self.release(None);
                 return;
             }
-            KeyCode::Char('s') if self.stopped.is_some() => {
+            KeyCode::Char('s') if self.controls && self.stopped.is_some() => {
                 self.release(Some(NodeStatus::Success));
                 return;
             }
-            KeyCode::Char('x') if self.stopped.is_some() => {
+            KeyCode::Char('x') if self.controls && self.stopped.is_some() => {
                 self.release(Some(NodeStatus::Failure));
                 return;
             }
@@ -375,13 +399,14 @@ impl MonitorScreen {
     }
 }
 
-/// Show the monitor until the person quits or `duration` has passed; standard error goes
-/// to `stderr_to` meanwhile.
+/// Show the monitor until the person quits or `duration` has passed, recording what is
+/// watched into `recorder` when given; standard error goes to `stderr_to` meanwhile.
 pub fn run(
     address: Address,
     duration: Option<Duration>,
     ascii: bool,
     stderr_to: Option<&Path>,
+    mut recorder: Option<&mut SessionRecorder>,
 ) -> Result<(), TuiError> {
     // The watch runs on a worker thread of its own, so drawing never delays a read (the
     // publisher drops changes past the 1000 it keeps between two reads).
@@ -404,6 +429,7 @@ pub fn run(
         spawn_input_reader(keys, stop.clone());
         let mut screen = MonitorScreen::new(address, ascii);
         let deadline = duration.map(|d| tokio::time::Instant::now() + d);
+        let mut told_stop = false;
         let result = loop {
             if let Err(e) = terminal.draw(|f| view::draw(f, &mut screen)) {
                 break Err(TuiError::Terminal(e));
@@ -411,7 +437,12 @@ pub fn run(
             let last_draw = tokio::time::Instant::now();
             let ended = tokio::select! {
                 Some(event) = watched.recv() => {
-                    gather(&mut screen, event, &mut watched, last_draw, |_| {}).await;
+                    let record = |event: &WatchEvent| {
+                        if let Some(recorder) = recorder.as_deref_mut() {
+                            recorder.watched(event);
+                        }
+                    };
+                    gather(&mut screen, event, &mut watched, last_draw, record).await;
                     false
                 }
                 input = input.recv() => match input {
@@ -425,8 +456,18 @@ pub fn run(
                 _ = sleep_until(deadline) => true,
             };
             for command in screen.take_commands() {
+                if let Some(recorder) = recorder.as_deref_mut() {
+                    recorder.asked(command);
+                }
                 // The watch ends only after this loop does.
                 let _ = commands.send(command);
+            }
+            if let Some(stopped) = recorder.as_deref().and_then(SessionRecorder::stopped)
+                && screen.said.is_none()
+                && !told_stop
+            {
+                screen.say(stopped.to_string());
+                told_stop = true;
             }
             if ended || screen.should_quit() {
                 break Ok(());
@@ -434,6 +475,9 @@ pub fn run(
         };
         // No breakpoint is left to stop the robot with no one watching: the watch sends
         // the clearing before it is stopped.
+        if let Some(recorder) = recorder.as_deref_mut() {
+            recorder.asked(WatchCommand::ClearAll);
+        }
         let _ = commands.send(WatchCommand::ClearAll);
         tokio::time::sleep(Duration::from_millis(200)).await;
         stop.store(true, std::sync::atomic::Ordering::Relaxed);

@@ -8,7 +8,6 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 use tui_tree_widget::{Tree as TreeWidget, TreeItem};
 
-use crate::bt::Status;
 use crate::http_text::printable;
 use crate::monitor::{LiveTree, NodeKind, NodeStatus};
 
@@ -69,7 +68,7 @@ fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>>
     let mut built: Vec<Option<TreeItem<'static, u16>>> = vec![None; live.tree.nodes.len()];
     for (i, node) in live.tree.nodes.iter().enumerate().rev() {
         let status = live.statuses[i];
-        let style = screen.theme.status(shown(status));
+        let style = screen.theme.status(status.as_status());
         let label = if screen.matches(i) {
             style.add_modifier(Modifier::UNDERLINED | Modifier::BOLD)
         } else {
@@ -107,16 +106,6 @@ fn items(live: &LiveTree, screen: &MonitorScreen) -> Vec<TreeItem<'static, u16>>
         .collect()
 }
 
-/// The workbench's colour for a BT.CPP status (a skipped node is drawn as idle).
-fn shown(status: NodeStatus) -> Status {
-    match status {
-        NodeStatus::Idle | NodeStatus::Skipped => Status::Idle,
-        NodeStatus::Running => Status::Running,
-        NodeStatus::Success => Status::Success,
-        NodeStatus::Failure => Status::Failure,
-    }
-}
-
 fn mark(screen: &MonitorScreen, status: NodeStatus) -> &'static str {
     let g = screen.glyphs;
     match status {
@@ -148,7 +137,7 @@ fn draw_details(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
             Span::raw("status "),
             Span::styled(
                 live.statuses[i].name(),
-                screen.theme.status(shown(live.statuses[i])),
+                screen.theme.status(live.statuses[i].as_status()),
             ),
         ]));
         if node.ports.is_empty() {
@@ -176,12 +165,26 @@ fn draw_details(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
 fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
     let rows = usize::from(area.height.saturating_sub(2));
     let skip = screen.recent.len().saturating_sub(rows);
-    let lines: Vec<Line> = screen
-        .recent
-        .iter()
-        .skip(skip)
-        .map(|l| Line::raw(l.clone()))
-        .collect();
+    let arrow = if screen.glyphs.success.is_ascii() {
+        "->"
+    } else {
+        "→"
+    };
+    let lines: Vec<Line> = match &screen.live {
+        Some(live) => screen
+            .recent
+            .iter()
+            .skip(skip)
+            .map(|(since, change)| {
+                Line::raw(
+                    live.describe_change(*since, change, arrow)
+                        .trim_start()
+                        .to_string(),
+                )
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     let title = if screen.missed == 0 {
         format!(" status changes ({}) ", screen.changes)
     } else {
@@ -209,23 +212,66 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         Some(live.tree.describe(live.tree.by_uid(uid)?))
     });
     if let Some(node) = stopped {
-        let text = format!(
-            " stopped before {node}{dot}c go on{dot}s succeed it{dot}x fail it{dot}b remove the breakpoint"
-        );
+        let text = if screen.controls {
+            format!(
+                " stopped before {node}{dot}c go on{dot}s succeed it{dot}x fail it{dot}b remove the breakpoint"
+            )
+        } else {
+            let playback = screen.playback.as_deref().unwrap_or_default();
+            format!("{playback}{dot}stopped at a breakpoint before {node}")
+        };
         frame.render_widget(
             Paragraph::new(Span::styled(text, screen.theme.stopped)),
             area,
         );
         return;
     }
-    if let Some(reason) = &screen.refused {
+    if let Some(reason) = &screen.said {
         frame.render_widget(
             Paragraph::new(Span::styled(format!(" {reason}"), screen.theme.error)),
             area,
         );
         return;
     }
-    let (mut state, style) = match &screen.connection {
+    let (mut state, style) = match (&screen.playback, &screen.connection) {
+        (Some(playback), Connection::Lost(reason)) => (
+            format!("{playback}{dot}the connection was lost: {reason}"),
+            screen.theme.error,
+        ),
+        (Some(playback), _) => (playback.clone(), screen.theme.status_bar),
+        (None, connection) => connection_state(screen, connection, dot),
+    };
+    if let Some(query) = &screen.not_found {
+        state.push_str(&format!("{dot}no node matches {:?}", printable(query)));
+    }
+    let keys = if screen.playback.is_some() {
+        replay_keys(dot)
+    } else {
+        watch_keys(dot, ascii)
+    };
+    let width = usize::from(area.width);
+    let text = match keys
+        .iter()
+        .find(|k| state.chars().count() + k.chars().count() <= width)
+    {
+        Some(keys) => format!("{state}{keys}"),
+        // A long reason is cut rather than the way out.
+        None => {
+            let room = width.saturating_sub(keys[3].chars().count() + 1);
+            let cut: String = state.chars().take(room).collect();
+            format!("{cut}…{}", keys[3])
+        }
+    };
+    frame.render_widget(Paragraph::new(Span::styled(text, style)), area);
+}
+
+/// The status bar's state of a live watch.
+fn connection_state(
+    screen: &MonitorScreen,
+    connection: &Connection,
+    dot: &str,
+) -> (String, ratatui::style::Style) {
+    match connection {
         Connection::Watching => {
             let nodes = screen.live.as_ref().map_or(0, |l| l.tree.nodes.len());
             let follow = if screen.follow {
@@ -248,33 +294,30 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
             format!(" connecting to {}", screen.address),
             screen.theme.status_bar,
         ),
-    };
-    if let Some(query) = &screen.not_found {
-        state.push_str(&format!("{dot}no node matches {:?}", printable(query)));
     }
-    // The keys after the state, fewer of them when the terminal is narrow; quitting is
-    // always said.
+}
+
+/// The keys said after the state, fewer of them when the terminal is narrow; quitting is
+/// always said.
+fn watch_keys(dot: &str, ascii: bool) -> [String; 4] {
     let fold = if ascii { "h/l fold" } else { "←→ fold" };
-    let keys = [
+    [
         format!(
             "{dot}f follow{dot}{fold}{dot}E/C open/close all{dot}/ find{dot}b breakpoint{dot}q quit"
         ),
         format!("{dot}f follow{dot}/ find{dot}b breakpoint{dot}q quit"),
         format!("{dot}f follow{dot}q quit"),
         format!("{dot}q quit"),
-    ];
-    let width = usize::from(area.width);
-    let text = match keys
-        .iter()
-        .find(|k| state.chars().count() + k.chars().count() <= width)
-    {
-        Some(keys) => format!("{state}{keys}"),
-        // A long reason is cut rather than the way out.
-        None => {
-            let room = width.saturating_sub(keys[3].chars().count() + 1);
-            let cut: String = state.chars().take(room).collect();
-            format!("{cut}…{}", keys[3])
-        }
-    };
-    frame.render_widget(Paragraph::new(Span::styled(text, style)), area);
+    ]
+}
+
+fn replay_keys(dot: &str) -> [String; 4] {
+    [
+        format!(
+            "{dot}space play{dot}. , step{dot}] [ failure{dot}g G start/end{dot}/ find{dot}q quit"
+        ),
+        format!("{dot}space play{dot}. , step{dot}q quit"),
+        format!("{dot}space play{dot}q quit"),
+        format!("{dot}q quit"),
+    ]
 }

@@ -62,8 +62,8 @@ impl Player {
     /// The player of a recording read back: the status bar names its scenario file.
     pub fn of(replay: Replay, keys: KeyBindings, theme: Theme) -> Player {
         let info = Info {
-            scenario: replay.header.scenario.file_stem().map_or_else(
-                || replay.header.name.clone(),
+            scenario: replay.scenario_file.file_stem().map_or_else(
+                || replay.scenario.name.clone(),
                 |s| s.to_string_lossy().into_owned(),
             ),
             objects: replay.scenario.domain.vocabulary.object_names(),
