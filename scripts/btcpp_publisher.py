@@ -6,7 +6,8 @@ by hand.
     python scripts/btcpp_publisher.py PORT 0 --nodes N --period-ms P
 
 Builds a tree with Fallback, ReactiveSequence, Inverter, RetryUntilSuccessful and a
-SubTree whose leaves answer from a fixed script, publishes it on PORT (and PORT + 1, as
+SubTree whose leaves answer from a fixed script (the main tree's blackboard holds
+`target` and `grasps`, the grasps tried so far), publishes it on PORT (and PORT + 1, as
 Groot2's publisher does), prints `ready PORT` and waits for a line on standard input.
 Then it ticks the tree TICKS times (default 6; 0 ticks until standard input closes), 20 ms
 apart, and prints on one line the status changes BT.CPP's own StdCoutLogger saw, in
@@ -133,9 +134,18 @@ def main():
     factory.register_simple_condition(
         "IsBlocked", lambda node: bt.NodeStatus.SUCCESS if next(blocked) else bt.NodeStatus.FAILURE
     )
-    factory.register_simple_action("Grasp", lambda node: next(grasps))
+    tried = itertools.count(1)
+
+    def grasp(node):
+        board.set_int("grasps", next(tried))
+        return next(grasps)
+
+    factory.register_simple_action("Grasp", grasp)
     factory.register_simple_action("Recover", lambda node: bt.NodeStatus.SUCCESS)
     tree = factory.create_tree_from_text(TREE)
+    # The main tree's blackboard: what the grasp is for, and how many grasps were tried.
+    board = tree.root_blackboard()
+    board.set_string("target", "red cube")
     publisher = bt.Groot2Publisher(tree, port)
 
     # BT.CPP's logger writes to the process's standard output: into a file while ticking.

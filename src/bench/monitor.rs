@@ -206,7 +206,10 @@ impl FrameTally {
             WatchEvent::Lost(reason) | WatchEvent::Waiting(reason) => {
                 self.failed.get_or_insert(reason.clone());
             }
-            WatchEvent::Restarted | WatchEvent::Stopped(_) | WatchEvent::Refused(_) => {}
+            WatchEvent::Restarted
+            | WatchEvent::Stopped(_)
+            | WatchEvent::Refused(_)
+            | WatchEvent::Blackboards(_) => {}
         }
     }
 }

@@ -12,7 +12,10 @@ use tokio::sync::mpsc;
 
 use betr::http_text::printable;
 use betr::monitor::protocol::KEPT_CHANGES;
-use betr::monitor::{Address, LiveTree, WatchEvent, WatchTiming, missed_some, watch_only};
+use betr::monitor::{
+    Address, Blackboard, LiveTree, WatchEvent, WatchTiming, changed_blackboards, missed_some,
+    watch_only,
+};
 use betr::record::SessionRecorder;
 
 /// What `betr monitor` is asked.
@@ -120,6 +123,7 @@ pub(super) struct Printer {
     since: Duration,
     arrow: &'static str,
     last_wait: Option<String>,
+    boards: Vec<Blackboard>,
 }
 
 impl Printer {
@@ -129,6 +133,7 @@ impl Printer {
             since: Duration::ZERO,
             arrow: if ascii { "->" } else { "→" },
             last_wait: None,
+            boards: Vec::new(),
         }
     }
 
@@ -186,6 +191,12 @@ impl Printer {
             // Nothing sets breakpoints while printing; another client's stop is said.
             WatchEvent::Stopped(uid) => outln!("# node {uid} stopped at a breakpoint"),
             WatchEvent::Refused(reason) => outln!("# {reason}"),
+            WatchEvent::Blackboards(boards) => {
+                for board in changed_blackboards(&self.boards, &boards) {
+                    outln!("# blackboard {}", board.describe());
+                }
+                self.boards = boards;
+            }
             WatchEvent::Waiting(reason) => {
                 outln!("# {reason}; trying again");
                 self.last_wait = Some(reason);

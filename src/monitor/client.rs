@@ -285,6 +285,19 @@ impl Publisher {
         Ok(Notifications { address, socket })
     }
 
+    /// The blackboards named, with their entries (a name the publisher does not know is
+    /// left out).
+    pub async fn blackboards(
+        &mut self,
+        names: &[&str],
+    ) -> Result<Vec<protocol::Blackboard>, ClientError> {
+        let body = names.join(";");
+        let (_, payload) = self
+            .ask_payload(RequestKind::Blackboard, Some(body.as_bytes()))
+            .await?;
+        protocol::read_blackboards(&payload).map_err(|source| self.protocol(source))
+    }
+
     /// The status changes since the last call (or since recording started).
     pub async fn transitions(&mut self) -> Result<(TreeId, Vec<Transition>), ClientError> {
         let (id, payload) = self.ask_payload(RequestKind::Transitions, None).await?;

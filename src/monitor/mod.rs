@@ -13,7 +13,7 @@ use std::time::Duration;
 use tokio::sync::mpsc;
 
 pub use client::{Address, AddressError, ClientError, DEFAULT_PORT, Publisher, TreeId};
-pub use protocol::{NodeStatus, Transition};
+pub use protocol::{Blackboard, NodeStatus, Transition, changed_blackboards};
 pub use tree::{NodeKind, WatchedNode, WatchedTree};
 
 /// How the watch talks to the publisher.
@@ -25,6 +25,8 @@ pub struct WatchTiming {
     pub timeout: Duration,
     /// Between two tries to connect after a failure.
     pub retry: Duration,
+    /// Between two reads of the blackboards.
+    pub blackboards: Duration,
 }
 
 impl Default for WatchTiming {
@@ -33,6 +35,7 @@ impl Default for WatchTiming {
             poll: Duration::from_millis(5),
             timeout: Duration::from_secs(2),
             retry: Duration::from_millis(500),
+            blackboards: Duration::from_millis(250),
         }
     }
 }
@@ -64,8 +67,11 @@ pub enum WatchEvent {
     Waiting(String),
     /// The node with this uid stopped at its breakpoint; the tree waits for a release.
     Stopped(u16),
-    /// The publisher refused a breakpoint command: why.
+    /// The publisher refused a breakpoint command, or its blackboards could not be read:
+    /// why.
     Refused(String),
+    /// The tree's blackboards and their entries, when they changed.
+    Blackboards(Vec<Blackboard>),
 }
 
 /// What a front end asks of the publisher while watching.
@@ -197,6 +203,7 @@ async fn follow(
     let mut notifications = publisher.notifications().await.map_err(after)?;
     let (_, started) = publisher.start_recording().await.map_err(after)?;
     let (_, statuses) = publisher.statuses().await.map_err(after)?;
+    let boards_of_tree = Boards::new(&tree);
     let connected = WatchEvent::Connected {
         address: address.clone(),
         tree: Box::new(tree),
@@ -212,12 +219,23 @@ async fn follow(
     // `protocol::KEPT_CHANGES`.
     let mut beat = tokio::time::interval(timing.poll);
     beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut board_beat = tokio::time::interval(timing.blackboards);
+    board_beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut boards = boards_of_tree;
     let mut busy = false;
     let mut commanded = true;
     loop {
         if !busy {
             tokio::select! {
                 _ = beat.tick() => {}
+                _ = board_beat.tick(), if boards.reading => {
+                    if let Some(event) = boards.read(&mut publisher).await.map_err(after)?
+                        && events.send(event).await.is_err()
+                    {
+                        return Ok(Ended::Closed);
+                    }
+                    continue;
+                }
                 command = commands.recv(), if commanded => {
                     match command {
                         Some(command) => {
@@ -249,6 +267,45 @@ async fn follow(
         busy = changes.len() >= protocol::KEPT_CHANGES / 4;
         if !changes.is_empty() && events.send(WatchEvent::Changes(changes)).await.is_err() {
             return Ok(Ended::Closed);
+        }
+    }
+}
+
+/// The blackboards of the watched tree, read on their own beat.
+struct Boards {
+    names: Vec<String>,
+    last: Option<Vec<Blackboard>>,
+    /// False once a read failed: the publisher (or the build of BT.CPP) does not offer
+    /// them, said once.
+    reading: bool,
+}
+
+impl Boards {
+    fn new(tree: &WatchedTree) -> Boards {
+        Boards {
+            names: tree.blackboards().into_iter().map(str::to_string).collect(),
+            last: None,
+            reading: true,
+        }
+    }
+
+    /// The blackboards when they changed since the last read; why not, once, when the
+    /// publisher does not answer with them. A lost connection is the watch's error.
+    async fn read(&mut self, publisher: &mut Publisher) -> Result<Option<WatchEvent>, ClientError> {
+        let names: Vec<&str> = self.names.iter().map(String::as_str).collect();
+        match publisher.blackboards(&names).await {
+            Ok(boards) if self.last.as_ref() != Some(&boards) => {
+                self.last = Some(boards.clone());
+                Ok(Some(WatchEvent::Blackboards(boards)))
+            }
+            Ok(_) => Ok(None),
+            Err(e @ (ClientError::Protocol { .. } | ClientError::Empty { .. })) => {
+                self.reading = false;
+                Ok(Some(WatchEvent::Refused(format!(
+                    "the blackboards cannot be read ({e}); the statuses are still followed"
+                ))))
+            }
+            Err(e) => Err(e),
         }
     }
 }

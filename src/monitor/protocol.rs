@@ -35,6 +35,8 @@ pub enum RequestKind {
     BreakpointUnlock,
     /// Take every stop away.
     RemoveAllHooks,
+    /// The entries of the blackboards named in the body (`;` between names).
+    Blackboard,
 }
 
 impl RequestKind {
@@ -48,6 +50,7 @@ impl RequestKind {
             RequestKind::HookRemove => b'R',
             RequestKind::BreakpointUnlock => b'U',
             RequestKind::RemoveAllHooks => b'A',
+            RequestKind::Blackboard => b'B',
         }
     }
 
@@ -61,6 +64,7 @@ impl RequestKind {
             RequestKind::HookRemove => "breakpoint removal",
             RequestKind::BreakpointUnlock => "breakpoint release",
             RequestKind::RemoveAllHooks => "remove all breakpoints",
+            RequestKind::Blackboard => "blackboard",
         }
     }
 }
@@ -309,6 +313,103 @@ pub fn read_statuses(payload: &[u8]) -> Result<Vec<(u16, NodeStatus)>, ProtocolE
         .collect()
 }
 
+/// One blackboard as the publisher exports it: each entry's name and value, the value
+/// as the JSON BehaviorTree.CPP converts it to (entries of types with no JSON converter
+/// are left out by the publisher).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Blackboard {
+    /// The tree instance it belongs to (the main tree's ID, or a SubTree's path).
+    pub name: String,
+    pub entries: Vec<(String, String)>,
+}
+
+impl Blackboard {
+    /// One line: its name and every entry (`Main: goal = 3, target = "red cube"`).
+    pub fn describe(&self) -> String {
+        let entries: Vec<String> = self
+            .entries
+            .iter()
+            .map(|(k, v)| {
+                format!(
+                    "{} = {}",
+                    crate::http_text::printable(k),
+                    crate::http_text::printable(v)
+                )
+            })
+            .collect();
+        let entries = if entries.is_empty() {
+            "no entries".to_string()
+        } else {
+            entries.join(", ")
+        };
+        format!("{}: {entries}", crate::http_text::printable(&self.name))
+    }
+
+    /// The value of entry `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.entries
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// The blackboards of `now` that are new or differ from those of `before`.
+pub fn changed_blackboards<'a>(
+    before: &[Blackboard],
+    now: &'a [Blackboard],
+) -> Vec<&'a Blackboard> {
+    now.iter().filter(|b| !before.contains(b)).collect()
+}
+
+/// The blackboard payload: MessagePack of `{blackboard: {entry: value}}`.
+pub fn read_blackboards(payload: &[u8]) -> Result<Vec<Blackboard>, ProtocolError> {
+    let not = |what: String| ProtocolError::NotGroot2 {
+        request: RequestKind::Blackboard.name(),
+        what,
+    };
+    let value: serde_json::Value = rmp_serde::from_slice(payload)
+        .map_err(|e| not(format!("not MessagePack of JSON values ({e})")))?;
+    let serde_json::Value::Object(boards) = value else {
+        return Err(not(format!(
+            "a {} instead of a map of blackboards",
+            kind(&value)
+        )));
+    };
+    boards
+        .into_iter()
+        .map(|(name, entries)| match entries {
+            serde_json::Value::Object(entries) => Ok(Blackboard {
+                name,
+                entries: entries
+                    .into_iter()
+                    .map(|(key, value)| (key, value.to_string()))
+                    .collect(),
+            }),
+            // An empty blackboard exports as null.
+            serde_json::Value::Null => Ok(Blackboard {
+                name,
+                entries: Vec::new(),
+            }),
+            other => Err(not(format!(
+                "the blackboard {name:?} is a {} instead of a map of entries",
+                kind(&other)
+            ))),
+        })
+        .collect()
+}
+
+fn kind(value: &serde_json::Value) -> &'static str {
+    match value {
+        serde_json::Value::Null => "null",
+        serde_json::Value::Bool(_) => "boolean",
+        serde_json::Value::Number(_) => "number",
+        serde_json::Value::String(_) => "string",
+        serde_json::Value::Array(_) => "list",
+        serde_json::Value::Object(_) => "map",
+    }
+}
+
 /// One status change the publisher kept while recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Transition {
@@ -355,6 +456,38 @@ fn entries<'a>(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn blackboards_are_read_from_messagepack() {
+        let payload = rmp_serde::to_vec(&serde_json::json!({
+            "Main": {"target": "red cube", "grasps": 2},
+            "Work": null,
+        }))
+        .unwrap();
+        let boards = read_blackboards(&payload).unwrap();
+        assert_eq!(
+            boards[0].describe(),
+            "Main: grasps = 2, target = \"red cube\""
+        );
+        assert_eq!(boards[0].get("grasps"), Some("2"));
+        assert_eq!(boards[1].describe(), "Work: no entries");
+        assert_eq!(
+            changed_blackboards(&boards, &boards),
+            Vec::<&Blackboard>::new()
+        );
+
+        let list = rmp_serde::to_vec(&serde_json::json!([1, 2])).unwrap();
+        let said = read_blackboards(&list).unwrap_err().to_string();
+        assert!(
+            said.contains("a list instead of a map of blackboards"),
+            "{said}"
+        );
+        let flat = rmp_serde::to_vec(&serde_json::json!({"Main": 3})).unwrap();
+        let said = read_blackboards(&flat).unwrap_err().to_string();
+        assert!(said.contains("\"Main\" is a number"), "{said}");
+        let said = read_blackboards(b"\xc1").unwrap_err().to_string();
+        assert!(said.contains("not MessagePack"), "{said}");
+    }
+
     use super::*;
 
     fn reply_header(kind: u8, id: u32, protocol: u8) -> Vec<u8> {

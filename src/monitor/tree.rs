@@ -66,6 +66,9 @@ pub struct WatchedNode {
     /// names nodes everywhere.
     pub path: String,
     pub depth: usize,
+    /// The blackboard of the tree instance it is in, by the name the publisher exports it
+    /// under (the main tree's ID, a SubTree instance's path such as `Work::5`).
+    pub blackboard: String,
 }
 
 /// A watched tree: its nodes in depth-first order (index 0 the root). Written to a
@@ -97,6 +100,15 @@ impl TryFrom<Description> for WatchedTree {
 impl From<WatchedTree> for Description {
     fn from(tree: WatchedTree) -> Description {
         Description(tree.xml)
+    }
+}
+
+/// The name a `<BehaviorTree>` instance's blackboard is exported under: its path, or the
+/// tree's ID for the main tree (whose path is empty), as BT.CPP's publisher names it.
+fn blackboard_name(tree: roxmltree::Node) -> String {
+    match tree.attribute("_fullpath") {
+        Some(path) if !path.is_empty() => path.to_string(),
+        _ => tree.attribute("ID").unwrap_or_default().to_string(),
     }
 }
 
@@ -142,6 +154,7 @@ impl WatchedTree {
             .children()
             .find(|n| n.is_element())
             .ok_or(TreeError::NoTree)?;
+        let main_board = blackboard_name(*main);
         let mut tree = WatchedTree {
             main: main.attribute("ID").unwrap_or_default().to_string(),
             nodes: Vec::new(),
@@ -149,20 +162,27 @@ impl WatchedTree {
             xml: text.to_string(),
         };
         // Depth first without recursion, so a deep description cannot exhaust the stack:
-        // (element, parent index, path).
-        let mut stack = vec![(root, None::<usize>, "root".to_string())];
-        while let Some((element, parent, path)) = stack.pop() {
-            let index = tree.add(&doc, element, &kinds, path.clone(), parent)?;
-            let children: Vec<roxmltree::Node> =
+        // (element, parent index, path, blackboard).
+        let mut stack = vec![(root, None::<usize>, "root".to_string(), main_board)];
+        while let Some((element, parent, path, board)) = stack.pop() {
+            let index = tree.add(&doc, element, &kinds, path.clone(), parent, board.clone())?;
+            let (children, board): (Vec<roxmltree::Node>, String) =
                 if tree.nodes[index].kind == NodeKind::SubTree || element.has_tag_name("SubTree") {
-                    element
+                    let instance = element
                         .attribute("_fullpath")
-                        .and_then(|p| instance_of(&instances, p))
-                        .and_then(|t| t.children().find(|n| n.is_element()))
-                        .into_iter()
-                        .collect()
+                        .and_then(|p| instance_of(&instances, p));
+                    (
+                        instance
+                            .and_then(|t| t.children().find(|n| n.is_element()))
+                            .into_iter()
+                            .collect(),
+                        instance.map_or(board, blackboard_name),
+                    )
                 } else {
-                    element.children().filter(|n| n.is_element()).collect()
+                    (
+                        element.children().filter(|n| n.is_element()).collect(),
+                        board,
+                    )
                 };
             for (i, child) in children.into_iter().enumerate().rev() {
                 let child_path = if path == "root" {
@@ -170,7 +190,7 @@ impl WatchedTree {
                 } else {
                     format!("{path}.{i}")
                 };
-                stack.push((child, Some(index), child_path));
+                stack.push((child, Some(index), child_path, board.clone()));
             }
         }
         Ok(tree)
@@ -183,6 +203,7 @@ impl WatchedTree {
         kinds: &HashMap<String, NodeKind>,
         path: String,
         parent: Option<usize>,
+        blackboard: String,
     ) -> Result<usize, TreeError> {
         let tag = element.tag_name().name().to_string();
         let line = doc.text_pos_at(element.range().start).row;
@@ -228,11 +249,23 @@ impl WatchedTree {
             parent,
             path,
             depth,
+            blackboard,
         });
         if let Some(p) = parent {
             self.nodes[p].children.push(index);
         }
         Ok(index)
+    }
+
+    /// The names of the tree's blackboards, the main tree's first.
+    pub fn blackboards(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = Vec::new();
+        for node in &self.nodes {
+            if !names.contains(&node.blackboard.as_str()) {
+                names.push(&node.blackboard);
+            }
+        }
+        names
     }
 
     /// The node the publisher numbers `uid`.
@@ -353,6 +386,16 @@ mod tests {
         );
         assert_eq!(tree.by_uid(6).map(|n| n.depth), Some(3));
         assert_eq!(tree.uid_path(5), vec![1, 4, 5, 6]);
+        // Each node reads the blackboard of the tree instance it is written in: the
+        // SubTree node its parent's, the subtree's nodes the instance's.
+        let boards: Vec<&str> = tree.nodes.iter().map(|n| n.blackboard.as_str()).collect();
+        assert_eq!(
+            boards,
+            [
+                "MainTree", "MainTree", "MainTree", "MainTree", "walk", "walk"
+            ]
+        );
+        assert_eq!(tree.blackboards(), ["MainTree", "walk"]);
     }
 
     #[test]

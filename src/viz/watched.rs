@@ -45,6 +45,7 @@ pub fn write<'a>(
         since: Duration::ZERO,
         at: Duration::ZERO,
         changes: 0,
+        boards: Vec::new(),
     };
     for event in events {
         if let Err(e) = writer.on(event) {
@@ -90,6 +91,7 @@ struct Writer<'r> {
     /// The latest time logged (the timeline never goes back).
     at: Duration,
     changes: u64,
+    boards: Vec<crate::monitor::Blackboard>,
 }
 
 impl Writer<'_> {
@@ -147,6 +149,16 @@ impl Writer<'_> {
                 )
             }
             WatchEvent::Refused(reason) => self.line(TextLogLevel::ERROR, reason.clone()),
+            WatchEvent::Blackboards(boards) => {
+                for board in crate::monitor::changed_blackboards(&self.boards, boards) {
+                    self.line(
+                        TextLogLevel::INFO,
+                        format!("blackboard {}", board.describe()),
+                    )?;
+                }
+                self.boards.clone_from(boards);
+                Ok(())
+            }
         }
     }
 

@@ -128,6 +128,15 @@ fn print_reports_every_status_change_the_tree_made_in_order() {
     let reported = changes(&printed);
     assert!(seen.len() > 60, "six ticks change many statuses: {seen:?}");
     assert_eq!(reported, seen, "betr's lines:\n{}", printed.join("\n"));
+    // The main tree's blackboard, as the Python side set it.
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("# blackboard Main: grasps = ")
+                && l.ends_with("target = \"red cube\"")),
+        "{}",
+        printed.join("\n")
+    );
     let live: Vec<String> = [header, tree, printed.clone()].concat();
     replays_as_watched(&dir, &record, &live, seen.len());
     // Once the publisher is gone, that is said.
@@ -254,6 +263,9 @@ fn the_screen_shows_the_running_tree_and_a_lost_robot() {
     publisher.stop();
     drop(publisher);
     tmux.wait_for(&["was lost", "trying again"], 30);
+    // The root's pane shows the main tree's blackboard as last read.
+    tmux.keys(&["Home"]);
+    tmux.wait_for(&["blackboard Main", "target = \"red cube\""], 10);
     tmux.keys(&["q"]);
     tmux.wait_for(&["monitor exited 0"], 10);
 }

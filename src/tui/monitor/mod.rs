@@ -1,8 +1,8 @@
 //! The monitor screen (`betr monitor`): a BehaviorTree.CPP process's tree, live, as its
 //! Groot2 publisher reports it. The tree pane shows every node with its status, following
 //! the node the tree is busy in unless the person moves; the side pane the selected
-//! node's kind, ports (a `{name}` port is a blackboard entry) and the latest status
-//! changes; the status bar the connection. The screen only reads: nothing is sent to the
+//! node's kind, ports (a `{name}` port is a blackboard entry, shown with its value) and
+//! its tree's blackboard, and the latest status changes; the status bar the connection. The screen only reads: nothing is sent to the
 //! robot but Groot2's read requests.
 
 mod replay;
@@ -21,8 +21,8 @@ use tui_tree_widget::TreeState;
 
 use crate::bt::render::{ASCII, Glyphs, UNICODE};
 use crate::monitor::{
-    Address, Change, LiveTree, NodeStatus, Transition, WatchCommand, WatchEvent, WatchTiming,
-    missed_some, watch,
+    Address, Blackboard, Change, LiveTree, NodeStatus, Transition, WatchCommand, WatchEvent,
+    WatchTiming, missed_some, watch,
 };
 
 use crate::record::SessionRecorder;
@@ -75,6 +75,8 @@ pub struct MonitorScreen {
     stopped: Option<u16>,
     /// What the publisher refused, or why the recording stopped: said until the next key.
     said: Option<String>,
+    /// The tree's blackboards as last read.
+    blackboards: Vec<Blackboard>,
     /// Breakpoints can be set and released (not in a replay).
     controls: bool,
     /// In a replay: where it stands, said in the status bar instead of the connection.
@@ -105,6 +107,7 @@ impl MonitorScreen {
             breakpoints: HashSet::new(),
             stopped: None,
             said: None,
+            blackboards: Vec::new(),
             controls: true,
             playback: None,
             outbox: Vec::new(),
@@ -138,6 +141,7 @@ impl MonitorScreen {
                 if new_tree {
                     self.state = TreeState::default();
                     self.recent.clear();
+                    self.blackboards.clear();
                     self.open_all();
                 }
                 self.since = since;
@@ -167,6 +171,7 @@ impl MonitorScreen {
                 self.select_uid(uid);
             }
             WatchEvent::Refused(reason) => self.said = Some(reason),
+            WatchEvent::Blackboards(boards) => self.blackboards = boards,
             WatchEvent::Waiting(reason) => {
                 if !matches!(self.connection, Connection::Lost(_)) {
                     self.connection = Connection::Waiting(Some(reason));
@@ -196,6 +201,7 @@ impl MonitorScreen {
         self.changes = 0;
         self.missed = 0;
         self.stopped = None;
+        self.blackboards.clear();
     }
 
     /// Says `text` in the status bar until the next key.

@@ -193,21 +193,19 @@ impl WatchPlayer {
         }
     }
 
-    /// The position just after the next change to FAILURE after the current one, or
-    /// the last one before it (`forward` false).
-    fn failure(&self, forward: bool) -> Option<usize> {
-        let failed = |i: &usize| {
-            self.change(*i)
-                .is_some_and(|t| t.status == NodeStatus::Failure)
-        };
-        if forward {
-            (self.at..self.atoms.len()).find(failed).map(|i| i + 1)
-        } else {
-            (0..self.at.saturating_sub(1))
-                .rev()
-                .find(failed)
-                .map(|i| i + 1)
-        }
+    /// The position just after the next status change `wanted` picks.
+    fn next_change(&self, wanted: impl Fn(Transition) -> bool) -> Option<usize> {
+        (self.at..self.atoms.len())
+            .find(|&i| self.change(i).is_some_and(&wanted))
+            .map(|i| i + 1)
+    }
+
+    /// The position just after the last such change before the one the replay stands on.
+    fn previous_change(&self, wanted: impl Fn(Transition) -> bool) -> Option<usize> {
+        (0..self.at.saturating_sub(1))
+            .rev()
+            .find(|&i| self.change(i).is_some_and(&wanted))
+            .map(|i| i + 1)
     }
 
     /// The time at the current position, since the watch began.
@@ -253,12 +251,18 @@ impl WatchPlayer {
             return;
         }
         let target = match key.code {
-            KeyCode::Char('.') => self.at + 1,
-            KeyCode::Char(',') => self.at.saturating_sub(1),
+            KeyCode::Char('.') => self.next_change(|_| true).unwrap_or(self.atoms.len()),
+            KeyCode::Char(',') => self.previous_change(|_| true).unwrap_or(0),
             KeyCode::Char('g') => 0,
             KeyCode::Char('G') => self.atoms.len(),
             KeyCode::Char(']') | KeyCode::Char('[') => {
-                match self.failure(key.code == KeyCode::Char(']')) {
+                let failed = |t: Transition| t.status == NodeStatus::Failure;
+                let found = if key.code == KeyCode::Char(']') {
+                    self.next_change(failed)
+                } else {
+                    self.previous_change(failed)
+                };
+                match found {
                     Some(at) => at,
                     None => {
                         self.screen
@@ -416,25 +420,30 @@ mod tests {
         let mut player = WatchPlayer::new(run_of("stepping"), true);
         assert_eq!(player.len(), 4, "one tree and three changes");
         assert!(player.screen.live.is_none(), "nothing before the tree");
-        let mut forward = Vec::new();
-        for _ in 0..=player.len() {
-            forward.push(statuses(&player));
+        let mut forward = vec![statuses(&player)];
+        while player.position() < player.len() {
             player.on_key(key('.'));
+            forward.push(statuses(&player));
         }
+        use NodeStatus::*;
+        assert_eq!(
+            forward,
+            [
+                vec![],
+                vec![Running, Idle, Idle],
+                vec![Running, Success, Idle],
+                vec![Running, Success, Failure]
+            ],
+            "one status change a step"
+        );
         let mut back = Vec::new();
-        for _ in 0..=player.len() {
+        while player.position() > 0 {
             player.on_key(key(','));
             back.push(statuses(&player));
         }
-        back.reverse();
-        assert_eq!(
-            forward[..forward.len() - 1],
-            back[1..],
-            "{forward:?} {back:?}"
-        );
-        use NodeStatus::*;
-        assert_eq!(forward[2], vec![Running, Idle, Idle]);
-        assert_eq!(forward[4], vec![Running, Success, Failure]);
+        forward.pop();
+        forward.reverse();
+        assert_eq!(back, forward);
         assert!(player.screen.live.is_none(), "back at the start");
     }
 

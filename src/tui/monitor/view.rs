@@ -143,17 +143,44 @@ fn draw_details(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         if node.ports.is_empty() {
             lines.push(Line::styled("no ports", screen.theme.dim));
         }
+        let board = screen
+            .blackboards
+            .iter()
+            .find(|b| b.name == node.blackboard);
         for (port, value) in &node.ports {
             let entry = value
                 .strip_prefix('{')
                 .and_then(|v| v.strip_suffix('}'))
-                .map(|name| format!("  (blackboard entry {})", printable(name)))
+                .map(|name| match board.and_then(|b| b.get(name)) {
+                    Some(now) => format!(
+                        "  (blackboard entry {}: {})",
+                        printable(name),
+                        printable(now)
+                    ),
+                    None => format!("  (blackboard entry {})", printable(name)),
+                })
                 .unwrap_or_default();
             lines.push(Line::raw(format!(
                 "{} = {}{entry}",
                 printable(port),
                 printable(value)
             )));
+        }
+        if let Some(board) = board {
+            lines.push(Line::styled(
+                format!("blackboard {}", printable(&board.name)),
+                screen.theme.title,
+            ));
+            if board.entries.is_empty() {
+                lines.push(Line::styled("no entries", screen.theme.dim));
+            }
+            for (key, value) in &board.entries {
+                lines.push(Line::raw(format!(
+                    "{} = {}",
+                    printable(key),
+                    printable(value)
+                )));
+            }
         }
     }
     let pane = Paragraph::new(lines)
