@@ -14,8 +14,10 @@
 //! goal, conditions and value replies of a language model), `tree` (betr's tree text and
 //! actions), `btcpp` (BehaviorTree.CPP XML over a scenario's domain), `scenario`
 //! (scenario TOML and the world it describes), `policy` (saved policies), `cassette`
-//! (LLM cassettes), `journal` (lines of an evaluation journal), `wav` (WAV files) and
-//! `recording` (session recordings and their decoding into events).
+//! (LLM cassettes), `journal` (lines of an evaluation journal), `wav` (WAV files),
+//! `recording` (session recordings and their decoding into events) and `groot2` (what a
+//! BehaviorTree.CPP publisher sends `betr monitor`: its tree, statuses, changes and
+//! blackboards).
 
 mod corpus;
 mod mutate;
@@ -43,6 +45,7 @@ pub const TARGETS: &[&str] = &[
     "journal",
     "wav",
     "recording",
+    "groot2",
 ];
 
 /// An input the target got wrong.

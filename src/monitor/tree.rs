@@ -206,18 +206,19 @@ impl WatchedTree {
         blackboard: String,
     ) -> Result<usize, TreeError> {
         let tag = element.tag_name().name().to_string();
-        let line = doc.text_pos_at(element.range().start).row;
+        // Found only for an error: finding a line scans the text up to the element.
+        let line = || doc.text_pos_at(element.range().start).row;
         let uid = element
             .attribute("_uid")
             .and_then(|u| u.parse::<u16>().ok())
             .ok_or_else(|| TreeError::Uid {
-                line,
+                line: line(),
                 element: tag.clone(),
             })?;
         let index = self.nodes.len();
         if self.by_uid.insert(uid, index).is_some() {
             return Err(TreeError::SameUid {
-                line,
+                line: line(),
                 element: tag,
                 uid,
             });

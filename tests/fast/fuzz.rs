@@ -83,6 +83,11 @@ fn recording() {
 }
 
 #[test]
+fn groot2() {
+    fuzz("groot2", 3_000);
+}
+
+#[test]
 fn every_saved_regression_input_passes() {
     let dir = support::repo::path("fuzz/regressions");
     let mut replayed = 0;

@@ -4,6 +4,7 @@
 mod btcpp;
 mod cassette;
 mod goal;
+mod groot2;
 mod journal;
 mod policy;
 mod recording;
@@ -31,6 +32,7 @@ pub(super) fn build(name: &str, corpus: &Corpus) -> Result<Box<dyn Target>, Fuzz
         "journal" => Box::new(journal::JournalTarget::new(corpus)),
         "wav" => Box::new(wav::WavTarget::new()),
         "recording" => Box::new(recording::RecordingTarget::new(corpus)),
+        "groot2" => Box::new(groot2::Groot2Target::new()),
         other => {
             return Err(FuzzError::UnknownTarget {
                 name: other.to_string(),
