@@ -32,6 +32,10 @@ pub struct MonitorArgs {
     /// Stop after this many seconds (a fraction allowed); without it, watch until stopped.
     #[arg(long = "for", value_name = "SECONDS", value_parser = seconds)]
     pub duration: Option<Duration>,
+    /// Show a BehaviorTree.CPP 4 tree file instead of watching: every node of any kind,
+    /// its SubTrees under their SubTree nodes, with its ports (nothing runs it).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["duration", "record"])]
+    pub file: Option<PathBuf>,
     /// Record the watched run to FILE (the tree as the publisher describes it, every
     /// status change, breakpoints), for `betr replay FILE`.
     #[arg(long, value_name = "FILE")]
@@ -48,6 +52,9 @@ fn seconds(text: &str) -> Result<Duration, String> {
 }
 
 pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
+    if let Some(file) = &args.file {
+        return show_file(file, args.print, ascii);
+    }
     let address = Address::parse(&args.address)?;
     use std::io::IsTerminal as _;
     if !args.print && !std::io::stdout().is_terminal() {
@@ -76,6 +83,41 @@ pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
     if let Some(file) = &args.record {
         errln!("Recorded to {}", file.display());
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// A tree file shown on the monitor's screen, or printed one node a line.
+fn show_file(file: &std::path::Path, print: bool, ascii: bool) -> Result<ExitCode> {
+    let text = betr::store::read_text(file, betr::monitor::tree::MAX_TREE_BYTES as u64)
+        .with_context(|| file.display().to_string())?;
+    let tree = betr::monitor::WatchedTree::parse_file(text.as_bytes())
+        .with_context(|| file.display().to_string())?;
+    if print {
+        outln!(
+            "# {}: tree {}, {} nodes",
+            file.display(),
+            printable(&tree.main),
+            tree.nodes.len()
+        );
+        for node in &tree.nodes {
+            outln!(
+                "{:<10} {}{}",
+                node.path,
+                "  ".repeat(node.depth),
+                tree.describe(node)
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    use std::io::IsTerminal as _;
+    if !std::io::stdout().is_terminal() {
+        bail!(
+            "standard output is not a terminal, and the monitor opens a screen; --print prints the tree as text"
+        );
+    }
+    let label = file.display().to_string();
+    let view = betr::tui::monitor::FileView::new(tree, &label, ascii);
+    betr::tui::monitor::look(view, super::tui_cmd::log_path().as_deref())?;
     Ok(ExitCode::SUCCESS)
 }
 

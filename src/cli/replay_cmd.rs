@@ -108,7 +108,7 @@ fn watched(run: WatchedRun, args: &ReplayArgs, ascii: bool) -> Result<ExitCode> 
         );
     }
     let player = betr::tui::monitor::WatchPlayer::at_first_tree(run, ascii);
-    betr::tui::monitor::replay(player, super::tui_cmd::log_path().as_deref())?;
+    betr::tui::monitor::look(player, super::tui_cmd::log_path().as_deref())?;
     Ok(ExitCode::SUCCESS)
 }
 

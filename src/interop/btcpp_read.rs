@@ -540,13 +540,39 @@ fn btcpp_builtin(id: &str) -> Option<&'static str> {
     })
 }
 
+/// What kind of node BehaviorTree.CPP 4 registers `id` as, for the node kinds it ships.
+pub fn btcpp_builtin_kind(id: &str) -> Option<BuiltinKind> {
+    Some(match id {
+        "Sequence" | "Fallback" | "ReactiveSequence" | "ReactiveFallback" => BuiltinKind::Control,
+        "Inverter" => BuiltinKind::Decorator,
+        "SubTree" => BuiltinKind::SubTree,
+        other => match btcpp_builtin(other)? {
+            "control node" => BuiltinKind::Control,
+            "decorator" => BuiltinKind::Decorator,
+            "condition" => BuiltinKind::Condition,
+            _ => BuiltinKind::Action,
+        },
+    })
+}
+
+/// The kinds of node BehaviorTree.CPP 4 ships.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuiltinKind {
+    Control,
+    Decorator,
+    Action,
+    Condition,
+    SubTree,
+}
+
 /// Why a BT.CPP built-in is not read, and what would show or run the tree.
 fn builtin_refusal(id: &str) -> String {
     format!(
         "{id} is a BehaviorTree.CPP {} that betr's engine does not run (it runs Sequence, \
          Fallback, their reactive forms, Inverter over a condition, and the scenario's \
          skills and conditions); nothing of the tree is changed or dropped, so it is not \
-         read; `betr monitor` shows it whole while it runs in BehaviorTree.CPP",
+         read; `betr monitor --file FILE` shows it whole, and `betr monitor` while it \
+         runs in BehaviorTree.CPP",
         btcpp_builtin(id).unwrap_or("node")
     )
 }

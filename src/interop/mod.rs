@@ -26,7 +26,7 @@ mod btcpp_write;
 mod dot;
 mod tree_file;
 
-pub use btcpp_read::{Imported, XmlError, from_btcpp};
+pub use btcpp_read::{BuiltinKind, Imported, XmlError, btcpp_builtin_kind, from_btcpp};
 pub use btcpp_write::{ExportError, to_btcpp};
 pub use dot::to_dot;
 pub use tree_file::{LoadedTree, TreeFileError, TreeFormat, load_tree_file, read_tree};

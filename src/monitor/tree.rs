@@ -37,6 +37,17 @@ impl NodeKind {
         })
     }
 
+    fn of_builtin(kind: crate::interop::BuiltinKind) -> NodeKind {
+        use crate::interop::BuiltinKind;
+        match kind {
+            BuiltinKind::Control => NodeKind::Control,
+            BuiltinKind::Decorator => NodeKind::Decorator,
+            BuiltinKind::Action => NodeKind::Action,
+            BuiltinKind::Condition => NodeKind::Condition,
+            BuiltinKind::SubTree => NodeKind::SubTree,
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             NodeKind::Action => "Action",
@@ -129,11 +140,50 @@ pub enum TreeError {
         element: String,
         uid: u16,
     },
+    #[error("main_tree_to_execute names {id:?}, but no <BehaviorTree> has that ID")]
+    NoMain { id: String },
+    #[error("line {line}: the SubTree {id:?} runs a tree that is already running it")]
+    Recursive { line: u32, id: String },
+    #[error("the tree has more than 65,535 nodes, as many as BehaviorTree.CPP numbers")]
+    TooMany,
+}
+
+/// How a description numbers its nodes and finds the tree a SubTree runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Layout {
+    /// As a Groot2 publisher sends it: each node's `_uid`, each SubTree instance as its
+    /// own `<BehaviorTree>` named by `_fullpath`, the main tree first.
+    Published,
+    /// As a person writes a tree file: nodes numbered in order from 1, a SubTree runs the
+    /// `<BehaviorTree>` of its `ID`, the main tree the one `main_tree_to_execute` names
+    /// (or the first).
+    Written,
+}
+
+/// One node waiting to be read: its element, parent, path, blackboard, and the trees
+/// the SubTrees above it run (a written tree that runs itself would never end).
+struct Pending<'a, 'input> {
+    element: roxmltree::Node<'a, 'input>,
+    parent: Option<usize>,
+    path: String,
+    board: String,
+    running: std::rc::Rc<Vec<String>>,
 }
 
 impl WatchedTree {
     /// Reads the publisher's description.
     pub fn parse(xml: &[u8]) -> Result<WatchedTree, TreeError> {
+        Self::read(xml, Layout::Published)
+    }
+
+    /// Reads a BehaviorTree.CPP 4 tree file as a person writes one: any node kind, its
+    /// SubTrees hung under their SubTree nodes, its nodes numbered in order. A tree read
+    /// this way is shown, not recorded (a recording holds a publisher's description).
+    pub fn parse_file(xml: &[u8]) -> Result<WatchedTree, TreeError> {
+        Self::read(xml, Layout::Written)
+    }
+
+    fn read(xml: &[u8], layout: Layout) -> Result<WatchedTree, TreeError> {
         if xml.len() > MAX_TREE_BYTES {
             return Err(TreeError::TooLarge { len: xml.len() });
         }
@@ -144,53 +194,89 @@ impl WatchedTree {
             .descendants()
             .filter(|n| n.has_tag_name("BehaviorTree"))
             .collect();
-        let main = trees.first().ok_or(TreeError::NoTree)?;
-        let instances: HashMap<&str, roxmltree::Node> = trees
-            .iter()
-            .skip(1)
-            .filter_map(|t| Some((t.attribute("_fullpath")?, *t)))
-            .collect();
+        let main = match (layout, doc.root_element().attribute("main_tree_to_execute")) {
+            (Layout::Written, Some(id)) => trees
+                .iter()
+                .find(|t| t.attribute("ID") == Some(id))
+                .ok_or_else(|| TreeError::NoMain { id: id.to_string() })?,
+            _ => trees.first().ok_or(TreeError::NoTree)?,
+        };
+        let instances: HashMap<&str, roxmltree::Node> = match layout {
+            Layout::Published => trees
+                .iter()
+                .skip(1)
+                .filter_map(|t| Some((t.attribute("_fullpath")?, *t)))
+                .collect(),
+            Layout::Written => trees
+                .iter()
+                .filter_map(|t| Some((t.attribute("ID")?, *t)))
+                .collect(),
+        };
         let root = main
             .children()
             .find(|n| n.is_element())
             .ok_or(TreeError::NoTree)?;
-        let main_board = blackboard_name(*main);
         let mut tree = WatchedTree {
             main: main.attribute("ID").unwrap_or_default().to_string(),
             nodes: Vec::new(),
             by_uid: HashMap::new(),
             xml: text.to_string(),
         };
-        // Depth first without recursion, so a deep description cannot exhaust the stack:
-        // (element, parent index, path, blackboard).
-        let mut stack = vec![(root, None::<usize>, "root".to_string(), main_board)];
-        while let Some((element, parent, path, board)) = stack.pop() {
-            let index = tree.add(&doc, element, &kinds, path.clone(), parent, board.clone())?;
-            let (children, board): (Vec<roxmltree::Node>, String) =
-                if tree.nodes[index].kind == NodeKind::SubTree || element.has_tag_name("SubTree") {
-                    let instance = element
+        // Depth first without recursion, so a deep description cannot exhaust the stack.
+        let mut stack = vec![Pending {
+            element: root,
+            parent: None,
+            path: "root".to_string(),
+            board: blackboard_name(*main),
+            running: std::rc::Rc::new(vec![tree.main.clone()]),
+        }];
+        while let Some(at) = stack.pop() {
+            let index = tree.add(&doc, &at, &kinds, layout)?;
+            let mut board = at.board;
+            let mut running = at.running;
+            let children: Vec<roxmltree::Node> = if tree.nodes[index].kind == NodeKind::SubTree {
+                let instance = match layout {
+                    Layout::Published => at
+                        .element
                         .attribute("_fullpath")
-                        .and_then(|p| instance_of(&instances, p));
-                    (
-                        instance
-                            .and_then(|t| t.children().find(|n| n.is_element()))
-                            .into_iter()
-                            .collect(),
-                        instance.map_or(board, blackboard_name),
-                    )
-                } else {
-                    (
-                        element.children().filter(|n| n.is_element()).collect(),
-                        board,
-                    )
+                        .and_then(|p| instance_of(&instances, p)),
+                    Layout::Written => {
+                        let id = at.element.attribute("ID").unwrap_or_default();
+                        if running.iter().any(|r| r == id) {
+                            return Err(TreeError::Recursive {
+                                line: doc.text_pos_at(at.element.range().start).row,
+                                id: id.to_string(),
+                            });
+                        }
+                        let mut deeper = (*running).clone();
+                        deeper.push(id.to_string());
+                        running = std::rc::Rc::new(deeper);
+                        instances.get(id).copied()
+                    }
                 };
+                if let Some(instance) = instance {
+                    board = blackboard_name(instance);
+                }
+                instance
+                    .and_then(|t| t.children().find(|n| n.is_element()))
+                    .into_iter()
+                    .collect()
+            } else {
+                at.element.children().filter(|n| n.is_element()).collect()
+            };
             for (i, child) in children.into_iter().enumerate().rev() {
-                let child_path = if path == "root" {
+                let path = if at.path == "root" {
                     i.to_string()
                 } else {
-                    format!("{path}.{i}")
+                    format!("{}.{i}", at.path)
                 };
-                stack.push((child, Some(index), child_path, board.clone()));
+                stack.push(Pending {
+                    element: child,
+                    parent: Some(index),
+                    path,
+                    board: board.clone(),
+                    running: running.clone(),
+                });
             }
         }
         Ok(tree)
@@ -199,23 +285,25 @@ impl WatchedTree {
     fn add(
         &mut self,
         doc: &roxmltree::Document,
-        element: roxmltree::Node,
+        at: &Pending,
         kinds: &HashMap<String, NodeKind>,
-        path: String,
-        parent: Option<usize>,
-        blackboard: String,
+        layout: Layout,
     ) -> Result<usize, TreeError> {
+        let element = at.element;
         let tag = element.tag_name().name().to_string();
         // Found only for an error: finding a line scans the text up to the element.
         let line = || doc.text_pos_at(element.range().start).row;
-        let uid = element
-            .attribute("_uid")
-            .and_then(|u| u.parse::<u16>().ok())
-            .ok_or_else(|| TreeError::Uid {
-                line: line(),
-                element: tag.clone(),
-            })?;
         let index = self.nodes.len();
+        let uid = match layout {
+            Layout::Published => element
+                .attribute("_uid")
+                .and_then(|u| u.parse::<u16>().ok())
+                .ok_or_else(|| TreeError::Uid {
+                    line: line(),
+                    element: tag.clone(),
+                })?,
+            Layout::Written => u16::try_from(index + 1).map_err(|_| TreeError::TooMany)?,
+        };
         if self.by_uid.insert(uid, index).is_some() {
             return Err(TreeError::SameUid {
                 line: line(),
@@ -223,11 +311,21 @@ impl WatchedTree {
                 uid,
             });
         }
-        let kind = kinds.get(&tag).copied().unwrap_or(if tag == "SubTree" {
-            NodeKind::SubTree
-        } else {
-            NodeKind::Unknown
-        });
+        // The explicit form names the kind by the element and the node by its ID
+        // (`<Action ID="Grasp"/>`); a SubTree's ID is the tree it runs.
+        let explicit = NodeKind::of_model_tag(&tag).filter(|k| *k != NodeKind::SubTree);
+        let id = match explicit {
+            Some(_) => element.attribute("ID").unwrap_or(&tag).to_string(),
+            None => tag.clone(),
+        };
+        let kind = explicit
+            .or_else(|| kinds.get(&id).copied())
+            .or_else(|| {
+                (layout == Layout::Written || id == "SubTree")
+                    .then(|| crate::interop::btcpp_builtin_kind(&id).map(NodeKind::of_builtin))
+                    .flatten()
+            })
+            .unwrap_or(NodeKind::Unknown);
         let name = element
             .attribute("name")
             .or_else(|| element.attribute("ID"))
@@ -236,23 +334,23 @@ impl WatchedTree {
         let ports = element
             .attributes()
             .filter(|a| !matches!(a.name(), "name" | "_uid" | "_fullpath"))
-            .filter(|a| !(kind == NodeKind::SubTree && a.name() == "ID"))
+            .filter(|a| !((kind == NodeKind::SubTree || explicit.is_some()) && a.name() == "ID"))
             .map(|a| (a.name().to_string(), a.value().to_string()))
             .collect();
-        let depth = parent.map_or(0, |p| self.nodes[p].depth + 1);
+        let depth = at.parent.map_or(0, |p| self.nodes[p].depth + 1);
         self.nodes.push(WatchedNode {
             uid,
             kind,
-            id: tag,
+            id,
             name,
             ports,
             children: Vec::new(),
-            parent,
-            path,
+            parent: at.parent,
+            path: at.path.clone(),
             depth,
-            blackboard,
+            blackboard: at.board.clone(),
         });
-        if let Some(p) = parent {
+        if let Some(p) = at.parent {
             self.nodes[p].children.push(index);
         }
         Ok(index)
@@ -397,6 +495,80 @@ mod tests {
             ]
         );
         assert_eq!(tree.blackboards(), ["MainTree", "walk"]);
+    }
+
+    /// A tree file with every node kind BT.CPP 4 ships, written as its documentation
+    /// writes trees (no uids, the explicit `<Action ID=…>` form, a SubTree with ports).
+    const EVERY_KIND: &str = include_str!("../../tests/fixtures/btcpp/every_kind.xml");
+
+    #[test]
+    fn a_written_tree_of_every_kind_is_read_whole() {
+        let tree = WatchedTree::parse_file(EVERY_KIND.as_bytes()).expect("reads");
+        assert_eq!(tree.main, "Main");
+        assert_eq!(
+            tree.nodes.len(),
+            55,
+            "every element, the SubTree's tree once"
+        );
+        let unknown: Vec<&str> = tree
+            .nodes
+            .iter()
+            .filter(|n| n.kind == NodeKind::Unknown)
+            .map(|n| n.id.as_str())
+            .collect();
+        assert!(unknown.is_empty(), "{unknown:?}");
+        let kind = |id: &str| tree.nodes.iter().find(|n| n.id == id).map(|n| n.kind);
+        assert_eq!(kind("Parallel"), Some(NodeKind::Control));
+        assert_eq!(kind("Timeout"), Some(NodeKind::Decorator));
+        assert_eq!(kind("ScriptCondition"), Some(NodeKind::Condition));
+        assert_eq!(kind("Script"), Some(NodeKind::Action));
+        assert_eq!(kind("Grasp"), Some(NodeKind::Action), "the explicit form");
+        assert_eq!(kind("Holding"), Some(NodeKind::Condition));
+        assert_eq!(kind("Place"), Some(NodeKind::Action), "from the model");
+        let sub = tree.nodes.iter().find(|n| n.id == "SubTree").unwrap();
+        assert_eq!(sub.name, "PickPlace");
+        assert_eq!(
+            sub.ports,
+            [
+                ("object".to_string(), "{target}".to_string()),
+                ("_autoremap".to_string(), "false".to_string())
+            ]
+        );
+        let under = &tree.nodes[sub.children[0]];
+        assert_eq!(
+            (under.id.as_str(), under.path.as_str()),
+            ("RetryUntilSuccessful", "2.0.1.0")
+        );
+        assert_eq!(under.blackboard, "PickPlace");
+        assert_eq!(tree.blackboards(), ["Main", "PickPlace"]);
+        for (i, node) in tree.nodes.iter().enumerate() {
+            assert_eq!(tree.index_of(node.uid), Some(i));
+        }
+    }
+
+    #[test]
+    fn a_written_tree_that_runs_itself_or_a_missing_main_is_refused() {
+        let looped = r#"<root BTCPP_format="4">
+  <BehaviorTree ID="Main">
+    <Sequence>
+      <SubTree ID="Main"/>
+    </Sequence>
+  </BehaviorTree>
+</root>"#;
+        let e = WatchedTree::parse_file(looped.as_bytes()).unwrap_err();
+        assert_eq!(
+            e,
+            TreeError::Recursive {
+                line: 4,
+                id: "Main".into()
+            }
+        );
+        let elsewhere = EVERY_KIND.replace(
+            "main_tree_to_execute=\"Main\"",
+            "main_tree_to_execute=\"Nope\"",
+        );
+        let e = WatchedTree::parse_file(elsewhere.as_bytes()).unwrap_err();
+        assert_eq!(e, TreeError::NoMain { id: "Nope".into() });
     }
 
     #[test]

@@ -252,6 +252,12 @@ fn each_refusal_names_the_file_the_line_and_the_element_with_exit_2() {
             "<Sequence>",
             "<Sequence> has memory",
         ),
+        (
+            "every_kind.xml",
+            8,
+            "<Script code=\"attempts := 0\"/>",
+            "Script is a BehaviorTree.CPP action that betr's engine does not run",
+        ),
     ];
     for (file, line, element, reason) in cases {
         let path = root().join("tests/fixtures/btcpp").join(file);
@@ -280,6 +286,48 @@ fn each_refusal_names_the_file_the_line_and_the_element_with_exit_2() {
             assert!(err.contains(reason), "{command} {file}: {err}");
         }
     }
+}
+
+/// A file of every node kind BT.CPP 4 ships, which betr refuses to run, is shown whole:
+/// one line per node, each with its kind and ports, the SubTree's tree under it.
+#[test]
+fn a_tree_file_of_every_kind_is_shown_whole() {
+    let dir = tmp("btcpp-shown");
+    let path = root().join("tests/fixtures/btcpp/every_kind.xml");
+    let out = betr(
+        &dir,
+        &["monitor", "--file", path.to_str().unwrap(), "--print"],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let printed = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = printed.lines().collect();
+    assert!(lines[0].ends_with("tree Main, 55 nodes"), "{printed}");
+    let elements = std::fs::read_to_string(&path)
+        .unwrap()
+        .matches("<AlwaysSuccess/>")
+        .count();
+    assert_eq!(
+        lines
+            .iter()
+            .filter(|l| l.trim_end().ends_with("AlwaysSuccess (Action)"))
+            .count(),
+        elements,
+        "{printed}"
+    );
+    for shown in [
+        "2.0.1            SubTree \"PickPlace\" object=\"{target}\" _autoremap=\"false\"",
+        "2.0.1.0            RetryUntilSuccessful (Decorator) num_attempts=\"3\"",
+        "Parallel (Control) success_count=\"1\" failure_count=\"1\"",
+        "Switch2 (Control) variable=\"{target}\" case_1=\"red cube\" case_2=\"blue cube\"",
+        "Precondition (Decorator) if=\"attempts < 3\" else=\"FAILURE\"",
+        "ScriptCondition (Condition) code=\"attempts < 3\"",
+        "Grasp (Action) object=\"{object}\"",
+    ] {
+        assert!(printed.contains(shown), "{shown:?} in:\n{printed}");
+    }
+    let out = betr(&dir, &["monitor", "--file", "missing.xml", "--print"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("missing.xml"));
 }
 
 /// Graphviz's `dot`, or `None` (a loud skip) when it is missing outside CI.

@@ -8,7 +8,7 @@
 mod replay;
 mod view;
 
-pub use replay::{WatchPlayer, run as replay};
+pub use replay::{FileView, Looking, WatchPlayer, run as look};
 pub use view::draw;
 
 use std::collections::{HashSet, VecDeque};
@@ -47,6 +47,17 @@ pub enum Connection {
     Lost(String),
 }
 
+/// What the screen is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// A publisher watched live: breakpoints can be set and released.
+    Live,
+    /// A recorded watch, stepped or played.
+    Replay,
+    /// A tree file: nothing runs it.
+    File,
+}
+
 /// What the screen shows and where the person is in it.
 pub struct MonitorScreen {
     address: Address,
@@ -77,8 +88,8 @@ pub struct MonitorScreen {
     said: Option<String>,
     /// The tree's blackboards as last read.
     blackboards: Vec<Blackboard>,
-    /// Breakpoints can be set and released (not in a replay).
-    controls: bool,
+    /// Watching live, replaying, or showing a file.
+    mode: Mode,
     /// In a replay: where it stands, said in the status bar instead of the connection.
     playback: Option<String>,
     /// Commands for the publisher, taken by the terminal loop.
@@ -108,7 +119,7 @@ impl MonitorScreen {
             stopped: None,
             said: None,
             blackboards: Vec::new(),
-            controls: true,
+            mode: Mode::Live,
             playback: None,
             outbox: Vec::new(),
             quit: false,
@@ -321,19 +332,19 @@ impl MonitorScreen {
                 self.find_next();
                 return;
             }
-            KeyCode::Char('b') if self.controls => {
+            KeyCode::Char('b') if self.mode == Mode::Live => {
                 self.toggle_breakpoint();
                 return;
             }
-            KeyCode::Char('c') if self.controls && self.stopped.is_some() => {
+            KeyCode::Char('c') if self.mode == Mode::Live && self.stopped.is_some() => {
                 self.release(None);
                 return;
             }
-            KeyCode::Char('s') if self.controls && self.stopped.is_some() => {
+            KeyCode::Char('s') if self.mode == Mode::Live && self.stopped.is_some() => {
                 self.release(Some(NodeStatus::Success));
                 return;
             }
-            KeyCode::Char('x') if self.controls && self.stopped.is_some() => {
+            KeyCode::Char('x') if self.mode == Mode::Live && self.stopped.is_some() => {
                 self.release(Some(NodeStatus::Failure));
                 return;
             }

@@ -94,7 +94,7 @@ impl WatchPlayer {
             .filter(|a| matches!(a, Atom::Change { .. }))
             .count();
         let mut screen = MonitorScreen::new(run.address.clone(), ascii);
-        screen.controls = false;
+        screen.mode = super::Mode::Replay;
         let mut player = WatchPlayer {
             run,
             atoms,
@@ -310,8 +310,72 @@ impl WatchPlayer {
     }
 }
 
-/// The replay on the terminal until the person quits.
-pub fn run(mut player: WatchPlayer, stderr_to: Option<&Path>) -> Result<(), TuiError> {
+/// A screen that only looks back: a watched run replayed, or a tree file shown.
+pub trait Looking {
+    fn screen(&mut self) -> &mut MonitorScreen;
+    fn on_key(&mut self, key: KeyEvent);
+    /// When something is next due without a key (a replay playing).
+    fn due(&self) -> Option<Instant>;
+    /// Applies what has come due.
+    fn play(&mut self);
+}
+
+impl Looking for WatchPlayer {
+    fn screen(&mut self) -> &mut MonitorScreen {
+        &mut self.screen
+    }
+    fn on_key(&mut self, key: KeyEvent) {
+        WatchPlayer::on_key(self, key);
+    }
+    fn due(&self) -> Option<Instant> {
+        WatchPlayer::due(self)
+    }
+    fn play(&mut self) {
+        WatchPlayer::play(self);
+    }
+}
+
+/// A tree file shown whole, every node idle: nothing runs it.
+pub struct FileView(pub MonitorScreen);
+
+impl FileView {
+    /// `tree`, read from `file`, on a screen with no connection.
+    pub fn new(tree: crate::monitor::WatchedTree, file: &str, ascii: bool) -> FileView {
+        let address = crate::monitor::Address {
+            host: String::new(),
+            port: 0,
+        };
+        let mut screen = MonitorScreen::new(address, ascii);
+        screen.mode = super::Mode::File;
+        let nodes = tree.nodes.len();
+        screen.live = Some(crate::monitor::LiveTree::new(tree, &[]));
+        screen.open_all();
+        screen.follow = false;
+        screen.select_index(0);
+        let dot = if ascii { " | " } else { " · " };
+        screen.playback = Some(format!(
+            " {}{dot}{nodes} nodes{dot}a file, not running",
+            crate::http_text::printable(file)
+        ));
+        FileView(screen)
+    }
+}
+
+impl Looking for FileView {
+    fn screen(&mut self) -> &mut MonitorScreen {
+        &mut self.0
+    }
+    fn on_key(&mut self, key: KeyEvent) {
+        self.0.on_key(key);
+    }
+    fn due(&self) -> Option<Instant> {
+        None
+    }
+    fn play(&mut self) {}
+}
+
+/// A looking screen on the terminal until the person quits.
+pub fn run(mut looking: impl Looking, stderr_to: Option<&Path>) -> Result<(), TuiError> {
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()?;
@@ -321,26 +385,26 @@ pub fn run(mut player: WatchPlayer, stderr_to: Option<&Path>) -> Result<(), TuiE
         let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         spawn_input_reader(keys, stop.clone());
         let result = loop {
-            if let Err(e) = terminal.draw(|f| view::draw(f, &mut player.screen)) {
+            if let Err(e) = terminal.draw(|f| view::draw(f, looking.screen())) {
                 break Err(TuiError::Terminal(e));
             }
             // Playing draws at most once a frame, however close the changes come.
-            let wake = player.due().map(|due| due.max(Instant::now() + FRAME));
+            let wake = looking.due().map(|due| due.max(Instant::now() + FRAME));
             let ended = tokio::select! {
                 input = input.recv() => match input {
                     Some(QueueEvent::Input(TermEvent::Key(key))) => {
-                        player.on_key(key);
+                        looking.on_key(key);
                         false
                     }
                     Some(QueueEvent::InputEnded) | None => true,
                     Some(_) => false,
                 },
                 () = super::sleep_until(wake) => {
-                    player.play();
+                    looking.play();
                     false
                 }
             };
-            if ended || player.screen.should_quit() {
+            if ended || looking.screen().should_quit() {
                 break Ok(());
             }
         };

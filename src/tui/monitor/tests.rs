@@ -219,3 +219,18 @@ fn breakpoint_keys_become_commands_for_the_publisher() {
     let text = drawn(&mut screen);
     assert!(!text.contains("stopped before"), "{text}");
 }
+
+/// A tree file of every BT.CPP node kind on the screen: whole, every node idle, the
+/// SubTree's tree under it, and the file's keys in the status bar.
+#[test]
+fn a_tree_file_is_shown_whole() {
+    let xml = include_str!("../../../tests/fixtures/btcpp/every_kind.xml");
+    let tree = crate::monitor::WatchedTree::parse_file(xml.as_bytes()).expect("reads");
+    let mut view = super::FileView::new(tree, "every_kind.xml", false);
+    insta::assert_snapshot!(drawn_at(&mut view.0, 120, 40));
+    // Breakpoint keys do nothing on a file.
+    view.0.on_key(crossterm::event::KeyEvent::from(
+        crossterm::event::KeyCode::Char('b'),
+    ));
+    assert!(view.0.take_commands().is_empty());
+}

@@ -11,7 +11,7 @@ use tui_tree_widget::{Tree as TreeWidget, TreeItem};
 use crate::http_text::printable;
 use crate::monitor::{LiveTree, NodeKind, NodeStatus};
 
-use super::{Connection, MonitorScreen};
+use super::{Connection, Mode, MonitorScreen};
 
 pub fn draw(frame: &mut Frame, screen: &mut MonitorScreen) {
     let [main, bar] =
@@ -239,7 +239,7 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
         Some(live.tree.describe(live.tree.by_uid(uid)?))
     });
     if let Some(node) = stopped {
-        let text = if screen.controls {
+        let text = if screen.mode == Mode::Live {
             format!(
                 " stopped before {node}{dot}c go on{dot}s succeed it{dot}x fail it{dot}b remove the breakpoint"
             )
@@ -271,10 +271,10 @@ fn draw_bar(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
     if let Some(query) = &screen.not_found {
         state.push_str(&format!("{dot}no node matches {:?}", printable(query)));
     }
-    let keys = if screen.playback.is_some() {
-        replay_keys(dot)
-    } else {
-        watch_keys(dot, ascii)
+    let keys = match screen.mode {
+        Mode::Live => watch_keys(dot, ascii),
+        Mode::Replay => replay_keys(dot),
+        Mode::File => file_keys(dot, ascii),
     };
     let width = usize::from(area.width);
     let text = match keys
@@ -334,6 +334,16 @@ fn watch_keys(dot: &str, ascii: bool) -> [String; 4] {
         ),
         format!("{dot}f follow{dot}/ find{dot}b breakpoint{dot}q quit"),
         format!("{dot}f follow{dot}q quit"),
+        format!("{dot}q quit"),
+    ]
+}
+
+fn file_keys(dot: &str, ascii: bool) -> [String; 4] {
+    let fold = if ascii { "h/l fold" } else { "←→ fold" };
+    [
+        format!("{dot}{fold}{dot}E/C open/close all{dot}/ find{dot}n next{dot}q quit"),
+        format!("{dot}{fold}{dot}/ find{dot}q quit"),
+        format!("{dot}/ find{dot}q quit"),
         format!("{dot}q quit"),
     ]
 }
