@@ -114,6 +114,41 @@ pub fn tidy(nodes: &[(Vec<usize>, usize)]) -> Vec<(f32, f32)> {
         .collect()
 }
 
+/// A tree's graph as the viewer draws it: each node's id, label and colour, at its
+/// position.
+pub struct Graph {
+    pub ids: Vec<String>,
+    pub labels: Vec<String>,
+    pub colours: Vec<Color>,
+    pub positions: Vec<(f32, f32)>,
+}
+
+impl Graph {
+    /// Logs the nodes and, when given, the edges (parent, child) between them.
+    pub fn log(
+        self,
+        rec: &RecordingStream,
+        edges: Option<Vec<(String, String)>>,
+    ) -> RecordingStreamResult<()> {
+        let positions: Vec<Position2D> = self
+            .positions
+            .into_iter()
+            .map(|(x, y)| Position2D::new(x, y))
+            .collect();
+        rec.log(
+            TREE_GRAPH,
+            &GraphNodes::new(self.ids)
+                .with_labels(self.labels)
+                .with_colors(self.colours)
+                .with_positions(positions),
+        )?;
+        if let Some(pairs) = edges {
+            rec.log(TREE_GRAPH, &GraphEdges::new(pairs).with_directed_edges())?;
+        }
+        Ok(())
+    }
+}
+
 /// Log the nodes (with colours and marks from `record`, grey without) at their tidy
 /// positions and, when `edges` is true, the edges, plus the text rendering.
 pub fn log_tree(
@@ -140,19 +175,8 @@ pub fn log_tree(
             Color::from_rgb(r, g, b)
         })
         .collect();
-    let positions: Vec<Position2D> = tidy_positions(tree, &order)
-        .into_iter()
-        .map(|(x, y)| Position2D::new(x, y))
-        .collect();
-    rec.log(
-        TREE_GRAPH,
-        &GraphNodes::new(ids)
-            .with_labels(labels)
-            .with_colors(colours)
-            .with_positions(positions),
-    )?;
-    if edges {
-        let pairs: Vec<(String, String)> = order
+    let edges = edges.then(|| {
+        order
             .iter()
             .flat_map(|n| {
                 tree.children(*n)
@@ -161,9 +185,15 @@ pub fn log_tree(
                     .map(|c| (n.0.to_string(), c.0.to_string()))
                     .collect::<Vec<_>>()
             })
-            .collect();
-        rec.log(TREE_GRAPH, &GraphEdges::new(pairs).with_directed_edges())?;
-    }
+            .collect()
+    });
+    let graph = Graph {
+        ids,
+        labels,
+        colours,
+        positions: tidy_positions(tree, &order),
+    };
+    graph.log(rec, edges)?;
     let text = bt::render(tree, record, &VIEWER_GLYPHS).join("\n");
     rec.log(TREE_TEXT, &TextDocument::new(text))?;
     Ok(())

@@ -13,15 +13,15 @@ use rerun::blueprint::{
     Blueprint, BlueprintPanel, SelectionPanel, TextDocumentView, TextLogView, TimePanel, Vertical,
 };
 use rerun::{
-    Color, GraphEdges, GraphNodes, Position2D, RecordingStream, RecordingStreamBuilder,
-    RecordingStreamResult, TextDocument, TextLog, TextLogLevel,
+    Color, RecordingStream, RecordingStreamBuilder, RecordingStreamResult, TextDocument, TextLog,
+    TextLogLevel,
 };
 
 use crate::http_text::printable;
 use crate::monitor::{LiveTree, WatchEvent, WatchedTree, missed_some};
 
 use super::blueprint::{VIEW_GRAPH, VIEW_LOG, VIEW_TEXT, still_graph};
-use super::tree::{TREE_GRAPH, TREE_TEXT, VIEWER_GLYPHS, status_colour, tidy};
+use super::tree::{Graph, TREE_GRAPH, TREE_TEXT, VIEWER_GLYPHS, status_colour, tidy};
 use super::{APP_ID, EVENTS, VizError};
 
 /// The timeline of a watched run: seconds since the watch began.
@@ -220,29 +220,23 @@ fn log_tree(rec: &RecordingStream, live: &LiveTree, edges: bool) -> RecordingStr
         .iter()
         .map(|n| (n.children.clone(), label(tree, n).chars().count()))
         .collect();
-    let positions: Vec<Position2D> = tidy(&layout)
-        .into_iter()
-        .map(|(x, y)| Position2D::new(x, y))
-        .collect();
-    rec.log(
-        TREE_GRAPH,
-        &GraphNodes::new(ids)
-            .with_labels(labels)
-            .with_colors(colours)
-            .with_positions(positions),
-    )?;
-    if edges {
-        let pairs: Vec<(String, String)> = tree
-            .nodes
+    let edges = edges.then(|| {
+        tree.nodes
             .iter()
             .flat_map(|n| {
                 n.children
                     .iter()
                     .map(move |&c| (n.uid.to_string(), tree.nodes[c].uid.to_string()))
             })
-            .collect();
-        rec.log(TREE_GRAPH, &GraphEdges::new(pairs).with_directed_edges())?;
-    }
+            .collect()
+    });
+    let graph = Graph {
+        ids,
+        labels,
+        colours,
+        positions: tidy(&layout),
+    };
+    graph.log(rec, edges)?;
     rec.log(TREE_TEXT, &TextDocument::new(text(live)))
 }
 
