@@ -50,6 +50,15 @@ pub fn export(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
         || (!source.exists() && super::find_scenario(source).is_ok());
+    let drawn_as_written = !is_scenario
+        && format == Format::Dot
+        && scenario_arg.is_none()
+        && source
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+    if drawn_as_written {
+        return draw_as_written(source, out);
+    }
     let (scenario_path, tree, new_nodes) = if is_scenario {
         let path = super::find_scenario(source)?;
         let scenario = load(&path)?;
@@ -105,6 +114,21 @@ pub fn export(
             interop::to_dot(&tree, run.last.as_deref(), &new_nodes, &name)
         }
     };
+    write_out(&text, out)
+}
+
+/// A BehaviorTree.CPP file drawn as written, whatever its node kinds (nothing runs it, so
+/// nothing colours it).
+fn draw_as_written(source: &Path, out: Option<&Path>) -> Result<ExitCode> {
+    let text = betr::store::read_text(source, betr::monitor::tree::MAX_TREE_BYTES as u64)
+        .with_context(|| format!("reading tree file {}", source.display()))?;
+    let tree = betr::monitor::WatchedTree::parse_file(text.as_bytes())
+        .with_context(|| source.display().to_string())?;
+    write_out(&tree.to_dot(&tree.main), out)
+}
+
+/// `text` into `out` (whole or not at all), or on standard output.
+fn write_out(text: &str, out: Option<&Path>) -> Result<ExitCode> {
     match out {
         Some(path) => {
             betr::store::write_atomic(path, text.as_bytes())

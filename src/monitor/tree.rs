@@ -356,6 +356,36 @@ impl WatchedTree {
         Ok(index)
     }
 
+    /// The tree as a Graphviz digraph named `name`, drawn as written: controls as boxes,
+    /// decorators as rounded boxes, SubTrees as folders, conditions as ellipses, actions
+    /// as boxes, each labelled with its ID, name, kind and ports.
+    pub fn to_dot(&self, name: &str) -> String {
+        let mut out = format!("digraph {name:?} {{\n  ordering=out;\n");
+        out.push_str(
+            "  node [fontname=\"DejaVu Sans\", fontsize=11, color=\"#555555\"];\n  edge [color=\"#777777\", arrowsize=0.6];\n",
+        );
+        for node in &self.nodes {
+            let shape = match node.kind {
+                NodeKind::Condition => "shape=ellipse",
+                NodeKind::Decorator => "shape=box, style=rounded",
+                NodeKind::SubTree => "shape=folder",
+                NodeKind::Control | NodeKind::Action | NodeKind::Unknown => "shape=box",
+            };
+            out.push_str(&format!(
+                "  n{} [label={:?}, {shape}];\n",
+                node.uid,
+                self.describe(node)
+            ));
+        }
+        for node in &self.nodes {
+            for &child in &node.children {
+                out.push_str(&format!("  n{} -> n{};\n", node.uid, self.nodes[child].uid));
+            }
+        }
+        out.push_str("}\n");
+        out
+    }
+
     /// The names of the tree's blackboards, the main tree's first.
     pub fn blackboards(&self) -> Vec<&str> {
         let mut names: Vec<&str> = Vec::new();
@@ -544,6 +574,26 @@ mod tests {
         for (i, node) in tree.nodes.iter().enumerate() {
             assert_eq!(tree.index_of(node.uid), Some(i));
         }
+    }
+
+    #[test]
+    fn a_written_tree_is_drawn_whole() {
+        let tree = WatchedTree::parse_file(EVERY_KIND.as_bytes()).expect("reads");
+        let dot = tree.to_dot("every kind");
+        assert!(dot.starts_with("digraph \"every kind\" {"), "{dot}");
+        assert_eq!(dot.matches(" [label=").count(), 55);
+        assert_eq!(
+            dot.matches(" -> ").count(),
+            54,
+            "every node but the root has a parent"
+        );
+        assert!(
+            dot.contains(r#"[label="SubTree \"PickPlace\" object=\"{target}\" _autoremap=\"false\"", shape=folder]"#),
+            "{dot}"
+        );
+        assert!(dot.contains(
+            r#"label="ScriptCondition (Condition) code=\"attempts < 3\"", shape=ellipse"#
+        ));
     }
 
     #[test]

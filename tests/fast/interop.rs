@@ -325,6 +325,21 @@ fn a_tree_file_of_every_kind_is_shown_whole() {
     ] {
         assert!(printed.contains(shown), "{shown:?} in:\n{printed}");
     }
+    // Drawn as written for Graphviz, with no scenario.
+    let out = betr(
+        &dir,
+        &[
+            "export",
+            path.to_str().unwrap(),
+            "--format",
+            "dot",
+            "--out",
+            "every.dot",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    let dot = std::fs::read_to_string(dir.join("every.dot")).unwrap();
+    assert_eq!(dot.matches(" [label=").count(), 55, "{dot}");
     let out = betr(&dir, &["monitor", "--file", "missing.xml", "--print"]);
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(String::from_utf8_lossy(&out.stderr).contains("missing.xml"));
