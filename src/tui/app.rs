@@ -403,6 +403,7 @@ impl App {
             Action::SearchNext => return self.search(true),
             Action::SearchPrevious => return self.search(false),
             Action::CollapseAll => return self.tree.collapse_all(),
+            Action::ExpandAll => return self.tree.expand_all(),
             Action::ScrollLeft => return self.tree.scroll_left(),
             Action::ScrollRight => return self.tree.scroll_right(),
             Action::FocusNext => {

@@ -47,8 +47,9 @@ pub enum Action {
     Search,
     SearchNext,
     SearchPrevious,
-    /// Close every node; open the way to the running node only.
+    /// Close every node; open every node; open the way to the running node only.
     CollapseAll,
+    ExpandAll,
     ExpandToRunning,
     /// Scroll the tree sideways, for long labels deep in it.
     ScrollLeft,
@@ -336,6 +337,7 @@ bindings! {
     search_next: SearchNext = Key::plain('>'), Workbench;
     search_previous: SearchPrevious = Key::plain('<'), Workbench;
     collapse_all: CollapseAll = Key::plain('C'), Both;
+    expand_all: ExpandAll = Key::plain('+'), Both;
     expand_to_running: ExpandToRunning = Key::plain('E'), Both;
     scroll_left: ScrollLeft = Key::plain('H'), Both;
     scroll_right: ScrollRight = Key::plain('L'), Both;
@@ -457,8 +459,8 @@ mod tests {
             text,
             [
                 "space", "r", "p", "i", "d", "a", "x", "esc", "e", "u", "v", "s", "l", "o", "m",
-                "M", "n", "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "E", "H", "L",
-                "tab", "{", "}", "W", "[", "]", "?", "q"
+                "M", "n", "g", "w", "b", "f", "B", "D", "F", "/", ">", "<", "C", "+", "E", "H",
+                "L", "tab", "{", "}", "W", "[", "]", "?", "q"
             ]
         );
         assert_eq!(
@@ -514,8 +516,8 @@ mod tests {
         assert_eq!(
             text,
             [
-                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "E", "H", "L",
-                "tab", "{", "}", "[", "]", "?", "q"
+                "→", "←", ".", ",", "n", "N", "m", "M", "g", "G", "D", "F", "C", "+", "E", "H",
+                "L", "tab", "{", "}", "[", "]", "?", "q"
             ]
         );
         let right = KeyEvent::new(KeyCode::Right, KeyModifiers::NONE);

@@ -311,6 +311,7 @@ pub fn action_help(action: super::keys::Action) -> &'static str {
         SearchNext => "the next match of the search",
         SearchPrevious => "the previous match of the search",
         CollapseAll => "collapse every node",
+        ExpandAll => "expand every node",
         ExpandToRunning => "collapse all but the way to the running node",
         ScrollLeft => "scroll the tree left (long labels)",
         ScrollRight => "scroll the tree right (long labels)",

@@ -3,6 +3,7 @@
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Position, Rect};
+use ratatui::style::Modifier;
 use ratatui::text::{Line, Span};
 use tui_tree_widget::TreeItem;
 
@@ -31,19 +32,32 @@ pub(super) fn composite_paths(tree: &Tree) -> Vec<Vec<u32>> {
     out
 }
 
-/// The widget's items for `tree`, children before parents (no recursion).
+/// The widget's items for `tree`, children before parents (no recursion); every label
+/// holding `query` (any case) is underlined.
 pub(super) fn build_items(
     tree: &Tree,
     record: Option<&TickRecord>,
     marks: &Marks,
+    query: Option<&str>,
     theme: &Theme,
     widths: &mut [usize],
 ) -> TreeItem<'static, u32> {
+    let query = query.map(str::to_lowercase);
     let mut built: Vec<Option<TreeItem<'static, u32>>> = vec![None; tree.capacity()];
     let order = tree.preorder();
     for &node in order.iter().rev() {
         let status = record.map_or(Status::Idle, |r| r.status(node));
-        let line = decorated_line(tree, node, status, marks, theme);
+        let mut line = decorated_line(tree, node, status, marks, theme);
+        if let Some(query) = &query
+            && node_label(tree, node, theme)
+                .to_lowercase()
+                .contains(query.as_str())
+            && let Some(label) = line.spans.get_mut(2)
+        {
+            label.style = label
+                .style
+                .add_modifier(Modifier::UNDERLINED | Modifier::BOLD);
+        }
         if let Some(w) = widths.get_mut(node.index()) {
             *w = line.width();
         }

@@ -147,11 +147,22 @@ impl TreePane {
         }
     }
 
+    /// Open every node.
+    pub fn expand_all(&mut self) {
+        if let Some(tree) = &self.tree {
+            for path in composite_paths(tree) {
+                self.state.open(path);
+            }
+        }
+    }
+
     /// Select the next (or previous) node whose label holds `query` (any case), after
     /// the selected one in the tree's order, wrapping; its ancestors are opened.
     pub fn search(&mut self, query: &str, forward: bool, theme: &Theme) -> Option<Found> {
         let tree = self.tree.clone()?;
         let query = query.to_lowercase();
+        // Every match is marked at the next drawing.
+        self.dirty = true;
         let order = tree.preorder();
         let matches: Vec<NodeId> = order
             .iter()
@@ -395,6 +406,7 @@ impl TreePane {
                 tree,
                 self.record.as_deref(),
                 &self.marks,
+                self.query.as_deref(),
                 theme,
                 &mut self.widths,
             )],
@@ -488,6 +500,7 @@ mod tests {
     use crate::domain::{ActionCall, Condition};
     use ratatui::Terminal;
     use ratatui::backend::TestBackend;
+    use ratatui::style::Modifier;
 
     /// A tree of `n` nodes: a fallback of sequences, each a condition and an action.
     fn big(n: usize) -> Tree {
@@ -542,6 +555,35 @@ mod tests {
         pane.follow = true;
         terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
         insta::assert_snapshot!("searched_300_nodes_80x24", terminal.backend().to_string());
+    }
+
+    /// Every row whose label holds the search is underlined, not only the selected one;
+    /// `+` opens again what `C` closed.
+    #[test]
+    fn every_match_is_marked_and_expand_all_opens_everything() {
+        let tree = Arc::new(big(40));
+        let theme = Theme::default();
+        let mut pane = TreePane::default();
+        pane.set_tree(tree.clone(), Vec::new(), Vec::new());
+        pane.collapse_all();
+        pane.expand_all();
+        pane.query = Some("THING 1".into());
+        pane.search("THING 1", true, &theme).unwrap();
+        let mut terminal = Terminal::new(TestBackend::new(60, 45)).unwrap();
+        terminal.draw(|f| pane.draw(f, f.area(), &theme)).unwrap();
+        let buffer = terminal.backend().buffer().clone();
+        let mut marked = 0;
+        for y in 1..buffer.area.height - 1 {
+            let row: String = (0..buffer.area.width)
+                .map(|x| buffer[(x, y)].symbol().to_string())
+                .collect();
+            let underlined = (0..buffer.area.width)
+                .any(|x| buffer[(x, y)].modifier.contains(Modifier::UNDERLINED));
+            assert_eq!(row.contains("\"thing 1"), underlined, "row {y}: {row}");
+            marked += usize::from(underlined);
+        }
+        // Actions 1, 10, 13, 16, 19 (numbered 1, 4, 7, …): all open, all marked.
+        assert_eq!(marked, 5);
     }
 
     /// The new-node colour marks the rows of new nodes only.
