@@ -161,6 +161,7 @@ fn workbench(replay: Replay, args: &ReplayArgs, ascii: bool) -> Result<ExitCode>
 fn to_rrd(replay: &Replay, out: &Path) -> Result<ExitCode> {
     let mut viz = Viz::open(&Sinks {
         rrd: Some(out.to_path_buf()),
+        no_scene: replay.scenario.world_kind != "cell",
         ..Sinks::default()
     })?
     .context("--to-rrd: no recording was opened")?;

@@ -325,7 +325,7 @@ fn resolve(
     llm.model.set_purpose("resolve");
     let mut viz = args
         .viz
-        .open(false, betr::viz::ViewerLife::OutlivesCommand)?;
+        .open(false, betr::viz::ViewerLife::OutlivesCommand, scenario)?;
     let mut record = args.viz.recorder(scenario, args.scenario_path, None)?;
     outln!("Scenario:    {}", scenario.name);
     if let Some(i) = args.instruction.or(scenario.instruction.as_deref()) {

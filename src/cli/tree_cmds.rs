@@ -165,7 +165,7 @@ fn run(scenario: &Scenario, args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode>
             run_ticks: args.max_ticks,
             ..RunLimits::DEFAULT
         },
-        viz: viz.open(false, betr::viz::ViewerLife::OutlivesCommand)?,
+        viz: viz.open(false, betr::viz::ViewerLife::OutlivesCommand, scenario)?,
         record: viz.recorder(scenario, &scenario_file(scenario), variant)?,
         ..Start::new(scenario)
     };
@@ -301,7 +301,7 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
     let start = Start {
         scenario_path: Some(scenario_path),
         variant,
-        viz: viz.open(false, betr::viz::ViewerLife::OutlivesCommand)?,
+        viz: viz.open(false, betr::viz::ViewerLife::OutlivesCommand, scenario)?,
         record: viz.recorder(scenario, scenario_path, variant)?,
         ..Start::new(scenario)
     };

@@ -141,6 +141,9 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let record = args
         .viz
         .recorder(&scenario, &path, args.variant.as_deref())?;
+    let viz = args
+        .viz
+        .open(true, betr::viz::ViewerLife::StopsWithSession, &scenario)?;
     // A person is there to choose among readings that make the robot do different things.
     let options = betr::session::Options {
         choose_reading: true,
@@ -158,12 +161,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         ..Setup::new(scenario, path, model)
     };
     // The status bar says it when a viewer is not there or the recording stopped.
-    let mut tap = super::viz_flags::SessionTap {
-        viz: args
-            .viz
-            .open(true, betr::viz::ViewerLife::StopsWithSession)?,
-        record,
-    };
+    let mut tap = super::viz_flags::SessionTap { viz, record };
     let theme = Theme::new(if ascii {
         &betr::bt::ASCII
     } else {

@@ -36,17 +36,23 @@ pub struct VizFlags {
 }
 
 impl VizFlags {
-    /// The viz the flags ask for; a viewer that is not there is said once on stderr
+    /// The viz the flags ask for, laid out for `scenario`'s world; a viewer that is not there is said once on stderr
     /// (`quiet`: not said, the caller shows `Viz::notice` itself). A web viewer's address
     /// is always printed, before any workbench takes the screen, with the ports it moved
     /// to when the usual ones were taken; one that outlives the command is left running
     /// and its process said.
-    pub fn open(&self, quiet: bool, web_viewer: ViewerLife) -> Result<Option<Viz>> {
+    pub fn open(
+        &self,
+        quiet: bool,
+        web_viewer: ViewerLife,
+        scenario: &Scenario,
+    ) -> Result<Option<Viz>> {
         let mut viz = Viz::open(&Sinks {
             viewer: self.viewer.clone(),
             rrd: self.rrd.clone(),
             web_viewer,
             meshes: self.robot_meshes,
+            no_scene: scenario.world_kind != "cell",
         })?;
         if let Some(moved) = viz.as_ref().and_then(Viz::web_moved) {
             errln!("3D view: {moved}");

@@ -1,6 +1,7 @@
 //! The layout the viewer opens with: the cell in 3D taking most of the window, the tree
 //! beside it (the graph over its text), the event log below, and the time panel on the
-//! session's `step` timeline. Sent with every recording as the active and the default
+//! session's `step` timeline; with no cell to draw (a symbolic world, a watched
+//! BT.CPP process), the tree beside the log. Sent with every recording as the active and the default
 //! blueprint: a viewer shows it at once, and resetting a rearranged layout comes back
 //! to it.
 
@@ -24,6 +25,28 @@ pub const VIEW_3D: &str = "cell";
 pub const VIEW_GRAPH: &str = "tree";
 pub const VIEW_TEXT: &str = "tree (text)";
 pub const VIEW_LOG: &str = "events";
+
+/// The layout of a tree with no cell to draw (a symbolic world, a watched BT.CPP process):
+/// the tree (the graph over its text) beside the event log, the time panel on `timeline`.
+pub fn tree_and_log(timeline: &str) -> Blueprint {
+    let tree = Vertical::new([
+        still_graph(VIEW_GRAPH).with_origin(TREE_GRAPH).into(),
+        TextDocumentView::new(VIEW_TEXT)
+            .with_origin(TREE_TEXT)
+            .into(),
+    ])
+    .with_row_shares(vec![3.0, 2.0]);
+    let root = Horizontal::new([
+        tree.into(),
+        TextLogView::new(VIEW_LOG).with_origin(EVENTS).into(),
+    ])
+    .with_column_shares(vec![3.0, 2.0]);
+    Blueprint::new(root)
+        .with_auto_views(false)
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(TimePanel::new().with_timeline(timeline))
+}
 
 /// A graph view with every force off: the nodes stay where betr's tidy layout puts them.
 pub fn still_graph(name: &str) -> GraphView {

@@ -98,6 +98,9 @@ pub struct Sinks {
     pub web_viewer: ViewerLife,
     /// Which of the robot's meshes are drawn.
     pub meshes: RobotMeshes,
+    /// The session has no cell to draw (a symbolic world): the layout leaves the 3D view
+    /// out rather than show it empty.
+    pub no_scene: bool,
 }
 
 impl Sinks {
@@ -241,8 +244,12 @@ impl Viz {
                 Err(e) => notice = Some(format!("{NOT_CONNECTED} ({url}: {e})")),
             }
         }
-        let builder =
-            RecordingStreamBuilder::new(APP_ID).with_blueprint(blueprint::default_blueprint());
+        let layout = if sinks.no_scene {
+            blueprint::tree_and_log(STEPS)
+        } else {
+            blueprint::default_blueprint()
+        };
+        let builder = RecordingStreamBuilder::new(APP_ID).with_blueprint(layout);
         let rec = if out.is_empty() {
             RecordingStream::disabled()
         } else {

@@ -8,10 +8,6 @@
 use std::path::Path;
 use std::time::Duration;
 
-use rerun::blueprint::components::PanelState;
-use rerun::blueprint::{
-    Blueprint, BlueprintPanel, SelectionPanel, TextDocumentView, TextLogView, TimePanel, Vertical,
-};
 use rerun::{
     Color, RecordingStream, RecordingStreamBuilder, RecordingStreamResult, TextDocument, TextLog,
     TextLogLevel,
@@ -20,8 +16,8 @@ use rerun::{
 use crate::http_text::printable;
 use crate::monitor::{LiveTree, WatchEvent, WatchedTree, missed_some};
 
-use super::blueprint::{VIEW_GRAPH, VIEW_LOG, VIEW_TEXT, still_graph};
-use super::tree::{Graph, TREE_GRAPH, TREE_TEXT, VIEWER_GLYPHS, status_colour, tidy};
+use super::blueprint::tree_and_log;
+use super::tree::{Graph, TREE_TEXT, VIEWER_GLYPHS, status_colour, tidy};
 use super::{APP_ID, EVENTS, VizError};
 
 /// The timeline of a watched run: seconds since the watch began.
@@ -37,7 +33,7 @@ pub fn write<'a>(
         message: e.to_string(),
     })?;
     let rec = RecordingStreamBuilder::new(APP_ID)
-        .with_blueprint(blueprint())
+        .with_blueprint(tree_and_log(WATCH))
         .set_sinks((sink,))?;
     let mut writer = Writer {
         rec: &rec,
@@ -60,27 +56,6 @@ pub fn write<'a>(
         message: e.to_string(),
     })?;
     Ok(writer.changes)
-}
-
-/// The tree (graph over text) beside the event log, on the `watch` timeline.
-fn blueprint() -> Blueprint {
-    let tree = Vertical::new([
-        still_graph(VIEW_GRAPH).with_origin(TREE_GRAPH).into(),
-        TextDocumentView::new(VIEW_TEXT)
-            .with_origin(TREE_TEXT)
-            .into(),
-    ])
-    .with_row_shares(vec![3.0, 2.0]);
-    let root = rerun::blueprint::Horizontal::new([
-        tree.into(),
-        TextLogView::new(VIEW_LOG).with_origin(EVENTS).into(),
-    ])
-    .with_column_shares(vec![3.0, 2.0]);
-    Blueprint::new(root)
-        .with_auto_views(false)
-        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
-        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
-        .with_time_panel(TimePanel::new().with_timeline(WATCH))
 }
 
 struct Writer<'r> {

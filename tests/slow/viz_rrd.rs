@@ -95,6 +95,54 @@ fn scenario1_recording_verifies_and_lists_the_entities() {
     }
 }
 
+/// The views of a recording's layout (its blueprint's distinct `/view/…` entities).
+fn views(rrd: &Path) -> usize {
+    let print = rerun_rrd(&["print".as_ref(), "-v".as_ref(), rrd.as_os_str()]);
+    assert!(
+        print.status.success(),
+        "{}",
+        String::from_utf8_lossy(&print.stderr)
+    );
+    let listing = String::from_utf8_lossy(&print.stdout);
+    let mut views: Vec<&str> = listing
+        .match_indices("/view/")
+        .filter_map(|(at, _)| listing.get(at..at + "/view/".len() + 36))
+        .collect();
+    views.sort_unstable();
+    views.dedup();
+    views.len()
+}
+
+/// A session with a cell opens on the 3D view beside the tree and the log; one with no
+/// cell to draw (the cafe's symbolic world) leaves the empty 3D view out.
+#[test]
+fn a_world_with_no_cell_has_no_3d_view() {
+    let (cell, _) = repaired_scenario1("viz_rrd_views", "scenario1.rrd");
+    assert_eq!(
+        views(&cell),
+        4,
+        "the cell, the tree graph, its text, the log"
+    );
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("viz_rrd_views");
+    let cafe = dir.join("cafe.rrd");
+    // The run fails in the world (no coffee), as the scenario is written to.
+    let out = support::repo::betr(&[
+        "run",
+        "scenarios/cafe/no_coffee.toml",
+        "--rrd",
+        &cafe.to_string_lossy(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (ok, said) = verified(&cafe);
+    assert!(ok, "{said}");
+    assert_eq!(views(&cafe), 3, "the tree graph, its text, the log");
+}
+
 /// The YuMi's description in the cache, fetched on first use like the robot's own tests.
 fn description() {
     use betr::model::{Pip, Progress, YUMI_DESCRIPTION, cache_dir, ensure_description};
