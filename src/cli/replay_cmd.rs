@@ -12,8 +12,8 @@ use anyhow::{Context as _, Result, bail};
 
 use betr::record::{Replay, Resimulation, Source, Step, WatchedRun};
 use betr::session::Event;
+use betr::tui::Theme;
 use betr::tui::replay::{Player, ReplayScreen};
-use betr::tui::{KeyBindings, Theme};
 use betr::viz::{Sinks, Viz};
 
 /// What `betr replay` is asked.
@@ -131,20 +131,8 @@ fn workbench(replay: Replay, args: &ReplayArgs, ascii: bool) -> Result<ExitCode>
             args.file.display()
         );
     }
-    let var = |k: &str| std::env::var(k).ok();
-    let keys_path = args
-        .keys
-        .clone()
-        .or_else(|| super::tui_cmd::default_keys_path(&var));
-    let (keys, keys_error) = match &keys_path {
-        Some(p) => KeyBindings::load(p),
-        None => (KeyBindings::default(), None),
-    };
-    let theme = Theme::new(if ascii {
-        &betr::bt::ASCII
-    } else {
-        &betr::bt::UNICODE
-    });
+    let (keys, keys_error) = super::tui_cmd::key_bindings(args.keys.as_deref());
+    let theme = Theme::of(ascii);
     let cut = replay.cut_at;
     let player = Player::of(replay, keys, theme);
     let mut screen = ReplayScreen::open(player, usize::MAX);

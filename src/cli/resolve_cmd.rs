@@ -297,26 +297,7 @@ fn resolve(
     {
         submitted::read(scenario, text)?;
     }
-    // Where the work will be kept, checked before any of it is done: --save, else the
-    // policy directory the workbench and --learn use.
-    let policy_dir = match args.save {
-        Some(_) => None,
-        None => Some(args.policies.dir().context(
-            "no policy directory to keep the tree in: pass --policy-dir or --save (neither XDG_DATA_HOME nor HOME is set)",
-        )?),
-    };
-    let save_to = match (args.save, &policy_dir) {
-        (Some(path), _) => path.to_path_buf(),
-        (None, Some(dir)) => dir.join(format!("{}.bt", stem(args.scenario_path))),
-        (None, None) => PathBuf::new(),
-    };
-    betr::store::check_writable(&save_to)
-        .with_context(|| format!("the tree is to be saved to {}", save_to.display()))?;
-    if let Some(dir) = args.learn
-        && let Some(path) = dir.knowledge_path()
-    {
-        betr::store::check_writable(&path).context("--learn")?;
-    }
+    let policy_dir = checked_destination(args)?;
     let mut llm = setup(flags, call)?;
     llm.options.max_rounds = args.max_rounds;
     llm.options.use_scenario_goal = args.stated_goal;
@@ -381,33 +362,8 @@ fn resolve(
         anyhow::bail!("--record: {why}");
     }
     let success = matches!(resolved.ending, Ending::Success { .. });
-    // Saved before anything is printed (a policy by the loop itself, on success): the
-    // tree is kept whatever happens to the output.
-    let saved = match args.save {
-        Some(path) if success || resolved.repairs > 0 => {
-            betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
-                .with_context(|| format!("saving the tree to {}", path.display()))?;
-            Some(path.to_path_buf())
-        }
-        Some(_) => None,
-        None => resolved.saved.clone(),
-    };
-    outln!();
-    for line in bt::render(&resolved.tree, last.as_deref(), glyphs) {
-        outln!("{line}");
-    }
-    match &saved {
-        Some(path) => {
-            let note = if success { "" } else { " (it still fails)" };
-            outln!("\nSaved the tree to {}{note}", path.display());
-        }
-        None => outln!("\nNothing saved: no change was kept."),
-    }
-    outln!(
-        "{} question(s) about failures, {} change(s) kept",
-        resolved.rounds,
-        resolved.repairs
-    );
+    let saved = save(args, &resolved, success)?;
+    report(&resolved, last.as_deref(), saved.as_deref(), glyphs);
     if let Some(dir) = args.learn.filter(|_| success) {
         outln!();
         super::knowledge_cmd::offer(scenario, args.scenario_path, &resolved.kept, dir, args.yes)?;
@@ -418,6 +374,76 @@ fn resolve(
     } else {
         ExitCode::from(1)
     })
+}
+
+/// Where the work will be kept, checked before any of it is done: --save, else the
+/// policy directory the workbench and --learn use (returned).
+fn checked_destination(args: &ResolveArgs) -> Result<Option<PathBuf>> {
+    let policy_dir = match args.save {
+        Some(_) => None,
+        None => Some(args.policies.dir().context(
+            "no policy directory to keep the tree in: pass --policy-dir or --save (neither XDG_DATA_HOME nor HOME is set)",
+        )?),
+    };
+    let save_to = match (args.save, &policy_dir) {
+        (Some(path), _) => path.to_path_buf(),
+        (None, Some(dir)) => dir.join(format!("{}.bt", stem(args.scenario_path))),
+        (None, None) => PathBuf::new(),
+    };
+    betr::store::check_writable(&save_to)
+        .with_context(|| format!("the tree is to be saved to {}", save_to.display()))?;
+    if let Some(dir) = args.learn
+        && let Some(path) = dir.knowledge_path()
+    {
+        betr::store::check_writable(&path).context("--learn")?;
+    }
+    Ok(policy_dir)
+}
+
+/// Where the tree was saved: to --save when it succeeded or was changed, before anything
+/// is printed so the tree is kept whatever happens to the output; else where the loop
+/// itself saved a policy on success.
+fn save(
+    args: &ResolveArgs,
+    resolved: &session::Resolved,
+    success: bool,
+) -> Result<Option<PathBuf>> {
+    Ok(match args.save {
+        Some(path) if success || resolved.repairs > 0 => {
+            betr::store::write_atomic(path, bt::to_text(&resolved.tree).as_bytes())
+                .with_context(|| format!("saving the tree to {}", path.display()))?;
+            Some(path.to_path_buf())
+        }
+        Some(_) => None,
+        None => resolved.saved.clone(),
+    })
+}
+
+/// The tree with the statuses of its last run, where it was saved, and what was asked
+/// and kept.
+fn report(
+    resolved: &session::Resolved,
+    last: Option<&TickRecord>,
+    saved: Option<&Path>,
+    glyphs: &Glyphs,
+) {
+    outln!();
+    for line in bt::render(&resolved.tree, last, glyphs) {
+        outln!("{line}");
+    }
+    match saved {
+        Some(path) => {
+            let success = matches!(resolved.ending, Ending::Success { .. });
+            let note = if success { "" } else { " (it still fails)" };
+            outln!("\nSaved the tree to {}{note}", path.display());
+        }
+        None => outln!("\nNothing saved: no change was kept."),
+    }
+    outln!(
+        "{} question(s) about failures, {} change(s) kept",
+        resolved.rounds,
+        resolved.repairs
+    );
 }
 
 /// A scenario file's stem, as policies are named by it.

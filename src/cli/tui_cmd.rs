@@ -71,28 +71,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(betr::scenario::catalog::DEFAULT_SCENARIO));
     let path = super::find_scenario(&arg)?;
-    let microphone: Arc<dyn Microphone> = match &args.audio {
-        Some(file) => {
-            // A file that cannot be played is said now, not at the first key press.
-            betr::voice::Audio16k::from_wav(file).context("--audio")?;
-            Arc::new(WavMicrophone::new(file.clone()))
-        }
-        None => Arc::new(DefaultMicrophone),
-    };
-    let mut scenario = betr::scenario::Scenario::load(&path)?;
-    let knowledge_flags = super::knowledge_cmd::KnowledgeFlags {
-        dir: super::knowledge_cmd::PolicyDir {
-            policy_dir: args.policy_dir.clone(),
-        },
-        no_knowledge: args.no_knowledge,
-    };
-    // Fixes approved in the workbench may be kept as rules in the same file.
-    let knowledge = knowledge_flags.apply(&mut scenario)?;
-    let scenario = Arc::new(scenario);
-    // A tree that cannot be read is said before the screen opens (exit 2).
-    if let Some(tree) = &args.tree {
-        super::export_cmd::load_tree(&scenario, tree)?;
-    }
+    let microphone = microphone(args)?;
+    let (scenario, knowledge) = scenario_of(args, &path)?;
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
@@ -112,21 +92,13 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     } else {
         None
     };
-    let model_name = match settings.backend {
-        betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
-        _ => settings.model.clone(),
-    }
-    .unwrap_or_else(|| "(no model)".into());
+    let model_name = model_name(&settings);
     let no_model = model.as_ref().err().map(ToString::to_string);
     let policy_dir = args
         .policy_dir
         .clone()
         .or_else(|| PolicyStore::default_dir(&var));
-    let keys_path = args.keys.clone().or_else(|| default_keys_path(&var));
-    let (keys, keys_error) = match &keys_path {
-        Some(p) => KeyBindings::load(p),
-        None => (KeyBindings::default(), None),
-    };
+    let (keys, keys_error) = key_bindings(args.keys.as_deref());
     let info = Info {
         scenario: path
             .file_stem()
@@ -162,31 +134,18 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     };
     // The status bar says it when a viewer is not there or the recording stopped.
     let mut tap = super::viz_flags::SessionTap { viz, record };
-    let theme = Theme::new(if ascii {
-        &betr::bt::ASCII
-    } else {
-        &betr::bt::UNICODE
-    });
+    let theme = Theme::of(ascii);
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
         .build()
         .context("starting the async runtime")?;
-    // Speech-to-text for push-to-talk comes from the settings file and the `BETR_STT*`
-    // variables. Bad speech settings disable dictation (saying why when the key is
-    // pressed), not the workbench.
-    let no_flags = super::voice_cmd::SttFlags::default();
-    let loader = super::voice_cmd::settings(args.llm.config.as_deref(), &no_flags)
-        .map(betr::tui::dictation::loader_of)
-        .map_err(|e| betr::tui::dictation::DictationError::Settings {
-            reason: format!("{e:#}"),
-        });
     let workbench = Workbench {
         info,
         keys,
         theme,
         microphone,
-        stt: loader,
+        stt: speech_to_text(args),
         stderr_to: log_path(),
         tree: args.tree.clone(),
         model_arrival: background.is_some().then_some(arrivals),
@@ -202,6 +161,66 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     }
     report_session(&ran?, args, &mut tap);
     Ok(ExitCode::SUCCESS)
+}
+
+/// The microphone push-to-talk listens to: `--audio`'s file, checked now rather than at
+/// the first key press, or the default input device.
+fn microphone(args: &TuiArgs) -> Result<Arc<dyn Microphone>> {
+    Ok(match &args.audio {
+        Some(file) => {
+            betr::voice::Audio16k::from_wav(file).context("--audio")?;
+            Arc::new(WavMicrophone::new(file.clone()))
+        }
+        None => Arc::new(DefaultMicrophone),
+    })
+}
+
+/// The scenario at `path` with the rules learned for it (fixes approved in the workbench
+/// may be kept as rules in the same file); a `--tree` that cannot be read is said before
+/// the screen opens (exit 2).
+fn scenario_of(
+    args: &TuiArgs,
+    path: &std::path::Path,
+) -> Result<(
+    Arc<betr::scenario::Scenario>,
+    Option<betr::session::knowledge::Knowledge>,
+)> {
+    let mut scenario = betr::scenario::Scenario::load(path)?;
+    let knowledge_flags = super::knowledge_cmd::KnowledgeFlags {
+        dir: super::knowledge_cmd::PolicyDir {
+            policy_dir: args.policy_dir.clone(),
+        },
+        no_knowledge: args.no_knowledge,
+    };
+    let knowledge = knowledge_flags.apply(&mut scenario)?;
+    let scenario = Arc::new(scenario);
+    if let Some(tree) = &args.tree {
+        super::export_cmd::load_tree(&scenario, tree)?;
+    }
+    Ok((scenario, knowledge))
+}
+
+/// The model's name as the status bar says it.
+fn model_name(settings: &betr::llm::config::Settings) -> String {
+    match settings.backend {
+        betr::llm::config::Backend::Local => settings.local_model().map(|(name, _)| name).ok(),
+        _ => settings.model.clone(),
+    }
+    .unwrap_or_else(|| "(no model)".into())
+}
+
+/// Speech-to-text for push-to-talk, from the settings file and the `BETR_STT*` variables.
+/// Bad speech settings disable dictation (saying why when the key is pressed), not the
+/// workbench.
+fn speech_to_text(
+    args: &TuiArgs,
+) -> Result<betr::tui::dictation::SttLoader, betr::tui::dictation::DictationError> {
+    let no_flags = super::voice_cmd::SttFlags::default();
+    super::voice_cmd::settings(args.llm.config.as_deref(), &no_flags)
+        .map(betr::tui::dictation::loader_of)
+        .map_err(|e| betr::tui::dictation::DictationError::Settings {
+            reason: format!("{e:#}"),
+        })
 }
 
 /// The workbench's model: one being fetched (it answers once it has arrived, and the
@@ -294,6 +313,19 @@ fn ready_model(
 }
 
 /// Where the key bindings file is looked for when none is given.
+/// The key bindings: `keys` (a `--keys` file), else the default keys file, with the
+/// defaults patched by it; why a file could not be used, to say on the screen.
+pub fn key_bindings(keys: Option<&std::path::Path>) -> (KeyBindings, Option<String>) {
+    let var = |k: &str| std::env::var(k).ok();
+    let path = keys
+        .map(std::path::Path::to_path_buf)
+        .or_else(|| default_keys_path(&var));
+    match &path {
+        Some(p) => KeyBindings::load(p),
+        None => (KeyBindings::default(), None),
+    }
+}
+
 pub fn default_keys_path(var: &dyn Fn(&str) -> Option<String>) -> Option<PathBuf> {
     let config = var("XDG_CONFIG_HOME")
         .filter(|d| !d.is_empty())

@@ -329,7 +329,16 @@ impl App {
     }
 
     fn on_action(&mut self, action: Action) {
-        let command = match action {
+        match self.command_of(action) {
+            Some(command) => self.queue.push(AppEvent::Command(command)),
+            None => self.on_screen_action(action),
+        }
+    }
+
+    /// The engine command a key's action asks for; none for the actions on the screen
+    /// itself (and for a node's marks when no node is selected).
+    fn command_of(&mut self, action: Action) -> Option<Command> {
+        Some(match action {
             Action::Step => Command::Tick,
             Action::Run if self.status.running => Command::Pause,
             Action::Run => Command::Run,
@@ -355,9 +364,7 @@ impl App {
             Action::Knowledge => Command::ShowKnowledge,
             Action::Reset => Command::ResetWorld,
             Action::Breakpoint | Action::Force => {
-                let Some(node) = self.tree.selected() else {
-                    return self.message(strings::SELECT_A_NODE.to_string(), true);
-                };
+                let node = self.tree.selected()?;
                 if action == Action::Breakpoint {
                     Command::ToggleBreakpoint(node)
                 } else {
@@ -365,65 +372,59 @@ impl App {
                 }
             }
             Action::BreakOnFailure => Command::BreakOnFailure(!self.status.break_on_failure),
+            _ => return None,
+        })
+    }
+
+    /// A key's action on the screen: the input line, overlays, panes, moves in a replay.
+    fn on_screen_action(&mut self, action: Action) {
+        match action {
+            Action::Breakpoint | Action::Force => {
+                self.message(strings::SELECT_A_NODE.to_string(), true);
+            }
             // The recording panel holds the input line's place until the recording ends.
             Action::Instruction | Action::Edit if self.dictation.is_recording() => {
-                return self.message(strings::STOP_RECORDING_FIRST.to_string(), true);
+                self.message(strings::STOP_RECORDING_FIRST.to_string(), true);
             }
             Action::Instruction => {
-                return self.input.open(Mode::Instruction, "");
+                self.input.open(Mode::Instruction, "");
             }
-            Action::Dictate => return self.on_dictate_key(),
-            Action::Edit => {
-                let text = self
-                    .llm
-                    .proposal
-                    .as_ref()
-                    .map(|p| p.edit_text.clone())
-                    .unwrap_or_default();
-                if self.vocabulary.is_none() {
-                    self.vocabulary = Some(crate::session::vocabulary_words(&self.scenario));
-                }
-                self.input
-                    .set_vocabulary(self.vocabulary.clone().unwrap_or_default());
-                return self.input.open(Mode::Edit, &text);
-            }
+            Action::Dictate => self.on_dictate_key(),
+            Action::Edit => self.open_edit(),
             Action::Help => {
                 self.overlay = Some(Overlay::Help(0));
-                return;
             }
-            Action::Details => return self.show_details(),
+            Action::Details => self.show_details(),
             Action::Follow => {
                 self.tree.follow = !self.tree.follow;
                 if self.tree.follow {
                     self.tree.show_running(false);
                 }
-                return self.message(strings::follow(self.tree.follow).to_string(), false);
+                self.message(strings::follow(self.tree.follow).to_string(), false);
             }
-            Action::Search => return self.input.open(Mode::Search, ""),
-            Action::SearchNext => return self.search(true),
-            Action::SearchPrevious => return self.search(false),
-            Action::CollapseAll => return self.tree.collapse_all(),
-            Action::ExpandAll => return self.tree.expand_all(),
-            Action::ScrollLeft => return self.tree.scroll_left(),
-            Action::ScrollRight => return self.tree.scroll_right(),
+            Action::Search => self.input.open(Mode::Search, ""),
+            Action::SearchNext => self.search(true),
+            Action::SearchPrevious => self.search(false),
+            Action::CollapseAll => self.tree.collapse_all(),
+            Action::ExpandAll => self.tree.expand_all(),
+            Action::ScrollLeft => self.tree.scroll_left(),
+            Action::ScrollRight => self.tree.scroll_right(),
             Action::FocusNext => {
                 self.focus = self.focus.next();
-                return;
             }
-            Action::WorldUp => return self.world.scroll_up(),
-            Action::WorldDown => return self.world.scroll_down(),
+            Action::WorldUp => self.world.scroll_up(),
+            Action::WorldDown => self.world.scroll_down(),
             Action::WorldFilter => {
                 let now = self.world.filter.clone().unwrap_or_default();
-                return self.input.open(Mode::Filter, &now);
+                self.input.open(Mode::Filter, &now);
             }
             Action::ExpandToRunning => {
                 if !self.tree.show_running(true) {
                     self.message(strings::NOTHING_RUNNING.to_string(), true);
                 }
-                return;
             }
-            Action::LogUp => return self.llm.scroll_log_up(),
-            Action::LogDown => return self.llm.scroll_log_down(),
+            Action::LogUp => self.llm.scroll_log_up(),
+            Action::LogDown => self.llm.scroll_log_down(),
             Action::Quit => {
                 let lost = self.would_be_lost();
                 if lost.is_empty() {
@@ -431,7 +432,6 @@ impl App {
                 } else {
                     self.overlay = Some(Overlay::ConfirmQuit(lost));
                 }
-                return;
             }
             // Bound in a replay only: moves in the recording.
             Action::EventForward
@@ -447,10 +447,42 @@ impl App {
                 if let Some(m) = Move::of(action) {
                     self.queue.push(AppEvent::Replay(m));
                 }
-                return;
             }
-        };
-        self.queue.push(AppEvent::Command(command));
+            // Sent to the engine by `command_of`.
+            Action::Step
+            | Action::Run
+            | Action::Plan
+            | Action::Approve
+            | Action::Reject
+            | Action::Cancel
+            | Action::Undo
+            | Action::Verify
+            | Action::Save
+            | Action::Load
+            | Action::Export
+            | Action::KeepRule
+            | Action::KeepRuleOnly
+            | Action::DeclineRule
+            | Action::Knowledge
+            | Action::Reset
+            | Action::BreakOnFailure => {}
+        }
+    }
+
+    /// The input line on the proposal's conditions, completing the scenario's words.
+    fn open_edit(&mut self) {
+        let text = self
+            .llm
+            .proposal
+            .as_ref()
+            .map(|p| p.edit_text.clone())
+            .unwrap_or_default();
+        if self.vocabulary.is_none() {
+            self.vocabulary = Some(crate::session::vocabulary_words(&self.scenario));
+        }
+        self.input
+            .set_vocabulary(self.vocabulary.clone().unwrap_or_default());
+        self.input.open(Mode::Edit, &text);
     }
 
     /// Push-to-talk: the same key starts and stops a recording.

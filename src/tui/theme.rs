@@ -38,6 +38,15 @@ pub struct Theme {
 }
 
 impl Theme {
+    /// The theme with ASCII marks (`--ascii`) or Unicode ones.
+    pub fn of(ascii: bool) -> Theme {
+        Theme::new(if ascii {
+            &crate::bt::ASCII
+        } else {
+            &crate::bt::UNICODE
+        })
+    }
+
     pub fn new(glyphs: &'static Glyphs) -> Theme {
         Theme {
             glyphs,
