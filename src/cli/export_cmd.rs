@@ -120,10 +120,7 @@ pub fn export(
 /// A BehaviorTree.CPP file drawn as written, whatever its node kinds (nothing runs it, so
 /// nothing colours it).
 fn draw_as_written(source: &Path, out: Option<&Path>) -> Result<ExitCode> {
-    let text = betr::store::read_text(source, betr::monitor::tree::MAX_TREE_BYTES as u64)
-        .with_context(|| format!("reading tree file {}", source.display()))?;
-    let tree = betr::monitor::WatchedTree::parse_file(text.as_bytes())
-        .with_context(|| source.display().to_string())?;
+    let tree = super::monitor_cmd::read_tree_file(source)?;
     write_out(&tree.to_dot(&tree.main), out)
 }
 

@@ -86,12 +86,18 @@ pub fn monitor(args: &MonitorArgs, ascii: bool) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A BehaviorTree.CPP tree file as written, whatever its node kinds, read with the
+/// monitor's size cap; errors name the file.
+pub(super) fn read_tree_file(file: &std::path::Path) -> Result<betr::monitor::WatchedTree> {
+    let text = betr::store::read_text(file, betr::monitor::tree::MAX_TREE_BYTES as u64)
+        .with_context(|| format!("reading tree file {}", file.display()))?;
+    betr::monitor::WatchedTree::parse_file(text.as_bytes())
+        .with_context(|| file.display().to_string())
+}
+
 /// A tree file shown on the monitor's screen, or printed one node a line.
 fn show_file(file: &std::path::Path, print: bool, ascii: bool) -> Result<ExitCode> {
-    let text = betr::store::read_text(file, betr::monitor::tree::MAX_TREE_BYTES as u64)
-        .with_context(|| file.display().to_string())?;
-    let tree = betr::monitor::WatchedTree::parse_file(text.as_bytes())
-        .with_context(|| file.display().to_string())?;
+    let tree = read_tree_file(file)?;
     if print {
         outln!(
             "# {}: tree {}, {} nodes",

@@ -203,7 +203,7 @@ async fn follow(
     let mut notifications = publisher.notifications().await.map_err(after)?;
     let (_, started) = publisher.start_recording().await.map_err(after)?;
     let (_, statuses) = publisher.statuses().await.map_err(after)?;
-    let boards_of_tree = Boards::new(&tree);
+    let mut boards = Boards::new(&tree);
     let connected = WatchEvent::Connected {
         address: address.clone(),
         tree: Box::new(tree),
@@ -221,7 +221,6 @@ async fn follow(
     beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     let mut board_beat = tokio::time::interval(timing.blackboards);
     board_beat.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
-    let mut boards = boards_of_tree;
     let mut busy = false;
     let mut commanded = true;
     loop {

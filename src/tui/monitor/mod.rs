@@ -2,8 +2,9 @@
 //! Groot2 publisher reports it. The tree pane shows every node with its status, following
 //! the node the tree is busy in unless the person moves; the side pane the selected
 //! node's kind, ports (a `{name}` port is a blackboard entry, shown with its value) and
-//! its tree's blackboard, and the latest status changes; the status bar the connection. The screen only reads: nothing is sent to the
-//! robot but Groot2's read requests.
+//! its tree's blackboard, and the latest status changes; the status bar the connection.
+//! Live, the person's breakpoints go to the robot through Groot2's hooks; the same screen
+//! replays a recorded watch (`replay.rs`) and shows a tree file, sending nothing.
 
 mod replay;
 mod view;
@@ -397,15 +398,7 @@ impl MonitorScreen {
             return;
         };
         self.not_found = None;
-        let path = self
-            .live
-            .as_ref()
-            .map(|l| l.tree.uid_path(found))
-            .unwrap_or_default();
-        for depth in 1..path.len() {
-            self.state.open(path[..depth].to_vec());
-        }
-        self.state.select(path);
+        self.select_index(found);
         self.follow = false;
     }
 

@@ -44,15 +44,10 @@ pub struct WatchPlayer {
 }
 
 impl WatchPlayer {
-    /// The run at its start (nothing applied yet).
-    pub fn new(run: WatchedRun, ascii: bool) -> WatchPlayer {
-        Self::build(run, ascii)
-    }
-
     /// The run where there is something to see: just after its first tree arrived (at
     /// its start when none did).
     pub fn at_first_tree(run: WatchedRun, ascii: bool) -> WatchPlayer {
-        let mut player = Self::build(run, ascii);
+        let mut player = Self::new(run, ascii);
         let first = (0..player.atoms.len()).find(|&i| player.is_tree(i));
         if let Some(first) = first {
             player.seek(first + 1);
@@ -60,7 +55,8 @@ impl WatchPlayer {
         player
     }
 
-    fn build(run: WatchedRun, ascii: bool) -> WatchPlayer {
+    /// The run at its start (nothing applied yet).
+    pub fn new(run: WatchedRun, ascii: bool) -> WatchPlayer {
         let mut atoms = Vec::new();
         let mut times = Vec::new();
         let mut since = Duration::ZERO;
