@@ -52,9 +52,19 @@ pub fn nearest<'a>(
         .collect()
 }
 
-/// ` (did you mean "a" or "b"?)`, or nothing when no listed name is alike.
+/// ` (did you mean "a" or "b"?)`, or nothing when no listed name is alike. A name with
+/// quotes of its own (a condition over quoted objects) is set in single quotes, as typed.
 pub fn did_you_mean(nearest: &[String]) -> String {
-    let quoted: Vec<String> = nearest.iter().map(|n| format!("{n:?}")).collect();
+    let quoted: Vec<String> = nearest
+        .iter()
+        .map(|n| {
+            if n.contains('"') {
+                format!("'{n}'")
+            } else {
+                format!("{n:?}")
+            }
+        })
+        .collect();
     match quoted.as_slice() {
         [] => String::new(),
         [one] => format!(" (did you mean {one}?)"),
@@ -87,6 +97,10 @@ mod tests {
         assert!(near.len() <= 3);
         assert!(nearest("purple cube", listed.into_iter(), 0.99).is_empty());
         assert_eq!(did_you_mean(&[]), "");
+        assert_eq!(
+            did_you_mean(&["\"red cube\" on \"table\"".into()]),
+            " (did you mean '\"red cube\" on \"table\"'?)"
+        );
         assert_eq!(
             did_you_mean(&["a".into(), "b".into(), "c".into()]),
             " (did you mean \"a\", \"b\" or \"c\"?)"

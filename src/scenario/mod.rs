@@ -294,7 +294,8 @@ fn where_in(text: &str, atom: &Atom, error: &VocabularyError) -> usize {
 }
 
 /// The atoms of the vocabulary most like `atom` where it names a predicate or an object
-/// the vocabulary lacks: the same atom with the most similar name in that place.
+/// the vocabulary lacks: the same atom with the most similar name in that place (not one
+/// the atom names already).
 fn atoms_like(vocabulary: &Vocabulary, atom: &Atom, error: &VocabularyError) -> Vec<String> {
     let min = MIN_SIMILARITY;
     match error {
@@ -324,7 +325,12 @@ fn atoms_like(vocabulary: &Vocabulary, atom: &Atom, error: &VocabularyError) -> 
                 .and_then(|p| p.arg_types.get(position))
                 .cloned()
                 .unwrap_or_default();
-            nearest(object, vocabulary.objects_fitting(&types), min)
+            // An object already named elsewhere in the atom is no offer: a thing is not on
+            // itself.
+            let others = vocabulary
+                .objects_fitting(&types)
+                .filter(|name| !atom.args.iter().any(|a| a == *name));
+            nearest(object, others, min)
                 .into_iter()
                 .map(|name| {
                     let mut like = atom.clone();

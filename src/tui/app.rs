@@ -115,8 +115,6 @@ pub struct App {
     areas: PaneAreas,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
-    /// The scene's conditions the edit line completes from (built when first edited).
-    vocabulary: Option<Vec<String>>,
     /// What was saved, exported, and is not saved yet.
     pub summary: Summary,
     quit: bool,
@@ -152,7 +150,6 @@ impl App {
             focus: Pane::default(),
             areas: PaneAreas::default(),
             queue: Vec::new(),
-            vocabulary: None,
             summary: Summary::default(),
             quit: false,
         }
@@ -242,7 +239,16 @@ impl App {
             match self.input.event(&key) {
                 Some(Submitted::Instruction(text)) => {
                     self.llm.error = None;
-                    self.queue.push(AppEvent::Command(Command::Submit(text)));
+                    // A goal formula the scene cannot hold stays in the line with why under
+                    // it, as an edit does; the engine would refuse it the same way.
+                    match crate::session::interpret::submitted::read(&self.scenario, &text) {
+                        Err(e) => {
+                            self.show_error(e.to_string());
+                            self.input
+                                .reopen_with_error(Mode::Instruction, &text, e.reason());
+                        }
+                        Ok(_) => self.queue.push(AppEvent::Command(Command::Submit(text))),
+                    }
                 }
                 Some(Submitted::Edit(text)) => {
                     self.llm.error = None;
@@ -252,7 +258,8 @@ impl App {
                         // with the error under it; nothing reaches the session.
                         Err(e) => {
                             self.show_error(e.to_string());
-                            self.input.reopen_with_error(&text, e.to_string());
+                            self.input
+                                .reopen_with_error(Mode::Edit, &text, e.to_string());
                         }
                     }
                 }
@@ -387,6 +394,7 @@ impl App {
                 self.message(strings::STOP_RECORDING_FIRST.to_string(), true);
             }
             Action::Instruction => {
+                self.set_vocabulary();
                 self.input.open(Mode::Instruction, "");
             }
             Action::Dictate => self.on_dictate_key(),
@@ -477,12 +485,16 @@ impl App {
             .as_ref()
             .map(|p| p.edit_text.clone())
             .unwrap_or_default();
-        if self.vocabulary.is_none() {
-            self.vocabulary = Some(crate::session::vocabulary_words(&self.scenario));
-        }
-        self.input
-            .set_vocabulary(self.vocabulary.clone().unwrap_or_default());
+        self.set_vocabulary();
         self.input.open(Mode::Edit, &text);
+    }
+
+    /// Give the input line the scene's conditions to complete, read from the scenario once.
+    fn set_vocabulary(&mut self) {
+        if !self.input.has_vocabulary() {
+            self.input
+                .set_vocabulary(crate::session::vocabulary_words(&self.scenario));
+        }
     }
 
     /// Push-to-talk: the same key starts and stops a recording.

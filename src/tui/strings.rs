@@ -56,6 +56,11 @@ pub fn completions(listed: &[&str], count: usize) -> String {
     format!("{count} match: {}{more}", listed.join(", "))
 }
 
+/// Under the line while Tab goes through the matches one by one.
+pub fn cycling(shown: usize, count: usize) -> String {
+    format!("match {shown} of {count} \u{b7} Tab next \u{b7} Shift-Tab back")
+}
+
 pub const REJECTED: &str = "rejected: the tree is unchanged; the model is asked again without it (e: type the fix yourself)";
 pub const CONFIRM_QUIT_TITLE: &str = " Quit? ";
 
@@ -262,6 +267,11 @@ pub const NAVIGATION: &[(&str, &str)] = &[
     ("PgUp PgDn Home End", "scroll the focused pane"),
     ("mouse", "click: focus a pane, select a node; wheel: scroll"),
     ("shift-wheel", "scroll the tree sideways"),
+    ("typing: ↑ ↓", "what was submitted before in that line"),
+    (
+        "typing: Tab",
+        "complete a condition; again: the next match (Shift-Tab back)",
+    ),
     ("Ctrl-C", "quit"),
 ];
 

@@ -15,7 +15,7 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     let area = frame.area();
     let [main, input, status] = Layout::vertical([
         Constraint::Min(3),
-        Constraint::Length(3),
+        Constraint::Length(app.input.height(area.width)),
         Constraint::Length(1),
     ])
     .areas(area);

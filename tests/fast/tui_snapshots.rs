@@ -121,6 +121,45 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
     });
 }
 
+/// A goal formula the scene cannot hold stays in the instruction line with the whole
+/// error wrapped under it (80 columns), never reaches the engine, and is one ↑ away after
+/// the line is closed; Tab completes a condition without its opening quote.
+#[test]
+fn a_refused_goal_stays_typed_with_its_error_wrapped_and_in_the_history() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        let goal = "\"blue cube\" on \"gren cube\" & ~\"red cube\" on \"blue cube\"";
+        b.key(KeyCode::Char('i'));
+        b.type_text(goal);
+        b.key(KeyCode::Enter);
+        assert!(
+            !b.sent.iter().any(|c| matches!(c, Command::Submit(_))),
+            "{:?}",
+            b.sent
+        );
+        let screen = b.screen(80, 24);
+        assert!(screen.contains("did you mean"), "{screen}");
+        assert!(screen.contains("on \"green"), "{screen}");
+        insta::assert_snapshot!("a_refused_goal_kept_with_its_error_wrapped", screen);
+        b.key(KeyCode::Esc);
+        b.key(KeyCode::Char('i'));
+        b.key(KeyCode::Up);
+        assert_eq!(b.app.input.text(), goal);
+        // Corrected where the error pointed, the goal goes to the engine.
+        b.key(KeyCode::Esc);
+        b.key(KeyCode::Char('i'));
+        b.type_text("blue cube\" on \"gre");
+        b.key(KeyCode::Tab);
+        assert_eq!(b.app.input.text(), "\"blue cube\" on \"green cube\"");
+        b.key(KeyCode::Enter);
+        assert!(
+            b.sent.iter().any(|c| matches!(c, Command::Submit(_))),
+            "{:?}",
+            b.sent
+        );
+    });
+}
+
 #[test]
 fn an_approved_fix_kept_as_a_rule_is_marked_in_the_tree() {
     let dir = std::env::temp_dir().join(format!("betr-tui-knowledge-{}", std::process::id()));

@@ -29,6 +29,19 @@ pub enum SubmitError {
     },
 }
 
+impl SubmitError {
+    /// What is wrong, without the text itself: for where the text is shown already (the
+    /// line it was typed in).
+    pub fn reason(&self) -> String {
+        match self {
+            SubmitError::Empty => self.to_string(),
+            SubmitError::Goal { error, .. } => {
+                format!("a goal formula that does not fit the scene: {error}")
+            }
+        }
+    }
+}
+
 /// Read `text` against `scenario`: a goal, an instruction, or a refusal.
 pub fn read(scenario: &Scenario, text: &str) -> Result<Submitted, SubmitError> {
     let text = text.trim();

@@ -12,9 +12,9 @@
 use std::fmt;
 
 use crate::domain::action::{ActionError, parse_value};
-use crate::domain::{Condition, Value, VocabularyError};
-use crate::goal::{Formula, GoalError};
-use crate::scenario::Scenario;
+use crate::domain::{Condition, Value};
+use crate::goal::GoalError;
+use crate::scenario::{GoalTextError, Scenario};
 
 /// A person's edit, read.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,10 +54,11 @@ pub enum EditError {
         /// A condition of the scenario in use, in its own words.
         example: String,
     },
+    /// An atom the scene does not have, with where it stands and the atoms most like it.
     #[error("'{text}': {error}")]
     Vocabulary {
         text: String,
-        error: VocabularyError,
+        error: Box<GoalTextError>,
     },
     #[error("'{text}': expected one condition or a conjunction ('A & ~B'), found {formula}")]
     NotAConjunction { text: String, formula: String },
@@ -90,21 +91,17 @@ pub fn parse_edit(scenario: &Scenario, text: &str) -> Result<Edit, EditError> {
 
 /// One condition or a conjunction, every atom in the vocabulary.
 fn parse_conditions(scenario: &Scenario, text: &str) -> Result<Vec<Condition>, EditError> {
-    let formula = Formula::parse(text).map_err(|error| EditError::Syntax {
-        text: text.to_string(),
-        error,
-        example: example(scenario),
+    let formula = scenario.parse_goal(text).map_err(|error| match error {
+        GoalTextError::Syntax(error) => EditError::Syntax {
+            text: text.to_string(),
+            error,
+            example: example(scenario),
+        },
+        error @ GoalTextError::Vocabulary { .. } => EditError::Vocabulary {
+            text: text.to_string(),
+            error: Box::new(error),
+        },
     })?;
-    for atom in formula.atoms() {
-        scenario
-            .domain
-            .vocabulary
-            .check_atom(&atom)
-            .map_err(|error| EditError::Vocabulary {
-                text: text.to_string(),
-                error,
-            })?;
-    }
     match formula.to_dnf().0.as_slice() {
         [one] if !one.is_empty() => Ok(one.clone()),
         _ => Err(EditError::NotAConjunction {
@@ -224,6 +221,13 @@ mod tests {
         let e = parse_edit(&s, "\"purple cube\" on \"blue cube\"").unwrap_err();
         assert!(matches!(e, EditError::Vocabulary { .. }), "{e:?}");
         assert!(e.to_string().contains("\"purple cube\""), "{e}");
+        // A misspelt object is offered the scene's object most like it.
+        let e = parse_edit(&s, "~\"any object\" on \"blue cub\"").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("(did you mean '\"any object\" on \"blue cube\"'?)"),
+            "{e}"
+        );
         let e = parse_edit(&s, "~\"blue cube\" on \"blue cube\" | ").unwrap_err();
         assert!(matches!(e, EditError::Syntax { .. }), "{e:?}");
         assert!(e.to_string().contains("column"), "{e}");

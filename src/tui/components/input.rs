@@ -1,13 +1,16 @@
 //! The input line: an instruction (or a goal formula) to submit, or a proposal to edit.
-//! Enter submits, Esc cancels; while it is open it takes every key. Editing, Tab completes
-//! the condition under the cursor from the scene's vocabulary (the choices left are listed
-//! under the line), and a line that could not be read stays open with the error under it.
+//! Enter submits, Esc cancels; while it is open it takes every key. ↑ and ↓ go through
+//! what was submitted before in the same kind of line (a refused goal is one ↑ away).
+//! Tab completes the condition under the cursor from the scene's vocabulary, with or
+//! without its opening quote: as far as the matches agree, then — pressed again — through
+//! each match in turn (Shift-Tab back); the choices are listed under the line. A line that
+//! could not be read stays open with the error under it, wrapped to the screen's width.
 
 use crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
 use ratatui::Frame;
 use ratatui::layout::{Position, Rect};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Borders, Paragraph};
+use ratatui::widgets::{Block, Borders, Paragraph, Wrap};
 
 use super::super::strings;
 use super::super::theme::Theme;
@@ -43,6 +46,23 @@ pub struct InputLine {
     vocabulary: Vec<String>,
     /// Under the line: why it could not be read, or the completions left.
     note: Option<Note>,
+    /// What was submitted, oldest first, with the kind of line it was submitted in.
+    history: Vec<(Mode, String)>,
+    /// Going through the history: the entry shown (an index into `history`) and the text
+    /// that was being typed before, given back by ↓ past the newest entry.
+    recalled: Option<(usize, String)>,
+    /// Tab pressed again on a condition with several matches: which are being gone through.
+    cycle: Option<Cycle>,
+}
+
+/// Several matches of a condition, gone through by repeated Tab.
+struct Cycle {
+    /// Where the condition starts, in bytes.
+    start: usize,
+    /// The matching words, as indices into the vocabulary.
+    matches: Vec<usize>,
+    /// The match in the line now.
+    shown: usize,
 }
 
 /// What the line's lower border says.
@@ -55,6 +75,12 @@ pub enum Note {
 /// Completions listed under the line at most.
 const LISTED: usize = 4;
 
+/// Entries the history keeps at most; the oldest go first.
+const HISTORY: usize = 200;
+
+/// Lines a wrapped error takes under the text at most.
+const ERROR_LINES: u16 = 4;
+
 impl InputLine {
     /// What the line says while closed.
     pub fn set_idle(&mut self, title: &'static str, hint: String) {
@@ -66,17 +92,23 @@ impl InputLine {
         self.text = text.to_string();
         self.cursor = self.text.chars().count();
         self.note = None;
+        self.recalled = None;
+        self.cycle = None;
     }
 
-    /// Open the edit line again on `text` that could not be read, with why under it.
-    pub fn reopen_with_error(&mut self, text: &str, error: String) {
-        self.open(Mode::Edit, text);
+    /// Open the line again on `text` that could not be read, with why under it.
+    pub fn reopen_with_error(&mut self, mode: Mode, text: &str, error: String) {
+        self.open(mode, text);
         self.note = Some(Note::Error(error));
     }
 
     /// The conditions Tab completes from.
     pub fn set_vocabulary(&mut self, words: Vec<String>) {
         self.vocabulary = words;
+    }
+
+    pub fn has_vocabulary(&self) -> bool {
+        !self.vocabulary.is_empty()
     }
 
     /// What is under the line, if anything.
@@ -89,8 +121,19 @@ impl InputLine {
     }
 
     /// Complete the condition before the cursor: to the one condition it begins, or as
-    /// far as all it begins agree, listing them under the line.
-    fn complete(&mut self) {
+    /// far as all it begins agree, listing them under the line. The opening quote of an
+    /// object's name may be left out. When the matches agree no further, Tab goes through
+    /// them one by one (`forward`), and Shift-Tab back.
+    fn complete(&mut self, forward: bool) {
+        if let Some(cycle) = self.cycle.as_mut() {
+            let count = cycle.matches.len();
+            cycle.shown = if forward {
+                (cycle.shown + 1) % count
+            } else {
+                (cycle.shown + count - 1) % count
+            };
+            return self.show_cycled();
+        }
         let at = self.byte_at(self.cursor);
         // The condition under the cursor starts after the last operator before it.
         let start = self.text[..at]
@@ -98,38 +141,121 @@ impl InputLine {
             .map_or(0, |i| i + 1);
         let typed = self.text[start..at].trim_start();
         let start = at - typed.len();
-        let lower = typed.to_lowercase();
-        let matching: Vec<&String> = self
-            .vocabulary
-            .iter()
-            .filter(|w| w.to_lowercase().starts_with(&lower))
+        let lower = typed.trim_start_matches('"').to_lowercase();
+        let matching: Vec<usize> = (0..self.vocabulary.len())
+            .filter(|&i| {
+                let word = self.vocabulary[i].trim_start_matches('"').to_lowercase();
+                word.starts_with(&lower)
+            })
             .collect();
-        let Some(first) = matching.first() else {
+        let Some(&first) = matching.first() else {
             self.note = Some(Note::Choices(strings::NO_COMPLETION.to_string()));
             return;
         };
-        let common = matching.iter().fold(first.as_str(), |acc, w| {
+        let first = self.vocabulary[first].as_str();
+        let common = matching.iter().fold(first, |acc, &i| {
             let same = acc
                 .char_indices()
-                .zip(w.chars())
+                .zip(self.vocabulary[i].chars())
                 .take_while(|((_, a), b)| a.eq_ignore_ascii_case(b))
                 .last()
                 .map_or(0, |((i, a), _)| i + a.len_utf8());
             &acc[..same]
         });
-        let replacement = if common.len() >= typed.len() {
-            common.to_string()
-        } else {
-            typed.to_string()
-        };
+        let count = matching.len();
+        if count > 1 && common.trim_start_matches('"').len() <= lower.len() {
+            // Nothing more the matches agree on: go through them.
+            self.cycle = Some(Cycle {
+                start,
+                matches: matching,
+                // One step from here is the first match forward, the last back.
+                shown: if forward { count - 1 } else { 0 },
+            });
+            return self.complete(forward);
+        }
+        let replacement = common.to_string();
         self.text.replace_range(start..at, &replacement);
         self.cursor = self.text[..start + replacement.len()].chars().count();
         self.note = if matching.len() == 1 {
             None
         } else {
-            let listed: Vec<&str> = matching.iter().take(LISTED).map(|w| w.as_str()).collect();
+            let listed: Vec<&str> = matching
+                .iter()
+                .take(LISTED)
+                .map(|&i| self.vocabulary[i].as_str())
+                .collect();
             Some(Note::Choices(strings::completions(&listed, matching.len())))
         };
+    }
+
+    /// Put the match the cycle is on in place of the condition, and say which it is.
+    fn show_cycled(&mut self) {
+        let Some(cycle) = &self.cycle else { return };
+        let shown = cycle.shown % cycle.matches.len();
+        let word = &self.vocabulary[cycle.matches[shown]];
+        let at = self.byte_at(self.cursor);
+        self.text.replace_range(cycle.start..at, word);
+        self.cursor = self.text[..cycle.start + word.len()].chars().count();
+        self.note = Some(Note::Choices(strings::cycling(
+            shown + 1,
+            cycle.matches.len(),
+        )));
+    }
+
+    /// Show the submitted entry before (`back`) or after the one shown, the newest first;
+    /// past the newest, the text that was being typed.
+    fn recall(&mut self, back: bool) {
+        let Some(mode) = self.mode else { return };
+        let shown = self.recalled.as_ref().map(|(i, _)| *i);
+        let same_mode = |(i, (m, _)): (usize, &(Mode, String))| (*m == mode).then_some(i);
+        let next = if back {
+            let before = shown.unwrap_or(self.history.len());
+            self.history[..before]
+                .iter()
+                .enumerate()
+                .filter_map(same_mode)
+                .next_back()
+        } else {
+            let Some(shown) = shown else { return };
+            self.history
+                .iter()
+                .enumerate()
+                .skip(shown + 1)
+                .find_map(same_mode)
+        };
+        let text = match next {
+            Some(i) => {
+                let draft = match self.recalled.take() {
+                    Some((_, draft)) => draft,
+                    None => self.text.clone(),
+                };
+                self.recalled = Some((i, draft));
+                self.history[i].1.clone()
+            }
+            // ↓ past the newest entry: back to what was being typed.
+            None if !back => match self.recalled.take() {
+                Some((_, draft)) => draft,
+                None => return,
+            },
+            None => return,
+        };
+        self.text = text;
+        self.cursor = self.text.chars().count();
+    }
+
+    /// Keep a submitted line for ↑, unless it is empty or the same as the last of its kind.
+    fn remember(&mut self, mode: Mode, text: &str) {
+        if text.trim().is_empty() {
+            return;
+        }
+        let last = self.history.iter().rev().find(|(m, _)| *m == mode);
+        if last.is_some_and(|(_, t)| t == text) {
+            return;
+        }
+        if self.history.len() >= HISTORY {
+            self.history.remove(0);
+        }
+        self.history.push((mode, text.to_string()));
     }
 
     pub fn is_open(&self) -> bool {
@@ -161,16 +287,23 @@ impl InputLine {
     /// Handle a key while open: `Some` when Enter submitted the text.
     pub fn event(&mut self, key: &KeyEvent) -> Option<Submitted> {
         let mode = self.mode?;
-        if key.code != KeyCode::Tab {
+        if !matches!(key.code, KeyCode::Tab | KeyCode::BackTab) {
             // A key that changes the line makes what was said under it stale.
             self.note = None;
+            self.cycle = None;
         }
+        let completes = matches!(mode, Mode::Edit | Mode::Instruction);
         match key.code {
-            KeyCode::Tab if mode == Mode::Edit => self.complete(),
+            KeyCode::Tab if completes => self.complete(true),
+            KeyCode::BackTab if completes => self.complete(false),
+            KeyCode::Up => self.recall(true),
+            KeyCode::Down => self.recall(false),
             KeyCode::Enter => {
                 let text = std::mem::take(&mut self.text);
+                self.remember(mode, &text);
                 self.mode = None;
                 self.cursor = 0;
+                self.recalled = None;
                 return Some(match mode {
                     Mode::Instruction => Submitted::Instruction(text),
                     Mode::Edit => Submitted::Edit(text),
@@ -182,6 +315,7 @@ impl InputLine {
                 self.mode = None;
                 self.text.clear();
                 self.cursor = 0;
+                self.recalled = None;
             }
             KeyCode::Char('u') if key.modifiers.contains(KeyModifiers::CONTROL) => {
                 self.text.clear();
@@ -208,6 +342,21 @@ impl InputLine {
             _ => {}
         }
         None
+    }
+
+    /// Rows the line takes at `width` columns: the text between borders, and an error
+    /// under it wrapped to a few rows.
+    pub fn height(&self, width: u16) -> u16 {
+        let error_rows = match (&self.note, self.mode) {
+            (Some(Note::Error(e)), Some(_)) => {
+                let rows = Paragraph::new(e.as_str())
+                    .wrap(Wrap { trim: true })
+                    .line_count(width.saturating_sub(2).max(1));
+                u16::try_from(rows).unwrap_or(ERROR_LINES).min(ERROR_LINES)
+            }
+            _ => 0,
+        };
+        3 + error_rows
     }
 
     fn byte_at(&self, chars: usize) -> usize {
@@ -239,6 +388,10 @@ impl InputLine {
                 ]),
             ),
         };
+        let error = match (&self.note, self.mode) {
+            (Some(Note::Error(e)), Some(_)) => Some(e.as_str()),
+            _ => None,
+        };
         let inner_width = usize::from(area.width.saturating_sub(4)).max(1);
         // Keep the cursor in view on long text.
         let scroll = self.cursor.saturating_sub(inner_width.saturating_sub(1));
@@ -247,19 +400,31 @@ impl InputLine {
             .border_style(theme.border)
             .title(Span::styled(title, theme.title));
         let block = match (&self.note, self.mode) {
-            (Some(Note::Error(e)), Some(_)) => {
-                block.title_bottom(Span::styled(format!(" {e} "), theme.error))
-            }
             (Some(Note::Choices(c)), Some(_)) => {
                 block.title_bottom(Span::styled(format!(" {c} "), theme.dim))
             }
-            (None, Some(Mode::Edit)) if !self.vocabulary.is_empty() => {
+            (None, Some(Mode::Edit | Mode::Instruction)) if !self.vocabulary.is_empty() => {
                 block.title_bottom(Span::styled(strings::TAB_COMPLETES, theme.dim))
             }
             _ => block,
         };
         let scroll = u16::try_from(scroll).unwrap_or(u16::MAX);
-        frame.render_widget(Paragraph::new(line).block(block).scroll((0, scroll)), area);
+        let inner = block.inner(area);
+        frame.render_widget(block, area);
+        let text_area = Rect { height: 1, ..inner };
+        frame.render_widget(Paragraph::new(line).scroll((0, scroll)), text_area);
+        if let Some(error) = error {
+            // The whole error, wrapped under the text: cut at the border it could not be read.
+            let below = Rect {
+                y: inner.y.saturating_add(1),
+                height: inner.height.saturating_sub(1),
+                ..inner
+            };
+            frame.render_widget(
+                Paragraph::new(Span::styled(error, theme.error)).wrap(Wrap { trim: true }),
+                below,
+            );
+        }
         if self.mode.is_some() {
             let x = area.x.saturating_add(3).saturating_add(
                 u16::try_from(self.cursor)
@@ -358,5 +523,96 @@ mod tests {
                 "Carefully put the cup on the table! then".into()
             ))
         );
+    }
+
+    fn type_text(input: &mut InputLine, text: &str) {
+        for c in text.chars() {
+            input.event(&key(KeyCode::Char(c)));
+        }
+    }
+
+    #[test]
+    fn up_and_down_go_through_what_was_submitted_in_that_kind_of_line() {
+        let mut input = InputLine::default();
+        for (mode, text) in [
+            (Mode::Instruction, "first"),
+            (Mode::Edit, "an edit"),
+            (Mode::Instruction, "On_Cofee_Table1"),
+            (Mode::Instruction, "On_Cofee_Table1"),
+        ] {
+            input.open(mode, "");
+            type_text(&mut input, text);
+            input.event(&key(KeyCode::Enter));
+        }
+        input.open(Mode::Instruction, "");
+        type_text(&mut input, "half typed");
+        input.event(&key(KeyCode::Up));
+        // The same line twice in a row is kept once.
+        assert_eq!(input.text(), "On_Cofee_Table1");
+        input.event(&key(KeyCode::Up));
+        assert_eq!(input.text(), "first");
+        input.event(&key(KeyCode::Up));
+        assert_eq!(input.text(), "first", "the oldest stays");
+        input.event(&key(KeyCode::Down));
+        assert_eq!(input.text(), "On_Cofee_Table1");
+        input.event(&key(KeyCode::Down));
+        assert_eq!(
+            input.text(),
+            "half typed",
+            "past the newest: what was typed"
+        );
+        input.event(&key(KeyCode::Down));
+        assert_eq!(input.text(), "half typed");
+        input.event(&key(KeyCode::Esc));
+        // The edit line has its own.
+        input.open(Mode::Edit, "");
+        input.event(&key(KeyCode::Up));
+        assert_eq!(input.text(), "an edit");
+        input.event(&key(KeyCode::Up));
+        assert_eq!(input.text(), "an edit");
+    }
+
+    #[test]
+    fn tab_completes_without_the_quote_and_goes_through_the_matches() {
+        let mut input = InputLine::default();
+        input.set_vocabulary(vec![
+            "\"red cube\" on \"blue cube\"".into(),
+            "\"red cube\" on \"green cube\"".into(),
+            "\"red cube\" on \"table\"".into(),
+            "Active_AC".into(),
+        ]);
+        input.open(Mode::Instruction, "Active_AC & re");
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(input.text(), "Active_AC & \"red cube\" on \"");
+        assert!(matches!(input.note(), Some(Note::Choices(c)) if c.starts_with("3 match")));
+        // Nothing more they agree on: each Tab shows the next, Shift-Tab the one before.
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(input.text(), "Active_AC & \"red cube\" on \"blue cube\"");
+        assert!(matches!(input.note(), Some(Note::Choices(c)) if c.starts_with("match 1 of 3")));
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(input.text(), "Active_AC & \"red cube\" on \"green cube\"");
+        input.event(&key(KeyCode::BackTab));
+        input.event(&key(KeyCode::BackTab));
+        assert_eq!(input.text(), "Active_AC & \"red cube\" on \"table\"");
+        // Typing ends the round; the text stays as it was shown.
+        type_text(&mut input, " & act");
+        input.event(&key(KeyCode::Tab));
+        assert_eq!(
+            input.text(),
+            "Active_AC & \"red cube\" on \"table\" & Active_AC"
+        );
+    }
+
+    #[test]
+    fn an_error_is_wrapped_under_the_text_in_a_taller_line() {
+        let mut input = InputLine::default();
+        assert_eq!(input.height(40), 3);
+        input.reopen_with_error(Mode::Instruction, "x & y", "word ".repeat(20));
+        // 100 characters in 38 columns: three rows under the text.
+        assert_eq!(input.height(40), 6);
+        input.reopen_with_error(Mode::Instruction, "x", "word ".repeat(200));
+        assert_eq!(input.height(40), 3 + ERROR_LINES);
+        input.event(&key(KeyCode::Char('z')));
+        assert_eq!(input.height(40), 3, "a key makes the error stale");
     }
 }
