@@ -110,6 +110,9 @@ fn headline(event: &Event) -> Option<String> {
         }
         Event::Success { ticks } => format!("✓ SUCCESS in simulation after {ticks} tick(s)"),
         Event::GaveUp { reason } => format!("Gave up: {reason}"),
+        Event::PersonDecides { action, why, .. } => {
+            format!("nothing more is asked about {action}!: {why}; a person decides")
+        }
         Event::BreakpointHit {
             node_path,
             tick,

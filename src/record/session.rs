@@ -96,6 +96,7 @@ pub fn command_text(command: &Command) -> String {
         Command::Submit(text) => format!("submit {text}"),
         Command::SubmitGoal { goal, .. } => format!("submit goal {goal}"),
         Command::Plan => "plan".into(),
+        Command::PlanKeepingRefused => "plan, keeping the refused fixes".into(),
         Command::Tick => "tick".into(),
         Command::Run => "run".into(),
         Command::Pause => "pause".into(),

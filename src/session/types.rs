@@ -397,6 +397,20 @@ pub enum Event {
     GaveUp {
         reason: String,
     },
+    /// Nothing more is asked about the failure of `action` (`why`): a person decides what
+    /// comes next. `rounds_left`: stepping asks the model again; `undoable`: a change to
+    /// the tree can be undone.
+    PersonDecides {
+        action: String,
+        why: String,
+        rounds_left: bool,
+        undoable: bool,
+    },
+    /// How many fixes are refused for the current goal's failures (by a person, the
+    /// simulation or verification); told whenever it changes.
+    RefusedFixes {
+        count: usize,
+    },
     /// The tree changed: all of it, the nodes the change added, the conditions learned
     /// rules put there (with the rules' ids), and why.
     TreeChanged {

@@ -82,6 +82,17 @@ pub enum Overlay {
     /// Quitting would lose what these lines say: the quit key again quits, any other
     /// key stays.
     ConfirmQuit(Vec<String>),
+    /// Planning again with fixes refused: keep them or forget them (these lines ask).
+    PlanAgain(Vec<String>),
+}
+
+/// A failure nothing more is asked about (`Event::PersonDecides`).
+#[derive(Debug, Clone, PartialEq)]
+struct Stuck {
+    action: String,
+    why: String,
+    rounds_left: bool,
+    undoable: bool,
 }
 
 /// What a session of the workbench left behind, for the lines printed after it.
@@ -115,6 +126,10 @@ pub struct App {
     areas: PaneAreas,
     /// What components asked, in order, until the event loop takes it.
     queue: Vec<AppEvent>,
+    /// Fixes refused for the goal's failures, as the engine last told.
+    pub refused_fixes: usize,
+    /// The failure nothing more is asked about, while it waits for the person.
+    stuck: Option<Stuck>,
     /// What was saved, exported, and is not saved yet.
     pub summary: Summary,
     quit: bool,
@@ -150,6 +165,8 @@ impl App {
             focus: Pane::default(),
             areas: PaneAreas::default(),
             queue: Vec::new(),
+            refused_fixes: 0,
+            stuck: None,
             summary: Summary::default(),
             quit: false,
         }
@@ -293,6 +310,19 @@ impl App {
             }
             return;
         }
+        if let Some(Overlay::PlanAgain(_)) = &self.overlay {
+            self.overlay = None;
+            match key.code {
+                KeyCode::Char(strings::KEEP_REFUSED_KEY) => self
+                    .queue
+                    .push(AppEvent::Command(Command::PlanKeepingRefused)),
+                KeyCode::Char(strings::FORGET_REFUSED_KEY) => {
+                    self.queue.push(AppEvent::Command(Command::Plan));
+                }
+                _ => {}
+            }
+            return;
+        }
         if let Some(Overlay::Help(first)) = self.overlay {
             let last = self.keys.help_lines(self.mode).len().saturating_sub(1);
             self.overlay = match key.code {
@@ -349,6 +379,8 @@ impl App {
             Action::Step => Command::Tick,
             Action::Run if self.status.running => Command::Pause,
             Action::Run => Command::Run,
+            // With fixes refused, the person says whether planning again keeps them.
+            Action::Plan if self.refused_fixes > 0 => return None,
             Action::Plan => Command::Plan,
             Action::Approve => Command::Approve,
             Action::Reject => Command::Reject,
@@ -433,6 +465,9 @@ impl App {
             }
             Action::LogUp => self.llm.scroll_log_up(),
             Action::LogDown => self.llm.scroll_log_down(),
+            Action::Plan => {
+                self.overlay = Some(Overlay::PlanAgain(strings::plan_again(self.refused_fixes)));
+            }
             Action::Quit => {
                 let lost = self.would_be_lost();
                 if lost.is_empty() {
@@ -459,7 +494,6 @@ impl App {
             // Sent to the engine by `command_of`.
             Action::Step
             | Action::Run
-            | Action::Plan
             | Action::Approve
             | Action::Reject
             | Action::Cancel

@@ -64,6 +64,42 @@ pub fn cycling(shown: usize, count: usize) -> String {
 pub const REJECTED: &str = "rejected: the tree is unchanged; the model is asked again without it (e: type the fix yourself)";
 pub const CONFIRM_QUIT_TITLE: &str = " Quit? ";
 
+pub const PLAN_AGAIN_TITLE: &str = " Plan again? ";
+pub const KEEP_REFUSED_KEY: char = 'k';
+pub const FORGET_REFUSED_KEY: char = 'f';
+
+/// The question before planning again with `count` fixes refused.
+pub fn plan_again(count: usize) -> Vec<String> {
+    vec![
+        format!(
+            "Planning again starts the tree afresh; {count} fix(es) were refused for its failures."
+        ),
+        format!(
+            "{KEEP_REFUSED_KEY}  keep them: the model is told them and they are not offered again"
+        ),
+        format!("{FORGET_REFUSED_KEY}  forget them: ask as if for the first time"),
+        "any other key: do not plan".to_string(),
+    ]
+}
+
+/// What the person can do when nothing more is asked about a failure: the head, then
+/// each key with what it does.
+pub fn person_decides(action: &str, why: &str) -> String {
+    format!("Nothing more is asked about {action}!: {why}. What now:")
+}
+pub const TYPE_THE_FIX: &str = "type the missing condition(s) or value yourself (Tab completes)";
+pub const UNDO_THE_CHANGE: &str = "undo the last change to the tree";
+pub const STEP_ASKS_AGAIN: &str = "step: the model is asked again";
+
+/// Planning again, in the guidance: with the refused fixes or without any.
+pub fn plan_from_the_goal(refused: usize) -> String {
+    if refused == 0 {
+        "plan the goal again".to_string()
+    } else {
+        format!("plan the goal again, keeping the {refused} refused fix(es) or forgetting them")
+    }
+}
+
 /// Approved fixes no saved policy holds, in the quit question.
 pub fn unsaved_fixes(count: usize, save_key: &str) -> String {
     format!(

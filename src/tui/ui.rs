@@ -78,6 +78,9 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
         Some(Overlay::ConfirmQuit(lines)) => {
             draw_report(frame, area, strings::CONFIRM_QUIT_TITLE, lines, &theme);
         }
+        Some(Overlay::PlanAgain(lines)) => {
+            draw_report(frame, area, strings::PLAN_AGAIN_TITLE, lines, &theme);
+        }
         Some(Overlay::Readings(readings, doubt)) => {
             draw_readings(frame, area, readings, doubt.as_deref(), &theme);
         }

@@ -483,6 +483,7 @@ impl Viz {
                 | Event::ActionFailed { .. }
                 | Event::Success { .. }
                 | Event::GaveUp { .. }
+                | Event::PersonDecides { .. }
                 | Event::Error { .. }
                 | Event::Failed { .. }
                 | Event::BreakpointHit { .. }
@@ -519,7 +520,8 @@ fn log_level(event: &Event) -> &'static str {
         | Event::DidNotHelp { .. }
         | Event::ChangeViolates { .. }
         | Event::RuleRefused { .. }
-        | Event::BreakpointHit { .. } => L::WARN,
+        | Event::BreakpointHit { .. }
+        | Event::PersonDecides { .. } => L::WARN,
         Event::ArmMotion { motion } if motion.length.is_none() => L::WARN,
         Event::GaveUp { .. } | Event::Error { .. } | Event::Failed { .. } => L::ERROR,
         Event::Asking { .. }

@@ -230,10 +230,7 @@ fn a_slow_model_call_does_not_block_ticks() {
 #[test]
 fn a_question_to_the_model_is_cancelled_and_the_person_writes_the_fix() {
     rt().block_on(async {
-        let mut s = Session::start(setup(
-            Ok(Arc::new(model(Duration::from_secs(600)))),
-            None,
-        ));
+        let mut s = Session::start(setup(Ok(Arc::new(model(Duration::from_secs(600)))), None));
         s.send(Command::Submit("\"blue cube\" on \"green cube\"".into()));
         s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
             .await;
@@ -243,7 +240,8 @@ fn a_question_to_the_model_is_cancelled_and_the_person_writes_the_fix() {
         s.send(Command::Cancel);
         let got = s
             .until("the cancel", |e| {
-                matches!(e, Event::Notice { message } if message.starts_with("the question was cancelled"))
+                matches!(e, Event::PersonDecides { why, rounds_left: true, .. }
+                    if why.starts_with("the question was cancelled"))
             })
             .await;
         assert!(

@@ -160,6 +160,55 @@ fn a_refused_goal_stays_typed_with_its_error_wrapped_and_in_the_history() {
     });
 }
 
+/// When nothing more is asked about the failure, the pane says every way on with its key;
+/// `p` then asks whether planning again keeps the refused fixes, and keeping them plans
+/// again without forgetting them.
+#[test]
+fn when_nothing_more_is_asked_the_ways_on_are_shown_and_plan_asks() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.step_to_failure().await;
+        b.key(KeyCode::Char('x'));
+        b.until(|e| matches!(e, Event::PersonDecides { .. })).await;
+        let refused = b.app.refused_fixes;
+        assert!(refused > 0);
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("What now:"), "{screen}");
+        assert!(
+            screen.contains(&format!("keeping the {refused} refused")),
+            "{screen}"
+        );
+        insta::assert_snapshot!("nothing_more_is_asked_the_ways_on", screen);
+
+        b.key(KeyCode::Char('p'));
+        assert!(!b.sent.contains(&Command::Plan), "{:?}", b.sent);
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("Plan again?"), "{screen}");
+        insta::assert_snapshot!("plan_asks_about_the_refused_fixes", screen);
+        // Any other key plans nothing.
+        b.key(KeyCode::Char('z'));
+        assert!(!b.screen(120, 40).contains("Plan again?"));
+        assert_eq!(b.sent.last(), Some(&Command::Reject));
+
+        b.key(KeyCode::Char('p'));
+        b.key(KeyCode::Char('k'));
+        assert_eq!(b.sent.last(), Some(&Command::PlanKeepingRefused));
+        b.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        assert_eq!(b.app.refused_fixes, refused, "kept");
+        assert!(!b.screen(120, 40).contains("What now:"));
+
+        b.key(KeyCode::Char('p'));
+        b.key(KeyCode::Char('f'));
+        assert_eq!(b.sent.last(), Some(&Command::Plan));
+        b.until(|e| matches!(e, Event::RefusedFixes { count: 0 }))
+            .await;
+        assert_eq!(b.app.refused_fixes, 0, "forgotten");
+        // With none refused, p plans at once.
+        b.key(KeyCode::Char('p'));
+        assert_eq!(b.sent.last(), Some(&Command::Plan));
+    });
+}
+
 #[test]
 fn an_approved_fix_kept_as_a_rule_is_marked_in_the_tree() {
     let dir = std::env::temp_dir().join(format!("betr-tui-knowledge-{}", std::process::id()));

@@ -645,7 +645,7 @@ fn a_person_cancels_a_slow_question_and_writes_the_fix() {
     tmux.wait_for(&["asking the model for", "esc cancels"], 30);
     tmux.wait_for(&[" 2 s · esc cancels"], 10);
     tmux.keys(&["Escape"]);
-    let screen = tmux.wait_for(&["the question was cancelled"], 10);
+    let screen = tmux.wait_for(&["What now:", "question was cancelled"], 10);
     assert!(!screen.contains("esc cancels"), "{screen}");
     tmux.keys(&["e"]);
     tmux.text("~\"any object\" on \"blue cube\"");

@@ -2,7 +2,9 @@
 //! OpenAI server from scenario 1's hand-written fixtures. Approve then undo: the undone fix
 //! is proposed again. Reject: the model is asked again without the rejected fix and
 //! proposes the other; a mistyped edit stays on the line with the error under it and Tab
-//! completes it from the scene's vocabulary.
+//! completes it from the scene's vocabulary. Every proposal rejected: the screen says the
+//! ways on, and planning again asks whether to keep the refused fixes. A goal the scene
+//! cannot hold stays typed and is one ↑ away.
 
 #![allow(clippy::unwrap_used)] // test helpers outside #[test] functions
 
@@ -123,4 +125,70 @@ fn reject_then_the_model_is_asked_again_and_a_mistyped_edit_is_kept() {
         ],
         10,
     );
+}
+
+/// A goal the scene cannot hold stays in the line and is one ↑ away after it is closed;
+/// corrected with Tab, it is planned. Every proposal then rejected, the screen says the
+/// ways on; `p` asks whether to keep the refused fixes, and keeping them plans again.
+#[test]
+fn rejecting_every_proposal_ends_in_the_ways_on_and_typing_has_a_history() {
+    let (_dir, _server, tmux) = start("tmux-ways-on");
+    tmux.wait_for(&["press i to type an instruction"], 20);
+    tmux.keys(&["i"]);
+    tmux.wait_for(&["Instruction or goal"], 10);
+    tmux.text("\"blue cube\" on \"gren cube\"");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(
+        &[
+            "unknown object \"gren cube\"",
+            "> \"blue cube\" on \"gren cube\"",
+        ],
+        10,
+    );
+    tmux.keys(&["Escape"]);
+    tmux.wait_for(&["press i to type"], 10);
+    tmux.keys(&["i"]);
+    tmux.keys(&["Up"]);
+    tmux.wait_for(&["> \"blue cube\" on \"gren cube\""], 10);
+    for _ in 0.."gren cube\"".len() {
+        tmux.keys(&["BSpace"]);
+    }
+    tmux.text("gre");
+    tmux.keys(&["Tab"]);
+    tmux.wait_for(&["> \"blue cube\" on \"green cube\""], 10);
+    tmux.keys(&["Enter"]);
+    tmux.wait_for(&["Goal: \"blue cube\" on \"green cube\""], 20);
+    step_to_proposal(&tmux);
+
+    // Reject whatever is proposed until nothing more is asked.
+    let mut screen = tmux.screen();
+    for _ in 0..10 {
+        if screen.contains("What now:") {
+            break;
+        }
+        tmux.keys(&["x"]);
+        tmux.wait_for_any(&["awaiting approval", "What now:"], 30);
+        // The rejected proposal's line may still show: wait for the next state.
+        std::thread::sleep(Duration::from_millis(300));
+        screen = tmux.screen();
+    }
+    assert!(screen.contains("What now:"), "{screen}");
+    assert!(screen.contains("type the missing condition(s)"), "{screen}");
+    assert!(
+        screen.contains("keeping the ") && screen.contains(" refused"),
+        "{screen}"
+    );
+
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["Plan again?", "keep them", "forget them"], 10);
+    tmux.keys(&["k"]);
+    let screen = tmux.wait_until(&["What now: gone"], 20, |s| {
+        !s.contains("What now:") && !s.contains("Plan again?")
+    });
+    assert!(!screen.contains("◀ failed"), "{screen}");
+
+    // What was submitted last is one ↑ away.
+    tmux.keys(&["i"]);
+    tmux.keys(&["Up"]);
+    tmux.wait_for(&["> \"blue cube\" on \"green cube\""], 10);
 }

@@ -94,10 +94,7 @@ impl Engine {
             .filter(|(f, t)| *f == failure && t.why == REJECTED)
             .count();
         if rejected > self.settings.options.max_rejections || self.settings.model.is_err() {
-            return self.notice(format!(
-                "{rejected} proposal(s) for {}! rejected: type the missing condition(s) or value yourself (e)",
-                failure.action
-            ));
+            return self.wait_for_person(failure, format!("{rejected} proposal(s) rejected"));
         }
         self.ask_about(failure);
     }

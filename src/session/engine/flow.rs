@@ -169,6 +169,24 @@ impl Engine {
 
     /// Plan the task's goal (the scenario's when none was given), or start from its
     /// saved policy.
+    /// Plan afresh as [`Self::plan`] does, keeping the fixes refused for the goal's
+    /// failures: planning (and a saved policy it loads) starts the history afresh, so
+    /// they are put back after.
+    pub(super) fn plan_keeping_refused(&mut self) {
+        let refused = std::mem::take(&mut self.task.tried);
+        self.plan();
+        self.task.tried = refused;
+    }
+
+    /// Tell the front end how many fixes are refused now, when that changed.
+    pub(super) fn tell_refused(&mut self) {
+        let count = self.task.tried.len();
+        if count != self.task.told_refused {
+            self.task.told_refused = count;
+            self.emit(Event::RefusedFixes { count });
+        }
+    }
+
     pub(super) fn plan(&mut self) {
         let scenario = &self.settings.scenario;
         let goal = match (&self.task.goal, &scenario.goal) {

@@ -111,8 +111,13 @@ pub enum Command {
         goal: crate::goal::Formula,
         instruction: String,
     },
-    /// Plan the current goal (the scenario's when none was submitted).
+    /// Plan the current goal afresh (the scenario's when none was submitted): the tree's
+    /// changes and every refused fix forgotten.
     Plan,
+    /// Plan the current goal afresh, keeping the fixes refused for its failures (by a
+    /// person, the simulation or verification): the model is told them again and they are
+    /// not offered again.
+    PlanKeepingRefused,
     /// One tick of the tree in the execution world.
     Tick,
     /// Tick on their own until success, failure, a pause, a breakpoint or the tick limit.
@@ -318,7 +323,10 @@ impl Engine {
                     None | Some(Command::Shutdown) => break,
                     Some(c) => self.handle(c),
                 },
-                Some(message) = self.internal_rx.recv() => self.on_internal(message),
+                Some(message) = self.internal_rx.recv() => {
+                    self.on_internal(message);
+                    self.tell_refused();
+                }
                 () = pace(interval), if running => self.run_step(),
             }
         }
@@ -326,9 +334,14 @@ impl Engine {
     }
 
     /// Carry out one command (model calls it starts run on the current tokio runtime).
+    pub fn handle(&mut self, command: Command) {
+        self.carry_out(command);
+        self.tell_refused();
+    }
+
     /// What a command does depends on the phase; commands that mean the same in every
     /// phase come last.
-    pub fn handle(&mut self, command: Command) {
+    fn carry_out(&mut self, command: Command) {
         match (&mut self.phase, command) {
             (Phase::Idle, Command::Tick) => {
                 self.error("nothing to tick: submit an instruction or plan first");
@@ -370,10 +383,14 @@ impl Engine {
             (_, Command::Reject) => self.error("no proposal to reject"),
             (Phase::Asking { failure, .. }, Command::Cancel) => {
                 let failure = failure.clone();
-                self.enter(Phase::Failed { failure });
+                self.enter(Phase::Failed {
+                    failure: failure.clone(),
+                });
                 self.emit(Event::CallCancelled);
-                self.notice(
-                    "the question was cancelled: write the fix yourself (the shortlist above says what fixes the failure in simulation), or step to ask again",
+                self.wait_for_person(
+                    failure,
+                    "the question was cancelled (the log says what fixes the failure in simulation)"
+                        .into(),
                 );
             }
             (Phase::Reading { .. }, Command::Cancel) => {
@@ -396,6 +413,7 @@ impl Engine {
             (_, Command::Submit(text)) => self.submit(&text),
             (_, Command::SubmitGoal { goal, instruction }) => self.submit_goal(goal, instruction),
             (_, Command::Plan) => self.plan(),
+            (_, Command::PlanKeepingRefused) => self.plan_keeping_refused(),
             (_, Command::Force { node, status }) => self.force(node, status),
             (_, Command::CycleForce(node)) => self.cycle_force(node),
             (_, Command::ToggleBreakpoint(node)) => self.toggle_breakpoint(node),
@@ -430,6 +448,7 @@ impl Engine {
         match self.internal_rx.recv().await {
             Some(m) => {
                 self.on_internal(m);
+                self.tell_refused();
                 true
             }
             None => false,

@@ -111,26 +111,34 @@ impl Engine {
         });
     }
 
+    /// Nothing more is asked about `failure` (`why`): it waits for a person, who is told
+    /// the ways on.
+    pub(super) fn wait_for_person(&mut self, failure: Failure, why: String) {
+        self.emit(Event::PersonDecides {
+            action: failure.action.to_string(),
+            why,
+            rounds_left: self.settings.model.is_ok()
+                && self.task.rounds < self.settings.options.max_rounds,
+            undoable: !self.task.undo.is_empty(),
+        });
+        self.enter(Phase::Failed { failure });
+    }
+
     /// Ask the model what `failure` misses, unless there is no model or the rounds are
     /// used up: then the failure waits for a person.
     pub(super) fn ask_about(&mut self, failure: Failure) {
         let model = match self.settings.model.clone() {
             Ok(m) => m,
-            Err(why) => {
-                self.notice(format!(
-                    "no language model ({why}): press e to type the missing condition(s) yourself"
-                ));
-                return self.enter(Phase::Failed { failure });
-            }
+            Err(why) => return self.wait_for_person(failure, format!("no language model ({why})")),
         };
         if self.task.rounds >= self.settings.options.max_rounds {
-            self.emit(Event::GaveUp {
-                reason: format!(
-                    "{} round(s) asked and {}! still fails: {}",
-                    self.task.rounds, failure.action, failure.error
-                ),
-            });
-            return self.enter(Phase::Failed { failure });
+            let reason = format!(
+                "{} round(s) asked and {}! still fails: {}",
+                self.task.rounds, failure.action, failure.error
+            );
+            self.emit(Event::GaveUp { reason });
+            let why = format!("{} round(s) asked", self.task.rounds);
+            return self.wait_for_person(failure, why);
         }
         let Some(tree) = self.task.tree.clone() else {
             self.error("no tree to change");
@@ -210,7 +218,11 @@ impl Engine {
                 };
                 match answer.result {
                     Ok(asked) => self.on_asked(failure, asked, answer.evidence, &replies),
-                    Err(error) => self.emit(Event::Failed { error }),
+                    Err(error) => {
+                        let why = format!("the model's answer could not be used: {error}");
+                        self.emit(Event::Failed { error });
+                        self.wait_for_person(failure, why);
+                    }
                 }
             }
         }

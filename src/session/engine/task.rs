@@ -65,6 +65,8 @@ pub(super) struct Task {
     pub(super) tried: Vec<(Failure, Tried)>,
     /// Questions asked about failures of this tree.
     pub(super) rounds: usize,
+    /// How many refused fixes the front end was last told of (`Event::RefusedFixes`).
+    pub(super) told_refused: usize,
 }
 
 impl Task {

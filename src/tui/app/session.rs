@@ -4,11 +4,11 @@
 use crate::session::Event;
 
 use super::super::components::help::report_lines;
-use super::super::components::llm_pane::ProposalView;
+use super::super::components::llm_pane::{Guidance, ProposalView};
 use super::super::components::status_bar::Ending;
 use super::super::keys::Action;
 use super::super::strings;
-use super::{App, Overlay};
+use super::{App, Overlay, Stuck};
 
 impl App {
     pub fn on_session(&mut self, event: Event) {
@@ -27,7 +27,9 @@ impl App {
             | Event::Approved
             | Event::Rejected
             | Event::DidNotHelp { .. }
-            | Event::GaveUp { .. }) => self.on_failure_or_proposal(e),
+            | Event::GaveUp { .. }
+            | Event::PersonDecides { .. }
+            | Event::RefusedFixes { .. }) => self.on_failure_or_proposal(e),
             e @ (Event::Ticked { .. }
             | Event::WorldChanged { .. }
             | Event::RunState { .. }
@@ -55,10 +57,41 @@ impl App {
         }
     }
 
+    /// The ways on from a failure nothing more is asked about, with the keys as bound.
+    fn show_guidance(&mut self) {
+        let Some(stuck) = &self.stuck else {
+            self.llm.guidance = None;
+            return;
+        };
+        let key = |a: Action| self.keys.key(a).map(|k| k.to_string()).unwrap_or_default();
+        let mut ways = vec![(key(Action::Edit), strings::TYPE_THE_FIX.to_string())];
+        if stuck.undoable {
+            ways.push((key(Action::Undo), strings::UNDO_THE_CHANGE.to_string()));
+        }
+        ways.push((
+            key(Action::Plan),
+            strings::plan_from_the_goal(self.refused_fixes),
+        ));
+        if stuck.rounds_left {
+            ways.push((key(Action::Step), strings::STEP_ASKS_AGAIN.to_string()));
+        }
+        self.llm.guidance = Some(Guidance {
+            head: strings::person_decides(&stuck.action, &stuck.why),
+            ways,
+        });
+    }
+
+    /// A way on was taken (a proposal, a question, a changed tree): the guidance goes.
+    fn clear_guidance(&mut self) {
+        self.stuck = None;
+        self.llm.guidance = None;
+    }
+
     /// The model: a question under way, its answer, a goal read, the tokens spent.
     fn on_model_talk(&mut self, event: Event) {
         match event {
             Event::Asking { what } => {
+                self.clear_guidance();
                 self.status.awaiting = Some(&strings::AWAITING_MODEL);
                 self.llm.error = None;
                 self.llm.asking = Some(what.to_string());
@@ -121,6 +154,7 @@ impl App {
 
     /// A new tree (planned, repaired, undone, loaded) and what a repair added.
     fn on_tree_change(&mut self, event: Event) {
+        self.clear_guidance();
         match event {
             Event::TreeChanged {
                 tree,
@@ -171,6 +205,7 @@ impl App {
                 author,
                 evidence,
             } => {
+                self.clear_guidance();
                 self.llm.asking = None;
                 self.llm.proposal = Some(ProposalView::of(&proposal, &author, reasoning, evidence));
                 self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
@@ -197,6 +232,27 @@ impl App {
             Event::GaveUp { reason } => {
                 self.status.awaiting = None;
                 self.llm.log(reason);
+            }
+            Event::PersonDecides {
+                action,
+                why,
+                rounds_left,
+                undoable,
+            } => {
+                self.status.awaiting = None;
+                self.llm
+                    .log(format!("nothing more is asked about {action}!: {why}"));
+                self.stuck = Some(Stuck {
+                    action,
+                    why,
+                    rounds_left,
+                    undoable,
+                });
+                self.show_guidance();
+            }
+            Event::RefusedFixes { count } => {
+                self.refused_fixes = count;
+                self.show_guidance();
             }
             _ => {}
         }

@@ -31,6 +31,15 @@ pub struct PaneHints<'a> {
     pub cancel: Option<&'a str>,
 }
 
+/// What a person can do when nothing more is asked about a failure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Guidance {
+    /// What ended, and "What now:".
+    pub head: String,
+    /// Each way on: its key as bound, and what it does.
+    pub ways: Vec<(String, String)>,
+}
+
 /// A proposal as the pane shows it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProposalView {
@@ -125,6 +134,8 @@ pub struct LlmPane {
     pub proposal: Option<ProposalView>,
     /// An approved fix offered as a rule, with the keys that answer it.
     pub offer: Option<String>,
+    /// Nothing more is asked about a failure: the ways on, each with its key.
+    pub guidance: Option<Guidance>,
     pub error: Option<String>,
     /// Each line with how many times in a row it was said.
     log: Vec<(String, usize)>,
@@ -233,9 +244,21 @@ impl LlmPane {
                 theme.running,
             )));
         }
-        match &self.proposal {
-            Some(p) => proposal_lines(p, theme, hints.proposal, &mut lines),
-            None => match &self.offer {
+        match (&self.proposal, &self.guidance) {
+            (Some(p), _) => proposal_lines(p, theme, hints.proposal, &mut lines),
+            (None, Some(guidance)) => {
+                lines.push(Line::from(Span::styled(
+                    guidance.head.clone(),
+                    theme.proposal,
+                )));
+                for (key, what) in &guidance.ways {
+                    lines.push(Line::from(vec![
+                        Span::styled(format!("  {key:>5}  "), theme.key),
+                        Span::raw(what.clone()),
+                    ]));
+                }
+            }
+            (None, None) => match &self.offer {
                 Some(offer) => lines.push(Line::from(Span::styled(offer.clone(), theme.proposal))),
                 None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
             },
