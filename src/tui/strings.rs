@@ -393,6 +393,11 @@ pub fn calls(n: usize, tokens: u64, price: f64) -> String {
     format!("{n} call(s), {tokens} tok, ${price:.4}")
 }
 
+/// The calls where the status bar has no room for their tokens and price.
+pub fn calls_short(n: usize) -> String {
+    format!("{n} call(s)")
+}
+
 pub fn tick(n: u64) -> String {
     format!("tick {n}")
 }

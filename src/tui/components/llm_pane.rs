@@ -231,6 +231,32 @@ impl LlmPane {
     }
 
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, hints: &PaneHints) {
+        let block = self.block(theme, hints);
+        let inner = block.inner(area);
+        frame.render_widget(block, area);
+        // The parts above the log take the rows they wrap to; the log gets the rest. A
+        // proposal whose findings would push it out of view comes first, with its keys.
+        let mut head =
+            Paragraph::new(self.head_lines(theme, hints, false)).wrap(Wrap { trim: false });
+        let mut head_rows = head.line_count(inner.width);
+        if self.proposal.is_some() && head_rows > usize::from(inner.height) {
+            head = Paragraph::new(self.head_lines(theme, hints, true)).wrap(Wrap { trim: false });
+            head_rows = head.line_count(inner.width);
+        }
+        let [head_area, log_area] = Layout::vertical([
+            Constraint::Length(u16::try_from(head_rows).unwrap_or(u16::MAX)),
+            Constraint::Fill(1),
+        ])
+        .areas(inner);
+        self.draw_head(frame, head, head_rows, head_area, theme);
+        self.log_area.set(log_area);
+        self.draw_log(frame, log_area, theme);
+    }
+
+    /// What stands above the log: a question under way, the proposal (`proposal_first`:
+    /// before betr's findings), the guidance or the offer of a rule, the goal, who replied
+    /// last, an error, and the log's heading.
+    fn head_lines(&self, theme: &Theme, hints: &PaneHints, proposal_first: bool) -> Vec<Line<'_>> {
         let mut lines: Vec<Line> = Vec::new();
         if let Some(what) = &self.asking {
             let live = match (hints.cancel, self.asking_since) {
@@ -245,7 +271,7 @@ impl LlmPane {
             )));
         }
         match (&self.proposal, &self.guidance) {
-            (Some(p), _) => proposal_lines(p, theme, hints.proposal, &mut lines),
+            (Some(p), _) => proposal_lines(p, theme, hints.proposal, proposal_first, &mut lines),
             (None, Some(guidance)) => {
                 lines.push(Line::from(Span::styled(
                     guidance.head.clone(),
@@ -304,6 +330,11 @@ impl LlmPane {
                 theme.dim
             },
         )));
+        lines
+    }
+
+    /// The pane's frame: its title, and a proposal's conditions and keys on the border.
+    fn block(&self, theme: &Theme, hints: &PaneHints) -> Block<'_> {
         let mut block = Block::default()
             .borders(Borders::ALL)
             .border_style(if self.focused {
@@ -322,19 +353,7 @@ impl LlmPane {
                 ))
                 .title_bottom(Span::styled(format!(" {} ", hints.proposal), theme.key));
         }
-        let inner = block.inner(area);
-        frame.render_widget(block, area);
-        // The parts above the log take the rows they wrap to; the log gets the rest.
-        let head = Paragraph::new(lines).wrap(Wrap { trim: false });
-        let head_rows = head.line_count(inner.width);
-        let [head_area, log_area] = Layout::vertical([
-            Constraint::Length(u16::try_from(head_rows).unwrap_or(u16::MAX)),
-            Constraint::Fill(1),
-        ])
-        .areas(inner);
-        self.draw_head(frame, head, head_rows, head_area, theme);
-        self.log_area.set(log_area);
-        self.draw_log(frame, log_area, theme);
+        block
     }
 
     /// The proposal and the goal: whole when they fit, else the rows scrolled to with a
@@ -374,21 +393,28 @@ impl LlmPane {
 }
 
 /// A pending proposal: betr's findings, the proposal with its author and keys, then the
-/// author's reasoning labelled as theirs.
+/// author's reasoning labelled as theirs. `proposal_first` (a pane too small for it all):
+/// the proposal and its keys, then the findings.
 fn proposal_lines<'a>(
     p: &'a ProposalView,
     theme: &Theme,
     keys_hint: &str,
+    proposal_first: bool,
     lines: &mut Vec<Line<'a>>,
 ) {
-    if !p.findings.is_empty() {
-        lines.push(Line::from(Span::styled(
-            strings::FOUND_BY_BETR,
-            theme.title,
-        )));
-        for f in &p.findings {
-            lines.push(Line::from(format!("  {f}")));
+    let findings = |lines: &mut Vec<Line<'a>>| {
+        if !p.findings.is_empty() {
+            lines.push(Line::from(Span::styled(
+                strings::FOUND_BY_BETR,
+                theme.title,
+            )));
+            for f in &p.findings {
+                lines.push(Line::from(format!("  {f}")));
+            }
         }
+    };
+    if !proposal_first {
+        findings(lines);
     }
     lines.push(Line::from(Span::styled(
         strings::proposal_by(&p.target, &p.author),
@@ -398,6 +424,9 @@ fn proposal_lines<'a>(
         lines.push(Line::from(Span::styled(format!("  {l}"), theme.proposal)));
     }
     lines.push(Line::from(Span::styled(keys_hint.to_string(), theme.key)));
+    if proposal_first {
+        findings(lines);
+    }
     if let Some(r) = &p.reasoning {
         let style = if p.doubt.is_some() {
             theme.error

@@ -4,7 +4,7 @@
 //! what the step was.
 
 use ratatui::Frame;
-use ratatui::layout::Rect;
+use ratatui::layout::{Constraint, Layout, Rect};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
 
@@ -12,6 +12,9 @@ use crate::llm::usage::UsageTotals;
 
 use super::super::strings;
 use super::super::theme::Theme;
+
+/// Characters a model's name keeps where the status bar is tight.
+const TIGHT_MODEL_NAME: usize = 14;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Ending {
@@ -81,14 +84,23 @@ impl StatusBar {
         if let Some(message) = &self.message {
             return self.draw_message(frame, area, theme, message, (&sep, help));
         }
-        let mut spans = self.session_spans(theme, narrow, &sep);
-        self.push_flags(&mut spans, theme, &sep);
-        spans.push(sep);
-        spans.push(Span::styled(help, theme.status_bar));
-        frame.render_widget(
-            Paragraph::new(Line::from(spans)).style(theme.status_bar),
-            area,
-        );
+        // The help key keeps its place at the right edge; the state left of it says the
+        // calls and the model shorter before anything is cut.
+        let help = Line::from(vec![sep.clone(), Span::styled(help, theme.status_bar)]);
+        let help_width = u16::try_from(help.width()).unwrap_or(u16::MAX);
+        let [state_area, help_area] =
+            Layout::horizontal([Constraint::Fill(1), Constraint::Length(help_width)]).areas(area);
+        let state = |tight: bool| {
+            let mut spans = self.session_spans(theme, narrow, tight, &sep);
+            self.push_flags(&mut spans, theme, &sep);
+            Line::from(spans)
+        };
+        let mut line = state(false);
+        if line.width() > usize::from(state_area.width) {
+            line = state(true);
+        }
+        frame.render_widget(Paragraph::new(line).style(theme.status_bar), state_area);
+        frame.render_widget(Paragraph::new(help).style(theme.status_bar), help_area);
     }
 
     /// `scenario │ message │ ? help`: the message gets the width; the help key stays at
@@ -127,17 +139,28 @@ impl StatusBar {
     }
 
     /// The session's state, each part followed by `sep` but the last: scenario, backend
-    /// and model, the model's fetch, calls, tick, and whether it runs.
+    /// and model, the model's fetch, calls, tick, and whether it runs. `tight`: the calls
+    /// counted without tokens and price, and a long model name shortened.
     fn session_spans(
         &self,
         theme: &Theme,
         narrow: bool,
+        tight: bool,
         sep: &Span<'static>,
     ) -> Vec<Span<'static>> {
-        let who = if narrow {
-            self.model.clone()
+        let who = match (narrow, tight) {
+            (_, true) => crate::excerpt::shortened(&self.model, TIGHT_MODEL_NAME),
+            (true, false) => self.model.clone(),
+            (false, false) => format!("{} {}", self.backend, self.model),
+        };
+        let calls = if tight {
+            strings::calls_short(self.usage.calls)
         } else {
-            format!("{} {}", self.backend, self.model)
+            strings::calls(
+                self.usage.calls,
+                self.usage.prompt_tokens + self.usage.completion_tokens,
+                self.usage.price_usd,
+            )
         };
         let mut spans = vec![
             Span::styled(format!(" {}", self.scenario), theme.status_bar),
@@ -153,14 +176,7 @@ impl StatusBar {
             spans.push(sep.clone());
         }
         spans.extend([
-            Span::styled(
-                strings::calls(
-                    self.usage.calls,
-                    self.usage.prompt_tokens + self.usage.completion_tokens,
-                    self.usage.price_usd,
-                ),
-                theme.status_bar,
-            ),
+            Span::styled(calls, theme.status_bar),
             sep.clone(),
             Span::styled(strings::tick(self.ticks), theme.status_bar),
             sep.clone(),
@@ -262,5 +278,56 @@ impl StatusBar {
             Paragraph::new(Line::from(spans)).style(theme.status_bar),
             area,
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::Terminal;
+    use ratatui::backend::TestBackend;
+
+    fn drawn(bar: &StatusBar, width: u16) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(width, 1)).unwrap();
+        terminal
+            .draw(|f| bar.draw(f, f.area(), &Theme::default(), "?"))
+            .unwrap();
+        terminal.backend().to_string()
+    }
+
+    /// At 80 columns a long model name and the calls' tokens and price give way before
+    /// anything is cut; the help key stays at the right edge.
+    #[test]
+    fn a_tight_bar_abbreviates_before_it_cuts() {
+        let bar = StatusBar {
+            scenario: "cafe/no_coffee".into(),
+            backend: "local".into(),
+            model: "qwen2.5-coder-1.5b-instruct-q4_k_m".into(),
+            usage: UsageTotals {
+                calls: 12,
+                prompt_tokens: 48_000,
+                completion_tokens: 1_200,
+                price_usd: 0.0,
+                ..UsageTotals::default()
+            },
+            ticks: 120,
+            ending: Some(Ending::Failed),
+            break_on_failure: true,
+            ..StatusBar::default()
+        };
+        let wide = drawn(&bar, 160);
+        assert!(
+            wide.contains("qwen2.5-coder-1.5b-instruct-q4_k_m"),
+            "{wide}"
+        );
+        assert!(wide.contains("49200 tok"), "{wide}");
+        let tight = drawn(&bar, 80);
+        assert!(tight.contains("qwen2.5-coder…"), "{tight}");
+        assert!(
+            tight.contains("12 call(s)│") && !tight.contains("tok"),
+            "{tight}"
+        );
+        assert!(tight.contains("FAILED"), "{tight}");
+        assert!(tight.trim_end().ends_with("│?\""), "{tight}");
     }
 }
