@@ -114,7 +114,7 @@ fn a_rejection_asks_again_without_the_rejected_fix_then_leaves_it_to_the_person(
         s.send(Command::Reject);
         let got = s
             .until("left to the person", |e| {
-                matches!(e, Event::Notice { message } if message.contains("type the missing condition(s) or value yourself"))
+                matches!(e, Event::PersonDecides { why, .. } if why == "2 proposal(s) rejected")
             })
             .await;
         assert!(
