@@ -59,6 +59,51 @@ pub const OPENING_PHRASES: &[(&str, Join)] = &[
 /// Words that turn around what follows them in their clause ("n't" is read as "not").
 pub const NEGATIONS: &[&str] = &["not", "no", "never", "nor", "neither", "without", "cannot"];
 
+/// Words of a statement that only link what it says of an object to the object ("the red
+/// cube *is still* on the blue cube", "it *lies* on").
+pub const BEING: &[&str] = &[
+    "is",
+    "are",
+    "was",
+    "were",
+    "be",
+    "been",
+    "being",
+    "has",
+    "have",
+    "had",
+    "still",
+    "currently",
+    "already",
+    "now",
+    "also",
+    "remains",
+    "stays",
+    "lies",
+    "rests",
+    "sits",
+    "stands",
+    "placed",
+    "located",
+];
+
+/// Words by which a statement says what must hold rather than what holds ("the cube
+/// *must* not be on the table", "*needs to* be").
+pub const NEEDING: &[&str] = &[
+    "must", "should", "need", "needs", "needed", "to", "ought", "required",
+];
+
+/// Words by which a statement names the condition a failure lacks ("the *missing*
+/// condition is").
+pub const MISSING: &[&str] = &["missing", "lacking", "lacks", "absent"];
+
+/// Words by which a clause only supposes ("*if* the cube were on the table") and claims
+/// nothing of the world.
+pub const HYPOTHETICAL: &[&str] = &[
+    "if", "once", "after", "when", "until", "unless", "would", "could", "might", "may", "will",
+    "whether", "suppose",
+];
+
 /// Verbs that ask for something not to happen ("avoid the bar", "forget the milk").
 pub const NEGATING_VERBS: &[&str] = &["avoid", "forget", "refrain"];
 

@@ -10,11 +10,13 @@
 //! the relation said before a place
 //! and a scene's conventions ([`relation_words`]), and about a goal's objects and
 //! conjuncts ([`names`]), about the order of a relation's objects ([`order`]), and about
-//! the kinds a "both", "all" or "every" asks each object of ([`kinds`]).
+//! the kinds a "both", "all" or "every" asks each object of ([`kinds`]). What a model's
+//! reasoning claims of the scene's conditions is read here too ([`claims`]).
 //!
 //! The session asks the model and judges its answers with what is here; formula rewrites
 //! that know nothing of words (rename, map atoms, flip) are [`crate::goal::rewrite`]'s.
 
+pub mod claims;
 pub mod english;
 pub mod kinds;
 pub mod lexicon;

@@ -522,6 +522,10 @@ fn log_level(event: &Event) -> &'static str {
         | Event::RuleRefused { .. }
         | Event::BreakpointHit { .. }
         | Event::PersonDecides { .. } => L::WARN,
+        // A reasoning the evidence contradicts is marked in the log as on the screen.
+        Event::Proposal {
+            evidence: Some(e), ..
+        } if e.doubt.is_some() => L::WARN,
         Event::ArmMotion { motion } if motion.length.is_none() => L::WARN,
         Event::GaveUp { .. } | Event::Error { .. } | Event::Failed { .. } => L::ERROR,
         Event::Asking { .. }

@@ -191,6 +191,51 @@ fn a_recording_cut_mid_entry_replays_up_to_its_last_whole_entry() {
     assert!(text(&out).contains("line 2"), "{}", text(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+/// A reasoning whose claim the world contradicts ("the red cube is on the table", while it
+/// lies on the blue cube) is recorded as doubtful with the claim quoted: the replay says so
+/// where it tells the proposal.
+#[test]
+fn a_false_claim_in_the_reasoning_is_recorded_as_doubtful() {
+    let dir = tmp("record-false-claim");
+    let scenario = fixtures::root().join("scenarios/cell/red_on_blue.toml");
+    let scenario_s = scenario.to_string_lossy().to_string();
+    let record = dir.join("session.jsonl");
+    let record_s = record.to_string_lossy().to_string();
+    {
+        let mut replies = vec![fixtures::false_claim_reply()];
+        replies.extend(fixtures::replies_of("red_on_blue.toml"));
+        let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
+        let base = server.base_url();
+        let out = betr(
+            &dir,
+            &[
+                "resolve",
+                &scenario_s,
+                "--yes",
+                "--base-url",
+                &base,
+                "--model",
+                "fake-model",
+                "--api-key-env",
+                KEY_VAR,
+                "--record",
+                &record_s,
+            ],
+        );
+        assert!(out.status.code().is_some(), "{}", text(&out));
+    }
+    let out = betr(&dir, &["replay", &record_s, "--print"]);
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{log}");
+    assert!(
+        log.contains(
+            "doubtful (it says \"The red cube is on the table\", but \"red cube\" on \"table\" is false at the failure)"
+        ),
+        "{log}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The steps of `replay` in words, as `betr replay --print` tells them.
 fn told(replay: &Replay) -> Vec<String> {
     replay

@@ -209,6 +209,32 @@ fn when_nothing_more_is_asked_the_ways_on_are_shown_and_plan_asks() {
     });
 }
 
+/// A reasoning that states what the world contradicts is marked doubtful with the claim
+/// quoted, after betr's own findings.
+#[test]
+fn a_false_claim_in_the_reasoning_is_marked_doubtful_with_the_claim_quoted() {
+    rt().block_on(async {
+        let mut replies = vec![support::fixtures::false_claim_reply()];
+        replies.extend(support::fixtures::every_reply());
+        let mut b = Bench::answering(replies);
+        b.step_to_failure().await;
+        let doubt = b
+            .app
+            .llm
+            .proposal
+            .as_ref()
+            .and_then(|p| p.doubt.clone())
+            .unwrap_or_default();
+        assert_eq!(
+            doubt,
+            "it says \"The red cube is on the table\", but \"red cube\" on \"table\" is false at the failure"
+        );
+        let screen = b.screen(160, 50);
+        assert!(screen.contains("DOUBTFUL"), "{screen}");
+        insta::assert_snapshot!("a_false_claim_marked_doubtful", screen);
+    });
+}
+
 #[test]
 fn an_approved_fix_kept_as_a_rule_is_marked_in_the_tree() {
     let dir = std::env::temp_dir().join(format!("betr-tui-knowledge-{}", std::process::id()));

@@ -111,3 +111,19 @@ pub fn replies_of(name: &str) -> Vec<FixtureReply> {
         .flat_map(|(p, f)| replies(p, f))
         .collect()
 }
+
+/// Scenario 1's failure answered with the expected fix and a reasoning whose first claim
+/// the world contradicts: the red cube lies on the blue cube, not on the table.
+pub fn false_claim_reply() -> FixtureReply {
+    FixtureReply {
+        when: vec![
+            "# Task: failure resolution".into(),
+            "`grasp \"blue cube\"`".into(),
+        ],
+        seed: None,
+        text: "Reasoning: The red cube is on the table, so the blue cube must be clear.\n\
+               Conditions:\n~\"any object\" on \"blue cube\"\n"
+            .into(),
+        note: "hand-written: a reasoning with a false claim".into(),
+    }
+}

@@ -17,7 +17,7 @@ use betr::voice::{Audio16k, SpeechToText, SttFuture, Transcript};
 use tokio::sync::mpsc::UnboundedReceiver;
 
 use super::fake_model::FixtureModel;
-use super::fixtures;
+use super::fixtures::{self, FixtureReply};
 use super::microphone::AudioMicrophone;
 
 pub struct Bench {
@@ -70,6 +70,25 @@ impl Bench {
         loader: SttLoader,
         knowledge: Option<betr::session::Knowledge>,
     ) -> Bench {
+        Bench::build(microphone, loader, knowledge, fixtures::every_reply())
+    }
+
+    /// A bench whose model answers with `replies` (the first that fits a prompt).
+    pub fn answering(replies: Vec<FixtureReply>) -> Bench {
+        Bench::build(
+            AudioMicrophone::missing(),
+            fixed_words("unused"),
+            None,
+            replies,
+        )
+    }
+
+    fn build(
+        microphone: Arc<dyn Microphone>,
+        loader: SttLoader,
+        knowledge: Option<betr::session::Knowledge>,
+        replies: Vec<FixtureReply>,
+    ) -> Bench {
         // Scenario 1 moves the real arms when the YuMi's description is in the cache: have
         // it there, so the screens do not depend on which tests ran before.
         super::verify::fetch_yumi();
@@ -84,7 +103,7 @@ impl Bench {
             no_model: None,
             keys_error: None,
         };
-        let model = FixtureModel::new(fixtures::every_reply());
+        let model = FixtureModel::new(replies);
         let setup = Setup {
             knowledge,
             ..Setup::new(scenario.clone(), path, Ok(Arc::new(model)))

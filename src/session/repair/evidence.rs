@@ -2,11 +2,13 @@
 //! failure, what stood in the way, the conditions tried in simulation and which fixed it,
 //! what the changes tried before did, and what the offered change did in simulation. A
 //! person approves on this evidence; the model's reasoning comes after it, labelled as the
-//! model's, and is checked against it: a reasoning that names none of the failure's
-//! objects, or blames objects while the simulation found others in the way, is doubtful
-//! and never shown as the reason.
+//! model's, and is checked against it: a reasoning that states a condition of the scene
+//! the facts at the failure contradict, names as missing a condition that holds or the
+//! opposite of its own proposal, names none of the failure's objects, or blames objects
+//! while the simulation found others in the way, is doubtful and never shown as the reason.
 
-use crate::domain::{ANY_OBJECT, Atom, Condition, Object};
+use crate::domain::{ANY_OBJECT, Atom, Condition, Object, Vocabulary};
+use crate::reading::claims::claims;
 
 use super::super::types::{Evidence, Proposal};
 use super::ask::Tried;
@@ -28,8 +30,10 @@ pub struct Found<'a> {
 }
 
 impl Evidence {
-    /// The evidence of `found`, with `reasoning` (the model's, if any) checked against it.
-    pub fn of(found: &Found<'_>, reasoning: Option<&str>, scene: &[Object]) -> Evidence {
+    /// The evidence of `found`, with `reasoning` (the model's, if any) checked against it
+    /// and against the scene's `vocabulary`.
+    pub fn of(found: &Found<'_>, reasoning: Option<&str>, vocabulary: &Vocabulary) -> Evidence {
+        let scene = &vocabulary.objects;
         let failure = found.failure;
         let mut findings = vec![format!("{}! failed: {}", failure.action, failure.error)];
         let mut objects: Vec<String> = failure.action.args.clone();
@@ -72,7 +76,9 @@ impl Evidence {
             Some(v) => format!("this change, tried in simulation: {}", verdict_text(v)),
             None => "this change was not tried in simulation before it was offered".into(),
         });
-        let doubt = reasoning.and_then(|r| doubt(r, &objects, &blockers, scene));
+        let doubt = reasoning.and_then(|r| {
+            contradicted(r, found, vocabulary).or_else(|| doubt(r, &objects, &blockers, scene))
+        });
         Evidence {
             findings,
             objects,
@@ -149,6 +155,51 @@ fn covers(pattern: &Atom, atom: &Atom) -> bool {
             .iter()
             .zip(&atom.args)
             .all(|(p, a)| p == ANY_OBJECT || p == a)
+}
+
+/// The first claim of `reasoning` about the scene's conditions that the facts at the
+/// failure or the proposal contradict, quoted with what contradicts it: a condition said to
+/// hold (or not) that does not (or does); one named as missing that holds already; one
+/// said to be needed whose opposite is proposed.
+fn contradicted(reasoning: &str, found: &Found<'_>, vocabulary: &Vocabulary) -> Option<String> {
+    let true_now = |atom: &Atom| found.facts.iter().any(|f| !f.negated && f.atom == *atom);
+    let proposed: &[Condition] = match found.proposal {
+        Proposal::Conditions { conditions, .. } => conditions,
+        _ => &[],
+    };
+    for claim in claims(reasoning, vocabulary) {
+        let atom = &claim.condition.atom;
+        if vocabulary.check_atom(atom).is_err() {
+            continue;
+        }
+        let holds = true_now(atom) != claim.condition.negated;
+        let said = &claim.said;
+        if !claim.needed && !holds {
+            let truth = if claim.condition.negated {
+                "true"
+            } else {
+                "false"
+            };
+            return Some(format!(
+                "it says \"{said}\", but {atom} is {truth} at the failure"
+            ));
+        }
+        if claim.as_missing && holds {
+            return Some(format!(
+                "it says \"{said}\", but {} holds already at the failure",
+                claim.condition
+            ));
+        }
+        let opposite = proposed
+            .iter()
+            .any(|p| p.negated != claim.condition.negated && covers(&p.atom, atom));
+        if claim.needed && opposite {
+            return Some(format!(
+                "it says \"{said}\", the opposite of its own proposal"
+            ));
+        }
+    }
+    None
 }
 
 /// Why `reasoning` is not to be taken as the reason: it names none of `objects` (the
@@ -231,19 +282,14 @@ mod tests {
     use crate::bt::NodeId;
     use crate::domain::ActionCall;
 
-    fn object(name: &str) -> Object {
-        Object {
-            name: name.into(),
-            types: vec!["cube".into()],
-            called: Vec::new(),
-        }
-    }
-
-    fn scene() -> Vec<Object> {
-        ["table", "blue cube", "green cube", "red cube"]
-            .into_iter()
-            .map(object)
-            .collect()
+    /// Scenario 1's vocabulary: the table and three cubes.
+    fn vocabulary() -> Vocabulary {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/cell/red_on_blue.toml");
+        crate::scenario::Scenario::load(&path)
+            .unwrap()
+            .domain
+            .vocabulary
     }
 
     fn condition(text: &str) -> Condition {
@@ -261,6 +307,7 @@ mod tests {
             condition("\"blue cube\" on \"table\""),
             condition("\"green cube\" on \"table\""),
             condition("\"red cube\" on \"blue cube\""),
+            condition("\"blue cube\" near robot"),
         ];
         let fixes = vec![
             condition("~\"any object\" on \"blue cube\""),
@@ -285,7 +332,7 @@ mod tests {
             proposal: &proposal,
             verdict: Some(Verdict::Succeeds),
         };
-        Evidence::of(&found, Some(reasoning), &scene())
+        Evidence::of(&found, Some(reasoning), &vocabulary())
     }
 
     #[test]
@@ -333,6 +380,40 @@ mod tests {
     fn a_reasoning_cut_mid_sentence_is_doubtful() {
         let e = evidence_of("The red cube is on the blue cube and the");
         assert_eq!(e.doubt.as_deref(), Some("it stops mid-sentence"));
+    }
+
+    /// The claims the engineer found unmarked: each contradicted, quoted.
+    #[test]
+    fn a_claim_the_facts_or_the_proposal_contradict_is_doubtful_with_the_claim_quoted() {
+        let e = evidence_of("The blue cube was not near the robot, so the arm cannot reach it.");
+        assert_eq!(
+            e.doubt.as_deref(),
+            Some(
+                "it says \"The blue cube was not near the robot\", but \"blue cube\" near robot is true at the failure"
+            )
+        );
+        let e = evidence_of("The missing condition is that the red cube must not be on the table.");
+        assert_eq!(
+            e.doubt.as_deref(),
+            Some(
+                "it says \"The missing condition is that the red cube must not be on the table\", but ~\"red cube\" on \"table\" holds already at the failure"
+            )
+        );
+        let e = evidence_of("The green cube is on the blue cube.");
+        assert!(
+            e.doubt
+                .as_deref()
+                .is_some_and(|d| d.contains("\"green cube\" on \"blue cube\" is false")),
+            "{:?}",
+            e.doubt
+        );
+        let e = evidence_of("The blue cube must have something on it: nothing may be moved.");
+        assert_eq!(e.doubt, None, "no claim read, none contradicted");
+        // True claims, and a need the proposal answers, leave the reasoning alone.
+        let e = evidence_of(
+            "The red cube is on the blue cube. The blue cube needs to have nothing on it.",
+        );
+        assert_eq!(e.doubt, None);
     }
 
     #[test]

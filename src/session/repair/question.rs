@@ -91,7 +91,7 @@ impl Question {
             Some(Box::new(Evidence::of(
                 &found,
                 reasoning.as_deref(),
-                &scenario.domain.vocabulary.objects,
+                &scenario.domain.vocabulary,
             )))
         });
         Answer { result, evidence }
