@@ -297,4 +297,29 @@ mod tests {
         assert!(said("Focus on the blue cube.").is_empty());
         assert!(said("The blue cube failed to move on top of the table.").is_empty());
     }
+
+    /// A domain the reader was not written for: symbol names, the scene's own words.
+    #[test]
+    fn a_domain_of_symbol_names_is_read_the_same_way() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/warehouse/warehouse.toml");
+        let vocabulary = crate::scenario::Scenario::load(&path)
+            .unwrap()
+            .domain
+            .vocabulary;
+        let said: Vec<(String, bool)> = claims(
+            "The small box is not on pallet 1 because the robot put it onto the conveyor. \
+             The fragile box must be on the packing station.",
+            &vocabulary,
+        )
+        .into_iter()
+        .map(|c| (c.condition.to_string(), c.needed))
+        .collect();
+        assert_eq!(
+            said,
+            [
+                ("~On_SmallBox_Pallet1".to_string(), false),
+                ("On_FragileBox_PackingStation".to_string(), true),
+            ]
+        );
+    }
 }
