@@ -406,11 +406,8 @@ pub enum Event {
         rounds_left: bool,
         undoable: bool,
     },
-    /// How many fixes are refused for the current goal's failures (by a person, the
-    /// simulation or verification); told whenever it changes.
-    RefusedFixes {
-        count: usize,
-    },
+    /// How many fixes are refused and unsaved; told whenever either changes.
+    FixCounts(FixCounts),
     /// The tree changed: all of it, the nodes the change added, the conditions learned
     /// rules put there (with the rules' ids), and why.
     TreeChanged {
@@ -569,6 +566,15 @@ pub enum Ending {
     Success { ticks: u64 },
     Rejected,
     GaveUp { reason: String },
+}
+
+/// Fixes the session holds for its goal, counted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct FixCounts {
+    /// Refused for the goal's failures (by a person, the simulation or verification).
+    pub refused: usize,
+    /// Applied to the tree and held by no saved policy.
+    pub unsaved: usize,
 }
 
 /// The loop's result: the final tree (with every change that helped) and how it ended.

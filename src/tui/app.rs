@@ -387,7 +387,6 @@ impl App {
             Action::Cancel => Command::Cancel,
             Action::Undo => {
                 self.llm.offer = None;
-                self.summary.unsaved_fixes = self.summary.unsaved_fixes.saturating_sub(1);
                 Command::Undo
             }
             Action::Verify => Command::Verify,

@@ -48,11 +48,27 @@ fn an_undone_fix_is_a_candidate_again() {
         let mut s = Session::start(setup(Ok(Arc::new(model(Duration::ZERO))), None));
         s.run_to_proposal().await;
         s.send(Command::Approve);
-        s.until("repaired", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
+        s.until(
+            "one fix unsaved",
+            |e| matches!(e, Event::FixCounts(c) if c.unsaved == 1),
+        )
+        .await;
         s.send(Command::Undo);
-        s.until("undone", |e| matches!(e, Event::TreeChanged { .. }))
+        // The engine's count follows the tree: the undone fix is no longer unsaved, and
+        // a second undo (nothing to undo) changes no count.
+        s.until(
+            "no fix unsaved",
+            |e| matches!(e, Event::FixCounts(c) if c.unsaved == 0),
+        )
+        .await;
+        s.send(Command::Undo);
+        let got = s
+            .until("nothing to undo", |e| matches!(e, Event::Error { .. }))
             .await;
+        assert!(
+            !got.iter().any(|e| matches!(e, Event::FixCounts(_))),
+            "{got:#?}"
+        );
         s.seen.clear();
         let again = s.run_to_proposal().await;
         let notice = shortlist_notice(&again).unwrap();

@@ -49,7 +49,10 @@ fn failure_with_a_pending_proposal_then_approval() {
         insta::assert_snapshot!("failure_with_pending_proposal", screen);
 
         b.key(KeyCode::Char('a'));
-        b.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        // The changed tree is verified before it runs: the screen after its verdict.
+        b.until(|e| matches!(e, Event::Notice { message } if message == "the changed tree verifies in the model"))
+            .await;
+        assert_eq!(b.app.summary.unsaved_fixes, 1);
         let screen = b.screen(120, 40);
         assert!(
             screen.contains("+[-] ~\"any object\" on \"blue cube\"?"),
@@ -200,7 +203,7 @@ fn when_nothing_more_is_asked_the_ways_on_are_shown_and_plan_asks() {
         b.key(KeyCode::Char('p'));
         b.key(KeyCode::Char('f'));
         assert_eq!(b.sent.last(), Some(&Command::Plan));
-        b.until(|e| matches!(e, Event::RefusedFixes { count: 0 }))
+        b.until(|e| matches!(e, Event::FixCounts(c) if c.refused == 0))
             .await;
         assert_eq!(b.app.refused_fixes, 0, "forgotten");
         // With none refused, p plans at once.

@@ -178,12 +178,12 @@ impl Engine {
         self.task.tried = refused;
     }
 
-    /// Tell the front end how many fixes are refused now, when that changed.
-    pub(super) fn tell_refused(&mut self) {
-        let count = self.task.tried.len();
-        if count != self.task.told_refused {
-            self.task.told_refused = count;
-            self.emit(Event::RefusedFixes { count });
+    /// Tell the front end how many fixes are refused and unsaved now, when that changed.
+    pub(super) fn tell_counts(&mut self) {
+        let counts = self.task.counts();
+        if counts != self.task.told {
+            self.task.told = counts;
+            self.emit(Event::FixCounts(counts));
         }
     }
 
@@ -271,6 +271,7 @@ impl Engine {
         self.drop_offers();
         let undone = self.task.fixes.len().saturating_sub(entry.fixes);
         self.task.fixes.truncate(entry.fixes);
+        self.task.saved = self.task.saved.min(entry.fixes);
         // Undoing is not rejecting: the undone change may be proposed again.
         if let Some(proposal) = &entry.proposal {
             self.task.tried.retain(|(_, t)| &t.proposal != proposal);

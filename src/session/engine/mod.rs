@@ -325,7 +325,7 @@ impl Engine {
                 },
                 Some(message) = self.internal_rx.recv() => {
                     self.on_internal(message);
-                    self.tell_refused();
+                    self.tell_counts();
                 }
                 () = pace(interval), if running => self.run_step(),
             }
@@ -336,7 +336,7 @@ impl Engine {
     /// Carry out one command (model calls it starts run on the current tokio runtime).
     pub fn handle(&mut self, command: Command) {
         self.carry_out(command);
-        self.tell_refused();
+        self.tell_counts();
     }
 
     /// What a command does depends on the phase; commands that mean the same in every
@@ -448,7 +448,7 @@ impl Engine {
         match self.internal_rx.recv().await {
             Some(m) => {
                 self.on_internal(m);
-                self.tell_refused();
+                self.tell_counts();
                 true
             }
             None => false,

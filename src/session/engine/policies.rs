@@ -55,10 +55,13 @@ impl Engine {
             tree: tree.clone(),
         };
         match policy::save(&path, &saved) {
-            Ok(()) => self.emit(Event::PolicySaved {
-                path,
-                fixes: saved.fixes.len(),
-            }),
+            Ok(()) => {
+                self.task.saved = self.task.fixes.len();
+                self.emit(Event::PolicySaved {
+                    path,
+                    fixes: saved.fixes.len(),
+                });
+            }
             Err(e) => self.emit(Event::Failed { error: e.into() }),
         }
     }
@@ -137,6 +140,7 @@ impl Engine {
                 at: f.at.clone(),
             })
             .collect();
+        self.task.saved = self.task.fixes.len();
         self.emit(Event::PolicyLoaded {
             path: path.clone(),
             fixes: self.task.fixes.len(),

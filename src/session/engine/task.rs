@@ -7,7 +7,7 @@ use crate::bt::{NodeId, Tree};
 use crate::goal::Formula;
 use crate::session::policy::Approval;
 use crate::session::repair::ask::Tried;
-use crate::session::types::Proposal;
+use crate::session::types::{FixCounts, Proposal};
 
 use super::phase::Failure;
 
@@ -65,8 +65,10 @@ pub(super) struct Task {
     pub(super) tried: Vec<(Failure, Tried)>,
     /// Questions asked about failures of this tree.
     pub(super) rounds: usize,
-    /// How many refused fixes the front end was last told of (`Event::RefusedFixes`).
-    pub(super) told_refused: usize,
+    /// How many of `fixes` a saved policy holds (the first ones).
+    pub(super) saved: usize,
+    /// The counts the front end was last told (`Event::FixCounts`).
+    pub(super) told: FixCounts,
 }
 
 impl Task {
@@ -78,6 +80,16 @@ impl Task {
         self.tried.clear();
         self.undo.clear();
         self.fixes.clear();
+        self.saved = 0;
+    }
+
+    /// The fixes refused for the goal's failures, and those applied that no saved policy
+    /// holds.
+    pub(super) fn counts(&self) -> FixCounts {
+        FixCounts {
+            refused: self.tried.len(),
+            unsaved: self.fixes.len().saturating_sub(self.saved),
+        }
     }
 
     /// Record the tree before a change, to undo it.

@@ -29,7 +29,7 @@ impl App {
             | Event::DidNotHelp { .. }
             | Event::GaveUp { .. }
             | Event::PersonDecides { .. }
-            | Event::RefusedFixes { .. }) => self.on_failure_or_proposal(e),
+            | Event::FixCounts(_)) => self.on_failure_or_proposal(e),
             e @ (Event::Ticked { .. }
             | Event::WorldChanged { .. }
             | Event::RunState { .. }
@@ -176,7 +176,6 @@ impl App {
                 added_nodes,
                 valued_nodes,
             } => {
-                self.summary.unsaved_fixes += 1;
                 self.llm.log(strings::repaired(added_nodes, valued_nodes));
             }
             _ => {}
@@ -250,8 +249,9 @@ impl App {
                 });
                 self.show_guidance();
             }
-            Event::RefusedFixes { count } => {
-                self.refused_fixes = count;
+            Event::FixCounts(counts) => {
+                self.refused_fixes = counts.refused;
+                self.summary.unsaved_fixes = counts.unsaved;
                 self.show_guidance();
             }
             _ => {}
@@ -324,7 +324,6 @@ impl App {
             Event::PolicySaved { path, fixes } => {
                 self.llm
                     .log(strings::policy_saved(&path.display().to_string(), fixes));
-                self.summary.unsaved_fixes = 0;
                 self.summary.policies.push(path);
             }
             Event::Exported { paths } => {
@@ -335,7 +334,6 @@ impl App {
             Event::PolicyLoaded { path, fixes } => {
                 self.llm
                     .log(strings::policy_loaded(&path.display().to_string(), fixes));
-                self.summary.unsaved_fixes = 0;
                 self.llm.goal_by = Some(strings::from_policy(&path.display().to_string()));
             }
             _ => {}
