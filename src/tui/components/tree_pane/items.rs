@@ -97,6 +97,24 @@ pub(super) fn node_label(tree: &Tree, node: NodeId, theme: &Theme) -> String {
     }
 }
 
+/// What a composite is for, so a collapsed one still says it: a fallback's condition
+/// (` for "blue cube" on "green cube"`, what its other children achieve when it fails), a
+/// sequence's last action (` to grasp "blue cube"!`, what the children before prepare).
+fn purpose(tree: &Tree, node: NodeId) -> Option<String> {
+    let children = tree.children(node).ok()?;
+    match tree.kind(node).ok()? {
+        NodeKind::Fallback => match tree.kind(*children.first()?).ok()? {
+            NodeKind::Condition(c) => Some(strings::fallback_for(&c.to_string())),
+            _ => None,
+        },
+        NodeKind::Sequence => match tree.kind(*children.last()?).ok()? {
+            NodeKind::Action(a) => Some(strings::sequence_to(&a.to_string())),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
 /// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
 fn node_line(
     tree: &Tree,
@@ -131,6 +149,9 @@ fn node_line(
         theme.status(status)
     };
     spans.push(Span::styled(label, style));
+    if let Some(purpose) = purpose(tree, node) {
+        spans.push(Span::styled(purpose, theme.dim));
+    }
     if failing {
         spans.push(Span::styled(
             format!(" {}", strings::FAILED_MARK),
