@@ -250,19 +250,24 @@ mod tests {
     use super::*;
     use std::path::Path;
 
-    fn cell() -> Vocabulary {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml");
+    fn vocabulary(scenario: &str) -> Vocabulary {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(scenario);
         crate::scenario::Scenario::load(&path)
             .unwrap()
             .domain
             .vocabulary
     }
 
-    fn said(text: &str) -> Vec<(String, bool)> {
-        claims(text, &cell())
+    /// What `text` claims over `scenario`'s vocabulary, in words.
+    fn said_in(scenario: &str, text: &str) -> Vec<(String, bool)> {
+        claims(text, &vocabulary(scenario))
             .into_iter()
             .map(|c| (c.condition.to_string(), c.needed))
             .collect()
+    }
+
+    fn said(text: &str) -> Vec<(String, bool)> {
+        said_in("scenarios/cell/red_on_blue.toml", text)
     }
 
     #[test]
@@ -301,19 +306,11 @@ mod tests {
     /// A domain the reader was not written for: symbol names, the scene's own words.
     #[test]
     fn a_domain_of_symbol_names_is_read_the_same_way() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/warehouse/warehouse.toml");
-        let vocabulary = crate::scenario::Scenario::load(&path)
-            .unwrap()
-            .domain
-            .vocabulary;
-        let said: Vec<(String, bool)> = claims(
+        let said = said_in(
+            "scenarios/warehouse/warehouse.toml",
             "The small box is not on pallet 1 because the robot put it onto the conveyor. \
              The fragile box must be on the packing station.",
-            &vocabulary,
-        )
-        .into_iter()
-        .map(|c| (c.condition.to_string(), c.needed))
-        .collect();
+        );
         assert_eq!(
             said,
             [
