@@ -1,7 +1,9 @@
 //! What a text (a model's reasoning about a failure) claims about the scene's conditions,
 //! read from its words: in each clause, an object of the scene, then a predicate's words
 //! ("on", "near the robot", "grasped", or the words the scene lists for it and for its
-//! opposite), then — for a relation — a second object. A negation between them turns the
+//! opposite), then — for a relation — a second object; between the first object and the
+//! predicate, a word that links them ("is", "lies", "must be"), or the object is only what
+//! a verb acts on ("place the cube on the table"). A negation between them turns the
 //! claim round; a word of need ("must", "needs to") makes it a claim about what is
 //! missing rather than about what holds. Clauses that only suppose ("if", "once", "would")
 //! claim nothing. Nothing here knows the world: [`Claim`]s are checked by those who do.
@@ -179,6 +181,14 @@ fn claim_at(
     {
         return None;
     }
+    // A statement links the object to what is said of it ("is", "must be"); without such a
+    // word the object is what a verb acts on ("place the blue cube on the green cube").
+    if !between
+        .iter()
+        .any(|w| listed(BEING, w) || needs(w) || contracted.contains(w))
+    {
+        return None;
+    }
     let negated = between
         .iter()
         .any(|w| is_negation(w) || contracted.contains(w));
@@ -301,6 +311,12 @@ mod tests {
         // "on" without an object before it, and objects far apart, say no relation.
         assert!(said("Focus on the blue cube.").is_empty());
         assert!(said("The blue cube failed to move on top of the table.").is_empty());
+        // What the robot was doing is no claim of what holds (the embedded model's own
+        // words in scenario 1).
+        assert!(
+            said("The robot was trying to place the blue cube on the green cube, but it failed.")
+                .is_empty()
+        );
     }
 
     /// A domain the reader was not written for: symbol names, the scene's own words.
