@@ -234,8 +234,8 @@ fn phrase_len(words: &[String], at: usize, phrase: &[String]) -> usize {
     end - at
 }
 
-/// The clauses of a text: cut at sentence ends, semicolons and commas, and before the
-/// words that join clauses.
+/// The clauses of a text: cut at sentence ends, semicolons and commas, and at the words
+/// that join clauses (left out of both).
 fn clauses(text: &str) -> Vec<&str> {
     let mut out = Vec::new();
     for sentence in text.split(['.', ';', '!', '?', ',', ':', '\n']) {
@@ -247,7 +247,7 @@ fn clauses(text: &str) -> Vec<&str> {
                 "and" | "but" | "because" | "so" | "since" | "while" | "whereas" | "which"
             ) {
                 out.push(&sentence[start..i]);
-                start = i + 1;
+                start = i + 1 + next.len();
             }
         }
         out.push(&sentence[start..]);
@@ -316,6 +316,23 @@ mod tests {
         assert!(
             said("The robot was trying to place the blue cube on the green cube, but it failed.")
                 .is_empty()
+        );
+    }
+
+    /// A claim is quoted as its clause says it, without the word that joined it on.
+    #[test]
+    fn a_clause_is_quoted_without_its_joining_word() {
+        let claims = claims(
+            "The blue cube was on the table and the red cube was on the table.",
+            &vocabulary("scenarios/cell/red_on_blue.toml"),
+        );
+        let said: Vec<&str> = claims.iter().map(|c| c.said.as_str()).collect();
+        assert_eq!(
+            said,
+            [
+                "The blue cube was on the table",
+                "the red cube was on the table"
+            ]
         );
     }
 

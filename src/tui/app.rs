@@ -253,39 +253,8 @@ impl App {
             if key.code == KeyCode::Enter || key.code == KeyCode::Esc {
                 self.status.message = None;
             }
-            match self.input.event(&key) {
-                Some(Submitted::Instruction(text)) => {
-                    self.llm.error = None;
-                    // A goal formula the scene cannot hold stays in the line with why under
-                    // it, as an edit does; the engine would refuse it the same way.
-                    match crate::session::interpret::submitted::read(&self.scenario, &text) {
-                        Err(e) => {
-                            self.show_error(e.to_string());
-                            self.input
-                                .reopen_with_error(Mode::Instruction, &text, e.reason());
-                        }
-                        Ok(_) => self.queue.push(AppEvent::Command(Command::Submit(text))),
-                    }
-                }
-                Some(Submitted::Edit(text)) => {
-                    self.llm.error = None;
-                    match parse_edit(&self.scenario, &text) {
-                        Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
-                        // Shown as the engine's errors are, and the line stays as typed
-                        // with the error under it; nothing reaches the session.
-                        Err(e) => {
-                            self.show_error(e.to_string());
-                            self.input
-                                .reopen_with_error(Mode::Edit, &text, e.to_string());
-                        }
-                    }
-                }
-                Some(Submitted::Filter(text)) => self.world.set_filter(Some(text)),
-                Some(Submitted::Search(text)) => {
-                    self.tree.query = (!text.is_empty()).then(|| text.clone());
-                    self.search(true);
-                }
-                None => {}
+            if let Some(submitted) = self.input.event(&key) {
+                self.on_submitted(submitted);
             }
             return;
         }
@@ -296,50 +265,99 @@ impl App {
             self.dictation.idle();
             return;
         }
-        if let Some(Overlay::Readings(readings, _)) = &self.overlay {
-            return self.on_reading_key(&key, readings.len());
-        }
-        if let Some(Overlay::ConfirmQuit(_)) = &self.overlay {
-            self.overlay = None;
-            // The question names the save key for the unsaved fixes: it saves them, and
-            // the person quits after (any other key stays).
-            match self.keys.action_in(self.mode, &key) {
-                Some(Action::Quit) => self.queue.push(AppEvent::Quit),
-                Some(Action::Save) => self.on_action(Action::Save),
-                _ => {}
-            }
-            return;
-        }
-        if let Some(Overlay::PlanAgain(_)) = &self.overlay {
-            self.overlay = None;
-            match key.code {
-                KeyCode::Char(strings::KEEP_REFUSED_KEY) => self
-                    .queue
-                    .push(AppEvent::Command(Command::PlanKeepingRefused)),
-                KeyCode::Char(strings::FORGET_REFUSED_KEY) => {
-                    self.queue.push(AppEvent::Command(Command::Plan));
-                }
-                _ => {}
-            }
-            return;
-        }
-        if let Some(Overlay::Help(first)) = self.overlay {
-            let last = self.keys.help_lines(self.mode).len().saturating_sub(1);
-            self.overlay = match key.code {
-                KeyCode::Down | KeyCode::Char('j') => Some(Overlay::Help((first + 1).min(last))),
-                KeyCode::Up | KeyCode::Char('k') => Some(Overlay::Help(first.saturating_sub(1))),
-                KeyCode::PageDown => Some(Overlay::Help((first + HELP_PAGE).min(last))),
-                KeyCode::PageUp => Some(Overlay::Help(first.saturating_sub(HELP_PAGE))),
-                _ => None,
-            };
-            return;
-        }
-        if self.overlay.take().is_some() {
-            return;
+        if self.overlay.is_some() {
+            return self.on_overlay_key(&key);
         }
         match self.keys.action_in(self.mode, &key) {
             Some(action) => self.on_action(action),
             None => self.on_navigation(&key),
+        }
+    }
+
+    /// What the input line gave when Enter was pressed: an instruction or a fix is read
+    /// over the scene's vocabulary first, and stays in the line with why when it cannot be.
+    fn on_submitted(&mut self, submitted: Submitted) {
+        match submitted {
+            Submitted::Instruction(text) => {
+                self.llm.error = None;
+                // A goal formula the scene cannot hold stays in the line with why under
+                // it, as an edit does; the engine would refuse it the same way.
+                match crate::session::interpret::submitted::read(&self.scenario, &text) {
+                    Err(e) => {
+                        self.show_error(e.to_string());
+                        self.input
+                            .reopen_with_error(Mode::Instruction, &text, e.reason());
+                    }
+                    Ok(_) => self.queue.push(AppEvent::Command(Command::Submit(text))),
+                }
+            }
+            Submitted::Edit(text) => {
+                self.llm.error = None;
+                match parse_edit(&self.scenario, &text) {
+                    Ok(edit) => self.queue.push(AppEvent::Command(Command::Edit(edit))),
+                    // Shown as the engine's errors are, and the line stays as typed
+                    // with the error under it; nothing reaches the session.
+                    Err(e) => {
+                        self.show_error(e.to_string());
+                        self.input
+                            .reopen_with_error(Mode::Edit, &text, e.to_string());
+                    }
+                }
+            }
+            Submitted::Filter(text) => self.world.set_filter(Some(text)),
+            Submitted::Search(text) => {
+                self.tree.query = (!text.is_empty()).then(|| text.clone());
+                self.search(true);
+            }
+        }
+    }
+
+    /// A key while an overlay is shown: its own keys (a reading's number, the quit and
+    /// save keys of the quit question, keep or forget before planning again, scrolling the
+    /// help); any other key closes it.
+    fn on_overlay_key(&mut self, key: &KeyEvent) {
+        match &self.overlay {
+            Some(Overlay::Readings(readings, _)) => {
+                let count = readings.len();
+                self.on_reading_key(key, count);
+            }
+            Some(Overlay::ConfirmQuit(_)) => {
+                self.overlay = None;
+                // The question names the save key for the unsaved fixes: it saves them, and
+                // the person quits after (any other key stays).
+                match self.keys.action_in(self.mode, key) {
+                    Some(Action::Quit) => self.queue.push(AppEvent::Quit),
+                    Some(Action::Save) => self.on_action(Action::Save),
+                    _ => {}
+                }
+            }
+            Some(Overlay::PlanAgain(_)) => {
+                self.overlay = None;
+                let command = match key.code {
+                    KeyCode::Char(strings::KEEP_REFUSED_KEY) => Some(Command::PlanKeepingRefused),
+                    KeyCode::Char(strings::FORGET_REFUSED_KEY) => Some(Command::Plan),
+                    _ => None,
+                };
+                if let Some(command) = command {
+                    self.queue.push(AppEvent::Command(command));
+                }
+            }
+            Some(Overlay::Help(first)) => {
+                let first = *first;
+                let last = self.keys.help_lines(self.mode).len().saturating_sub(1);
+                self.overlay = match key.code {
+                    KeyCode::Down | KeyCode::Char('j') => {
+                        Some(Overlay::Help((first + 1).min(last)))
+                    }
+                    KeyCode::Up | KeyCode::Char('k') => {
+                        Some(Overlay::Help(first.saturating_sub(1)))
+                    }
+                    KeyCode::PageDown => Some(Overlay::Help((first + HELP_PAGE).min(last))),
+                    KeyCode::PageUp => Some(Overlay::Help(first.saturating_sub(HELP_PAGE))),
+                    _ => None,
+                };
+            }
+            Some(Overlay::Report { .. }) | None => self.overlay = None,
         }
     }
 
