@@ -24,11 +24,21 @@ fn offered(
     doubt: Option<String>,
 ) -> App {
     let mut app = App::new(
-        scenario,
+        scenario.clone(),
         Info::default(),
         KeyBindings::default(),
         Theme::default(),
     );
+    // The model's answer comes first; the readings follow it when they differ.
+    if let Some(first) = readings.first() {
+        app.on_session(Event::Goal {
+            goal: first.goal.clone(),
+            reasoning: Some("the first reading".into()),
+            matches_expected: None,
+            author: "model".into(),
+            first_answer: None,
+        });
+    }
     app.on_session(Event::Readings {
         instruction: "a request".into(),
         readings,
@@ -57,6 +67,8 @@ fn readings_to_choose_among_are_shown_over_the_screen() {
     };
     let screen = draw(&mut app);
     assert!(screen.contains("Readings of the instruction"), "{screen}");
+    // While the choice waits, no goal is shown as the one worked on.
+    assert_eq!(app.llm.goal, None);
     insta::assert_snapshot!("readings_overlay", screen);
     // Keys other than a reading's number leave the choice open.
     for code in [KeyCode::Char(' '), KeyCode::Char('9'), KeyCode::Enter] {

@@ -145,6 +145,11 @@ impl App {
                         readings.len()
                     ),
                 });
+                // No goal is worked on until the person chooses: the model's first answer
+                // is not shown as the goal meanwhile.
+                self.llm.goal = None;
+                self.llm.goal_by = None;
+                self.llm.goal_reasoning = None;
                 self.overlay = Some(Overlay::Readings(readings, doubt));
             }
             Event::Usage { totals } => self.status.usage = totals,
