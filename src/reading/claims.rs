@@ -10,7 +10,9 @@
 
 use crate::domain::{Atom, Condition, Object, Predicate, Vocabulary};
 
-use super::english::{BEING, HYPOTHETICAL, MISSING, NEEDING, is_negated_form, is_negation};
+use super::english::{
+    ARTICLES, BEING, HYPOTHETICAL, MISSING, NEEDING, is_negated_form, is_negation,
+};
 use super::words::{every_term, same_word};
 
 /// A condition of the scene the text says holds (or does not), or is needed.
@@ -47,8 +49,9 @@ pub fn claims(text: &str, vocabulary: &Vocabulary) -> Vec<Claim> {
         let mentions = mentions(&words, &vocabulary.objects);
         let as_missing = words.iter().any(|w| listed(MISSING, w));
         for form in &forms {
-            for at in phrase_at(&words, &form.words) {
-                let Some((condition, needed)) = claim_at(&words, &mentions, form, at, &contracted)
+            for span in phrase_spans(&words, &form.words) {
+                let Some((condition, needed)) =
+                    claim_at(&words, &mentions, form, span, &contracted)
                 else {
                     continue;
                 };
@@ -116,12 +119,8 @@ fn mentions<'a>(words: &[String], objects: &'a [Object]) -> Vec<Mention<'a>> {
     for object in objects {
         for name in std::iter::once(&object.name).chain(&object.called) {
             let name_words = every_term(name);
-            for start in phrase_at(words, &name_words) {
-                all.push(Mention {
-                    start,
-                    end: start + name_words.len(),
-                    object,
-                });
+            for (start, end) in phrase_spans(words, &name_words) {
+                all.push(Mention { start, end, object });
             }
         }
     }
@@ -135,41 +134,41 @@ fn mentions<'a>(words: &[String], objects: &'a [Object]) -> Vec<Mention<'a>> {
     kept
 }
 
-/// Where `phrase` starts in `words`, its words in order with articles allowed between
-/// ("near the robot" says `near robot`).
-fn phrase_at(words: &[String], phrase: &[String]) -> Vec<usize> {
+/// Where `phrase` stands in `words` (its first word, and the word after its last), its
+/// words in order with articles allowed between ("near the robot" says `near robot`).
+fn phrase_spans(words: &[String], phrase: &[String]) -> Vec<(usize, usize)> {
     let Some(first) = phrase.first() else {
         return Vec::new();
     };
     let alike = |a: &str, b: &str| if b.len() < 4 { a == b } else { same_word(a, b) };
     (0..words.len())
-        .filter(|&start| {
+        .filter_map(|start| {
             if !alike(&words[start], first) {
-                return false;
+                return None;
             }
             let mut at = start + 1;
             for want in &phrase[1..] {
-                while at < words.len() && matches!(words[at].as_str(), "the" | "a" | "an") {
+                while at < words.len() && ARTICLES.contains(&words[at].as_str()) {
                     at += 1;
                 }
                 if at >= words.len() || !alike(&words[at], want) {
-                    return false;
+                    return None;
                 }
                 at += 1;
             }
-            true
+            Some((start, at))
         })
         .collect()
 }
 
-/// The claim of a predicate's words at `at`: the object just before them (only words of
+/// The claim of a predicate's words at `(at, end)`: the object just before them (only words of
 /// being, need and negation between), and for a relation the object just after; with
 /// whether it is turned round and whether it says what is needed.
 fn claim_at(
     words: &[String],
     mentions: &[Mention],
     form: &Form,
-    at: usize,
+    (at, end): (usize, usize),
     contracted: &[String],
 ) -> Option<(Condition, bool)> {
     let subject = mentions.iter().rev().find(|m| m.end <= at)?;
@@ -195,12 +194,11 @@ fn claim_at(
     let needed = between.iter().any(needs);
     let mut args = vec![subject.object.name.clone()];
     if form.predicate.arg_types.len() == 2 {
-        let end = at + phrase_len(words, at, &form.words);
         let object = mentions.iter().find(|m| m.start >= end)?;
         let gap = &words[end..object.start];
         if !gap
             .iter()
-            .all(|w| matches!(w.as_str(), "the" | "a" | "an" | "top" | "of"))
+            .all(|w| ARTICLES.contains(&w.as_str()) || matches!(w.as_str(), "top" | "of"))
         {
             return None;
         }
@@ -220,18 +218,6 @@ fn claim_at(
 fn listed(list: &[&str], word: &str) -> bool {
     list.iter()
         .any(|w| every_term(w).first().is_some_and(|t| t == word))
-}
-
-/// How many words the phrase takes from `at`, articles between its words counted.
-fn phrase_len(words: &[String], at: usize, phrase: &[String]) -> usize {
-    let mut end = at + 1;
-    for _ in 1..phrase.len() {
-        while end < words.len() && matches!(words[end].as_str(), "the" | "a" | "an") {
-            end += 1;
-        }
-        end += 1;
-    }
-    end - at
 }
 
 /// The clauses of a text: cut at sentence ends, semicolons and commas, and at the words
