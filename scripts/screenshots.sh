@@ -3,7 +3,9 @@
 # (tmux, 140×45), driven with keys as a person would on scenario 1 with the embedded
 # default model, captured with its colours at three moments and drawn as SVG images into
 # docs/images/: the planned tree, the failure with the proposal awaiting approval, and
-# success after the repair. Run it again whenever the screens change.
+# success after the repair. Each picture comes with the terminal's plain text of the same
+# capture (NAME.txt beside NAME.svg), which `bash scripts/check-pictures.sh` compares with
+# the picture as a browser renders it. Run it again whenever the screens change.
 # Usage: bash scripts/screenshots.sh   (needs tmux and python3; fetches the model once)
 #        BETR=path/to/betr bash scripts/screenshots.sh   (a betr already built, e.g. the
 #        dev profile's target/debug/betr, instead of building the release one)
@@ -50,9 +52,11 @@ wait_for() {
     sleep 0.2
   done
 }
+# One capture drawn as $out/NAME.svg, its plain text as $out/NAME.txt.
 shot() {
-  tmux -L "$socket" capture-pane -e -p -t betr | python3 scripts/ansi_to_svg.py > "$out/$1"
-  echo "wrote $out/$1"
+  tmux -L "$socket" capture-pane -e -p -t betr |
+    python3 scripts/ansi_to_svg.py --text "$out/$1.txt" > "$out/$1.svg"
+  echo "wrote $out/$1.svg and $out/$1.txt"
 }
 keys() { tmux -L "$socket" send-keys -t betr "$@"; }
 
@@ -63,7 +67,7 @@ keys -l "Put the blue cube on the green cube"
 keys Enter
 wait_for 'Goal: "blue cube" on "green cube"' '[o] Fallback'
 sleep 0.5
-shot workbench-planned.svg
+shot workbench-planned
 
 for _ in $(seq 1 10); do
   keys Space
@@ -72,12 +76,12 @@ for _ in $(seq 1 10); do
 done
 wait_for "◀ failed" "Proposal for grasp" "awaiting approval"
 sleep 0.5
-shot workbench-proposal.svg
+shot workbench-proposal
 
 keys a
 wait_for "repaired:"
 keys r
 wait_for "SUCCESS"
 sleep 0.5
-shot workbench-success.svg
+shot workbench-success
 keys q
