@@ -39,6 +39,7 @@ import urllib.request
 
 import websocket
 
+sys.dont_write_bytecode = True  # no __pycache__ left in scripts/ by the import below
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from ansi_to_svg import BASELINE, CELL_H, CELL_W, TOP, width  # noqa: E402  the grid drawn
 
