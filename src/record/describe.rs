@@ -184,6 +184,7 @@ fn about_the_tree(event: &Event) -> Option<String> {
         Event::Error { message } => format!("error: {message}"),
         Event::Failed { error } => format!("error: {error}"),
         Event::Notice { message } => message.clone(),
+        Event::Screened { action, shortlist } => format!("for {action}!: {shortlist}"),
         _ => return None,
     })
 }
@@ -217,6 +218,7 @@ pub fn brief(step: &Step) -> String {
         Event::WorldChanged { .. } => "the world changed".into(),
         Event::RunState { running: true } => "running".into(),
         Event::RunState { running: false } => "paused".into(),
+        Event::Phase(phase) => format!("phase: {phase:?}").to_lowercase(),
         Event::Usage { totals } => format!("model calls so far: {}", totals.calls),
         Event::Forced { forced } => format!("{} node(s) forced", forced.len()),
         Event::Breakpoints { nodes, .. } => format!("{} breakpoint(s)", nodes.len()),

@@ -30,8 +30,8 @@ pub use repair::ask::missing_value;
 pub use repair::edit::{Edit, EditError, parse_edit, vocabulary_words};
 pub use resolve::{resolve, resolve_with_scenes};
 pub use types::{
-    BreakReason, Ending, Event, Evidence, FixCounts, NoModel, Options, Proposal, Question, Reading,
-    Resolved, SessionError, Steps,
+    BreakReason, Ending, Event, Evidence, FixCounts, NoModel, Options, PhaseKind, Proposal,
+    Question, Reading, Resolved, SessionError, Shortlist, Steps,
 };
 
 /// Calls `check` with each worked example of the shipped scenes (the cafe and the cell),

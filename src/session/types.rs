@@ -40,6 +40,74 @@ pub struct Evidence {
     pub doubt: Option<String>,
 }
 
+/// What trying the conditions related to a failed action found in simulation, before
+/// the model is asked: the model chooses among `fixes`.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Shortlist {
+    /// Conditions that fix the failure alone: those after which the whole tree succeeds,
+    /// or when there are none, those after which it gets further (to an action it had
+    /// before); conditions about any object first, then positive ones, then negations.
+    pub fixes: Vec<Condition>,
+    /// How many conditions were tried.
+    pub tried: usize,
+    /// The objects the conditions were about.
+    pub objects: Vec<String>,
+    /// Fixes left out because they were proposed for this failure before and refused.
+    #[serde(default)]
+    pub refused: usize,
+    /// Fixes left out because the tree with them breaks a property the scenario declares,
+    /// each with that property.
+    #[serde(default)]
+    pub breaking: Vec<(Condition, String)>,
+}
+
+impl Shortlist {
+    /// Leaves out the fixes that break a declared property, keeping each with the
+    /// property it breaks.
+    pub fn leave_out_breaking(&mut self, breaking: Vec<(Condition, String)>) {
+        self.fixes.retain(|c| !breaking.iter().any(|(b, _)| b == c));
+        self.breaking = breaking;
+    }
+
+    /// What was tried and what fixes the failure, as one finding of the evidence.
+    pub fn finding(&self) -> String {
+        let about: Vec<String> = self.objects.iter().map(|o| format!("\"{o}\"")).collect();
+        let tried = format!(
+            "tried {} condition(s) about {} in simulation",
+            self.tried,
+            about.join(", ")
+        );
+        let mut left_out = String::new();
+        if self.refused > 0 {
+            left_out.push_str(&format!(" ({} refused before, left out)", self.refused));
+        }
+        for (condition, property) in &self.breaking {
+            left_out.push_str(&format!(" ({condition} left out: it breaks {property})"));
+        }
+        if self.fixes.is_empty() {
+            return format!("{tried}: none fixes the failure alone{left_out}");
+        }
+        let fixes: Vec<String> = self.fixes.iter().map(ToString::to_string).collect();
+        format!(
+            "{tried}: {} fix the failure ({}){left_out}",
+            self.fixes.len(),
+            fixes.join(", ")
+        )
+    }
+}
+
+impl std::fmt::Display for Shortlist {
+    /// The finding, with what the model is asked to do with it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let asked = if self.fixes.is_empty() {
+            "the model names the condition itself"
+        } else {
+            "the model chooses among them"
+        };
+        write!(f, "{}; {asked}", self.finding())
+    }
+}
+
 /// One reading of an instruction, as a person chooses it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Reading {
@@ -470,6 +538,14 @@ pub enum Event {
     RunState {
         running: bool,
     },
+    /// What the engine does or waits for now; told whenever that changes.
+    Phase(PhaseKind),
+    /// The conditions related to the failed `action` were tried in simulation before the
+    /// model is asked; it chooses among the shortlist's fixes.
+    Screened {
+        action: ActionCall,
+        shortlist: Shortlist,
+    },
     /// The nodes whose status is forced in every tick of the execution world (all of
     /// them, after every change of the set; empty when cleared).
     Forced {
@@ -558,6 +634,34 @@ pub enum BreakReason {
     /// With break-on-failure, the tick just performed made a node fail that succeeded or
     /// ran in the tick before, or made an action fail.
     Failure,
+}
+
+/// What the engine does or waits for, as front ends are told it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PhaseKind {
+    /// No tree yet.
+    #[default]
+    Idle,
+    /// The model reads an instruction.
+    Reading,
+    /// The readings of an instruction wait for the person's choice.
+    Choosing,
+    /// A tree, stepped by hand.
+    Ready,
+    /// The tree ticks on its own.
+    Running,
+    /// An action failed and nothing is asked about it: a person decides.
+    Failed,
+    /// The model is asked what a failure misses.
+    Asking,
+    /// A proposal waits for approval.
+    Proposed,
+    /// An applied change is verified before the changed tree may run.
+    Checking,
+    /// The changed tree fails verification: the change waits to be approved again,
+    /// rejected or undone.
+    Violated,
 }
 
 /// How the loop ended.

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use crossterm::event::{KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
 
 use crate::scenario::Scenario;
-use crate::session::{Command, parse_edit};
+use crate::session::{Command, PhaseKind, parse_edit};
 
 use super::components::dictation::DictationPanel;
 use super::components::input::{InputLine, Mode, Submitted};
@@ -395,7 +395,7 @@ impl App {
     fn command_of(&mut self, action: Action) -> Option<Command> {
         Some(match action {
             Action::Step => Command::Tick,
-            Action::Run if self.status.running => Command::Pause,
+            Action::Run if self.status.phase == PhaseKind::Running => Command::Pause,
             Action::Run => Command::Run,
             // With fixes refused, the person says whether planning again keeps them.
             Action::Plan if self.refused_fixes > 0 => return None,
@@ -529,13 +529,19 @@ impl App {
     }
 
     /// The input line on the proposal's conditions, completing the scenario's words.
+    /// The fix line opens with the proposal, else with the first fix betr's screening
+    /// found for the failure waiting, else empty.
     fn open_edit(&mut self) {
-        let text = self
+        let screened = self
             .llm
-            .proposal
+            .screened
             .as_ref()
-            .map(|p| p.edit_text.clone())
-            .unwrap_or_default();
+            .and_then(|(_, s)| s.fixes.first());
+        let text = match (&self.llm.proposal, screened) {
+            (Some(p), _) => p.edit_text.clone(),
+            (None, Some(fix)) => fix.to_string(),
+            (None, None) => String::new(),
+        };
         self.set_vocabulary();
         self.input.open(Mode::Edit, &text);
     }

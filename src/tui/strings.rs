@@ -1,6 +1,7 @@
 //! Every user-facing text of the workbench, in one place.
 
 use crate::bt::Status;
+use crate::session::PhaseKind;
 
 pub const TREE_TITLE: &str = " Behavior tree ";
 pub const FOLLOWING: &str = " following the running node ";
@@ -214,24 +215,66 @@ pub struct Awaiting {
     pub long: &'static str,
     pub short: &'static str,
 }
-pub const AWAITING_MODEL: Awaiting = Awaiting {
-    long: "asking the model",
-    short: "asking",
-};
-pub const AWAITING_APPROVAL: Awaiting = Awaiting {
-    long: "awaiting approval",
-    short: "approve?",
-};
-pub const AWAITING_VIOLATION: Awaiting = Awaiting {
-    long: "fails verification: approve again, reject or undo",
-    short: "violates",
-};
+/// What the status bar says the engine waits for in `phase`; none when it waits for
+/// nothing (running, or paused with a tree or none).
+pub fn waiting_for(phase: PhaseKind) -> Option<&'static Awaiting> {
+    const READING: Awaiting = Awaiting {
+        long: "reading the instruction",
+        short: "reading",
+    };
+    const CHOOSING: Awaiting = Awaiting {
+        long: "choose a reading",
+        short: "choose",
+    };
+    const FAILED: Awaiting = Awaiting {
+        long: "waits for you",
+        short: "yours",
+    };
+    const ASKING: Awaiting = Awaiting {
+        long: "asking the model",
+        short: "asking",
+    };
+    const PROPOSED: Awaiting = Awaiting {
+        long: "awaiting approval",
+        short: "approve?",
+    };
+    const CHECKING: Awaiting = Awaiting {
+        long: "verifying the change",
+        short: "verifying",
+    };
+    const VIOLATED: Awaiting = Awaiting {
+        long: "fails verification: approve again, reject or undo",
+        short: "violates",
+    };
+    match phase {
+        PhaseKind::Idle | PhaseKind::Ready | PhaseKind::Running => None,
+        PhaseKind::Reading => Some(&READING),
+        PhaseKind::Choosing => Some(&CHOOSING),
+        PhaseKind::Failed => Some(&FAILED),
+        PhaseKind::Asking => Some(&ASKING),
+        PhaseKind::Proposed => Some(&PROPOSED),
+        PhaseKind::Checking => Some(&CHECKING),
+        PhaseKind::Violated => Some(&VIOLATED),
+    }
+}
 pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, reject it (x: undone, and the model is asked again knowing why), or undo it (u).";
 pub const PROPOSAL_FOR: &str = "Proposal for";
 pub const NO_PROPOSAL: &str = "No proposal pending.";
 pub const ASKING: &str = "asking the model for";
 /// Above what betr itself established about a failure.
 pub const FOUND_BY_BETR: &str = "Found by betr:";
+/// Under the shortlist when no model chooses from it (the question was cancelled or is
+/// over).
+pub const SHORTLIST_IS_YOURS: &str = "  choose one yourself: the fix line opens with the first";
+
+/// Under the shortlist while the model is asked.
+pub fn model_chooses_among(n: usize) -> String {
+    if n == 1 {
+        "  the model is asked to confirm it".to_string()
+    } else {
+        format!("  the model is choosing among these {n}")
+    }
+}
 pub const GOAL: &str = "Goal";
 
 /// The LLM pane's border while a proposal waits.

@@ -9,7 +9,7 @@ use crate::support;
 use std::sync::Arc;
 use std::time::Duration;
 
-use betr::session::{Command, Event, Proposal};
+use betr::session::{Command, Event, Proposal, Shortlist};
 use support::engine::{Session, model, setup};
 use support::fake_model::FixtureModel;
 use support::fixtures;
@@ -32,12 +32,10 @@ fn proposed(events: &[Event]) -> Option<String> {
     })
 }
 
-/// The notice telling the conditions tried in simulation before the model was asked.
-fn shortlist_notice(events: &[Event]) -> Option<String> {
+/// What trying conditions in simulation found before the model was asked.
+fn screened(events: &[Event]) -> Option<Shortlist> {
     events.iter().rev().find_map(|e| match e {
-        Event::Notice { message } if message.contains("condition(s) about") => {
-            Some(message.clone())
-        }
+        Event::Screened { shortlist, .. } => Some(shortlist.clone()),
         _ => None,
     })
 }
@@ -71,13 +69,14 @@ fn an_undone_fix_is_a_candidate_again() {
         );
         s.seen.clear();
         let again = s.run_to_proposal().await;
-        let notice = shortlist_notice(&again).unwrap();
-        assert!(!notice.contains("refused before"), "{notice}");
-        // The undone fix is among the choices again (how many others fix the failure
+        let list = screened(&again).unwrap();
+        assert_eq!(list.refused, 0, "{list:?}");
+        // The undone fix is the first choice again (how many others fix the failure
         // depends on where the arm left things).
-        assert!(
-            notice.contains("chooses among: ~\"any object\" on \"blue cube\""),
-            "{notice}"
+        assert_eq!(
+            list.fixes.first().map(ToString::to_string).as_deref(),
+            Some("~\"any object\" on \"blue cube\""),
+            "{list:?}"
         );
         assert_eq!(
             proposed(&again).as_deref(),
@@ -101,8 +100,8 @@ fn a_rejected_fix_applied_by_hand_then_undone_is_a_candidate_again() {
             .await;
         s.seen.clear();
         let again = s.run_to_proposal().await;
-        let notice = shortlist_notice(&again).unwrap();
-        assert!(!notice.contains("refused before"), "{notice}");
+        let list = screened(&again).unwrap();
+        assert_eq!(list.refused, 0, "{list:?}");
         assert_eq!(
             proposed(&again).as_deref(),
             Some("~\"any object\" on \"blue cube\"")
@@ -119,8 +118,12 @@ fn a_rejection_asks_again_without_the_rejected_fix_then_leaves_it_to_the_person(
         let got = s
             .until("the next proposal", |e| matches!(e, Event::Proposal { .. }))
             .await;
-        let notice = shortlist_notice(&got).unwrap();
-        assert!(notice.contains("1 refused before, left out"), "{notice}");
+        let list = screened(&got).unwrap();
+        assert_eq!(list.refused, 1, "{list:?}");
+        assert!(
+            list.to_string().contains("(1 refused before, left out)"),
+            "{list}"
+        );
         assert_eq!(
             proposed(&got).as_deref(),
             Some("~\"red cube\" on \"blue cube\"")

@@ -32,13 +32,11 @@ fn a_harmful_change_is_refused_with_a_counterexample_before_any_tick() {
         let mut s = Session::start(fragile_setup());
         let asked = s.run_to_proposal().await;
         // The shortlist's fixes all grasp the red cube: verified before the model is
-        // asked, they are left out, and the notice says which property they break.
-        let left_out: Vec<&String> = asked
+        // asked, they are left out, and the screening says which property they break.
+        let left_out: Vec<String> = asked
             .iter()
             .filter_map(|e| match e {
-                Event::Notice { message } if message.contains("left out: it breaks") => {
-                    Some(message)
-                }
+                Event::Screened { shortlist, .. } => Some(shortlist.to_string()),
                 _ => None,
             })
             .collect();
@@ -221,9 +219,10 @@ fn a_rejected_change_that_failed_its_check_is_undone_and_told_to_the_model() {
         assert_eq!(bt::to_text(&tree_of(&got).unwrap().0), planned);
         // The failure is met again; the refused fix is no longer offered to the model.
         s.send(Command::Run);
-        s.until("the shortlist", |e| {
-            matches!(e, Event::Notice { message } if message.contains("(1 refused before, left out)"))
-        })
+        s.until(
+            "the shortlist",
+            |e| matches!(e, Event::Screened { shortlist, .. } if shortlist.refused == 1),
+        )
         .await;
     });
 }

@@ -87,7 +87,10 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
         // The model is asked again without the rejected fix; every answer of these
         // fixtures names it again, so the questions end with the rounds.
         b.until(|e| matches!(e, Event::GaveUp { .. })).await;
+        // The fix line opens with the first fix betr's simulation found; Ctrl-U clears it.
         b.key(KeyCode::Char('e'));
+        b.app
+            .on_key(KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL));
         b.type_text("\"purple cube\" on \"blue cube\"");
         b.key(KeyCode::Enter);
         assert!(
@@ -111,6 +114,8 @@ fn an_edit_that_cannot_be_read_is_shown_like_the_engines_errors() {
         b.key(KeyCode::Esc);
 
         b.key(KeyCode::Char('e'));
+        b.app
+            .on_key(KeyEvent::new(KeyCode::Char('u'), KeyModifiers::CONTROL));
         b.type_text("5 N");
         b.key(KeyCode::Enter);
         b.until(|e| matches!(e, Event::Error { .. })).await;
@@ -579,4 +584,63 @@ fn a_replay_steps_back_to_the_failure_and_on_to_the_proposal() {
     }
     assert!(!help.contains("approve the proposal"), "{help}");
     insta::assert_snapshot!("replay_help", help);
+}
+
+/// While the model is asked about the grasp that failed, what betr's simulation found is
+/// already on screen with how many fixes the model chooses among, the call under way is
+/// counted, and `Esc` leaves the shortlist to the person: the fix line opens with its
+/// first fix.
+#[test]
+fn the_wait_for_the_model_shows_the_shortlist_and_esc_leaves_it_to_the_person() {
+    rt().block_on(async {
+        let mut b = Bench::slow_to_propose(Duration::from_secs(30));
+        b.step_to_question().await;
+        // The elapsed time is the clock's: fixed for the snapshot.
+        b.app.llm.asking_since = Some(std::time::Instant::now());
+        let screen = b.screen(120, 40);
+        assert!(
+            screen.contains("Found by betr: grasp \"blue cube\"!"),
+            "{screen}"
+        );
+        assert!(
+            screen.contains("the model is choosing among these"),
+            "{screen}"
+        );
+        assert!(screen.contains("0 s · call 1 · esc cancels"), "{screen}");
+        assert!(screen.contains("asking the model"), "{screen}");
+        insta::assert_snapshot!("waiting_for_the_model", screen);
+        b.key(KeyCode::Esc);
+        b.until(|e| matches!(e, Event::PersonDecides { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(!screen.contains("asking the model"), "{screen}");
+        assert!(screen.contains("choose one yourself"), "{screen}");
+        assert!(screen.contains("waits for you"), "{screen}");
+        let first = b.app.llm.screened.as_ref().unwrap().1.fixes[0].to_string();
+        b.key(KeyCode::Char('e'));
+        assert!(b.screen(120, 40).contains(&first), "{first}");
+    });
+}
+
+/// A tree that fails because a person forced its root to fail (no action failed) ends
+/// FAILED in the status bar, as a failed action does.
+#[test]
+fn a_tree_failed_on_a_forced_status_is_marked_failed() {
+    rt().block_on(async {
+        let mut b = Bench::start();
+        b.key(KeyCode::Char('p'));
+        b.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        // The first row is the root (selected in the tree as drawn).
+        b.screen(120, 40);
+        b.key(KeyCode::Home);
+        let root = b.app.tree.selected().unwrap();
+        assert!(b.engine.send(Command::Force {
+            node: root,
+            status: Some(betr::bt::Forced::Failure),
+        }));
+        b.key(KeyCode::Char(' '));
+        b.until(|e| matches!(e, Event::GaveUp { .. })).await;
+        let screen = b.screen(120, 40);
+        assert!(screen.contains("FAILED"), "{screen}");
+        assert!(screen.contains("paused"), "{screen}");
+    });
 }

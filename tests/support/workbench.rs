@@ -70,7 +70,25 @@ impl Bench {
         loader: SttLoader,
         knowledge: Option<betr::session::Knowledge>,
     ) -> Bench {
-        Bench::build(microphone, loader, knowledge, fixtures::every_reply())
+        Bench::build(
+            microphone,
+            loader,
+            knowledge,
+            FixtureModel::new(fixtures::every_reply()),
+        )
+    }
+
+    /// A bench whose model takes `delay` to answer a question about a failure (goals are
+    /// read at once).
+    pub fn slow_to_propose(delay: Duration) -> Bench {
+        let mut model = FixtureModel::new(fixtures::every_reply());
+        model.delay = delay;
+        Bench::build(
+            AudioMicrophone::missing(),
+            fixed_words("unused"),
+            None,
+            model,
+        )
     }
 
     /// A bench whose model answers with `replies` (the first that fits a prompt).
@@ -79,7 +97,7 @@ impl Bench {
             AudioMicrophone::missing(),
             fixed_words("unused"),
             None,
-            replies,
+            FixtureModel::new(replies),
         )
     }
 
@@ -87,7 +105,7 @@ impl Bench {
         microphone: Arc<dyn Microphone>,
         loader: SttLoader,
         knowledge: Option<betr::session::Knowledge>,
-        replies: Vec<FixtureReply>,
+        model: FixtureModel,
     ) -> Bench {
         // Scenario 1 moves the real arms when the YuMi's description is in the cache: have
         // it there, so the screens do not depend on which tests ran before.
@@ -103,7 +121,6 @@ impl Bench {
             no_model: None,
             keys_error: None,
         };
-        let model = FixtureModel::new(replies);
         let setup = Setup {
             knowledge,
             ..Setup::new(scenario.clone(), path, Ok(Arc::new(model)))
@@ -182,6 +199,23 @@ impl Bench {
             }
         }
         panic!("no proposal after 10 ticks:\n{}", self.screen(120, 40));
+    }
+
+    /// Type the instruction of scenario 1 and step until the grasp fails and the model is
+    /// asked about it (the model must be slow to answer: see [`Bench::slow_to_propose`]).
+    pub async fn step_to_question(&mut self) {
+        self.key(KeyCode::Char('i'));
+        self.type_text("Put the blue cube on the green cube");
+        self.key(KeyCode::Enter);
+        self.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        for _ in 0..10 {
+            self.key(KeyCode::Char(' '));
+            self.until(|e| matches!(e, Event::Ticked { .. })).await;
+            if self.screen(120, 40).contains("◀ failed") {
+                return self.until(|e| matches!(e, Event::Asking { .. })).await;
+            }
+        }
+        panic!("no failure after 10 ticks:\n{}", self.screen(120, 40));
     }
 }
 

@@ -178,12 +178,24 @@ impl Engine {
         self.task.tried = refused;
     }
 
-    /// Tell the front end how many fixes are refused and unsaved now, when that changed.
-    pub(super) fn tell_counts(&mut self) {
+    /// Tell the front end what it shows of the engine's state when that changed: the
+    /// phase, and how many fixes are refused and unsaved. Told after each command, answer
+    /// and tick, so a front end's status lines follow the engine's and nothing else.
+    pub(super) fn tell_state(&mut self) {
+        self.tell_phase();
         let counts = self.task.counts();
         if counts != self.task.told {
             self.task.told = counts;
             self.emit(Event::FixCounts(counts));
+        }
+    }
+
+    /// Tell the front end the phase, when it changed since it was last told.
+    pub(super) fn tell_phase(&mut self) {
+        let kind = self.phase.kind();
+        if kind != self.told_phase {
+            self.told_phase = kind;
+            self.emit(Event::Phase(kind));
         }
     }
 

@@ -41,7 +41,7 @@ use crate::scenario::Scenario;
 use crate::world;
 
 use super::policy::{Approval, PolicyStore};
-use super::types::{Event, NoModel, Options, SessionError};
+use super::types::{Event, NoModel, Options, PhaseKind, SessionError};
 
 use phase::Phase;
 use requests::Internal;
@@ -238,6 +238,8 @@ pub struct Engine {
     settings: Settings,
     /// What the engine is doing, with the data of that alone.
     phase: Phase,
+    /// The phase front ends were last told (`Event::Phase`).
+    told_phase: PhaseKind,
     /// The goal, the tree and how it came to be.
     task: Task,
     /// The planning and execution worlds and what ticking them showed.
@@ -285,6 +287,7 @@ impl Engine {
                 scenes: setup.scenes,
             },
             phase: Phase::Idle,
+            told_phase: PhaseKind::Idle,
             task: Task::default(),
             run: Run::new(planning, execution.world),
             learning: learning::Learning::new(setup.knowledge),
@@ -325,9 +328,12 @@ impl Engine {
                 },
                 Some(message) = self.internal_rx.recv() => {
                     self.on_internal(message);
-                    self.tell_counts();
+                    self.tell_state();
                 }
-                () = pace(interval), if running => self.run_step(),
+                () = pace(interval), if running => {
+                    self.run_step();
+                    self.tell_state();
+                }
             }
         }
         self.phase.abort_call();
@@ -336,7 +342,7 @@ impl Engine {
     /// Carry out one command (model calls it starts run on the current tokio runtime).
     pub fn handle(&mut self, command: Command) {
         self.carry_out(command);
-        self.tell_counts();
+        self.tell_state();
     }
 
     /// What a command does depends on the phase; commands that mean the same in every
@@ -448,7 +454,7 @@ impl Engine {
         match self.internal_rx.recv().await {
             Some(m) => {
                 self.on_internal(m);
-                self.tell_counts();
+                self.tell_state();
                 true
             }
             None => false,

@@ -3,7 +3,7 @@
 //! a change). Leaving a phase drops its data: a call it started is aborted, so its late
 //! answer finds no phase waiting for it.
 
-use crate::session::types::{Event, Proposal, Reading};
+use crate::session::types::{Event, PhaseKind, Proposal, Reading};
 
 use super::Engine;
 
@@ -72,6 +72,22 @@ pub(super) enum Phase {
 }
 
 impl Phase {
+    /// The phase as front ends are told it, without its data.
+    pub(super) fn kind(&self) -> PhaseKind {
+        match self {
+            Phase::Idle => PhaseKind::Idle,
+            Phase::Reading { .. } => PhaseKind::Reading,
+            Phase::Choosing { .. } => PhaseKind::Choosing,
+            Phase::Ready => PhaseKind::Ready,
+            Phase::Running => PhaseKind::Running,
+            Phase::Failed { .. } => PhaseKind::Failed,
+            Phase::Asking { .. } => PhaseKind::Asking,
+            Phase::Proposed(_) => PhaseKind::Proposed,
+            Phase::Checking { .. } => PhaseKind::Checking,
+            Phase::Violated { .. } => PhaseKind::Violated,
+        }
+    }
+
     pub(super) fn has_call(&self) -> bool {
         matches!(self, Phase::Reading { .. } | Phase::Asking { .. })
     }
@@ -126,7 +142,8 @@ impl Phase {
 
 impl Engine {
     /// Leave the current phase for `next`: a model call under way is aborted (its answer
-    /// would be ignored), and front ends hear when running starts or stops.
+    /// would be ignored), and front ends hear when running starts or stops and what the
+    /// phase is now.
     pub(super) fn enter(&mut self, next: Phase) {
         let was = std::mem::replace(&mut self.phase, next);
         if was.abort_call() {
@@ -139,6 +156,7 @@ impl Engine {
         if was_running != running {
             self.emit(Event::RunState { running });
         }
+        self.tell_phase();
     }
 
     /// The phase with nothing under way: ready when there is a tree, else idle.

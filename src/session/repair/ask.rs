@@ -12,10 +12,10 @@ use crate::llm::{LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
 use super::super::call::ask;
+use super::super::types::Shortlist;
 use super::super::types::{Event, Options, Proposal, Question, SessionError};
-use super::evidence::breaking_text;
 use super::screen::{NotHelped, Screen, Verdict};
-use super::shortlist::{Shortlist, shortlist, without_implied};
+use super::shortlist::{shortlist, without_implied};
 use super::value_bounds::Bounds;
 use super::value_levels::{as_levels, level_value};
 
@@ -245,35 +245,6 @@ fn refused_alone(tried: &[Tried], condition: &Condition) -> bool {
     })
 }
 
-/// What the person reads about the conditions tried before the model was asked.
-fn shortlist_notice(list: &Shortlist, refused: usize) -> String {
-    let about = list
-        .objects
-        .iter()
-        .map(|o| format!("\"{o}\""))
-        .collect::<Vec<_>>()
-        .join(", ");
-    let mut left_out = if refused > 0 {
-        format!(" ({refused} refused before, left out)")
-    } else {
-        String::new()
-    };
-    left_out.push_str(&breaking_text(list));
-    if list.fixes.is_empty() {
-        return format!(
-            "tried {} condition(s) about {about} in simulation: none fixes the failure alone{left_out}; the model names the condition itself",
-            list.tried
-        );
-    }
-    let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
-    format!(
-        "tried {} condition(s) about {about} in simulation; {} fix the failure{left_out}, the model chooses among: {}",
-        list.tried,
-        list.fixes.len(),
-        fixes.join(", ")
-    )
-}
-
 pub(crate) async fn ask_conditions(
     ctx: &Context<'_>,
     model: &dyn LanguageModel,
@@ -295,12 +266,13 @@ pub(crate) async fn ask_conditions(
         // grammar that allows only the shortlist, so it would choose it again.
         let before = list.fixes.len();
         list.fixes.retain(|c| !refused_alone(tried, c));
-        let refused = before - list.fixes.len();
+        list.refused = before - list.fixes.len();
         // A fix that breaks a property the scenario declares would fail the changed
         // tree's check after approval: left out before anyone is asked, and said.
         list.leave_out_breaking(screen.breaking(&list.fixes));
-        emit(&Event::Notice {
-            message: shortlist_notice(&list, refused),
+        emit(&Event::Screened {
+            action: action.clone(),
+            shortlist: list.clone(),
         });
         Some(list)
     } else {

@@ -10,10 +10,10 @@
 use crate::domain::{ANY_OBJECT, Atom, Condition, Object, Vocabulary};
 use crate::reading::claims::claims;
 
+use super::super::types::Shortlist;
 use super::super::types::{Evidence, Proposal};
 use super::ask::Tried;
 use super::screen::{FailureAt, Verdict};
-use super::shortlist::Shortlist;
 
 /// What went into a question about a failure and what came out of it.
 pub struct Found<'a> {
@@ -58,7 +58,7 @@ impl Evidence {
             }
         }
         if let Some(list) = found.shortlist {
-            findings.push(shortlist_finding(list));
+            findings.push(list.finding());
         }
         for t in found.tried {
             findings.push(format!("proposed before and turned down: {t}"));
@@ -96,35 +96,6 @@ fn verdict_text(v: Verdict) -> &'static str {
         }
         Verdict::FailsItself => "the failure is gone; an action the change brings in then fails",
     }
-}
-
-/// The fixes left out of a shortlist for breaking a declared property, as a clause to
-/// append (empty when none was).
-pub(super) fn breaking_text(list: &Shortlist) -> String {
-    list.breaking
-        .iter()
-        .map(|(condition, property)| format!(" ({condition} left out: it breaks {property})"))
-        .collect()
-}
-
-fn shortlist_finding(list: &Shortlist) -> String {
-    let about: Vec<String> = list.objects.iter().map(|o| format!("\"{o}\"")).collect();
-    let about = about.join(", ");
-    if list.fixes.is_empty() {
-        return format!(
-            "tried {} condition(s) about {about} in simulation: none fixes the failure alone{}",
-            list.tried,
-            breaking_text(list)
-        );
-    }
-    let fixes: Vec<String> = list.fixes.iter().map(ToString::to_string).collect();
-    format!(
-        "tried {} condition(s) about {about} in simulation: {} fix the failure ({}){}",
-        list.tried,
-        list.fixes.len(),
-        fixes.join(", "),
-        breaking_text(list)
-    )
 }
 
 /// The facts true at the failure that a fix found in simulation makes false: a negated
@@ -317,6 +288,7 @@ mod tests {
             fixes: fixes.clone(),
             tried: 19,
             objects: vec!["blue cube".into()],
+            refused: 0,
             breaking: Vec::new(),
         };
         let proposal = Proposal::Conditions {

@@ -6,34 +6,9 @@
 //! more reliably than it names one out of the whole vocabulary. The list is told to the
 //! person as well, so what the model chose from is never hidden.
 
-use super::super::types::Proposal;
+use super::super::types::{Proposal, Shortlist};
 use super::screen::{Screen, Verdict};
 use crate::domain::{ANY_OBJECT, Atom, Condition, GroundSkill};
-
-/// What trying the related conditions found.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Shortlist {
-    /// Conditions that fix the failure alone: those after which the whole tree succeeds,
-    /// or when there are none, those after which it gets further (to an action it had
-    /// before); conditions about any object first, then positive ones, then negations.
-    pub fixes: Vec<Condition>,
-    /// How many conditions were tried.
-    pub tried: usize,
-    /// The objects the conditions were about.
-    pub objects: Vec<String>,
-    /// Fixes left out because the tree with them breaks a property the scenario declares,
-    /// each with that property ([`super::screen::Screen::breaking`]).
-    pub breaking: Vec<(Condition, String)>,
-}
-
-impl Shortlist {
-    /// Leaves out the fixes that break a declared property, keeping each with the
-    /// property it breaks.
-    pub fn leave_out_breaking(&mut self, breaking: Vec<(Condition, String)>) {
-        self.fixes.retain(|c| !breaking.iter().any(|(b, _)| b == c));
-        self.breaking = breaking;
-    }
-}
 
 /// Bound on the conditions tried in each pass, so a huge scene stays quick to screen.
 const MAX_TRIED: usize = 3000;
@@ -77,6 +52,7 @@ pub fn shortlist(screen: &Screen) -> Shortlist {
         fixes: found.fixes,
         tried,
         objects,
+        refused: 0,
         breaking: Vec::new(),
     }
 }
@@ -157,6 +133,7 @@ fn screen_all(
         fixes: without_indirect(screen, succeeding),
         tried,
         objects: objects.to_vec(),
+        refused: 0,
         breaking: Vec::new(),
     }
 }

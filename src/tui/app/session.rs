@@ -1,7 +1,7 @@
 //! What the session's events do to the app's state, one function per group of events:
 //! `on_session` routes each event to its group.
 
-use crate::session::Event;
+use crate::session::{Event, PhaseKind};
 
 use super::super::components::help::report_lines;
 use super::super::components::llm_pane::{Guidance, ProposalView};
@@ -29,10 +29,12 @@ impl App {
             | Event::DidNotHelp { .. }
             | Event::GaveUp { .. }
             | Event::PersonDecides { .. }
+            | Event::Screened { .. }
             | Event::FixCounts(_)) => self.on_failure_or_proposal(e),
             e @ (Event::Ticked { .. }
             | Event::WorldChanged { .. }
             | Event::RunState { .. }
+            | Event::Phase(_)
             | Event::Success { .. }
             | Event::Scene { .. }
             | Event::ArmMotion { .. }) => self.on_world(e),
@@ -92,17 +94,16 @@ impl App {
         match event {
             Event::Asking { what } => {
                 self.clear_guidance();
-                self.status.awaiting = Some(&strings::AWAITING_MODEL);
                 self.llm.error = None;
                 self.llm.asking = Some(what.to_string());
                 self.llm.asking_since = Some(std::time::Instant::now());
+                self.llm.replies_to_question = 0;
             }
-            Event::CallCancelled => {
-                self.status.awaiting = None;
-                self.llm.asking = None;
-            }
+            Event::CallCancelled => self.llm.stop_asking(),
+            // The question stays shown until the engine leaves it: a reply the checks
+            // refuse is followed by another call.
             Event::Replied { attribution, .. } => {
-                self.llm.asking = None;
+                self.llm.replies_to_question += 1;
                 self.llm.replied_by = Some(attribution);
             }
             Event::InvalidReply { error } => self.llm.log(format!("unusable reply: {error}")),
@@ -118,7 +119,6 @@ impl App {
                 first_answer,
                 ..
             } => {
-                self.status.awaiting = None;
                 if let Some(first) = first_answer {
                     self.llm.log(format!(
                         "the model answered {first} first; the goal kept is {goal}, which the \
@@ -137,7 +137,6 @@ impl App {
             Event::Readings {
                 readings, doubt, ..
             } => {
-                self.status.awaiting = None;
                 self.llm.log(match &doubt {
                     Some(why) => format!("the goal read is doubtful ({why}): approve it or not"),
                     None => format!(
@@ -201,7 +200,12 @@ impl App {
                 self.world.last_error = Some(text.clone());
                 self.world.error_resolved = false;
                 self.status.ending = Some(Ending::Failed);
+                self.llm.screened = None;
                 self.llm.log(text);
+            }
+            Event::Screened { action, shortlist } => {
+                self.llm.log(shortlist.to_string());
+                self.llm.screened = Some((format!("{action}!"), shortlist));
             }
             Event::Proposal {
                 proposal,
@@ -210,12 +214,10 @@ impl App {
                 evidence,
             } => {
                 self.clear_guidance();
-                self.llm.asking = None;
+                self.llm.stop_asking();
                 self.llm.proposal = Some(ProposalView::of(&proposal, &author, reasoning, evidence));
-                self.status.awaiting = Some(&strings::AWAITING_APPROVAL);
             }
             Event::Approved => {
-                self.status.awaiting = None;
                 // The log keeps who proposed what was approved.
                 let line = match self.llm.proposal.take() {
                     Some(p) => strings::approved(&p.lines.join(" & "), &p.target, &p.author),
@@ -224,17 +226,19 @@ impl App {
                 self.llm.log(line);
             }
             Event::Rejected => {
-                self.status.awaiting = None;
                 self.llm.proposal = None;
                 self.llm.log(strings::REJECTED);
             }
             Event::DidNotHelp { reason } => {
-                self.status.awaiting = None;
                 self.llm
                     .log(format!("the change did not help and was undone: {reason}"));
             }
             Event::GaveUp { reason } => {
-                self.status.awaiting = None;
+                // A tree that failed with no action failing (a forced status, a condition
+                // nothing achieves) has failed as much as one whose action did.
+                if self.tree.root_failed() {
+                    self.status.ending = Some(Ending::Failed);
+                }
                 self.llm.log(reason);
             }
             Event::PersonDecides {
@@ -243,7 +247,6 @@ impl App {
                 rounds_left,
                 undoable,
             } => {
-                self.status.awaiting = None;
                 self.llm
                     .log(format!("nothing more is asked about {action}!: {why}"));
                 self.stuck = Some(Stuck {
@@ -286,7 +289,24 @@ impl App {
                     self.tree.clear_statuses();
                 }
             }
-            Event::RunState { running } => self.status.running = running,
+            // Recordings made before the engine told its phase say only this.
+            Event::RunState { running: true } => self.status.phase = PhaseKind::Running,
+            Event::RunState { running: false } if self.status.phase == PhaseKind::Running => {
+                self.status.phase = PhaseKind::Ready;
+            }
+            Event::Phase(phase) => {
+                self.status.phase = phase;
+                if !matches!(phase, PhaseKind::Reading | PhaseKind::Asking) {
+                    self.llm.stop_asking();
+                }
+                // What screening found stays while its failure waits.
+                if matches!(
+                    phase,
+                    PhaseKind::Idle | PhaseKind::Ready | PhaseKind::Running
+                ) {
+                    self.llm.screened = None;
+                }
+            }
             Event::Success { ticks } => {
                 self.status.ending = Some(Ending::Success);
                 self.world.error_resolved = true;
@@ -314,7 +334,6 @@ impl App {
                     .log(if holds { "verified" } else { "NOT verified" });
             }
             Event::ChangeViolates { report, inherited } => {
-                self.status.awaiting = Some(&strings::AWAITING_VIOLATION);
                 let mut lines = vec![strings::CHANGE_VIOLATES.to_string()];
                 if !inherited.is_empty() {
                     lines.push(crate::record::describe::not_the_change(&inherited));
@@ -441,8 +460,7 @@ impl App {
         match event {
             Event::Error { message } => self.show_error(message),
             Event::Failed { error } => {
-                self.status.awaiting = None;
-                self.llm.asking = None;
+                self.llm.stop_asking();
                 self.llm.error = Some(error.to_string());
                 self.llm.log(format!("error: {error}"));
             }

@@ -124,6 +124,12 @@ pub struct LlmPane {
     pub asking: Option<String>,
     /// When the question under way was asked.
     pub asking_since: Option<std::time::Instant>,
+    /// The model's replies to the question under way so far (a reply the checks refuse
+    /// is followed by another call).
+    pub replies_to_question: usize,
+    /// What trying conditions in simulation found for the failed action (named), shown
+    /// while its failure waits without a proposal.
+    pub screened: Option<(String, crate::session::Shortlist)>,
     /// Who answered the last model call (`model qwen…`, a fixture).
     pub replied_by: Option<String>,
     pub goal: Option<String>,
@@ -230,6 +236,12 @@ impl LlmPane {
         self.spin = (self.spin + 1) % SPINNER.len();
     }
 
+    /// The question under way is over (answered, cancelled, or left).
+    pub fn stop_asking(&mut self) {
+        self.asking = None;
+        self.asking_since = None;
+    }
+
     pub fn draw(&self, frame: &mut Frame, area: Rect, theme: &Theme, hints: &PaneHints) {
         let block = self.block(theme, hints);
         let inner = block.inner(area);
@@ -260,15 +272,27 @@ impl LlmPane {
         let mut lines: Vec<Line> = Vec::new();
         if let Some(what) = &self.asking {
             let live = match (hints.cancel, self.asking_since) {
-                (Some(key), Some(since)) => {
-                    format!(" {} s · {key} cancels", since.elapsed().as_secs())
-                }
+                (Some(key), Some(since)) => format!(
+                    " {} s · call {} · {key} cancels",
+                    since.elapsed().as_secs(),
+                    self.replies_to_question + 1
+                ),
                 _ => String::new(),
             };
             lines.push(Line::from(Span::styled(
                 format!("{} {} {what} …{live}", SPINNER[self.spin], strings::ASKING),
                 theme.running,
             )));
+        }
+        // What screening found: above while the model chooses from it, below the ways on
+        // once the person does.
+        let screened = match (&self.screened, &self.proposal) {
+            (Some((action, shortlist)), None) => Some((action, shortlist)),
+            _ => None,
+        };
+        let asking = self.asking.is_some();
+        if let Some((action, shortlist)) = screened.filter(|_| asking) {
+            screened_lines(action, shortlist, true, theme, &mut lines);
         }
         match (&self.proposal, &self.guidance) {
             (Some(p), _) => proposal_lines(p, theme, hints.proposal, proposal_first, &mut lines),
@@ -288,6 +312,9 @@ impl LlmPane {
                 Some(offer) => lines.push(Line::from(Span::styled(offer.clone(), theme.proposal))),
                 None => lines.push(Line::from(Span::styled(strings::NO_PROPOSAL, theme.dim))),
             },
+        }
+        if let Some((action, shortlist)) = screened.filter(|_| !asking) {
+            screened_lines(action, shortlist, false, theme, &mut lines);
         }
         if let Some(goal) = &self.goal {
             let by = self.goal_by.as_deref().unwrap_or("the scenario file");
@@ -395,6 +422,30 @@ impl LlmPane {
 /// A pending proposal: betr's findings, the proposal with its author and keys, then the
 /// author's reasoning labelled as theirs. `proposal_first` (a pane too small for it all):
 /// the proposal and its keys, then the findings.
+/// What screening found for the failed `action`, before a proposal: the fixes betr's
+/// simulation confirmed, and what is done with them (the model chooses among them, or the
+/// person does).
+fn screened_lines(
+    action: &str,
+    shortlist: &crate::session::Shortlist,
+    asking: bool,
+    theme: &Theme,
+    lines: &mut Vec<Line<'_>>,
+) {
+    lines.push(Line::from(vec![
+        Span::styled(strings::FOUND_BY_BETR, theme.title),
+        Span::styled(format!(" {action}"), theme.dim),
+    ]));
+    lines.push(Line::from(format!("  {}", shortlist.finding())));
+    let n = shortlist.fixes.len();
+    let next = match (asking, n) {
+        (_, 0) => return,
+        (true, _) => strings::model_chooses_among(n),
+        (false, _) => strings::SHORTLIST_IS_YOURS.to_string(),
+    };
+    lines.push(Line::from(Span::styled(next, theme.dim)));
+}
+
 fn proposal_lines<'a>(
     p: &'a ProposalView,
     theme: &Theme,
@@ -516,7 +567,7 @@ mod tests {
         };
         let live = screen_with(&pane, 80, 6, Some("esc"));
         assert!(
-            live.contains("the missing precondition … 7 s · esc cancels"),
+            live.contains("the missing precondition … 7 s · call 1 · esc cancels"),
             "{live}"
         );
         let replayed = screen_with(&pane, 80, 6, None);

@@ -9,6 +9,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::Paragraph;
 
 use crate::llm::usage::UsageTotals;
+use crate::session::PhaseKind;
 
 use super::super::strings;
 use super::super::theme::Theme;
@@ -51,12 +52,11 @@ pub struct StatusBar {
     pub auto_approve: bool,
     pub usage: UsageTotals,
     pub ticks: u64,
-    pub running: bool,
+    /// What the engine does or waits for, as it last said.
+    pub phase: PhaseKind,
     pub ending: Option<Ending>,
     /// Whether running stops after a node fails.
     pub break_on_failure: bool,
-    /// What a failure waits for (the model's proposal, a person's approval).
-    pub awaiting: Option<&'static strings::Awaiting>,
     /// Where the model's fetch stands while the workbench is open without it.
     pub fetching: Option<String>,
     /// Said once when a 3D viewer was asked for and is not there.
@@ -180,15 +180,17 @@ impl StatusBar {
             sep.clone(),
             Span::styled(strings::tick(self.ticks), theme.status_bar),
             sep.clone(),
-            // A failure that waits (for the model, for approval) says so where the run
-            // state stands: the tree does not tick meanwhile.
-            match (self.running, self.awaiting) {
-                (true, _) => Span::styled(strings::RUNNING, theme.status_bar),
-                (false, Some(what)) => Span::styled(
+            // What the engine waits for (the model, approval, a person) stands where the
+            // run state does: the tree does not tick meanwhile.
+            match strings::waiting_for(self.phase) {
+                Some(what) => Span::styled(
                     if narrow { what.short } else { what.long },
                     theme.status_bar.patch(theme.running),
                 ),
-                (false, None) => Span::styled(strings::PAUSED, theme.status_bar),
+                None if self.phase == PhaseKind::Running => {
+                    Span::styled(strings::RUNNING, theme.status_bar)
+                }
+                None => Span::styled(strings::PAUSED, theme.status_bar),
             },
         ]);
         spans

@@ -103,6 +103,13 @@ impl TreePane {
         }
     }
 
+    /// Whether the last tick ended with the root failed.
+    pub fn root_failed(&self) -> bool {
+        self.record
+            .as_ref()
+            .is_some_and(|r| r.root == crate::bt::Outcome::Failure)
+    }
+
     pub fn set_record(&mut self, record: Arc<TickRecord>) {
         self.record = Some(record);
         self.marks.stopped = None;
