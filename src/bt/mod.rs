@@ -28,4 +28,4 @@ pub use text::{ParseError, parse, to_text};
 /// stack; trees people write and the planner grows are tens of levels deep.
 pub const MAX_DEPTH: usize = 256;
 pub use tick::{ForcedStatuses, Leaves, TickRecord, Ticker};
-pub use tree::{NodeId, NodeKind, Tree, TreeError, path_text};
+pub use tree::{NodeId, NodeKind, Purpose, Tree, TreeError, path_text};

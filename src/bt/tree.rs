@@ -64,6 +64,15 @@ impl NodeKind {
     }
 }
 
+/// What a composite is for ([`Tree::purpose`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Purpose<'a> {
+    /// A fallback that makes this condition hold.
+    Achieves(&'a Condition),
+    /// A sequence that prepares this action and runs it.
+    Runs(&'a ActionCall),
+}
+
 /// Why a tree operation was refused.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum TreeError {
@@ -188,6 +197,26 @@ impl Tree {
 
     pub fn children(&self, id: NodeId) -> Result<&[NodeId], TreeError> {
         Ok(&self.node(id)?.children)
+    }
+
+    /// What a composite is for, so that folded away it still says it: a fallback whose
+    /// first child is a condition achieves that condition (its other children run when it
+    /// is false); a sequence whose last child is an action prepares and runs that action.
+    pub fn purpose(&self, id: NodeId) -> Option<Purpose<'_>> {
+        let children = self.children(id).ok()?;
+        match self.kind(id).ok()? {
+            NodeKind::Fallback => self
+                .kind(*children.first()?)
+                .ok()?
+                .as_condition()
+                .map(Purpose::Achieves),
+            NodeKind::Sequence => self
+                .kind(*children.last()?)
+                .ok()?
+                .as_action()
+                .map(Purpose::Runs),
+            _ => None,
+        }
     }
 
     /// The parent, or `None` for the root.

@@ -145,6 +145,8 @@ const FLUSH_TIMEOUT: Duration = Duration::from_secs(2);
 pub struct Viz {
     rec: RecordingStream,
     tree: Option<Arc<Tree>>,
+    /// The nodes the last change added to the tree, marked in the graph.
+    new_nodes: Vec<crate::bt::NodeId>,
     /// The session's step (the `step` timeline).
     step: i64,
     /// Ticks logged so far.
@@ -181,7 +183,7 @@ pub struct Viz {
 impl Viz {
     /// A run begins: the tree it ticks and the world before its first tick.
     pub fn run_start(&mut self, tree: &Tree, world: &dyn World) {
-        self.set_tree(Arc::new(tree.clone()));
+        self.set_tree(Arc::new(tree.clone()), Vec::new());
         if let Some(scene) = CellWorld::scene_of(world) {
             self.scene(&scene);
         }
@@ -276,6 +278,7 @@ impl Viz {
         Viz {
             rec,
             tree: None,
+            new_nodes: Vec::new(),
             step: 0,
             ticks: 0,
             motion: 0,
@@ -356,13 +359,15 @@ impl Viz {
         }
     }
 
-    /// A new tree (shown with no statuses until it is ticked).
-    pub fn set_tree(&mut self, tree: Arc<Tree>) {
+    /// A new tree (shown with no statuses until it is ticked), with the nodes the change
+    /// that made it added.
+    pub fn set_tree(&mut self, tree: Arc<Tree>, new_nodes: Vec<crate::bt::NodeId>) {
         if !self.rec.is_enabled() {
             return;
         }
-        Self::warn(tree::log_tree(&self.rec, &tree, None, true));
+        Self::warn(tree::log_tree(&self.rec, &tree, None, true, &new_nodes));
         self.tree = Some(tree);
+        self.new_nodes = new_nodes;
     }
 
     /// One tick: the next step, at the tick's own number, with the tree's statuses and
@@ -376,7 +381,13 @@ impl Viz {
         self.rec
             .set_time_sequence(TIMELINE, i64::try_from(record.tick).unwrap_or(i64::MAX));
         if let Some(tree) = &self.tree {
-            Self::warn(tree::log_tree(&self.rec, tree, Some(record), false));
+            Self::warn(tree::log_tree(
+                &self.rec,
+                tree,
+                Some(record),
+                false,
+                &self.new_nodes,
+            ));
         }
         if let Some(scene) = scene {
             self.scene(scene);
@@ -467,7 +478,9 @@ impl Viz {
             self.next_step();
         }
         match event {
-            Event::TreeChanged { tree, .. } => self.set_tree(tree.clone()),
+            Event::TreeChanged {
+                tree, new_nodes, ..
+            } => self.set_tree(tree.clone(), new_nodes.clone()),
             Event::Ticked { record } => self.tick(record, None),
             Event::Scene { scene } => self.scene(scene),
             _ => {}

@@ -462,3 +462,86 @@ fn a_web_viewer_that_stops_at_once_is_said_with_its_ports() {
 /// The YuMi's real arms in the view.
 #[path = "robot_tests.rs"]
 mod arms;
+
+/// The cafe goal of five wishes plans a tree of more than 40 nodes. Its graph shows the
+/// way to the node each tick is at, each composite off that way folded into one node that
+/// says what it is for; the nodes a change added are marked.
+#[test]
+fn a_large_tree_graph_shows_the_way_to_the_tick_and_folds_the_rest() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/no_coffee.toml");
+    let scenario = Scenario::load(&path).unwrap();
+    let goal = scenario
+        .parse_goal(
+            "On_Water_Table2 & On_Dessert_Table3 & Active_AC & IsClean_Floor & On_Coffee_Table1",
+        )
+        .unwrap();
+    let mut world = crate::world::load(&scenario).unwrap();
+    let tree = Planner::new(&scenario.domain)
+        .plan(&goal.to_dnf(), world.as_ref())
+        .unwrap()
+        .tree;
+    let whole = tree.preorder().len();
+    assert!(whole > tree::WHOLE_GRAPH_NODES, "{whole} nodes");
+
+    // Not ticked yet: the root and its children, each folded.
+    let (graph, edges) = tree::graph_of(&tree, None, false, &[]);
+    let root_children = tree.children(tree.root()).unwrap().len();
+    assert_eq!(graph.ids.len(), 1 + root_children, "{:?}", graph.labels);
+    assert_eq!(edges.map(|e| e.len()), Some(root_children));
+    assert!(
+        graph
+            .labels
+            .iter()
+            .any(|l| l.starts_with("▸ ? fallback for ") && l.ends_with(" more)")),
+        "{:?}",
+        graph.labels
+    );
+
+    // Ticked: the running action is shown, with every node on the way to it.
+    let mut records = Vec::new();
+    run_tree(&tree, world.as_mut(), &scenario.domain, 3, |r, _| {
+        records.push(r.clone());
+        true
+    });
+    let record = records.last().unwrap();
+    let (graph, _) = tree::graph_of(&tree, Some(record), false, &[]);
+    assert!(
+        graph.ids.len() < whole / 2,
+        "{} of {whole}",
+        graph.ids.len()
+    );
+    let running: Vec<&String> = graph
+        .labels
+        .iter()
+        .filter(|l| {
+            l.starts_with(tree::VIEWER_GLYPHS.running) && l.ends_with('!') && !l.contains("→")
+        })
+        .collect();
+    assert_eq!(running.len(), 1, "{:?}", graph.labels);
+    // Parents over their children, as in the whole graph.
+    for (i, id) in graph.ids.iter().enumerate() {
+        let node = crate::bt::NodeId(id.parse().unwrap());
+        if let Some(parent) = tree.parent(node).unwrap() {
+            let p = graph
+                .ids
+                .iter()
+                .position(|x| *x == parent.0.to_string())
+                .unwrap();
+            assert!(graph.positions[p].1 < graph.positions[i].1);
+        }
+    }
+
+    // A change's new nodes are marked.
+    let first_leaf = *tree
+        .preorder()
+        .iter()
+        .find(|n| tree.children(**n).unwrap().is_empty())
+        .unwrap();
+    let (graph, _) = tree::graph_of(&tree, None, false, &[first_leaf]);
+    let at = graph
+        .ids
+        .iter()
+        .position(|x| *x == first_leaf.0.to_string())
+        .unwrap();
+    assert!(graph.labels[at].starts_with("+ "), "{}", graph.labels[at]);
+}

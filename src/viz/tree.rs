@@ -6,7 +6,7 @@ use rerun::{
     Color, GraphEdges, GraphNodes, Position2D, RecordingStream, RecordingStreamResult, TextDocument,
 };
 
-use crate::bt::{self, Glyphs, NodeId, NodeKind, Status, TickRecord, Tree};
+use crate::bt::{self, Glyphs, NodeId, NodeKind, Purpose, Status, TickRecord, Tree};
 
 pub const TREE_GRAPH: &str = "tree/graph";
 pub const TREE_TEXT: &str = "tree/text";
@@ -48,29 +48,31 @@ fn label(kind: &NodeKind) -> String {
     }
 }
 
-/// A node's label in the graph: its status mark first once the tick reached it.
-fn graph_label(kind: &NodeKind, status: Status) -> String {
-    match status {
-        Status::Idle => label(kind),
-        shown => format!("{} {}", VIEWER_GLYPHS.status(shown), label(kind)),
-    }
-}
-
 /// Positions of the nodes of `order` (the tree's preorder) as a tidy tree ([`tidy`]).
 pub fn tidy_positions(tree: &Tree, order: &[NodeId]) -> Vec<(f32, f32)> {
+    let labels: Vec<String> = order
+        .iter()
+        .map(|&id| tree.kind(id).map(label).unwrap_or_default())
+        .collect();
+    positions_of(tree, order, &labels)
+}
+
+/// Positions of the nodes of `order` (preorder, any part of the tree that holds its root)
+/// with these labels: only children in `order` count.
+fn positions_of(tree: &Tree, order: &[NodeId], labels: &[String]) -> Vec<(f32, f32)> {
     let index: std::collections::HashMap<NodeId, usize> =
         order.iter().enumerate().map(|(i, &id)| (id, i)).collect();
     let nodes: Vec<(Vec<usize>, usize)> = order
         .iter()
-        .map(|&id| {
+        .zip(labels)
+        .map(|(&id, label)| {
             let children = tree.children(id).unwrap_or_default();
-            let chars = tree.kind(id).map_or(0, |k| label(k).chars().count());
             (
                 children
                     .iter()
                     .filter_map(|c| index.get(c).copied())
                     .collect(),
-                chars,
+                label.chars().count(),
             )
         })
         .collect();
@@ -149,41 +151,156 @@ impl Graph {
     }
 }
 
-/// Log the nodes (with colours and marks from `record`, grey without) at their tidy
-/// positions and, when `edges` is true, the edges, plus the text rendering.
-pub fn log_tree(
-    rec: &RecordingStream,
+/// Above this many nodes the graph shows the way from the root to where the tick is
+/// (the running node, else the failed one, else the change's first new node), with the
+/// children of each node on it; every other composite is folded into one node that says
+/// what it is for and how many nodes it holds. A whole tree of 60 nodes side by side is
+/// thousands of units wide: unreadable in the viewer at any zoom that shows it whole.
+pub const WHOLE_GRAPH_NODES: usize = 40;
+
+/// The node the graph of a large tree is opened to.
+fn focus(tree: &Tree, order: &[NodeId], record: Option<&TickRecord>, new: &[NodeId]) -> NodeId {
+    let running = record.and_then(|r| {
+        // In preorder the deepest running node comes last.
+        order
+            .iter()
+            .rev()
+            .find(|&&n| {
+                r.status(n) == Status::Running && tree.children(n).is_ok_and(<[_]>::is_empty)
+            })
+            .copied()
+    });
+    let failed = record.and_then(|r| r.failures.first().map(|(n, _)| *n));
+    running
+        .or(failed)
+        .or_else(|| new.first().copied())
+        .unwrap_or_else(|| tree.root())
+}
+
+/// What the graph shows of a tree: the nodes in preorder, and for each folded composite
+/// how many nodes hang below it.
+struct Shown {
+    nodes: Vec<NodeId>,
+    folded: std::collections::HashMap<NodeId, usize>,
+}
+
+fn shown(tree: &Tree, order: &[NodeId], focus: NodeId) -> Shown {
+    if order.len() <= WHOLE_GRAPH_NODES {
+        return Shown {
+            nodes: order.to_vec(),
+            folded: std::collections::HashMap::new(),
+        };
+    }
+    let mut way = std::collections::HashSet::new();
+    let mut at = Some(focus);
+    while let Some(n) = at {
+        way.insert(n);
+        at = tree.parent(n).ok().flatten();
+    }
+    // Nodes below each node: its children's counts, gathered in reverse preorder.
+    let mut below: std::collections::HashMap<NodeId, usize> = std::collections::HashMap::new();
+    for &n in order.iter().rev() {
+        let count = tree
+            .children(n)
+            .unwrap_or_default()
+            .iter()
+            .map(|c| 1 + below.get(c).copied().unwrap_or(0))
+            .sum();
+        below.insert(n, count);
+    }
+    let nodes: Vec<NodeId> = order
+        .iter()
+        .copied()
+        .filter(|&n| {
+            n == tree.root()
+                || tree
+                    .parent(n)
+                    .ok()
+                    .flatten()
+                    .is_some_and(|p| way.contains(&p))
+        })
+        .collect();
+    let folded = nodes
+        .iter()
+        .filter(|n| !way.contains(n))
+        .filter_map(|&n| below.get(&n).filter(|&&c| c > 0).map(|&c| (n, c)))
+        .collect();
+    Shown { nodes, folded }
+}
+
+/// A node's label in a large tree's graph: a composite with what it is for, and a folded
+/// one with how many nodes it holds.
+fn large_label(tree: &Tree, node: NodeId, kind: &NodeKind, folded: Option<usize>) -> String {
+    let purpose = match tree.purpose(node) {
+        Some(Purpose::Achieves(c)) => format!(" for {c}"),
+        Some(Purpose::Runs(a)) => format!(" to {a}!"),
+        None => String::new(),
+    };
+    match folded {
+        Some(n) => format!("▸ {}{purpose} ({n} more)", label(kind)),
+        None => format!("{}{purpose}", label(kind)),
+    }
+}
+
+/// The graph of `tree` as the viewer shows it: the nodes (with colours and marks from
+/// `record`, grey without; `+` before the nodes the last change added) at their tidy
+/// positions, and the edges when `edges` is true or the tree is too large to show whole
+/// (the nodes shown then change with the tick).
+pub fn graph_of(
     tree: &Tree,
     record: Option<&TickRecord>,
     edges: bool,
-) -> RecordingStreamResult<()> {
+    new: &[NodeId],
+) -> (Graph, Option<Vec<(String, String)>>) {
     let order = tree.preorder();
+    let large = order.len() > WHOLE_GRAPH_NODES;
+    let shown = shown(tree, &order, focus(tree, &order, record, new));
     let status = |n: NodeId| record.map_or(Status::Idle, |r| r.status(n));
-    let ids: Vec<String> = order.iter().map(|n| n.0.to_string()).collect();
-    let labels: Vec<String> = order
+    let ids: Vec<String> = shown.nodes.iter().map(|n| n.0.to_string()).collect();
+    let plain: Vec<String> = shown
+        .nodes
         .iter()
-        .map(|n| {
-            tree.kind(*n)
-                .map(|k| graph_label(k, status(*n)))
-                .unwrap_or_default()
+        .map(|&n| {
+            let Ok(kind) = tree.kind(n) else {
+                return String::new();
+            };
+            let text = if large {
+                large_label(tree, n, kind, shown.folded.get(&n).copied())
+            } else {
+                label(kind)
+            };
+            if new.contains(&n) {
+                format!("+ {text}")
+            } else {
+                text
+            }
         })
         .collect();
-    let colours: Vec<Color> = order
+    let positions = positions_of(tree, &shown.nodes, &plain);
+    let labels: Vec<String> = shown
+        .nodes
+        .iter()
+        .zip(plain)
+        .map(|(&n, text)| match status(n) {
+            Status::Idle => text,
+            s => format!("{} {text}", VIEWER_GLYPHS.status(s)),
+        })
+        .collect();
+    let colours: Vec<Color> = shown
+        .nodes
         .iter()
         .map(|n| {
             let [r, g, b] = status_colour(status(*n));
             Color::from_rgb(r, g, b)
         })
         .collect();
-    let edges = edges.then(|| {
-        order
+    let edges = (edges || large).then(|| {
+        shown
+            .nodes
             .iter()
-            .flat_map(|n| {
-                tree.children(*n)
-                    .unwrap_or_default()
-                    .iter()
-                    .map(|c| (n.0.to_string(), c.0.to_string()))
-                    .collect::<Vec<_>>()
+            .filter_map(|&n| {
+                let parent = tree.parent(n).ok().flatten()?;
+                Some((parent.0.to_string(), n.0.to_string()))
             })
             .collect()
     });
@@ -191,8 +308,20 @@ pub fn log_tree(
         ids,
         labels,
         colours,
-        positions: tidy_positions(tree, &order),
+        positions,
     };
+    (graph, edges)
+}
+
+/// Log the tree's graph ([`graph_of`]) and its text rendering.
+pub fn log_tree(
+    rec: &RecordingStream,
+    tree: &Tree,
+    record: Option<&TickRecord>,
+    edges: bool,
+    new: &[NodeId],
+) -> RecordingStreamResult<()> {
+    let (graph, edges) = graph_of(tree, record, edges, new);
     graph.log(rec, edges)?;
     let text = bt::render(tree, record, &VIEWER_GLYPHS).join("\n");
     rec.log(TREE_TEXT, &TextDocument::new(text))?;

@@ -7,7 +7,7 @@ use ratatui::style::Modifier;
 use ratatui::text::{Line, Span};
 use tui_tree_widget::TreeItem;
 
-use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree};
+use crate::bt::{NodeId, NodeKind, Purpose, Status, TickRecord, Tree};
 
 use super::super::super::strings;
 use super::super::super::theme::Theme;
@@ -97,22 +97,13 @@ pub(super) fn node_label(tree: &Tree, node: NodeId, theme: &Theme) -> String {
     }
 }
 
-/// What a composite is for, so a collapsed one still says it: a fallback's condition
-/// (` for "blue cube" on "green cube"`, what its other children achieve when it fails), a
-/// sequence's last action (` to grasp "blue cube"!`, what the children before prepare).
+/// What a composite is for, so a collapsed one still says it: ` for "blue cube" on
+/// "green cube"`, ` to grasp "blue cube"!`.
 fn purpose(tree: &Tree, node: NodeId) -> Option<String> {
-    let children = tree.children(node).ok()?;
-    match tree.kind(node).ok()? {
-        NodeKind::Fallback => match tree.kind(*children.first()?).ok()? {
-            NodeKind::Condition(c) => Some(strings::fallback_for(&c.to_string())),
-            _ => None,
-        },
-        NodeKind::Sequence => match tree.kind(*children.last()?).ok()? {
-            NodeKind::Action(a) => Some(strings::sequence_to(&a.to_string())),
-            _ => None,
-        },
-        _ => None,
-    }
+    Some(match tree.purpose(node)? {
+        Purpose::Achieves(c) => strings::fallback_for(&c.to_string()),
+        Purpose::Runs(a) => strings::sequence_to(&a.to_string()),
+    })
 }
 
 /// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
