@@ -132,6 +132,8 @@ pub struct App {
     stuck: Option<Stuck>,
     /// What was saved, exported, and is not saved yet.
     pub summary: Summary,
+    /// The web page of the 3D view, when betr started a web viewer: in the log and in `?`.
+    pub viewer_page: Option<String>,
     quit: bool,
 }
 
@@ -166,6 +168,7 @@ impl App {
             areas: PaneAreas::default(),
             queue: Vec::new(),
             refused_fixes: 0,
+            viewer_page: None,
             stuck: None,
             summary: Summary::default(),
             quit: false,

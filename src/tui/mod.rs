@@ -146,7 +146,8 @@ pub async fn run(
     app.status.viewer = tap.as_ref().and_then(|t| t.notice());
     if let Some(page) = tap.as_ref().and_then(|t| t.viewer_page()) {
         app.llm.log(strings::VIEWER_PAGE);
-        app.llm.log(page);
+        app.llm.log(page.clone());
+        app.viewer_page = Some(page);
     }
     let (_guard, mut terminal) = TerminalGuard::enter(stderr_to.as_deref())?;
     let queue = event_loop::Queue::new();

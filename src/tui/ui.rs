@@ -73,7 +73,14 @@ pub fn draw(frame: &mut Frame, app: &mut App) {
     }
     app.status.draw(frame, status, &theme, &help_key);
     match &app.overlay {
-        Some(Overlay::Help(first)) => draw_help(frame, area, &app.keys, app.mode, *first, &theme),
+        Some(Overlay::Help(first)) => draw_help(
+            frame,
+            area,
+            (&app.keys, app.mode),
+            app.viewer_page.as_deref(),
+            *first,
+            &theme,
+        ),
         Some(Overlay::Report { title, lines }) => draw_report(frame, area, title, lines, &theme),
         Some(Overlay::ConfirmQuit(lines)) => {
             draw_report(frame, area, strings::CONFIRM_QUIT_TITLE, lines, &theme);

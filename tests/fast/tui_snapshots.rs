@@ -644,3 +644,23 @@ fn a_tree_failed_on_a_forced_status_is_marked_failed() {
         assert!(screen.contains("paused"), "{screen}");
     });
 }
+
+/// The 3D view's web page, when betr started a web viewer, is in `?` on a line of its own,
+/// whole at 80 columns, so it can be copied.
+#[test]
+fn the_help_shows_the_viewer_page_whole() {
+    rt().block_on(async {
+        let page = "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy";
+        let mut b = Bench::start();
+        b.app.viewer_page = Some(page.to_string());
+        b.key(KeyCode::Char('?'));
+        for (w, h) in [(120, 40), (80, 24)] {
+            let screen = b.screen(w, h);
+            assert!(screen.lines().any(|l| l.contains(page)), "{screen}");
+            assert!(
+                screen.contains("3D view: open this address in a browser:"),
+                "{screen}"
+            );
+        }
+    });
+}

@@ -25,18 +25,19 @@ fn centered(area: Rect, width: u16, height: u16) -> Rect {
 
 /// The keys in a box over the screen: in two columns when one does not fit the height and
 /// two fit the width, else in one; a list taller than the screen shows the rows from
-/// `first` on, and says which rows show and how to scroll.
+/// `first` on, and says which rows show and how to scroll. The 3D view's web page, when
+/// there is one, stands under the keys on a line of its own, to copy whole.
 pub fn draw_help(
     frame: &mut Frame,
     area: Rect,
-    keys: &KeyBindings,
-    mode: KeyMode,
+    (keys, mode): (&KeyBindings, KeyMode),
+    viewer_page: Option<&str>,
     first: usize,
     theme: &Theme,
 ) {
     let entries = keys.help_lines(mode);
-    // Borders, the blank line and the footer.
-    let fixed = 4;
+    // Borders, the blank line and the footer, and the viewer's page with its heading.
+    let fixed = 4 + if viewer_page.is_some() { 2 } else { 0 };
     let two = if entries.len() + fixed > usize::from(area.height) {
         let columns = two_columns(&entries, theme);
         let wide = columns.iter().map(Line::width).max().unwrap_or(0) + 3;
@@ -71,6 +72,13 @@ pub fn draw_help(
         strings::HELP_FOOTER.to_string()
     };
     lines.push(Line::from(""));
+    if let Some(page) = viewer_page {
+        lines.push(Line::from(Span::styled(
+            format!(" {}", strings::VIEWER_PAGE),
+            theme.title,
+        )));
+        lines.push(Line::from(format!(" {page}")));
+    }
     lines.push(Line::from(Span::styled(format!(" {footer}"), theme.dim)));
     let width = lines.iter().map(Line::width).max().unwrap_or(20) + 3;
     let height = lines.len() + 2;
