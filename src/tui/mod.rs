@@ -69,6 +69,7 @@ impl TerminalGuard {
         install_panic_hook();
         let guard = TerminalGuard;
         enable_raw_mode()?;
+        discard_typed_ahead();
         execute!(stdout(), EnterAlternateScreen, Hide, EnableMouseCapture)?;
         if let Some(file) = stderr_to
             && let Err(e) = stderr::redirect(file)
@@ -92,6 +93,23 @@ pub fn restore() {
     stderr::restore();
     let _ = disable_raw_mode();
     let _ = execute!(stdout(), DisableMouseCapture, LeaveAlternateScreen, Show);
+}
+
+/// Drop what was typed while betr started: the terminal echoed it already, and read now
+/// it would act as keys nobody pressed in the workbench (a `q` typed ahead would quit it;
+/// an Enter typed in line mode would arrive as Ctrl-J).
+fn discard_typed_ahead() {
+    let stdin = std::io::stdin();
+    if std::io::IsTerminal::is_terminal(&stdin)
+        && let Err(e) = nix::sys::termios::tcflush(&stdin, nix::sys::termios::FlushArg::TCIFLUSH)
+    {
+        tracing::warn!(error = %e, "cannot discard the keys typed before the workbench opened");
+    }
+    while matches!(crossterm::event::poll(std::time::Duration::ZERO), Ok(true)) {
+        if crossterm::event::read().is_err() {
+            break;
+        }
+    }
 }
 
 fn install_panic_hook() {

@@ -568,8 +568,10 @@ fn replay_position(screen: &str) -> (usize, usize) {
 fn bare_betr_with_a_scenario_name_opens_the_workbench_on_it() {
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let dir = tmp("tmux-bare");
+    // The shell sleeps first: a `q` typed meanwhile waits in the terminal, as keys typed
+    // while betr starts do, and must not quit the workbench when it opens.
     let command = format!(
-        "cd {repo} && {isolated} {key_var}={key} {bin} cafe/no_coffee --backend openai \
+        "cd {repo} && sleep 1 && {isolated} {key_var}={key} {bin} cafe/no_coffee --backend openai \
          --base-url {url} --model fake-model --api-key-env {key_var} --policy-dir {policies}; \
          echo \"betr exited with status $?\"; sleep 60",
         repo = quote(&fixtures::root()),
@@ -581,7 +583,11 @@ fn bare_betr_with_a_scenario_name_opens_the_workbench_on_it() {
         policies = quote(&dir.join("policies")),
     );
     let tmux = Tmux::start(&command);
+    tmux.keys(&["q"]);
     tmux.wait_for(&["Behavior tree", "no_coffee", "openai fake-model"], 20);
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let screen = tmux.screen();
+    assert!(!screen.contains("betr exited"), "{screen}");
     tmux.keys(&["q"]);
     tmux.wait_for(&["betr exited with status 0"], 10);
     drop(tmux);
