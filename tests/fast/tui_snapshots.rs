@@ -55,7 +55,7 @@ fn failure_with_a_pending_proposal_then_approval() {
         assert_eq!(b.app.summary.unsaved_fixes, 1);
         let screen = b.screen(120, 40);
         assert!(
-            screen.contains("+[-] ~\"any object\" on \"blue cube\"?"),
+            screen.contains("+[ ] ~\"any object\" on \"blue cube\"?"),
             "{screen}"
         );
         insta::assert_snapshot!("after_approval", screen);

@@ -113,7 +113,7 @@ fn a_person_resolves_scenario_1_in_the_workbench() {
     tmux.keys(&["a"]);
     tmux.wait_for(
         &[
-            "+[-] ~\"any object\" on \"blue cube\"?",
+            "+[ ] ~\"any object\" on \"blue cube\"?",
             "place \"red cube\"",
             "Keep as a rule for later tasks: grasp {x} needs",
         ],
@@ -230,26 +230,26 @@ fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
     // Reject: the tree stays as planned.
     tmux.keys(&["x"]);
     let screen = tmux.wait_for(&["rejected: the tree is unchanged"], 10);
-    assert!(!screen.contains("+[-]"), "{screen}");
+    assert!(!screen.contains("+["), "{screen}");
 
     // Edit: the person types the condition; it is applied like an approved proposal.
     tmux.keys(&["e"]);
     tmux.wait_for(&[strings_edit_title()], 10);
     tmux.text("~\"any object\" on \"blue cube\"");
     tmux.keys(&["Enter"]);
-    tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
+    tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 20);
 
     // Undo: the planned tree is back.
     tmux.keys(&["u"]);
     let screen = tmux.wait_for(&["undid the last change (1 fix(es) removed)"], 10);
-    assert!(!screen.contains("+[-]"), "{screen}");
+    assert!(!screen.contains("+["), "{screen}");
 
     // The failure again: the model proposes, the person approves.
     step_to_proposal(&tmux);
     tmux.keys(&["a"]);
     tmux.wait_for(
         &[
-            "+[-] ~\"any object\" on \"blue cube\"?",
+            "+[ ] ~\"any object\" on \"blue cube\"?",
             "Keep as a rule for later tasks",
         ],
         20,
@@ -280,7 +280,7 @@ fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
     tmux.wait_for(
         &[
             "no LLM call needed",
-            "[-] ~\"any object\" on \"blue cube\"?",
+            "[ ] ~\"any object\" on \"blue cube\"?",
         ],
         20,
     );
@@ -393,7 +393,7 @@ fn a_person_stops_a_run_at_a_breakpoint() {
         &[
             "stopped at a breakpoint: grasp \"blue cube\"! (node 1.0.1.1) before tick 1",
             // Not ticked yet.
-            "[-] grasp \"blue cube\"! ● break ◀ stopped here",
+            "[ ] grasp \"blue cube\"! ● break ◀ stopped here",
         ],
         20,
     );
@@ -424,7 +424,7 @@ fn a_person_forces_the_goal_condition_to_fail() {
         &[
             "SUCCESS",
             "[✓] \"blue cube\" on \"green cube\"?",
-            "[-] grasp \"blue cube\"!",
+            "[ ] grasp \"blue cube\"!",
         ],
         30,
     );
@@ -656,7 +656,7 @@ fn a_person_cancels_a_slow_question_and_writes_the_fix() {
     tmux.keys(&["e"]);
     tmux.text("~\"any object\" on \"blue cube\"");
     tmux.keys(&["Enter"]);
-    tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
+    tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 20);
     tmux.keys(&["r"]);
     tmux.wait_for(&["SUCCESS"], 30);
     drop(tmux);

@@ -72,7 +72,7 @@ fn search_finds_each_match_of_a_300_node_tree() {
     // Collapse all: one row under the root's; the search finds its way back in.
     tmux.keys(&["C"]);
     tmux.wait_until(&["every sequence closed"], 10, |s| {
-        s.contains("▾  [-] [o] Fallback") && !s.contains("▾  [-] [-] Sequence")
+        s.contains("▾  [ ] [o] Fallback") && !s.contains("▾  [ ] [-] Sequence")
     });
     tmux.keys(&[">"]);
     tmux.wait_for(

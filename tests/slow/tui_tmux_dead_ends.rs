@@ -66,10 +66,10 @@ fn undo_then_the_undone_fix_is_proposed_again() {
     let (_dir, _server, tmux) = start("tmux-undo");
     to_the_first_proposal(&tmux);
     tmux.keys(&["a"]);
-    tmux.wait_for(&["+[-] ~\"any object\" on \"blue cube\"?"], 20);
+    tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 20);
     tmux.keys(&["u"]);
     let screen = tmux.wait_for(&["undid the last change (1 fix(es) removed)"], 10);
-    assert!(!screen.contains("+[-]"), "{screen}");
+    assert!(!screen.contains("+["), "{screen}");
     let screen = step_to_proposal(&tmux);
     assert!(
         screen.contains("proposed: ~\"any object\" on \"blue cube\""),
@@ -112,7 +112,7 @@ fn reject_then_the_model_is_asked_again_and_a_mistyped_edit_is_kept() {
     tmux.wait_for(&["> ~\"red cube\" on \"green cube\""], 10);
     tmux.keys(&["Escape"]);
     tmux.keys(&["a"]);
-    tmux.wait_for(&["+[-] ~\"red cube\" on \"blue cube\"?"], 20);
+    tmux.wait_for(&["+[ ] ~\"red cube\" on \"blue cube\"?"], 20);
 
     // Quitting with the fix unsaved asks first; quitting again says what was not saved.
     tmux.keys(&["q"]);

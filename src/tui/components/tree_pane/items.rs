@@ -106,6 +106,15 @@ fn purpose(tree: &Tree, node: NodeId) -> Option<String> {
     })
 }
 
+/// The status in a row's first brackets: blank for a node not ticked, so that it never
+/// reads as the sequence's own `[-]` beside it (`[ ] [-] Sequence`).
+fn status_mark(status: Status, theme: &Theme) -> &'static str {
+    match status {
+        Status::Idle => " ",
+        shown => theme.glyphs.status(shown),
+    }
+}
+
 /// `[✓] [-] Sequence`, `[✕] grasp "blue cube"! ◀ failed`, with `+` before new nodes.
 fn node_line(
     tree: &Tree,
@@ -126,7 +135,7 @@ fn node_line(
             Span::raw(" ")
         },
         Span::styled(
-            format!("[{}] ", theme.glyphs.status(status)),
+            format!("[{}] ", status_mark(status, theme)),
             theme.status(status),
         ),
     ];
