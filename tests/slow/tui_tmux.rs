@@ -235,6 +235,8 @@ fn a_person_rejects_edits_undoes_verifies_and_reuses_the_saved_policy() {
     // Edit: the person types the condition; it is applied like an approved proposal.
     tmux.keys(&["e"]);
     tmux.wait_for(&[strings_edit_title()], 10);
+    // The line opens with betr's first shortlisted fix; Ctrl-U clears it.
+    tmux.keys(&["C-u"]);
     tmux.text("~\"any object\" on \"blue cube\"");
     tmux.keys(&["Enter"]);
     tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 20);
@@ -649,12 +651,21 @@ fn a_person_cancels_a_slow_question_and_writes_the_fix() {
     tmux.wait_for(&["grasp \"blue cube\"!"], 20);
     tmux.keys(&["r"]);
     tmux.wait_for(&["asking the model for", "esc cancels"], 30);
-    tmux.wait_for(&[" 2 s · esc cancels"], 10);
+    // While the model is asked, betr's shortlist is on screen, with the call counted.
+    tmux.wait_for(
+        &[
+            " 2 s · call 1 · esc cancels",
+            "the model is choosing among these 2",
+        ],
+        10,
+    );
     tmux.keys(&["Escape"]);
     let screen = tmux.wait_for(&["What now:", "question was cancelled"], 10);
     assert!(!screen.contains("esc cancels"), "{screen}");
+    assert!(screen.contains("choose one yourself"), "{screen}");
+    // The fix line opens with the shortlist's first fix: Enter applies it.
     tmux.keys(&["e"]);
-    tmux.text("~\"any object\" on \"blue cube\"");
+    tmux.wait_for(&["~\"any object\" on \"blue cube\""], 10);
     tmux.keys(&["Enter"]);
     tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 20);
     tmux.keys(&["r"]);
