@@ -179,13 +179,18 @@ impl Bench {
         terminal.backend().to_string()
     }
 
-    /// Type the instruction of scenario 1 and step until the grasp fails and the
-    /// proposal is shown.
-    pub async fn step_to_failure(&mut self) {
+    /// Type the instruction of scenario 1 and wait for its tree.
+    async fn plan_scenario_instruction(&mut self) {
         self.key(KeyCode::Char('i'));
         self.type_text("Put the blue cube on the green cube");
         self.key(KeyCode::Enter);
         self.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+    }
+
+    /// Type the instruction of scenario 1 and step until the grasp fails and the
+    /// proposal is shown.
+    pub async fn step_to_failure(&mut self) {
+        self.plan_scenario_instruction().await;
         for _ in 0..10 {
             self.key(KeyCode::Char(' '));
             self.until(|e| matches!(e, Event::Ticked { .. })).await;
@@ -204,10 +209,7 @@ impl Bench {
     /// Type the instruction of scenario 1 and step until the grasp fails and the model is
     /// asked about it (the model must be slow to answer: see [`Bench::slow_to_propose`]).
     pub async fn step_to_question(&mut self) {
-        self.key(KeyCode::Char('i'));
-        self.type_text("Put the blue cube on the green cube");
-        self.key(KeyCode::Enter);
-        self.until(|e| matches!(e, Event::TreeChanged { .. })).await;
+        self.plan_scenario_instruction().await;
         for _ in 0..10 {
             self.key(KeyCode::Char(' '));
             self.until(|e| matches!(e, Event::Ticked { .. })).await;
