@@ -531,9 +531,8 @@ impl App {
         }
     }
 
-    /// The input line on the proposal's conditions, completing the scenario's words.
-    /// The fix line opens with the proposal, else with the first fix betr's screening
-    /// found for the failure waiting, else empty.
+    /// The fix line, completing the scenario's words: on the proposal's conditions, else
+    /// on the first fix betr's screening found for the failure waiting, else empty.
     fn open_edit(&mut self) {
         let screened = self
             .llm

@@ -210,52 +210,28 @@ pub const OBJECTS: &str = "Objects:";
 pub const LAST_ERROR: &str = "Last error:";
 pub const LAST_ERROR_RESOLVED: &str = "Last error (resolved: the tree has succeeded since):";
 /// What a failure waits for, in the status bar: in full, and for narrow terminals.
-#[derive(Debug, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Awaiting {
     pub long: &'static str,
     pub short: &'static str,
 }
 /// What the status bar says the engine waits for in `phase`; none when it waits for
 /// nothing (running, or paused with a tree or none).
-pub fn waiting_for(phase: PhaseKind) -> Option<&'static Awaiting> {
-    const READING: Awaiting = Awaiting {
-        long: "reading the instruction",
-        short: "reading",
+pub fn waiting_for(phase: PhaseKind) -> Option<Awaiting> {
+    let (long, short) = match phase {
+        PhaseKind::Idle | PhaseKind::Ready | PhaseKind::Running => return None,
+        PhaseKind::Reading => ("reading the instruction", "reading"),
+        PhaseKind::Choosing => ("choose a reading", "choose"),
+        PhaseKind::Failed => ("waits for you", "yours"),
+        PhaseKind::Asking => ("asking the model", "asking"),
+        PhaseKind::Proposed => ("awaiting approval", "approve?"),
+        PhaseKind::Checking => ("verifying the change", "verifying"),
+        PhaseKind::Violated => (
+            "fails verification: approve again, reject or undo",
+            "violates",
+        ),
     };
-    const CHOOSING: Awaiting = Awaiting {
-        long: "choose a reading",
-        short: "choose",
-    };
-    const FAILED: Awaiting = Awaiting {
-        long: "waits for you",
-        short: "yours",
-    };
-    const ASKING: Awaiting = Awaiting {
-        long: "asking the model",
-        short: "asking",
-    };
-    const PROPOSED: Awaiting = Awaiting {
-        long: "awaiting approval",
-        short: "approve?",
-    };
-    const CHECKING: Awaiting = Awaiting {
-        long: "verifying the change",
-        short: "verifying",
-    };
-    const VIOLATED: Awaiting = Awaiting {
-        long: "fails verification: approve again, reject or undo",
-        short: "violates",
-    };
-    match phase {
-        PhaseKind::Idle | PhaseKind::Ready | PhaseKind::Running => None,
-        PhaseKind::Reading => Some(&READING),
-        PhaseKind::Choosing => Some(&CHOOSING),
-        PhaseKind::Failed => Some(&FAILED),
-        PhaseKind::Asking => Some(&ASKING),
-        PhaseKind::Proposed => Some(&PROPOSED),
-        PhaseKind::Checking => Some(&CHECKING),
-        PhaseKind::Violated => Some(&VIOLATED),
-    }
+    Some(Awaiting { long, short })
 }
 pub const CHANGE_VIOLATES: &str = "The changed tree fails verification in the model: it does not run until you approve the change again (a) with this counterexample in view, reject it (x: undone, and the model is asked again knowing why), or undo it (u).";
 pub const PROPOSAL_FOR: &str = "Proposal for";

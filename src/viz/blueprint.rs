@@ -59,7 +59,7 @@ pub fn still_graph(name: &str) -> GraphView {
 }
 
 /// The default layout. The graph view's forces are all off: the nodes stay where betr's
-/// tidy layout puts them (`tree::tidy_positions`) instead of being pushed apart. The
+/// tidy layout puts them (`tree::graph_of`) instead of being pushed apart. The
 /// blueprint and selection panels start collapsed, leaving the window to the views.
 pub fn default_blueprint() -> Blueprint {
     let graph = still_graph(VIEW_GRAPH).with_origin(TREE_GRAPH);

@@ -347,7 +347,8 @@ fn the_tidy_layout_puts_parents_over_their_children_and_leaves_apart() {
         .unwrap()
         .tree;
     let order = tree.preorder();
-    let positions = tree::tidy_positions(&tree, &order);
+    let (graph, _) = tree::graph_of(&tree, None, true, &[]);
+    let positions = graph.positions;
     let at = |id| positions[order.iter().position(|n| *n == id).unwrap()];
     for &id in &order {
         let children = tree.children(id).unwrap();

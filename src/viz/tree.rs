@@ -48,15 +48,6 @@ fn label(kind: &NodeKind) -> String {
     }
 }
 
-/// Positions of the nodes of `order` (the tree's preorder) as a tidy tree ([`tidy`]).
-pub fn tidy_positions(tree: &Tree, order: &[NodeId]) -> Vec<(f32, f32)> {
-    let labels: Vec<String> = order
-        .iter()
-        .map(|&id| tree.kind(id).map(label).unwrap_or_default())
-        .collect();
-    positions_of(tree, order, &labels)
-}
-
 /// Positions of the nodes of `order` (preorder, any part of the tree that holds its root)
 /// with these labels: only children in `order` count.
 fn positions_of(tree: &Tree, order: &[NodeId], labels: &[String]) -> Vec<(f32, f32)> {

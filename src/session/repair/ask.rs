@@ -12,8 +12,7 @@ use crate::llm::{LanguageModel, Message, OutputConstraint, grammar, schema};
 use crate::scenario::Scenario;
 
 use super::super::call::ask;
-use super::super::types::Shortlist;
-use super::super::types::{Event, Options, Proposal, Question, SessionError};
+use super::super::types::{Event, Options, Proposal, Question, SessionError, Shortlist};
 use super::screen::{NotHelped, Screen, Verdict};
 use super::shortlist::{shortlist, without_implied};
 use super::value_bounds::Bounds;

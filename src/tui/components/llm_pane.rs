@@ -419,9 +419,6 @@ impl LlmPane {
     }
 }
 
-/// A pending proposal: betr's findings, the proposal with its author and keys, then the
-/// author's reasoning labelled as theirs. `proposal_first` (a pane too small for it all):
-/// the proposal and its keys, then the findings.
 /// What screening found for the failed `action`, before a proposal: the fixes betr's
 /// simulation confirmed, and what is done with them (the model chooses among them, or the
 /// person does).
@@ -446,6 +443,9 @@ fn screened_lines(
     lines.push(Line::from(Span::styled(next, theme.dim)));
 }
 
+/// A pending proposal: betr's findings, the proposal with its author and keys, then the
+/// author's reasoning labelled as theirs. `proposal_first` (a pane too small for it all):
+/// the proposal and its keys, then the findings.
 fn proposal_lines<'a>(
     p: &'a ProposalView,
     theme: &Theme,
