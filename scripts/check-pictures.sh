@@ -15,24 +15,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! command -v chromium >/dev/null; then
-  echo "installing Debian's chromium for the headless browser" >&2
-  if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium >&2
-fi
-
-# The DevTools client (websocket-client) in the venv scripts/viewer-screenshots.sh uses.
-target="${CARGO_TARGET_DIR:-target}"
-mkdir -p "$target"
-venv="$target/viewer-venv"
-exec 9>"$venv.lock"
-flock 9
-if ! "$venv/bin/python" -c "import websocket" >/dev/null 2>&1; then
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install --quiet --disable-pip-version-check "websocket-client==1.8.0"
-fi
-flock -u 9
+. scripts/chromium-env.sh
+needs_chromium
+viewer_venv "import websocket" "websocket-client==1.8.0"
 
 options=()
 pictures=()

@@ -30,18 +30,13 @@ import json
 import os
 import pathlib
 import re
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
-import urllib.request
-
-import websocket
 
 sys.dont_write_bytecode = True  # no __pycache__ left in scripts/ by the import below
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from ansi_to_svg import BASELINE, CELL_H, CELL_W, TOP, width  # noqa: E402  the grid drawn
+from devtools import Browser, DevToolsError  # noqa: E402
 
 # A glyph's start may be this far from its cell's left edge. The converter places every
 # character exactly (to a tenth of a pixel), so anything more means the browser moved it
@@ -85,43 +80,7 @@ LAYOUT_JS = r"""
 
 
 class Failure(Exception):
-    """Chromium could not be driven or a file could not be read (exit status 2)."""
-
-
-def devtools_page(port, deadline):
-    while time.time() < deadline:
-        try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=2) as r:
-                pages = [t for t in json.load(r) if t.get("type") == "page"]
-            if pages:
-                return pages[0]["webSocketDebuggerUrl"]
-        except OSError:
-            pass
-        time.sleep(0.3)
-    raise Failure(f"Chromium's DevTools endpoint on port {port} did not answer")
-
-
-class Page:
-    def __init__(self, url):
-        self.ws = websocket.create_connection(url, timeout=60)
-        self.next_id = 0
-
-    def call(self, method, **params):
-        self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
-            reply = json.loads(self.ws.recv())
-            if reply.get("id") == self.next_id:
-                if "error" in reply:
-                    raise Failure(f"{method}: {reply['error']}")
-                return reply.get("result", {})
-
-    def evaluate(self, expression):
-        result = self.call("Runtime.evaluate", expression=expression, returnByValue=True,
-                           awaitPromise=True)
-        if "exceptionDetails" in result:
-            raise Failure(f"script failed in the page: {result['exceptionDetails']}")
-        return result["result"].get("value")
+    """A file could not be read or Chromium could not render it (exit status 2)."""
 
 
 def expected_grid(text):
@@ -272,40 +231,23 @@ def main():
     parser.add_argument("--max", type=int, default=20, help="mismatches shown per picture (20)")
     parser.add_argument("--port", type=int, default=9334, help="Chromium's DevTools port")
     args = parser.parse_args()
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    if not chromium:
-        print("picture_check: chromium is not installed (Debian: apt-get install chromium)",
-              file=sys.stderr)
-        return 2
     args.png_dir.mkdir(parents=True, exist_ok=True)
-    profile = tempfile.mkdtemp(prefix="betr-chromium-")
-    browser = subprocess.Popen(
-        [chromium, "--headless=new", "--no-sandbox", "--hide-scrollbars",
-         f"--remote-debugging-port={args.port}", f"--user-data-dir={profile}", "about:blank"],
-        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     failed = False
     try:
-        page = Page(devtools_page(args.port, time.time() + 30))
-        page.call("Page.enable")
-        page.call("DOM.enable")
-        page.call("CSS.enable")
-        for svg_path in args.svg:
-            summary, lines = check(page, svg_path, svg_path.with_suffix(".txt"), args.png_dir,
-                                   args.font, args.max)
-            print(summary)
-            for line in lines:
-                print(line)
-            failed = failed or bool(lines)
-    except Failure as e:
+        with Browser(args.port, ["--hide-scrollbars"]) as page:
+            page.call("Page.enable")
+            page.call("DOM.enable")
+            page.call("CSS.enable")
+            for svg_path in args.svg:
+                summary, lines = check(page, svg_path, svg_path.with_suffix(".txt"),
+                                       args.png_dir, args.font, args.max)
+                print(summary)
+                for line in lines:
+                    print(line)
+                failed = failed or bool(lines)
+    except (Failure, DevToolsError) as e:
         print(f"picture_check: {e}", file=sys.stderr)
         return 2
-    finally:
-        browser.terminate()
-        try:
-            browser.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            browser.kill()
-        shutil.rmtree(profile, ignore_errors=True)
     if failed:
         print("picture_check: FAILED: the pictures above do not render as the terminal showed "
               "them", file=sys.stderr)

@@ -12,15 +12,13 @@ reason when Chromium does not start or the picture cannot be taken.
 
 import argparse
 import base64
-import json
-import shutil
-import subprocess
+import os
 import sys
-import tempfile
 import time
-import urllib.request
 
-import websocket
+sys.dont_write_bytecode = True  # no __pycache__ left in scripts/ by the import below
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from devtools import Browser, DevToolsError  # noqa: E402
 
 KEYS = {
     "Home": ("Home", 36),
@@ -36,35 +34,6 @@ def fail(message):
     sys.exit(1)
 
 
-def devtools_page(port, deadline):
-    while time.time() < deadline:
-        try:
-            with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=2) as r:
-                pages = [t for t in json.load(r) if t.get("type") == "page"]
-            if pages:
-                return pages[0]["webSocketDebuggerUrl"]
-        except OSError:
-            pass
-        time.sleep(0.3)
-    fail("Chromium's DevTools endpoint did not answer")
-
-
-class Page:
-    def __init__(self, url):
-        self.ws = websocket.create_connection(url, timeout=60)
-        self.next_id = 0
-
-    def call(self, method, **params):
-        self.next_id += 1
-        self.ws.send(json.dumps({"id": self.next_id, "method": method, "params": params}))
-        while True:
-            reply = json.loads(self.ws.recv())
-            if reply.get("id") == self.next_id:
-                if "error" in reply:
-                    fail(f"{method}: {reply['error']}")
-                return reply.get("result", {})
-
-
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("url")
@@ -75,50 +44,30 @@ def main():
     parser.add_argument("--port", type=int, default=9333)
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    if not chromium:
-        fail("chromium is not installed (Debian: apt-get install chromium)")
-    profile = tempfile.mkdtemp(prefix="betr-chromium-")
-    browser = subprocess.Popen(
-        [
-            chromium,
-            "--headless=new",
-            "--no-sandbox",
-            "--use-angle=swiftshader",
-            "--enable-unsafe-swiftshader",
-            "--ignore-gpu-blocklist",
-            f"--remote-debugging-port={args.port}",
-            f"--user-data-dir={profile}",
-            f"--window-size={width},{height}",
-            "about:blank",
-        ],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
+    flags = [
+        "--use-angle=swiftshader",
+        "--enable-unsafe-swiftshader",
+        "--ignore-gpu-blocklist",
+        f"--window-size={width},{height}",
+    ]
     try:
-        page = Page(devtools_page(args.port, time.time() + 30))
-        page.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
-                  deviceScaleFactor=1, mobile=False)
-        page.call("Page.enable")
-        page.call("Page.navigate", url=args.url)
-        time.sleep(args.wait)
-        for key in args.key:
-            name, code = KEYS.get(key, (key, 0))
-            for kind in ("keyDown", "keyUp"):
-                page.call("Input.dispatchKeyEvent", type=kind, key=name, code=key,
-                          windowsVirtualKeyCode=code)
-            time.sleep(1.0)
-        shot = page.call("Page.captureScreenshot", format="png")
-        with open(args.out, "wb") as f:
-            f.write(base64.b64decode(shot["data"]))
-    finally:
-        browser.terminate()
-        try:
-            browser.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            browser.kill()
-        shutil.rmtree(profile, ignore_errors=True)
-
+        with Browser(args.port, flags) as page:
+            page.call("Emulation.setDeviceMetricsOverride", width=width, height=height,
+                      deviceScaleFactor=1, mobile=False)
+            page.call("Page.enable")
+            page.call("Page.navigate", url=args.url)
+            time.sleep(args.wait)
+            for key in args.key:
+                name, code = KEYS.get(key, (key, 0))
+                for kind in ("keyDown", "keyUp"):
+                    page.call("Input.dispatchKeyEvent", type=kind, key=name, code=key,
+                              windowsVirtualKeyCode=code)
+                time.sleep(1.0)
+            shot = page.call("Page.captureScreenshot", format="png")
+    except DevToolsError as e:
+        fail(str(e))
+    with open(args.out, "wb") as f:
+        f.write(base64.b64decode(shot["data"]))
 
 if __name__ == "__main__":
     main()
