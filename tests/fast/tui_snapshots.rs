@@ -516,26 +516,6 @@ fn a_recording_can_be_discarded_and_a_silent_one_is_refused() {
     });
 }
 
-/// `text` with the digits of every duration in milliseconds (`183.0 ms`) written as `#`:
-/// how long the recorded session took to plan a motion differs from run to run.
-fn without_timings(text: &str) -> String {
-    let mut chars: Vec<char> = text.chars().collect();
-    let mut i = 0;
-    while i + 3 <= chars.len() {
-        if chars[i..i + 3] == [' ', 'm', 's'] {
-            let mut j = i;
-            while j > 0 && (chars[j - 1].is_ascii_digit() || chars[j - 1] == '.') {
-                j -= 1;
-                if chars[j].is_ascii_digit() {
-                    chars[j] = '#';
-                }
-            }
-        }
-        i += 1;
-    }
-    chars.into_iter().collect()
-}
-
 /// A recorded session replayed: from the end, back to the failure, then on to the
 /// proposal, with the replay's keys; the help lists them and none that edits or runs.
 #[test]
@@ -552,7 +532,7 @@ fn a_replay_steps_back_to_the_failure_and_on_to_the_proposal() {
         // How many steps follow the proposal depends on how the engine's events after it
         // interleaved with the commands the recording sent; the screen at the proposal
         // is what is compared.
-        let drawn = without_timings(&terminal.backend().to_string());
+        let drawn = terminal.backend().to_string();
         let Some((head, rest)) = drawn.split_once("REPLAY  step ") else {
             return drawn;
         };

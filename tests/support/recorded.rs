@@ -1,14 +1,15 @@
 //! A recording of scenario 1 resolved in the session engine as a person resolves it in the
 //! workbench (the instruction, a run to the failure, the fixture's proposal approved, a run
 //! to success), every command and event written by a `SessionRecorder`, then read back.
-//! The steps' times are rewritten to 10 ms apiece, so screens that show them are the same
-//! in every run.
+//! The steps' times are rewritten to 10 ms apiece and every arm motion's planning time to
+//! 12.5 ms (the attempts and the path are the seeded planner's own), so screens that show
+//! them are the same in every run.
 
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Duration;
 
-use betr::record::{Replay, SessionRecorder};
+use betr::record::{Replay, SessionRecorder, Step};
 use betr::session::{Command, Engine, Event};
 
 use super::engine::{INSTRUCTION, model, scenario_path, setup};
@@ -48,8 +49,11 @@ pub fn scenario_1(file: &Path) -> Replay {
         send(&mut recorder, Command::Shutdown);
     });
     let mut replay = Replay::load(file, None).unwrap();
-    for (i, (ms, _)) in replay.steps.iter_mut().enumerate() {
+    for (i, (ms, step)) in replay.steps.iter_mut().enumerate() {
         *ms = 10 * i as u64;
+        if let Step::Event(Event::ArmMotion { motion }) = step {
+            motion.seconds = 0.0125;
+        }
     }
     replay
 }
