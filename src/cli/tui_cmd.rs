@@ -135,8 +135,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     // The status bar says it when a viewer is not there or the recording stopped.
     let mut tap = super::viz_flags::SessionTap { viz, record };
     let theme = Theme::of(ascii);
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
+    // The screen's thread; the session engine gets threads of its own (`EngineThreads`).
+    let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .context("starting the async runtime")?;

@@ -40,7 +40,8 @@ use crossterm::terminal::{
 use ratatui::Terminal;
 use ratatui::backend::CrosstermBackend;
 
-use crate::session::{Engine, SessionError, Setup};
+use crate::session::{Engine, EngineHandle, Event, SessionError, Setup};
+use tokio::sync::mpsc::UnboundedReceiver;
 
 use dictation::{DictationService, Microphone, SttLoader};
 
@@ -54,6 +55,50 @@ pub enum TuiError {
     Terminal(#[from] std::io::Error),
     #[error(transparent)]
     Session(#[from] SessionError),
+    #[error("starting the session engine's threads: {0}")]
+    EngineThreads(std::io::Error),
+}
+
+/// The session engine on threads of its own, apart from the screen's: a step that
+/// computes for seconds (planning, moving the arms, screening fixes) never holds up the
+/// screen, and closing the workbench does not wait for it to end. What the engine writes
+/// is written whole or not at all, so leaving a step unfinished loses nothing written.
+pub struct EngineThreads {
+    handle: tokio::runtime::Handle,
+    /// Taken when dropped, to shut the threads down.
+    runtime: Option<tokio::runtime::Runtime>,
+}
+
+impl EngineThreads {
+    pub fn start() -> Result<EngineThreads, TuiError> {
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(2)
+            .thread_name("betr-engine")
+            .enable_all()
+            .build()
+            .map_err(TuiError::EngineThreads)?;
+        Ok(EngineThreads {
+            handle: runtime.handle().clone(),
+            runtime: Some(runtime),
+        })
+    }
+
+    /// Start the session on these threads.
+    pub fn spawn(
+        &self,
+        setup: Setup,
+    ) -> Result<(EngineHandle, UnboundedReceiver<Event>), TuiError> {
+        Ok(Engine::spawn_on(setup, &self.handle)?)
+    }
+}
+
+impl Drop for EngineThreads {
+    fn drop(&mut self) {
+        // Without waiting: a step under way ends with the process.
+        if let Some(runtime) = self.runtime.take() {
+            runtime.shutdown_background();
+        }
+    }
 }
 
 /// Puts the terminal back as it was (raw mode off, main screen, cursor shown) when
@@ -156,7 +201,8 @@ pub async fn run(
         model_arrival,
     } = workbench;
     let scenario = setup.scenario.clone();
-    let (engine, events) = Engine::spawn(setup)?;
+    let engine_threads = EngineThreads::start()?;
+    let (engine, events) = engine_threads.spawn(setup)?;
     if let Some(path) = tree {
         engine.send(crate::session::Command::LoadPolicy(Some(path)));
     }
@@ -189,5 +235,34 @@ pub async fn run(
     }
     // A recording still open is discarded with the service, before the screen goes.
     drop(dictation);
+    drop(engine_threads);
     Ok(app.summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    /// Closing the workbench while the engine computes a step returns at once, from
+    /// inside the screen's runtime as `run` closes it; the step is left, not waited for.
+    #[test]
+    fn closing_does_not_wait_for_a_step_under_way() {
+        let threads = EngineThreads::start().expect("the engine's threads");
+        let (started_tx, started_rx) = std::sync::mpsc::channel();
+        let finished = Arc::new(AtomicBool::new(false));
+        let done = finished.clone();
+        threads.handle.spawn(async move {
+            let _ = started_tx.send(());
+            // A step that computes without yielding, as planning or an arm's motion does.
+            std::thread::sleep(Duration::from_secs(20));
+            done.store(true, Ordering::SeqCst);
+        });
+        started_rx.recv().expect("the step started");
+        let screen = tokio::runtime::Builder::new_current_thread()
+            .build()
+            .expect("a runtime");
+        screen.block_on(async { drop(threads) });
+        assert!(!finished.load(Ordering::SeqCst), "the step was waited for");
+    }
 }

@@ -307,11 +307,20 @@ impl Engine {
         Ok((engine, events_rx))
     }
 
-    /// Start the engine as a tokio task; commands go through the handle.
+    /// Start the engine as a task of the current tokio runtime; commands go through the
+    /// handle.
     pub fn spawn(setup: Setup) -> Result<(EngineHandle, UnboundedReceiver<Event>), SessionError> {
+        Engine::spawn_on(setup, &tokio::runtime::Handle::current())
+    }
+
+    /// Start the engine as a task of `runtime`: the model calls it starts run there too.
+    pub fn spawn_on(
+        setup: Setup,
+        runtime: &tokio::runtime::Handle,
+    ) -> Result<(EngineHandle, UnboundedReceiver<Event>), SessionError> {
         let (engine, events) = Engine::new(setup)?;
         let (tx, rx) = unbounded_channel();
-        tokio::spawn(engine.run(rx));
+        runtime.spawn(engine.run(rx));
         Ok((EngineHandle { commands: tx }, events))
     }
 
