@@ -73,6 +73,11 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let path = super::find_scenario(&arg)?;
     let microphone = microphone(args)?;
     let (scenario, knowledge) = scenario_of(args, &path)?;
+    if let Some(file) = &args.tree
+        && let Err(refusal) = super::export_cmd::load_tree(&scenario, file)
+    {
+        return show_not_run(file, refusal, ascii);
+    }
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
@@ -163,6 +168,23 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// A `--tree` betr's engine does not run is the command's error (exit 2), said when
+/// the screen closes. A BehaviorTree.CPP tree the monitor can read (any node kind) is first
+/// shown whole on the monitor's file screen beside why, when a person is at the terminal.
+fn show_not_run(file: &Path, refusal: anyhow::Error, ascii: bool) -> Result<ExitCode> {
+    use std::io::IsTerminal as _;
+    if !std::io::stdout().is_terminal() {
+        return Err(refusal);
+    }
+    let Ok(tree) = super::monitor_cmd::read_tree_file(file) else {
+        return Err(refusal);
+    };
+    let view = betr::tui::monitor::FileView::new(tree, &file.display().to_string(), ascii)
+        .not_run(format!("{refusal:#}"));
+    betr::tui::monitor::look(view, log_path().as_deref())?;
+    Err(refusal.context(format!("{} was shown, not run", file.display())))
+}
+
 /// The microphone push-to-talk listens to: `--audio`'s file, checked now rather than at
 /// the first key press, or the default input device.
 fn microphone(args: &TuiArgs) -> Result<Arc<dyn Microphone>> {
@@ -176,8 +198,7 @@ fn microphone(args: &TuiArgs) -> Result<Arc<dyn Microphone>> {
 }
 
 /// The scenario at `path` with the rules learned for it (fixes approved in the workbench
-/// may be kept as rules in the same file); a `--tree` that cannot be read is said before
-/// the screen opens (exit 2).
+/// may be kept as rules in the same file).
 fn scenario_of(
     args: &TuiArgs,
     path: &std::path::Path,
@@ -193,11 +214,7 @@ fn scenario_of(
         no_knowledge: args.no_knowledge,
     };
     let knowledge = knowledge_flags.apply(&mut scenario)?;
-    let scenario = Arc::new(scenario);
-    if let Some(tree) = &args.tree {
-        super::export_cmd::load_tree(&scenario, tree)?;
-    }
-    Ok((scenario, knowledge))
+    Ok((Arc::new(scenario), knowledge))
 }
 
 /// The model's name as the status bar says it.

@@ -93,6 +93,8 @@ pub struct MonitorScreen {
     mode: Mode,
     /// In a replay: where it stands, said in the status bar instead of the connection.
     playback: Option<String>,
+    /// A file shown because betr's engine was asked to run it and does not: why.
+    not_run: Option<String>,
     /// Commands for the publisher, taken by the terminal loop.
     outbox: Vec<WatchCommand>,
     quit: bool,
@@ -122,6 +124,7 @@ impl MonitorScreen {
             blackboards: Vec::new(),
             mode: Mode::Live,
             playback: None,
+            not_run: None,
             outbox: Vec::new(),
             quit: false,
             glyphs,

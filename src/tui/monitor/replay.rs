@@ -355,6 +355,17 @@ impl FileView {
         ));
         FileView(screen)
     }
+
+    /// The same, for a file the workbench was asked to run: `why` betr's engine does not
+    /// run it is shown beside the tree.
+    pub fn not_run(mut self, why: String) -> FileView {
+        let screen = &mut self.0;
+        if let Some(playback) = &mut screen.playback {
+            *playback = playback.replace("a file, not running", "a file betr's engine does not run");
+        }
+        screen.not_run = Some(why);
+        self
+    }
 }
 
 impl Looking for FileView {

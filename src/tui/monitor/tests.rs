@@ -234,3 +234,18 @@ fn a_tree_file_is_shown_whole() {
     ));
     assert!(view.0.take_commands().is_empty());
 }
+
+/// A file the workbench was asked to run and betr's engine does not: shown whole, with why
+/// beside the tree where the status changes would be.
+#[test]
+fn a_tree_file_not_run_says_why_beside_it() {
+    let xml = include_str!("../../../tests/fixtures/btcpp/every_kind.xml");
+    let tree = crate::monitor::WatchedTree::parse_file(xml.as_bytes()).expect("reads");
+    let why = "every_kind.xml: line 8, column 7, <Script code=\"attempts := 0\"/>: Script is a \
+               BehaviorTree.CPP action that betr's engine does not run";
+    let mut view = super::FileView::new(tree, "every_kind.xml", false).not_run(why.into());
+    let drawn = drawn_at(&mut view.0, 120, 40);
+    assert!(drawn.contains("not run by betr's engine"), "{drawn}");
+    assert!(drawn.contains("a file betr's engine does not run"), "{drawn}");
+    insta::assert_snapshot!(drawn);
+}

@@ -190,6 +190,13 @@ fn draw_details(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
 }
 
 fn draw_recent(frame: &mut Frame, screen: &MonitorScreen, area: Rect) {
+    if let Some(why) = &screen.not_run {
+        let pane = Paragraph::new(printable(why).into_owned())
+            .wrap(Wrap { trim: false })
+            .block(block(screen, " not run by betr's engine ".into()));
+        frame.render_widget(pane, area);
+        return;
+    }
     let rows = usize::from(area.height.saturating_sub(2));
     let skip = screen.recent.len().saturating_sub(rows);
     let arrow = if screen.glyphs.success.is_ascii() {
