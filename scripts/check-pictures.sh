@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Checks that the workbench pictures in docs/images/ (made by scripts/screenshots.sh)
-# render in a browser as the terminal showed them: each workbench-*.svg is rendered in
+# Checks that the terminal pictures in docs/images/ (made by scripts/screenshots.sh)
+# render in a browser as the terminal showed them: each workbench-*.svg and monitor-*.svg
+# is rendered in
 # headless Chromium (Debian's `chromium`) and the character grid Chromium laid out is
-# compared with the terminal's plain text of the same capture (workbench-*.txt), cell by
+# compared with the terminal's plain text of the same capture (NAME.txt), cell by
 # cell (scripts/picture_check.py says what counts as a mismatch). A PNG of each rendered
 # picture goes to target/pictures/ for a person to look at.
 # Usage: bash scripts/check-pictures.sh [OPTIONS] [SVG...]
-#        (the pictures docs/images/workbench-*.svg unless named; OPTIONS are
+#        (the pictures docs/images/workbench-*.svg and monitor-*.svg unless named; OPTIONS are
 #        picture_check.py's: --font FAMILY renders with another font, --max N shows more
 #        mismatches, --png-dir DIR, --port PORT; installs chromium with apt when missing)
 # Exit status 0 with one line per picture when all match, 1 with the mismatches (picture,
@@ -30,7 +31,9 @@ while [ $# -gt 0 ]; do
   esac
 done
 if [ ${#pictures[@]} -eq 0 ]; then
-  pictures=(docs/images/workbench-*.svg)
-  [ -e "${pictures[0]}" ] || { echo "error: no docs/images/workbench-*.svg to check" >&2; exit 2; }
+  shopt -s nullglob
+  pictures=(docs/images/workbench-*.svg docs/images/monitor-*.svg)
+  shopt -u nullglob
+  [ ${#pictures[@]} -gt 0 ] || { echo "error: no docs/images/workbench-*.svg or monitor-*.svg to check" >&2; exit 2; }
 fi
 exec "$venv/bin/python" scripts/picture_check.py --png-dir "$target/pictures" "${options[@]}" "${pictures[@]}"

@@ -5,12 +5,20 @@
 # docs/images/: the planned tree, the failure with the proposal awaiting approval, and
 # success after the repair. Each picture comes with the terminal's plain text of the same
 # capture (NAME.txt beside NAME.svg), which `bash scripts/check-pictures.sh` compares with
-# the picture as a browser renders it. Run it again whenever the screens change.
-# Usage: bash scripts/screenshots.sh   (needs tmux and python3; fetches the model once)
+# the picture as a browser renders it. `monitor` draws docs/images/monitor-watching.svg:
+# `betr monitor` following a tree ticked in BehaviorTree.CPP itself (scripts/btcpp_publisher.py
+# in the venv scripts/btcpp-venv.sh makes). Run it again whenever the screens change.
+# Usage: bash scripts/screenshots.sh [workbench | monitor]   (no argument: both; needs
+#        tmux and python3; the workbench's fetch the model once)
 #        BETR=path/to/betr bash scripts/screenshots.sh   (a betr already built, e.g. the
 #        dev profile's target/debug/betr, instead of building the release one)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+which="${1:-all}"
+case "$which" in
+  workbench | monitor | all) ;;
+  *) echo "usage: bash scripts/screenshots.sh [workbench | monitor]" >&2; exit 2 ;;
+esac
 command -v tmux >/dev/null || { echo "error: tmux is needed (apt install tmux)" >&2; exit 2; }
 if [ -n "${BETR:-}" ]; then
   betr="$(cd "$(dirname "$BETR")" && pwd)/$(basename "$BETR")"
@@ -23,13 +31,6 @@ mkdir -p "$out"
 betr_dir="$(mktemp -d)"
 socket="betr-screenshots-$$"
 trap 'tmux -L "$socket" kill-server 2>/dev/null || true; rm -rf "$betr_dir"' EXIT
-
-# The model is fetched before the terminal opens (with its progress bar here), so the
-# screens show the workbench and not a download.
-"$betr" model fetch
-
-tmux -L "$socket" new-session -d -s betr -x 140 -y 45 \
-  "cd '$betr_dir' && XDG_STATE_HOME='$betr_dir/state' XDG_DATA_HOME='$betr_dir/data' '$betr' tui '$PWD/scenarios/cell/red_on_blue.toml' --policy-dir '$betr_dir/policies'; sleep 60"
 
 screen() { tmux -L "$socket" capture-pane -p -t betr; }
 # Wait until the screen shows every argument; give up after 300 s (the model is slow on
@@ -60,28 +61,72 @@ shot() {
 }
 keys() { tmux -L "$socket" send-keys -t betr "$@"; }
 
-wait_for "Behavior tree" "press i to type an instruction"
-keys i
-wait_for "Instruction or goal"
-keys -l "Put the blue cube on the green cube"
-keys Enter
-wait_for 'Goal: "blue cube" on "green cube"' '[o] Fallback'
-sleep 0.5
-shot workbench-planned
+workbench() {
+  # The model is fetched before the terminal opens (with its progress bar here), so the
+  # screens show the workbench and not a download.
+  "$betr" model fetch
 
-for _ in $(seq 1 10); do
-  keys Space
-  sleep 0.3
-  [[ "$(screen)" == *"◀ failed"* ]] && break
-done
-wait_for "◀ failed" "Proposal for grasp" "awaiting approval"
-sleep 0.5
-shot workbench-proposal
+  tmux -L "$socket" new-session -d -s betr -x 140 -y 45 \
+    "cd '$betr_dir' && XDG_STATE_HOME='$betr_dir/state' XDG_DATA_HOME='$betr_dir/data' '$betr' tui '$PWD/scenarios/cell/red_on_blue.toml' --policy-dir '$betr_dir/policies'; sleep 60"
 
-keys a
-wait_for "repaired:"
-keys r
-wait_for "SUCCESS"
-sleep 0.5
-shot workbench-success
-keys q
+  wait_for "Behavior tree" "press i to type an instruction"
+  keys i
+  wait_for "Instruction or goal"
+  keys -l "Put the blue cube on the green cube"
+  keys Enter
+  wait_for 'Goal: "blue cube" on "green cube"' '[o] Fallback'
+  sleep 0.5
+  shot workbench-planned
+
+  for _ in $(seq 1 10); do
+    keys Space
+    sleep 0.3
+    [[ "$(screen)" == *"◀ failed"* ]] && break
+  done
+  wait_for "◀ failed" "Proposal for grasp" "awaiting approval"
+  sleep 0.5
+  shot workbench-proposal
+
+  keys a
+  wait_for "repaired:"
+  keys r
+  wait_for "SUCCESS"
+  sleep 0.5
+  shot workbench-success
+  keys q
+  tmux -L "$socket" kill-session -t betr 2>/dev/null || true
+}
+
+# The monitor following scenario-like work in BehaviorTree.CPP: a publisher ticking its
+# tree every 20 ms until its input closes, watched for a few seconds.
+monitor() {
+  local python port=1677 fifo="$betr_dir/publisher-input"
+  python="$(bash scripts/btcpp-venv.sh)"
+  mkfifo "$fifo"
+  "$python" scripts/btcpp_publisher.py "$port" 0 <"$fifo" >"$betr_dir/publisher.log" &
+  local publisher=$!
+  exec 8>"$fifo"
+  tmux -L "$socket" new-session -d -s betr -x 120 -y 30 \
+    "cd '$betr_dir' && XDG_STATE_HOME='$betr_dir/state' '$betr' monitor :$port; sleep 60"
+  wait_for "status changes" "watching 127.0.0.1:$port"
+  echo go >&8
+  sleep 2
+  # The root selected (following stops), so the node pane shows the main blackboard.
+  keys Home
+  wait_for "grasps = " "not following"
+  sleep 1
+  shot monitor-watching
+  keys q
+  exec 8>&-
+  wait "$publisher" || true
+  tmux -L "$socket" kill-session -t betr 2>/dev/null || true
+}
+
+case "$which" in
+  workbench) workbench ;;
+  monitor) monitor ;;
+  all)
+    workbench
+    monitor
+    ;;
+esac
