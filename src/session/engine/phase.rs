@@ -159,6 +159,13 @@ impl Engine {
         self.tell_phase();
     }
 
+    /// The phase's model call has answered: on to `next` without [`Engine::enter`]'s
+    /// cancelling (the call's task is ending by itself). The answer usually moves the
+    /// phase on again, so front ends are told the phase once it is taken in (`tell_state`).
+    pub(super) fn call_answered(&mut self, next: Phase) {
+        self.phase = next;
+    }
+
     /// The phase with nothing under way: ready when there is a tree, else idle.
     pub(super) fn settled(&self) -> Phase {
         if self.task.tree.is_some() {

@@ -196,8 +196,7 @@ impl Engine {
                 if self.phase.call_id() != Some(id) {
                     return;
                 }
-                // The call is over: nothing to abort.
-                self.phase = self.settled();
+                self.call_answered(self.settled());
                 match result {
                     Ok(read) => self.on_interpretation(read, instruction),
                     Err(error) => self.emit(Event::Failed { error }),
@@ -213,9 +212,9 @@ impl Engine {
                 if self.phase.call_id() != Some(id) {
                     return;
                 }
-                self.phase = Phase::Failed {
+                self.call_answered(Phase::Failed {
                     failure: failure.clone(),
-                };
+                });
                 match answer.result {
                     Ok(asked) => self.on_asked(failure, asked, answer.evidence, &replies),
                     Err(error) => {

@@ -361,7 +361,8 @@ impl FileView {
     pub fn not_run(mut self, why: String) -> FileView {
         let screen = &mut self.0;
         if let Some(playback) = &mut screen.playback {
-            *playback = playback.replace("a file, not running", "a file betr's engine does not run");
+            *playback =
+                playback.replace("a file, not running", "a file betr's engine does not run");
         }
         screen.not_run = Some(why);
         self

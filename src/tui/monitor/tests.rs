@@ -246,6 +246,9 @@ fn a_tree_file_not_run_says_why_beside_it() {
     let mut view = super::FileView::new(tree, "every_kind.xml", false).not_run(why.into());
     let drawn = drawn_at(&mut view.0, 120, 40);
     assert!(drawn.contains("not run by betr's engine"), "{drawn}");
-    assert!(drawn.contains("a file betr's engine does not run"), "{drawn}");
+    assert!(
+        drawn.contains("a file betr's engine does not run"),
+        "{drawn}"
+    );
     insta::assert_snapshot!(drawn);
 }
