@@ -374,8 +374,9 @@ fn ranged(min: u64, max: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::<usize>::new().range(min..=max)
 }
 
-/// The async runtime of a one-shot command: one thread (the model and the server calls
-/// are awaited one at a time).
+/// The async runtime of a one-shot command, or of the workbench's screen: one thread (the
+/// model and the server calls are awaited one at a time; the workbench's engine has
+/// threads of its own).
 fn runtime() -> Result<tokio::runtime::Runtime> {
     tokio::runtime::Builder::new_current_thread()
         .enable_all()

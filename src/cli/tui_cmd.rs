@@ -81,22 +81,8 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let (settings, mut options) = llm_cmds::settings(&args.llm)?;
     options.max_rounds = 5;
     let ledger = Ledger::new(settings.usage_log.clone());
-    // What is not in the cache yet arrives while the workbench is open: the robot
-    // description the cell's arms need, then the embedded model. A failed fetch or load
-    // leaves the workbench usable without it and says why.
-    let (arrival_report, arrivals) = tokio::sync::mpsc::unbounded_channel();
-    let offline = args.offline;
-    let (model, wanted_model) = workbench_model(&settings, &ledger, offline, &var);
-    let robot = betr::session::missing_description(&scenario).filter(|_| !offline);
-    let background = if robot.is_some() || wanted_model.is_some() {
-        Some(super::background_fetch::start(
-            robot,
-            wanted_model,
-            arrival_report,
-        )?)
-    } else {
-        None
-    };
+    let (model, wanted_model) = workbench_model(&settings, &ledger, args.offline, &var);
+    let (background, arrivals) = fetch_missing(&scenario, wanted_model, args.offline)?.unzip();
     let model_name = model_name(&settings);
     let no_model = model.as_ref().err().map(ToString::to_string);
     let policy_dir = args
@@ -141,10 +127,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     let mut tap = super::viz_flags::SessionTap { viz, record };
     let theme = Theme::of(ascii);
     // The screen's thread; the session engine gets threads of its own (`EngineThreads`).
-    let runtime = tokio::runtime::Builder::new_current_thread()
-        .enable_all()
-        .build()
-        .context("starting the async runtime")?;
+    let runtime = super::runtime()?;
     let workbench = Workbench {
         info,
         keys,
@@ -153,7 +136,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         stt: speech_to_text(args),
         stderr_to: log_path(),
         tree: args.tree.clone(),
-        model_arrival: background.is_some().then_some(arrivals),
+        model_arrival: arrivals,
     };
     let ran = runtime.block_on(betr::tui::run(
         setup,
@@ -166,6 +149,29 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
     }
     report_session(&ran?, args, &mut tap);
     Ok(ExitCode::SUCCESS)
+}
+
+/// What is not in the cache yet, fetched while the workbench is open: the robot
+/// description the cell's arms need, then the embedded model (nothing when `offline`),
+/// with where the fetch reports. A failed fetch or load leaves the workbench usable
+/// without it and says why.
+fn fetch_missing(
+    scenario: &betr::scenario::Scenario,
+    model: Option<super::background_fetch::WantedModel>,
+    offline: bool,
+) -> Result<
+    Option<(
+        super::background_fetch::BackgroundFetch,
+        tokio::sync::mpsc::UnboundedReceiver<betr::tui::ModelArrival>,
+    )>,
+> {
+    let robot = betr::session::missing_description(scenario).filter(|_| !offline);
+    if robot.is_none() && model.is_none() {
+        return Ok(None);
+    }
+    let (report, arrivals) = tokio::sync::mpsc::unbounded_channel();
+    let fetch = super::background_fetch::start(robot, model, report)?;
+    Ok(Some((fetch, arrivals)))
 }
 
 /// A `--tree` betr's engine does not run is the command's error (exit 2), said when
