@@ -97,8 +97,8 @@ workbench() {
   tmux -L "$socket" kill-session -t betr 2>/dev/null || true
 }
 
-# The monitor following scenario-like work in BehaviorTree.CPP: a publisher ticking its
-# tree every 20 ms until its input closes, watched for a few seconds.
+# betr monitor following BehaviorTree.CPP: the test publisher ticks its tree every 20 ms
+# from the line sent on its input until the input closes.
 monitor() {
   local python port=1677 fifo="$betr_dir/publisher-input"
   python="$(bash scripts/btcpp-venv.sh)"

@@ -122,7 +122,7 @@ fn show_file(file: &std::path::Path, print: bool, ascii: bool) -> Result<ExitCod
         );
     }
     let label = file.display().to_string();
-    let view = betr::tui::monitor::FileView::new(tree, &label, ascii);
+    let view = betr::tui::monitor::FileView::new(tree, &label, None, ascii);
     betr::tui::monitor::look(view, super::tui_cmd::log_path().as_deref())?;
     Ok(ExitCode::SUCCESS)
 }

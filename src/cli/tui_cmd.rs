@@ -185,8 +185,8 @@ fn show_not_run(file: &Path, refusal: anyhow::Error, ascii: bool) -> Result<Exit
     let Ok(tree) = super::monitor_cmd::read_tree_file(file) else {
         return Err(refusal);
     };
-    let view = betr::tui::monitor::FileView::new(tree, &file.display().to_string(), ascii)
-        .not_run(format!("{refusal:#}"));
+    let label = file.display().to_string();
+    let view = betr::tui::monitor::FileView::new(tree, &label, Some(format!("{refusal:#}")), ascii);
     betr::tui::monitor::look(view, log_path().as_deref())?;
     Err(refusal.context(format!("{} was shown, not run", file.display())))
 }

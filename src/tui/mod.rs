@@ -63,14 +63,14 @@ pub enum TuiError {
 /// computes for seconds (planning, moving the arms, screening fixes) never holds up the
 /// screen, and closing the workbench does not wait for it to end. What the engine writes
 /// is written whole or not at all, so leaving a step unfinished loses nothing written.
-pub struct EngineThreads {
+struct EngineThreads {
     handle: tokio::runtime::Handle,
     /// Taken when dropped, to shut the threads down.
     runtime: Option<tokio::runtime::Runtime>,
 }
 
 impl EngineThreads {
-    pub fn start() -> Result<EngineThreads, TuiError> {
+    fn start() -> Result<EngineThreads, TuiError> {
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .worker_threads(2)
             .thread_name("betr-engine")
@@ -84,10 +84,7 @@ impl EngineThreads {
     }
 
     /// Start the session on these threads.
-    pub fn spawn(
-        &self,
-        setup: Setup,
-    ) -> Result<(EngineHandle, UnboundedReceiver<Event>), TuiError> {
+    fn spawn(&self, setup: Setup) -> Result<(EngineHandle, UnboundedReceiver<Event>), TuiError> {
         Ok(Engine::spawn_on(setup, &self.handle)?)
     }
 }

@@ -1,9 +1,8 @@
 //! A recording of scenario 1 resolved in the session engine as a person resolves it in the
 //! workbench (the instruction, a run to the failure, the fixture's proposal approved, a run
 //! to success), every command and event written by a `SessionRecorder`, then read back.
-//! The steps' times are rewritten to 10 ms apiece and every arm motion's planning time to
-//! 12.5 ms (the attempts and the path are the seeded planner's own), so screens that show
-//! them are the same in every run.
+//! The steps' times are rewritten to 10 ms apiece and its events made steady as the live
+//! bench's are (`workbench::steady`), so screens that show them are the same in every run.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -51,8 +50,8 @@ pub fn scenario_1(file: &Path) -> Replay {
     let mut replay = Replay::load(file, None).unwrap();
     for (i, (ms, step)) in replay.steps.iter_mut().enumerate() {
         *ms = 10 * i as u64;
-        if let Step::Event(Event::ArmMotion { motion }) = step {
-            motion.seconds = 0.0125;
+        if let Step::Event(event) = step {
+            super::workbench::steady(event);
         }
     }
     replay

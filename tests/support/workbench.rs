@@ -221,16 +221,17 @@ impl Bench {
     }
 }
 
-/// A session event to the app as the screens show it on every run: an arm motion's
-/// planning time is measured, so it is fixed here at 12.5 ms (the attempts and the path
-/// are the seeded planner's own).
-fn on_session_steady(app: &mut App, event: Event) {
-    match event {
-        Event::ArmMotion { mut motion } => {
-            motion.seconds = 0.0125;
-            app.on_session(Event::ArmMotion { motion });
-        }
-        e => app.on_session(e),
+/// A session event to the app as the screens show it on every run (see [`steady`]).
+fn on_session_steady(app: &mut App, mut event: Event) {
+    steady(&mut event);
+    app.on_session(event);
+}
+
+/// `event` as it is in every run: an arm motion's planning time is measured, so it is
+/// fixed at 12.5 ms (the attempts and the path are the seeded planner's own).
+pub fn steady(event: &mut Event) {
+    if let Event::ArmMotion { motion } = event {
+        motion.seconds = 0.0125;
     }
 }
 

@@ -335,8 +335,14 @@ impl Looking for WatchPlayer {
 pub struct FileView(pub MonitorScreen);
 
 impl FileView {
-    /// `tree`, read from `file`, on a screen with no connection.
-    pub fn new(tree: crate::monitor::WatchedTree, file: &str, ascii: bool) -> FileView {
+    /// `tree`, read from `file`, on a screen with no connection; `not_run`: why betr's
+    /// engine does not run it, when the workbench was asked to (shown beside the tree).
+    pub fn new(
+        tree: crate::monitor::WatchedTree,
+        file: &str,
+        not_run: Option<String>,
+        ascii: bool,
+    ) -> FileView {
         let address = crate::monitor::Address {
             host: String::new(),
             port: 0,
@@ -349,23 +355,17 @@ impl FileView {
         screen.follow = false;
         screen.select_index(0);
         let dot = if ascii { " | " } else { " · " };
+        let what = if not_run.is_some() {
+            "a file betr's engine does not run"
+        } else {
+            "a file, not running"
+        };
         screen.playback = Some(format!(
-            " {}{dot}{nodes} nodes{dot}a file, not running",
+            " {}{dot}{nodes} nodes{dot}{what}",
             crate::http_text::printable(file)
         ));
+        screen.not_run = not_run;
         FileView(screen)
-    }
-
-    /// The same, for a file the workbench was asked to run: `why` betr's engine does not
-    /// run it is shown beside the tree.
-    pub fn not_run(mut self, why: String) -> FileView {
-        let screen = &mut self.0;
-        if let Some(playback) = &mut screen.playback {
-            *playback =
-                playback.replace("a file, not running", "a file betr's engine does not run");
-        }
-        screen.not_run = Some(why);
-        self
     }
 }
 

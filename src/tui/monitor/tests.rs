@@ -226,7 +226,7 @@ fn breakpoint_keys_become_commands_for_the_publisher() {
 fn a_tree_file_is_shown_whole() {
     let xml = include_str!("../../../tests/fixtures/btcpp/every_kind.xml");
     let tree = crate::monitor::WatchedTree::parse_file(xml.as_bytes()).expect("reads");
-    let mut view = super::FileView::new(tree, "every_kind.xml", false);
+    let mut view = super::FileView::new(tree, "every_kind.xml", None, false);
     insta::assert_snapshot!(drawn_at(&mut view.0, 120, 40));
     // Breakpoint keys do nothing on a file.
     view.0.on_key(crossterm::event::KeyEvent::from(
@@ -243,7 +243,7 @@ fn a_tree_file_not_run_says_why_beside_it() {
     let tree = crate::monitor::WatchedTree::parse_file(xml.as_bytes()).expect("reads");
     let why = "every_kind.xml: line 8, column 7, <Script code=\"attempts := 0\"/>: Script is a \
                BehaviorTree.CPP action that betr's engine does not run";
-    let mut view = super::FileView::new(tree, "every_kind.xml", false).not_run(why.into());
+    let mut view = super::FileView::new(tree, "every_kind.xml", Some(why.into()), false);
     let drawn = drawn_at(&mut view.0, 120, 40);
     assert!(drawn.contains("not run by betr's engine"), "{drawn}");
     assert!(
