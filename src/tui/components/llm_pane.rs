@@ -286,10 +286,7 @@ impl LlmPane {
         }
         // What screening found: above while the model chooses from it, below the ways on
         // once the person does.
-        let screened = match (&self.screened, &self.proposal) {
-            (Some((action, shortlist)), None) => Some((action, shortlist)),
-            _ => None,
-        };
+        let screened = self.screened.as_ref().filter(|_| self.proposal.is_none());
         let asking = self.asking.is_some();
         if let Some((action, shortlist)) = screened.filter(|_| asking) {
             screened_lines(action, shortlist, true, theme, &mut lines);
