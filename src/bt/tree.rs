@@ -73,6 +73,17 @@ pub enum Purpose<'a> {
     Runs(&'a ActionCall),
 }
 
+impl std::fmt::Display for Purpose<'_> {
+    /// As it follows the composite's name: `for "blue cube" on "green cube"`, `to grasp
+    /// "blue cube"!`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Purpose::Achieves(c) => write!(f, "for {c}"),
+            Purpose::Runs(a) => write!(f, "to {a}!"),
+        }
+    }
+}
+
 /// Why a tree operation was refused.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum TreeError {

@@ -417,16 +417,6 @@ pub fn calls_short(n: usize) -> String {
     format!("{n} call(s)")
 }
 
-/// After a fallback whose first child is a condition: what it achieves.
-pub fn fallback_for(condition: &str) -> String {
-    format!(" for {condition}")
-}
-
-/// After a sequence whose last child is an action: what the children before it prepare.
-pub fn sequence_to(action: &str) -> String {
-    format!(" to {action}!")
-}
-
 pub fn tick(n: u64) -> String {
     format!("tick {n}")
 }

@@ -6,7 +6,7 @@ use rerun::{
     Color, GraphEdges, GraphNodes, Position2D, RecordingStream, RecordingStreamResult, TextDocument,
 };
 
-use crate::bt::{self, Glyphs, NodeId, NodeKind, Purpose, Status, TickRecord, Tree};
+use crate::bt::{self, Glyphs, NodeId, NodeKind, Status, TickRecord, Tree};
 
 pub const TREE_GRAPH: &str = "tree/graph";
 pub const TREE_TEXT: &str = "tree/text";
@@ -222,11 +222,10 @@ fn shown(tree: &Tree, order: &[NodeId], focus: NodeId) -> Shown {
 /// A node's label in a large tree's graph: a composite with what it is for, and a folded
 /// one with how many nodes it holds.
 fn large_label(tree: &Tree, node: NodeId, kind: &NodeKind, folded: Option<usize>) -> String {
-    let purpose = match tree.purpose(node) {
-        Some(Purpose::Achieves(c)) => format!(" for {c}"),
-        Some(Purpose::Runs(a)) => format!(" to {a}!"),
-        None => String::new(),
-    };
+    let purpose = tree
+        .purpose(node)
+        .map(|p| format!(" {p}"))
+        .unwrap_or_default();
     match folded {
         Some(n) => format!("▸ {}{purpose} ({n} more)", label(kind)),
         None => format!("{}{purpose}", label(kind)),

@@ -7,7 +7,7 @@ use ratatui::style::Modifier;
 use ratatui::text::{Line, Span};
 use tui_tree_widget::TreeItem;
 
-use crate::bt::{NodeId, NodeKind, Purpose, Status, TickRecord, Tree};
+use crate::bt::{NodeId, NodeKind, Status, TickRecord, Tree};
 
 use super::super::super::strings;
 use super::super::super::theme::Theme;
@@ -100,10 +100,7 @@ pub(super) fn node_label(tree: &Tree, node: NodeId, theme: &Theme) -> String {
 /// What a composite is for, so a collapsed one still says it: ` for "blue cube" on
 /// "green cube"`, ` to grasp "blue cube"!`.
 fn purpose(tree: &Tree, node: NodeId) -> Option<String> {
-    Some(match tree.purpose(node)? {
-        Purpose::Achieves(c) => strings::fallback_for(&c.to_string()),
-        Purpose::Runs(a) => strings::sequence_to(&a.to_string()),
-    })
+    tree.purpose(node).map(|p| format!(" {p}"))
 }
 
 /// The status in a row's first brackets: blank for a node not ticked, so that it never
