@@ -22,6 +22,7 @@ pub mod config_file;
 pub mod dataset;
 pub mod domain;
 pub mod excerpt;
+pub mod executor;
 pub mod goal;
 pub mod http_retry;
 pub mod http_text;

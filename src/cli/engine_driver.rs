@@ -54,6 +54,8 @@ pub struct Start<'a> {
     /// robot's real arms: only then is a missing robot description fetched first
     /// (planning never moves the arms).
     pub runs_tree: bool,
+    /// What performs the actions instead of the execution world (`--executor`).
+    pub executor: Option<Box<dyn betr::executor::Executor>>,
 }
 
 impl<'a> Start<'a> {
@@ -67,6 +69,7 @@ impl<'a> Start<'a> {
             viz: None,
             record: None,
             runs_tree: true,
+            executor: None,
         }
     }
 }
@@ -133,6 +136,7 @@ impl Driver {
         setup.variant = start.variant.map(str::to_string);
         setup.limits = start.limits;
         setup.scenes = start.viz.is_some();
+        setup.executor = start.executor;
         let runtime = super::runtime()?;
         let (handle, events) = {
             let _entered = runtime.enter();

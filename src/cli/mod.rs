@@ -374,6 +374,22 @@ fn ranged(min: u64, max: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::<usize>::new().range(min..=max)
 }
 
+/// The executor `--executor COMMAND` names: the program started with its arguments (the
+/// command line split as a shell splits it), or none when the flag is not given.
+fn executor_of(command: Option<&str>) -> Result<Option<Box<dyn betr::executor::Executor>>> {
+    let Some(command) = command else {
+        return Ok(None);
+    };
+    let words = shlex::split(command)
+        .with_context(|| format!("--executor {command:?}: an unclosed quote or escape"))?;
+    let Some((program, args)) = words.split_first() else {
+        bail!("--executor is empty: give the command that starts the executor");
+    };
+    let executor = betr::executor::ProcessExecutor::spawn(program, args)
+        .with_context(|| format!("--executor {command:?}"))?;
+    Ok(Some(Box::new(executor)))
+}
+
 /// The async runtime of a one-shot command, or of the workbench's screen: one thread (the
 /// model and the server calls are awaited one at a time; the workbench's engine has
 /// threads of its own).

@@ -44,6 +44,11 @@ pub struct RunArgs {
     /// while the tree goes on (exit status 3).
     #[arg(long)]
     pub break_on_failure: bool,
+    /// Perform the actions in this program (a simulator or a robot bridge speaking betr's
+    /// executor protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its
+    /// twin; split as a shell would: `--executor "python3 sim.py --seed 3"`.
+    #[arg(long, value_name = "COMMAND")]
+    pub executor: Option<String>,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
     #[command(flatten)]
@@ -167,6 +172,7 @@ fn run(scenario: &Scenario, args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode>
         },
         viz: viz.open(false, betr::viz::ViewerLife::OutlivesCommand, scenario)?,
         record: viz.recorder(scenario, &scenario_file(scenario), variant)?,
+        executor: super::executor_of(args.executor.as_deref())?,
         ..Start::new(scenario)
     };
     let mut session = with_tree(start, args.tree.as_deref(), false)?;

@@ -45,6 +45,11 @@ pub struct TuiArgs {
     /// Run in the scenario's `[world.variants.NAME]` world.
     #[arg(long)]
     pub variant: Option<String>,
+    /// Perform the actions in this program (a simulator or a robot bridge speaking betr's
+    /// executor protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its
+    /// twin; split as a shell would: `--executor "python3 sim.py --seed 3"`.
+    #[arg(long, value_name = "COMMAND")]
+    pub executor: Option<String>,
     /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml).
     #[arg(long, value_name = "FILE")]
     pub keys: Option<PathBuf>,
@@ -121,6 +126,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         tick_interval: Duration::from_millis(args.tick_ms),
         scenes: args.viz.viewer.is_some() || args.viz.rrd.is_some(),
         knowledge,
+        executor: super::executor_of(args.executor.as_deref())?,
         ..Setup::new(scenario, path, model)
     };
     // The status bar says it when a viewer is not there or the recording stopped.

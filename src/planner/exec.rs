@@ -24,11 +24,8 @@ impl Leaves for WorldLeaves<'_> {
         match self.world.step(action, started) {
             Step::Running => ActionStep::Running,
             Step::Failure(error) => ActionStep::Failure(error),
-            Step::Success => match unmet_postcondition(self.domain, &*self.world, action) {
-                Some(unmet) => ActionStep::Failure(format!(
-                    "Postcondition {unmet} not met after {} action completion",
-                    action.skill
-                )),
+            Step::Success => match postcondition_failure(self.domain, &*self.world, action) {
+                Some(error) => ActionStep::Failure(error),
                 None => ActionStep::Success,
             },
         }
@@ -37,6 +34,20 @@ impl Leaves for WorldLeaves<'_> {
     fn halt(&mut self, _node: NodeId, action: &ActionCall) {
         self.world.halt(action);
     }
+}
+
+/// The error an action that completed reports when one of its declared effects does not
+/// hold in `world` afterwards (the paper's words).
+pub fn postcondition_failure(
+    domain: &Domain,
+    world: &dyn World,
+    action: &ActionCall,
+) -> Option<String> {
+    let unmet = unmet_postcondition(domain, world, action)?;
+    Some(format!(
+        "Postcondition {unmet} not met after {} action completion",
+        action.skill
+    ))
 }
 
 /// The first declared effect of `action` that does not hold in `world`.

@@ -20,7 +20,7 @@ use crate::domain::{ActionCall, Condition, Domain};
 use crate::goal::Dnf;
 use crate::world::World;
 
-pub use exec::{RunEnd, RunLimits, RunReport, WorldLeaves, run_tree};
+pub use exec::{RunEnd, RunLimits, RunReport, WorldLeaves, postcondition_failure, run_tree};
 
 /// Bounds that keep planning finite.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,6 +6,7 @@
 //! behavior trees or language models.
 
 pub mod cell;
+pub mod observation;
 pub mod symbolic;
 
 use std::any::Any;
@@ -15,6 +16,7 @@ use crate::scenario::{Scenario, ScenarioError};
 
 pub use cell::CellWorld;
 pub use cell::skills::DISAGREEMENT_NOTE;
+pub use observation::{Observation, ObservationError};
 pub use symbolic::SymbolicWorld;
 
 /// The result of advancing an action by one tick.
@@ -62,6 +64,11 @@ pub trait World: Send {
     fn restore(&mut self, snapshot: &Snapshot) -> Result<(), WorldError>;
     /// The atoms true now, as conditions, in a stable order (for display and prompts).
     fn facts(&self) -> Vec<Condition>;
+    /// Take in what an executor observed (objects' poses, what the gripper holds), all or
+    /// nothing; the facts are then computed from it. Only a world with geometry can.
+    fn take_observation(&mut self, _observation: &Observation) -> Result<(), ObservationError> {
+        Err(ObservationError::NoGeometry(self.kind()))
+    }
     /// The world itself, for front ends that draw one kind of world (the 3D view reads
     /// the cell's scene through it: `CellWorld::scene_of`). `None` unless a world opts in.
     fn as_any(&self) -> Option<&dyn Any> {

@@ -23,6 +23,7 @@ mod engine_verification;
 mod eval_cmds;
 mod eval_sessions;
 mod example_pools;
+mod executor;
 mod full_disk;
 mod fuzz;
 mod goal_checks;

@@ -298,10 +298,13 @@ fn a_breakpoint_stops_the_real_tree_until_the_person_lets_it_go() {
     tmux.keys(&["b"]);
     tmux.wait_for(&["● [ ] Grasp"], 10);
     publisher.go();
-    let stopped = tmux.wait_for(
-        &["stopped before Grasp \"grasp\" (Action)", "▶ [ ] Grasp"],
-        30,
-    );
+    // The breakpoint's notice and the changes that led to it come over separate requests:
+    // the stop counts once the changes pane has them too.
+    let stopped = tmux.wait_until(&["stopped with the changes before it"], 30, |screen| {
+        screen.contains("stopped before Grasp \"grasp\" (Action)")
+            && screen.contains("▶ [ ] Grasp")
+            && changes_shown(screen) > 0
+    });
     // The tree waits: no change while stopped.
     std::thread::sleep(Duration::from_millis(500));
     let still = tmux.screen();

@@ -74,6 +74,9 @@ pub struct Setup {
     /// The learned knowledge: approved fixes of conditions are offered as rules and kept
     /// here (none: nothing is offered).
     pub knowledge: Option<super::knowledge::Knowledge>,
+    /// What performs the actions instead of the execution world, which then becomes its
+    /// twin (none: the execution world performs them).
+    pub executor: Option<Box<dyn crate::executor::Executor>>,
 }
 
 impl Setup {
@@ -96,6 +99,7 @@ impl Setup {
             limits: crate::planner::RunLimits::DEFAULT,
             scenes: false,
             knowledge: None,
+            executor: None,
         }
     }
 }
@@ -289,7 +293,11 @@ impl Engine {
             phase: Phase::Idle,
             told_phase: PhaseKind::Idle,
             task: Task::default(),
-            run: Run::new(planning, execution.world),
+            run: Run::new(
+                planning,
+                execution.world,
+                setup.executor.map(crate::executor::Reality::new),
+            ),
             learning: learning::Learning::new(setup.knowledge),
             calls: Calls::default(),
             events,

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use crate::bt::{Outcome as TickOutcome, TickRecord, Ticker};
 use crate::domain::Condition;
+use crate::executor::{Divergence, ExecutorError, Reality};
 use crate::planner::WorldLeaves;
 use crate::world::cell::snapshot::MotionView;
 use crate::world::{self, World};
@@ -17,7 +18,10 @@ use super::phase::{Failure, Phase};
 
 pub(super) struct Run {
     pub(super) planning: Box<dyn World>,
+    /// The world a tree runs in: it performs the actions, or is the twin of `reality`.
     pub(super) exec: Box<dyn World>,
+    /// The executor that performs the actions, when it is not `exec`.
+    pub(super) reality: Option<Reality>,
     pub(super) ticker: Ticker,
     /// Forced statuses and breakpoints.
     pub(super) debug: Debugger,
@@ -30,11 +34,16 @@ pub(super) struct Run {
 }
 
 impl Run {
-    pub(super) fn new(planning: Box<dyn World>, exec: Box<dyn World>) -> Run {
+    pub(super) fn new(
+        planning: Box<dyn World>,
+        exec: Box<dyn World>,
+        reality: Option<Reality>,
+    ) -> Run {
         let facts = exec.facts();
         Run {
             planning,
             exec,
+            reality,
             ticker: Ticker::new(),
             debug: Debugger::default(),
             ticks: 0,
@@ -72,15 +81,24 @@ impl Engine {
             self.stop_running();
             return self.error("nothing to tick: submit an instruction or plan first");
         };
-        let mut leaves = WorldLeaves {
-            world: self.run.exec.as_mut(),
-            domain: &self.settings.scenario.domain,
+        let domain = &self.settings.scenario.domain;
+        let forced = &self.run.debug.forced;
+        let (record, diverged, broken) = match self.run.reality.as_mut() {
+            Some(reality) => {
+                let mut leaves = reality.leaves(&mut self.run.exec, domain);
+                let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
+                (record, leaves.diverged, leaves.broken)
+            }
+            None => {
+                let mut leaves = WorldLeaves {
+                    world: self.run.exec.as_mut(),
+                    domain,
+                };
+                let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
+                (record, Vec::new(), None)
+            }
         };
-        let record = Arc::new(self.run.ticker.tick_forced(
-            tree,
-            &mut leaves,
-            &self.run.debug.forced,
-        ));
+        let record = Arc::new(record);
         self.run.ticks += 1;
         let failed = record.failures.first().and_then(|(node, error)| {
             let action = tree.kind(*node).ok()?.as_action()?.clone();
@@ -96,6 +114,10 @@ impl Engine {
         });
         self.emit_scene();
         self.tell_world_change();
+        self.tell_reality(&diverged);
+        if let Some(broken) = broken {
+            return self.executor_broke(&broken);
+        }
         self.end_of_tick(&record, failed);
         if self.is_running() && self.run.ticks >= self.settings.max_ticks {
             self.stop_running();
@@ -122,6 +144,27 @@ impl Engine {
                 self.emit(Event::ArmMotion { motion });
             }
         }
+    }
+
+    /// Say where reality did what the twin did not predict.
+    fn tell_reality(&self, diverged: &[Divergence]) {
+        let Some(reality) = &self.run.reality else {
+            return;
+        };
+        for divergence in diverged {
+            self.notice(divergence.describe(reality.name()));
+        }
+    }
+
+    /// The executor failed itself: nothing it reported this tick is taken as done, and
+    /// the run stops instead of asking how to repair the tree.
+    fn executor_broke(&mut self, error: &ExecutorError) {
+        self.stop_running();
+        self.emit(Event::GaveUp {
+            reason: format!(
+                "{error}; the run stops, and nothing this tick reported is taken as done"
+            ),
+        });
     }
 
     /// What the root's status means: running goes on; success ends a run; a failure is
@@ -187,6 +230,11 @@ impl Engine {
         match world::load_execution(&settings.scenario, settings.variant.as_deref()) {
             Ok(e) => self.run.exec = e.world,
             Err(e) => return self.error(format!("cannot reset the world: {e}")),
+        }
+        if let Some(reality) = &mut self.run.reality
+            && let Err(e) = reality.reset()
+        {
+            self.error(format!("cannot reset the executor: {e}"));
         }
         self.run.ticker = Ticker::new();
         self.run.debug.forget_stop();

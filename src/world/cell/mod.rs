@@ -16,6 +16,7 @@
 pub mod arms;
 pub mod geometry;
 mod motions;
+mod observe;
 pub mod robot;
 pub mod scene;
 pub mod skills;
@@ -493,6 +494,13 @@ impl World for CellWorld {
 
     fn as_any(&self) -> Option<&dyn Any> {
         Some(self)
+    }
+
+    fn take_observation(
+        &mut self,
+        observation: &super::Observation,
+    ) -> Result<(), super::ObservationError> {
+        self.take(observation)
     }
 
     fn facts(&self) -> Vec<Condition> {

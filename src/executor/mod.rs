@@ -1,0 +1,315 @@
+//! What carries out a running tree's actions, and betr's world as the twin that predicts.
+//!
+//! By default the execution world performs the actions itself: the cell moves its arms and
+//! its solids, and what it computes is what happens. An [`Executor`] is anything else that
+//! performs them — another simulator, a robot — behind one interface that names no
+//! transport: betr sends an [`ActionOrder`] (the action, and the joint path it planned for
+//! the arm when there is one), the executor reports progress tick by tick (`Running`,
+//! `Success`, or `Failure` with its own error text) and, when asked, an [`Observation`]
+//! (the objects' poses, what the gripper holds).
+//!
+//! With an executor, betr's execution world becomes the twin ([`Reality`]): before an
+//! action is sent, a copy of the twin performs it to predict it (an action the twin
+//! refuses — no collision-free path — is never sent, as a robot's own motion planner
+//! refuses before moving); the order carries the twin's planned path. When the executor
+//! reports the action's end, the twin takes the predicted state and then what the executor
+//! observed, so every condition is computed from reality's poses by the twin's geometry.
+//! An action the twin predicted to succeed that fails in reality, or completes without its
+//! declared effects, is a [`Divergence`], told to the person beside the failure.
+//!
+//! Writing an executor for a new simulator or robot: implement the five methods; an action
+//! that takes time returns `Running` until it ends (a real arm does); `Failure` text is
+//! what the person and the model read ("No collision free path found", "the grasp closed
+//! on nothing"); an `Err` means the executor itself broke (stopped answering, crashed), and
+//! stops the run instead of being repaired.
+
+use std::collections::HashMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::bt::{ActionStep, Leaves, NodeId};
+use crate::domain::{ActionCall, Condition, Domain};
+use crate::planner::postcondition_failure;
+use crate::world::{CellWorld, Observation, ObservationError, Step, World};
+
+pub mod process;
+pub use process::ProcessExecutor;
+
+/// Performs actions somewhere other than betr's own world.
+pub trait Executor: Send {
+    /// A short name for messages (`mujoco`, `robot`, a process's name).
+    fn name(&self) -> &str;
+    /// Start (`started`) or continue the action `order` describes; called once per tick
+    /// while the tree runs it.
+    fn perform(&mut self, order: &ActionOrder, started: bool) -> Result<Step, ExecutorError>;
+    /// Stop the action, which the tree no longer runs.
+    fn halt(&mut self, action: &ActionCall) -> Result<(), ExecutorError>;
+    /// What it sees now.
+    fn observe(&mut self) -> Result<Observation, ExecutorError>;
+    /// Back to the scenario's first state (a simulator), or refuse (a robot cannot).
+    fn reset(&mut self) -> Result<(), ExecutorError>;
+}
+
+/// One action sent to an executor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ActionOrder {
+    /// The skill, its objects and its parameter values (`place "blue cube" "green cube"`).
+    pub action: ActionCall,
+    /// The joint path the twin planned for the arm, when the action moves one.
+    pub path: Option<ArmPath>,
+    /// What the twin expects to observe once the action has ended (where a place puts
+    /// the object: the target a robot's skill takes), when the twin has geometry.
+    pub expected: Option<Observation>,
+}
+
+/// An arm's planned way: joint values (radians) from where the arm is to where it ends.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ArmPath {
+    /// The arm's name in the robot description.
+    pub arm: String,
+    pub joints: Vec<Vec<f64>>,
+    /// The index in `joints` where the fingers close or open.
+    pub acts_at: usize,
+}
+
+/// The executor itself failed; no action result can be trusted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExecutorError {
+    #[error("the {executor} executor stopped: {detail}")]
+    Stopped { executor: String, detail: String },
+    #[error("the {executor} executor's observation was refused: {source}")]
+    Observation {
+        executor: String,
+        source: ObservationError,
+    },
+}
+
+/// What the twin predicted and reality did otherwise.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Divergence {
+    pub action: ActionCall,
+    /// What reality reported instead of the predicted success.
+    pub reality: String,
+}
+
+impl Divergence {
+    /// In words, naming the executor that reported it.
+    pub fn describe(&self, executor: &str) -> String {
+        format!(
+            "the twin predicted {}! would succeed; the {executor} executor reports: {}",
+            self.action, self.reality
+        )
+    }
+}
+
+/// An executor with what the twin predicted of each action it is performing.
+pub struct Reality {
+    executor: Box<dyn Executor>,
+    pending: HashMap<NodeId, Pending>,
+}
+
+struct Pending {
+    order: ActionOrder,
+    /// The twin as it will be when the action has ended as predicted.
+    prediction: Box<dyn World>,
+}
+
+impl Reality {
+    pub fn new(executor: Box<dyn Executor>) -> Reality {
+        Reality {
+            executor,
+            pending: HashMap::new(),
+        }
+    }
+
+    pub fn name(&self) -> &str {
+        self.executor.name()
+    }
+
+    /// Back to the first state: nothing pending, the executor reset.
+    pub fn reset(&mut self) -> Result<(), ExecutorError> {
+        self.pending.clear();
+        self.executor.reset()
+    }
+
+    /// The leaves a tick runs against: conditions asked of `twin`, actions performed here.
+    pub fn leaves<'a>(
+        &'a mut self,
+        twin: &'a mut Box<dyn World>,
+        domain: &'a Domain,
+    ) -> RealityLeaves<'a> {
+        RealityLeaves {
+            reality: self,
+            twin,
+            domain,
+            diverged: Vec::new(),
+            broken: None,
+        }
+    }
+}
+
+/// One tick's leaves over a twin and an executor, with what the tick found.
+pub struct RealityLeaves<'a> {
+    reality: &'a mut Reality,
+    twin: &'a mut Box<dyn World>,
+    domain: &'a Domain,
+    /// Actions the twin predicted to succeed that reality did not.
+    pub diverged: Vec<Divergence>,
+    /// The executor broke during the tick (every later action of the tick fails with it).
+    pub broken: Option<ExecutorError>,
+}
+
+impl RealityLeaves<'_> {
+    fn broke(&mut self, error: ExecutorError) -> ActionStep {
+        let text = error.to_string();
+        self.broken = Some(error);
+        ActionStep::Failure(text)
+    }
+
+    /// The action has ended in reality, in success or with the executor's error; the
+    /// twin takes in what happened.
+    fn ended(&mut self, node: NodeId, action: &ActionCall, failed: Option<String>) -> ActionStep {
+        let Some(pending) = self.reality.pending.remove(&node) else {
+            return ActionStep::Failure(format!("{action}! ended without being started"));
+        };
+        let executor = self.reality.executor.as_mut();
+        let reality = match failed {
+            None => {
+                let mut prediction = pending.prediction;
+                if let Err(e) = take_in(executor, prediction.as_mut()) {
+                    return self.broke(e);
+                }
+                *self.twin = prediction;
+                match postcondition_failure(self.domain, self.twin.as_ref(), action) {
+                    Some(error) => error,
+                    None => return ActionStep::Success,
+                }
+            }
+            Some(error) => {
+                if let Err(e) = take_in(executor, self.twin.as_mut()) {
+                    return self.broke(e);
+                }
+                error
+            }
+        };
+        self.diverged.push(Divergence {
+            action: action.clone(),
+            reality: reality.clone(),
+        });
+        ActionStep::Failure(reality)
+    }
+}
+
+impl Leaves for RealityLeaves<'_> {
+    fn check(&mut self, condition: &Condition) -> bool {
+        self.twin.check(condition)
+    }
+
+    fn step(&mut self, node: NodeId, action: &ActionCall, started: bool) -> ActionStep {
+        if let Some(error) = &self.broken {
+            return ActionStep::Failure(error.to_string());
+        }
+        let fresh = started || !self.reality.pending.contains_key(&node);
+        if fresh {
+            match predict(self.twin.as_ref(), action, self.domain) {
+                Prediction::Succeeds(prediction) => {
+                    let order = ActionOrder {
+                        action: action.clone(),
+                        path: planned_path(self.twin.as_ref(), prediction.as_ref()),
+                        expected: cell(prediction.as_ref()).map(CellWorld::observation),
+                    };
+                    self.reality
+                        .pending
+                        .insert(node, Pending { order, prediction });
+                }
+                Prediction::Refused(refusal) => {
+                    self.reality.pending.remove(&node);
+                    return ActionStep::Failure(refusal);
+                }
+            }
+        }
+        let Some(pending) = self.reality.pending.get(&node) else {
+            return ActionStep::Failure(format!("{action}! was not predicted"));
+        };
+        match self.reality.executor.perform(&pending.order, fresh) {
+            Err(e) => {
+                self.reality.pending.remove(&node);
+                self.broke(e)
+            }
+            Ok(Step::Running) => ActionStep::Running,
+            Ok(Step::Success) => self.ended(node, action, None),
+            Ok(Step::Failure(error)) => self.ended(node, action, Some(error)),
+        }
+    }
+
+    fn halt(&mut self, node: NodeId, action: &ActionCall) {
+        if self.reality.pending.remove(&node).is_none() {
+            return;
+        }
+        if let Err(e) = self.reality.executor.halt(action) {
+            self.broken.get_or_insert(e);
+        }
+    }
+}
+
+/// `world` takes in what the executor sees now, or is left as it was.
+fn take_in(executor: &mut dyn Executor, world: &mut dyn World) -> Result<(), ExecutorError> {
+    let observation = executor.observe()?;
+    world
+        .take_observation(&observation)
+        .map_err(|source| ExecutorError::Observation {
+            executor: executor.name().to_string(),
+            source,
+        })
+}
+
+/// What the twin says of an action before it is sent.
+enum Prediction {
+    /// The twin as it will be when the action has ended.
+    Succeeds(Box<dyn World>),
+    /// The error the twin refuses it with (no path, a postcondition it would not meet).
+    Refused(String),
+}
+
+/// The twin's prediction of `action`, performed to its end in a copy of it.
+fn predict(twin: &dyn World, action: &ActionCall, domain: &Domain) -> Prediction {
+    let mut prediction = twin.fork();
+    let ticks = domain.resolve(action).map_or(1, |g| g.ticks.max(1));
+    for tick in 0..ticks {
+        match prediction.step(action, tick == 0) {
+            Step::Running => continue,
+            Step::Failure(error) => return Prediction::Refused(error),
+            Step::Success => {
+                return match postcondition_failure(domain, prediction.as_ref(), action) {
+                    Some(error) => Prediction::Refused(error),
+                    None => Prediction::Succeeds(prediction),
+                };
+            }
+        }
+    }
+    Prediction::Refused(format!(
+        "{action}! did not end in the twin after {ticks} ticks"
+    ))
+}
+
+/// The arm motion the prediction made, when the action moved an arm (a cell with real
+/// arms whose last motion changed).
+fn planned_path(twin: &dyn World, prediction: &dyn World) -> Option<ArmPath> {
+    let motion = |w: &dyn World| cell(w)?.last_motion();
+    let (arm, made) = motion(prediction)?;
+    if motion(twin).is_some_and(|(_, before)| before == made) {
+        return None;
+    }
+    Some(ArmPath {
+        arm,
+        joints: made.path,
+        acts_at: made.acts_at,
+    })
+}
+
+fn cell(world: &dyn World) -> Option<&CellWorld> {
+    world.as_any()?.downcast_ref::<CellWorld>()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,288 @@
+//! An executor in a process of its own, spoken to in JSON lines: one request per line on
+//! its standard input, one reply per line on its standard output. A simulator or a robot
+//! bridge in any language plugs in this way (docs/EXECUTORS.md has the protocol).
+//!
+//! ```text
+//! → {"request":"perform","order":{…},"started":true}
+//! ← {"reply":"running"} | {"reply":"success"} | {"reply":"failure","error":"…"}
+//! → {"request":"halt","action":"grasp \"blue cube\""}        ← {"reply":"done"}
+//! → {"request":"observe"}    ← {"reply":"observation","objects":[…],"held":null}
+//! → {"request":"reset"}      ← {"reply":"done"} | {"reply":"refused","error":"…"}
+//! ```
+//!
+//! A process that exits, closes its output, answers with something that is not a reply,
+//! or does not answer within [`REPLY_WITHIN`] has stopped: the run stops with what it
+//! said on its standard error, never with an action taken as done.
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Child, ChildStdin, Command, Stdio};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+
+use super::{ActionOrder, Executor, ExecutorError};
+use crate::domain::ActionCall;
+use crate::world::observation::ObservedObject;
+use crate::world::{Observation, Step};
+
+/// How long a reply may take: one tick of a simulator or of a robot's controller is far
+/// shorter; a process silent this long has hung.
+pub const REPLY_WITHIN: Duration = Duration::from_secs(10);
+
+/// Lines of the process's standard error kept to say why it stopped.
+const STDERR_LINES: usize = 8;
+/// A process whose output closed is given up to a second to exit.
+const EXIT_POLL: Duration = Duration::from_millis(50);
+const EXIT_POLLS: u32 = 20;
+
+#[derive(Serialize)]
+#[serde(tag = "request", rename_all = "snake_case")]
+enum Request<'a> {
+    Perform {
+        order: &'a ActionOrder,
+        started: bool,
+    },
+    Halt {
+        action: &'a ActionCall,
+    },
+    Observe,
+    Reset,
+}
+
+impl Request<'_> {
+    fn name(&self) -> &'static str {
+        match self {
+            Request::Perform { .. } => "perform",
+            Request::Halt { .. } => "halt",
+            Request::Observe => "observe",
+            Request::Reset => "reset",
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(tag = "reply", rename_all = "snake_case", deny_unknown_fields)]
+enum Reply {
+    Running,
+    Success,
+    Failure {
+        error: String,
+    },
+    Done,
+    Refused {
+        error: String,
+    },
+    Observation {
+        objects: Vec<ObservedObject>,
+        held: Option<String>,
+    },
+}
+
+/// An executor process and the ends of its pipes.
+pub struct ProcessExecutor {
+    name: String,
+    child: Child,
+    stdin: ChildStdin,
+    lines: Receiver<std::io::Result<String>>,
+    stderr: Arc<Mutex<VecDeque<String>>>,
+    /// Says when the process's standard error has closed (it was read to the end).
+    stderr_closed: Receiver<()>,
+    reply_within: Duration,
+}
+
+impl ProcessExecutor {
+    /// Start `program` with `args`; it is named after the program's file name.
+    pub fn spawn(program: &str, args: &[String]) -> Result<ProcessExecutor, ExecutorError> {
+        let name = std::path::Path::new(program)
+            .file_name()
+            .map_or_else(|| program.to_string(), |n| n.to_string_lossy().into_owned());
+        let stopped = |detail: String| ExecutorError::Stopped {
+            executor: name.clone(),
+            detail,
+        };
+        let mut child = Command::new(program)
+            .args(args)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| stopped(format!("cannot start {program}: {e}")))?;
+        let (Some(stdin), Some(stdout), Some(stderr)) =
+            (child.stdin.take(), child.stdout.take(), child.stderr.take())
+        else {
+            return Err(stopped("its pipes were not opened".into()));
+        };
+        let (tx, lines) = channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines() {
+                if tx.send(line).is_err() {
+                    return;
+                }
+            }
+        });
+        let said = Arc::new(Mutex::new(VecDeque::new()));
+        let keep = said.clone();
+        let label = name.clone();
+        let (closed, stderr_closed) = channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                tracing::info!(executor = %label, "{line}");
+                if let Ok(mut kept) = keep.lock() {
+                    if kept.len() == STDERR_LINES {
+                        kept.pop_front();
+                    }
+                    kept.push_back(line);
+                }
+            }
+            let _ = closed.send(());
+        });
+        Ok(ProcessExecutor {
+            name,
+            child,
+            stdin,
+            lines,
+            stderr: said,
+            stderr_closed,
+            reply_within: REPLY_WITHIN,
+        })
+    }
+
+    /// Wait at most `limit` for each reply.
+    pub fn with_reply_limit(mut self, limit: Duration) -> ProcessExecutor {
+        self.reply_within = limit;
+        self
+    }
+
+    /// The executor's error, with how the process ended and its last words when its
+    /// output closed (it is given a moment to exit and to finish its standard error).
+    fn stopped(&mut self, detail: String) -> ExecutorError {
+        self.stopped_with(detail, false)
+    }
+
+    fn stopped_with(&mut self, detail: String, output_closed: bool) -> ExecutorError {
+        let mut status = self.child.try_wait().ok().flatten();
+        if output_closed {
+            for _ in 0..EXIT_POLLS {
+                if status.is_some() {
+                    break;
+                }
+                std::thread::sleep(EXIT_POLL);
+                status = self.child.try_wait().ok().flatten();
+            }
+            if status.is_some() {
+                let _ = self.stderr_closed.recv_timeout(EXIT_POLL * EXIT_POLLS);
+            }
+        }
+        let exited = match status {
+            Some(status) => format!(" (it exited: {status})"),
+            None => String::new(),
+        };
+        let said: Vec<String> = self
+            .stderr
+            .lock()
+            .map(|kept| kept.iter().cloned().collect())
+            .unwrap_or_default();
+        let last_words = match said.last() {
+            Some(line) => format!(
+                "; its standard error ends: {}",
+                crate::http_text::excerpt(line)
+            ),
+            None => String::new(),
+        };
+        ExecutorError::Stopped {
+            executor: self.name.clone(),
+            detail: format!("{detail}{exited}{last_words}"),
+        }
+    }
+
+    /// Send one request and read its reply.
+    fn ask(&mut self, request: &Request) -> Result<Reply, ExecutorError> {
+        let what = request.name();
+        let mut line = serde_json::to_string(request)
+            .map_err(|e| self.stopped(format!("the {what} request could not be written: {e}")))?;
+        line.push('\n');
+        if let Err(e) = self
+            .stdin
+            .write_all(line.as_bytes())
+            .and_then(|()| self.stdin.flush())
+        {
+            return Err(self.stopped(format!("the {what} request could not be sent: {e}")));
+        }
+        let text = match self.lines.recv_timeout(self.reply_within) {
+            Ok(Ok(text)) => text,
+            Ok(Err(e)) => return Err(self.stopped(format!("its output could not be read: {e}"))),
+            Err(RecvTimeoutError::Timeout) => {
+                let secs = self.reply_within.as_secs_f64();
+                return Err(self.stopped(format!("no reply to {what} within {secs} s")));
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                let detail = format!("its output closed before it replied to {what}");
+                return Err(self.stopped_with(detail, true));
+            }
+        };
+        serde_json::from_str(&text).map_err(|e| {
+            let shown = crate::http_text::excerpt(&text);
+            self.stopped(format!(
+                "it replied to {what} with `{shown}`, which is not a reply: {e}"
+            ))
+        })
+    }
+
+    fn unexpected(&mut self, what: &str, expected: &str) -> ExecutorError {
+        self.stopped(format!(
+            "it replied to {what} with something other than {expected}"
+        ))
+    }
+}
+
+impl Executor for ProcessExecutor {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn perform(&mut self, order: &ActionOrder, started: bool) -> Result<Step, ExecutorError> {
+        match self.ask(&Request::Perform { order, started })? {
+            Reply::Running => Ok(Step::Running),
+            Reply::Success => Ok(Step::Success),
+            Reply::Failure { error } => Ok(Step::Failure(error)),
+            _ => Err(self.unexpected("perform", "running, success or failure")),
+        }
+    }
+
+    fn halt(&mut self, action: &ActionCall) -> Result<(), ExecutorError> {
+        match self.ask(&Request::Halt { action })? {
+            Reply::Done => Ok(()),
+            _ => Err(self.unexpected("halt", "done")),
+        }
+    }
+
+    fn observe(&mut self) -> Result<Observation, ExecutorError> {
+        match self.ask(&Request::Observe)? {
+            Reply::Observation { objects, held } => Ok(Observation { objects, held }),
+            _ => Err(self.unexpected("observe", "an observation")),
+        }
+    }
+
+    fn reset(&mut self) -> Result<(), ExecutorError> {
+        match self.ask(&Request::Reset)? {
+            Reply::Done => Ok(()),
+            Reply::Refused { error } => Err(ExecutorError::Stopped {
+                executor: self.name.clone(),
+                detail: format!("it cannot go back to the first state: {error}"),
+            }),
+            _ => Err(self.unexpected("reset", "done or refused")),
+        }
+    }
+}
+
+impl Drop for ProcessExecutor {
+    fn drop(&mut self) {
+        // The process may be a simulator holding memory or a bridge holding a robot: it
+        // does not outlive the session that started it.
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
