@@ -73,6 +73,10 @@ pub struct LabFlags {
     /// failure when tried in simulation.
     #[arg(help_heading = LEVERS, long)]
     pub no_shortlist: bool,
+    /// Propose the model's first usable answer about a failure as it is, without trying
+    /// it in simulation first (with --no-shortlist: the model alone, as in the paper).
+    #[arg(help_heading = LEVERS, long)]
+    pub no_screening: bool,
     /// Leave out a detector of plain misreadings when goals are judged, to measure what it
     /// earns (repeatable; the names are listed in docs/ARCHITECTURE.md and in the error
     /// for an unknown one).
@@ -115,6 +119,7 @@ impl LabFlags {
             whole_request: self.whole_request,
             value_as_number: self.value_as_number,
             no_shortlist: self.no_shortlist,
+            no_screening: self.no_screening,
             without_misreadings: self.without_misreading.clone(),
             templates: self
                 .prompts

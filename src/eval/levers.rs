@@ -38,6 +38,8 @@ pub struct Levers {
     pub value_as_number: bool,
     /// Let the model name a failure's condition out of the whole vocabulary.
     pub no_shortlist: bool,
+    /// Propose the model's first usable answer for a failure without trying it first.
+    pub no_screening: bool,
     /// Detectors of plain misreadings left out, by name.
     pub without_misreadings: Vec<String>,
     /// Prompt templates instead of the built-in ones.
@@ -64,6 +66,7 @@ impl Levers {
             read_by_parts: !self.whole_request,
             value_levels: !self.value_as_number,
             shortlist: !self.no_shortlist,
+            screen_proposals: !self.no_screening,
             without_misreadings: self.without_misreadings.clone(),
         }
     }
@@ -98,6 +101,10 @@ mod tests {
         assert_eq!(options.steps.read_by_parts, product.steps.read_by_parts);
         assert_eq!(options.steps.value_levels, product.steps.value_levels);
         assert_eq!(options.steps.shortlist, product.steps.shortlist);
+        assert_eq!(
+            options.steps.screen_proposals,
+            product.steps.screen_proposals
+        );
         assert!(options.steps.without_misreadings.is_empty());
         assert_eq!(options.candidates, product.candidates);
         assert_eq!(options.beams, product.beams);

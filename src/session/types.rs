@@ -209,6 +209,10 @@ pub struct Steps {
     /// in simulation and let the model choose among those that fix it; off: the model
     /// names the condition out of the whole vocabulary.
     pub shortlist: bool,
+    /// Try each of the model's candidates for a failure in simulation and propose the
+    /// first that fixes it; off: the model's first usable answer is proposed as it is (the
+    /// paper's single call), and only the change's own check shows whether it helps.
+    pub screen_proposals: bool,
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): empty
     /// but in the lab, which measures what each earns.
     pub without_misreadings: Vec<String>,
@@ -222,6 +226,7 @@ impl Default for Steps {
             read_by_parts: true,
             value_levels: true,
             shortlist: true,
+            screen_proposals: true,
             without_misreadings: Vec::new(),
         }
     }

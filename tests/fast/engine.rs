@@ -427,3 +427,46 @@ fn a_value_set_by_a_person_is_checked_then_put_on_its_actions() {
         );
     });
 }
+
+/// The model alone (the lab's `--no-shortlist --no-screening`): nothing is tried in
+/// simulation before the model is asked or before its answer is proposed, and the
+/// proposal says so; approved, the change still meets its own check.
+#[test]
+fn the_model_alone_proposes_its_answer_untried() {
+    rt().block_on(async {
+        let mut setup = setup(Ok(Arc::new(model(Duration::ZERO))), None);
+        setup.options.steps.shortlist = false;
+        setup.options.steps.screen_proposals = false;
+        let mut s = Session::start(setup);
+        let got = s.run_to_proposal().await;
+        assert!(
+            !got.iter()
+                .any(|e| matches!(e, Event::Screened { .. } | Event::CandidateRejected { .. })),
+            "{got:#?}"
+        );
+        let findings = got.iter().find_map(|e| match e {
+            Event::Proposal {
+                proposal, evidence, ..
+            } => Some((proposal.to_string(), evidence.clone())),
+            _ => None,
+        });
+        let (proposal, evidence) = findings.unwrap();
+        assert!(proposal.contains(FIX), "{proposal}");
+        let evidence = evidence.unwrap();
+        assert!(
+            evidence
+                .findings
+                .iter()
+                .any(|f| f == "this change was not tried in simulation before it was offered"),
+            "{evidence:#?}"
+        );
+        s.send(Command::Approve);
+        s.until("the repaired tree", |e| {
+            matches!(e, Event::TreeChanged { .. })
+        })
+        .await;
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+    });
+}

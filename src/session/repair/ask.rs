@@ -181,6 +181,10 @@ async fn draw_and_screen(
             asked.rejected.push((proposal, why));
             continue;
         }
+        if !options.steps.screen_proposals {
+            asked.chosen = Some((proposal, reasoning));
+            return Ok(asked);
+        }
         match screen_one(screen, bounds, (&proposal, None), emit) {
             Ok(verdict) => {
                 asked.verdict = Some(verdict);
@@ -411,7 +415,7 @@ pub(crate) async fn ask_value(
         emit,
     )
     .await?;
-    if asked.chosen.is_none() {
+    if asked.chosen.is_none() && options.steps.screen_proposals {
         try_midway(&mut asked, &mut bounds, screen, unit, &proposal, emit);
     }
     Ok(asked)
