@@ -196,6 +196,7 @@ fn run_settings(
         ("beams", options.beams.to_string()),
         ("feedback_rounds", options.goal_feedback_rounds.to_string()),
         ("shortlist", steps.shortlist.to_string()),
+        ("screen_proposals", steps.screen_proposals.to_string()),
         ("read_by_parts", steps.read_by_parts.to_string()),
         (
             "scene_word_examples",
@@ -244,5 +245,11 @@ fn reading_label(options: &Options) -> String {
     } else {
         "unchecked".to_string()
     };
-    format!("{examples}, {checks}")
+    let failures = match (options.steps.shortlist, options.steps.screen_proposals) {
+        (true, true) => "",
+        (false, true) => ", failures without a shortlist",
+        (true, false) => ", failures' proposals untried",
+        (false, false) => ", failures asked of the model alone (no shortlist, untried)",
+    };
+    format!("{examples}, {checks}{failures}")
 }
