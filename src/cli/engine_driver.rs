@@ -263,6 +263,12 @@ impl Driver {
                     };
                 }
                 Event::GaveUp { reason } => break RunEnd::Stopped { reason },
+                // Where reality did otherwise than the twin predicted, before the failure.
+                e @ Event::Diverged { .. } => {
+                    for line in betr::record::describe(&e) {
+                        errln!("note: {line}");
+                    }
+                }
                 Event::BreakpointHit {
                     node,
                     node_path,

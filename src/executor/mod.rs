@@ -95,9 +95,13 @@ pub struct Divergence {
 impl Divergence {
     /// In words, naming the executor that reported it.
     pub fn describe(&self, executor: &str) -> String {
+        Divergence::describe_parts(&self.action, executor, &self.reality)
+    }
+
+    /// A divergence in words from its parts (as an event carries them).
+    pub fn describe_parts(action: &ActionCall, executor: &str, reality: &str) -> String {
         format!(
-            "the twin predicted {}! would succeed; the {executor} executor reports: {}",
-            self.action, self.reality
+            "the twin predicted {action}! would succeed; the {executor} executor reports: {reality}"
         )
     }
 }

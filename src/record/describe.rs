@@ -184,6 +184,14 @@ fn about_the_tree(event: &Event) -> Option<String> {
         Event::Error { message } => format!("error: {message}"),
         Event::Failed { error } => format!("error: {error}"),
         Event::Notice { message } => message.clone(),
+        Event::Executor { name } => {
+            format!("the {name} executor performs the actions; betr's world is its twin")
+        }
+        Event::Diverged {
+            executor,
+            action,
+            reality,
+        } => crate::executor::Divergence::describe_parts(action, executor, reality),
         Event::Screened { action, shortlist } => format!("for {action}!: {shortlist}"),
         _ => return None,
     })

@@ -615,6 +615,18 @@ pub enum Event {
     Notice {
         message: String,
     },
+    /// An executor performs the actions and the execution world is its twin; told once,
+    /// when the engine starts.
+    Executor {
+        name: String,
+    },
+    /// An action the twin predicted to succeed that the executor reported otherwise: its
+    /// error, or the effect it did not have.
+    Diverged {
+        executor: String,
+        action: ActionCall,
+        reality: String,
+    },
 }
 
 /// A failure as a recording keeps it: its message (the errors it wraps, from the model

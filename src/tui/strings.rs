@@ -154,6 +154,16 @@ pub const MADE_FALSE: &str = "- ";
 pub const VALUE_SET: &str = "value set:";
 pub const LAST_MOTION: &str = "last motion:";
 
+/// The world pane's row naming what performs the actions.
+pub fn performed_by(executor: &str) -> String {
+    format!("Performed by the {executor} executor; this world is its twin.")
+}
+
+/// The world pane's row of what reality did that the twin did not predict.
+pub fn reality_differs(what: &str) -> String {
+    format!("Reality differs: {what}")
+}
+
 /// The last motion of a real arm in one line: the arm, the joint path's length or what
 /// blocked it, how long finding it took and in how many attempts.
 pub fn last_motion(m: &crate::world::cell::snapshot::MotionView) -> String {

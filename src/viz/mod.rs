@@ -534,7 +534,8 @@ fn log_level(event: &Event) -> &'static str {
         | Event::ChangeViolates { .. }
         | Event::RuleRefused { .. }
         | Event::BreakpointHit { .. }
-        | Event::PersonDecides { .. } => L::WARN,
+        | Event::PersonDecides { .. }
+        | Event::Diverged { .. } => L::WARN,
         // A reasoning the evidence contradicts is marked in the log as on the screen.
         Event::Proposal {
             evidence: Some(e), ..

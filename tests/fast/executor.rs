@@ -267,9 +267,19 @@ fn a_grasp_reality_refuses_reaches_the_question_and_the_approved_change() {
             failed.as_deref(),
             Some(r#"grasp "blue cube": No collision free path found"#)
         );
-        let told = s.seen.iter().any(|e| matches!(e, Event::Notice { message } if message
-            == r#"the twin predicted grasp "blue cube"! would succeed; the slow-arm executor reports: No collision free path found"#));
-        assert!(told, "{:#?}", s.seen);
+        let told: Vec<String> = s
+            .seen
+            .iter()
+            .filter(|e| matches!(e, Event::Executor { .. } | Event::Diverged { .. }))
+            .flat_map(betr::record::describe)
+            .collect();
+        assert_eq!(
+            told,
+            [
+                "the slow-arm executor performs the actions; betr's world is its twin",
+                r#"the twin predicted grasp "blue cube"! would succeed; the slow-arm executor reports: No collision free path found"#
+            ],
+        );
         // What reality showed is the twin's now: the red cube on the blue cube.
         let red_on_blue = Condition::parse(r#""red cube" on "blue cube""#).unwrap();
         let facts = s.seen.iter().rev().find_map(|e| match e {

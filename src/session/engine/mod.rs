@@ -307,6 +307,11 @@ impl Engine {
         if let Some(why) = execution.notice {
             engine.notice(why);
         }
+        if let Some(reality) = &engine.run.reality {
+            engine.emit(Event::Executor {
+                name: reality.name().to_string(),
+            });
+        }
         engine.emit(Event::WorldChanged {
             facts: engine.run.facts.clone(),
             reset: true,

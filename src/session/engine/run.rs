@@ -114,7 +114,7 @@ impl Engine {
         });
         self.emit_scene();
         self.tell_world_change();
-        self.tell_reality(&diverged);
+        self.tell_reality(diverged);
         if let Some(broken) = broken {
             return self.executor_broke(&broken);
         }
@@ -147,12 +147,20 @@ impl Engine {
     }
 
     /// Say where reality did what the twin did not predict.
-    fn tell_reality(&self, diverged: &[Divergence]) {
+    fn tell_reality(&self, diverged: Vec<Divergence>) {
         let Some(reality) = &self.run.reality else {
             return;
         };
-        for divergence in diverged {
-            self.notice(divergence.describe(reality.name()));
+        for Divergence {
+            action,
+            reality: what,
+        } in diverged
+        {
+            self.emit(Event::Diverged {
+                executor: reality.name().to_string(),
+                action,
+                reality: what,
+            });
         }
     }
 

@@ -37,7 +37,9 @@ impl App {
             | Event::Phase(_)
             | Event::Success { .. }
             | Event::Scene { .. }
-            | Event::ArmMotion { .. }) => self.on_world(e),
+            | Event::ArmMotion { .. }
+            | Event::Executor { .. }
+            | Event::Diverged { .. }) => self.on_world(e),
             e @ (Event::Verified { .. }
             | Event::ChangeViolates { .. }
             | Event::PolicySaved { .. }
@@ -286,6 +288,7 @@ impl App {
                     self.status.ending = None;
                     self.world.last_error = None;
                     self.world.motion = None;
+                    self.world.diverged = None;
                     self.tree.clear_statuses();
                 }
             }
@@ -313,6 +316,18 @@ impl App {
                 self.llm.log(strings::success(ticks));
             }
             Event::ArmMotion { motion } => self.world.motion = Some(motion),
+            Event::Executor { ref name } => {
+                self.world.executor = Some(name.clone());
+                for line in crate::record::describe(&event) {
+                    self.llm.log(line);
+                }
+            }
+            Event::Diverged { ref reality, .. } => {
+                self.world.diverged = Some(reality.clone());
+                for line in crate::record::describe(&event) {
+                    self.llm.log(line);
+                }
+            }
             // For the 3D view; the world pane shows facts.
             Event::Scene { .. } => {}
             _ => {}

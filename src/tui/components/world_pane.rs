@@ -35,6 +35,10 @@ pub struct WorldPane {
     pub values: Vec<String>,
     /// The last motion of a real arm, when the cell moves them.
     pub motion: Option<MotionView>,
+    /// The executor that performs the actions, when this world is its twin.
+    pub executor: Option<String>,
+    /// What the executor last reported that the twin did not predict.
+    pub diverged: Option<String>,
     /// Only facts holding this text (any case) are listed.
     pub filter: Option<String>,
     /// Rows of the fact table scrolled past.
@@ -133,6 +137,7 @@ impl WorldPane {
         // and D show it whole).
         let short = area.height < SHORT_PANE;
         self.push_last_error(&mut lines, theme, width, short);
+        self.push_executor(&mut lines, theme, width);
         for v in &self.values {
             lines.push(Line::from(Span::styled(
                 format!("{} {v}", strings::VALUE_SET),
@@ -204,6 +209,24 @@ impl WorldPane {
                 lines.push(Line::from(Span::styled(strings::LAST_ERROR, theme.title)));
                 lines.push(Line::from(Span::styled(format!("  {e}"), theme.error)));
             }
+        }
+    }
+
+    /// Which executor performs the actions and, when it reported what the twin did not
+    /// predict, what: one row each.
+    fn push_executor(&self, lines: &mut Vec<Line<'_>>, theme: &Theme, width: usize) {
+        let Some(executor) = &self.executor else {
+            return;
+        };
+        lines.push(Line::from(Span::styled(
+            cut_to(&strings::performed_by(executor), width),
+            theme.dim,
+        )));
+        if let Some(what) = &self.diverged {
+            lines.push(Line::from(Span::styled(
+                cut_to(&strings::reality_differs(what), width),
+                theme.error,
+            )));
         }
     }
 
@@ -351,6 +374,26 @@ mod tests {
             s.contains(
                 "last motion: yumi_link_7_l found no path, blocked by red cube, 500.0 ms, 6 attempts"
             ),
+            "{s}"
+        );
+    }
+
+    #[test]
+    fn an_executor_and_what_reality_did_otherwise_are_one_row_each() {
+        let mut pane = WorldPane::of(vec!["red cube".into(), "blue cube".into()]);
+        pane.set_facts(vec!["\"red cube\" on \"blue cube\"".into()], true);
+        pane.executor = Some("follower.py".into());
+        let s = screen_of(&pane, 90, 8);
+        assert!(
+            s.contains("Performed by the follower.py executor; this world is its twin."),
+            "{s}"
+        );
+        assert!(!s.contains("Reality differs"), "{s}");
+        pane.diverged = Some("No collision free path found".into());
+        let s = screen_of(&pane, 90, 8);
+        insta::assert_snapshot!("blackboard_with_an_executor", s);
+        assert!(
+            s.contains("Reality differs: No collision free path found"),
             "{s}"
         );
     }
