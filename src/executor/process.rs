@@ -94,11 +94,21 @@ pub struct ProcessExecutor {
 }
 
 impl ProcessExecutor {
-    /// Start `program` with `args`; it is named after the program's file name.
+    /// Start `program` with `args`; it is named after the program's file name and, when
+    /// the first argument is not an option, that argument's (`python3 sim.py`: an
+    /// interpreter's name alone says nothing).
     pub fn spawn(program: &str, args: &[String]) -> Result<ProcessExecutor, ExecutorError> {
-        let name = std::path::Path::new(program)
-            .file_name()
-            .map_or_else(|| program.to_string(), |n| n.to_string_lossy().into_owned());
+        let file_name = |path: &str| {
+            std::path::Path::new(path)
+                .file_name()
+                .map_or_else(|| path.to_string(), |n| n.to_string_lossy().into_owned())
+        };
+        let name = match args.first() {
+            Some(first) if !first.starts_with('-') => {
+                format!("{} {}", file_name(program), file_name(first))
+            }
+            _ => file_name(program),
+        };
         let stopped = |detail: String| ExecutorError::Stopped {
             executor: name.clone(),
             detail,

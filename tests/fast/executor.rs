@@ -389,12 +389,12 @@ fn a_process_that_misbehaves_is_reported_by_what_it_did() {
     };
     assert_eq!(
         err(&["--fault", "hang"]),
-        "the python3 executor stopped: no reply to perform within 1.5 s"
+        "the python3 follower.py executor stopped: no reply to perform within 1.5 s"
     );
     let exited = err(&["--fault", "exit"]);
     assert!(
         exited.starts_with(
-            "the python3 executor stopped: its output closed before it replied to perform"
+            "the python3 follower.py executor stopped: its output closed before it replied to perform"
         ) && exited.contains("exit status: 3")
             && exited.ends_with(
                 "its standard error ends: follower: the simulated controller lost power"
@@ -403,13 +403,13 @@ fn a_process_that_misbehaves_is_reported_by_what_it_did() {
     );
     assert!(
         err(&["--fault", "garbage"]).starts_with(
-            "the python3 executor stopped: it replied to perform with `this is not json`, which is not a reply"
+            "the python3 follower.py executor stopped: it replied to perform with `this is not json`, which is not a reply"
         )
     );
     let mut arm = follower(&["--fault", "refuse-reset"]);
     assert_eq!(
         arm.reset().unwrap_err().to_string(),
-        "the python3 executor stopped: it cannot go back to the first state: a real arm is not put back by software"
+        "the python3 follower.py executor stopped: it cannot go back to the first state: a real arm is not put back by software"
     );
     let missing = ProcessExecutor::spawn("/nonexistent/simulator", &[])
         .err()
