@@ -103,6 +103,35 @@ fn one_action(text: &str) -> Tree {
     Tree::new(NodeKind::Action(action(text)))
 }
 
+/// What one tick of a tree of one grasp (of the blue cube) did with `script`'s executor
+/// and the twin of `variant`.
+struct OneTick {
+    record: crate::bt::TickRecord,
+    diverged: Vec<Divergence>,
+    broken: Option<ExecutorError>,
+    /// The twin after the tick, and its facts before it.
+    twin: Box<dyn World>,
+    before: Vec<Condition>,
+}
+
+fn grasp_once(script: &Arc<Mutex<Script>>, variant: Option<&str>) -> OneTick {
+    let mut reality = reality(script);
+    let mut twin = twin(variant);
+    let before = twin.facts();
+    let scenario = scenario();
+    let tree = one_action(r#"grasp "blue cube""#);
+    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
+    let record = Ticker::new().tick(&tree, &mut leaves);
+    let (diverged, broken) = (leaves.diverged, leaves.broken);
+    OneTick {
+        record,
+        diverged,
+        broken,
+        twin,
+        before,
+    }
+}
+
 #[test]
 fn an_action_runs_for_the_executors_ticks_then_the_twin_takes_its_result() {
     // It sees the cube in the gripper afterwards (and reports no poses: none moved).
@@ -146,15 +175,10 @@ fn an_action_the_twin_refuses_is_never_sent() {
         ticks: 1,
         ..Script::default()
     }));
-    let mut reality = reality(&script);
     // The red cube lies on the blue cube: the gripper's way down is blocked in the twin.
-    let mut twin = twin(None);
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    let record = Ticker::new().tick(&tree, &mut leaves);
-    assert_eq!(record.root, Outcome::Failure);
-    assert!(leaves.diverged.is_empty(), "the twin itself predicted it");
+    let tick = grasp_once(&script, None);
+    assert_eq!(tick.record.root, Outcome::Failure);
+    assert!(tick.diverged.is_empty(), "the twin itself predicted it");
     assert!(script.lock().unwrap().orders.is_empty());
 }
 
@@ -197,17 +221,12 @@ fn an_action_that_ends_without_its_effects_fails_by_its_postcondition() {
         seen: start.observation(),
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    let record = Ticker::new().tick(&tree, &mut leaves);
+    let tick = grasp_once(&script, Some("clear"));
     assert_eq!(
-        record.failures[0].1,
+        tick.record.failures[0].1,
         "Postcondition \"blue cube\" grasped not met after grasp action completion"
     );
-    assert_eq!(leaves.diverged.len(), 1);
+    assert_eq!(tick.diverged.len(), 1);
 }
 
 #[test]
@@ -217,19 +236,14 @@ fn an_executor_that_breaks_stops_the_tick_without_a_result() {
         broken: true,
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    let record = Ticker::new().tick(&tree, &mut leaves);
-    assert_eq!(record.root, Outcome::Failure);
-    assert!(record.completed.is_empty());
+    let tick = grasp_once(&script, Some("clear"));
+    assert_eq!(tick.record.root, Outcome::Failure);
+    assert!(tick.record.completed.is_empty());
     assert_eq!(
-        leaves.broken.as_ref().map(ToString::to_string).as_deref(),
+        tick.broken.as_ref().map(ToString::to_string).as_deref(),
         Some("the scripted executor stopped: no answer in 2 s")
     );
-    assert!(!holds(twin.as_ref(), r#""blue cube" grasped"#));
+    assert!(!holds(tick.twin.as_ref(), r#""blue cube" grasped"#));
 }
 
 #[test]
@@ -246,21 +260,15 @@ fn an_observation_naming_an_unknown_object_changes_nothing() {
         },
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    let before = twin.facts();
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    Ticker::new().tick(&tree, &mut leaves);
+    let tick = grasp_once(&script, Some("clear"));
     assert_eq!(
-        leaves.broken.as_ref().map(ToString::to_string).as_deref(),
+        tick.broken.as_ref().map(ToString::to_string).as_deref(),
         Some(
             "the scripted executor's observation was refused: the observation names \"purple cube\", which is not an object of this scene"
         )
     );
     // Neither the prediction nor the refused observation was taken.
-    assert_eq!(twin.facts(), before);
+    assert_eq!(tick.twin.facts(), tick.before);
 }
 
 #[test]

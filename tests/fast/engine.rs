@@ -12,12 +12,12 @@ use crate::support;
 use std::sync::Arc;
 use std::time::Duration;
 
-use betr::bt::{self, NodeKind};
+use betr::bt;
 use betr::domain::{Condition, Value};
 use betr::scenario::Scenario;
 use betr::session::repair::values;
 use betr::session::{Command, Edit, Event, NoModel, Setup};
-use support::engine::{FIX, INSTRUCTION, Session, edit, model, setup, tree_of};
+use support::engine::{FIX, INSTRUCTION, Session, edit, fix_inserted, model, setup, tree_of};
 use support::repo::runtime as rt;
 
 #[test]
@@ -41,19 +41,10 @@ fn submit_plan_fail_propose_approve_run_to_success() {
         // Nothing proposed changes the tree before approval.
         assert!(!got.iter().any(|e| matches!(e, Event::TreeChanged { .. })));
         let planned = tree_of(&s.seen).unwrap().0;
-        s.send(Command::Approve);
-        let got = s
-            .until("the repaired tree", |e| {
-                matches!(e, Event::TreeChanged { .. })
-            })
-            .await;
-        let (tree, new_nodes) = tree_of(&got).unwrap();
+        let got = s.approve().await;
+        let (tree, _) = tree_of(&got).unwrap();
         assert!(tree.len() > planned.len());
-        assert!(!new_nodes.is_empty());
-        let inserted = new_nodes
-            .iter()
-            .any(|n| matches!(tree.kind(*n), Ok(NodeKind::Condition(c)) if c.to_string() == FIX));
-        assert!(inserted, "{}", bt::to_text(&tree));
+        assert!(fix_inserted(&got), "{}", bt::to_text(&tree));
         s.send(Command::Run);
         s.until("success", |e| matches!(e, Event::Success { .. }))
             .await;
@@ -460,11 +451,7 @@ fn the_model_alone_proposes_its_answer_untried() {
                 .any(|f| f == "this change was not tried in simulation before it was offered"),
             "{evidence:#?}"
         );
-        s.send(Command::Approve);
-        s.until("the repaired tree", |e| {
-            matches!(e, Event::TreeChanged { .. })
-        })
-        .await;
+        assert!(fix_inserted(&s.approve().await));
         s.send(Command::Run);
         s.until("success", |e| matches!(e, Event::Success { .. }))
             .await;

@@ -21,7 +21,7 @@ use betr::session::{Command, Event, Setup};
 use betr::world::Observation;
 use betr::world::Step;
 use betr::world::observation::ObservedObject;
-use support::engine::{FIX, INSTRUCTION, Session, model, setup, tree_of};
+use support::engine::{INSTRUCTION, Session, fix_inserted, model, setup, tree_of};
 use support::repo::runtime as rt;
 
 const CUBE: f32 = 0.04;
@@ -287,17 +287,8 @@ fn a_grasp_reality_refuses_reaches_the_question_and_the_approved_change() {
             _ => None,
         });
         assert!(facts.unwrap().contains(&red_on_blue));
-        s.send(Command::Approve);
-        let got = s
-            .until("the repaired tree", |e| {
-                matches!(e, Event::TreeChanged { .. })
-            })
-            .await;
-        let (tree, new_nodes) = tree_of(&got).unwrap();
-        let inserted = new_nodes
-            .iter()
-            .any(|n| matches!(tree.kind(*n), Ok(NodeKind::Condition(c)) if c.to_string() == FIX));
-        assert!(inserted, "{}", bt::to_text(&tree));
+        let got = s.approve().await;
+        assert!(fix_inserted(&got), "{got:#?}");
     });
 }
 

@@ -85,6 +85,15 @@ impl Session {
         assert_eq!(calls.load(Ordering::SeqCst), 0, "no model call");
     }
 
+    /// Approve the pending proposal; the events up to the changed tree.
+    pub async fn approve(&mut self) -> Vec<Event> {
+        self.send(Command::Approve);
+        self.until("the repaired tree", |e| {
+            matches!(e, Event::TreeChanged { .. })
+        })
+        .await
+    }
+
     pub fn send(&self, c: Command) {
         assert!(self.engine.send(c));
     }
@@ -148,6 +157,16 @@ impl Session {
             .unwrap_or(0);
         self.seen[failed_at..].to_vec()
     }
+}
+
+/// Whether the last change of the tree in `events` inserted scenario 1's fix.
+pub fn fix_inserted(events: &[Event]) -> bool {
+    let Some((tree, new_nodes)) = tree_of(events) else {
+        return false;
+    };
+    new_nodes
+        .iter()
+        .any(|n| matches!(tree.kind(*n), Ok(bt::NodeKind::Condition(c)) if c.to_string() == FIX))
 }
 
 pub fn tree_of(events: &[Event]) -> Option<(Arc<bt::Tree>, Vec<bt::NodeId>)> {
