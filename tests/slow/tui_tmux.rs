@@ -673,3 +673,34 @@ fn a_person_cancels_a_slow_question_and_writes_the_fix() {
     drop(tmux);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// With `--executor`, the workbench says what performs the actions and runs the tree in
+/// it: the fixture executor process (three ticks an action) takes scenario 1's tree, in
+/// its `clear` world, to success.
+#[test]
+fn a_person_runs_the_tree_in_an_executor_process() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-executor");
+    let follower = fixtures::root().join("tests/fixtures/executor/follower.py");
+    let extra = format!(
+        "--variant clear --executor \"python3 {} --ticks 3\"",
+        quote(&follower)
+    );
+    let tmux = Tmux::start(&workbench_command(&dir, &server, "", &extra));
+    tmux.wait_for(
+        &[
+            "Performed by the python3 follower.py executor",
+            "the python3 follower.py executor performs the",
+        ],
+        20,
+    );
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["grasp \"blue cube\"!"], 20);
+    tmux.keys(&["r"]);
+    // The grasp in ticks 1-3, the place in 3-5, the goal found at tick 6.
+    tmux.wait_for(&["SUCCESS after 6 tick(s)"], 60);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
