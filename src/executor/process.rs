@@ -17,7 +17,7 @@
 use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, Command, Stdio};
-use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -85,7 +85,12 @@ enum Reply {
 pub struct ProcessExecutor {
     name: String,
     child: Child,
-    stdin: ChildStdin,
+    /// Requests go to the process's standard input through a thread of their own, so a
+    /// process that stops reading (its pipe full) cannot block the engine past the
+    /// reply's time limit.
+    requests: Sender<String>,
+    /// Why writing a request failed, once it has.
+    write_failed: Receiver<std::io::Error>,
     lines: Receiver<std::io::Result<String>>,
     stderr: Arc<Mutex<VecDeque<String>>>,
     /// Says when the process's standard error has closed (it was read to the end).
@@ -125,6 +130,7 @@ impl ProcessExecutor {
         else {
             return Err(stopped("its pipes were not opened".into()));
         };
+        let (requests, write_failed) = write_requests(stdin);
         let (tx, lines) = channel();
         std::thread::spawn(move || {
             for line in BufReader::new(stdout).lines() {
@@ -152,7 +158,8 @@ impl ProcessExecutor {
         Ok(ProcessExecutor {
             name,
             child,
-            stdin,
+            requests,
+            write_failed,
             lines,
             stderr: said,
             stderr_closed,
@@ -214,12 +221,12 @@ impl ProcessExecutor {
         let mut line = serde_json::to_string(request)
             .map_err(|e| self.stopped(format!("the {what} request could not be written: {e}")))?;
         line.push('\n');
-        if let Err(e) = self
-            .stdin
-            .write_all(line.as_bytes())
-            .and_then(|()| self.stdin.flush())
-        {
-            return Err(self.stopped(format!("the {what} request could not be sent: {e}")));
+        let refused = |e: String| format!("the {what} request could not be sent: {e}");
+        if let Ok(e) = self.write_failed.try_recv() {
+            return Err(self.stopped(refused(e.to_string())));
+        }
+        if self.requests.send(line).is_err() {
+            return Err(self.stopped(refused("its input is closed".into())));
         }
         let text = match self.lines.recv_timeout(self.reply_within) {
             Ok(Ok(text)) => text,
@@ -286,6 +293,25 @@ impl Executor for ProcessExecutor {
             _ => Err(self.unexpected("reset", "done or refused")),
         }
     }
+}
+
+/// A thread writing each request sent to `stdin`, a line at a time; the first error it
+/// meets is sent back and ends it.
+fn write_requests(mut stdin: ChildStdin) -> (Sender<String>, Receiver<std::io::Error>) {
+    let (requests, lines) = channel::<String>();
+    let (failed, write_failed) = channel();
+    std::thread::spawn(move || {
+        for line in lines {
+            if let Err(e) = stdin
+                .write_all(line.as_bytes())
+                .and_then(|()| stdin.flush())
+            {
+                let _ = failed.send(e);
+                return;
+            }
+        }
+    });
+    (requests, write_failed)
 }
 
 impl Drop for ProcessExecutor {

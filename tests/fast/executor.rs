@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use betr::bt::{self, NodeKind, Status};
 use betr::domain::{ActionCall, Condition};
-use betr::executor::{ActionOrder, Executor, ExecutorError, ProcessExecutor};
+use betr::executor::{ActionOrder, ArmPath, Executor, ExecutorError, ProcessExecutor};
 use betr::session::{Command, Event, Setup};
 use betr::world::Observation;
 use betr::world::Step;
@@ -396,6 +396,21 @@ fn a_process_that_misbehaves_is_reported_by_what_it_did() {
         err(&["--fault", "garbage"]).starts_with(
             "the python3 follower.py executor stopped: it replied to perform with `this is not json`, which is not a reply"
         )
+    );
+    // A process that never reads: an order larger than its input pipe holds (a long arm
+    // path) still ends in the reply's time limit, not in a write that never returns.
+    let mut long = grasp.clone();
+    long.path = Some(ArmPath {
+        arm: "yumi_r".into(),
+        joints: vec![vec![0.123_456_789; 7]; 4000],
+        acts_at: 2000,
+    });
+    let deaf = follower(&["--fault", "deaf"])
+        .perform(&long, true)
+        .unwrap_err();
+    assert_eq!(
+        deaf.to_string(),
+        "the python3 follower.py executor stopped: no reply to perform within 1.5 s"
     );
     let mut arm = follower(&["--fault", "refuse-reset"]);
     assert_eq!(
