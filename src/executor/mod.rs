@@ -23,7 +23,7 @@
 //! on nothing"); an `Err` means the executor itself broke (stopped answering, crashed), and
 //! stops the run instead of being repaired.
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 
 use serde::{Deserialize, Serialize};
 
@@ -106,10 +106,18 @@ impl Divergence {
     }
 }
 
-/// An executor with what the twin predicted of each action it is performing.
+/// An executor with what the twin predicted of each action it is performing, and what
+/// reality has shown of the scene's first state.
 pub struct Reality {
     executor: Box<dyn Executor>,
     pending: HashMap<NodeId, Pending>,
+    /// The objects actions were sent for since the first state: only these can have been
+    /// moved by the robot.
+    touched: BTreeSet<String>,
+    /// Poses reality showed of objects no action had touched: where they were in the first
+    /// state, unlike what the scenario's scene says. The twin starts from these after a
+    /// reset, and the planning world takes them in, so repairs are screened in them.
+    learned: Observation,
 }
 
 struct Pending {
@@ -123,17 +131,58 @@ impl Reality {
         Reality {
             executor,
             pending: HashMap::new(),
+            touched: BTreeSet::new(),
+            learned: Observation::default(),
         }
+    }
+
+    /// Poses reality showed of objects the robot had not touched: the first state as it
+    /// really was, where betr's scene had it otherwise.
+    pub fn learned(&self) -> &Observation {
+        &self.learned
+    }
+
+    /// Keep the poses of `observation`'s untouched objects that differ from `before`'s
+    /// (the twin's before it took the observation in); their names.
+    fn learn(&mut self, observation: &Observation, before: &Observation) -> Vec<String> {
+        let mut names = Vec::new();
+        for seen in &observation.objects {
+            if self.touched.contains(&seen.name) {
+                continue;
+            }
+            let moved = before
+                .objects
+                .iter()
+                .find(|b| b.name == seen.name)
+                .is_none_or(|b| !near(b, seen));
+            if !moved {
+                continue;
+            }
+            self.learned.objects.retain(|l| l.name != seen.name);
+            self.learned.objects.push(seen.clone());
+            names.push(seen.name.clone());
+        }
+        names
     }
 
     pub fn name(&self) -> &str {
         self.executor.name()
     }
 
-    /// Back to the first state: nothing pending, the executor reset.
-    pub fn reset(&mut self) -> Result<(), ExecutorError> {
+    /// Back to the first state: nothing pending or touched, the executor reset, and
+    /// `twin` (reloaded from the scenario) given the poses reality showed of it.
+    pub fn reset(&mut self, twin: &mut dyn World) -> Result<(), ExecutorError> {
         self.pending.clear();
-        self.executor.reset()
+        self.touched.clear();
+        self.executor.reset()?;
+        if self.learned.objects.is_empty() {
+            return Ok(());
+        }
+        twin.take_observation(&self.learned)
+            .map_err(|source| ExecutorError::Observation {
+                executor: self.executor.name().to_string(),
+                source,
+            })
     }
 
     /// The leaves a tick runs against: conditions asked of `twin`, actions performed here.
@@ -148,6 +197,7 @@ impl Reality {
             domain,
             diverged: Vec::new(),
             broken: None,
+            learned: Vec::new(),
         }
     }
 }
@@ -161,6 +211,8 @@ pub struct RealityLeaves<'a> {
     pub diverged: Vec<Divergence>,
     /// The executor broke during the tick (every later action of the tick fails with it).
     pub broken: Option<ExecutorError>,
+    /// Objects whose first-state pose reality showed otherwise than the scene this tick.
+    pub learned: Vec<String>,
 }
 
 impl RealityLeaves<'_> {
@@ -168,6 +220,15 @@ impl RealityLeaves<'_> {
         let text = error.to_string();
         self.broken = Some(error);
         ActionStep::Failure(text)
+    }
+
+    /// What `observation` shows of the first state where the twin had it otherwise
+    /// (`before`: the twin's own view, none for a world without geometry).
+    fn learn(&mut self, observation: &Observation, before: Option<Observation>) {
+        if let Some(before) = before {
+            let learned = self.reality.learn(observation, &before);
+            self.learned.extend(learned);
+        }
     }
 
     /// The action has ended in reality, in success or with the executor's error; the
@@ -180,9 +241,12 @@ impl RealityLeaves<'_> {
         let reality = match failed {
             None => {
                 let mut prediction = pending.prediction;
-                if let Err(e) = take_in(executor, prediction.as_mut()) {
-                    return self.broke(e);
-                }
+                let before = cell(prediction.as_ref()).map(CellWorld::observation);
+                let observation = match take_in(executor, prediction.as_mut()) {
+                    Ok(observation) => observation,
+                    Err(e) => return self.broke(e),
+                };
+                self.learn(&observation, before);
                 *self.twin = prediction;
                 match postcondition_failure(self.domain, self.twin.as_ref(), action) {
                     Some(error) => error,
@@ -190,9 +254,12 @@ impl RealityLeaves<'_> {
                 }
             }
             Some(error) => {
-                if let Err(e) = take_in(executor, self.twin.as_mut()) {
-                    return self.broke(e);
-                }
+                let before = cell(self.twin.as_ref()).map(CellWorld::observation);
+                let observation = match take_in(executor, self.twin.as_mut()) {
+                    Ok(observation) => observation,
+                    Err(e) => return self.broke(e),
+                };
+                self.learn(&observation, before);
                 error
             }
         };
@@ -225,6 +292,7 @@ impl Leaves for RealityLeaves<'_> {
                     self.reality
                         .pending
                         .insert(node, Pending { order, prediction });
+                    self.reality.touched.extend(action.args.iter().cloned());
                 }
                 Prediction::Refused(refusal) => {
                     self.reality.pending.remove(&node);
@@ -256,15 +324,35 @@ impl Leaves for RealityLeaves<'_> {
     }
 }
 
-/// `world` takes in what the executor sees now, or is left as it was.
-fn take_in(executor: &mut dyn Executor, world: &mut dyn World) -> Result<(), ExecutorError> {
+/// `world` takes in what the executor sees now (and it is returned), or is left as it was.
+fn take_in(
+    executor: &mut dyn Executor,
+    world: &mut dyn World,
+) -> Result<Observation, ExecutorError> {
     let observation = executor.observe()?;
     world
         .take_observation(&observation)
         .map_err(|source| ExecutorError::Observation {
             executor: executor.name().to_string(),
             source,
-        })
+        })?;
+    Ok(observation)
+}
+
+/// Positions this close (metres) are the same place: reality's poses are measured.
+const SAME_PLACE: f32 = 0.005;
+
+fn near(
+    a: &crate::world::observation::ObservedObject,
+    b: &crate::world::observation::ObservedObject,
+) -> bool {
+    let d2: f32 = a
+        .position
+        .iter()
+        .zip(&b.position)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum();
+    d2.sqrt() <= SAME_PLACE
 }
 
 /// What the twin says of an action before it is sent.

@@ -2,7 +2,8 @@
 //! executor that is not the cell (`SlowArm`: cubes as points with a 4 cm height, each
 //! action taking four ticks), with betr's cell as the twin. An action runs across ticks
 //! and then ends; a grasp reality refuses where the twin predicted it free reaches the
-//! question, the proposal and the approved change; an executor that stops answering stops
+//! question and the proposal, the scene takes in where the object in the way really lay,
+//! and the approved change clears it in reality; an executor that stops answering stops
 //! the run without a repair. The same through a process speaking the JSON-lines protocol
 //! (tests/fixtures/executor/follower.py), and that process's faults named.
 
@@ -248,11 +249,13 @@ fn an_action_runs_for_the_executors_ticks_and_the_run_succeeds() {
 }
 
 #[test]
-fn a_grasp_reality_refuses_reaches_the_question_and_the_approved_change() {
+fn a_grasp_reality_refuses_is_repaired_in_the_scene_reality_showed_and_then_succeeds() {
     rt().block_on(async {
         // The camera's scene (the twin) has the red cube on the table; in reality it lies
         // on the blue cube.
-        let mut s = session(SlowArm::new(Cubes::scenario_1(true)));
+        let arm = SlowArm::new(Cubes::scenario_1(true));
+        let orders = arm.orders.clone();
+        let mut s = session(arm);
         s.send(Command::Submit(INSTRUCTION.into()));
         s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
             .await;
@@ -287,8 +290,27 @@ fn a_grasp_reality_refuses_reaches_the_question_and_the_approved_change() {
             _ => None,
         });
         assert!(facts.unwrap().contains(&red_on_blue));
+        // The robot never touched the red cube: it lay there from the start, and the
+        // scene's first state takes that in, so the repair is tried where it is.
+        let learned = s.seen.iter().any(|e| {
+            matches!(e, Event::Notice { message } if message.starts_with(
+                "reality showed red cube elsewhere than the scene said, untouched by the robot"
+            ))
+        });
+        assert!(learned, "{:#?}", s.seen);
         let got = s.approve().await;
         assert!(fix_inserted(&got), "{got:#?}");
+        // Run again from the first state: the twin starts from what reality showed, so the
+        // tree clears the blue cube first, and reality lets it.
+        s.send(Command::Run);
+        s.until("success", |e| matches!(e, Event::Success { .. }))
+            .await;
+        let sent: Vec<String> = orders.lock().unwrap().iter().map(|a| a.to_string()).collect();
+        assert_eq!(
+            sent[1..3],
+            [r#"grasp "red cube""#.to_string(), r#"place "red cube" "table""#.to_string()],
+            "{sent:?}"
+        );
     });
 }
 

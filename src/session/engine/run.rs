@@ -83,11 +83,11 @@ impl Engine {
         };
         let domain = &self.settings.scenario.domain;
         let forced = &self.run.debug.forced;
-        let (record, diverged, broken) = match self.run.reality.as_mut() {
+        let (record, diverged, broken, learned) = match self.run.reality.as_mut() {
             Some(reality) => {
                 let mut leaves = reality.leaves(&mut self.run.exec, domain);
                 let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
-                (record, leaves.diverged, leaves.broken)
+                (record, leaves.diverged, leaves.broken, leaves.learned)
             }
             None => {
                 let mut leaves = WorldLeaves {
@@ -95,9 +95,19 @@ impl Engine {
                     domain,
                 };
                 let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
-                (record, Vec::new(), None)
+                (record, Vec::new(), None, Vec::new())
             }
         };
+        if let Some(reality) = &self.run.reality
+            && !learned.is_empty()
+        {
+            learn_first_state(self.run.planning.as_mut(), reality, &learned);
+            self.notice(format!(
+                "reality showed {} elsewhere than the scene said, untouched by the robot: the \
+                 scene's first state now has it there, and repairs are tried in it",
+                learned.join(", ")
+            ));
+        }
         let record = Arc::new(record);
         self.run.ticks += 1;
         let failed = record.failures.first().and_then(|(node, error)| {
@@ -146,7 +156,8 @@ impl Engine {
         }
     }
 
-    /// Say where reality did what the twin did not predict.
+    /// Say where reality did what the twin did not predict (and what it showed of the
+    /// first state, which the planning world has taken in).
     fn tell_reality(&self, diverged: Vec<Divergence>) {
         let Some(reality) = &self.run.reality else {
             return;
@@ -240,7 +251,7 @@ impl Engine {
             Err(e) => return self.error(format!("cannot reset the world: {e}")),
         }
         if let Some(reality) = &mut self.run.reality
-            && let Err(e) = reality.reset()
+            && let Err(e) = reality.reset(self.run.exec.as_mut())
         {
             self.error(format!("cannot reset the executor: {e}"));
         }
@@ -273,5 +284,14 @@ impl Engine {
                  world reset or the next tree",
             );
         }
+    }
+}
+
+/// The planning world takes in the first state's poses reality showed of `objects` (the
+/// robot had not touched them, so they were there from the start): the repair is screened
+/// and the tree re-planned in the scene as it is, not as the scenario said.
+fn learn_first_state(planning: &mut dyn World, reality: &Reality, objects: &[String]) {
+    if let Err(e) = planning.take_observation(reality.learned()) {
+        tracing::warn!("the planning world cannot take in what reality showed of {objects:?}: {e}");
     }
 }
