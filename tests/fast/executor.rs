@@ -173,6 +173,14 @@ impl Executor for SlowArm {
     }
 }
 
+/// Submit scenario 1's instruction and run the tree once it is planned.
+async fn submit_and_run(s: &mut Session) {
+    s.send(Command::Submit(INSTRUCTION.into()));
+    s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
+        .await;
+    s.send(Command::Run);
+}
+
 /// Scenario 1 with the twin in the `clear` variant (the red cube on the table) and `arm`
 /// performing the actions.
 fn session(arm: SlowArm) -> Session {
@@ -199,10 +207,7 @@ fn an_action_runs_for_the_executors_ticks_and_the_run_succeeds() {
         let arm = SlowArm::new(Cubes::scenario_1(false));
         let orders = arm.orders.clone();
         let mut s = session(arm);
-        s.send(Command::Submit(INSTRUCTION.into()));
-        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
-        s.send(Command::Run);
+        submit_and_run(&mut s).await;
         s.until("success", |e| matches!(e, Event::Success { .. }))
             .await;
         let tree = tree_of(&s.seen).unwrap().0;
@@ -256,10 +261,7 @@ fn a_grasp_reality_refuses_is_repaired_in_the_scene_reality_showed_and_then_succ
         let arm = SlowArm::new(Cubes::scenario_1(true));
         let orders = arm.orders.clone();
         let mut s = session(arm);
-        s.send(Command::Submit(INSTRUCTION.into()));
-        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
-        s.send(Command::Run);
+        submit_and_run(&mut s).await;
         s.until("the proposal", |e| matches!(e, Event::Proposal { .. }))
             .await;
         let failed = s.seen.iter().find_map(|e| match e {
@@ -320,10 +322,7 @@ fn an_executor_that_stops_answering_stops_the_run_without_a_repair() {
         let mut arm = SlowArm::new(Cubes::scenario_1(false));
         arm.answers = false;
         let mut s = session(arm);
-        s.send(Command::Submit(INSTRUCTION.into()));
-        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
-        s.send(Command::Run);
+        submit_and_run(&mut s).await;
         let got = s
             .until("the run given up", |e| matches!(e, Event::GaveUp { .. }))
             .await;
@@ -374,10 +373,7 @@ fn a_process_executor_runs_scenario_1_to_success_over_json_lines() {
             ..setup(Ok(Arc::new(model(Duration::ZERO))), None)
         };
         let mut s = Session::start(setup);
-        s.send(Command::Submit(INSTRUCTION.into()));
-        s.until("the tree", |e| matches!(e, Event::TreeChanged { .. }))
-            .await;
-        s.send(Command::Run);
+        submit_and_run(&mut s).await;
         let got = s
             .until("success", |e| matches!(e, Event::Success { .. }))
             .await;
