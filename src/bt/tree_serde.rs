@@ -16,6 +16,11 @@ struct Written {
     capacity: usize,
 }
 
+/// The most slots (live and removed nodes) a tree read back may claim: far beyond any
+/// tree a session grows, and a bound on what a damaged or hostile file makes betr allocate
+/// (the arena is made before the ids are checked against it).
+pub const MAX_SLOTS: usize = 1 << 20;
+
 impl Serialize for Tree {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         Written {
@@ -43,6 +48,11 @@ fn with_ids<E: serde::de::Error>(
     ids: &[NodeId],
     capacity: usize,
 ) -> Result<Tree, E> {
+    if capacity > MAX_SLOTS {
+        return Err(E::custom(format!(
+            "the tree claims {capacity} node slots; betr reads trees of at most {MAX_SLOTS}"
+        )));
+    }
     let order = parsed.preorder();
     if order.len() != ids.len() {
         return Err(E::custom(format!(
@@ -122,5 +132,15 @@ mod tests {
         ] {
             assert!(serde_json::from_str::<Tree>(json).is_err(), "{json}");
         }
+        // A capacity no session reaches is refused before anything is allocated for it.
+        let huge =
+            r#"{"text":"fallback\n  \"a\" on \"b\"?\n","ids":[0,1],"capacity":240518168576}"#;
+        let err = serde_json::from_str::<Tree>(huge).unwrap_err().to_string();
+        assert!(
+            err.starts_with(
+                "the tree claims 240518168576 node slots; betr reads trees of at most 1048576"
+            ),
+            "{err}"
+        );
     }
 }

@@ -194,7 +194,7 @@ fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
     let any = |rng: &mut Rng| NodeId(rng.below(tree.capacity() + 1) as u32);
     let action = near.action;
     let fact = near.fact;
-    match rng.below(11) {
+    match rng.below(12) {
         0..=2 => Event::Ticked {
             record: Arc::new(TickRecord {
                 tick: rng.below(100) as u64,
@@ -248,6 +248,11 @@ fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
         },
         9 => Event::Usage {
             totals: UsageTotals::default(),
+        },
+        10 => Event::Diverged {
+            executor: (0..rng.small(12)).map(|_| random_char(rng)).collect(),
+            action: action.clone(),
+            reality: (0..rng.small(40)).map(|_| random_char(rng)).collect(),
         },
         _ => Event::Success { ticks: 4 },
     }
