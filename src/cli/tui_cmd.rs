@@ -61,10 +61,6 @@ pub struct TuiArgs {
     pub tick_ms: u64,
     #[command(flatten)]
     pub llm: LlmFlags,
-    /// Push-to-talk plays this WAV file instead of recording from the microphone (for
-    /// machines without one, demonstrations and tests).
-    #[arg(long, value_name = "FILE.wav")]
-    pub audio: Option<PathBuf>,
     #[command(flatten)]
     pub viz: super::viz_flags::VizFlags,
 }
@@ -76,7 +72,7 @@ pub fn tui(args: &TuiArgs, ascii: bool) -> Result<ExitCode> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(betr::scenario::catalog::DEFAULT_SCENARIO));
     let path = super::find_scenario(&arg)?;
-    let microphone = microphone(args)?;
+    let microphone = microphone()?;
     let (scenario, knowledge) = scenario_of(args, &path)?;
     if let Some(file) = &args.tree
         && let Err(refusal) = super::export_cmd::load_tree(&scenario, file)
@@ -197,13 +193,19 @@ fn show_not_run(file: &Path, refusal: anyhow::Error, ascii: bool) -> Result<Exit
     Err(refusal.context(format!("{} was shown, not run", file.display())))
 }
 
-/// The microphone push-to-talk listens to: `--audio`'s file, checked now rather than at
+/// The variable naming a WAV file push-to-talk plays instead of the microphone: a stand-in
+/// for demonstrations and tests on machines without one, not a setting of the workbench
+/// (people without a microphone dictate a file with `betr interpret --audio`).
+const STAND_IN_MICROPHONE: &str = "BETR_PUSH_TO_TALK_WAV";
+
+/// The microphone push-to-talk listens to: the stand-in file, checked now rather than at
 /// the first key press, or the default input device.
-fn microphone(args: &TuiArgs) -> Result<Arc<dyn Microphone>> {
-    Ok(match &args.audio {
+fn microphone() -> Result<Arc<dyn Microphone>> {
+    Ok(match std::env::var_os(STAND_IN_MICROPHONE) {
         Some(file) => {
-            betr::voice::Audio16k::from_wav(file).context("--audio")?;
-            Arc::new(WavMicrophone::new(file.clone()))
+            let file = PathBuf::from(file);
+            betr::voice::Audio16k::from_wav(&file).context(STAND_IN_MICROPHONE)?;
+            Arc::new(WavMicrophone::new(file))
         }
         None => Arc::new(DefaultMicrophone),
     })

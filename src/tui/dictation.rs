@@ -86,7 +86,7 @@ impl Microphone for DefaultMicrophone {
     }
 }
 
-/// A WAV file played as the microphone (`betr tui --audio FILE.wav`): for machines without
+/// A WAV file played as the microphone (`BETR_PUSH_TO_TALK_WAV=FILE.wav betr tui`): for machines without
 /// one, demonstrations and end-to-end tests. Its levels arrive in real time, 50 ms at a
 /// time, while "recording"; stopping returns the whole file.
 pub struct WavMicrophone {

@@ -302,7 +302,7 @@ fn strings_edit_title() -> &'static str {
     betr::tui::strings::INPUT_TITLE_EDIT.trim()
 }
 
-/// Push-to-talk with real speech through the real binary: `--audio` plays an espeak-ng
+/// Push-to-talk with real speech through the real binary: `BETR_PUSH_TO_TALK_WAV` plays an espeak-ng
 /// recording of scenario 1's instruction as the microphone, the embedded Whisper model
 /// (fetched into the cache first when missing) transcribes it, the transcript waits in the
 /// input line, and Enter sends it to the model like typed words.
@@ -326,8 +326,12 @@ fn a_person_dictates_the_instruction_in_the_workbench() {
     let tmux = Tmux::start(&workbench_command(
         &dir,
         &server,
-        &format!("BETR_MODEL_DIR={}", quote(models)),
-        &format!("--audio {}", quote(&wav)),
+        &format!(
+            "BETR_MODEL_DIR={} BETR_PUSH_TO_TALK_WAV={}",
+            quote(models),
+            quote(&wav)
+        ),
+        "",
     ));
     tmux.wait_for(&["press i to type an instruction, d to dictate one"], 20);
 
