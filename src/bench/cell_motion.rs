@@ -38,12 +38,7 @@ pub fn scenario_queries(path: &Path) -> Result<Option<ScenarioQueries>, BenchErr
         return Ok(None);
     }
     let exec = world::load_execution(&scenario, None).map_err(|e| setup(e.to_string()))?;
-    let Some(arms) = exec
-        .world
-        .as_any()
-        .and_then(|a| a.downcast_ref::<CellWorld>())
-        .and_then(|c| c.arms().cloned())
-    else {
+    let Some(arms) = CellWorld::of(exec.world.as_ref()).and_then(|c| c.arms().cloned()) else {
         return Ok(None);
     };
     if scenario.goal.is_none() {

@@ -30,6 +30,7 @@ use serde::{Deserialize, Serialize};
 use crate::bt::{ActionStep, Leaves, NodeId};
 use crate::domain::{ActionCall, Condition, Domain};
 use crate::planner::postcondition_failure;
+use crate::world::observation::ObservedObject;
 use crate::world::{CellWorld, Observation, ObservationError, Step, World};
 
 pub mod process;
@@ -92,18 +93,22 @@ pub struct Divergence {
     pub reality: String,
 }
 
-impl Divergence {
-    /// In words, naming the executor that reported it.
-    pub fn describe(&self, executor: &str) -> String {
-        Divergence::describe_parts(&self.action, executor, &self.reality)
-    }
+/// A divergence in words, naming the executor that reported it (as an event carries it).
+pub fn describe_divergence(action: &ActionCall, executor: &str, reality: &str) -> String {
+    format!(
+        "the twin predicted {action}! would succeed; the {executor} executor reports: {reality}"
+    )
+}
 
-    /// A divergence in words from its parts (as an event carries them).
-    pub fn describe_parts(action: &ActionCall, executor: &str, reality: &str) -> String {
-        format!(
-            "the twin predicted {action}! would succeed; the {executor} executor reports: {reality}"
-        )
-    }
+/// What one tick over an executor found besides the tick's own record.
+#[derive(Debug, Default)]
+pub struct Findings {
+    /// Actions the twin predicted to succeed that reality did not.
+    pub diverged: Vec<Divergence>,
+    /// The executor broke during the tick (every later action of the tick fails with it).
+    pub broken: Option<ExecutorError>,
+    /// Objects whose first-state pose reality showed otherwise than the scene.
+    pub learned: Vec<String>,
 }
 
 /// An executor with what the twin predicted of each action it is performing, and what
@@ -195,9 +200,7 @@ impl Reality {
             reality: self,
             twin,
             domain,
-            diverged: Vec::new(),
-            broken: None,
-            learned: Vec::new(),
+            found: Findings::default(),
         }
     }
 }
@@ -207,18 +210,14 @@ pub struct RealityLeaves<'a> {
     reality: &'a mut Reality,
     twin: &'a mut Box<dyn World>,
     domain: &'a Domain,
-    /// Actions the twin predicted to succeed that reality did not.
-    pub diverged: Vec<Divergence>,
-    /// The executor broke during the tick (every later action of the tick fails with it).
-    pub broken: Option<ExecutorError>,
-    /// Objects whose first-state pose reality showed otherwise than the scene this tick.
-    pub learned: Vec<String>,
+    /// What the tick found so far.
+    pub found: Findings,
 }
 
 impl RealityLeaves<'_> {
     fn broke(&mut self, error: ExecutorError) -> ActionStep {
         let text = error.to_string();
-        self.broken = Some(error);
+        self.found.broken = Some(error);
         ActionStep::Failure(text)
     }
 
@@ -227,7 +226,7 @@ impl RealityLeaves<'_> {
     fn learn(&mut self, observation: &Observation, before: Option<Observation>) {
         if let Some(before) = before {
             let learned = self.reality.learn(observation, &before);
-            self.learned.extend(learned);
+            self.found.learned.extend(learned);
         }
     }
 
@@ -240,8 +239,8 @@ impl RealityLeaves<'_> {
         let executor = self.reality.executor.as_mut();
         let reality = match failed {
             None => {
-                let mut prediction = pending.prediction;
-                let before = cell(prediction.as_ref()).map(CellWorld::observation);
+                // What the twin expected afterwards is what it sent with the order.
+                let (mut prediction, before) = (pending.prediction, pending.order.expected);
                 let observation = match take_in(executor, prediction.as_mut()) {
                     Ok(observation) => observation,
                     Err(e) => return self.broke(e),
@@ -254,7 +253,7 @@ impl RealityLeaves<'_> {
                 }
             }
             Some(error) => {
-                let before = cell(self.twin.as_ref()).map(CellWorld::observation);
+                let before = CellWorld::of(self.twin.as_ref()).map(CellWorld::observation);
                 let observation = match take_in(executor, self.twin.as_mut()) {
                     Ok(observation) => observation,
                     Err(e) => return self.broke(e),
@@ -263,7 +262,7 @@ impl RealityLeaves<'_> {
                 error
             }
         };
-        self.diverged.push(Divergence {
+        self.found.diverged.push(Divergence {
             action: action.clone(),
             reality: reality.clone(),
         });
@@ -277,7 +276,7 @@ impl Leaves for RealityLeaves<'_> {
     }
 
     fn step(&mut self, node: NodeId, action: &ActionCall, started: bool) -> ActionStep {
-        if let Some(error) = &self.broken {
+        if let Some(error) = &self.found.broken {
             return ActionStep::Failure(error.to_string());
         }
         let fresh = started || !self.reality.pending.contains_key(&node);
@@ -287,7 +286,7 @@ impl Leaves for RealityLeaves<'_> {
                     let order = ActionOrder {
                         action: action.clone(),
                         path: planned_path(self.twin.as_ref(), prediction.as_ref()),
-                        expected: cell(prediction.as_ref()).map(CellWorld::observation),
+                        expected: CellWorld::of(prediction.as_ref()).map(CellWorld::observation),
                     };
                     self.reality
                         .pending
@@ -319,7 +318,7 @@ impl Leaves for RealityLeaves<'_> {
             return;
         }
         if let Err(e) = self.reality.executor.halt(action) {
-            self.broken.get_or_insert(e);
+            self.found.broken.get_or_insert(e);
         }
     }
 }
@@ -342,10 +341,7 @@ fn take_in(
 /// Positions this close (metres) are the same place: reality's poses are measured.
 const SAME_PLACE: f32 = 0.005;
 
-fn near(
-    a: &crate::world::observation::ObservedObject,
-    b: &crate::world::observation::ObservedObject,
-) -> bool {
+fn near(a: &ObservedObject, b: &ObservedObject) -> bool {
     let d2: f32 = a
         .position
         .iter()
@@ -387,7 +383,7 @@ fn predict(twin: &dyn World, action: &ActionCall, domain: &Domain) -> Prediction
 /// The arm motion the prediction made, when the action moved an arm (a cell with real
 /// arms whose last motion changed).
 fn planned_path(twin: &dyn World, prediction: &dyn World) -> Option<ArmPath> {
-    let motion = |w: &dyn World| cell(w)?.last_motion();
+    let motion = |w: &dyn World| CellWorld::of(w)?.last_motion();
     let (arm, made) = motion(prediction)?;
     if motion(twin).is_some_and(|(_, before)| before == made) {
         return None;
@@ -397,10 +393,6 @@ fn planned_path(twin: &dyn World, prediction: &dyn World) -> Option<ArmPath> {
         joints: made.path,
         acts_at: made.acts_at,
     })
-}
-
-fn cell(world: &dyn World) -> Option<&CellWorld> {
-    world.as_any()?.downcast_ref::<CellWorld>()
 }
 
 #[cfg(test)]

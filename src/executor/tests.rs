@@ -8,7 +8,6 @@ use std::sync::{Arc, Mutex};
 use super::*;
 use crate::bt::{NodeKind, Outcome, Ticker, Tree};
 use crate::scenario::Scenario;
-use crate::world::observation::ObservedObject;
 
 fn scenario() -> Scenario {
     Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cell/red_on_blue.toml"))
@@ -103,32 +102,36 @@ fn one_action(text: &str) -> Tree {
     Tree::new(NodeKind::Action(action(text)))
 }
 
-/// What one tick of a tree of one grasp (of the blue cube) did with `script`'s executor
-/// and the twin of `variant`.
-struct OneTick {
-    record: crate::bt::TickRecord,
-    diverged: Vec<Divergence>,
-    broken: Option<ExecutorError>,
-    /// The twin after the tick, and its facts before it.
+/// A tree of one grasp (of the blue cube) ticked over `script`'s executor and a twin.
+struct Grasping {
+    reality: Reality,
     twin: Box<dyn World>,
-    before: Vec<Condition>,
+    scenario: Scenario,
+    tree: Tree,
+    ticker: Ticker,
 }
 
-fn grasp_once(script: &Arc<Mutex<Script>>, variant: Option<&str>) -> OneTick {
-    let mut reality = reality(script);
-    let mut twin = twin(variant);
-    let before = twin.facts();
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    let record = Ticker::new().tick(&tree, &mut leaves);
-    let (diverged, broken) = (leaves.diverged, leaves.broken);
-    OneTick {
-        record,
-        diverged,
-        broken,
-        twin,
-        before,
+impl Grasping {
+    /// The twin of the scenario's `variant`.
+    fn new(script: &Arc<Mutex<Script>>, variant: Option<&str>) -> Grasping {
+        Grasping {
+            reality: reality(script),
+            twin: twin(variant),
+            scenario: scenario(),
+            tree: one_action(r#"grasp "blue cube""#),
+            ticker: Ticker::new(),
+        }
+    }
+
+    /// One tick: its record, and what it found.
+    fn tick(&mut self) -> (crate::bt::TickRecord, Findings) {
+        let mut leaves = self.reality.leaves(&mut self.twin, &self.scenario.domain);
+        let record = self.ticker.tick(&self.tree, &mut leaves);
+        (record, leaves.found)
+    }
+
+    fn holds(&self, condition: &str) -> bool {
+        holds(self.twin.as_ref(), condition)
     }
 }
 
@@ -143,26 +146,22 @@ fn an_action_runs_for_the_executors_ticks_then_the_twin_takes_its_result() {
         },
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut ticker = Ticker::new();
+    let mut grasping = Grasping::new(&script, Some("clear"));
     let mut roots = Vec::new();
     for _ in 0..5 {
-        let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-        roots.push(ticker.tick(&tree, &mut leaves).root);
-        assert!(leaves.diverged.is_empty() && leaves.broken.is_none());
+        let (record, found) = grasping.tick();
+        roots.push(record.root);
+        assert!(found.diverged.is_empty() && found.broken.is_none());
         if roots.last() == Some(&Outcome::Running) {
             assert!(
-                !holds(twin.as_ref(), r#""blue cube" grasped"#),
+                !grasping.holds(r#""blue cube" grasped"#),
                 "not before it ends"
             );
         }
     }
     assert_eq!(roots[..4], [Outcome::Running; 4]);
     assert_eq!(roots[4], Outcome::Success);
-    assert!(holds(twin.as_ref(), r#""blue cube" grasped"#));
+    assert!(grasping.holds(r#""blue cube" grasped"#));
     let script = script.lock().unwrap();
     let started: Vec<bool> = script.orders.iter().map(|(_, s)| *s).collect();
     assert_eq!(started, [true, false, false, false, false]);
@@ -176,9 +175,9 @@ fn an_action_the_twin_refuses_is_never_sent() {
         ..Script::default()
     }));
     // The red cube lies on the blue cube: the gripper's way down is blocked in the twin.
-    let tick = grasp_once(&script, None);
-    assert_eq!(tick.record.root, Outcome::Failure);
-    assert!(tick.diverged.is_empty(), "the twin itself predicted it");
+    let (record, found) = Grasping::new(&script, None).tick();
+    assert_eq!(record.root, Outcome::Failure);
+    assert!(found.diverged.is_empty(), "the twin itself predicted it");
     assert!(script.lock().unwrap().orders.is_empty());
 }
 
@@ -193,23 +192,18 @@ fn reality_failing_what_the_twin_predicted_is_a_divergence_and_its_poses_become_
         seen: truth.observation(),
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    assert!(!holds(twin.as_ref(), r#""red cube" on "blue cube""#));
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut ticker = Ticker::new();
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    assert_eq!(ticker.tick(&tree, &mut leaves).root, Outcome::Running);
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    let record = ticker.tick(&tree, &mut leaves);
+    let mut grasping = Grasping::new(&script, Some("clear"));
+    assert!(!grasping.holds(r#""red cube" on "blue cube""#));
+    assert_eq!(grasping.tick().0.root, Outcome::Running);
+    let (record, found) = grasping.tick();
     assert_eq!(record.root, Outcome::Failure);
     assert_eq!(record.failures[0].1, "No collision free path found");
+    let divergence = &found.diverged[0];
     assert_eq!(
-        leaves.diverged[0].describe("scripted"),
+        describe_divergence(&divergence.action, "scripted", &divergence.reality),
         "the twin predicted grasp \"blue cube\"! would succeed; the scripted executor reports: No collision free path found"
     );
-    assert!(holds(twin.as_ref(), r#""red cube" on "blue cube""#));
+    assert!(grasping.holds(r#""red cube" on "blue cube""#));
 }
 
 #[test]
@@ -221,12 +215,12 @@ fn an_action_that_ends_without_its_effects_fails_by_its_postcondition() {
         seen: start.observation(),
         ..Script::default()
     }));
-    let tick = grasp_once(&script, Some("clear"));
+    let (record, found) = Grasping::new(&script, Some("clear")).tick();
     assert_eq!(
-        tick.record.failures[0].1,
+        record.failures[0].1,
         "Postcondition \"blue cube\" grasped not met after grasp action completion"
     );
-    assert_eq!(tick.diverged.len(), 1);
+    assert_eq!(found.diverged.len(), 1);
 }
 
 #[test]
@@ -236,14 +230,15 @@ fn an_executor_that_breaks_stops_the_tick_without_a_result() {
         broken: true,
         ..Script::default()
     }));
-    let tick = grasp_once(&script, Some("clear"));
-    assert_eq!(tick.record.root, Outcome::Failure);
-    assert!(tick.record.completed.is_empty());
+    let mut grasping = Grasping::new(&script, Some("clear"));
+    let (record, found) = grasping.tick();
+    assert_eq!(record.root, Outcome::Failure);
+    assert!(record.completed.is_empty());
     assert_eq!(
-        tick.broken.as_ref().map(ToString::to_string).as_deref(),
+        found.broken.as_ref().map(ToString::to_string).as_deref(),
         Some("the scripted executor stopped: no answer in 2 s")
     );
-    assert!(!holds(tick.twin.as_ref(), r#""blue cube" grasped"#));
+    assert!(!grasping.holds(r#""blue cube" grasped"#));
 }
 
 #[test]
@@ -260,15 +255,17 @@ fn an_observation_naming_an_unknown_object_changes_nothing() {
         },
         ..Script::default()
     }));
-    let tick = grasp_once(&script, Some("clear"));
+    let mut grasping = Grasping::new(&script, Some("clear"));
+    let before = grasping.twin.facts();
+    let (_, found) = grasping.tick();
     assert_eq!(
-        tick.broken.as_ref().map(ToString::to_string).as_deref(),
+        found.broken.as_ref().map(ToString::to_string).as_deref(),
         Some(
             "the scripted executor's observation was refused: the observation names \"purple cube\", which is not an object of this scene"
         )
     );
     // Neither the prediction nor the refused observation was taken.
-    assert_eq!(tick.twin.facts(), tick.before);
+    assert_eq!(grasping.twin.facts(), before);
 }
 
 #[test]
@@ -277,14 +274,16 @@ fn a_halted_action_is_halted_in_reality() {
         ticks: 5,
         ..Script::default()
     }));
-    let mut reality = reality(&script);
-    let mut twin = twin(Some("clear"));
-    let scenario = scenario();
-    let tree = one_action(r#"grasp "blue cube""#);
-    let mut ticker = Ticker::new();
-    let mut leaves = reality.leaves(&mut twin, &scenario.domain);
-    ticker.tick(&tree, &mut leaves);
-    ticker.halt_all(&tree, &mut leaves);
+    let mut grasping = Grasping::new(&script, Some("clear"));
+    grasping.tick();
+    let Grasping {
+        reality,
+        twin,
+        scenario,
+        tree,
+        ticker,
+    } = &mut grasping;
+    ticker.halt_all(tree, &mut reality.leaves(twin, &scenario.domain));
     assert_eq!(
         script.lock().unwrap().halted,
         [action(r#"grasp "blue cube""#)]

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use crate::bt::{Outcome as TickOutcome, TickRecord, Ticker};
 use crate::domain::Condition;
-use crate::executor::{Divergence, ExecutorError, Reality};
+use crate::executor::{Divergence, ExecutorError, Findings, Reality};
 use crate::planner::WorldLeaves;
 use crate::world::cell::snapshot::MotionView;
 use crate::world::{self, World};
@@ -83,11 +83,11 @@ impl Engine {
         };
         let domain = &self.settings.scenario.domain;
         let forced = &self.run.debug.forced;
-        let (record, diverged, broken, learned) = match self.run.reality.as_mut() {
+        let (record, found) = match self.run.reality.as_mut() {
             Some(reality) => {
                 let mut leaves = reality.leaves(&mut self.run.exec, domain);
                 let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
-                (record, leaves.diverged, leaves.broken, leaves.learned)
+                (record, leaves.found)
             }
             None => {
                 let mut leaves = WorldLeaves {
@@ -95,19 +95,9 @@ impl Engine {
                     domain,
                 };
                 let record = self.run.ticker.tick_forced(tree, &mut leaves, forced);
-                (record, Vec::new(), None, Vec::new())
+                (record, Findings::default())
             }
         };
-        if let Some(reality) = &self.run.reality
-            && !learned.is_empty()
-        {
-            learn_first_state(self.run.planning.as_mut(), reality, &learned);
-            self.notice(format!(
-                "reality showed {} elsewhere than the scene said, untouched by the robot: the \
-                 scene's first state now has it there, and repairs are tried in it",
-                learned.join(", ")
-            ));
-        }
         let record = Arc::new(record);
         self.run.ticks += 1;
         let failed = record.failures.first().and_then(|(node, error)| {
@@ -124,8 +114,7 @@ impl Engine {
         });
         self.emit_scene();
         self.tell_world_change();
-        self.tell_reality(diverged);
-        if let Some(broken) = broken {
+        if let Some(broken) = self.take_findings(found) {
             return self.executor_broke(&broken);
         }
         self.end_of_tick(&record, failed);
@@ -156,16 +145,28 @@ impl Engine {
         }
     }
 
-    /// Say where reality did what the twin did not predict (and what it showed of the
-    /// first state, which the planning world has taken in).
-    fn tell_reality(&self, diverged: Vec<Divergence>) {
+    /// Take in what a tick over the executor found: what reality showed of the first state
+    /// goes into the planning world (before the failure is asked about, so the repair is
+    /// screened in it) and is said, and so is each action the twin predicted that reality
+    /// did otherwise; the executor's breakdown, if any, is returned.
+    fn take_findings(&mut self, found: Findings) -> Option<ExecutorError> {
         let Some(reality) = &self.run.reality else {
-            return;
+            return found.broken;
         };
+        if !found.learned.is_empty() {
+            if let Err(e) = self.run.planning.take_observation(reality.learned()) {
+                tracing::warn!("the planning world cannot take in what reality showed: {e}");
+            }
+            self.notice(format!(
+                "reality showed {} elsewhere than the scene said, untouched by the robot: the \
+                 scene's first state now has it there, and repairs are tried in it",
+                found.learned.join(", ")
+            ));
+        }
         for Divergence {
             action,
             reality: what,
-        } in diverged
+        } in found.diverged
         {
             self.emit(Event::Diverged {
                 executor: reality.name().to_string(),
@@ -173,6 +174,7 @@ impl Engine {
                 reality: what,
             });
         }
+        found.broken
     }
 
     /// The executor failed itself: nothing it reported this tick is taken as done, and
@@ -284,14 +286,5 @@ impl Engine {
                  world reset or the next tree",
             );
         }
-    }
-}
-
-/// The planning world takes in the first state's poses reality showed of `objects` (the
-/// robot had not touched them, so they were there from the start): the repair is screened
-/// and the tree re-planned in the scene as it is, not as the scenario said.
-fn learn_first_state(planning: &mut dyn World, reality: &Reality, objects: &[String]) {
-    if let Err(e) = planning.take_observation(reality.learned()) {
-        tracing::warn!("the planning world cannot take in what reality showed of {objects:?}: {e}");
     }
 }

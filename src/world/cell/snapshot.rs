@@ -151,21 +151,20 @@ pub struct SceneSnapshot {
 }
 
 impl CellWorld {
+    /// The world as a cell, when it is one.
+    pub fn of(world: &dyn World) -> Option<&CellWorld> {
+        world.as_any()?.downcast_ref::<CellWorld>()
+    }
+
     /// The scene of a world that is a cell (`None` for other worlds).
     pub fn scene_of(world: &dyn World) -> Option<SceneSnapshot> {
-        world
-            .as_any()
-            .and_then(|w| w.downcast_ref::<CellWorld>())
-            .map(CellWorld::scene)
+        CellWorld::of(world).map(CellWorld::scene)
     }
 
     /// The last motion asked of a cell's real arms (`None` for other worlds, worlds
     /// without real arms, and before the first motion).
     pub fn motion_of(world: &dyn World) -> Option<MotionView> {
-        world
-            .as_any()
-            .and_then(|w| w.downcast_ref::<CellWorld>())
-            .and_then(CellWorld::motion_view)
+        CellWorld::of(world).and_then(CellWorld::motion_view)
     }
 
     fn motion_view(&self) -> Option<MotionView> {
