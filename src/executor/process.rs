@@ -14,9 +14,8 @@
 //! or does not answer within [`REPLY_WITHIN`] has stopped: the run stops with what it
 //! said on its standard error, never with an action taken as done.
 
-use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Write};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::process::{Child, ChildStderr, ChildStdin, ChildStdout, Command, Stdio};
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, channel};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -32,8 +31,6 @@ use crate::world::{Observation, Step};
 /// shorter; a process silent this long has hung.
 pub const REPLY_WITHIN: Duration = Duration::from_secs(10);
 
-/// Lines of the process's standard error kept to say why it stopped.
-const STDERR_LINES: usize = 8;
 /// A process whose output closed is given up to a second to exit.
 const EXIT_POLL: Duration = Duration::from_millis(50);
 const EXIT_POLLS: u32 = 20;
@@ -92,7 +89,8 @@ pub struct ProcessExecutor {
     /// Why writing a request failed, once it has.
     write_failed: Receiver<std::io::Error>,
     lines: Receiver<std::io::Result<String>>,
-    stderr: Arc<Mutex<VecDeque<String>>>,
+    /// The last line the process wrote on its standard error (its last words).
+    last_words: Arc<Mutex<Option<String>>>,
     /// Says when the process's standard error has closed (it was read to the end).
     stderr_closed: Receiver<()>,
     reply_within: Duration,
@@ -131,37 +129,15 @@ impl ProcessExecutor {
             return Err(stopped("its pipes were not opened".into()));
         };
         let (requests, write_failed) = write_requests(stdin);
-        let (tx, lines) = channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines() {
-                if tx.send(line).is_err() {
-                    return;
-                }
-            }
-        });
-        let said = Arc::new(Mutex::new(VecDeque::new()));
-        let keep = said.clone();
-        let label = name.clone();
-        let (closed, stderr_closed) = channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                tracing::info!(executor = %label, "{line}");
-                if let Ok(mut kept) = keep.lock() {
-                    if kept.len() == STDERR_LINES {
-                        kept.pop_front();
-                    }
-                    kept.push_back(line);
-                }
-            }
-            let _ = closed.send(());
-        });
+        let lines = read_replies(stdout);
+        let (last_words, stderr_closed) = log_stderr(stderr, name.clone());
         Ok(ProcessExecutor {
             name,
             child,
             requests,
             write_failed,
             lines,
-            stderr: said,
+            last_words,
             stderr_closed,
             reply_within: REPLY_WITHIN,
         })
@@ -197,15 +173,11 @@ impl ProcessExecutor {
             Some(status) => format!(" (it exited: {status})"),
             None => String::new(),
         };
-        let said: Vec<String> = self
-            .stderr
-            .lock()
-            .map(|kept| kept.iter().cloned().collect())
-            .unwrap_or_default();
-        let last_words = match said.last() {
+        let said = self.last_words.lock().ok().and_then(|line| line.clone());
+        let last_words = match said {
             Some(line) => format!(
                 "; its standard error ends: {}",
-                crate::http_text::excerpt(line)
+                crate::http_text::excerpt(&line)
             ),
             None => String::new(),
         };
@@ -293,6 +265,37 @@ impl Executor for ProcessExecutor {
             _ => Err(self.unexpected("reset", "done or refused")),
         }
     }
+}
+
+/// A thread reading the process's replies, a line at a time, into the channel returned.
+fn read_replies(stdout: ChildStdout) -> Receiver<std::io::Result<String>> {
+    let (tx, lines) = channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines() {
+            if tx.send(line).is_err() {
+                return;
+            }
+        }
+    });
+    lines
+}
+
+/// A thread passing the process's standard error to the log, keeping its last line; the
+/// receiver hears when it has been read to the end.
+fn log_stderr(stderr: ChildStderr, name: String) -> (Arc<Mutex<Option<String>>>, Receiver<()>) {
+    let last_words = Arc::new(Mutex::new(None));
+    let keep = last_words.clone();
+    let (closed, stderr_closed) = channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            tracing::info!(executor = %name, "{line}");
+            if let Ok(mut last) = keep.lock() {
+                *last = Some(line);
+            }
+        }
+        let _ = closed.send(());
+    });
+    (last_words, stderr_closed)
 }
 
 /// A thread writing each request sent to `stdin`, a line at a time; the first error it

@@ -318,19 +318,22 @@ impl App {
             Event::ArmMotion { motion } => self.world.motion = Some(motion),
             Event::Executor { ref name } => {
                 self.world.executor = Some(name.clone());
-                for line in crate::record::describe(&event) {
-                    self.llm.log(line);
-                }
+                self.log_described(&event);
             }
             Event::Diverged { ref reality, .. } => {
                 self.world.diverged = Some(reality.clone());
-                for line in crate::record::describe(&event) {
-                    self.llm.log(line);
-                }
+                self.log_described(&event);
             }
             // For the 3D view; the world pane shows facts.
             Event::Scene { .. } => {}
             _ => {}
+        }
+    }
+
+    /// `event` in the log, in `record::describe`'s words.
+    fn log_described(&mut self, event: &Event) {
+        for line in crate::record::describe(event) {
+            self.llm.log(line);
         }
     }
 
