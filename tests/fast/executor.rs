@@ -173,6 +173,14 @@ impl Executor for SlowArm {
     }
 }
 
+/// The facts of the latest world change among `events`.
+fn facts_now(events: &[Event]) -> Option<Vec<Condition>> {
+    events.iter().rev().find_map(|e| match e {
+        Event::WorldChanged { facts, .. } => Some(facts.clone()),
+        _ => None,
+    })
+}
+
 /// Submit scenario 1's instruction and run the tree once it is planned.
 async fn submit_and_run(s: &mut Session) {
     s.send(Command::Submit(INSTRUCTION.into()));
@@ -241,10 +249,7 @@ fn an_action_runs_for_the_executors_ticks_and_the_run_succeeds() {
             sent,
             [r#"grasp "blue cube""#, r#"place "blue cube" "green cube""#]
         );
-        let facts = s.seen.iter().rev().find_map(|e| match e {
-            Event::WorldChanged { facts, .. } => Some(facts.clone()),
-            _ => None,
-        });
+        let facts = facts_now(&s.seen);
         let on = Condition::parse(r#""blue cube" on "green cube""#).unwrap();
         assert!(
             facts.unwrap().contains(&on),
@@ -287,10 +292,7 @@ fn a_grasp_reality_refuses_is_repaired_in_the_scene_reality_showed_and_then_succ
         );
         // What reality showed is the twin's now: the red cube on the blue cube.
         let red_on_blue = Condition::parse(r#""red cube" on "blue cube""#).unwrap();
-        let facts = s.seen.iter().rev().find_map(|e| match e {
-            Event::WorldChanged { facts, .. } => Some(facts.clone()),
-            _ => None,
-        });
+        let facts = facts_now(&s.seen);
         assert!(facts.unwrap().contains(&red_on_blue));
         // The robot never touched the red cube: it lay there from the start, and the
         // scene's first state takes that in, so the repair is tried where it is.
