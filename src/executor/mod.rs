@@ -31,7 +31,7 @@ use crate::bt::{ActionStep, Leaves, NodeId};
 use crate::domain::{ActionCall, Condition, Domain};
 use crate::planner::postcondition_failure;
 use crate::world::observation::ObservedObject;
-use crate::world::{CellWorld, Observation, ObservationError, Step, World};
+use crate::world::{CellWorld, Observation, ObservationError, SceneDescription, Step, World};
 
 pub mod process;
 pub use process::ProcessExecutor;
@@ -49,6 +49,12 @@ pub trait Executor: Send {
     fn observe(&mut self) -> Result<Observation, ExecutorError>;
     /// Back to the scenario's first state (a simulator), or refuse (a robot cannot).
     fn reset(&mut self) -> Result<(), ExecutorError>;
+    /// The scene to simulate, once before the first action: a simulator builds its world
+    /// from it. A robot, or a simulator with its own world, takes it as it is.
+    fn load(&mut self, scene: &SceneDescription) -> Result<(), ExecutorError> {
+        let _ = scene;
+        Ok(())
+    }
 }
 
 /// One action sent to an executor.
@@ -66,8 +72,10 @@ pub struct ActionOrder {
 /// An arm's planned way: joint values (radians) from where the arm is to where it ends.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ArmPath {
-    /// The arm's name in the robot description.
+    /// The arm's name in the robot description (its flange link).
     pub arm: String,
+    /// Where the robot's root stands while the arm moves (x, y in metres).
+    pub base: [f32; 2],
     pub joints: Vec<Vec<f64>>,
     /// The index in `joints` where the fingers close or open.
     pub acts_at: usize,
@@ -78,6 +86,8 @@ pub struct ArmPath {
 pub enum ExecutorError {
     #[error("the {executor} executor stopped: {detail}")]
     Stopped { executor: String, detail: String },
+    #[error("the {executor} executor cannot build the scene: {detail}")]
+    Load { executor: String, detail: String },
     #[error("the {executor} executor's observation was refused: {source}")]
     Observation {
         executor: String,
@@ -132,6 +142,24 @@ struct Pending {
 }
 
 impl Reality {
+    /// `executor` as reality beside `twin`: a twin with geometry gives it its scene, as
+    /// `[world.reality]` says reality differs from it.
+    pub fn start(
+        mut executor: Box<dyn Executor>,
+        twin: &dyn World,
+    ) -> Result<Reality, ExecutorError> {
+        if let Some(cell) = CellWorld::of(twin) {
+            let scene = cell
+                .reality_description()
+                .map_err(|detail| ExecutorError::Load {
+                    executor: executor.name().to_string(),
+                    detail,
+                })?;
+            executor.load(&scene)?;
+        }
+        Ok(Reality::new(executor))
+    }
+
     pub fn new(executor: Box<dyn Executor>) -> Reality {
         Reality {
             executor,
@@ -390,6 +418,7 @@ fn planned_path(twin: &dyn World, prediction: &dyn World) -> Option<ArmPath> {
     }
     Some(ArmPath {
         arm,
+        base: CellWorld::of(prediction)?.base(),
         joints: made.path,
         acts_at: made.acts_at,
     })

@@ -8,6 +8,7 @@
 //! → {"request":"halt","action":"grasp \"blue cube\""}        ← {"reply":"done"}
 //! → {"request":"observe"}    ← {"reply":"observation","objects":[…],"held":null}
 //! → {"request":"reset"}      ← {"reply":"done"} | {"reply":"refused","error":"…"}
+//! → {"request":"load","scene":{…}}   ← {"reply":"done"} | {"reply":"refused","error":"…"}
 //! ```
 //!
 //! A process that exits, closes its output, answers with something that is not a reply,
@@ -25,7 +26,7 @@ use serde::{Deserialize, Serialize};
 use super::{ActionOrder, Executor, ExecutorError};
 use crate::domain::ActionCall;
 use crate::world::observation::ObservedObject;
-use crate::world::{Observation, Step};
+use crate::world::{Observation, SceneDescription, Step};
 
 /// How long a reply may take: one tick of a simulator or of a robot's controller is far
 /// shorter; a process silent this long has hung.
@@ -47,6 +48,9 @@ enum Request<'a> {
     },
     Observe,
     Reset,
+    Load {
+        scene: &'a SceneDescription,
+    },
 }
 
 impl Request<'_> {
@@ -56,6 +60,7 @@ impl Request<'_> {
             Request::Halt { .. } => "halt",
             Request::Observe => "observe",
             Request::Reset => "reset",
+            Request::Load { .. } => "load",
         }
     }
 }
@@ -263,6 +268,17 @@ impl Executor for ProcessExecutor {
                 detail: format!("it cannot go back to the first state: {error}"),
             }),
             _ => Err(self.unexpected("reset", "done or refused")),
+        }
+    }
+
+    fn load(&mut self, scene: &SceneDescription) -> Result<(), ExecutorError> {
+        match self.ask(&Request::Load { scene })? {
+            Reply::Done => Ok(()),
+            Reply::Refused { error } => Err(ExecutorError::Load {
+                executor: self.name.clone(),
+                detail: error,
+            }),
+            _ => Err(self.unexpected("load", "done or refused")),
         }
     }
 }

@@ -725,6 +725,8 @@ pub enum SessionError {
     #[error(transparent)]
     Plan(#[from] RepairError),
     #[error(transparent)]
+    Executor(#[from] crate::executor::ExecutorError),
+    #[error(transparent)]
     Misreading(#[from] crate::reading::UnknownMisreading),
     #[error("scenario {0:?} has no instruction; give one")]
     NoInstruction(String),

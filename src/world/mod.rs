@@ -6,6 +6,7 @@
 //! behavior trees or language models.
 
 pub mod cell;
+pub mod description;
 pub mod observation;
 pub mod symbolic;
 
@@ -16,6 +17,7 @@ use crate::scenario::{Scenario, ScenarioError};
 
 pub use cell::CellWorld;
 pub use cell::skills::DISAGREEMENT_NOTE;
+pub use description::{Perturbations, SceneDescription};
 pub use observation::{Observation, ObservationError};
 pub use symbolic::SymbolicWorld;
 

@@ -422,6 +422,7 @@ fn a_process_that_misbehaves_is_reported_by_what_it_did() {
     let mut long = grasp.clone();
     long.path = Some(ArmPath {
         arm: "yumi_r".into(),
+        base: [0.0, 0.0],
         joints: vec![vec![0.123_456_789; 7]; 4000],
         acts_at: 2000,
     });

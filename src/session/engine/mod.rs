@@ -274,6 +274,13 @@ impl Engine {
     pub fn new(setup: Setup) -> Result<(Engine, UnboundedReceiver<Event>), SessionError> {
         let planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
         let execution = world::load_execution(&setup.scenario, setup.variant.as_deref())?;
+        let reality = match setup.executor {
+            Some(executor) => Some(crate::executor::Reality::start(
+                executor,
+                execution.world.as_ref(),
+            )?),
+            None => None,
+        };
         let (events, events_rx) = unbounded_channel();
         let (internal_tx, internal_rx) = unbounded_channel();
         let engine = Engine {
@@ -293,11 +300,7 @@ impl Engine {
             phase: Phase::Idle,
             told_phase: PhaseKind::Idle,
             task: Task::default(),
-            run: Run::new(
-                planning,
-                execution.world,
-                setup.executor.map(crate::executor::Reality::new),
-            ),
+            run: Run::new(planning, execution.world, reality),
             learning: learning::Learning::new(setup.knowledge),
             calls: Calls::default(),
             events,

@@ -14,6 +14,7 @@
 //! first tick, and teleport objects to consistent poses when they complete.
 
 pub mod arms;
+mod describe;
 pub mod geometry;
 mod motions;
 mod observe;
@@ -177,6 +178,11 @@ impl CellWorld {
     /// The real arms this world moves, if it moves them.
     pub fn arms(&self) -> Option<&Arc<arms::Arms>> {
         self.arms.as_ref()
+    }
+
+    /// Where the robot's root stands (x, y).
+    pub fn base(&self) -> [f32; 2] {
+        [self.state.base.x, self.state.base.y]
     }
 
     /// Each real arm's joint values now (empty without real arms).

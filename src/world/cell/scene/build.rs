@@ -120,6 +120,7 @@ pub(super) fn build(
         solids,
         robot,
         judges,
+        reality: Default::default(),
     })
 }
 

@@ -39,6 +39,13 @@
 //! max = 6.0
 //! above = "The egg broke: {value} {unit} is more force than it can bear ({max} {unit} at most)"
 //!
+//! [world.reality]                      # how the world an executor runs differs (seeded)
+//! seed = 1
+//! offset."red cube" = [0.015, 0.0, 0.0] # its true position, relative to the scene's
+//! jitter = 0.005                        # every movable object off by up to this in x, y
+//! friction = [0.5, 1.0]                 # drawn for each movable object
+//! mass_scale = [0.8, 1.2]               # times the scene's mass
+//!
 //! [world.variants.clear]                # the same cell without the obstacle (`--variant clear`)
 //! description = "nothing lies on the blue cube"
 //! solids."red cube" = { on = "table", xy = [0.3, -0.2] }
@@ -52,6 +59,7 @@ use super::geometry::{Body, Pose};
 use super::robot::{ArmsSpec, Gripper, Robot};
 use super::values::Judge;
 use crate::scenario::{Scenario, ScenarioError, SourceFile};
+use crate::world::Perturbations;
 
 mod build;
 mod finite;
@@ -98,7 +106,28 @@ struct RawWorld {
     values: Vec<RawJudge>,
     #[serde(default)]
     variants: IndexMap<String, RawVariant>,
+    reality: Option<RawReality>,
 }
+
+/// `[world.reality]`: see `Perturbations`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawReality {
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    offset: IndexMap<String, Spanned<Offset>>,
+    #[serde(default, deserialize_with = "modest")]
+    jitter: Option<f32>,
+    #[serde(default, deserialize_with = "modest")]
+    friction: Option<[f32; 2]>,
+    #[serde(default, deserialize_with = "modest")]
+    mass_scale: Option<[f32; 2]>,
+}
+
+#[derive(Deserialize)]
+#[serde(transparent)]
+struct Offset(#[serde(deserialize_with = "modest")] [f32; 3]);
 
 #[derive(Deserialize, Default, Clone)]
 #[serde(deny_unknown_fields)]
@@ -252,6 +281,8 @@ pub struct Scene {
     pub robot: Robot,
     pub judges: Vec<Judge>,
     pub initial: Initial,
+    /// How the world an executor simulates differs from this scene.
+    pub reality: Perturbations,
 }
 
 /// A solid's merged entry and the file (index) that last touched it, for errors.
@@ -299,12 +330,16 @@ pub fn read(scenario: &Scenario, variant: Option<&str>) -> Result<Scene, Scenari
         robot,
         unknown,
         judges,
+        reality,
         ..
     } = merged;
     let base = robot.base.unwrap_or([0.0, 0.0]);
     let robot = build_robot(&files[last], robot)?;
     let mut scene = build(scenario, entries, unknown, judges, robot)?;
     scene.initial.base = base;
+    if let Some((index, raw)) = reality {
+        scene.reality = perturbations(&files[index], &scene, raw)?;
+    }
     Ok(scene)
 }
 
@@ -336,6 +371,8 @@ struct Merged {
     judges: Vec<Judge>,
     chosen: Option<(usize, RawVariant)>,
     variant_names: Vec<String>,
+    /// The last file's `[world.reality]`.
+    reality: Option<(usize, RawReality)>,
 }
 
 impl Merged {
@@ -379,6 +416,9 @@ impl Merged {
         }
         for j in world.values {
             self.judges.push(judge(scenario, file, j)?);
+        }
+        if let Some(r) = world.reality {
+            self.reality = Some((index, r));
         }
         for (name, v) in world.variants {
             self.variant_names.push(name.clone());
@@ -424,6 +464,46 @@ impl Merged {
         }
         Ok(())
     }
+}
+
+/// The declared perturbations, each offset naming a solid that moves and each range
+/// written low to high.
+fn perturbations(
+    file: &SourceFile,
+    scene: &Scene,
+    raw: RawReality,
+) -> Result<Perturbations, ScenarioError> {
+    let mut offsets = IndexMap::new();
+    for (name, offset) in raw.offset {
+        let movable = scene.solids.iter().any(|s| s.name == name && !s.fixed);
+        if !movable {
+            return Err(file.error_at(
+                offset.span().start,
+                format!("[world.reality] offset: {name:?} is not a solid that moves"),
+            ));
+        }
+        offsets.insert(name, offset.into_inner().0);
+    }
+    for (what, range) in [("friction", raw.friction), ("mass_scale", raw.mass_scale)] {
+        if let Some([low, high]) = range
+            && !(0.0 < low && low <= high)
+        {
+            return Err(near(
+                file,
+                what,
+                format!(
+                    "[world.reality] {what} = [{low}, {high}]: a range from low to high, above 0"
+                ),
+            ));
+        }
+    }
+    Ok(Perturbations {
+        seed: raw.seed,
+        offsets,
+        jitter: raw.jitter.unwrap_or(0.0).abs(),
+        friction: raw.friction,
+        mass_scale: raw.mass_scale,
+    })
 }
 
 fn build_robot(file: &SourceFile, r: RawRobot) -> Result<Robot, ScenarioError> {
