@@ -374,8 +374,9 @@ fn ranged(min: u64, max: u64) -> clap::builder::RangedU64ValueParser<usize> {
     clap::builder::RangedU64ValueParser::<usize>::new().range(min..=max)
 }
 
-/// The executor `--executor COMMAND` names: the program started with its arguments (the
-/// command line split as a shell splits it), or none when the flag is not given.
+/// The executor `--executor COMMAND` names: `mujoco` (the MuJoCo cell, installed on first
+/// use), or the program started with its arguments (the command line split as a shell
+/// splits it); none when the flag is not given.
 fn executor_of(command: Option<&str>) -> Result<Option<Box<dyn betr::executor::Executor>>> {
     let Some(command) = command else {
         return Ok(None);
@@ -385,8 +386,12 @@ fn executor_of(command: Option<&str>) -> Result<Option<Box<dyn betr::executor::E
     let Some((program, args)) = words.split_first() else {
         bail!("--executor is empty: give the command that starts the executor");
     };
-    let executor = betr::executor::ProcessExecutor::spawn(program, args)
-        .with_context(|| format!("--executor {command:?}"))?;
+    let executor = if program == betr::executor::mujoco::NAME {
+        betr::executor::mujoco::spawn(args, &|line| eprintln!("{line}"))
+    } else {
+        betr::executor::ProcessExecutor::spawn(program, args)
+    }
+    .with_context(|| format!("--executor {command:?}"))?;
     Ok(Some(Box::new(executor)))
 }
 

@@ -52,6 +52,11 @@ pub struct ResolveFlags {
     /// kept in the knowledge file beside the policies.
     #[arg(long)]
     pub learn: bool,
+    /// Perform the actions in `mujoco` (the cell in MuJoCo physics, installed on first
+    /// use) or in this program (a simulator or a robot bridge speaking betr's executor
+    /// protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its twin.
+    #[arg(long, value_name = "COMMAND")]
+    pub executor: Option<String>,
     #[command(flatten)]
     pub knowledge: super::knowledge_cmd::KnowledgeFlags,
     #[command(flatten)]
@@ -131,6 +136,7 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
             learn: args.learn.then_some(&args.knowledge.dir),
             reading: args.reading,
             policies: &args.knowledge.dir,
+            executor: args.executor.as_deref(),
         },
         (&args.llm, &args.call),
         glyphs,
@@ -282,6 +288,8 @@ pub struct ResolveArgs<'a> {
     pub reading: Option<u16>,
     /// Where the tree that succeeds is kept as a policy unless `save` says otherwise.
     pub policies: &'a super::knowledge_cmd::PolicyDir,
+    /// What performs the actions (`--executor`), instead of betr's world.
+    pub executor: Option<&'a str>,
 }
 
 fn resolve(
@@ -340,7 +348,10 @@ fn resolve(
         args.instruction,
         llm.model.clone(),
         &llm.options,
-        args.viz.viewer.is_some() || args.viz.rrd.is_some(),
+        session::Execution {
+            scenes: args.viz.viewer.is_some() || args.viz.rrd.is_some(),
+            executor: super::executor_of(args.executor)?,
+        },
         (&mut approve, &mut choose),
         &mut emit,
     ));

@@ -44,9 +44,10 @@ pub struct RunArgs {
     /// while the tree goes on (exit status 3).
     #[arg(long)]
     pub break_on_failure: bool,
-    /// Perform the actions in this program (a simulator or a robot bridge speaking betr's
-    /// executor protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its
-    /// twin; split as a shell would: `--executor "python3 sim.py --seed 3"`.
+    /// Perform the actions in `mujoco` (the cell in MuJoCo physics, installed on first
+    /// use) or in this program (a simulator or a robot bridge speaking betr's executor
+    /// protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its twin; split
+    /// as a shell would: `--executor "python3 sim.py --seed 3"`.
     #[arg(long, value_name = "COMMAND")]
     pub executor: Option<String>,
     #[command(flatten)]

@@ -45,9 +45,10 @@ pub struct TuiArgs {
     /// Run in the scenario's `[world.variants.NAME]` world.
     #[arg(long)]
     pub variant: Option<String>,
-    /// Perform the actions in this program (a simulator or a robot bridge speaking betr's
-    /// executor protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its
-    /// twin; split as a shell would: `--executor "python3 sim.py --seed 3"`.
+    /// Perform the actions in `mujoco` (the cell in MuJoCo physics, installed on first
+    /// use) or in this program (a simulator or a robot bridge speaking betr's executor
+    /// protocol: docs/EXECUTORS.md) instead of betr's world, which becomes its twin; split
+    /// as a shell would: `--executor "python3 sim.py --seed 3"`.
     #[arg(long, value_name = "COMMAND")]
     pub executor: Option<String>,
     /// Key bindings to override (default: $XDG_CONFIG_HOME/betr/keys.toml).

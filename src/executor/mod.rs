@@ -33,6 +33,7 @@ use crate::planner::postcondition_failure;
 use crate::world::observation::ObservedObject;
 use crate::world::{CellWorld, Observation, ObservationError, SceneDescription, Step, World};
 
+pub mod mujoco;
 pub mod process;
 pub use process::ProcessExecutor;
 

@@ -36,6 +36,8 @@ TICK_SECONDS = 0.5
 JOINT_SPEED = 1.0  # rad/s along a path
 FINGER_SECONDS = 0.4
 SETTLE_SECONDS = 0.4
+CONVERGED = 0.002  # radians: every joint this close to its target
+CONVERGE_SECONDS = 1.0
 PUSH_LIMIT = 0.01  # metres an object the action is not about may be pushed
 GRIP_FORCE = 20.0  # newtons, when the action names no force
 ARM_KP = 4000.0
@@ -43,6 +45,10 @@ ARM_KV = 200.0
 FINGER_KP = 300.0
 FINGER_OPEN = 0.025
 ROBOT_GROUP = 2  # contype bit of the robot's geoms: they touch objects, not the table
+
+
+# The skills whose motion the twin plans: the arm follows the path it sends.
+ARM_SKILLS = ("grasp", "place", "put_in", "flip")
 
 
 class Refused(Exception):
@@ -144,8 +150,12 @@ class Cell:
         world = spec.worldbody
         self.arms = []
         robot = scene.get("robot")
-        if robot:
-            self.attach_robot(spec, robot)
+        if not robot:
+            raise Refused(
+                "the MuJoCo cell needs the robot's description (the scenario names none, or "
+                "betr could not read it), to move its arms along the twin's paths"
+            )
+        self.attach_robot(spec, robot)
         for obj in scene["objects"]:
             self.add_object(spec, world, obj)
         for obj in scene["objects"]:
@@ -305,6 +315,18 @@ class Cell:
         self.data.mocap_pos[mocap] = base_pos + pos
         self.data.mocap_quat[mocap] = q
 
+    def converge(self, arm, watch):
+        """Hold the arm's targets until it is within CONVERGED of them (at most
+        CONVERGE_SECONDS)."""
+        for _ in range(round(CONVERGE_SECONDS / TIMESTEP)):
+            error = max(abs(self.data.qpos[q] - self.data.ctrl[a]) for q, a in zip(arm["qadr"], arm["act"]))
+            if error < CONVERGED:
+                return None
+            why = self.step(TIMESTEP, watch)
+            if why:
+                return why
+        return None
+
     def step(self, seconds, watch=None):
         """Simulate; with `watch`, stop early with the reason an arm must stop."""
         for _ in range(max(1, round(seconds / TIMESTEP))):
@@ -441,6 +463,8 @@ class Action:
     def tick(self):
         """Advance one tick: None while running, else ("success"|"failure", error)."""
         cell = self.cell
+        if not self.waypoints and self.skill in ARM_SKILLS:
+            return ("failure", f"{self.skill} came without the arm's path to follow")
         if not self.waypoints:
             return self.finish_without_path()
         budget = TICK_SECONDS
@@ -478,15 +502,26 @@ class Action:
         cell = self.cell
         self.acted = True
         arm = cell.arms[self.arm]
+        # A controller reaches the pose before the fingers act (a fine point), not while
+        # the arm still lags behind its path.
+        cell.converge(arm, self.watch)
         closing = self.skill in ("grasp", "flip")
         for a in arm["finger_act"]:
             cell.data.ctrl[a] = 0.0 if closing else FINGER_OPEN
         if not closing:
             cell.release()
-        cell.step(FINGER_SECONDS)
-        if self.skill == "grasp":
-            if not cell.grip(self.arm, self.objects[0]):
-                return f"Grasp failed: the fingers closed without holding {self.objects[0]!r}"
+            cell.step(FINGER_SECONDS)
+            return None
+        # The grip is made the moment both fingers touch, and the fingers stop there.
+        target = self.objects[0]
+        for _ in range(round(FINGER_SECONDS / TIMESTEP)):
+            cell.step(TIMESTEP)
+            if self.skill == "grasp" and cell.grip(self.arm, target):
+                for a, q in zip(arm["finger_act"], arm["finger_qadr"]):
+                    cell.data.ctrl[a] = cell.data.qpos[q]
+                break
+        if self.skill == "grasp" and cell.held is None:
+            return f"Grasp failed: the fingers closed without holding {target!r}"
         if self.skill == "flip":
             expected = {o["name"]: o for o in (self.order.get("expected") or {}).get("objects", [])}
             turned = expected.get(self.objects[0])
@@ -526,6 +561,21 @@ def set_pose(self, name, seen):
 Cell.set_pose = set_pose
 
 
+def log(cell, action, result):
+    """One line on standard error (betr's log) per action ended: what, how, and where
+    every movable object is."""
+    where = ", ".join(
+        f"{n} ({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f})"
+        for n in cell.names
+        if cell.movable(n)
+        for p in [cell.pose(n)[0]]
+    )
+    held = cell.held[1] if cell.held else "nothing"
+    how = result[0] + (f": {result[1]}" if result[1] else "")
+    print(f"{action.order['action']}: {how} at {cell.data.time:.2f} s; holds {held}; {where}",
+          file=sys.stderr, flush=True)
+
+
 def serve(lines, out):
     cell = None
     action = None
@@ -544,11 +594,11 @@ def serve(lines, out):
                 result = action.tick()
                 if result is None:
                     reply = {"reply": "running"}
-                elif result[0] == "success":
-                    reply = {"reply": "success"}
-                    action = None
                 else:
-                    reply = {"reply": "failure", "error": result[1]}
+                    reply = {"reply": result[0]}
+                    if result[1]:
+                        reply["error"] = result[1]
+                    log(cell, action, result)
                     action = None
             elif kind == "halt":
                 if action is not None and action.arm is not None:

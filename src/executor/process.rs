@@ -106,16 +106,26 @@ impl ProcessExecutor {
     /// the first argument is not an option, that argument's (`python3 sim.py`: an
     /// interpreter's name alone says nothing).
     pub fn spawn(program: &str, args: &[String]) -> Result<ProcessExecutor, ExecutorError> {
+        ProcessExecutor::spawn_named(None, program, args)
+    }
+
+    /// [`ProcessExecutor::spawn`], known by `name` when one is given.
+    pub fn spawn_named(
+        name: Option<&str>,
+        program: &str,
+        args: &[String],
+    ) -> Result<ProcessExecutor, ExecutorError> {
         let file_name = |path: &str| {
             std::path::Path::new(path)
                 .file_name()
                 .map_or_else(|| path.to_string(), |n| n.to_string_lossy().into_owned())
         };
-        let name = match args.first() {
-            Some(first) if !first.starts_with('-') => {
+        let name = match (name, args.first()) {
+            (Some(name), _) => name.to_string(),
+            (None, Some(first)) if !first.starts_with('-') => {
                 format!("{} {}", file_name(program), file_name(first))
             }
-            _ => file_name(program),
+            (None, _) => file_name(program),
         };
         let stopped = |detail: String| ExecutorError::Stopped {
             executor: name.clone(),

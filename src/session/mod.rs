@@ -28,7 +28,7 @@ pub use planned::{PlanSummary, Prediction};
 pub use policy::{Policy, PolicyStore};
 pub use repair::ask::missing_value;
 pub use repair::edit::{Edit, EditError, parse_edit, vocabulary_words};
-pub use resolve::{resolve, resolve_with_scenes};
+pub use resolve::{Execution, resolve, resolve_with_scenes};
 pub use types::{
     BreakReason, Ending, Event, Evidence, FixCounts, NoModel, Options, PhaseKind, Proposal,
     Question, Reading, Resolved, SessionError, Shortlist, Steps,

@@ -35,7 +35,7 @@ pub async fn resolve(
         instruction,
         model,
         options,
-        false,
+        Execution::default(),
         (approve, &mut best),
         emit,
     )
@@ -49,7 +49,15 @@ pub type Approver<'a> = &'a mut dyn FnMut(&Proposal) -> bool;
 /// about a single one), or none to stop.
 pub type ReadingChooser<'a> = &'a mut dyn FnMut(&[Reading], Option<&str>) -> Option<usize>;
 
-/// [`resolve`], and with `scenes` the engine also emits the cell's scene after every tick
+/// Where a resolve loop's trees run: betr's own execution world, or an executor's with the
+/// execution world as its twin; and whether the cell's scene is emitted after every tick.
+#[derive(Default)]
+pub struct Execution {
+    pub scenes: bool,
+    pub executor: Option<Box<dyn crate::executor::Executor>>,
+}
+
+/// [`resolve`] in `execution`: with `scenes` the engine also emits the cell's scene after every tick
 /// (`Event::Scene`, for a 3D view). `choose` picks among the readings of the instruction
 /// (with `options.choose_reading`): the index of one, or none to stop.
 pub async fn resolve_with_scenes(
@@ -57,7 +65,7 @@ pub async fn resolve_with_scenes(
     instruction: Option<&str>,
     model: Arc<dyn LanguageModel>,
     options: &Options,
-    scenes: bool,
+    execution: Execution,
     (approve, choose): (Approver<'_>, ReadingChooser<'_>),
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
@@ -72,7 +80,8 @@ pub async fn resolve_with_scenes(
         .unwrap_or_default();
     let mut setup = Setup::new(Arc::new(scenario.clone()), path.clone(), Ok(model));
     setup.options = options.clone();
-    setup.scenes = scenes;
+    setup.scenes = execution.scenes;
+    setup.executor = execution.executor;
     let (engine, mut events) = Engine::spawn(setup)?;
     match (&scenario.goal, options.use_scenario_goal) {
         (Some(goal), true) => {
