@@ -16,6 +16,7 @@ pub mod cold;
 pub mod model;
 pub mod monitor;
 pub mod motion;
+pub mod mujoco;
 pub mod pybullet;
 pub mod replay;
 pub mod scale;
@@ -155,6 +156,8 @@ pub enum Target {
     RatioAtLeast(f64),
     /// betr's value, at most this (in the row's unit).
     AtMost(f64),
+    /// betr's value, at least this (in the row's unit).
+    AtLeast(f64),
 }
 
 /// One line of the table.
@@ -188,6 +191,7 @@ impl Row {
         Some(match self.target? {
             Target::RatioAtLeast(min) => self.ratio().is_some_and(|r| r >= min),
             Target::AtMost(max) => self.betr <= max,
+            Target::AtLeast(min) => self.betr >= min,
         })
     }
 }
@@ -293,6 +297,7 @@ impl Report {
             let target = match r.target {
                 Some(Target::RatioAtLeast(x)) => format!("≥ {}×", number(x)),
                 Some(Target::AtMost(x)) => format!("≤ {} {}", number(x), r.unit),
+                Some(Target::AtLeast(x)) => format!("≥ {} {}", number(x), r.unit),
                 None => "—".to_string(),
             };
             let met = match r.met() {

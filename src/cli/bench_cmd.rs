@@ -33,6 +33,9 @@ pub enum Part {
     /// `betr monitor` following a ~500-node BehaviorTree.CPP tree ticked at 100 Hz under
     /// Groot2's publisher (behaviortreepy); not part of the default set.
     Monitor,
+    /// The MuJoCo cell: its simulation speed against real time, and scenario 1 end to end
+    /// with every action performed in MuJoCo (no model time); not part of the default set.
+    Mujoco,
     /// Every call of the goal prompt in detail (cold, warm, with and without the grammar);
     /// not part of the default set.
     Llm,
@@ -119,6 +122,13 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 500,
                 if args.quick { 1.0 } else { 10.0 },
             )?),
+            Part::Mujoco => vec![
+                bench::mujoco::step_rate(
+                    &args.scenario,
+                    if args.quick { 1.0 } else { args.seconds },
+                )?,
+                bench::mujoco::scenario_one(&args.scenario, if args.quick { 1 } else { 3 })?,
+            ],
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {

@@ -387,7 +387,7 @@ fn executor_of(command: Option<&str>) -> Result<Option<Box<dyn betr::executor::E
         bail!("--executor is empty: give the command that starts the executor");
     };
     let executor = if program == betr::executor::mujoco::NAME {
-        betr::executor::mujoco::spawn(args, &|line| eprintln!("{line}"))
+        betr::executor::mujoco::spawn(args, offline(), &|line| eprintln!("{line}"))
     } else {
         betr::executor::ProcessExecutor::spawn(program, args)
     }

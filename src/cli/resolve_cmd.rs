@@ -510,6 +510,8 @@ fn print_event_line(event: &Event) {
             "  "
         }
         Event::Goal { .. }
+        | Event::Executor { .. }
+        | Event::Diverged { .. }
         | Event::Proposal { .. }
         | Event::Repaired { .. }
         | Event::DidNotHelp { .. }

@@ -37,24 +37,43 @@ fn failed(detail: String) -> ExecutorError {
     }
 }
 
-/// The MuJoCo executor, its environment made first when it is not there; `args` go to
-/// the script. `say` hears what is being done (pip's own progress goes to standard error).
-pub fn spawn(args: &[String], say: &dyn Fn(&str)) -> Result<ProcessExecutor, ExecutorError> {
-    let home = home();
-    let python = environment(&home, say)?;
-    let script = home.join("mujoco_executor.py");
-    write_if_changed(&script, SCRIPT)?;
+/// The MuJoCo executor, its environment made first when it is not there (unless
+/// `offline`); `args` go to the script. `say` hears what is being done (pip's own
+/// progress goes to standard error).
+pub fn spawn(
+    args: &[String],
+    offline: bool,
+    say: &dyn Fn(&str),
+) -> Result<ProcessExecutor, ExecutorError> {
+    let (python, script) = installed(offline, say)?;
     let mut argv = vec![script.display().to_string()];
     argv.extend(args.iter().cloned());
     ProcessExecutor::spawn_named(Some(NAME), &python.display().to_string(), &argv)
 }
 
+/// The environment's Python and the executor's script, both in place (the environment
+/// made first when it is not there, unless `offline`).
+pub fn installed(offline: bool, say: &dyn Fn(&str)) -> Result<(PathBuf, PathBuf), ExecutorError> {
+    let home = home();
+    let python = environment(&home, offline, say)?;
+    let script = home.join("mujoco_executor.py");
+    write_if_changed(&script, SCRIPT)?;
+    Ok((python, script))
+}
+
 /// The environment's Python, after making the environment if it is not complete.
-fn environment(home: &Path, say: &dyn Fn(&str)) -> Result<PathBuf, ExecutorError> {
+fn environment(home: &Path, offline: bool, say: &dyn Fn(&str)) -> Result<PathBuf, ExecutorError> {
     let venv = home.join("venv");
     let python = venv.join("bin").join("python");
     if venv.join(COMPLETE).is_file() {
         return Ok(python);
+    }
+    if offline {
+        return Err(failed(format!(
+            "MuJoCo {MUJOCO_VERSION} is not installed in {} and this command fetches nothing \
+             (offline): run it once online to install it",
+            venv.display()
+        )));
     }
     std::fs::create_dir_all(home)
         .map_err(|e| failed(format!("cannot make {}: {e}", home.display())))?;

@@ -621,5 +621,27 @@ def serve(lines, out):
         out.flush()
 
 
+def step_rate(scene_file, seconds):
+    """How fast the cell simulates: the scene in `scene_file` (a load request's scene)
+    with every arm swinging 0.3 rad about its rest values, for `seconds` of wall time."""
+    import time
+
+    with open(scene_file, encoding="utf-8") as f:
+        cell = Cell(json.load(f))
+    steps, began = 0, time.perf_counter()
+    while time.perf_counter() - began < seconds:
+        for arm in cell.arms:
+            for k, (a, q) in enumerate(zip(arm["act"], arm["rest"])):
+                cell.data.ctrl[a] = q + 0.3 * math.sin(cell.data.time * (1 + 0.2 * k))
+        for _ in range(100):
+            mujoco.mj_step(cell.model, cell.data)
+        steps += 100
+    wall = time.perf_counter() - began
+    print(json.dumps({"steps": steps, "wall": wall, "simulated": steps * TIMESTEP}))
+
+
 if __name__ == "__main__":
-    serve(sys.stdin, sys.stdout)
+    if len(sys.argv) == 4 and sys.argv[1] == "--step-rate":
+        step_rate(sys.argv[2], float(sys.argv[3]))
+    else:
+        serve(sys.stdin, sys.stdout)

@@ -17,6 +17,7 @@ mod first_run;
 mod local_model;
 mod monitor_btcpp;
 mod motion_anchor;
+mod mujoco;
 mod policy_kill;
 mod recording;
 mod run_anywhere;

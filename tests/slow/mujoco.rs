@@ -1,0 +1,106 @@
+//! The MuJoCo cell as the executor, through the real binary: scenario 1's tree planned in
+//! the twin, its failure found there, the fix asked, approved and planned, and every
+//! action of the repaired tree performed in MuJoCo physics until the blue cube rests on
+//! the green cube; and a scene whose blue cube is 3 cm off where it really is, so the
+//! grasp the twin planned closes beside the cube in MuJoCo: the divergence is said, and
+//! the failure reaches the question, the proposal and the approval. MuJoCo is installed
+//! on first use into the shared cache (as a person's first `--executor mujoco` does).
+
+use crate::support;
+
+use support::cli::{betr_with, resolve_yes, text, tmp};
+use support::fake_openai::{Behavior, FakeServer};
+use support::fixtures::{self, FixtureReply};
+
+fn cache() -> String {
+    betr::model::cache_dir().display().to_string()
+}
+
+/// `betr resolve SCENARIO --yes --executor mujoco` against `server`, with the executor's
+/// log lines on standard error; its exit code and output.
+fn resolve_in_mujoco(name: &str, scenario: &str, server: &FakeServer) -> (Option<i32>, String) {
+    let dir = tmp(name);
+    let path = format!("{}/{scenario}", env!("CARGO_MANIFEST_DIR"));
+    let base = server.base_url();
+    let mut args = resolve_yes(&path, &base);
+    args.extend(["--executor", "mujoco", "--max-rounds", "3"]);
+    let cache = cache();
+    let out = betr_with(
+        &dir,
+        &args,
+        &[
+            ("BETR_MODEL_DIR", cache.as_str()),
+            ("BETR_OFFLINE", "0"),
+            ("BETR_LOG", "betr::executor=info"),
+        ],
+    );
+    (out.status.code(), text(&out))
+}
+
+#[test]
+fn scenario_1_is_repaired_and_its_actions_performed_in_mujoco() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let (code, log) = resolve_in_mujoco("mujoco-s1", "scenarios/cell/red_on_blue.toml", &server);
+    assert_eq!(code, Some(0), "{log}");
+    assert!(
+        log.contains("Proposal: insert ~\"any object\" on \"blue cube\""),
+        "{log}"
+    );
+    assert!(log.contains("SUCCESS"), "{log}");
+    // Every action of the repaired tree ended in MuJoCo, the last with the blue cube
+    // resting on the green cube (4 cm up, over it).
+    for action in [
+        "grasp \"red cube\": success",
+        "place \"red cube\" \"table\": success",
+        "grasp \"blue cube\": success",
+        "place \"blue cube\" \"green cube\": success",
+    ] {
+        assert!(
+            log.contains(action),
+            "{action} not performed in MuJoCo:\n{log}"
+        );
+    }
+    let last = log
+        .lines()
+        .filter(|l| l.contains("place \"blue cube\" \"green cube\": success"))
+        .next_back()
+        .unwrap_or_default();
+    let blue = last.split("blue cube (").nth(1).unwrap_or_default();
+    let z: f64 = blue
+        .split(", ")
+        .nth(2)
+        .and_then(|z| z.trim_end_matches(')').parse().ok())
+        .unwrap_or(f64::NAN);
+    assert!(
+        (z - 0.04).abs() < 0.005,
+        "the blue cube's height {z}: {last}"
+    );
+}
+
+#[test]
+fn a_cube_off_its_scene_pose_makes_the_twins_grasp_miss_in_mujoco_and_asks_for_a_fix() {
+    let miss = "Grasp failed: the fingers closed without holding";
+    let reply = FixtureReply {
+        when: vec!["# Task: failure resolution".into(), miss.into()],
+        seed: None,
+        text: "Reasoning: The gripper closed where the scene put the blue cube and held \
+               nothing: the cube is not where the camera saw it. Its location must be known \
+               first.\nConditions:\n\"blue cube\" location known\n"
+            .into(),
+        note: "hand-written: the camera-offset failure".into(),
+    };
+    let mut replies = vec![reply];
+    replies.extend(fixtures::every_reply());
+    let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
+    let (_, log) = resolve_in_mujoco(
+        "mujoco-offset",
+        "tests/fixtures/scenarios/camera_off.toml",
+        &server,
+    );
+    let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
+    said(&format!(
+        "the twin predicted grasp \"blue cube\"! would succeed; the mujoco executor reports: {miss}"
+    ));
+    said("→ asking the model for missing preconditions of grasp \"blue cube\"!");
+    said("hand-written: the camera-offset failure");
+}
