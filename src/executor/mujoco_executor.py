@@ -31,13 +31,14 @@ import sys
 import mujoco
 import numpy as np
 
-TIMESTEP = 0.002
+TIMESTEP = 0.001  # seconds: at 2 ms a tube dropped into the centrifuge passes through its floor
 TICK_SECONDS = 0.5
 JOINT_SPEED = 1.0  # rad/s along a path
 FINGER_SECONDS = 0.4
 SETTLE_SECONDS = 0.4
 CONVERGED = 0.002  # radians: every joint this close to its target
 CONVERGE_SECONDS = 1.0
+FLOOR_DEPTH = 0.03  # metres a fixture's floor on the table reaches into it
 PUSH_LIMIT = 0.01  # metres an object the action is not about may be pushed
 GRIP_FORCE = 20.0  # newtons, when the action names no force
 ARM_KP = 4000.0
@@ -89,6 +90,20 @@ def add_parts(body, parts, friction, rgba, contype, conaffinity, density_mass=No
         geom.rgba = rgba
         geom.contype = contype
         geom.conaffinity = conaffinity
+
+
+def thickened(part, base_z):
+    """A fixture's box part resting on the table, reaching FLOOR_DEPTH down into it: a
+    thin floor (a centrifuge's, 1 cm) is otherwise passed through by an object dropped
+    onto it, contact pushing it out on the far side. Fixtures do not move, and nothing
+    is below the table top, so the part is the same to everything else."""
+    if part["shape"] != "box" or abs(base_z) > 1e-6 or part["rotation"] != [0, 0, 0, 1]:
+        return part
+    hx, hy, hz = part["half"]
+    x, y, z = part["position"]
+    if abs(z - hz) > 1e-4:
+        return part
+    return dict(part, half=[hx, hy, hz + FLOOR_DEPTH / 2], position=[x, y, z - FLOOR_DEPTH / 2])
 
 
 def robot_spec(robot):
@@ -231,7 +246,8 @@ class Cell:
         body.pos = obj["position"]
         body.quat = quat_wxyz(obj["rotation"])
         if obj["fixed"]:
-            add_parts(body, obj["parts"], obj["friction"], [0.6, 0.5, 0.4, 1], 1, 1 | ROBOT_GROUP)
+            parts = [thickened(p, obj["position"][2]) for p in obj["parts"]]
+            add_parts(body, parts, obj["friction"], [0.6, 0.5, 0.4, 1], 1, 1 | ROBOT_GROUP)
             return
         body.add_freejoint().name = f"free:{name}"
         add_parts(body, obj["parts"], obj["friction"], [0.3, 0.4, 0.8, 1], 1, 1 | ROBOT_GROUP)
