@@ -15,6 +15,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use sha2::Digest as _;
+
 use super::{ExecutorError, ProcessExecutor};
 
 /// The MuJoCo release the requirements pin.
@@ -56,7 +58,10 @@ pub fn spawn(
 pub fn installed(offline: bool, say: &dyn Fn(&str)) -> Result<(PathBuf, PathBuf), ExecutorError> {
     let home = home();
     let python = environment(&home, offline, say)?;
-    let script = home.join("mujoco_executor.py");
+    // Named by its content: two betr builds sharing the cache each run their own.
+    let digest = sha2::Sha256::digest(SCRIPT.as_bytes());
+    let short: String = digest.iter().take(6).map(|b| format!("{b:02x}")).collect();
+    let script = home.join(format!("mujoco_executor-{short}.py"));
     write_if_changed(&script, SCRIPT)?;
     Ok((python, script))
 }

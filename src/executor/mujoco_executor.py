@@ -87,6 +87,11 @@ def add_parts(body, parts, friction, rgba, contype, conaffinity, density_mass=No
         else:
             raise Refused(f"a part of shape {shape!r} (box, cylinder, ball or capsule)")
         geom.friction = [friction, 0.005, 0.0001]
+        # Stiff contacts (the time constant at twice the step): a resting object sinks
+        # well under a millimetre into its support, as the twin's geometry expects of
+        # things at rest, instead of MuJoCo's default few millimetres for a heavy plate.
+        geom.solref = [2 * TIMESTEP, 1.0]
+        geom.solimp = [0.95, 0.99, 0.001, 0.5, 2.0]
         geom.rgba = rgba
         geom.contype = contype
         geom.conaffinity = conaffinity
