@@ -101,8 +101,10 @@ pub fn scenario_one(path: &Path, runs: u32) -> Result<Row, BenchError> {
         .enable_all()
         .build()
         .map_err(setup)?;
-    let mut options = Options::default();
-    options.use_scenario_goal = true;
+    let options = Options {
+        use_scenario_goal: true,
+        ..Options::default()
+    };
     let began = Instant::now();
     for _ in 0..runs.max(1) {
         let executor =

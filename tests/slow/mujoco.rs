@@ -62,8 +62,7 @@ fn scenario_1_is_repaired_and_its_actions_performed_in_mujoco() {
     }
     let last = log
         .lines()
-        .filter(|l| l.contains("place \"blue cube\" \"green cube\": success"))
-        .next_back()
+        .rfind(|l| l.contains("place \"blue cube\" \"green cube\": success"))
         .unwrap_or_default();
     let blue = last.split("blue cube (").nth(1).unwrap_or_default();
     let z: f64 = blue
