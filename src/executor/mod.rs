@@ -154,7 +154,7 @@ impl Reality {
                 .reality_description()
                 .map_err(|detail| ExecutorError::Load {
                     executor: executor.name().to_string(),
-                    detail,
+                    detail: detail.to_string(),
                 })?;
             executor.load(&scene)?;
         }

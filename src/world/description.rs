@@ -117,18 +117,28 @@ impl Perturbations {
     }
 }
 
+/// Why the scene cannot be described to an executor.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DescriptionError {
+    #[error("an offset for {0:?}, which is not an object of the scene")]
+    UnknownOffset(String),
+    #[error("{0:?} has a part that is not a box, cylinder, ball or capsule")]
+    NotPrimitive(String),
+}
+
 impl SceneDescription {
     /// The scene as the executor's world has it: `perturbations` applied, the same
     /// numbers for the same seed. An offset naming no object of the scene is refused.
-    pub fn perturbed(&self, perturbations: &Perturbations) -> Result<SceneDescription, String> {
+    pub fn perturbed(
+        &self,
+        perturbations: &Perturbations,
+    ) -> Result<SceneDescription, DescriptionError> {
         if let Some(name) = perturbations
             .offsets
             .keys()
             .find(|n| !self.objects.iter().any(|o| &o.name == *n))
         {
-            return Err(format!(
-                "an offset for {name:?}, which is not an object of the scene"
-            ));
+            return Err(DescriptionError::UnknownOffset(name.clone()));
         }
         let mut rng = SplitMix::new(perturbations.seed);
         let mut draw = |[low, high]: [f32; 2]| low + (high - low) * rng.unit() as f32;
@@ -211,7 +221,7 @@ mod tests {
         assert!((moved.objects[1].position[0] - 0.415).abs() < 1e-6);
         assert_eq!(moved.objects[0], scene().objects[0]);
         p.offsets.insert("banana".into(), [0.0; 3]);
-        let error = scene().perturbed(&p).unwrap_err();
+        let error = scene().perturbed(&p).unwrap_err().to_string();
         assert!(error.contains("\"banana\""), "{error}");
     }
 

@@ -10,8 +10,8 @@ use nalgebra::{UnitQuaternion, Vector3};
 use super::CellWorld;
 use super::geometry::{Part, Pose};
 use crate::world::description::{
-    ArmDescription, DEFAULT_FRICTION, LidDescription, ObjectDescription, PartDescription,
-    Placement, PrimitiveShape, RobotDescription, SceneDescription,
+    ArmDescription, DEFAULT_FRICTION, DescriptionError, LidDescription, ObjectDescription,
+    PartDescription, Placement, PrimitiveShape, RobotDescription, SceneDescription,
 };
 
 /// Why a part cannot be described as a primitive.
@@ -58,9 +58,9 @@ impl CellWorld {
     }
 
     /// The scene the executor's world is: this one as `[world.reality]` perturbs it.
-    pub fn reality_description(&self) -> Result<SceneDescription, String> {
+    pub fn reality_description(&self) -> Result<SceneDescription, DescriptionError> {
         self.describe()
-            .map_err(|e| e.to_string())?
+            .map_err(|e| DescriptionError::NotPrimitive(e.object))?
             .perturbed(&self.scene.reality)
     }
 
