@@ -277,6 +277,7 @@ fn goal_set(
         limit: flags.limit,
         prices: p.model_settings.prices.clone(),
         progress: &bar,
+        executor: None,
     };
     let results = super::runtime()?
         .block_on(goals_run::run_goals_in_scenes(
@@ -394,6 +395,7 @@ fn sequence_experiment(
         limit: flags.limit,
         prices: p.model_settings.prices.clone(),
         progress: &bar,
+        executor: None,
     };
     let results = super::runtime()?
         .block_on(eval::sequence::run_sequence(
@@ -484,12 +486,21 @@ pub fn session_experiment(
     p.llm.model.set_purpose(&format!("eval {name}"));
     let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let bar = Bar::new();
+    let executor = flags
+        .lab
+        .executor
+        .as_deref()
+        .map(super::executor_factory)
+        .transpose()?;
     let cfg = RunConfig {
         runs: runs.max(1),
         concurrency: p.concurrency,
         limit: flags.limit,
         prices: p.model_settings.prices.clone(),
         progress: &bar,
+        executor: executor
+            .as_ref()
+            .map(|f| f as &betr::eval::run::ExecutorFactory),
     };
     let rt = super::runtime()?;
     match which {

@@ -207,6 +207,12 @@ fn run_settings(
     ] {
         settings.insert(k.into(), v);
     }
+    if steps.planning_without_hidden_rules {
+        settings.insert("planning_without_hidden_rules".into(), "true".into());
+    }
+    if let Some(executor) = &lab.executor {
+        settings.insert("executor".into(), executor.clone());
+    }
     if !steps.without_misreadings.is_empty() {
         settings.insert(
             "without_misreadings".into(),

@@ -77,6 +77,16 @@ pub struct LabFlags {
     /// it in simulation first (with --no-shortlist: the model alone, as in the paper).
     #[arg(help_heading = LEVERS, long)]
     pub no_screening: bool,
+    /// Plan and try fixes in the scenario's model only: a symbolic world's hidden rules
+    /// (what its failures come from) are left out of the planning world, as a robot's
+    /// planner knows only its model (the cell's model is its geometry: unchanged).
+    #[arg(help_heading = LEVERS, long)]
+    pub twin_screening: bool,
+    /// Perform the actions of the cell scenarios in this executor (`mujoco`, or a program
+    /// speaking the executor protocol), betr's cell as its twin; other scenarios run in
+    /// betr's world.
+    #[arg(help_heading = LEVERS, long, value_name = "COMMAND")]
+    pub executor: Option<String>,
     /// Leave out a detector of plain misreadings when goals are judged, to measure what it
     /// earns (repeatable; the names are listed in docs/ARCHITECTURE.md and in the error
     /// for an unknown one).
@@ -120,6 +130,7 @@ impl LabFlags {
             value_as_number: self.value_as_number,
             no_shortlist: self.no_shortlist,
             no_screening: self.no_screening,
+            twin_screening: self.twin_screening,
             without_misreadings: self.without_misreading.clone(),
             templates: self
                 .prompts

@@ -386,13 +386,37 @@ fn executor_of(command: Option<&str>) -> Result<Option<Box<dyn betr::executor::E
     let Some((program, args)) = words.split_first() else {
         bail!("--executor is empty: give the command that starts the executor");
     };
-    let executor = if program == betr::executor::mujoco::NAME {
-        betr::executor::mujoco::spawn(args, offline(), &|line| eprintln!("{line}"))
+    let executor =
+        start_executor(program, args).with_context(|| format!("--executor {command:?}"))?;
+    Ok(Some(executor))
+}
+
+/// Start the executor `program` names (`mujoco`: the MuJoCo cell) with `args`.
+fn start_executor(
+    program: &str,
+    args: &[String],
+) -> Result<Box<dyn betr::executor::Executor>, betr::executor::ExecutorError> {
+    Ok(if program == betr::executor::mujoco::NAME {
+        Box::new(betr::executor::mujoco::spawn(args, offline(), &|line| {
+            eprintln!("{line}")
+        })?)
     } else {
-        betr::executor::ProcessExecutor::spawn(program, args)
+        Box::new(betr::executor::ProcessExecutor::spawn(program, args)?)
+    })
+}
+
+/// An executor for each session an evaluation runs, from `--executor COMMAND`.
+fn executor_factory(
+    command: &str,
+) -> Result<
+    impl Fn() -> Result<Box<dyn betr::executor::Executor>, betr::executor::ExecutorError> + Sync + use<>,
+> {
+    let words = shlex::split(command)
+        .with_context(|| format!("--executor {command:?}: an unclosed quote or escape"))?;
+    if words.is_empty() {
+        bail!("--executor is empty: give the command that starts the executor");
     }
-    .with_context(|| format!("--executor {command:?}"))?;
-    Ok(Some(Box::new(executor)))
+    Ok(move || start_executor(&words[0], &words[1..]))
 }
 
 /// The async runtime of a one-shot command, or of the workbench's screen: one thread (the

@@ -40,6 +40,8 @@ pub struct Levers {
     pub no_shortlist: bool,
     /// Propose the model's first usable answer for a failure without trying it first.
     pub no_screening: bool,
+    /// Plan and screen without the symbolic worlds' hidden rules.
+    pub twin_screening: bool,
     /// Detectors of plain misreadings left out, by name.
     pub without_misreadings: Vec<String>,
     /// Prompt templates instead of the built-in ones.
@@ -67,6 +69,7 @@ impl Levers {
             value_levels: !self.value_as_number,
             shortlist: !self.no_shortlist,
             screen_proposals: !self.no_screening,
+            planning_without_hidden_rules: self.twin_screening,
             without_misreadings: self.without_misreadings.clone(),
         }
     }

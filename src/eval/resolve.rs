@@ -157,7 +157,16 @@ where
         |(run, (path, scenario))| async move {
             let tap = Arc::new(Tap::new(model.clone(), Some(run as u64), &cfg.prices));
             let start = Instant::now();
-            let trace = resolve_approving(scenario, tap.clone(), options)
+            let executor = match cfg.executor {
+                Some(start) if scenario.world_kind == "cell" => {
+                    Some(start().map_err(|e| EvalError::Session {
+                        case: format!("{path}, run {run}"),
+                        source: e.into(),
+                    })?)
+                }
+                _ => None,
+            };
+            let trace = resolve_approving(scenario, tap.clone(), options, executor)
                 .await
                 .map_err(|source| EvalError::Session {
                     case: format!("{path}, run {run}"),

@@ -44,7 +44,14 @@ pub struct RunConfig<'a> {
     pub limit: Option<usize>,
     pub prices: PriceTable,
     pub progress: &'a dyn Progress,
+    /// Starts the executor each cell scenario's session performs its actions in (none:
+    /// betr's world performs them).
+    pub executor: Option<&'a ExecutorFactory>,
 }
+
+/// Starts an executor for one session.
+pub type ExecutorFactory =
+    dyn Fn() -> Result<Box<dyn crate::executor::Executor>, crate::executor::ExecutorError> + Sync;
 
 /// One call a case made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

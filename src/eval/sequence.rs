@@ -132,7 +132,7 @@ async fn run_step(
     };
     let tap = Arc::new(Tap::new(model.clone(), Some(1), &cfg.prices));
     let start = Instant::now();
-    let trace = resolve_approving(&planned, tap.clone(), options)
+    let trace = resolve_approving(&planned, tap.clone(), options, None)
         .await
         .map_err(|source| EvalError::Session {
             case: format!("{path} ({})", mode(with_knowledge)),

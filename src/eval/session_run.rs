@@ -38,11 +38,26 @@ pub async fn resolve_approving(
     scenario: &Scenario,
     model: Arc<dyn LanguageModel>,
     options: &Options,
+    executor: Option<Box<dyn crate::executor::Executor>>,
 ) -> Result<Trace, SessionError> {
     let mut events = Vec::new();
     let mut approve = |_: &session::Proposal| true;
+    let mut best = |_: &[session::Reading], _: Option<&str>| Some(0);
     let mut emit = |e: &Event| events.push(e.clone());
-    let result = session::resolve(scenario, None, model, options, &mut approve, &mut emit).await;
+    let execution = session::Execution {
+        scenes: false,
+        executor,
+    };
+    let result = session::resolve_with_scenes(
+        scenario,
+        None,
+        model,
+        options,
+        execution,
+        (&mut approve, &mut best),
+        &mut emit,
+    )
+    .await;
     let (ending, rounds, kept) = match result {
         Ok(r) => (
             match r.ending {

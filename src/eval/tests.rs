@@ -114,6 +114,7 @@ fn requests_run_concurrently_up_to_the_limit_and_each_run_sends_its_seed() {
         limit: None,
         prices: Default::default(),
         progress: &Silent,
+        executor: None,
     };
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
@@ -253,6 +254,7 @@ fn a_case_past_the_context_window_fails_alone() {
         limit: None,
         prices: Default::default(),
         progress: &Silent,
+        executor: None,
     };
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()

@@ -213,6 +213,11 @@ pub struct Steps {
     /// first that fixes it; off: the model's first usable answer is proposed as it is (the
     /// paper's single call), and only the change's own check shows whether it helps.
     pub screen_proposals: bool,
+    /// Plan and screen in the scenario's model only: a symbolic world's hidden rules (the
+    /// requirements its failures come from) are left out of the planning world, as a
+    /// robot's planner has only its model of the world; off: the planning world is the
+    /// world as the scenario writes it.
+    pub planning_without_hidden_rules: bool,
     /// Detectors of plain misreadings left out, by name (`reading::MISREADINGS`): empty
     /// but in the lab, which measures what each earns.
     pub without_misreadings: Vec<String>,
@@ -227,6 +232,7 @@ impl Default for Steps {
             value_levels: true,
             shortlist: true,
             screen_proposals: true,
+            planning_without_hidden_rules: false,
             without_misreadings: Vec::new(),
         }
     }

@@ -213,6 +213,12 @@ impl Rule {
 }
 
 impl SymbolicWorld {
+    /// This world without its hidden rules: the scenario's model of it.
+    pub fn without_rules(mut self) -> Self {
+        self.rules = Arc::new(Vec::new());
+        self
+    }
+
     pub fn new(
         domain: Arc<Domain>,
         initial: impl IntoIterator<Item = Atom>,
@@ -281,6 +287,10 @@ impl SymbolicWorld {
 }
 
 impl World for SymbolicWorld {
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     fn kind(&self) -> &'static str {
         "symbolic"
     }

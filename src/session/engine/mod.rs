@@ -272,7 +272,14 @@ impl EngineHandle {
 impl Engine {
     /// An engine for `setup`, and the receiver of its events.
     pub fn new(setup: Setup) -> Result<(Engine, UnboundedReceiver<Event>), SessionError> {
-        let planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
+        let mut planning = world::load_variant(&setup.scenario, setup.variant.as_deref())?;
+        if setup.options.steps.planning_without_hidden_rules
+            && let Some(symbolic) = planning
+                .as_any()
+                .and_then(|a| a.downcast_ref::<crate::world::SymbolicWorld>())
+        {
+            planning = Box::new(symbolic.clone().without_rules());
+        }
         let execution = world::load_execution(&setup.scenario, setup.variant.as_deref())?;
         let reality = match setup.executor {
             Some(executor) => Some(crate::executor::Reality::start(

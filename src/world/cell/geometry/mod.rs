@@ -243,9 +243,16 @@ impl Body {
         }
     }
 
-    /// The box around the body at `pose`.
+    /// The box around the body at `pose`: its own box moved when the pose turns it by
+    /// quarter turns (exact then), else the box around its parts (the box around a turned
+    /// box is larger than the body: a banana rolled a little about its length would seem
+    /// to sink into what it lies on).
     pub fn aabb(&self, pose: &Pose) -> Aabb {
-        self.local_aabb.transform_by(pose)
+        if quarter_turns(&pose.rotation) {
+            self.local_aabb.transform_by(pose)
+        } else {
+            aabb_of(&self.parts, pose)
+        }
     }
 
     /// The pose that rests the body, turned by `rotation`, on a face at height `top`
@@ -296,6 +303,15 @@ impl Body {
             shape: SharedShape::cuboid(half.x - shrink, half.y - shrink, half.z - shrink),
         })
     }
+}
+
+/// Whether `rotation` maps each axis onto an axis (every matrix entry 0 or ±1).
+fn quarter_turns(rotation: &UnitQuaternion<f32>) -> bool {
+    rotation
+        .to_rotation_matrix()
+        .matrix()
+        .iter()
+        .all(|v| v.abs() < 1e-4 || (v.abs() - 1.0).abs() < 1e-4)
 }
 
 /// The box around some parts placed at `pose`.

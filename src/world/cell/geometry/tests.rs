@@ -72,3 +72,25 @@ fn cavity_and_opening_follow_the_pose() {
     let region = cup.opening_region(&down).unwrap();
     assert!(region.local.translation.vector.z < 0.0);
 }
+
+#[test]
+fn a_capsule_rolled_about_its_length_keeps_its_bottom_where_it_lies() {
+    // A banana lying along x, rolled 20° about its length (as it settles after a place):
+    // its lowest point stays at the height it rests on, not the turned box's corner.
+    let banana = Body::new(&ShapeSpec::Capsule {
+        radius: 0.018,
+        length: 0.18,
+    });
+    let roll = UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), 20f32.to_radians());
+    let resting = banana.resting(roll, 0.3, -0.25, 0.01);
+    let b = banana.aabb(&resting);
+    assert!((b.mins.z - 0.01).abs() < 1e-5, "{}", b.mins.z);
+    // Quarter turns keep the fast way, and the same box.
+    let turned = Pose::from_parts(
+        Translation3::new(0.1, 0.2, 0.0),
+        UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), std::f32::consts::FRAC_PI_2),
+    );
+    let fast = banana.aabb(&turned);
+    let exact = aabb_of(&banana.parts, &turned);
+    assert!((fast.mins - exact.mins).norm() < 1e-5 && (fast.maxs - exact.maxs).norm() < 1e-5);
+}
