@@ -127,10 +127,11 @@ pub struct Findings {
 pub struct Reality {
     executor: Box<dyn Executor>,
     pending: HashMap<NodeId, Pending>,
-    /// The objects actions were sent for since the first state: only these can have been
-    /// moved by the robot.
+    /// The objects the robot may have moved since the first state: those it has held and
+    /// those of the actions that succeeded. A grasp that closed on nothing moved nothing
+    /// (where reality shows that object is where it was from the start).
     touched: BTreeSet<String>,
-    /// Poses reality showed of objects no action had touched: where they were in the first
+    /// Poses reality showed of objects the robot had not moved: where they were in the first
     /// state, unlike what the scenario's scene says. The twin starts from these after a
     /// reset, and the planning world takes them in, so repairs are screened in them.
     learned: Observation,
@@ -179,6 +180,8 @@ impl Reality {
     /// Keep the poses of `observation`'s untouched objects that differ from `before`'s
     /// (the twin's before it took the observation in); their names.
     fn learn(&mut self, observation: &Observation, before: &Observation) -> Vec<String> {
+        // What the gripper holds may have been moved by it from now on.
+        self.touched.extend(observation.held.iter().cloned());
         let mut names = Vec::new();
         for seen in &observation.objects {
             if self.touched.contains(&seen.name) {
@@ -274,6 +277,8 @@ impl RealityLeaves<'_> {
                     Ok(observation) => observation,
                     Err(e) => return self.broke(e),
                 };
+                // An action that did what it should may have moved its objects.
+                self.reality.touched.extend(action.args.iter().cloned());
                 self.learn(&observation, before);
                 *self.twin = prediction;
                 match postcondition_failure(self.domain, self.twin.as_ref(), action) {
@@ -320,7 +325,6 @@ impl Leaves for RealityLeaves<'_> {
                     self.reality
                         .pending
                         .insert(node, Pending { order, prediction });
-                    self.reality.touched.extend(action.args.iter().cloned());
                 }
                 Prediction::Refused(refusal) => {
                     self.reality.pending.remove(&node);

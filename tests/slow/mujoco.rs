@@ -1,16 +1,18 @@
 //! The MuJoCo cell as the executor, through the real binary: scenario 1's tree planned in
 //! the twin, its failure found there, the fix asked, approved and planned, and every
 //! action of the repaired tree performed in MuJoCo physics until the blue cube rests on
-//! the green cube; and a scene whose blue cube is 3 cm off where it really is, so the
-//! grasp the twin planned closes beside the cube in MuJoCo: the divergence is said, and
-//! the failure reaches the question, the proposal and the approval. MuJoCo is installed
-//! on first use into the shared cache (as a person's first `--executor mujoco` does).
+//! the green cube. Two scenes that differ from reality: the blue cube 3 cm off where it
+//! is, so the grasp the twin planned closes beside it (reality shows where it is, and the
+//! tree runs again without a question), and a red cube the camera missed on the blue
+//! cube, onto which the arm comes down (the failure goes to the question, the proposal and
+//! the approval, and the repaired tree succeeds in MuJoCo). MuJoCo is installed on first
+//! use into the shared cache (as a person's first `--executor mujoco` does).
 
 use crate::support;
 
 use support::cli::{betr_with, resolve_yes, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
-use support::fixtures::{self, FixtureReply};
+use support::fixtures;
 
 fn cache() -> String {
     betr::model::cache_dir().display().to_string()
@@ -77,29 +79,43 @@ fn scenario_1_is_repaired_and_its_actions_performed_in_mujoco() {
 }
 
 #[test]
-fn a_cube_off_its_scene_pose_makes_the_twins_grasp_miss_in_mujoco_and_asks_for_a_fix() {
-    let miss = "Grasp failed: the fingers closed without holding";
-    let reply = FixtureReply {
-        when: vec!["# Task: failure resolution".into(), miss.into()],
-        seed: None,
-        text: "Reasoning: The gripper closed where the scene put the blue cube and held \
-               nothing: the cube is not where the camera saw it. Its location must be known \
-               first.\nConditions:\n\"blue cube\" location known\n"
-            .into(),
-        note: "hand-written: the camera-offset failure".into(),
-    };
-    let mut replies = vec![reply];
-    replies.extend(fixtures::every_reply());
-    let server = FakeServer::start(vec![], Behavior::Fixtures(replies));
-    let (_, log) = resolve_in_mujoco(
+fn a_cube_off_its_scene_pose_is_found_by_the_missed_grasp_and_the_tree_runs_again() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let (code, log) = resolve_in_mujoco(
         "mujoco-offset",
         "tests/fixtures/scenarios/camera_off.toml",
         &server,
     );
     let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
-    said(&format!(
-        "the twin predicted grasp \"blue cube\"! would succeed; the mujoco executor reports: {miss}"
-    ));
+    said(
+        "the twin predicted grasp \"blue cube\"! would succeed; the mujoco executor reports: \
+         Grasp failed: the fingers closed without holding",
+    );
+    // Nothing was missing from the tree: the scene was wrong. No question; the tree ran
+    // again with the blue cube where the missed grasp showed it, and the grasp held.
+    said("0 question(s) about failures");
+    said("grasp \"blue cube\": success");
+    assert_eq!(code, Some(0), "{log}");
+}
+
+#[test]
+fn a_cube_the_camera_missed_blocks_the_grasp_in_mujoco_and_the_loop_clears_it() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let (code, log) = resolve_in_mujoco(
+        "mujoco-unseen",
+        "tests/fixtures/scenarios/red_unseen.toml",
+        &server,
+    );
+    let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
+    // The twin saw the way clear; MuJoCo's arm came down onto the red cube.
+    said(
+        "the twin predicted grasp \"blue cube\"! would succeed; the mujoco executor reports: \
+         No collision free path found",
+    );
     said("→ asking the model for missing preconditions of grasp \"blue cube\"!");
-    said("hand-written: the camera-offset failure");
+    said("Proposal: insert ~\"any object\" on \"blue cube\"");
+    said("Approve? yes (--yes)");
+    said("place \"red cube\" \"table\": success");
+    said("place \"blue cube\" \"green cube\": success");
+    assert_eq!(code, Some(0), "{log}");
 }

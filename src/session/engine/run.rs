@@ -108,6 +108,9 @@ impl Engine {
                 error: error.clone(),
             })
         });
+        let scene_was_wrong = failed
+            .as_ref()
+            .is_some_and(|f| scene_was_wrong_about(&found, &f.action));
         self.run.last = Some(record.clone());
         self.emit(Event::Ticked {
             record: record.clone(),
@@ -116,6 +119,9 @@ impl Engine {
         self.tell_world_change();
         if let Some(broken) = self.take_findings(found) {
             return self.executor_broke(&broken);
+        }
+        if scene_was_wrong && record.root == TickOutcome::Failure {
+            return self.run_again_as_reality_showed(failed);
         }
         self.end_of_tick(&record, failed);
         if self.is_running() && self.run.ticks >= self.settings.max_ticks {
@@ -219,6 +225,33 @@ impl Engine {
         }
     }
 
+    /// The failed action's object was not where the scene said, and reality showed where
+    /// it is: nothing is missing from the tree, the scene was wrong. The failure is told,
+    /// and the tree runs again from the first state as reality has it, without asking.
+    fn run_again_as_reality_showed(&mut self, failed: Option<Failure>) {
+        self.stop_running();
+        if let Some(failure) = failed {
+            let node_path = self
+                .task
+                .tree
+                .as_ref()
+                .and_then(|t| t.path(failure.node).ok())
+                .unwrap_or_default();
+            self.emit(Event::ActionFailed {
+                action: failure.action,
+                node: failure.node,
+                node_path,
+                error: failure.error,
+            });
+        }
+        self.notice(
+            "the action failed on an object the scene had elsewhere: nothing is asked; the tree \
+             runs again from the first state as reality showed it",
+        );
+        self.reset_world(false);
+        self.start_running();
+    }
+
     fn on_failure(&mut self, failure: Failure) {
         let node_path = self
             .task
@@ -287,4 +320,12 @@ impl Engine {
             );
         }
     }
+}
+
+/// Whether a tick's failure of `action` is reality disagreeing with the twin about where
+/// one of the action's objects lay from the start (a grasp planned at the scene's pose
+/// that closed on nothing), not something the tree lacks.
+fn scene_was_wrong_about(found: &Findings, action: &crate::domain::ActionCall) -> bool {
+    found.diverged.iter().any(|d| d.action == *action)
+        && action.args.iter().any(|a| found.learned.contains(a))
 }
