@@ -24,12 +24,14 @@
 //! stops the run instead of being repaired.
 
 use std::collections::{BTreeSet, HashMap};
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
 use crate::bt::{ActionStep, Leaves, NodeId};
 use crate::domain::{ActionCall, Condition, Domain};
 use crate::planner::postcondition_failure;
+use crate::world::cell::snapshot::SceneSnapshot;
 use crate::world::observation::ObservedObject;
 use crate::world::{CellWorld, Observation, ObservationError, SceneDescription, Step, World};
 
@@ -102,6 +104,8 @@ pub struct Divergence {
     pub action: ActionCall,
     /// What reality reported instead of the predicted success.
     pub reality: String,
+    /// The twin's scene as it predicted the action would leave it (a cell twin).
+    pub predicted: Option<Arc<SceneSnapshot>>,
 }
 
 /// A divergence in words, naming the executor that reported it (as an event carries it).
@@ -269,6 +273,8 @@ impl RealityLeaves<'_> {
             return ActionStep::Failure(format!("{action}! ended without being started"));
         };
         let executor = self.reality.executor.as_mut();
+        // The scene the twin predicted, drawn beside reality's when they differ.
+        let predicted = CellWorld::scene_of(pending.prediction.as_ref()).map(Arc::new);
         let reality = match failed {
             None => {
                 // What the twin expected afterwards is what it sent with the order.
@@ -299,6 +305,7 @@ impl RealityLeaves<'_> {
         self.found.diverged.push(Divergence {
             action: action.clone(),
             reality: reality.clone(),
+            predicted,
         });
         ActionStep::Failure(reality)
     }

@@ -191,6 +191,7 @@ fn about_the_tree(event: &Event) -> Option<String> {
             executor,
             action,
             reality,
+            ..
         } => crate::executor::describe_divergence(action, executor, reality),
         Event::Screened { action, shortlist } => format!("for {action}!: {shortlist}"),
         _ => return None,

@@ -632,6 +632,10 @@ pub enum Event {
         executor: String,
         action: ActionCall,
         reality: String,
+        /// The twin's scene as it predicted the action would leave it (a cell twin, when
+        /// the engine emits scenes); not written to recordings, like `Scene`.
+        #[serde(skip)]
+        predicted: Option<Arc<SceneSnapshot>>,
     },
 }
 

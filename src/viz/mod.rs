@@ -483,6 +483,15 @@ impl Viz {
             } => self.set_tree(tree.clone(), new_nodes.clone()),
             Event::Ticked { record } => self.tick(record, None),
             Event::Scene { scene } => self.scene(scene),
+            Event::Diverged {
+                predicted: Some(predicted),
+                ..
+            } if self.rec.is_enabled() => {
+                Self::warn(scene::log_prediction(&self.rec, predicted));
+            }
+            Event::WorldChanged { reset: true, .. } if self.rec.is_enabled() => {
+                Self::warn(self.rec.log(scene::TWIN, &rerun::Clear::recursive()));
+            }
             _ => {}
         }
         let level = log_level(event);

@@ -12,6 +12,8 @@ use crate::world::cell::snapshot::{
 
 /// Entity paths of the scene (also used by the tests).
 pub const SOLIDS: &str = "world/solids";
+/// Where the twin's prediction of an action reality did otherwise is drawn, faint.
+pub const TWIN: &str = "world/twin";
 pub const ROBOT_TORSO: &str = "world/robot/torso";
 pub const ROBOT_ARMS: &str = "world/robot/arms";
 pub const ROBOT_JOINTS: &str = "world/robot/joints";
@@ -122,8 +124,18 @@ fn log_parts(
     rgb: [u8; 3],
     label: Option<&str>,
 ) -> RecordingStreamResult<()> {
+    log_parts_drawn(rec, path, parts, (colour(rgb, 255), FillMode::Solid), label)
+}
+
+/// [`log_parts`] in a colour and fill of its own (the twin's prediction: faint wires).
+fn log_parts_drawn(
+    rec: &RecordingStream,
+    path: &str,
+    parts: &[PartView],
+    (c, fill): (Color, FillMode),
+    label: Option<&str>,
+) -> RecordingStreamResult<()> {
     let k = ByKind::of(parts);
-    let c = colour(rgb, 255);
     let labels = |n: usize| {
         label
             .map(|l| {
@@ -144,7 +156,7 @@ fn log_parts(
             &Boxes3D::from_centers_and_half_sizes(k.box_centres, k.box_halves)
                 .with_quaternions(k.box_turns)
                 .with_colors([c])
-                .with_fill_mode(FillMode::Solid)
+                .with_fill_mode(fill)
                 .with_labels(labels(n)),
         )?;
     }
@@ -158,7 +170,7 @@ fn log_parts(
                 .with_centers(k.cylinder_centres)
                 .with_quaternions(k.cylinder_turns)
                 .with_colors([c])
-                .with_fill_mode(FillMode::Solid)
+                .with_fill_mode(fill)
                 .with_labels(labels(n)),
         )?;
     }
@@ -167,7 +179,7 @@ fn log_parts(
             sub("balls"),
             &Ellipsoids3D::from_centers_and_radii(k.ball_centres, k.ball_radii)
                 .with_colors([c])
-                .with_fill_mode(FillMode::Solid),
+                .with_fill_mode(fill),
         )?;
     }
     if !k.capsule_starts.is_empty() {
@@ -178,6 +190,21 @@ fn log_parts(
                 .with_quaternions(k.capsule_turns)
                 .with_colors([c]),
         )?;
+    }
+    Ok(())
+}
+
+/// The twin's prediction of the action reality did otherwise: every solid that moves, as
+/// faint wires where the twin expected it, beside reality's solids.
+pub fn log_prediction(
+    rec: &RecordingStream,
+    predicted: &SceneSnapshot,
+) -> RecordingStreamResult<()> {
+    for s in predicted.solids.iter().filter(|s| !s.fixed) {
+        let path = format!("{TWIN}/{}", slug(&s.name));
+        let label = format!("{} (the twin's prediction)", s.name);
+        let faint = (colour(s.colour, 90), FillMode::MajorWireframe);
+        log_parts_drawn(rec, &path, &s.parts, faint, Some(&label))?;
     }
     Ok(())
 }

@@ -546,3 +546,40 @@ fn a_large_tree_graph_shows_the_way_to_the_tick_and_folds_the_rest() {
         .unwrap();
     assert!(graph.labels[at].starts_with("+ "), "{}", graph.labels[at]);
 }
+
+#[test]
+fn a_divergence_draws_the_twins_prediction_beside_reality_until_the_world_resets() {
+    let scenario = scenario1();
+    let world = crate::world::load(&scenario).unwrap();
+    let scene = Arc::new(CellWorld::scene_of(world.as_ref()).unwrap());
+    let (rec, storage) = RecordingStreamBuilder::new("betr-test").memory().unwrap();
+    let mut viz = Viz::with_stream(rec);
+    viz.on_event(&Event::Scene {
+        scene: scene.clone(),
+    });
+    viz.on_event(&Event::Diverged {
+        executor: "mujoco".into(),
+        action: crate::domain::ActionCall::new("grasp", ["blue cube"]),
+        reality: "Grasp failed".into(),
+        predicted: Some(scene),
+    });
+    viz.on_event(&Event::WorldChanged {
+        facts: Vec::new(),
+        reset: true,
+    });
+    viz.stream().flush_blocking().unwrap();
+    let logged = decode(storage.take());
+    // Every solid that moves, faint where the twin expected it; the table is not drawn.
+    assert!(logged.components.contains_key("world/twin/blue_cube"));
+    assert!(!logged.components.contains_key("world/twin/table"));
+    assert!(logged.components[EVENTS].contains("TextLog:text"));
+    // The reset cleared it (a recursive clear at the twin's root).
+    assert!(
+        logged
+            .components
+            .get(scene::TWIN)
+            .is_some_and(|c| c.iter().any(|k| k.starts_with("Clear"))),
+        "{:?}",
+        logged.components.get(scene::TWIN)
+    );
+}

@@ -253,6 +253,7 @@ fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
             executor: (0..rng.small(12)).map(|_| random_char(rng)).collect(),
             action: action.clone(),
             reality: (0..rng.small(40)).map(|_| random_char(rng)).collect(),
+            predicted: None,
         },
         _ => Event::Success { ticks: 4 },
     }

@@ -172,12 +172,14 @@ impl Engine {
         for Divergence {
             action,
             reality: what,
+            predicted,
         } in found.diverged
         {
             self.emit(Event::Diverged {
                 executor: reality.name().to_string(),
                 action,
                 reality: what,
+                predicted: predicted.filter(|_| self.settings.scenes),
             });
         }
         found.broken
