@@ -8,7 +8,10 @@
 #                        description cached: the robot's meshes, the red cube that blocks
 #                        the arm drawn red)
 #   viewer-repaired.png  the same tree repaired with the fix, run to success
-# Usage: bash scripts/viewer-screenshots.sh   (installs chromium with apt when missing;
+#   viewer-mujoco.png    scenario 1 with the red cube the camera missed, run in MuJoCo
+#                        (--executor mujoco): the arm comes down onto the red cube, and
+#                        the twin's prediction is drawn faint beside reality's cubes
+# Usage: bash scripts/viewer-screenshots.sh [NAME.png...]   (only those; installs chromium with apt when missing;
 #        BETR=path/to/betr uses that binary instead of building one; the viewer listens
 #        on VIEWER_GRPC_PORT and VIEWER_PAGE_PORT, 9931 and 9932 unless set)
 set -euo pipefail
@@ -58,6 +61,9 @@ fix='~"any object" on "blue cube"'
 capture() {
   local png="$1"
   shift
+  if [ "${#wanted[@]}" -gt 0 ] && [[ ! " ${wanted[*]} " =~ " $png " ]]; then
+    return
+  fi
   local rrd="$work/${png%.png}.rrd"
   (cd "$work" && "$betr" "$@" --rrd "$rrd" >"$work/betr.out" 2>"$work/betr.err") || true
   if [ ! -s "$rrd" ]; then
@@ -78,5 +84,7 @@ capture() {
   echo "$out/$png" >&2
 }
 
+wanted=("$@")
 capture viewer-failure.png run "$scenario"
 capture viewer-repaired.png repair "$scenario" --add "$fix"
+capture viewer-mujoco.png run "$PWD/tests/fixtures/scenarios/red_unseen.toml" --executor mujoco
