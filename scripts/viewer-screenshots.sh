@@ -13,7 +13,8 @@
 #                        the twin's prediction is drawn faint beside reality's cubes
 # Usage: bash scripts/viewer-screenshots.sh [NAME.png...]   (only those; installs chromium with apt when missing;
 #        BETR=path/to/betr uses that binary instead of building one; the viewer listens
-#        on VIEWER_GRPC_PORT and VIEWER_PAGE_PORT, 9931 and 9932 unless set)
+#        on VIEWER_GRPC_PORT and VIEWER_PAGE_PORT, 9931 and 9932 unless set; VIEWER_WAIT:
+#        seconds the page is given to draw, 30 unless set)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -79,7 +80,7 @@ capture() {
     sleep 0.2
   done
   local url="http://127.0.0.1:$page_port/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A$grpc_port%2Fproxy"
-  "$venv/bin/python" scripts/viewer_screenshot.py "$url" "$out/$png" --wait 30 --size 1920x1080
+  "$venv/bin/python" scripts/viewer_screenshot.py "$url" "$out/$png" --wait "${VIEWER_WAIT:-30}" --size 1920x1080
   stop_viewer
   echo "$out/$png" >&2
 }
