@@ -36,6 +36,7 @@ TICK_SECONDS = 0.5
 JOINT_SPEED = 1.0  # rad/s along a path
 FINGER_SECONDS = 0.4
 SETTLE_SECONDS = 0.4
+CONTROL_STEPS = 10  # steps between two looks of the controller (new targets, contacts)
 CONVERGED = 0.002  # radians: every joint this close to its target
 CONVERGE_SECONDS = 1.0
 FLOOR_DEPTH = 0.03  # metres a fixture's floor on the table reaches into it
@@ -282,9 +283,6 @@ class Cell:
     def index(self):
         m = self.model
         self.bodies = {n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"object:{n}") for n in self.names}
-        self.owner = {}
-        for g in range(m.ngeom):
-            self.owner[g] = int(m.geom_bodyid[g])
         self.robot_bodies = {
             b for b in range(m.nbody) if (mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or "").startswith("robot:")
         }
@@ -349,9 +347,13 @@ class Cell:
         return None
 
     def step(self, seconds, watch=None):
-        """Simulate; with `watch`, stop early with the reason an arm must stop."""
-        for _ in range(max(1, round(seconds / TIMESTEP))):
-            mujoco.mj_step(self.model, self.data)
+        """Simulate, the grip and `watch` looked at every CONTROL_STEPS steps; with
+        `watch`, stop early with the reason an arm must stop."""
+        left = max(1, round(seconds / TIMESTEP))
+        while left > 0:
+            n = min(CONTROL_STEPS, left)
+            mujoco.mj_step(self.model, self.data, nstep=n)
+            left -= n
             self.check_grip()
             if watch is not None:
                 why = watch()
@@ -385,11 +387,13 @@ class Cell:
 
     def touching(self, body_a_set, body_b):
         d = self.data
-        for c in d.contact[: d.ncon]:
-            a, b = self.owner[c.geom1], self.owner[c.geom2]
-            if (a in body_a_set and b == body_b) or (b in body_a_set and a == body_b):
-                return True
-        return False
+        if d.ncon == 0:
+            return False
+        bodies = self.model.geom_bodyid
+        a = bodies[d.contact.geom1[: d.ncon]]
+        b = bodies[d.contact.geom2[: d.ncon]]
+        group = np.fromiter(body_a_set, dtype=a.dtype)
+        return bool(np.any((np.isin(a, group) & (b == body_b)) | (np.isin(b, group) & (a == body_b))))
 
     def grip(self, arm, name):
         """Weld `name` to the hand if both fingers touch it."""
@@ -496,11 +500,14 @@ class Action:
             span = float(np.max(np.abs(target - now))) / JOINT_SPEED
             dt = min(budget, max(span, TIMESTEP))
             steps = max(1, round(dt / TIMESTEP))
-            for k in range(1, steps + 1):
-                q = now + (target - now) * min(1.0, k * TIMESTEP / max(span, TIMESTEP))
-                for a, v in zip(arm["act"], q):
-                    cell.data.ctrl[a] = v
-                why = cell.step(TIMESTEP, self.watch)
+            # The target moves along the segment every CONTROL_STEPS steps (10 ms).
+            done = 0
+            while done < steps:
+                n = min(CONTROL_STEPS, steps - done)
+                done += n
+                q = now + (target - now) * min(1.0, done * TIMESTEP / max(span, TIMESTEP))
+                cell.data.ctrl[arm["act"]] = q
+                why = cell.step(n * TIMESTEP, self.watch)
                 if why:
                     self.hold_still()
                     return ("failure", why)
