@@ -430,17 +430,18 @@ class Cell:
 
 
 def parse_action(text):
-    """`place "blue cube" "green cube" force=20N` -> ("place", [...], {"force": 20.0})."""
-    parts = re.findall(r'"([^"]*)"|(\S+)', text)
+    """`grasp "hammer" {force = 40 N}` -> ("grasp", ["hammer"], {"force": 40.0}), as
+    betr writes actions: the skill, the quoted objects, the values in braces."""
+    head, _, tail = text.partition(" {")
+    parts = re.findall(r'"([^"]*)"|(\S+)', head)
     skill = parts[0][1]
-    objects, values = [], {}
-    for quoted, bare in parts[1:]:
-        if quoted:
-            objects.append(quoted)
-        elif "=" in bare:
-            key, value = bare.split("=", 1)
-            number = re.match(r"[-+0-9.eE]+", value)
-            values[key] = float(number.group()) if number else value
+    objects = [quoted for quoted, _ in parts[1:] if quoted]
+    values = {}
+    if tail:
+        for item in tail.rstrip("}").split(","):
+            key, _, value = item.partition("=")
+            number = re.match(r"\s*([-+0-9.eE]+)", value)
+            values[key.strip()] = float(number.group(1)) if number else value.strip().strip('"')
     return skill, objects, values
 
 
@@ -523,7 +524,16 @@ class Action:
             return None
         why = cell.step(SETTLE_SECONDS)
         if cell.slipped:
-            return ("failure", f"Object {cell.slipped!r} slipped from the grasp")
+            name = cell.slipped
+            force = cell.force.get(name, GRIP_FORCE)
+            mass = cell.model.body_subtreemass[cell.bodies[name]]
+            # What holds it: its weight borne by the friction of two fingers.
+            needed = mass * 9.81 / (2 * cell.friction(name))
+            return (
+                "failure",
+                f"Object {name!r} slipped from the grasp: {force:g} N is too little force to "
+                f"hold its {mass:.1f} kg ({math.ceil(needed)} N at least)",
+            )
         return ("success", None)
 
     def act(self):

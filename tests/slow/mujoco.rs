@@ -5,8 +5,11 @@
 //! is, so the grasp the twin planned closes beside it (reality shows where it is, and the
 //! tree runs again without a question), and a red cube the camera missed on the blue
 //! cube, onto which the arm comes down (the failure goes to the question, the proposal and
-//! the approval, and the repaired tree succeeds in MuJoCo). MuJoCo is installed on first
-//! use into the shared cache (as a person's first `--executor mujoco` does).
+//! the approval, and the repaired tree succeeds in MuJoCo). And a hammer twenty times as
+//! heavy as the scene says, which slips in MuJoCo from a force the twin accepts: the slip
+//! states the force that holds it, and the value asked next is above it. MuJoCo is
+//! installed on first use into the shared cache (as a person's first `--executor mujoco`
+//! does).
 
 use crate::support;
 
@@ -117,5 +120,28 @@ fn a_cube_the_camera_missed_blocks_the_grasp_in_mujoco_and_the_loop_clears_it() 
     said("Approve? yes (--yes)");
     said("place \"red cube\" \"table\": success");
     said("place \"blue cube\" \"green cube\": success");
+    assert_eq!(code, Some(0), "{log}");
+}
+
+#[test]
+fn a_hammer_heavier_than_the_scene_slips_in_mujoco_and_the_value_is_asked_above_its_bound() {
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let (code, log) = resolve_in_mujoco(
+        "mujoco-heavy",
+        "tests/fixtures/scenarios/heavy_hammer.toml",
+        &server,
+    );
+    let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
+    // The twin accepts 37.2 N (20 N at least); MuJoCo's 9 kg hammer slips from it.
+    said("Proposal: set force = 37.2 N on every grasp \"hammer\"");
+    said(
+        "the mujoco executor reports: Object 'hammer' slipped from the grasp: 37.2 N is too \
+         little force to hold its 9.0 kg (56 N at least)",
+    );
+    // The same value is not proposed again: the bound the slip stated holds, and betr
+    // tries midway between it and the gripper's 80 N, which MuJoCo's grip holds.
+    said("37.2 N was refused before");
+    said("Proposal: set force = 68 N on every grasp \"hammer\"");
+    said("grasp \"hammer\" {force = 68 N}: success");
     assert_eq!(code, Some(0), "{log}");
 }

@@ -345,12 +345,17 @@ pub(crate) async fn ask_value(
             action: action.clone(),
         },
     });
-    // What the world said of the values tried so far bounds the next ones.
+    // What the world said of the values tried so far bounds the next ones, and so does
+    // what it said of the value the action failed with (an executor's world may refuse
+    // a value the twin accepted).
     let mut bounds = Bounds::declared(param);
     for t in tried {
         if let Some(v) = value_of(&t.proposal) {
             bounds.learn(v, &t.why);
         }
+    }
+    if let Some(v) = action.value(&param.name) {
+        bounds.learn(v, error);
     }
     let unit = param.unit.as_deref().unwrap_or("");
     let summary = bounds.summary(unit);
