@@ -122,13 +122,13 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
                 500,
                 if args.quick { 1.0 } else { 10.0 },
             )?),
-            Part::Mujoco => vec![
-                bench::mujoco::step_rate(
-                    &args.scenario,
-                    if args.quick { 1.0 } else { args.seconds },
-                )?,
-                bench::mujoco::scenario_one(&args.scenario, if args.quick { 1 } else { 3 })?,
-            ],
+            Part::Mujoco => {
+                let seconds = if args.quick { 1.0 } else { args.seconds };
+                let runs = if args.quick { 1 } else { 3 };
+                let mut rows = vec![bench::mujoco::step_rate(&args.scenario, seconds)?];
+                rows.extend(bench::mujoco::scenario_one(&args.scenario, runs)?);
+                rows
+            }
             Part::Llm => anyhow::bail!("`llm` runs alone: betr bench llm"),
         };
         for row in &rows {
