@@ -7,7 +7,9 @@
 //! cube, onto which the arm comes down (the failure goes to the question, the proposal and
 //! the approval, and the repaired tree succeeds in MuJoCo). And a hammer twenty times as
 //! heavy as the scene says, which slips in MuJoCo from a force the twin accepts: the slip
-//! states the force that holds it, and the value asked next is above it. MuJoCo is
+//! states the force that holds it, and the value asked next is above it. And the
+//! workbench in tmux: the world pane names the executor and says where reality differs,
+//! the person approves the fix, and the tree succeeds in MuJoCo. MuJoCo is
 //! installed on first use into the shared cache (as a person's first `--executor mujoco`
 //! does).
 
@@ -144,4 +146,47 @@ fn a_hammer_heavier_than_the_scene_slips_in_mujoco_and_the_value_is_asked_above_
     said("Proposal: set force = 68 N on every grasp \"hammer\"");
     said("grasp \"hammer\" {force = 68 N}: success");
     assert_eq!(code, Some(0), "{log}");
+}
+
+#[test]
+fn a_person_watches_the_workbench_find_reality_otherwise_and_approves_the_fix() {
+    use support::tmux::{Tmux, workbench_command_on};
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let dir = tmp("tmux-mujoco");
+    // The cache with MuJoCo and the YuMi's description (installed on first use).
+    let env = format!(
+        "BETR_MODEL_DIR={} BETR_OFFLINE=0",
+        support::tmux::quote(std::path::Path::new(&cache()))
+    );
+    let tmux = Tmux::start(&workbench_command_on(
+        "tests/fixtures/scenarios/red_unseen.toml",
+        &dir,
+        &server,
+        (&env, "--executor mujoco"),
+    ));
+    tmux.wait_for(&["Performed by the mujoco executor"], 120);
+    tmux.keys(&["p"]);
+    tmux.wait_for(&["grasp \"blue cube\"!"], 30);
+    tmux.keys(&["r"]);
+    // The twin saw the way clear; in MuJoCo the arm came down onto the red cube. The
+    // world pane says so, and the fixture's proposal waits for the person.
+    tmux.wait_for(
+        &[
+            "Reality differs",
+            "No collision free path found",
+            "~\"any object\" on \"blue cube\"",
+            "a approve",
+        ],
+        60,
+    );
+    tmux.keys(&["a"]);
+    tmux.wait_for(&["+[ ] ~\"any object\" on \"blue cube\"?"], 30);
+    tmux.keys(&["r"]);
+    tmux.wait_for(&["SUCCESS", "+ \"blue cube\" on \"green cube\""], 90);
+    // The approved fix is not saved: quitting asks once more.
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["Press q again to quit"], 10);
+    tmux.keys(&["q"]);
+    tmux.wait_for(&["betr exited with status 0"], 10);
+    drop(tmux);
 }
