@@ -406,6 +406,7 @@ fn start_executor(
 }
 
 /// An executor for each session an evaluation runs, from `--executor COMMAND`.
+#[cfg(feature = "lab")]
 fn executor_factory(
     command: &str,
 ) -> Result<
