@@ -68,6 +68,13 @@ pub enum EvalExperiment {
         /// not used).
         #[arg(long)]
         sequence: bool,
+        /// Run the ten scenarios in three settings, each into a folder of its own under
+        /// --out, and print them side by side: the model alone (nothing tried before it is
+        /// proposed, the paper's setting), twin-screened (fixes tried in the scenario's
+        /// model only: the cafe without its hidden rules), and executed (the cell
+        /// scenarios' actions performed by --executor, MuJoCo unless it names another).
+        #[arg(long, conflicts_with = "sequence")]
+        three_settings: bool,
         #[command(flatten)]
         run: RunFlags,
     },
@@ -143,8 +150,18 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
             goal,
             scenarios,
             sequence: false,
+            three_settings: false,
             run,
         } => session_experiment(S::Resolve, &scenarios, runs, (max_rounds, goal), &run),
+        EvalExperiment::Resolve {
+            runs,
+            max_rounds,
+            goal,
+            scenarios,
+            three_settings: true,
+            run,
+            ..
+        } => three_settings(&scenarios, runs, (max_rounds, goal), &run),
         EvalExperiment::Resolve {
             max_rounds,
             goal,
@@ -437,6 +454,71 @@ fn load_scenarios(dir: &Path, paths: &[impl AsRef<str>]) -> Result<Vec<(String, 
 pub enum SessionExperiment {
     Resolve,
     Params,
+}
+
+/// `betr eval resolve --three-settings`: the experiment in each setting, then the table
+/// of the three (`settings.md` in the output directory).
+fn three_settings(
+    scenarios_dir: &Path,
+    runs: usize,
+    rounds_and_goal: (usize, GoalSource),
+    flags: &RunFlags,
+) -> Result<ExitCode> {
+    let dir = eval::output_dir(flags.out.as_deref(), "resolve-settings")
+        .context("creating the output directory")?;
+    let executor = flags
+        .lab
+        .executor
+        .clone()
+        .unwrap_or_else(|| "mujoco".into());
+    let pulled: [(&str, &str, fn(&mut super::lab_flags::LabFlags)); 3] = [
+        ("model alone", "model-alone", |lab| {
+            lab.no_shortlist = true;
+            lab.no_screening = true;
+            lab.executor = None;
+        }),
+        ("twin-screened", "twin-screened", |lab| {
+            lab.twin_screening = true;
+            lab.executor = None;
+        }),
+        ("executed", "executed", |_| {}),
+    ];
+    let mut settings = Vec::new();
+    for (name, folder, pull) in pulled {
+        let mut setting = flags.clone();
+        setting.out = Some(dir.join(folder));
+        pull(&mut setting.lab);
+        if folder == "executed" {
+            setting.lab.executor = Some(executor.clone());
+        }
+        errln!("eval resolve: {name}");
+        session_experiment(
+            SessionExperiment::Resolve,
+            scenarios_dir,
+            runs,
+            rounds_and_goal,
+            &setting,
+        )?;
+        let file = dir.join(folder).join("results.json");
+        let text = std::fs::read_to_string(&file)
+            .with_context(|| format!("reading {}", file.display()))?;
+        let results =
+            serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))?;
+        settings.push(resolve::Setting {
+            name: if folder == "executed" {
+                format!("executed by {executor}")
+            } else {
+                name.to_string()
+            },
+            results,
+            cell_only: folder == "executed",
+        });
+    }
+    let table = resolve::settings_table(&settings);
+    betr::store::write_atomic(&dir.join("settings.md"), table.as_bytes())
+        .with_context(|| format!("writing {}", dir.join("settings.md").display()))?;
+    outln!("\n{table}\nresults: {}", dir.display());
+    Ok(ExitCode::SUCCESS)
 }
 
 /// `betr eval resolve` and `betr eval params`: each scenario resolved `runs` times.

@@ -122,6 +122,57 @@ pub struct ResolveResults {
     pub cases: Vec<ResolveCase>,
 }
 
+/// One setting of `betr eval resolve --three-settings`: its name, its results, and whether
+/// it performs only the cell scenarios' actions elsewhere (its other rows are left out).
+pub struct Setting {
+    pub name: String,
+    pub results: ResolveResults,
+    pub cell_only: bool,
+}
+
+/// The settings side by side, a row per scenario: resolved of the runs, and how many
+/// runs' first candidate was right; a total row.
+pub fn settings_table(settings: &[Setting]) -> String {
+    let mut out = String::from("| # | scenario |");
+    for s in settings {
+        out.push_str(&format!(" {} |", s.name));
+    }
+    out.push_str("\n|---|---|");
+    out.push_str(&"---|".repeat(settings.len()));
+    out.push('\n');
+    let rows = settings.first().map_or(0, |s| s.results.scenarios.len());
+    let mut totals = vec![(0, 0); settings.len()];
+    for i in 0..rows {
+        let first = &settings[0].results.scenarios[i];
+        out.push_str(&format!("| {} | {} |", i + 1, first.name));
+        for (s, total) in settings.iter().zip(totals.iter_mut()) {
+            let row = s
+                .results
+                .scenarios
+                .iter()
+                .find(|r| r.scenario == first.scenario);
+            match row {
+                Some(r) if !(s.cell_only && !r.scenario.starts_with("cell/")) => {
+                    out.push_str(&format!(
+                        " {}/{} (first right {}) |",
+                        r.resolved, r.runs, r.first_candidate_right
+                    ));
+                    total.0 += r.resolved;
+                    total.1 += r.runs;
+                }
+                _ => out.push_str(" — |"),
+            }
+        }
+        out.push('\n');
+    }
+    out.push_str("| | all |");
+    for (resolved, runs) in totals {
+        out.push_str(&format!(" {resolved}/{runs} |"));
+    }
+    out.push('\n');
+    out
+}
+
 /// Run every (scenario, run) pair the journal in `dir` does not hold yet through the
 /// session with `make`, and return every recorded case of runs 1..=runs, by scenario then run.
 pub(crate) async fn run_sessions<T>(

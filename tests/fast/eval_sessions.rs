@@ -271,3 +271,78 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
         "{table}"
     );
 }
+
+#[test]
+fn three_settings_are_run_each_into_its_folder_and_tabled_side_by_side() {
+    let dir = tmp("eval-settings");
+    let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
+    let scenarios = fixtures::root().join("scenarios").display().to_string();
+    let follower = fixtures::root()
+        .join("tests/fixtures/executor/follower.py")
+        .display()
+        .to_string();
+    let executor = format!("python3 {follower}");
+    let url = server.base_url();
+    let o = betr(
+        &dir,
+        &[
+            "eval",
+            "resolve",
+            "--three-settings",
+            "--runs",
+            "1",
+            "--goal",
+            "scenario",
+            "--scenarios",
+            &scenarios,
+            "--out",
+            "out",
+            "--executor",
+            &executor,
+            "--backend",
+            "openai",
+            "--base-url",
+            &url,
+            "--model",
+            "fake-model",
+            "--api-key-env",
+            KEY_VAR,
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let table = std::fs::read_to_string(dir.join("out/settings.md")).unwrap();
+    // Each setting's levers, as its folder records them.
+    let lever = |folder: &str, key: &str| {
+        let run = read_json(&dir.join(format!("out/{folder}/run.json")));
+        let r = read_json(&dir.join(format!("out/{folder}/results.json")));
+        assert_eq!(r["scenarios"].as_array().unwrap().len(), 10, "{folder}");
+        run["settings"][key].as_str().map(str::to_string)
+    };
+    assert_eq!(lever("model-alone", "shortlist").as_deref(), Some("false"));
+    assert_eq!(
+        lever("model-alone", "screen_proposals").as_deref(),
+        Some("false")
+    );
+    assert_eq!(lever("model-alone", "executor"), None);
+    assert_eq!(
+        lever("twin-screened", "planning_without_hidden_rules").as_deref(),
+        Some("true")
+    );
+    assert_eq!(lever("twin-screened", "executor"), None);
+    assert_eq!(lever("executed", "executor"), Some(executor.clone()));
+    assert!(
+        table.starts_with("| # | scenario | model alone | twin-screened | executed by python3 "),
+        "{table}"
+    );
+    // The executor performs the cell scenarios only: the cafe's rows are left out there.
+    let sweep = table
+        .lines()
+        .find(|l| l.contains("Sweep without a mop"))
+        .unwrap();
+    assert!(sweep.trim_end().ends_with("| — |"), "{sweep}");
+    // The fixtures answer the named fix: the model alone resolves all ten, and the cell
+    // scenarios resolve with the follower performing their actions.
+    let all = table.lines().last().unwrap();
+    assert!(all.starts_with("| | all | 10/10 | "), "{all}");
+    assert!(all.trim_end().ends_with("| 7/7 |"), "{all}");
+}
