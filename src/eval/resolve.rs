@@ -152,7 +152,7 @@ pub fn settings_table(settings: &[Setting]) -> String {
                 .iter()
                 .find(|r| r.scenario == first.scenario);
             match row {
-                Some(r) if !(s.cell_only && !r.scenario.starts_with("cell/")) => {
+                Some(r) if !s.cell_only || r.scenario.starts_with("cell/") => {
                     out.push_str(&format!(
                         " {}/{} (first right {}) |",
                         r.resolved, r.runs, r.first_candidate_right
