@@ -456,6 +456,9 @@ pub enum SessionExperiment {
     Params,
 }
 
+/// What makes one of the three settings out of the command's lab flags.
+type PullLevers = fn(&mut super::lab_flags::LabFlags);
+
 /// `betr eval resolve --three-settings`: the experiment in each setting, then the table
 /// of the three (`settings.md` in the output directory).
 fn three_settings(
@@ -471,7 +474,7 @@ fn three_settings(
         .executor
         .clone()
         .unwrap_or_else(|| "mujoco".into());
-    let pulled: [(&str, &str, fn(&mut super::lab_flags::LabFlags)); 3] = [
+    let pulled: [(&str, &str, PullLevers); 3] = [
         ("model alone", "model-alone", |lab| {
             lab.no_shortlist = true;
             lab.no_screening = true;
