@@ -317,17 +317,30 @@ impl Context<'_> {
 
 /// Changes already tried for this failure, with what happened after each: the model
 /// learns from the world's verdict instead of repeating itself.
+/// The refusals told back: the latest ones, each cut short, so five rounds of answers
+/// and their reasons stay well inside a small model's context (an unbounded list passed
+/// 23,000 tokens in a cafe with many objects).
+const MAX_TRIED_LINES: usize = 12;
+const MAX_TRIED_CHARS: usize = 600;
+
 fn tried_text(tried: &[String]) -> String {
     if tried.is_empty() {
         return String::new();
     }
+    let left_out = tried.len().saturating_sub(MAX_TRIED_LINES);
+    let mut lines: Vec<String> = tried[left_out..]
+        .iter()
+        .map(|t| match t.char_indices().nth(MAX_TRIED_CHARS) {
+            Some((cut, _)) => format!("- {}…", &t[..cut]),
+            None => format!("- {t}"),
+        })
+        .collect();
+    if left_out > 0 {
+        lines.insert(0, format!("- ({left_out} earlier ones left out)"));
+    }
     format!(
         "\nAlready proposed and refused (why is in parentheses: the action still failed when it was tried in simulation, or it was not tried because of what the world said before); learn from it and propose something else:\n{}\n",
-        tried
-            .iter()
-            .map(|t| format!("- {t}"))
-            .collect::<Vec<_>>()
-            .join("\n")
+        lines.join("\n")
     )
 }
 

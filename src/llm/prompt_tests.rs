@@ -241,3 +241,31 @@ fn everything_before_the_examples_is_the_same_for_every_request() {
         "after the examples:\n{rest}"
     );
 }
+
+#[test]
+fn the_refusals_told_back_are_the_latest_each_cut_short() {
+    let tried: Vec<String> = (0..20)
+        .map(|i| {
+            format!(
+                "insert Cond_{i} ({})",
+                "after the change, x ".repeat(i * 10)
+            )
+        })
+        .collect();
+    let text = tried_text(&tried);
+    assert!(text.contains("- (8 earlier ones left out)"), "{text}");
+    assert!(!text.contains("Cond_7 "), "{text}");
+    assert!(text.contains("insert Cond_19 "), "{text}");
+    assert!(
+        text.lines()
+            .all(|l| l.chars().count() <= MAX_TRIED_CHARS + 3),
+        "{text}"
+    );
+    assert!(text.contains('…'));
+    // A short list is told whole.
+    let short = tried_text(&tried[..2]);
+    assert!(
+        short.contains("- insert Cond_0 ()") && !short.contains("left out"),
+        "{short}"
+    );
+}
