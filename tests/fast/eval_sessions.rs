@@ -24,29 +24,30 @@ fn session_eval(
     experiment: &str,
     runs: &str,
 ) -> std::process::Output {
+    session_eval_with(dir, server, &[experiment, "--runs", runs])
+}
+
+/// `betr eval ARGS…` on the repository's scenarios into `out`, answered by `server`.
+fn session_eval_with(dir: &Path, server: &FakeServer, args: &[&str]) -> std::process::Output {
     let scenarios = fixtures::root().join("scenarios").display().to_string();
     let url = server.base_url();
-    betr(
-        dir,
-        &[
-            "eval",
-            experiment,
-            "--runs",
-            runs,
-            "--scenarios",
-            &scenarios,
-            "--out",
-            "out",
-            "--backend",
-            "openai",
-            "--base-url",
-            &url,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
-        ],
-    )
+    let mut all = vec!["eval"];
+    all.extend_from_slice(args);
+    all.extend([
+        "--scenarios",
+        &scenarios,
+        "--out",
+        "out",
+        "--backend",
+        "openai",
+        "--base-url",
+        &url,
+        "--model",
+        "fake-model",
+        "--api-key-env",
+        KEY_VAR,
+    ]);
+    betr(dir, &all)
 }
 
 #[test]
@@ -276,37 +277,23 @@ fn values_beyond_what_the_world_refused_are_not_tried_and_a_midway_value_is() {
 fn three_settings_are_run_each_into_its_folder_and_tabled_side_by_side() {
     let dir = tmp("eval-settings");
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
-    let scenarios = fixtures::root().join("scenarios").display().to_string();
     let follower = fixtures::root()
         .join("tests/fixtures/executor/follower.py")
         .display()
         .to_string();
     let executor = format!("python3 {follower}");
-    let url = server.base_url();
-    let o = betr(
+    let o = session_eval_with(
         &dir,
+        &server,
         &[
-            "eval",
             "resolve",
             "--three-settings",
             "--runs",
             "1",
             "--goal",
             "scenario",
-            "--scenarios",
-            &scenarios,
-            "--out",
-            "out",
             "--executor",
             &executor,
-            "--backend",
-            "openai",
-            "--base-url",
-            &url,
-            "--model",
-            "fake-model",
-            "--api-key-env",
-            KEY_VAR,
         ],
     );
     assert!(o.status.success(), "{}", text(&o));

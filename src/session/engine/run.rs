@@ -232,19 +232,8 @@ impl Engine {
     /// and the tree runs again from the first state as reality has it, without asking.
     fn run_again_as_reality_showed(&mut self, failed: Option<Failure>) {
         self.stop_running();
-        if let Some(failure) = failed {
-            let node_path = self
-                .task
-                .tree
-                .as_ref()
-                .and_then(|t| t.path(failure.node).ok())
-                .unwrap_or_default();
-            self.emit(Event::ActionFailed {
-                action: failure.action,
-                node: failure.node,
-                node_path,
-                error: failure.error,
-            });
+        if let Some(failure) = &failed {
+            self.tell_failure(failure);
         }
         self.notice(
             "the action failed on an object the scene had elsewhere: nothing is asked; the tree \
@@ -254,7 +243,8 @@ impl Engine {
         self.start_running();
     }
 
-    fn on_failure(&mut self, failure: Failure) {
+    /// Say which action failed, where in the tree, and why.
+    fn tell_failure(&self, failure: &Failure) {
         let node_path = self
             .task
             .tree
@@ -267,6 +257,10 @@ impl Engine {
             node_path,
             error: failure.error.clone(),
         });
+    }
+
+    fn on_failure(&mut self, failure: Failure) {
+        self.tell_failure(&failure);
         if failure.error.contains(world::DISAGREEMENT_NOTE) {
             // The planning world keeps its abstraction (re-planning every candidate with
             // the arms costs seconds per candidate); the fix approved is checked by
