@@ -262,7 +262,16 @@ pub(crate) async fn ask_conditions(
         error,
         tried,
     } = *failed;
-    let list = if options.steps.shortlist {
+    let screens = options.steps.shortlist && screen.reproduces();
+    if options.steps.shortlist && !screens {
+        emit(&Event::Notice {
+            message: format!(
+                "{action}! fails in execution but the tree succeeds in the planning world: no \
+                 condition can be tried there, so the model names one from the whole vocabulary"
+            ),
+        });
+    }
+    let list = if screens {
         let mut list = shortlist(screen);
         // A fix already proposed for this failure and refused (by the simulation, by
         // verification or by a person) is not offered again: the model chooses under a

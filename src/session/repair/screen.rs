@@ -146,6 +146,22 @@ impl Screen {
         apply(&planner, &self.tree, proposal, self.world.as_ref()).map(|(plan, _)| plan)
     }
 
+    /// Whether the tree as it is fails in this copy of the world as it did: a world that
+    /// lacks what the failure came from (a twin without the hidden rule, a scene without
+    /// the physics) runs it to success, and then no change can be told from another.
+    pub fn reproduces(&self) -> bool {
+        let mut sim = self.world.fork();
+        let planner = Planner::new(&self.scenario.domain);
+        let report = run_tree(
+            &self.tree,
+            sim.as_mut(),
+            &self.scenario.domain,
+            planner.options.max_ticks,
+            |_, _| true,
+        );
+        !matches!(report.end, crate::planner::RunEnd::Success)
+    }
+
     /// Whether running `tree` in a copy of the world completes the failed action.
     fn completes_failed_action(&self, tree: &Tree) -> bool {
         let mut sim = self.world.fork();
