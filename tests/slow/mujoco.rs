@@ -190,3 +190,26 @@ fn a_person_watches_the_workbench_find_reality_otherwise_and_approves_the_fix() 
     tmux.wait_for(&["betr exited with status 0"], 10);
     drop(tmux);
 }
+
+#[test]
+fn a_scene_mujoco_cannot_build_is_refused_by_name_before_anything_runs() {
+    // The abstract cell (no robot description named): the MuJoCo cell has no arms to move.
+    let dir = tmp("mujoco-no-robot");
+    let path = format!(
+        "{}/tests/fixtures/scenarios/no_robot.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let cache = cache();
+    let out = betr_with(
+        &dir,
+        &["run", &path, "--executor", "mujoco"],
+        &[("BETR_MODEL_DIR", cache.as_str()), ("BETR_OFFLINE", "0")],
+    );
+    let log = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("the mujoco executor cannot build the scene: the MuJoCo cell needs the robot's description"),
+        "{log}"
+    );
+    assert!(!log.contains("SUCCESS"), "{log}");
+}
