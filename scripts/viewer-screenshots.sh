@@ -88,4 +88,4 @@ capture() {
 wanted=("$@")
 capture viewer-failure.png run "$scenario"
 capture viewer-repaired.png repair "$scenario" --add "$fix"
-capture viewer-mujoco.png run "$PWD/scenarios/cell/reality/red_unseen.toml" --executor mujoco
+capture viewer-mujoco.png run "$PWD/tests/fixtures/scenarios/red_unseen.toml" --executor mujoco

@@ -85,18 +85,6 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../scenarios/cell/params/sand.toml"),
     ),
     (
-        "cell/reality/camera_off.toml",
-        include_str!("../../scenarios/cell/reality/camera_off.toml"),
-    ),
-    (
-        "cell/reality/heavy_hammer.toml",
-        include_str!("../../scenarios/cell/reality/heavy_hammer.toml"),
-    ),
-    (
-        "cell/reality/red_unseen.toml",
-        include_str!("../../scenarios/cell/reality/red_unseen.toml"),
-    ),
-    (
         "cell/red_on_blue.toml",
         include_str!("../../scenarios/cell/red_on_blue.toml"),
     ),

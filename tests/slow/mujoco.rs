@@ -88,7 +88,7 @@ fn a_cube_off_its_scene_pose_is_found_by_the_missed_grasp_and_the_tree_runs_agai
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let (code, log) = resolve_in_mujoco(
         "mujoco-offset",
-        "scenarios/cell/reality/camera_off.toml",
+        "tests/fixtures/scenarios/camera_off.toml",
         &server,
     );
     let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
@@ -108,7 +108,7 @@ fn a_cube_the_camera_missed_blocks_the_grasp_in_mujoco_and_the_loop_clears_it() 
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let (code, log) = resolve_in_mujoco(
         "mujoco-unseen",
-        "scenarios/cell/reality/red_unseen.toml",
+        "tests/fixtures/scenarios/red_unseen.toml",
         &server,
     );
     let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
@@ -130,7 +130,7 @@ fn a_hammer_heavier_than_the_scene_slips_in_mujoco_and_the_value_is_asked_above_
     let server = FakeServer::start(vec![], Behavior::Fixtures(fixtures::every_reply()));
     let (code, log) = resolve_in_mujoco(
         "mujoco-heavy",
-        "scenarios/cell/reality/heavy_hammer.toml",
+        "tests/fixtures/scenarios/heavy_hammer.toml",
         &server,
     );
     let said = |needle: &str| assert!(log.contains(needle), "{needle:?} not in:\n{log}");
@@ -159,7 +159,7 @@ fn a_person_watches_the_workbench_find_reality_otherwise_and_approves_the_fix() 
         support::tmux::quote(std::path::Path::new(&cache()))
     );
     let tmux = Tmux::start(&workbench_command_on(
-        "scenarios/cell/reality/red_unseen.toml",
+        "tests/fixtures/scenarios/red_unseen.toml",
         &dir,
         &server,
         (&env, "--executor mujoco"),
