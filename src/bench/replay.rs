@@ -159,6 +159,7 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
                 node: action,
                 node_path: path.clone(),
                 error: "No collision free path found".into(),
+                executor: None,
             }),
             event(Event::RunState { running: false }),
             event(Event::Asking {

@@ -88,10 +88,15 @@ fn headline(event: &Event) -> Option<String> {
             action,
             node_path,
             error,
+            executor,
             ..
         } => format!(
-            "✗ {action}! (node {}) failed in simulation: {error}",
-            path_text(node_path)
+            "✗ {action}! (node {}) failed {}: {error}",
+            path_text(node_path),
+            match executor {
+                Some(name) => format!("in the {name} executor"),
+                None => "in simulation".to_string(),
+            }
         ),
         Event::Approved => "approved".into(),
         Event::Rejected => "Not approved".into(),

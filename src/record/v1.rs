@@ -286,6 +286,7 @@ impl Decoder {
                     node,
                     node_path: self.path(node),
                     error: error.clone(),
+                    executor: None,
                 }
             }
             Recorded::Proposal {

@@ -439,6 +439,9 @@ pub enum Event {
         node: NodeId,
         node_path: Vec<usize>,
         error: String,
+        /// The executor it failed in (reality), or none: in betr's world.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        executor: Option<String>,
     },
     /// A proposal, before approval, with who wrote it (the model, the simulation that
     /// narrowed it, a person, betr's midway value).

@@ -311,6 +311,7 @@ fn the_resolve_loop_takes_its_own_steps_after_the_failing_tick() {
         node_path: vec![1, 0, 1, 1],
         action: crate::domain::ActionCall::new("grasp", ["blue cube"]),
         error: record.failures[0].1.clone(),
+        executor: None,
     });
     viz.on_event(&Event::Asking {
         what: crate::session::Question::Preconditions {

@@ -117,6 +117,7 @@ fn a_cube_the_camera_missed_blocks_the_grasp_in_mujoco_and_the_loop_clears_it() 
         "the twin predicted grasp \"blue cube\"! would succeed; the mujoco executor reports: \
          No collision free path found",
     );
+    said("✗ grasp \"blue cube\"! (node 1.0.1.1) failed in the mujoco executor: No collision");
     said("→ asking the model for missing preconditions of grasp \"blue cube\"!");
     said("Proposal: insert ~\"any object\" on \"blue cube\"");
     said("Approve? yes (--yes)");

@@ -214,6 +214,7 @@ fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
             node,
             node_path: tree.path(node).unwrap_or_default(),
             error: "it failed".into(),
+            executor: (rng.below(2) == 0).then(|| "mujoco".to_string()),
         },
         4 => Event::Proposal {
             proposal: Proposal::Conditions {

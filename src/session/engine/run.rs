@@ -111,6 +111,13 @@ impl Engine {
         let scene_was_wrong = failed
             .as_ref()
             .is_some_and(|f| scene_was_wrong_about(&found, &f.action));
+        // Where the failed action failed: in the executor (reality), or in betr's world
+        // (the world itself, or the twin refusing before anything was sent).
+        let failed_in = failed.as_ref().and_then(|f| {
+            let in_reality = found.diverged.iter().any(|d| d.action == f.action);
+            let reality = self.run.reality.as_ref().filter(|_| in_reality)?;
+            Some(reality.name().to_string())
+        });
         self.run.last = Some(record.clone());
         self.emit(Event::Ticked {
             record: record.clone(),
@@ -121,9 +128,9 @@ impl Engine {
             return self.executor_broke(&broken);
         }
         if scene_was_wrong && record.root == TickOutcome::Failure {
-            return self.run_again_as_reality_showed(failed);
+            return self.run_again_as_reality_showed(failed, failed_in);
         }
-        self.end_of_tick(&record, failed);
+        self.end_of_tick(&record, failed, failed_in);
         if self.is_running() && self.run.ticks >= self.settings.max_ticks {
             self.stop_running();
             self.emit(Event::GaveUp {
@@ -198,7 +205,12 @@ impl Engine {
 
     /// What the root's status means: running goes on; success ends a run; a failure is
     /// asked about, or told when no action failed.
-    fn end_of_tick(&mut self, record: &TickRecord, failed: Option<Failure>) {
+    fn end_of_tick(
+        &mut self,
+        record: &TickRecord,
+        failed: Option<Failure>,
+        failed_in: Option<String>,
+    ) {
         match (record.root, failed) {
             (TickOutcome::Running, _) => {}
             (TickOutcome::Success, _) if !record.completed.is_empty() => {}
@@ -210,7 +222,7 @@ impl Engine {
             }
             (TickOutcome::Failure, Some(failure)) => {
                 self.stop_running();
-                self.on_failure(failure);
+                self.on_failure(failure, failed_in);
             }
             (TickOutcome::Failure, None) => {
                 self.stop_running();
@@ -230,10 +242,10 @@ impl Engine {
     /// The failed action's object was not where the scene said, and reality showed where
     /// it is: nothing is missing from the tree, the scene was wrong. The failure is told,
     /// and the tree runs again from the first state as reality has it, without asking.
-    fn run_again_as_reality_showed(&mut self, failed: Option<Failure>) {
+    fn run_again_as_reality_showed(&mut self, failed: Option<Failure>, failed_in: Option<String>) {
         self.stop_running();
         if let Some(failure) = &failed {
-            self.tell_failure(failure);
+            self.tell_failure(failure, failed_in);
         }
         self.notice(
             "the action failed on an object the scene had elsewhere: nothing is asked; the tree \
@@ -243,8 +255,9 @@ impl Engine {
         self.start_running();
     }
 
-    /// Say which action failed, where in the tree, and why.
-    fn tell_failure(&self, failure: &Failure) {
+    /// Say which action failed, where in the tree, in which executor (none: in betr's
+    /// world), and why.
+    fn tell_failure(&self, failure: &Failure, executor: Option<String>) {
         let node_path = self
             .task
             .tree
@@ -256,11 +269,12 @@ impl Engine {
             node: failure.node,
             node_path,
             error: failure.error.clone(),
+            executor,
         });
     }
 
-    fn on_failure(&mut self, failure: Failure) {
-        self.tell_failure(&failure);
+    fn on_failure(&mut self, failure: Failure, failed_in: Option<String>) {
+        self.tell_failure(&failure, failed_in);
         if failure.error.contains(world::DISAGREEMENT_NOTE) {
             // The planning world keeps its abstraction (re-planning every candidate with
             // the arms costs seconds per candidate); the fix approved is checked by
