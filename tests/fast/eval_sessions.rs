@@ -10,7 +10,7 @@ use crate::support;
 use std::path::Path;
 
 use serde_json::Value as Json;
-use support::cli::{KEY_VAR, betr, text, tmp};
+use support::cli::{betr, openai_flags, text, tmp};
 use support::fake_openai::{Behavior, FakeServer};
 use support::fixtures::{self, FixtureReply};
 
@@ -33,20 +33,8 @@ fn session_eval_with(dir: &Path, server: &FakeServer, args: &[&str]) -> std::pro
     let url = server.base_url();
     let mut all = vec!["eval"];
     all.extend_from_slice(args);
-    all.extend([
-        "--scenarios",
-        &scenarios,
-        "--out",
-        "out",
-        "--backend",
-        "openai",
-        "--base-url",
-        &url,
-        "--model",
-        "fake-model",
-        "--api-key-env",
-        KEY_VAR,
-    ]);
+    all.extend(["--scenarios", &scenarios, "--out", "out"]);
+    all.extend(openai_flags(&url));
     betr(dir, &all)
 }
 
