@@ -599,20 +599,7 @@ pub fn session_experiment(
                     &dir,
                 ))
                 .with_context(|| stopped(&dir))?;
-            let bars: Vec<(String, f64)> = results
-                .scenarios
-                .iter()
-                .enumerate()
-                .map(|(i, s)| (format!("{} {}", i + 1, s.name), s.success_rate))
-                .collect();
-            let table = results.table(&p.label, cfg.runs);
-            write_all(&dir, &results, &results.csv(), &table, || {
-                chart_runs::success_chart(
-                    &dir.join("resolve.png"),
-                    &format!("Failure resolution: success rate ({})", p.label),
-                    &bars,
-                )
-            })?;
+            write_resolve(&dir, &results, &p.label, cfg.runs)?;
         }
         SessionExperiment::Params => {
             let results = rt
@@ -624,20 +611,50 @@ pub fn session_experiment(
                     &dir,
                 ))
                 .with_context(|| stopped(&dir))?;
-            let table = results.table(&p.label, cfg.runs);
-            write_all(&dir, &results, &results.csv(), &table, || {
-                chart_runs::params_chart(
-                    &dir.join("params.png"),
-                    &format!(
-                        "Proposed parameter values, accepted range shaded ({})",
-                        p.label
-                    ),
-                    &chart_runs::params_panels(&results),
-                )
-            })?;
+            write_params(&dir, &results, &p.label, cfg.runs)?;
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `betr eval resolve`'s results into `dir`: JSON, CSV, the table and the chart.
+fn write_resolve(
+    dir: &Path,
+    results: &resolve::ResolveResults,
+    label: &str,
+    runs: usize,
+) -> Result<()> {
+    let bars: Vec<(String, f64)> = results
+        .scenarios
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (format!("{} {}", i + 1, s.name), s.success_rate))
+        .collect();
+    let table = results.table(label, runs);
+    write_all(dir, results, &results.csv(), &table, || {
+        chart_runs::success_chart(
+            &dir.join("resolve.png"),
+            &format!("Failure resolution: success rate ({label})"),
+            &bars,
+        )
+    })
+}
+
+/// `betr eval params`' results into `dir`: JSON, CSV, the table and the chart.
+fn write_params(
+    dir: &Path,
+    results: &params::ParamsResults,
+    label: &str,
+    runs: usize,
+) -> Result<()> {
+    let table = results.table(label, runs);
+    write_all(dir, results, &results.csv(), &table, || {
+        chart_runs::params_chart(
+            &dir.join("params.png"),
+            &format!("Proposed parameter values, accepted range shaded ({label})"),
+            &chart_runs::params_panels(results),
+        )
+    })
 }
 
 /// The goal dataset's cases; a dataset directory that is not there is said with where it

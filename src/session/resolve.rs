@@ -15,7 +15,9 @@ use crate::bt::Tree;
 use crate::llm::LanguageModel;
 use crate::scenario::Scenario;
 
-use super::engine::{Command, Engine, Setup};
+use tokio::sync::mpsc::UnboundedReceiver;
+
+use super::engine::{Command, Engine, EngineHandle, Setup};
 use super::policy::PolicyStore;
 use super::types::{Ending, Event, Options, Proposal, Reading, Resolved, SessionError};
 
@@ -69,35 +71,7 @@ pub async fn resolve_with_scenes(
     (approve, choose): (Approver<'_>, ReadingChooser<'_>),
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
-    let instruction = instruction
-        .map(str::to_string)
-        .or_else(|| scenario.instruction.clone())
-        .ok_or_else(|| SessionError::NoInstruction(scenario.name.clone()))?;
-    let path = scenario
-        .files
-        .last()
-        .map(|f| f.path.clone())
-        .unwrap_or_default();
-    let mut setup = Setup::new(Arc::new(scenario.clone()), path.clone(), Ok(model));
-    setup.options = options.clone();
-    setup.scenes = execution.scenes;
-    setup.executor = execution.executor;
-    let (engine, mut events) = Engine::spawn(setup)?;
-    match (&scenario.goal, options.use_scenario_goal) {
-        (Some(goal), true) => {
-            engine.send(Command::SubmitGoal {
-                goal: goal.clone(),
-                instruction,
-            });
-        }
-        (None, true) => {
-            engine.send(Command::Shutdown);
-            return Err(SessionError::NoStatedGoal(scenario.name.clone()));
-        }
-        (_, false) => {
-            engine.send(Command::Submit(instruction));
-        }
-    }
+    let (engine, mut events, path) = start(scenario, instruction, model, options, execution)?;
 
     let mut goal = None;
     let mut tree: Option<Arc<Tree>> = None;
@@ -172,14 +146,7 @@ pub async fn resolve_with_scenes(
     let saved = match (&ending, &options.policy_dir, &goal) {
         (Ending::Success { .. }, Some(dir), Some(goal)) => {
             let to = PolicyStore::new(dir).path_for(&path, goal);
-            engine.send(Command::SavePolicyTo(to));
-            match saved_policy(&mut events, emit).await {
-                Ok(saved) => Some(saved),
-                Err(e) => {
-                    engine.send(Command::Shutdown);
-                    return Err(e);
-                }
-            }
+            Some(save_policy(&engine, &mut events, to, emit).await?)
         }
         _ => None,
     };
@@ -195,6 +162,61 @@ pub async fn resolve_with_scenes(
         repairs,
         kept,
         saved,
+    })
+}
+
+/// An engine for `scenario` in `execution`, given the instruction (or, with
+/// `use_scenario_goal`, the scenario's stated goal) to work on; and the scenario's file.
+fn start(
+    scenario: &Scenario,
+    instruction: Option<&str>,
+    model: Arc<dyn LanguageModel>,
+    options: &Options,
+    execution: Execution,
+) -> Result<(EngineHandle, UnboundedReceiver<Event>, std::path::PathBuf), SessionError> {
+    let instruction = instruction
+        .map(str::to_string)
+        .or_else(|| scenario.instruction.clone())
+        .ok_or_else(|| SessionError::NoInstruction(scenario.name.clone()))?;
+    let path = scenario
+        .files
+        .last()
+        .map(|f| f.path.clone())
+        .unwrap_or_default();
+    let mut setup = Setup::new(Arc::new(scenario.clone()), path.clone(), Ok(model));
+    setup.options = options.clone();
+    setup.scenes = execution.scenes;
+    setup.executor = execution.executor;
+    let (engine, events) = Engine::spawn(setup)?;
+    match (&scenario.goal, options.use_scenario_goal) {
+        (Some(goal), true) => {
+            engine.send(Command::SubmitGoal {
+                goal: goal.clone(),
+                instruction,
+            });
+        }
+        (None, true) => {
+            engine.send(Command::Shutdown);
+            return Err(SessionError::NoStatedGoal(scenario.name.clone()));
+        }
+        (_, false) => {
+            engine.send(Command::Submit(instruction));
+        }
+    }
+    Ok((engine, events, path))
+}
+
+/// Have the engine save the policy to `to`; where it saved it. The engine is shut down
+/// when it cannot.
+async fn save_policy(
+    engine: &EngineHandle,
+    events: &mut UnboundedReceiver<Event>,
+    to: std::path::PathBuf,
+    emit: &mut dyn FnMut(&Event),
+) -> Result<std::path::PathBuf, SessionError> {
+    engine.send(Command::SavePolicyTo(to));
+    saved_policy(events, emit).await.inspect_err(|_| {
+        engine.send(Command::Shutdown);
     })
 }
 

@@ -333,6 +333,22 @@ pub(crate) async fn ask_conditions(
     Ok(asked)
 }
 
+/// What the world said of the values tried so far bounds the next ones, and so does what
+/// it said of the value the action failed with (an executor's world may refuse a value
+/// the twin accepted).
+fn bounds_for(param: &ValueParam, tried: &[Tried], action: &ActionCall, error: &str) -> Bounds {
+    let mut bounds = Bounds::declared(param);
+    for t in tried {
+        if let Some(v) = value_of(&t.proposal) {
+            bounds.learn(v, &t.why);
+        }
+    }
+    if let Some(v) = action.value(&param.name) {
+        bounds.learn(v, error);
+    }
+    bounds
+}
+
 pub(crate) async fn ask_value(
     ctx: &Context<'_>,
     model: &dyn LanguageModel,
@@ -354,18 +370,7 @@ pub(crate) async fn ask_value(
             action: action.clone(),
         },
     });
-    // What the world said of the values tried so far bounds the next ones, and so does
-    // what it said of the value the action failed with (an executor's world may refuse
-    // a value the twin accepted).
-    let mut bounds = Bounds::declared(param);
-    for t in tried {
-        if let Some(v) = value_of(&t.proposal) {
-            bounds.learn(v, &t.why);
-        }
-    }
-    if let Some(v) = action.value(&param.name) {
-        bounds.learn(v, error);
-    }
+    let mut bounds = bounds_for(param, tried, action, error);
     let unit = param.unit.as_deref().unwrap_or("");
     let summary = bounds.summary(unit);
     let tried_lines: Vec<String> = tried.iter().map(ToString::to_string).collect();
