@@ -108,9 +108,6 @@ impl Engine {
                 error: error.clone(),
             })
         });
-        let scene_was_wrong = failed
-            .as_ref()
-            .is_some_and(|f| scene_was_wrong_about(&found, &f.action));
         // Where the failed action failed: in the executor (reality), or in betr's world
         // (the world itself, or the twin refusing before anything was sent).
         let failed_in = failed.as_ref().and_then(|f| {
@@ -118,6 +115,12 @@ impl Engine {
             let reality = self.run.reality.as_ref().filter(|_| in_reality)?;
             Some(reality.name().to_string())
         });
+        // Reality showed one of its objects elsewhere than the scene: the scene was wrong,
+        // not the tree (a grasp planned at the scene's pose that closed on nothing).
+        let scene_was_wrong = failed_in.is_some()
+            && failed
+                .as_ref()
+                .is_some_and(|f| f.action.args.iter().any(|a| found.learned.contains(a)));
         self.run.last = Some(record.clone());
         self.emit(Event::Ticked {
             record: record.clone(),
@@ -330,12 +333,4 @@ impl Engine {
             );
         }
     }
-}
-
-/// Whether a tick's failure of `action` is reality disagreeing with the twin about where
-/// one of the action's objects lay from the start (a grasp planned at the scene's pose
-/// that closed on nothing), not something the tree lacks.
-fn scene_was_wrong_about(found: &Findings, action: &crate::domain::ActionCall) -> bool {
-    found.diverged.iter().any(|d| d.action == *action)
-        && action.args.iter().any(|a| found.learned.contains(a))
 }
