@@ -67,7 +67,7 @@ def quat_xyzw(wxyz):
     return [float(x), float(y), float(z), float(w)]
 
 
-def add_parts(body, parts, friction, rgba, contype, conaffinity, density_mass=None):
+def add_parts(body, parts, friction, rgba, contype, conaffinity):
     for part in parts:
         geom = body.add_geom()
         geom.pos = part["position"]
@@ -257,8 +257,6 @@ class Cell:
             return
         body.add_freejoint().name = f"free:{name}"
         add_parts(body, obj["parts"], obj["friction"], [0.3, 0.4, 0.8, 1], 1, 1 | ROBOT_GROUP)
-        body.mass = obj["mass"]
-        body.explicitinertial = False
         for geom in body.geoms:
             geom.density = 0  # the mass below is the body's
         body.mass = obj["mass"]
@@ -333,6 +331,17 @@ class Cell:
         mujoco.mju_mulQuat(q, base_q, np.array(quat_wxyz(local["rotation"]), dtype=float))
         self.data.mocap_pos[mocap] = base_pos + pos
         self.data.mocap_quat[mocap] = q
+
+    def set_pose(self, name, seen):
+        """Put `name` at the pose `seen` (an observation's), just above it, at rest."""
+        m, d = self.model, self.data
+        j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"free:{name}")
+        adr = m.jnt_qposadr[j]
+        d.qpos[adr : adr + 3] = seen["position"]
+        d.qpos[adr + 2] += 0.002
+        d.qpos[adr + 3 : adr + 7] = quat_wxyz(seen["rotation"])
+        d.qvel[m.jnt_dofadr[j] : m.jnt_dofadr[j] + 6] = 0
+        mujoco.mj_forward(m, d)
 
     def converge(self, arm, watch):
         """Hold the arm's targets until it is within CONVERGED of them (at most
@@ -585,18 +594,6 @@ class Action:
             cell.data.ctrl[a] = cell.data.qpos[adr]
 
 
-def set_pose(self, name, seen):
-    m, d = self.model, self.data
-    j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"free:{name}")
-    adr = m.jnt_qposadr[j]
-    d.qpos[adr : adr + 3] = seen["position"]
-    d.qpos[adr + 2] += 0.002
-    d.qpos[adr + 3 : adr + 7] = quat_wxyz(seen["rotation"])
-    d.qvel[m.jnt_dofadr[j] : m.jnt_dofadr[j] + 6] = 0
-    mujoco.mj_forward(m, d)
-
-
-Cell.set_pose = set_pose
 
 
 def log(cell, action, result):
