@@ -43,6 +43,12 @@ pub enum EvalExperiment {
         /// of its own, and print them side by side; --dataset and --scenario are not used.
         #[arg(long, value_name = "FILE")]
         suite: Option<PathBuf>,
+        /// Read every set twice: first as the product reads, then each request again with
+        /// every other request's miss kept as a person's correction (its gold goal), as
+        /// betr keeps corrections for later requests of the domain (never its own). The
+        /// second pass goes to `second-pass/` and is reported beside the first.
+        #[arg(long, conflicts_with = "answers")]
+        learn: bool,
         #[command(flatten)]
         run: RunFlags,
     },
@@ -133,17 +139,19 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
             answers: None,
             suite: Some(suite),
             runs,
+            learn,
             run,
             ..
-        } => goals_suite(&suite, runs, &run),
+        } => goals_suite(&suite, runs, learn, &run),
         EvalExperiment::Goals {
             dataset,
             answers: None,
             scenario,
             runs,
+            learn,
             run,
             suite: None,
-        } => goals_with_model(&dataset, &scenario, runs, &run),
+        } => goals_with_model(&dataset, &scenario, (runs, learn), &run),
         EvalExperiment::Resolve {
             runs,
             max_rounds,
@@ -256,7 +264,7 @@ fn goals_chart(
 pub fn goals_with_model(
     dataset_dir: &Path,
     scenario_path: &Path,
-    runs: usize,
+    (runs, learn): (usize, bool),
     flags: &RunFlags,
 ) -> Result<ExitCode> {
     let cases = load_dataset(dataset_dir)?;
@@ -270,9 +278,10 @@ pub fn goals_with_model(
         .map(|case| goals_run::SceneCase {
             scenario: &scenario,
             case: case.clone(),
+            examples: None,
         })
         .collect();
-    goal_set(&p, &in_scene, runs, flags, &dir)?;
+    goal_set(&p, &in_scene, (runs, learn), flags, &dir)?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -281,10 +290,49 @@ pub fn goals_with_model(
 fn goal_set(
     p: &super::eval_setup::Prepared,
     cases: &[goals_run::SceneCase],
+    (runs, learn): (usize, bool),
+    flags: &RunFlags,
+    dir: &Path,
+) -> Result<goals::GoalsResults> {
+    let mut results = read_set(p, cases, runs, flags, dir)?;
+    if learn {
+        let pool = p.llm.options.steps.prompt.examples.as_deref();
+        let second = goals_run::with_corrections(cases, &results, pool);
+        let second_dir = dir.join("second-pass");
+        eprintln!(
+            "second pass: {} request(s), {} correction(s) kept",
+            second.len(),
+            results.cases.iter().filter(|c| !c.correct).count()
+        );
+        let second_results = read_set(p, &second, runs, flags, &second_dir)?;
+        write(
+            &second_dir,
+            "results.json",
+            serde_json::to_string_pretty(&second_results)?.as_bytes(),
+        )?;
+        results.second_pass = Some(second_results.tallies());
+    }
+    let table = goals_run::table(
+        &results,
+        &p.label,
+        p.llm.options.temperature,
+        runs.max(1) * cases.len(),
+    );
+    write_all(dir, &results, &results.csv(), &table, || {
+        goals_chart(dir, &p.label, &results)
+    })?;
+    Ok(results)
+}
+
+/// The cases read into `dir`'s journal (resumed), its results written there too.
+fn read_set(
+    p: &super::eval_setup::Prepared,
+    cases: &[goals_run::SceneCase],
     runs: usize,
     flags: &RunFlags,
     dir: &Path,
 ) -> Result<goals::GoalsResults> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     eval::run::check_settings(dir, "goals", &p.settings)?;
     let model: Arc<dyn LanguageModel> = p.llm.model.clone();
     let bar = Bar::new();
@@ -305,21 +353,12 @@ fn goal_set(
             dir,
         ))
         .with_context(|| stopped(dir))?;
-    let table = goals_run::table(
-        &results,
-        &p.label,
-        p.llm.options.temperature,
-        cfg.runs * cases.len(),
-    );
-    write_all(dir, &results, &results.csv(), &table, || {
-        goals_chart(dir, &p.label, &results)
-    })?;
     Ok(results)
 }
 
 /// `betr eval goals --suite FILE`: every set of the suite, each into `OUT/<set>/` (resumed
 /// like a single run), then the sets side by side in `OUT/suite.md`.
-fn goals_suite(suite: &Path, runs: usize, flags: &RunFlags) -> Result<ExitCode> {
+fn goals_suite(suite: &Path, runs: usize, learn: bool, flags: &RunFlags) -> Result<ExitCode> {
     let sets = eval::suite::load(suite)?;
     let p = prepare(flags, &[("suite", suite.display().to_string())])?;
     let dir = eval::output_dir(flags.out.as_deref(), "goals-suite")
@@ -337,9 +376,10 @@ fn goals_suite(suite: &Path, runs: usize, flags: &RunFlags) -> Result<ExitCode> 
             .map(|(scene, case)| goals_run::SceneCase {
                 scenario: &set.scenes[*scene],
                 case: case.clone(),
+                examples: None,
             })
             .collect();
-        let results = goal_set(&p, &cases, runs, flags, &set_dir)?;
+        let results = goal_set(&p, &cases, (runs, learn), flags, &set_dir)?;
         done.push((set.name.clone(), set.tuned, results));
     }
     let rows: Vec<eval::suite::SetRow> = done

@@ -70,7 +70,8 @@ impl KnowledgeFlags {
             return Ok(None);
         };
         let (applied, notes) = knowledge.apply(scenario);
-        for note in &notes {
+        let (examples, example_notes) = knowledge.apply_examples(scenario);
+        for note in notes.iter().chain(&example_notes) {
             errln!("Knowledge: {note}");
         }
         if !applied.is_empty() {
@@ -79,6 +80,14 @@ impl KnowledgeFlags {
                 applied.len(),
                 knowledge.path.display(),
                 applied.join(", ")
+            );
+        }
+        if !examples.is_empty() {
+            errln!(
+                "Knowledge: {} kept example(s) of corrected readings from {} ({}); --no-knowledge reads without them",
+                examples.len(),
+                knowledge.examples.path.display(),
+                examples.join(", ")
             );
         }
         Ok(Some(knowledge))

@@ -162,6 +162,7 @@ fn read_examples(path: &Path) -> Result<Vec<Example>> {
         .map(|r| Example {
             instruction: r.instruction,
             goal: r.goal,
+            source: Default::default(),
         })
         .collect())
 }

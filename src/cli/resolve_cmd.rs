@@ -176,9 +176,7 @@ fn interpret(
     ));
     print_usage(&llm.model);
     let reading = result?;
-    if let Some(why) = &reading.doubt {
-        outln!("note: kept with a doubt: {why}");
-    }
+    outln!("Doubt:       {}", reading.evidence.summary());
     outln!(
         "{} call(s), {} feedback round(s)",
         reading.calls,

@@ -50,6 +50,10 @@ pub struct CaseResult {
     /// Whether the gold goal is among the readings offered.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gold_in_readings: Option<bool>,
+    /// What was found for and against the answer, whose doubt level the calibration
+    /// counts (the level is summed up again when results are read, by the rule in use).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub evidence: Option<crate::session::interpret::doubt::Evidence>,
 }
 
 fn first_run() -> usize {
@@ -84,7 +88,75 @@ pub struct GoalsResults {
     /// Calls, tokens, cost and latency, when the answers came from a model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub usage: Option<UsageSummary>,
+    /// With `--learn`: the answers of the second pass, each request read with every other
+    /// request's correction kept as an example of the domain.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub second_pass: Option<PassTallies>,
+    /// How often the doubt level marked a wrong answer, and a right one, when the cases
+    /// recorded their evidence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub doubt: Option<DoubtCalibration>,
     pub cases: Vec<CaseResult>,
+}
+
+/// The answers right per difficulty, of one pass over a set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct PassTallies {
+    pub easy: Tally,
+    pub medium: Tally,
+    pub hard: Tally,
+}
+
+impl PassTallies {
+    pub fn overall(&self) -> Tally {
+        Tally {
+            correct: self.easy.correct + self.medium.correct + self.hard.correct,
+            total: self.easy.total + self.medium.total + self.hard.total,
+        }
+    }
+}
+
+/// The doubt level against the answers: of the wrong answers, those marked doubtful; of
+/// the right ones, those marked doubtful too.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DoubtCalibration {
+    pub wrong_marked: Tally,
+    pub right_marked: Tally,
+}
+
+impl DoubtCalibration {
+    /// Counted over the cases that recorded their evidence, by the doubt rule in use.
+    pub fn of<'a>(cases: impl IntoIterator<Item = &'a CaseResult>) -> Option<DoubtCalibration> {
+        let mut out = DoubtCalibration::default();
+        let mut any = false;
+        for c in cases {
+            let Some(evidence) = &c.evidence else {
+                continue;
+            };
+            any = true;
+            let marked = evidence.level() == crate::session::interpret::doubt::Level::Doubtful;
+            let tally = if c.correct {
+                &mut out.right_marked
+            } else {
+                &mut out.wrong_marked
+            };
+            tally.total += 1;
+            tally.correct += usize::from(marked);
+        }
+        any.then_some(out)
+    }
+
+    /// The two counts added up with another set's.
+    pub fn add(self, other: DoubtCalibration) -> DoubtCalibration {
+        let sum = |a: Tally, b: Tally| Tally {
+            correct: a.correct + b.correct,
+            total: a.total + b.total,
+        };
+        DoubtCalibration {
+            wrong_marked: sum(self.wrong_marked, other.wrong_marked),
+            right_marked: sum(self.right_marked, other.right_marked),
+        }
+    }
 }
 
 /// The tallies of one run.
@@ -142,6 +214,7 @@ pub fn score(vocabulary: &Vocabulary, case: &Case, answer: Option<&str>) -> Case
         first_correct: None,
         readings: Vec::new(),
         gold_in_readings: None,
+        evidence: None,
         feedback_rounds: 0,
     }
 }
@@ -233,7 +306,18 @@ impl GoalsResults {
             hard: tally(None, Difficulty::Hard),
             runs,
             usage: (!calls.is_empty()).then(|| UsageSummary::of(calls)),
+            second_pass: None,
+            doubt: DoubtCalibration::of(&cases),
             cases,
+        }
+    }
+
+    /// The answers right per difficulty.
+    pub fn tallies(&self) -> PassTallies {
+        PassTallies {
+            easy: self.easy,
+            medium: self.medium,
+            hard: self.hard,
         }
     }
 

@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use crate::dataset::{Case, Difficulty};
 use crate::llm::LanguageModel;
-use crate::scenario::Scenario;
+use crate::scenario::{Example, ExampleSource, Scenario};
 use crate::session::{self, Event, Options};
 use crate::world::World;
 
@@ -34,6 +34,7 @@ pub async fn run_goals(
         .map(|case| SceneCase {
             scenario,
             case: case.clone(),
+            examples: None,
         })
         .collect();
     run_goals_in_scenes(model, &in_scene, options, cfg, dir).await
@@ -43,6 +44,58 @@ pub async fn run_goals(
 pub struct SceneCase<'a> {
     pub scenario: &'a Scenario,
     pub case: Case,
+    /// The example pool its prompt chooses from, when not the options' or the scene's.
+    pub examples: Option<Vec<Example>>,
+}
+
+/// The cases of a second pass that learns from the first (`--learn`): each case's pool is
+/// its scene's (or `pool`, when the run replaces the scene's) with every other case's
+/// miss of `first` kept as a person would correct it, the instruction with its gold goal,
+/// never the case's own. A correction is kept for the cases of the same domain whose scene
+/// has every object its goal names.
+pub fn with_corrections<'a>(
+    cases: &[SceneCase<'a>],
+    first: &GoalsResults,
+    pool: Option<&[Example]>,
+) -> Vec<SceneCase<'a>> {
+    let misses: Vec<(&SceneCase, String)> = cases
+        .iter()
+        .filter(|c| {
+            first.cases.iter().any(|r| {
+                !r.correct && r.difficulty == c.case.difficulty.as_str() && r.index == c.case.index
+            })
+        })
+        .map(|c| {
+            let id = format!("{}#{}", c.case.difficulty.as_str(), c.case.index + 1);
+            (c, id)
+        })
+        .collect();
+    cases
+        .iter()
+        .map(|c| {
+            let domain = crate::session::knowledge::domain_of(c.scenario);
+            let mut examples: Vec<Example> = pool.unwrap_or(&c.scenario.examples).to_vec();
+            for (miss, id) in &misses {
+                let own = miss.case.difficulty == c.case.difficulty && miss.case.index == c.case.index;
+                if own
+                    || crate::session::knowledge::domain_of(miss.scenario) != domain
+                    || c.scenario.parse_goal(&miss.case.gold).is_err()
+                {
+                    continue;
+                }
+                examples.push(Example {
+                    instruction: miss.case.instruction.clone(),
+                    goal: miss.case.gold.clone(),
+                    source: ExampleSource::Kept(id.clone()),
+                });
+            }
+            SceneCase {
+                scenario: c.scenario,
+                case: c.case.clone(),
+                examples: Some(examples),
+            }
+        })
+        .collect()
 }
 
 /// [`run_goals`] with each case in its own scene (a domain's scenario files, each with
@@ -78,11 +131,14 @@ pub async fn run_goals_in_scenes(
         &journal,
         |c: &CaseResult| format!("run {} {} #{}", c.run, c.difficulty, c.index + 1),
         |(run, c)| {
-            let options = &options;
+            let mut options = options.clone();
+            if let Some(pool) = &c.examples {
+                options.steps.prompt.examples = Some(pool.clone());
+            }
             async move {
                 // Each instruction is read against its scenario's first state.
                 let world = crate::world::load(c.scenario)?;
-                ask_one(model, c.scenario, world, &c.case, run, options, cfg).await
+                ask_one(model, c.scenario, world, &c.case, run, &options, cfg).await
             }
         },
     )
@@ -113,7 +169,7 @@ async fn ask_one(
     let mut result = match reading {
         Ok(r) => {
             let mut result = score(vocabulary, case, Some(&r.answer.goal.to_string()));
-            let first = r.first.map(|f| f.to_string());
+            let first = r.first.as_ref().map(|f| f.to_string());
             result.first_correct = Some(is_correct(vocabulary, case, first.as_deref()));
             result.first_answer = first;
             result.feedback_rounds = r.feedback_rounds;
@@ -124,9 +180,10 @@ async fn ask_one(
                     .iter()
                     .any(|g| is_correct(vocabulary, case, Some(g))),
             );
-            if let Some(why) = r.doubt {
+            if let Some(why) = r.doubt() {
                 result.problem = Some(format!("kept with a doubt: {why}"));
             }
+            result.evidence = Some(r.evidence);
             result
         }
         // No usable reply at all is a wrong answer, not an error that stops the run.
@@ -206,6 +263,10 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
         (
             "gold among the readings offered",
             results.gold_in_readings(),
+        ),
+        (
+            "second pass, every other request's miss kept as a correction",
+            results.second_pass.map(|p| [p.easy, p.medium, p.hard]),
         ),
     ] {
         let Some([easy, medium, hard]) = tallies else {
@@ -289,6 +350,12 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
             calls as f64 / cases,
             percentile(&per_instruction, 50.0),
             percentile(&per_instruction, 95.0),
+        ));
+    }
+    if let Some(d) = &results.doubt {
+        notes.push(format!(
+            "Doubt: {} of {} wrong answers marked doubtful, {} of {} right ones.",
+            d.wrong_marked.correct, d.wrong_marked.total, d.right_marked.correct, d.right_marked.total
         ));
     }
     if let Some(u) = &results.usage {

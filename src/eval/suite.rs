@@ -281,6 +281,72 @@ pub fn table(rows: &[SetRow]) -> String {
             median,
         ));
     }
+    out.push_str(&learned_table(rows));
+    out
+}
+
+/// With `--learn` or recorded evidence: per set the answers right in the first pass and
+/// in the second (every other request's miss kept as a correction), and how the doubt
+/// level marked wrong and right answers; the doubt over every set last.
+fn learned_table(rows: &[SetRow]) -> String {
+    let learned = rows.iter().any(|r| r.results.second_pass.is_some());
+    let doubts = rows.iter().any(|r| r.results.doubt.is_some());
+    if !learned && !doubts {
+        return String::new();
+    }
+    let cell = |t: Tally| format!("{:.1}% ({}/{})", t.percent(), t.correct, t.total);
+    let share = |t: Tally| {
+        if t.total == 0 {
+            "–".to_string()
+        } else {
+            format!("{:.0}", t.percent())
+        }
+    };
+    let by_difficulty = |p: &super::goals::PassTallies| {
+        format!(
+            "{} / {} / {} %",
+            share(p.easy),
+            share(p.medium),
+            share(p.hard)
+        )
+    };
+    let mut out = String::from(
+        "\n| set | first pass (easy / medium / hard) | first pass | corrections kept | second pass (easy / medium / hard) | second pass | wrong answers marked doubtful | right answers marked doubtful |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    let mut all = super::goals::DoubtCalibration::default();
+    for row in rows {
+        let r = row.results;
+        let first = r.tallies();
+        let (second_by, second) = r.second_pass.as_ref().map_or_else(
+            || ("–".to_string(), "–".to_string()),
+            |p| (by_difficulty(p), cell(p.overall())),
+        );
+        let (wrong, right) = r.doubt.map_or_else(
+            || ("–".to_string(), "–".to_string()),
+            |d| (cell(d.wrong_marked), cell(d.right_marked)),
+        );
+        if let Some(d) = r.doubt {
+            all = all.add(d);
+        }
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {second_by} | {second} | {wrong} | {right} |\n",
+            row.name,
+            by_difficulty(&first),
+            cell(first.overall()),
+            if r.second_pass.is_some() {
+                r.cases.iter().filter(|c| !c.correct).count().to_string()
+            } else {
+                "–".to_string()
+            },
+        ));
+    }
+    if doubts {
+        out.push_str(&format!(
+            "| every set | | | | | | {} | {} |\n",
+            cell(all.wrong_marked),
+            cell(all.right_marked)
+        ));
+    }
     out
 }
 

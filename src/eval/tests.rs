@@ -166,6 +166,7 @@ fn the_goals_table_gives_the_time_a_person_waits_per_instruction() {
         feedback_rounds: 0,
         readings: Vec::new(),
         gold_in_readings: None,
+        evidence: None,
     };
     // Three instructions: one call of 4 s, two calls of 1 + 2 s, three calls of 2 s each.
     let cases = vec![
@@ -184,6 +185,8 @@ fn the_goals_table_gives_the_time_a_person_waits_per_instruction() {
         usage: Some(super::run::UsageSummary::of(
             cases.iter().flat_map(|c| &c.calls),
         )),
+        second_pass: None,
+        doubt: None,
         cases,
     };
     let table = super::goals_run::table(&results, "fake", 0.0, 3);

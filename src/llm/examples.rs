@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use crate::reading::Request;
 use crate::reading::words::terms;
-use crate::scenario::Example;
+use crate::scenario::{Example, ExampleSource};
 
 /// BM25's usual constants: term-frequency saturation and length normalisation.
 const K1: f64 = 1.2;
@@ -120,7 +120,11 @@ pub fn from_scene_words(request: &Request, most: usize) -> Vec<Example> {
         if let Some(first) = instruction.get(..1) {
             instruction = first.to_uppercase() + &instruction[1..];
         }
-        made.push(Example { instruction, goal });
+        made.push(Example {
+            instruction,
+            goal,
+            source: ExampleSource::Made,
+        });
         if made.len() == most {
             return made;
         }
@@ -142,6 +146,7 @@ pub fn from_scene_words(request: &Request, most: usize) -> Vec<Example> {
         made.push(Example {
             instruction: format!("{item} {phrase} {place}."),
             goal,
+            source: ExampleSource::Made,
         });
         if made.len() == most {
             break;
@@ -158,6 +163,7 @@ mod tests {
         Example {
             instruction: instruction.into(),
             goal: goal.into(),
+            source: Default::default(),
         }
     }
 

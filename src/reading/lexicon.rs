@@ -294,6 +294,7 @@ mod tests {
         Example {
             instruction: instruction.into(),
             goal: goal.into(),
+            source: Default::default(),
         }
     }
 
@@ -359,6 +360,7 @@ mod tests {
         let example = |instruction: &str, goal: &str| Example {
             instruction: instruction.into(),
             goal: goal.into(),
+            source: Default::default(),
         };
         let once = [example(
             "I'm sitting by the window, a soda please",

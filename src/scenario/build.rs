@@ -255,6 +255,7 @@ fn examples(
             Ok(Example {
                 instruction: e.instruction.clone(),
                 goal: e.goal.get_ref().clone(),
+                source: Default::default(),
             })
         })
         .collect()

@@ -37,6 +37,30 @@ pub struct SourceFile {
 pub struct Example {
     pub instruction: String,
     pub goal: String,
+    pub source: ExampleSource,
+}
+
+/// Where an example of a domain's pool comes from.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub enum ExampleSource {
+    /// Written in the scenario file.
+    #[default]
+    Written,
+    /// Made by betr from the domain itself, for a domain whose file has none.
+    Made,
+    /// A person's correction of a reading, kept (its id in the knowledge directory).
+    Kept(String),
+}
+
+impl Example {
+    /// An example as a scenario file writes it.
+    pub fn written(instruction: impl Into<String>, goal: impl Into<String>) -> Example {
+        Example {
+            instruction: instruction.into(),
+            goal: goal.into(),
+            source: ExampleSource::Written,
+        }
+    }
 }
 
 /// What a request means in a domain beyond its vocabulary ("what is brought to the

@@ -105,7 +105,7 @@ impl Engine {
             );
             // Several readings that do different things, or one the checks doubt: a
             // person decides before anything runs.
-            let doubt = read.doubt.clone().filter(|_| readings.len() == 1);
+            let doubt = read.doubt().filter(|_| readings.len() == 1);
             if readings.len() > 1 || doubt.is_some() {
                 self.emit(Event::Readings {
                     instruction: instruction.clone(),

@@ -42,6 +42,7 @@ fn a_condition_pasted_from_an_example_is_found() {
     let example = crate::scenario::Example {
         instruction: "Put the sponge in the bowl and leave your gripper empty".into(),
         goal: r#""sponge" in "bowl" & ~"any object" grasped"#.into(),
+        source: Default::default(),
     };
     let shown = [&example];
     let request = "Put the blue cube on the green cube";
@@ -64,6 +65,7 @@ fn a_pasted_conjunct_goes_only_when_the_rest_covers_the_request() {
     let example = crate::scenario::Example {
         instruction: "It's really stuffy in here, and leave your gripper empty".into(),
         goal: r#"Active_AC & ~"any object" grasped"#.into(),
+        source: Default::default(),
     };
     let shown = [&example];
     let pasted =

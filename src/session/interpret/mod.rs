@@ -13,6 +13,7 @@
 //! chosen goal's alternatives are put in the order the request names them, since a
 //! behavior tree tries them in that order.
 
+pub mod doubt;
 pub mod goal_checks;
 pub mod judge;
 mod parts;
@@ -51,13 +52,20 @@ pub struct Interpretation {
     pub calls: usize,
     /// Feedback rounds used (0: the first round's candidates sufficed).
     pub feedback_rounds: usize,
-    /// A doubt the checks raised about the chosen goal (it holds already, or a condition
-    /// of it comes from an example), for the person to look at before it runs.
-    pub doubt: Option<String>,
+    /// What speaks for and against the goal chosen, summed up in its doubt level: a
+    /// doubtful goal is for the person to look at before it runs.
+    pub evidence: doubt::Evidence,
     /// The distinct readings that passed the checks, the chosen one first, then the others
     /// by their votes (at most [`MAX_READINGS`]): what a person chooses among when they
     /// would make the robot do different things.
     pub readings: Vec<Formula>,
+}
+
+impl Interpretation {
+    /// Why the goal chosen is doubtful; `None` when its doubt is low.
+    pub fn doubt(&self) -> Option<String> {
+        self.evidence.doubt()
+    }
 }
 
 /// How many readings an interpretation offers at most.
@@ -131,7 +139,10 @@ fn announce(scenario: &Scenario, found: &Interpretation, emit: &mut (dyn FnMut(&
         .as_ref()
         .filter(|first| !goal::equivalent(first, chosen).unwrap_or(*first == chosen));
     emit_goal(scenario, &found.answer, first, emit);
-    if let Some(why) = &found.doubt {
+    emit(&Event::Notice {
+        message: found.evidence.summary(),
+    });
+    if let Some(why) = found.doubt() {
         emit(&Event::Notice {
             message: format!("check the goal before it runs: {why}"),
         });
@@ -178,6 +189,7 @@ pub(super) async fn read_goal(
         first: None,
         last_error: ReplyError::NoConditions,
         runners_up: Vec::new(),
+        margin: None,
     };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
@@ -192,12 +204,28 @@ pub(super) async fn read_goal(
             let answer = in_asked_order(answer, &lexicon, &judge, checks, emit);
             let others: Vec<&Candidate> = set_aside.iter().chain(&drawn.runners_up).collect();
             let readings = judge.readings(&answer.goal, &candidates, &others, MAX_READINGS);
+            let first = drawn.first.flatten();
+            let usable = candidates.iter().filter_map(|c| c.read.as_ref().ok());
+            let evidence = doubt::Evidence {
+                first_kept: first
+                    .as_ref()
+                    .is_some_and(|f| judge::same_goal(f, &answer.goal)),
+                margin: drawn.margin,
+                votes: usable
+                    .clone()
+                    .filter(|a| judge::same_goal(&a.goal, &answer.goal))
+                    .count(),
+                candidates: usable.count(),
+                feedback_rounds: round,
+                checked_doubt: doubt,
+                parts: 0,
+            };
             return Ok(Interpretation {
                 answer,
-                first: drawn.first.flatten(),
+                first,
                 calls: drawn.calls,
                 feedback_rounds: round,
-                doubt,
+                evidence,
                 readings,
             });
         }
@@ -231,6 +259,8 @@ struct Drawn {
     last_error: ReplyError,
     /// The model's runners-up to its first answer (beams), judged like any candidate.
     runners_up: Vec<Candidate>,
+    /// How far the first answer's beam is ahead of the best beam with another goal.
+    margin: Option<f64>,
 }
 
 impl Drawer<'_> {
@@ -302,6 +332,17 @@ async fn draw_round(
         let r = drawer.ask(messages, draw, draws, emit).await?;
         drawn.calls += 1;
         let first_draw = round == 0 && draw == 0;
+        if first_draw {
+            let beams: Vec<(Option<Formula>, f64)> = r
+                .ranked
+                .iter()
+                .map(|(text, score)| {
+                    let read = reply::goal(text, drawer.vocabulary, drawer.options.min_similarity);
+                    (read.ok().map(|a| a.goal), *score)
+                })
+                .collect();
+            drawn.margin = doubt::margin(&beams, judge::same_goal);
+        }
         if first_draw && checks {
             drawn.runners_up = r
                 .ranked

@@ -134,7 +134,10 @@ pub(super) async fn read_parts(
         feedback_rounds: read.iter().map(|r| r.feedback_rounds).max().unwrap_or(0),
         // A part's own doubt may not hold for the whole ("the light is off already" is
         // no doubt about "the light off and a tea on the bar"): the whole's is the one.
-        doubt: problem.map(|p| p.reason),
+        evidence: super::doubt::Evidence::joined(
+            &read.iter().map(|r| r.evidence.clone()).collect::<Vec<_>>(),
+            problem.map(|p| p.reason),
+        ),
         readings: vec![goal_read],
     }))
 }

@@ -18,6 +18,7 @@ use crate::domain::{ActionCall, Condition, LearnError, LearnedRule};
 use crate::scenario::Scenario;
 
 mod check;
+pub mod examples;
 
 pub use check::{Refusal, Unplannable, check_rule, domain_scenarios, offered_rule, rule_for_fix};
 
@@ -131,15 +132,23 @@ pub enum KnowledgeError {
         path: PathBuf,
         known: String,
     },
+    #[error("no kept example {id:?} in {} (examples: {known})", path.display())]
+    NoSuchExample {
+        id: String,
+        path: PathBuf,
+        known: String,
+    },
     #[error(transparent)]
     Learn(#[from] LearnError),
 }
 
-/// The rules kept so far, and where they live.
+/// The rules and the corrected readings kept so far, and where they live.
 #[derive(Debug, Clone)]
 pub struct Knowledge {
     pub path: PathBuf,
     pub rules: Vec<KeptRule>,
+    /// Corrections of readings kept as worked examples, in the same directory.
+    pub examples: examples::KeptExamples,
 }
 
 /// The domain a scenario belongs to: the stem of the base file of its `extends` chain.
@@ -157,15 +166,22 @@ impl Knowledge {
         policy_dir.join(FILE_NAME)
     }
 
-    /// Read the file; a missing file is no knowledge yet.
+    /// Read the file and the kept examples beside it; a missing file is no knowledge yet.
     pub fn open(path: &Path) -> Result<Knowledge, KnowledgeError> {
+        let examples = examples::KeptExamples::open(&path.with_file_name(examples::FILE_NAME))?;
+        Ok(Knowledge {
+            path: path.to_path_buf(),
+            rules: Knowledge::open_rules(path)?,
+            examples,
+        })
+    }
+
+    /// The rules of the knowledge file.
+    fn open_rules(path: &Path) -> Result<Vec<KeptRule>, KnowledgeError> {
         let text = match crate::store::read_text(path, crate::store::SMALL_FILE_BYTES) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                return Ok(Knowledge {
-                    path: path.to_path_buf(),
-                    rules: Vec::new(),
-                });
+                return Ok(Vec::new());
             }
             Err(source) => {
                 return Err(KnowledgeError::Read {
@@ -187,15 +203,30 @@ impl Knowledge {
                 ),
             });
         }
-        Ok(Knowledge {
-            path: path.to_path_buf(),
-            rules: file.rules,
-        })
+        Ok(file.rules)
     }
 
     /// The rules of `domain`.
     pub fn rules_of<'a>(&'a self, domain: &'a str) -> impl Iterator<Item = &'a KeptRule> + 'a {
         self.rules.iter().filter(move |r| r.domain == domain)
+    }
+
+    /// Add the kept examples of the scenario's domain that fit the scene to its example
+    /// pool. An example naming what the scene lacks is left out and said in the returned
+    /// notes, with each line of the examples' file that did not read; the ids added come
+    /// first.
+    pub fn apply_examples(&self, scenario: &mut Scenario) -> (Vec<String>, Vec<String>) {
+        let mut notes = self.examples.problems.clone();
+        let (kept, left_out) = self.examples.for_scenario(scenario);
+        notes.extend(left_out);
+        let mut added = Vec::new();
+        for example in kept {
+            if let crate::scenario::ExampleSource::Kept(id) = &example.source {
+                added.push(id.clone());
+            }
+            scenario.examples.push(example);
+        }
+        (added, notes)
     }
 
     /// Add the rules of the scenario's domain to its skills. A rule that does not fit this
@@ -304,7 +335,7 @@ impl Knowledge {
 
     /// The rules as the file holds them now.
     fn reread(&mut self) -> Result<(), KnowledgeError> {
-        self.rules = Knowledge::open(&self.path)?.rules;
+        self.rules = Knowledge::open_rules(&self.path)?;
         Ok(())
     }
 
