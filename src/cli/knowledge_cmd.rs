@@ -96,18 +96,20 @@ impl KnowledgeFlags {
 
 #[derive(Subcommand, Debug)]
 pub enum KnowledgeAction {
-    /// The kept rules, one per line: id, domain, the rule in words.
+    /// Everything kept, one per line: the rules (id r…, domain, the rule in words), then
+    /// the corrected readings kept as examples (id e…, domain, instruction → goal).
     List {
         #[command(flatten)]
         dir: PolicyDir,
     },
-    /// One rule with where it came from.
+    /// One rule or kept example with where it came from.
     Show {
         id: String,
         #[command(flatten)]
         dir: PolicyDir,
     },
-    /// Take a rule out: planning no longer adds it.
+    /// Take a rule or a kept example out: planning no longer adds the rule, reading no
+    /// longer shows the example.
     Revoke {
         id: String,
         #[command(flatten)]
@@ -125,9 +127,37 @@ pub fn run(action: KnowledgeAction) -> Result<ExitCode> {
             for r in &knowledge.rules {
                 outln!("{:<4} {:<6} {}", r.id, r.domain, words(r));
             }
+            let examples = &knowledge.examples;
+            if examples.examples.is_empty() {
+                outln!("No kept examples in {}", examples.path.display());
+            }
+            for e in &examples.examples {
+                outln!(
+                    "{:<4} {:<6} \u{ab}{}\u{bb} \u{2192} {}",
+                    e.id,
+                    e.domain,
+                    e.instruction,
+                    e.goal
+                );
+            }
+            for problem in &examples.problems {
+                errln!("warning: {problem}");
+            }
         }
         KnowledgeAction::Show { id, dir } => {
             let knowledge = dir.open()?;
+            if let Some(e) = knowledge.examples.examples.iter().find(|e| e.id == id) {
+                outln!("Example:     {}", e.id);
+                outln!("Domain:      {}", e.domain);
+                outln!("Instruction: {}", e.instruction);
+                outln!("Goal:        {}", e.goal);
+                if let Some(replaced) = &e.replaced {
+                    outln!("Replaced:    {replaced}");
+                }
+                outln!("From:        {} in {}", e.scenario, e.kept_at);
+                outln!("Kept by:     {}", e.kept_by);
+                return Ok(ExitCode::SUCCESS);
+            }
             let r = knowledge.get(&id)?;
             outln!("Rule:        {} ({})", r.id, words(r));
             outln!("Domain:      {}", r.domain);
@@ -140,6 +170,17 @@ pub fn run(action: KnowledgeAction) -> Result<ExitCode> {
             outln!("Fix:         {} before {}!", r.condition, r.action);
             outln!("Proposed by: {}", r.proposed_by);
             outln!("Kept by:     {}", r.kept_by);
+        }
+        KnowledgeAction::Revoke { id, dir } if id.starts_with('e') => {
+            let mut knowledge = dir.open()?;
+            let e = knowledge.examples.revoke(&id)?;
+            outln!(
+                "Revoked {} (\u{ab}{}\u{bb} \u{2192} {}) from {}",
+                e.id,
+                e.instruction,
+                e.goal,
+                knowledge.examples.path.display()
+            );
         }
         KnowledgeAction::Revoke { id, dir } => {
             let mut knowledge = dir.open()?;
@@ -183,6 +224,41 @@ fn words(r: &KeptRule) -> String {
         }
     };
     format!("{} needs {requires}", subject.trim_end())
+}
+
+/// The person chose reading `index` (from 0) of `readings` for `instruction`: when it was
+/// not the one offered first, keep it as a correction in the policy directory's examples
+/// and say so (or why not).
+pub fn keep_choice(
+    dir: &PolicyDir,
+    (scenario, scenario_path): (&Scenario, &std::path::Path),
+    instruction: &str,
+    readings: &[betr::session::Reading],
+    index: usize,
+) -> Result<()> {
+    let (Some(first), Some(chosen)) = (readings.first(), readings.get(index)) else {
+        return Ok(());
+    };
+    if index == 0 {
+        return Ok(());
+    }
+    let mut knowledge = dir.open()?;
+    match knowledge.examples.keep_correction(
+        (scenario, scenario_path),
+        (instruction, &chosen.goal),
+        Some(&first.goal),
+        "a person, choosing a reading not offered first (terminal)",
+    ) {
+        Ok((kept, _)) => outln!(
+            "Correction kept as example {} of the {} domain (in {}; betr knowledge revoke {} takes it out)",
+            kept.id,
+            kept.domain,
+            knowledge.examples.path.display(),
+            kept.id
+        ),
+        Err(e) => outln!("{e}"),
+    }
+    Ok(())
 }
 
 /// After a resolved session: offer each kept fix as a rule (asking unless `yes`), check

@@ -326,7 +326,20 @@ fn load(arg: &Path) -> Result<Scenario> {
 fn load_with(arg: &Path, knowledge: &knowledge_cmd::KnowledgeFlags) -> Result<Scenario> {
     let mut scenario = load(arg)?;
     knowledge.apply(&mut scenario)?;
+    with_made_examples(&mut scenario);
     Ok(scenario)
+}
+
+/// A scenario whose files write no worked examples reads with a pool made from its domain
+/// (said on stderr).
+fn with_made_examples(scenario: &mut Scenario) {
+    let made = betr::session::interpret::made_pool::fill(scenario);
+    if made > 0 {
+        errln!(
+            "Examples: {:?} writes none; {made} made from its domain, each replaced as corrections are kept",
+            scenario.name
+        );
+    }
 }
 
 /// The file a scenario argument names: a path as given, else a name under `scenarios/`

@@ -88,6 +88,8 @@ pub struct InterpretArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub reading: Option<u16>,
     #[command(flatten)]
+    pub knowledge: super::knowledge_cmd::KnowledgeFlags,
+    #[command(flatten)]
     pub llm: LlmFlags,
     #[command(flatten)]
     pub call: CallFlags,
@@ -97,7 +99,8 @@ pub struct InterpretArgs {
 
 /// `betr interpret`: the instruction typed or dictated, then read.
 pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
-    let scenario = super::load(&args.scenario)?;
+    let scenario_path = super::find_scenario(&args.scenario)?;
+    let scenario = super::load_with(&args.scenario, &args.knowledge)?;
     let instruction = super::voice_cmd::instruction(
         args.instruction.clone(),
         args.audio.as_deref(),
@@ -106,9 +109,9 @@ pub fn interpret_command(args: &InterpretArgs) -> Result<ExitCode> {
         args.yes,
     )?;
     interpret(
-        &scenario,
+        (&scenario, &scenario_path),
         instruction.as_deref(),
-        args.reading,
+        (args.reading, &args.knowledge.dir),
         (&args.llm, &args.call),
     )
 }
@@ -144,9 +147,9 @@ pub fn resolve_command(args: &ResolveFlags, glyphs: &Glyphs) -> Result<ExitCode>
 }
 
 fn interpret(
-    scenario: &Scenario,
+    (scenario, scenario_path): (&Scenario, &Path),
     instruction: Option<&str>,
-    chosen: Option<u16>,
+    (chosen, policies): (Option<u16>, &super::knowledge_cmd::PolicyDir),
     (flags, call): (&LlmFlags, &CallFlags),
 ) -> Result<ExitCode> {
     let instruction = instruction
@@ -202,8 +205,32 @@ fn interpret(
             anyhow::bail!("no reading {n}: the instruction has {count} (1 to {count})");
         };
         outln!("Goal (reading {n}): {goal}");
+        keep_choice(
+            policies,
+            (scenario, scenario_path),
+            &instruction,
+            &readings,
+            usize::from(n) - 1,
+        );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Keep a reading chosen that was not offered first as a correction, when there is a
+/// policy directory; a correction not kept never stops the command.
+fn keep_choice(
+    dir: &super::knowledge_cmd::PolicyDir,
+    scenario: (&Scenario, &Path),
+    instruction: &str,
+    readings: &[session::Reading],
+    index: usize,
+) {
+    if dir.dir().is_none() {
+        return;
+    }
+    if let Err(e) = super::knowledge_cmd::keep_choice(dir, scenario, instruction, readings, index) {
+        errln!("warning: the correction is not kept: {e:#}");
+    }
 }
 
 /// The readings to choose among, numbered from 1, each with its words, goal and first
@@ -339,8 +366,24 @@ fn resolve(
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
-    let mut choose =
-        |r: &[session::Reading], doubt: Option<&str>| choose_reading(r, doubt, args.reading, yes);
+    let said = args
+        .instruction
+        .or(scenario.instruction.as_deref())
+        .unwrap_or_default()
+        .to_string();
+    let mut choose = |r: &[session::Reading], doubt: Option<&str>| {
+        let chosen = choose_reading(r, doubt, args.reading, yes);
+        if let Some(index) = chosen {
+            keep_choice(
+                args.policies,
+                (scenario, args.scenario_path),
+                &said,
+                r,
+                index,
+            );
+        }
+        chosen
+    };
     let result = super::runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,

@@ -229,6 +229,7 @@ fn scenario_of(
         no_knowledge: args.no_knowledge,
     };
     let knowledge = knowledge_flags.apply(&mut scenario)?;
+    super::with_made_examples(&mut scenario);
     Ok((Arc::new(scenario), knowledge))
 }
 

@@ -76,7 +76,8 @@ pub fn with_corrections<'a>(
             let domain = crate::session::knowledge::domain_of(c.scenario);
             let mut examples: Vec<Example> = pool.unwrap_or(&c.scenario.examples).to_vec();
             for (miss, id) in &misses {
-                let own = miss.case.difficulty == c.case.difficulty && miss.case.index == c.case.index;
+                let own =
+                    miss.case.difficulty == c.case.difficulty && miss.case.index == c.case.index;
                 if own
                     || crate::session::knowledge::domain_of(miss.scenario) != domain
                     || c.scenario.parse_goal(&miss.case.gold).is_err()
@@ -355,7 +356,10 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
     if let Some(d) = &results.doubt {
         notes.push(format!(
             "Doubt: {} of {} wrong answers marked doubtful, {} of {} right ones.",
-            d.wrong_marked.correct, d.wrong_marked.total, d.right_marked.correct, d.right_marked.total
+            d.wrong_marked.correct,
+            d.wrong_marked.total,
+            d.right_marked.correct,
+            d.right_marked.total
         ));
     }
     if let Some(u) = &results.usage {

@@ -19,6 +19,7 @@ pub fn describe(event: &Event) -> Vec<String> {
             reasoning,
             matches_expected,
             first_answer,
+            doubt,
             ..
         } => {
             let check = match matches_expected {
@@ -36,6 +37,9 @@ pub fn describe(event: &Event) -> Vec<String> {
                     "  (the model answered {first} first; this goal is the one the \
                      request's words and the checks kept)"
                 ));
+            }
+            if let Some(doubt) = doubt {
+                lines.push(format!("  ({doubt})"));
             }
             lines
         }
@@ -264,6 +268,7 @@ mod tests {
             matches_expected: Some(true),
             author: "model".into(),
             first_answer: None,
+            doubt: None,
         };
         assert_eq!(
             describe(&event),

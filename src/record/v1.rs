@@ -274,6 +274,7 @@ impl Decoder {
                 reasoning: reasoning.clone(),
                 matches_expected: *matches_expected,
                 first_answer: None,
+                doubt: None,
             },
             Recorded::ActionFailed {
                 action,

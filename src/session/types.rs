@@ -423,6 +423,9 @@ pub enum Event {
         /// candidate voted for): said, so that no change to what the model wrote is silent.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         first_answer: Option<Formula>,
+        /// A model's reading: its doubt level and what it rests on, in one line.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        doubt: Option<String>,
     },
     /// The instruction has more than one reading that would make the robot do different
     /// things, or one the checks doubt (`doubt`, why): the person chooses one

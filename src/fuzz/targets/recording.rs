@@ -140,6 +140,7 @@ fn recording(rng: &mut Rng, scene: &(String, Arc<Scenario>, String)) -> String {
             matches_expected: Some(true),
             author: "model".into(),
             first_answer: None,
+            doubt: None,
         });
     }
     let near = Near {

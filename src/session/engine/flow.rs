@@ -23,6 +23,10 @@ const TYPED: &str = "a person, typed as a goal";
 const CHOSEN: &str = "a person, chosen among the model's readings";
 /// Who wrote a goal the caller gave with the instruction.
 const GIVEN: &str = "given with the instruction";
+/// Who kept a correction made by choosing a reading.
+const CORRECTED_BY_CHOICE: &str = "a person, choosing a reading not offered first";
+/// Who kept a correction made by typing the goal.
+const CORRECTED_BY_TYPING: &str = "a person, typing the goal the instruction meant";
 
 impl Engine {
     pub(super) fn submit_goal(&mut self, goal: crate::goal::Formula, instruction: String) {
@@ -48,6 +52,7 @@ impl Engine {
             matches_expected,
             author: author.to_string(),
             first_answer: None,
+            doubt: None,
         });
         self.task.goal = Some(Goal {
             formula: goal,
@@ -57,11 +62,30 @@ impl Engine {
     }
 
     pub(super) fn submit(&mut self, text: &str) {
+        // A goal typed while readings wait, or before the reading taken has run, is what
+        // the instruction meant.
+        let correcting = match &self.phase {
+            Phase::Choosing {
+                instruction,
+                readings,
+            } => Some((
+                instruction.clone(),
+                readings.first().map(|r| r.goal.clone()),
+            )),
+            _ => self.task.reading.clone().map(|(i, g)| (i, Some(g))),
+        };
         if matches!(self.phase, Phase::Choosing { .. }) {
             self.enter(self.settled());
         }
+        self.task.reading = None;
         let text = match submitted::read(&self.settings.scenario, text) {
-            Ok(Submitted::Goal(goal)) => return self.start_task(goal, None, TYPED),
+            Ok(Submitted::Goal(goal)) => {
+                let Some((instruction, replaced)) = correcting else {
+                    return self.start_task(goal, None, TYPED);
+                };
+                self.keep_correction(&instruction, &goal, replaced.as_ref(), CORRECTED_BY_TYPING);
+                return self.start_task(goal, Some(instruction), TYPED);
+            }
             Ok(Submitted::Instruction(text)) => text,
             Err(e) => return self.error(e.to_string()),
         };
@@ -119,10 +143,11 @@ impl Engine {
             }
         }
         self.task.goal = Some(Goal {
-            formula: read.answer.goal,
-            instruction: Some(instruction),
+            formula: read.answer.goal.clone(),
+            instruction: Some(instruction.clone()),
         });
         self.plan();
+        self.task.reading = Some((instruction, read.answer.goal));
     }
 
     /// Work on reading `index` (from 0) of those offered.
@@ -142,7 +167,16 @@ impl Engine {
             ));
         };
         let (goal, instruction) = (reading.goal.clone(), instruction.clone());
+        let offered_first = readings.first().map(|r| r.goal.clone());
         self.notice(format!("reading {} chosen: {goal}", index + 1));
+        if index > 0 {
+            self.keep_correction(
+                &instruction,
+                &goal,
+                offered_first.as_ref(),
+                CORRECTED_BY_CHOICE,
+            );
+        }
         self.start_task(goal, Some(instruction), CHOSEN);
     }
 
@@ -163,6 +197,7 @@ impl Engine {
             matches_expected: None,
             author: format!("policy {}", path.display()),
             first_answer: None,
+            doubt: None,
         });
         Some(goal)
     }

@@ -147,6 +147,47 @@ impl Engine {
         self.show_offer();
     }
 
+    /// Keep `goal` as what `instruction` means, a worked example of the domain for later
+    /// requests (this session's too), when the engine has a knowledge directory and the
+    /// goal is one the scene can plan; said either way.
+    pub(super) fn keep_correction(
+        &mut self,
+        instruction: &str,
+        goal: &crate::goal::Formula,
+        replaced: Option<&crate::goal::Formula>,
+        kept_by: &str,
+    ) {
+        let settings = &mut self.settings;
+        let Some(store) = self.learning.knowledge.as_mut() else {
+            return;
+        };
+        let kept = store.examples.keep_correction(
+            (&settings.scenario, &settings.scenario_path),
+            (instruction, goal),
+            replaced,
+            kept_by,
+        );
+        match kept {
+            Ok((kept, new)) => {
+                if new {
+                    let scenario = Arc::make_mut(&mut settings.scenario);
+                    scenario.examples.retain(|e| {
+                        !(e.instruction == kept.instruction
+                            && matches!(e.source, crate::scenario::ExampleSource::Kept(_)))
+                    });
+                    scenario.examples.push(kept.example());
+                    crate::session::interpret::made_pool::fill(scenario);
+                }
+                let path = store.examples.path.display().to_string();
+                self.notice(format!(
+                    "correction kept as example {} of the {} domain: \u{ab}{}\u{bb} \u{2192} {}; later requests like it are read with it ({path}; betr knowledge revoke {} takes it out)",
+                    kept.id, kept.domain, kept.instruction, kept.goal, kept.id
+                ));
+            }
+            Err(e) => self.notice(e.to_string()),
+        }
+    }
+
     /// Keep nothing of the first offer.
     pub(super) fn decline_rule(&mut self) {
         if self.learning.offers.is_empty() {

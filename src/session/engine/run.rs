@@ -77,6 +77,8 @@ impl Engine {
 
     /// One tick in the execution world.
     pub(super) fn tick(&mut self) {
+        // Once the tree runs, a goal typed is a new task, not a correction of the reading.
+        self.task.reading = None;
         let Some(tree) = &self.task.tree else {
             self.stop_running();
             return self.error("nothing to tick: submit an instruction or plan first");

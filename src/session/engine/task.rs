@@ -69,6 +69,9 @@ pub(super) struct Task {
     pub(super) saved: usize,
     /// The counts the front end was last told (`Event::FixCounts`).
     pub(super) told: FixCounts,
+    /// The instruction and the model's reading of it, while the goal worked on is that
+    /// reading and nothing has run: a goal typed now corrects it.
+    pub(super) reading: Option<(String, Formula)>,
 }
 
 impl Task {

@@ -216,6 +216,9 @@ mod tests {
         assert_eq!(joined.margin, Some(0.2));
         assert_eq!(joined.parts, 2);
         assert_eq!(joined.level(), Level::Doubtful);
-        assert_eq!(Evidence::joined(&[sure(), sure()], None).level(), Level::Low);
+        assert_eq!(
+            Evidence::joined(&[sure(), sure()], None).level(),
+            Level::Low
+        );
     }
 }

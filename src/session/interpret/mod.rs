@@ -16,6 +16,7 @@
 pub mod doubt;
 pub mod goal_checks;
 pub mod judge;
+pub mod made_pool;
 mod parts;
 pub mod readings;
 pub mod submitted;
@@ -138,10 +139,7 @@ fn announce(scenario: &Scenario, found: &Interpretation, emit: &mut (dyn FnMut(&
         .first
         .as_ref()
         .filter(|first| !goal::equivalent(first, chosen).unwrap_or(*first == chosen));
-    emit_goal(scenario, &found.answer, first, emit);
-    emit(&Event::Notice {
-        message: found.evidence.summary(),
-    });
+    emit_goal(scenario, found, first, emit);
     if let Some(why) = found.doubt() {
         emit(&Event::Notice {
             message: format!("check the goal before it runs: {why}"),
@@ -172,6 +170,7 @@ pub(super) async fn read_goal(
     let lexicon = Lexicon::new(vocabulary, example_pool(scenario, options));
     let request = Request::new(instruction, scenario, &lexicon);
     let mut judge = Judge::new(scenario, world, request, options, one_of_several)?;
+    tell_kept_examples(&judge.shown, emit);
     let drawer = Drawer {
         model,
         options,
@@ -238,6 +237,28 @@ pub(super) async fn read_goal(
         attempts: drawn.calls,
         last: drawn.last_error,
     })
+}
+
+/// Say which kept corrections the prompt shows as examples: a request phrased like a
+/// corrected one is read with its correction.
+fn tell_kept_examples(shown: &[&crate::scenario::Example], emit: &mut (dyn FnMut(&Event) + Send)) {
+    let kept: Vec<String> = shown
+        .iter()
+        .filter_map(|e| match &e.source {
+            crate::scenario::ExampleSource::Kept(id) => Some(format!(
+                "{id} (\u{ab}{}\u{bb} \u{2192} {})",
+                e.instruction, e.goal
+            )),
+            _ => None,
+        })
+        .collect();
+    if kept.is_empty() {
+        return;
+    }
+    tracing::info!(examples = %kept.join(", "), "kept examples shown to the model");
+    emit(&Event::Notice {
+        message: format!("read with the kept example(s) {}", kept.join(", ")),
+    });
 }
 
 /// What every draw of one reading shares: the model, the options, and the answer's format
@@ -465,10 +486,11 @@ fn in_asked_order(
 
 fn emit_goal(
     scenario: &Scenario,
-    answer: &GoalAnswer,
+    found: &Interpretation,
     first_answer: Option<&Formula>,
     emit: &mut (dyn FnMut(&Event) + Send),
 ) {
+    let answer = &found.answer;
     let matches_expected = scenario
         .goal
         .as_ref()
@@ -479,6 +501,7 @@ fn emit_goal(
         matches_expected,
         author: "model".into(),
         first_answer: first_answer.cloned(),
+        doubt: Some(found.evidence.summary()),
     });
 }
 

@@ -136,7 +136,10 @@ impl KeptExamples {
     /// Keep `example` (its id is given here): appended to the file as it is now, unless it
     /// holds the same instruction of the domain with the same goal already (that one is
     /// returned, not new); one with another goal is replaced by it.
-    pub fn keep(&mut self, mut example: KeptExample) -> Result<(KeptExample, bool), KnowledgeError> {
+    pub fn keep(
+        &mut self,
+        mut example: KeptExample,
+    ) -> Result<(KeptExample, bool), KnowledgeError> {
         let _lock = self.lock()?;
         self.reread()?;
         let same: Vec<&KeptExample> = self
@@ -160,13 +163,36 @@ impl KeptExamples {
             message: e.to_string(),
         })?;
         if same.is_empty() {
-            crate::store::append_line(&self.path, &line).map_err(|source| self.write_error(source))?;
+            crate::store::append_line(&self.path, &line)
+                .map_err(|source| self.write_error(source))?;
         } else {
             let replaced: Vec<String> = same.iter().map(|e| e.id.clone()).collect();
-            self.rewrite(|kept| kept.is_none_or(|k| !replaced.contains(&k.id)), Some(&line))?;
+            self.rewrite(
+                |kept| kept.is_none_or(|k| !replaced.contains(&k.id)),
+                Some(&line),
+            )?;
         }
         self.reread()?;
         Ok((example, true))
+    }
+
+    /// Keep a correction of `instruction` in `scenario` (`goal` run instead of
+    /// `replaced`) once [`check_correction`] passes; with whether it is new.
+    pub fn keep_correction(
+        &mut self,
+        (scenario, scenario_file): (&Scenario, &Path),
+        (instruction, goal): (&str, &Formula),
+        replaced: Option<&Formula>,
+        kept_by: &str,
+    ) -> Result<(KeptExample, bool), KnowledgeError> {
+        check_correction(scenario, instruction, goal)?;
+        self.keep(correction(
+            scenario,
+            scenario_file,
+            (instruction, goal),
+            replaced,
+            kept_by,
+        ))
     }
 
     /// Take an example out: later requests no longer see it.
@@ -315,7 +341,7 @@ pub fn check_correction(
 }
 
 /// A correction of `instruction` in `scenario`: `goal` run instead of `replaced`.
-pub fn correction(
+fn correction(
     scenario: &Scenario,
     scenario_file: &Path,
     (instruction, goal): (&str, &Formula),
@@ -363,16 +389,24 @@ mod tests {
         let path = KeptExamples::path_in(&d);
         let mut examples = KeptExamples::open(&path).unwrap();
         assert!(examples.examples.is_empty());
-        let (first, new) = examples.keep(kept("Draw the blinds", "~Closed_Curtain")).unwrap();
+        let (first, new) = examples
+            .keep(kept("Draw the blinds", "~Closed_Curtain"))
+            .unwrap();
         assert!(new);
         assert_eq!(first.id, "e1");
         // The same instruction with the same goal is not kept twice.
-        let (again, new) = examples.keep(kept("draw  the blinds", "~Closed_Curtain")).unwrap();
+        let (again, new) = examples
+            .keep(kept("draw  the blinds", "~Closed_Curtain"))
+            .unwrap();
         assert!(!new);
         assert_eq!(again.id, "e1");
-        examples.keep(kept("Coffee for table 2", "On_Coffee_Table2")).unwrap();
+        examples
+            .keep(kept("Coffee for table 2", "On_Coffee_Table2"))
+            .unwrap();
         // Another goal for the same instruction replaces the first.
-        let (third, _) = examples.keep(kept("Draw the blinds", "Closed_Curtain")).unwrap();
+        let (third, _) = examples
+            .keep(kept("Draw the blinds", "Closed_Curtain"))
+            .unwrap();
         assert_eq!(third.id, "e3");
         let read = KeptExamples::open(&path).unwrap();
         let ids: Vec<&str> = read.examples.iter().map(|e| e.id.as_str()).collect();
@@ -380,7 +414,13 @@ mod tests {
         examples.revoke("e2").unwrap();
         let read = KeptExamples::open(&path).unwrap();
         assert_eq!(read.examples.len(), 1);
-        assert!(examples.revoke("e9").unwrap_err().to_string().contains("e3"));
+        assert!(
+            examples
+                .revoke("e9")
+                .unwrap_err()
+                .to_string()
+                .contains("e3")
+        );
         std::fs::remove_dir_all(&d).unwrap();
     }
 
@@ -389,11 +429,15 @@ mod tests {
         let d = dir("bad");
         let path = KeptExamples::path_in(&d);
         let mut examples = KeptExamples::open(&path).unwrap();
-        examples.keep(kept("Draw the blinds", "~Closed_Curtain")).unwrap();
+        examples
+            .keep(kept("Draw the blinds", "~Closed_Curtain"))
+            .unwrap();
         let mut text = std::fs::read_to_string(&path).unwrap();
         text.push_str("{\"id\": \"e7\", hand-edited\n");
         std::fs::write(&path, &text).unwrap();
-        examples.keep(kept("Coffee for table 2", "On_Coffee_Table2")).unwrap();
+        examples
+            .keep(kept("Coffee for table 2", "On_Coffee_Table2"))
+            .unwrap();
         let read = KeptExamples::open(&path).unwrap();
         assert_eq!(read.examples.len(), 2);
         assert_eq!(read.problems.len(), 1);

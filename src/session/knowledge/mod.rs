@@ -140,6 +140,8 @@ pub enum KnowledgeError {
     },
     #[error(transparent)]
     Learn(#[from] LearnError),
+    #[error("the correction is not kept: {0}")]
+    NotKept(#[from] examples::NotKept),
 }
 
 /// The rules and the corrected readings kept so far, and where they live.

@@ -119,8 +119,10 @@ impl App {
                 reasoning,
                 author,
                 first_answer,
+                doubt,
                 ..
             } => {
+                self.llm.goal_doubt = doubt;
                 if let Some(first) = first_answer {
                     self.llm.log(format!(
                         "the model answered {first} first; the goal kept is {goal}, which the \

@@ -137,6 +137,8 @@ pub struct LlmPane {
     pub goal_by: Option<String>,
     /// The model's reasoning for the goal, when a model read it.
     pub goal_reasoning: Option<String>,
+    /// The doubt level of a model's reading and what it rests on.
+    pub goal_doubt: Option<String>,
     pub proposal: Option<ProposalView>,
     /// An approved fix offered as a rule, with the keys that answer it.
     pub offer: Option<String>,
@@ -320,6 +322,14 @@ impl LlmPane {
                 Span::raw(goal.clone()),
             ]));
             lines.push(Line::from(Span::styled(strings::goal_by(by), theme.dim)));
+            if let Some(doubt) = &self.goal_doubt {
+                let style = if doubt.starts_with("doubtful") {
+                    theme.failing
+                } else {
+                    theme.dim
+                };
+                lines.push(Line::from(Span::styled(format!("  {doubt}"), style)));
+            }
             // The goal's reasoning only while no proposal's is shown: one reasoning at a
             // time, each under what it is about.
             if let (Some(r), None) = (&self.goal_reasoning, &self.proposal) {

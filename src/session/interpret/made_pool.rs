@@ -1,0 +1,262 @@
+//! A first example pool made from the domain itself, for a scenario file that writes none.
+//!
+//! A user's new scenario usually has no worked examples, and a prompt without any shows
+//! the model neither the answer format nor how the domain's words map to its conditions.
+//! The made pool says plainly, in the scene's own words, goals its planner can reach from
+//! the scene's first state: each condition of the vocabulary that does not hold yet (or its
+//! opposite, where the scene lists words for it), with its objects called as the scene
+//! calls them, the conditions taken in turn so every predicate shows; then two of them
+//! joined by "and" and by "or" for the formula's shape. Made examples are marked as such,
+//! and each written or kept example takes one made example's place.
+
+use crate::domain::{Atom, Condition, Vocabulary};
+use crate::goal::Formula;
+use crate::planner::{Outcome, Planner};
+use crate::scenario::{Example, ExampleSource, Scenario};
+
+/// How many examples a domain's pool holds when made examples fill it.
+pub const MADE_POOL: usize = 12;
+
+/// How many conditions of one predicate are tried, at most, to find reachable ones.
+const TRIED_PER_PREDICATE: usize = 8;
+
+/// Fill `scenario`'s pool with made examples when it has no written ones, up to
+/// [`MADE_POOL`] with its kept examples; made examples it held before are taken out first.
+/// The number made.
+pub fn fill(scenario: &mut Scenario) -> usize {
+    scenario
+        .examples
+        .retain(|e| e.source != ExampleSource::Made);
+    if scenario
+        .examples
+        .iter()
+        .any(|e| e.source == ExampleSource::Written)
+    {
+        return 0;
+    }
+    let room = MADE_POOL.saturating_sub(scenario.examples.len());
+    if room == 0 {
+        return 0;
+    }
+    let made = made_pool(scenario, room);
+    let count = made.len();
+    scenario.examples.extend(made);
+    count
+}
+
+/// At most `most` examples made from `scenario`'s domain (see the module); none when its
+/// world cannot be built.
+pub fn made_pool(scenario: &Scenario, most: usize) -> Vec<Example> {
+    let Ok(world) = crate::world::load(scenario) else {
+        return Vec::new();
+    };
+    let vocabulary = &scenario.domain.vocabulary;
+    let planner = Planner::new(&scenario.domain);
+    let reachable = |goal: &Formula| {
+        planner
+            .plan(&goal.to_dnf(), world.as_ref())
+            .is_ok_and(|p| matches!(p.outcome, Outcome::Success | Outcome::ActionFailed { .. }))
+    };
+    let mut per_predicate: Vec<Vec<(Formula, String)>> = vocabulary
+        .predicates
+        .iter()
+        .map(|p| {
+            let mut found = Vec::new();
+            for atom in atoms_of(vocabulary, &p.name).take(TRIED_PER_PREDICATE) {
+                let holds = world.check(&Condition {
+                    atom: atom.clone(),
+                    negated: false,
+                });
+                let Some(said) = plainly(&atom, !holds, vocabulary) else {
+                    continue;
+                };
+                let goal = if holds {
+                    Formula::Not(Box::new(Formula::Atom(atom)))
+                } else {
+                    Formula::Atom(atom)
+                };
+                if reachable(&goal) {
+                    found.push((goal, said));
+                }
+            }
+            found
+        })
+        .collect();
+    // The predicates in turn, so each shows before any shows twice.
+    let mut singles: Vec<(Formula, String)> = Vec::new();
+    while singles.len() < most && per_predicate.iter().any(|p| !p.is_empty()) {
+        for found in per_predicate.iter_mut().filter(|p| !p.is_empty()) {
+            singles.push(found.remove(0));
+        }
+    }
+    let mut made: Vec<Example> = Vec::new();
+    // Two of different predicates joined, when the pool has room: the shape of "and"
+    // and "or" goals.
+    let other = singles.first().and_then(|(a, _)| {
+        singles
+            .iter()
+            .position(|(b, _)| predicate_of(b) != predicate_of(a))
+    });
+    if let Some(j) = other.filter(|_| most >= 4) {
+        let ((a, said_a), (b, said_b)) = (&singles[0], &singles[j]);
+        let both = Formula::and(vec![a.clone(), b.clone()]);
+        if reachable(&both) {
+            made.push(example(&format!("{said_a} and {}", lower(said_b)), &both));
+        }
+        let either = Formula::or(vec![a.clone(), b.clone()]);
+        made.push(example(&format!("{said_a} or {}", lower(said_b)), &either));
+    }
+    let room = most.saturating_sub(made.len());
+    let mut out: Vec<Example> = singles
+        .iter()
+        .take(room)
+        .map(|(goal, said)| example(said, goal))
+        .collect();
+    out.extend(made);
+    out
+}
+
+fn example(said: &str, goal: &Formula) -> Example {
+    Example {
+        instruction: format!("{said}."),
+        goal: goal.to_string(),
+        source: ExampleSource::Made,
+    }
+}
+
+fn predicate_of(goal: &Formula) -> Option<&str> {
+    match goal {
+        Formula::Atom(a) => Some(&a.predicate),
+        Formula::Not(inner) => predicate_of(inner),
+        _ => None,
+    }
+}
+
+fn lower(text: &str) -> String {
+    let mut chars = text.chars();
+    chars
+        .next()
+        .map(|c| c.to_lowercase().chain(chars).collect())
+        .unwrap_or_default()
+}
+
+/// The ground atoms of `predicate`, an object never twice in one.
+fn atoms_of<'a>(vocabulary: &'a Vocabulary, predicate: &'a str) -> impl Iterator<Item = Atom> + 'a {
+    vocabulary
+        .ground_atoms()
+        .into_iter()
+        .filter(move |a| a.predicate == predicate)
+        .filter(|a| {
+            let mut args = a.args.clone();
+            args.sort_unstable();
+            args.windows(2).all(|w| w[0] != w[1])
+        })
+}
+
+/// `atom` (or, when not `wanted`, its opposite) said plainly: the scene's first phrase for
+/// the condition or its opposite with the objects as the scene calls them ("Close the
+/// curtain", "Coffee to table 2"); else the predicate's description with its objects put
+/// in, for a wanted condition ("Make sure "Chips" is at "Table3""). `None` for an opposite
+/// the scene lists no words for.
+pub fn plainly(atom: &Atom, wanted: bool, vocabulary: &Vocabulary) -> Option<String> {
+    let predicate = vocabulary.predicate(&atom.predicate)?;
+    let (says, opposite) = (&predicate.words.says, &predicate.words.opposite);
+    let called = |name: &String| {
+        vocabulary
+            .object(name)
+            .and_then(|o| o.called.first())
+            .map_or_else(|| name.clone(), |c| format!("the {c}"))
+    };
+    let phrase = if wanted {
+        says.first()
+    } else {
+        opposite.first()
+    };
+    let said = match (phrase, atom.args.as_slice()) {
+        (Some(p), [one]) => format!("{p} {}", called(one)),
+        (Some(p), [item, place]) => format!("{} {p} {}", called(item), called(place)),
+        (None, _) if wanted => {
+            let words = super::readings::in_words(&Formula::Atom(atom.clone()), vocabulary);
+            format!("make sure {words}")
+        }
+        _ => return None,
+    };
+    Some(capitalised(&said))
+}
+
+fn capitalised(text: &str) -> String {
+    let mut chars = text.chars();
+    chars
+        .next()
+        .map(|c| c.to_uppercase().chain(chars).collect())
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cafe() -> Scenario {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
+        Scenario::load(&path).expect("cafe scenario")
+    }
+
+    #[test]
+    fn a_pool_without_written_examples_is_made_from_the_domain() {
+        let mut scenario = cafe();
+        assert_eq!(fill(&mut scenario), 0, "a written pool is left as it is");
+        scenario.examples.clear();
+        let made = fill(&mut scenario);
+        assert!(made > 4 && made <= MADE_POOL, "{made}");
+        assert!(
+            scenario
+                .examples
+                .iter()
+                .all(|e| e.source == ExampleSource::Made)
+        );
+        // Every goal is of the scene and reachable, and the pool shows "and" and "or".
+        for e in &scenario.examples {
+            let goal = scenario.parse_goal(&e.goal).expect("a goal of the scene");
+            let world = crate::world::load(&scenario).unwrap();
+            assert!(
+                Planner::new(&scenario.domain)
+                    .plan(&goal.to_dnf(), world.as_ref())
+                    .is_ok()
+            );
+        }
+        assert!(scenario.examples.iter().any(|e| e.goal.contains('&')));
+        assert!(scenario.examples.iter().any(|e| e.goal.contains('|')));
+        // Predicates are taken in turn: the first examples name different ones.
+        let firsts: Vec<&str> = scenario.examples[..3]
+            .iter()
+            .map(|e| e.goal.split('_').next().unwrap_or(""))
+            .collect();
+        assert!(
+            firsts[0] != firsts[1] && firsts[1] != firsts[2],
+            "{firsts:?}"
+        );
+        // A kept example takes a made one's place; filling again replaces the made ones.
+        scenario.examples.push(Example {
+            instruction: "Curtains shut".into(),
+            goal: "Closed_Curtain".into(),
+            source: ExampleSource::Kept("e1".into()),
+        });
+        let again = fill(&mut scenario);
+        assert_eq!(scenario.examples.len(), again + 1);
+        assert!(again < MADE_POOL, "{again}");
+    }
+
+    #[test]
+    fn a_condition_is_said_with_the_scenes_words() {
+        let scenario = cafe();
+        let v = &scenario.domain.vocabulary;
+        let atom = |p: &str, args: &[&str]| Atom {
+            predicate: p.into(),
+            args: args.iter().map(|a| a.to_string()).collect(),
+        };
+        let said = plainly(&atom("Closed", &["Curtain"]), true, v).unwrap();
+        assert!(said.to_lowercase().contains("curtain"), "{said}");
+        assert!(said.starts_with(char::is_uppercase), "{said}");
+    }
+}
