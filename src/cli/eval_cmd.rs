@@ -49,6 +49,15 @@ pub enum EvalExperiment {
         /// second pass goes to `second-pass/` and is reported beside the first.
         #[arg(long, conflicts_with = "answers")]
         learn: bool,
+        /// The example pool requests are read with: the scenario's written one, only the
+        /// pool betr makes from the domain when a scenario writes none, or none.
+        #[arg(
+            long,
+            value_enum,
+            default_value = "written",
+            conflicts_with = "answers"
+        )]
+        example_pool: goals_run::ExamplePool,
         #[command(flatten)]
         run: RunFlags,
     },
@@ -140,18 +149,20 @@ pub fn run(experiment: EvalExperiment) -> Result<ExitCode> {
             suite: Some(suite),
             runs,
             learn,
+            example_pool,
             run,
             ..
-        } => goals_suite(&suite, runs, learn, &run),
+        } => goals_suite(&suite, (runs, learn, example_pool), &run),
         EvalExperiment::Goals {
             dataset,
             answers: None,
             scenario,
             runs,
             learn,
+            example_pool,
             run,
             suite: None,
-        } => goals_with_model(&dataset, &scenario, (runs, learn), &run),
+        } => goals_with_model(&dataset, &scenario, (runs, learn, example_pool), &run),
         EvalExperiment::Resolve {
             runs,
             max_rounds,
@@ -264,16 +275,18 @@ fn goals_chart(
 pub fn goals_with_model(
     dataset_dir: &Path,
     scenario_path: &Path,
-    (runs, learn): (usize, bool),
+    (runs, learn, pool): (usize, bool, goals_run::ExamplePool),
     flags: &RunFlags,
 ) -> Result<ExitCode> {
     let cases = load_dataset(dataset_dir)?;
     let scenario = Scenario::load(scenario_path)?;
-    let p = prepare(flags, &[("dataset", dataset_dir.display().to_string())])?;
+    let mut settings = vec![("dataset", dataset_dir.display().to_string())];
+    settings.extend(pool_setting(pool));
+    let p = prepare(flags, &settings)?;
     let dir =
         eval::output_dir(flags.out.as_deref(), "goals").context("creating the output directory")?;
     p.llm.model.set_purpose("eval goals");
-    let in_scene: Vec<goals_run::SceneCase> = cases
+    let mut in_scene: Vec<goals_run::SceneCase> = cases
         .iter()
         .map(|case| goals_run::SceneCase {
             scenario: &scenario,
@@ -281,6 +294,7 @@ pub fn goals_with_model(
             examples: None,
         })
         .collect();
+    pool.apply(&mut in_scene);
     goal_set(&p, &in_scene, (runs, learn), flags, &dir)?;
     Ok(ExitCode::SUCCESS)
 }
@@ -356,11 +370,23 @@ fn read_set(
     Ok(results)
 }
 
+/// The example pool as run.json records it: only when it is not the scenario's own, so
+/// a run of the product's reading reads as before.
+fn pool_setting(pool: goals_run::ExamplePool) -> Option<(&'static str, String)> {
+    (pool != goals_run::ExamplePool::Written).then(|| ("example_pool", pool.name().to_string()))
+}
+
 /// `betr eval goals --suite FILE`: every set of the suite, each into `OUT/<set>/` (resumed
 /// like a single run), then the sets side by side in `OUT/suite.md`.
-fn goals_suite(suite: &Path, runs: usize, learn: bool, flags: &RunFlags) -> Result<ExitCode> {
+fn goals_suite(
+    suite: &Path,
+    (runs, learn, pool): (usize, bool, goals_run::ExamplePool),
+    flags: &RunFlags,
+) -> Result<ExitCode> {
     let sets = eval::suite::load(suite)?;
-    let p = prepare(flags, &[("suite", suite.display().to_string())])?;
+    let mut settings = vec![("suite", suite.display().to_string())];
+    settings.extend(pool_setting(pool));
+    let p = prepare(flags, &settings)?;
     let dir = eval::output_dir(flags.out.as_deref(), "goals-suite")
         .context("creating the output directory")?;
     p.llm.model.set_purpose("eval goals");
@@ -370,7 +396,7 @@ fn goals_suite(suite: &Path, runs: usize, learn: bool, flags: &RunFlags) -> Resu
         std::fs::create_dir_all(&set_dir)
             .with_context(|| format!("creating {}", set_dir.display()))?;
         eprintln!("{}: {} request(s)", set.name, set.cases.len());
-        let cases: Vec<goals_run::SceneCase> = set
+        let mut cases: Vec<goals_run::SceneCase> = set
             .cases
             .iter()
             .map(|(scene, case)| goals_run::SceneCase {
@@ -379,6 +405,7 @@ fn goals_suite(suite: &Path, runs: usize, learn: bool, flags: &RunFlags) -> Resu
                 examples: None,
             })
             .collect();
+        pool.apply(&mut cases);
         let results = goal_set(&p, &cases, (runs, learn), flags, &set_dir)?;
         done.push((set.name.clone(), set.tuned, results));
     }

@@ -40,6 +40,53 @@ pub async fn run_goals(
     run_goals_in_scenes(model, &in_scene, options, cfg, dir).await
 }
 
+/// Which example pool the cases of a run read with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ExamplePool {
+    /// The scenario's own (the product's reading).
+    Written,
+    /// Only the pool betr makes from the domain for a scenario that writes none.
+    Made,
+    /// No pool at all (the examples made for each request from its own words stay).
+    None,
+}
+
+impl ExamplePool {
+    pub fn name(self) -> &'static str {
+        match self {
+            ExamplePool::Written => "written",
+            ExamplePool::Made => "made",
+            ExamplePool::None => "none",
+        }
+    }
+
+    /// `cases` with this pool in place of their scene's (unchanged for `Written`).
+    pub fn apply(self, cases: &mut [SceneCase<'_>]) {
+        let mut made: Vec<(*const Scenario, Vec<Example>)> = Vec::new();
+        for c in cases {
+            c.examples = match self {
+                ExamplePool::Written => continue,
+                ExamplePool::None => Some(Vec::new()),
+                ExamplePool::Made => {
+                    let key: *const Scenario = c.scenario;
+                    let pool = match made.iter().find(|(k, _)| *k == key) {
+                        Some((_, pool)) => pool.clone(),
+                        None => {
+                            let pool = crate::session::interpret::made_pool::made_pool(
+                                c.scenario,
+                                crate::session::interpret::made_pool::MADE_POOL,
+                            );
+                            made.push((key, pool.clone()));
+                            pool
+                        }
+                    };
+                    Some(pool)
+                }
+            };
+        }
+    }
+}
+
 /// A case and the scene its instruction is given in.
 pub struct SceneCase<'a> {
     pub scenario: &'a Scenario,
@@ -49,7 +96,7 @@ pub struct SceneCase<'a> {
 }
 
 /// The cases of a second pass that learns from the first (`--learn`): each case's pool is
-/// its scene's (or `pool`, when the run replaces the scene's) with every other case's
+/// its own, else `pool` (when the run replaces the scene's), else its scene's, with every other case's
 /// miss of `first` kept as a person would correct it, the instruction with its gold goal,
 /// never the case's own. A correction is kept for the cases of the same domain whose scene
 /// has every object its goal names.
@@ -74,7 +121,8 @@ pub fn with_corrections<'a>(
         .iter()
         .map(|c| {
             let domain = crate::session::knowledge::domain_of(c.scenario);
-            let mut examples: Vec<Example> = pool.unwrap_or(&c.scenario.examples).to_vec();
+            let base = c.examples.as_deref().or(pool);
+            let mut examples: Vec<Example> = base.unwrap_or(&c.scenario.examples).to_vec();
             for (miss, id) in &misses {
                 let own =
                     miss.case.difficulty == c.case.difficulty && miss.case.index == c.case.index;

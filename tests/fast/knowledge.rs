@@ -171,6 +171,7 @@ fn empty_knowledge() -> Knowledge {
     Knowledge {
         path: "unused.toml".into(),
         rules: Vec::new(),
+        examples: Default::default(),
     }
 }
 

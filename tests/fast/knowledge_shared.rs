@@ -69,6 +69,7 @@ fn sessions_sharing_a_knowledge_file_keep_each_others_rules() {
     let mut stale = Knowledge {
         path: path.clone(),
         rules: Vec::new(),
+        examples: Default::default(),
     };
     stale.revoke("r1").unwrap();
     let ids: Vec<String> = Knowledge::open(&path)

@@ -378,8 +378,13 @@ fn a_goal_other_than_the_first_answer_is_said_in_the_log() {
             matches_expected: None,
             author: "model".into(),
             first_answer: Some(goal("\"green cube\" on \"blue cube\"")),
+            doubt: Some("doubtful: the model's first answer failed its checks".into()),
         });
         let screen = b.screen(160, 50);
+        assert!(
+            screen.contains("doubtful: the model's first answer failed its checks"),
+            "the doubt level is shown beside the goal: {screen}"
+        );
         assert!(
             screen.contains("the model answered \"green cube\" on \"blue cube\" first"),
             "{screen}"

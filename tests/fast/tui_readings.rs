@@ -37,6 +37,7 @@ fn offered(
             matches_expected: None,
             author: "model".into(),
             first_answer: None,
+            doubt: None,
         });
     }
     app.on_session(Event::Readings {

@@ -24,6 +24,10 @@ pub struct Evidence {
     /// with another goal; `None` when there were no beams or every beam read alike.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub margin: Option<f64>,
+    /// How many beams the model searched for its first answer (0 or 1: no runner-up to
+    /// compare with).
+    #[serde(default)]
+    pub beams: usize,
     /// Candidates with the chosen goal, of the usable candidates of the round it won.
     pub votes: usize,
     pub candidates: usize,
@@ -88,26 +92,25 @@ impl Evidence {
 
     /// The doubt level and what it rests on, in one line, for beside the goal.
     pub fn summary(&self) -> String {
-        match self.doubt() {
-            Some(why) => format!("doubtful: {why}"),
-            None => {
-                let mut for_it = vec!["the model's first answer passed every check".to_string()];
-                match self.margin {
-                    Some(m) => for_it.push(format!("margin {m:.2} over another goal")),
-                    None => for_it.push("its beams agree".into()),
-                }
-                if self.candidates > 1 {
-                    for_it.push(format!(
-                        "{} of {} candidates agree",
-                        self.votes, self.candidates
-                    ));
-                }
-                if self.parts > 1 {
-                    for_it.push(format!("read in {} parts", self.parts));
-                }
-                format!("doubt low: {}", for_it.join(", "))
-            }
+        if let Some(why) = self.doubt() {
+            return format!("doubtful: {why}");
         }
+        let mut for_it = vec!["first answer kept".to_string()];
+        match self.margin {
+            Some(m) => for_it.push(format!("margin {m:.2} over another goal")),
+            None if self.beams > 1 => for_it.push(format!("all {} beams alike", self.beams)),
+            None => {}
+        }
+        if self.candidates > 1 {
+            for_it.push(format!(
+                "{} of {} candidates agree",
+                self.votes, self.candidates
+            ));
+        }
+        if self.parts > 1 {
+            for_it.push(format!("{} parts", self.parts));
+        }
+        format!("doubt low: {}", for_it.join(", "))
     }
 
     /// The evidence of a goal joined from parts read each on its own: the weakest part's
@@ -120,6 +123,7 @@ impl Evidence {
                 .iter()
                 .filter_map(|p| p.margin)
                 .min_by(|a, b| a.total_cmp(b)),
+            beams: parts.iter().map(|p| p.beams).min().unwrap_or(0),
             votes: parts.iter().map(|p| p.votes).min().unwrap_or(0),
             candidates: parts.iter().map(|p| p.candidates).max().unwrap_or(0),
             feedback_rounds: parts.iter().map(|p| p.feedback_rounds).max().unwrap_or(0),

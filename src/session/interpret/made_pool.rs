@@ -155,9 +155,10 @@ fn atoms_of<'a>(vocabulary: &'a Vocabulary, predicate: &'a str) -> impl Iterator
 
 /// `atom` (or, when not `wanted`, its opposite) said plainly: the scene's first phrase for
 /// the condition or its opposite with the objects as the scene calls them ("Close the
-/// curtain", "Coffee to table 2"); else the predicate's description with its objects put
-/// in, for a wanted condition ("Make sure "Chips" is at "Table3""). `None` for an opposite
-/// the scene lists no words for.
+/// curtain"); a wanted relation with no phrase as an item to a place ("Coffee to Table2");
+/// else the predicate's description with its objects put in, for a wanted condition
+/// ("Make sure "Coffee" has been made"). `None` for an opposite the scene lists no words
+/// for.
 pub fn plainly(atom: &Atom, wanted: bool, vocabulary: &Vocabulary) -> Option<String> {
     let predicate = vocabulary.predicate(&atom.predicate)?;
     let (says, opposite) = (&predicate.words.says, &predicate.words.opposite);
@@ -175,6 +176,9 @@ pub fn plainly(atom: &Atom, wanted: bool, vocabulary: &Vocabulary) -> Option<Str
     let said = match (phrase, atom.args.as_slice()) {
         (Some(p), [one]) => format!("{p} {}", called(one)),
         (Some(p), [item, place]) => format!("{} {p} {}", called(item), called(place)),
+        // A relation of an item and a place with no phrase, as the scene's own words
+        // for a request's items say it ("coffee to table 2").
+        (None, [item, place]) if wanted => format!("{} to {}", called(item), called(place)),
         (None, _) if wanted => {
             let words = super::readings::in_words(&Formula::Atom(atom.clone()), vocabulary);
             format!("make sure {words}")

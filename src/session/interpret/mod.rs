@@ -189,6 +189,7 @@ pub(super) async fn read_goal(
         last_error: ReplyError::NoConditions,
         runners_up: Vec::new(),
         margin: None,
+        beams: 0,
     };
     // Doubtful candidates of earlier rounds, eligible again in the last round's vote.
     let mut set_aside: Vec<Candidate> = Vec::new();
@@ -210,6 +211,7 @@ pub(super) async fn read_goal(
                     .as_ref()
                     .is_some_and(|f| judge::same_goal(f, &answer.goal)),
                 margin: drawn.margin,
+                beams: drawn.beams,
                 votes: usable
                     .clone()
                     .filter(|a| judge::same_goal(&a.goal, &answer.goal))
@@ -282,6 +284,8 @@ struct Drawn {
     runners_up: Vec<Candidate>,
     /// How far the first answer's beam is ahead of the best beam with another goal.
     margin: Option<f64>,
+    /// How many beams the first answer was searched with.
+    beams: usize,
 }
 
 impl Drawer<'_> {
@@ -363,6 +367,7 @@ async fn draw_round(
                 })
                 .collect();
             drawn.margin = doubt::margin(&beams, judge::same_goal);
+            drawn.beams = beams.len();
         }
         if first_draw && checks {
             drawn.runners_up = r
