@@ -39,7 +39,7 @@ async fn interprets_scenario_1_exactly() {
         reading.answer.goal.to_string(),
         "\"blue cube\" on \"green cube\""
     );
-    assert!(reading.doubt.is_none());
+    assert!(reading.doubt().is_none(), "{:?}", reading.evidence);
 }
 
 #[tokio::test]
