@@ -147,7 +147,7 @@ impl DoubtCalibration {
     }
 
     /// The two counts added up with another set's.
-    pub fn add(self, other: DoubtCalibration) -> DoubtCalibration {
+    pub fn plus(self, other: DoubtCalibration) -> DoubtCalibration {
         let sum = |a: Tally, b: Tally| Tally {
             correct: a.correct + b.correct,
             total: a.total + b.total,

@@ -326,7 +326,7 @@ fn learned_table(rows: &[SetRow]) -> String {
             |d| (cell(d.wrong_marked), cell(d.right_marked)),
         );
         if let Some(d) = r.doubt {
-            all = all.add(d);
+            all = all.plus(d);
         }
         out.push_str(&format!(
             "| {} | {} | {} | {} | {second_by} | {second} | {wrong} | {right} |\n",

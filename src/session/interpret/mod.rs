@@ -105,7 +105,7 @@ pub async fn interpret(
             match read_parts(scenario, forked, &parts, instruction, model, options, emit).await? {
                 PartsRead::Read(found) => {
                     announce(scenario, &found, emit);
-                    return Ok(found);
+                    return Ok(*found);
                 }
                 PartsRead::Whole { calls } => earlier_calls = calls,
             }

@@ -21,7 +21,7 @@ use super::{Interpretation, example_pool, read_goal};
 /// What reading a request part by part came to.
 pub(super) enum PartsRead {
     /// Every part read, and the joined goal passed its checks.
-    Read(Interpretation),
+    Read(Box<Interpretation>),
     /// The request is to be read whole; `calls` were spent on the parts.
     Whole { calls: usize },
 }
@@ -124,7 +124,7 @@ pub(super) async fn read_parts(
         .iter()
         .filter_map(|r| r.answer.reasoning.clone())
         .collect();
-    Ok(PartsRead::Read(Interpretation {
+    Ok(PartsRead::Read(Box::new(Interpretation {
         answer: GoalAnswer {
             goal,
             reasoning: (!reasoning.is_empty()).then(|| reasoning.join("\n")),
@@ -139,7 +139,7 @@ pub(super) async fn read_parts(
             problem.map(|p| p.reason),
         ),
         readings: vec![goal_read],
-    }))
+    })))
 }
 
 /// The joined `goal` with what it plainly misread in the whole request undone, when it
