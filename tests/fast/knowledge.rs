@@ -493,3 +493,50 @@ fn learn_without_yes_asks_and_can_keep_the_rule_for_the_fixs_objects_only() {
     assert_eq!(knowledge.rules[0].kept_by, "a person");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// In the engine, a reading chosen that was not offered first is kept as an example of the
+/// domain, with the reading it replaced, and said; the engine's own pool has it at once.
+#[tokio::test]
+async fn a_reading_chosen_not_first_is_kept_as_an_example_of_the_domain() {
+    use betr::session::knowledge::examples::KeptExamples;
+    use betr::session::{Command, Event};
+    let dir = support::cli::tmp("engine-correction");
+    let path = support::repo::root().join("scenarios/cafe/cafe.toml");
+    let scenario = betr::scenario::Scenario::load(&path).unwrap();
+    let model =
+        support::fake_model::FixtureModel::new(support::fixtures::replies_of("readings_cafe.toml"));
+    let mut setup = betr::session::Setup::new(
+        std::sync::Arc::new(scenario),
+        path,
+        Ok(std::sync::Arc::new(model)),
+    );
+    setup.options.choose_reading = true;
+    setup.knowledge = Some(Knowledge::open(&Knowledge::path_in(&dir)).unwrap());
+    let mut session = support::engine::Session::start(setup);
+    session.send(Command::Submit("Bring something sweet to table 3.".into()));
+    session
+        .until("readings", |e| matches!(e, Event::Readings { .. }))
+        .await;
+    session.send(Command::ChooseReading(1));
+    session
+        .until("the correction kept", |e| {
+            matches!(e, Event::Notice { message } if message.contains("correction kept as example e1 of the cafe domain"))
+        })
+        .await;
+    let kept = KeptExamples::open(&KeptExamples::path_in(&dir)).unwrap();
+    assert_eq!(kept.examples.len(), 1);
+    let e = &kept.examples[0];
+    assert_eq!(
+        (
+            e.instruction.as_str(),
+            e.goal.as_str(),
+            e.replaced.as_deref()
+        ),
+        (
+            "Bring something sweet to table 3.",
+            "On_Chocolate_Table3",
+            Some("On_Dessert_Table3")
+        )
+    );
+    assert!(e.kept_by.contains("choosing a reading"), "{}", e.kept_by);
+}

@@ -496,5 +496,14 @@ mod tests {
             check_correction(&cafe, "  ", &goal("On_Coffee_Table2")),
             Err(NotKept::NoInstruction)
         );
+        // The robot holds one thing at a time: both at once cannot be reached.
+        assert!(matches!(
+            check_correction(
+                &cafe,
+                "Hold the coffee and the chips",
+                &goal("Holding_Coffee & Holding_Chips")
+            ),
+            Err(NotKept::Unplannable { .. })
+        ));
     }
 }
