@@ -98,16 +98,7 @@ impl KeptExamples {
 
     /// Read the file; a missing file is none kept yet.
     pub fn open(path: &Path) -> Result<KeptExamples, KnowledgeError> {
-        let text = match crate::store::read_text(path, crate::store::SMALL_FILE_BYTES) {
-            Ok(t) => t,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-            Err(source) => {
-                return Err(KnowledgeError::Read {
-                    path: path.to_path_buf(),
-                    source,
-                });
-            }
-        };
+        let text = super::read_or_empty(path)?;
         let mut kept = KeptExamples {
             path: path.to_path_buf(),
             ..KeptExamples::default()
@@ -150,14 +141,7 @@ impl KeptExamples {
         if let Some(e) = same.iter().find(|e| e.goal == example.goal) {
             return Ok(((*e).clone(), false));
         }
-        let next = self
-            .examples
-            .iter()
-            .filter_map(|e| e.id.strip_prefix('e')?.parse::<u32>().ok())
-            .max()
-            .unwrap_or(0)
-            + 1;
-        example.id = format!("e{next}");
+        example.id = super::next_id('e', self.examples.iter().map(|e| e.id.as_str()));
         let line = serde_json::to_string(&example).map_err(|e| KnowledgeError::Parse {
             path: self.path.clone(),
             message: e.to_string(),
@@ -200,15 +184,10 @@ impl KeptExamples {
         let _lock = self.lock()?;
         self.reread()?;
         let Some(removed) = self.examples.iter().find(|e| e.id == id).cloned() else {
-            let known: Vec<&str> = self.examples.iter().map(|e| e.id.as_str()).collect();
             return Err(KnowledgeError::NoSuchExample {
                 id: id.to_string(),
                 path: self.path.clone(),
-                known: if known.is_empty() {
-                    "none".into()
-                } else {
-                    known.join(", ")
-                },
+                known: super::known_ids(self.examples.iter().map(|e| e.id.as_str())),
             });
         };
         self.rewrite(|kept| kept.is_none_or(|k| k.id != id), None)?;
@@ -224,16 +203,7 @@ impl KeptExamples {
         keep: impl Fn(Option<&KeptExample>) -> bool,
         add: Option<&str>,
     ) -> Result<(), KnowledgeError> {
-        let text = match crate::store::read_text(&self.path, crate::store::SMALL_FILE_BYTES) {
-            Ok(t) => t,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-            Err(source) => {
-                return Err(KnowledgeError::Read {
-                    path: self.path.clone(),
-                    source,
-                });
-            }
-        };
+        let text = super::read_or_empty(&self.path)?;
         let mut out = String::new();
         for line in text.lines().filter(|l| !l.trim().is_empty()) {
             let read = serde_json::from_str::<KeptExample>(line).ok();
@@ -259,22 +229,7 @@ impl KeptExamples {
     /// An exclusive lock of the file, on `examples.jsonl.lock` beside it (the file itself
     /// is replaced when an example is taken out).
     fn lock(&self) -> Result<std::fs::File, KnowledgeError> {
-        let path = self.path.with_extension("jsonl.lock");
-        let failed = |source| KnowledgeError::Write {
-            path: path.clone(),
-            source,
-        };
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(failed)?;
-        }
-        let file = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .map_err(failed)?;
-        file.lock().map_err(failed)?;
-        Ok(file)
+        super::lock_beside(&self.path)
     }
 
     fn reread(&mut self) -> Result<(), KnowledgeError> {

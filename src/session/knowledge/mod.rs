@@ -257,15 +257,10 @@ impl Knowledge {
     }
 
     fn no_such_rule(&self, id: &str) -> KnowledgeError {
-        let known: Vec<&str> = self.rules.iter().map(|r| r.id.as_str()).collect();
         KnowledgeError::NoSuchRule {
             id: id.to_string(),
             path: self.path.clone(),
-            known: if known.is_empty() {
-                "none".into()
-            } else {
-                known.join(", ")
-            },
+            known: known_ids(self.rules.iter().map(|r| r.id.as_str())),
         }
     }
 
@@ -282,14 +277,7 @@ impl Knowledge {
         }) {
             return Ok((same.clone(), false));
         }
-        let next = self
-            .rules
-            .iter()
-            .filter_map(|r| r.id.strip_prefix('r')?.parse::<u32>().ok())
-            .max()
-            .unwrap_or(0)
-            + 1;
-        rule.id = format!("r{next}");
+        rule.id = next_id('r', self.rules.iter().map(|r| r.id.as_str()));
         self.rules.push(rule.clone());
         if let Err(e) = self.write() {
             self.rules.pop();
@@ -317,22 +305,7 @@ impl Knowledge {
     /// The lock is on `knowledge.toml.lock` beside it, since the file itself is replaced
     /// by each write.
     fn lock(&self) -> Result<std::fs::File, KnowledgeError> {
-        let path = self.path.with_extension("toml.lock");
-        let failed = |source| KnowledgeError::Write {
-            path: path.clone(),
-            source,
-        };
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(failed)?;
-        }
-        let file = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .map_err(failed)?;
-        file.lock().map_err(failed)?;
-        Ok(file)
+        lock_beside(&self.path)
     }
 
     /// The rules as the file holds them now.
@@ -360,6 +333,61 @@ impl Knowledge {
                 source,
             }
         })
+    }
+}
+
+/// An exclusive lock for changing `path`, on the file of its name with `.lock` added
+/// beside it (the file itself is replaced by writes), held until the returned file is
+/// dropped.
+pub(super) fn lock_beside(path: &Path) -> Result<std::fs::File, KnowledgeError> {
+    let mut name = path.as_os_str().to_os_string();
+    name.push(".lock");
+    let lock = PathBuf::from(name);
+    let failed = |source| KnowledgeError::Write {
+        path: lock.clone(),
+        source,
+    };
+    if let Some(dir) = lock.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(failed)?;
+    }
+    let file = std::fs::File::options()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock)
+        .map_err(failed)?;
+    file.lock().map_err(failed)?;
+    Ok(file)
+}
+
+/// `ids` in a list for an error, `none` when there are none.
+pub(super) fn known_ids<'a>(ids: impl Iterator<Item = &'a str>) -> String {
+    let known: Vec<&str> = ids.collect();
+    if known.is_empty() {
+        "none".into()
+    } else {
+        known.join(", ")
+    }
+}
+
+/// The id after the largest of `ids` that are `prefix` and a number (`r3` → `r4`).
+pub(super) fn next_id<'a>(prefix: char, ids: impl Iterator<Item = &'a str>) -> String {
+    let last = ids
+        .filter_map(|id| id.strip_prefix(prefix)?.parse::<u32>().ok())
+        .max()
+        .unwrap_or(0);
+    format!("{prefix}{}", last + 1)
+}
+
+/// The text of `path`, empty when it does not exist yet.
+pub(super) fn read_or_empty(path: &Path) -> Result<String, KnowledgeError> {
+    match crate::store::read_text(path, crate::store::SMALL_FILE_BYTES) {
+        Ok(t) => Ok(t),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(String::new()),
+        Err(source) => Err(KnowledgeError::Read {
+            path: path.to_path_buf(),
+            source,
+        }),
     }
 }
 
