@@ -216,6 +216,30 @@ fn interpret(
     Ok(ExitCode::SUCCESS)
 }
 
+/// The reading chosen on the terminal (or by `--reading`), kept as a correction of the
+/// instruction when it was not the one offered first.
+fn choose_and_keep(
+    scenario: &Scenario,
+    args: &ResolveArgs,
+    (readings, doubt): (&[session::Reading], Option<&str>),
+) -> Option<usize> {
+    let chosen = choose_reading(readings, doubt, args.reading, args.yes);
+    if let Some(index) = chosen {
+        let said = args
+            .instruction
+            .or(scenario.instruction.as_deref())
+            .unwrap_or_default();
+        keep_choice(
+            args.policies,
+            (scenario, args.scenario_path),
+            said,
+            readings,
+            index,
+        );
+    }
+    chosen
+}
+
 /// Keep a reading chosen that was not offered first as a correction, when there is a
 /// policy directory; a correction not kept never stops the command.
 fn keep_choice(
@@ -366,24 +390,8 @@ fn resolve(
     };
     let yes = args.yes;
     let mut approve = |p: &session::Proposal| approve_on_terminal(p, yes);
-    let said = args
-        .instruction
-        .or(scenario.instruction.as_deref())
-        .unwrap_or_default()
-        .to_string();
-    let mut choose = |r: &[session::Reading], doubt: Option<&str>| {
-        let chosen = choose_reading(r, doubt, args.reading, yes);
-        if let Some(index) = chosen {
-            keep_choice(
-                args.policies,
-                (scenario, args.scenario_path),
-                &said,
-                r,
-                index,
-            );
-        }
-        chosen
-    };
+    let mut choose =
+        |r: &[session::Reading], doubt: Option<&str>| choose_and_keep(scenario, args, (r, doubt));
     let result = super::runtime()?.block_on(session::resolve_with_scenes(
         scenario,
         args.instruction,

@@ -368,6 +368,17 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
         cell(&results.overall()),
         usage(&results.usage.clone().unwrap_or_default())
     ));
+    let notes = table_notes(results, temperature, expected);
+    out.push('\n');
+    for n in notes {
+        out.push_str(&format!("- {n}\n"));
+    }
+    out
+}
+
+/// The notes under the table: a partial run, the temperature, calls and time per
+/// instruction, the doubt's calibration, what the usage leaves out.
+fn table_notes(results: &GoalsResults, temperature: f32, expected: usize) -> Vec<String> {
     let mut notes = Vec::new();
     let finished = results.cases.len();
     if finished < expected {
@@ -413,9 +424,5 @@ pub fn table(results: &GoalsResults, system: &str, temperature: f32, expected: u
     if let Some(u) = &results.usage {
         notes.extend(u.notes());
     }
-    out.push('\n');
-    for n in notes {
-        out.push_str(&format!("- {n}\n"));
-    }
-    out
+    notes
 }

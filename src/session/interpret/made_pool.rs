@@ -57,12 +57,14 @@ pub fn made_pool(scenario: &Scenario, most: usize) -> Vec<Example> {
             .plan(&goal.to_dnf(), world.as_ref())
             .is_ok_and(|p| matches!(p.outcome, Outcome::Success | Outcome::ActionFailed { .. }))
     };
+    // Every ground atom, formed once for all predicates.
+    let ground = vocabulary.ground_atoms();
     let mut per_predicate: Vec<Vec<(Formula, String)>> = vocabulary
         .predicates
         .iter()
         .map(|p| {
             let mut found = Vec::new();
-            for atom in atoms_of(vocabulary, &p.name).take(TRIED_PER_PREDICATE) {
+            for atom in atoms_of(&ground, &p.name).take(TRIED_PER_PREDICATE) {
                 let holds = world.check(&Condition {
                     atom: atom.clone(),
                     negated: false,
@@ -132,25 +134,31 @@ fn predicate_of(goal: &Formula) -> Option<&str> {
     }
 }
 
+/// `text` with its first letter lower case.
 fn lower(text: &str) -> String {
+    first_letter(text, char::to_lowercase)
+}
+
+/// `text` with its first letter as `case` makes it.
+fn first_letter<I: Iterator<Item = char>>(text: &str, case: impl Fn(char) -> I) -> String {
     let mut chars = text.chars();
     chars
         .next()
-        .map(|c| c.to_lowercase().chain(chars).collect())
+        .map(|c| case(c).chain(chars).collect())
         .unwrap_or_default()
 }
 
 /// The ground atoms of `predicate`, an object never twice in one.
-fn atoms_of<'a>(vocabulary: &'a Vocabulary, predicate: &'a str) -> impl Iterator<Item = Atom> + 'a {
-    vocabulary
-        .ground_atoms()
-        .into_iter()
+fn atoms_of<'a>(ground: &'a [Atom], predicate: &'a str) -> impl Iterator<Item = Atom> + 'a {
+    ground
+        .iter()
         .filter(move |a| a.predicate == predicate)
         .filter(|a| {
             let mut args = a.args.clone();
             args.sort_unstable();
             args.windows(2).all(|w| w[0] != w[1])
         })
+        .cloned()
 }
 
 /// `atom` (or, when not `wanted`, its opposite) said plainly: the scene's first phrase for
@@ -189,11 +197,7 @@ pub fn plainly(atom: &Atom, wanted: bool, vocabulary: &Vocabulary) -> Option<Str
 }
 
 fn capitalised(text: &str) -> String {
-    let mut chars = text.chars();
-    chars
-        .next()
-        .map(|c| c.to_uppercase().chain(chars).collect())
-        .unwrap_or_default()
+    first_letter(text, char::to_uppercase)
 }
 
 #[cfg(test)]

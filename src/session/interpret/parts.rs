@@ -114,7 +114,23 @@ pub(super) async fn read_parts(
         }
         None => (goal, problem),
     };
-    let goal_read = goal.clone();
+    Ok(PartsRead::Read(Box::new(joined_reading(
+        parts,
+        &read,
+        (goal, problem.map(|p| p.reason)),
+        calls,
+    ))))
+}
+
+/// The reading of the whole request from its parts' `read`: the joined `goal` with the
+/// whole's own doubt, the parts' first answers joined alike, their reasoning, calls and
+/// evidence.
+fn joined_reading(
+    parts: &[Part],
+    read: &[Interpretation],
+    (goal, doubt): (Formula, Option<String>),
+    calls: usize,
+) -> Interpretation {
     let first = read
         .iter()
         .map(|r| r.first.clone())
@@ -124,9 +140,9 @@ pub(super) async fn read_parts(
         .iter()
         .filter_map(|r| r.answer.reasoning.clone())
         .collect();
-    Ok(PartsRead::Read(Box::new(Interpretation {
+    Interpretation {
         answer: GoalAnswer {
-            goal,
+            goal: goal.clone(),
             reasoning: (!reasoning.is_empty()).then(|| reasoning.join("\n")),
         },
         first,
@@ -136,10 +152,10 @@ pub(super) async fn read_parts(
         // no doubt about "the light off and a tea on the bar"): the whole's is the one.
         evidence: super::doubt::Evidence::joined(
             &read.iter().map(|r| r.evidence.clone()).collect::<Vec<_>>(),
-            problem.map(|p| p.reason),
+            doubt,
         ),
-        readings: vec![goal_read],
-    })))
+        readings: vec![goal],
+    }
 }
 
 /// The joined `goal` with what it plainly misread in the whole request undone, when it
