@@ -170,12 +170,14 @@ impl Engine {
         match kept {
             Ok((kept, new)) => {
                 if new {
+                    // The pool's kept examples as the file holds them now (one the new
+                    // example replaced is gone from both).
                     let scenario = Arc::make_mut(&mut settings.scenario);
-                    scenario.examples.retain(|e| {
-                        !(e.instruction == kept.instruction
-                            && matches!(e.source, crate::scenario::ExampleSource::Kept(_)))
-                    });
-                    scenario.examples.push(kept.example());
+                    scenario
+                        .examples
+                        .retain(|e| !matches!(e.source, crate::scenario::ExampleSource::Kept(_)));
+                    let (kept_now, _) = store.examples.for_scenario(scenario);
+                    scenario.examples.extend(kept_now);
                     crate::session::interpret::made_pool::fill(scenario);
                 }
                 let path = store.examples.path.display().to_string();
