@@ -222,6 +222,7 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
         ms,
         event(Event::Success {
             ticks: u64::try_from(ticks).unwrap_or(u64::MAX),
+            executor: None,
         }),
     );
     Ok(steps)

@@ -117,7 +117,13 @@ fn headline(event: &Event) -> Option<String> {
         Event::DidNotHelp { reason } => {
             format!("The change did not help and was undone: {reason}")
         }
-        Event::Success { ticks } => format!("✓ SUCCESS in simulation after {ticks} tick(s)"),
+        Event::Success { ticks, executor } => format!(
+            "✓ SUCCESS {} after {ticks} tick(s)",
+            match executor {
+                Some(name) => format!("in the {name} executor"),
+                None => "in simulation".to_string(),
+            }
+        ),
         Event::GaveUp { reason } => format!("Gave up: {reason}"),
         Event::PersonDecides { action, why, .. } => {
             format!("nothing more is asked about {action}!: {why}; a person decides")

@@ -248,7 +248,10 @@ mod tests {
         .unwrap();
         r.write(&Entry::Event {
             ms: 2,
-            event: Event::Success { ticks: 3 },
+            event: Event::Success {
+                ticks: 3,
+                executor: None,
+            },
         })
         .unwrap();
         let back = read(&path).unwrap();
@@ -259,7 +262,7 @@ mod tests {
             back.entries[1].1,
             Entry::Event {
                 ms: 2,
-                event: Event::Success { ticks: 3 }
+                event: Event::Success { ticks: 3, .. }
             }
         ));
         assert_eq!(back.cut_at, None);

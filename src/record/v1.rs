@@ -459,7 +459,10 @@ fn plain(recorded: &Recorded) -> Result<Event, Refused> {
         Recorded::DidNotHelp { reason } => Event::DidNotHelp {
             reason: reason.clone(),
         },
-        Recorded::Success { ticks } => Event::Success { ticks: *ticks },
+        Recorded::Success { ticks } => Event::Success {
+            ticks: *ticks,
+            executor: None,
+        },
         Recorded::GaveUp { reason } => Event::GaveUp {
             reason: reason.clone(),
         },

@@ -133,7 +133,7 @@ pub async fn resolve_with_scenes(
                 kept.pop();
                 engine.send(Command::Reject);
             }
-            Event::Success { ticks } => break Ending::Success { ticks },
+            Event::Success { ticks, .. } => break Ending::Success { ticks },
             Event::GaveUp { reason } => break Ending::GaveUp { reason },
             Event::Failed { error } => {
                 engine.send(Command::Shutdown);

@@ -474,9 +474,11 @@ pub enum Event {
     DidNotHelp {
         reason: String,
     },
-    /// The tree succeeds in a fresh simulation.
+    /// The tree succeeded: in betr's world, or performed by `executor` (its name).
     Success {
         ticks: u64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        executor: Option<String>,
     },
     /// The loop stopped without success.
     GaveUp {

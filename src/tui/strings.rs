@@ -464,8 +464,11 @@ pub fn repaired(added: usize, valued: usize) -> String {
     }
 }
 
-pub fn success(ticks: u64) -> String {
-    format!("SUCCESS after {ticks} tick(s)")
+pub fn success(ticks: u64, executor: Option<&str>) -> String {
+    match executor {
+        Some(name) => format!("SUCCESS in the {name} executor after {ticks} tick(s)"),
+        None => format!("SUCCESS after {ticks} tick(s)"),
+    }
 }
 
 /// Said in the LLM pane's log when a model fetched while the workbench was open is there.

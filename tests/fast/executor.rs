@@ -379,13 +379,26 @@ fn a_process_executor_runs_scenario_1_to_success_over_json_lines() {
         let got = s
             .until("success", |e| matches!(e, Event::Success { .. }))
             .await;
-        let ticks = got.iter().find_map(|e| match e {
-            Event::Success { ticks } => Some(*ticks),
+        let ended = got.iter().find_map(|e| match e {
+            Event::Success { ticks, executor } => Some((*ticks, executor.clone())),
             _ => None,
         });
         // Two actions of four ticks each, the place starting in the tick the grasp ends
-        // (ticks 1-4 and 4-7), and the tick that finds the goal reached.
-        assert_eq!(ticks, Some(8));
+        // (ticks 1-4 and 4-7), and the tick that finds the goal reached; the success is
+        // the executor's, not the simulation's.
+        let (ticks, executor) = ended.expect("a success");
+        assert_eq!(ticks, 8);
+        let executor = executor.expect("the executor named");
+        assert!(executor.contains("follower"), "{executor}");
+        let said = betr::record::describe::describe(&Event::Success {
+            ticks,
+            executor: Some(executor),
+        })
+        .join("\n");
+        assert!(
+            said.contains("SUCCESS in the python3 follower.py executor"),
+            "{said}"
+        );
     });
 }
 

@@ -53,7 +53,7 @@ fn scenario_1_is_repaired_and_its_actions_performed_in_mujoco() {
         log.contains("Proposal: insert ~\"any object\" on \"blue cube\""),
         "{log}"
     );
-    assert!(log.contains("SUCCESS"), "{log}");
+    assert!(log.contains("SUCCESS in the mujoco executor"), "{log}");
     // Every action of the repaired tree ended in MuJoCo, the last with the blue cube
     // resting on the green cube (4 cm up, over it).
     for action in [

@@ -257,7 +257,10 @@ fn random_event(rng: &mut Rng, near: &Near<'_>) -> Event {
             reality: (0..rng.small(40)).map(|_| random_char(rng)).collect(),
             predicted: None,
         },
-        _ => Event::Success { ticks: 4 },
+        _ => Event::Success {
+            ticks: 4,
+            executor: None,
+        },
     }
 }
 

@@ -223,6 +223,7 @@ impl Engine {
                 self.stop_running();
                 self.emit(Event::Success {
                     ticks: self.run.ticker.tick_count(),
+                    executor: self.run.reality.as_ref().map(|r| r.name().to_string()),
                 });
             }
             (TickOutcome::Failure, Some(failure)) => {

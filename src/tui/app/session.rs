@@ -312,10 +312,13 @@ impl App {
                     self.llm.screened = None;
                 }
             }
-            Event::Success { ticks } => {
+            Event::Success {
+                ticks,
+                ref executor,
+            } => {
                 self.status.ending = Some(Ending::Success);
                 self.world.error_resolved = true;
-                self.llm.log(strings::success(ticks));
+                self.llm.log(strings::success(ticks, executor.as_deref()));
             }
             Event::ArmMotion { motion } => self.world.motion = Some(motion),
             Event::Executor { ref name } => {
