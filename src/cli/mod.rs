@@ -118,8 +118,9 @@ pub enum Command {
         #[command(subcommand)]
         experiment: eval_cmd::EvalExperiment,
     },
-    /// Rules learned from approved fixes (kept with `betr resolve --learn` or in the
-    /// workbench): list them, show one with where it came from, revoke one.
+    /// What betr learned: rules from approved fixes (kept with `betr resolve --learn` or in
+    /// the workbench) and readings a person corrected, kept as the domain's examples; list
+    /// them, show one with where it came from, revoke one.
     Knowledge {
         #[command(subcommand)]
         action: knowledge_cmd::KnowledgeAction,

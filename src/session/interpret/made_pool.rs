@@ -9,6 +9,8 @@
 //! joined by "and" and by "or" for the formula's shape. Made examples are marked as such,
 //! and each written or kept example takes one made example's place.
 
+use std::collections::HashMap;
+
 use crate::domain::{Atom, Condition, Vocabulary};
 use crate::goal::Formula;
 use crate::planner::{Outcome, Planner};
@@ -16,6 +18,9 @@ use crate::scenario::{Example, ExampleSource, Scenario};
 
 /// How many examples a domain's pool holds when made examples fill it.
 pub const MADE_POOL: usize = 12;
+
+/// How many undoings (a condition that holds asked to stop) a made pool shows.
+const UNDOINGS: usize = 2;
 
 /// How many conditions of one predicate are tried, at most, to find reachable ones.
 const TRIED_PER_PREDICATE: usize = 8;
@@ -57,65 +62,129 @@ pub fn made_pool(scenario: &Scenario, most: usize) -> Vec<Example> {
             .plan(&goal.to_dnf(), world.as_ref())
             .is_ok_and(|p| matches!(p.outcome, Outcome::Success | Outcome::ActionFailed { .. }))
     };
-    // Every ground atom, formed once for all predicates.
+    // Every ground atom, formed once for all predicates, each with whether it holds now.
     let ground = vocabulary.ground_atoms();
-    let mut per_predicate: Vec<Vec<(Formula, String)>> = vocabulary
+    let mut untried: Vec<Vec<(Atom, bool)>> = vocabulary
         .predicates
         .iter()
         .map(|p| {
-            let mut found = Vec::new();
-            for atom in atoms_of(&ground, &p.name).take(TRIED_PER_PREDICATE) {
-                let holds = world.check(&Condition {
-                    atom: atom.clone(),
-                    negated: false,
-                });
-                let Some(said) = plainly(&atom, !holds, vocabulary) else {
-                    continue;
-                };
-                let goal = if holds {
-                    Formula::Not(Box::new(Formula::Atom(atom)))
-                } else {
-                    Formula::Atom(atom)
-                };
-                if reachable(&goal) {
-                    found.push((goal, said));
-                }
-            }
-            found
+            atoms_of(&ground, &p.name)
+                .map(|atom| {
+                    let holds = world.check(&Condition {
+                        atom: atom.clone(),
+                        negated: false,
+                    });
+                    (atom, holds)
+                })
+                .collect()
         })
         .collect();
-    // The predicates in turn, so each shows before any shows twice.
+    // Room for the two joined examples when the pool is large enough to show them.
+    let wanted_singles = if most >= 4 { most - 2 } else { most };
+    let mut said_of: HashMap<String, usize> = HashMap::new();
     let mut singles: Vec<(Formula, String)> = Vec::new();
-    while singles.len() < most && per_predicate.iter().any(|p| !p.is_empty()) {
-        for found in per_predicate.iter_mut().filter(|p| !p.is_empty()) {
-            singles.push(found.remove(0));
+    // The predicates in turn, so each shows before any shows twice, room kept for
+    // [`UNDOINGS`] undoings (`~`) after the first round; then more changes.
+    let mut take_round = |undoing: bool, room: usize, singles: &mut Vec<(Formula, String)>| {
+        let goal_count = singles.len() + room;
+        for candidates in untried.iter_mut() {
+            if singles.len() >= goal_count {
+                break;
+            }
+            let Some(found) = next_single(candidates, undoing, &said_of, vocabulary, &reachable)
+            else {
+                continue;
+            };
+            for object in objects_of(&found.0) {
+                *said_of.entry(object.clone()).or_default() += 1;
+            }
+            singles.push(found);
         }
+    };
+    take_round(false, wanted_singles.saturating_sub(UNDOINGS), &mut singles);
+    take_round(
+        true,
+        UNDOINGS.min(wanted_singles - singles.len()),
+        &mut singles,
+    );
+    let mut before = usize::MAX;
+    while singles.len() < wanted_singles && singles.len() != before {
+        before = singles.len();
+        take_round(false, wanted_singles - singles.len(), &mut singles);
     }
-    let mut made: Vec<Example> = Vec::new();
-    // Two of different predicates joined, when the pool has room: the shape of "and"
-    // and "or" goals.
-    let other = singles.first().and_then(|(a, _)| {
-        singles
-            .iter()
-            .position(|(b, _)| predicate_of(b) != predicate_of(a))
-    });
-    if let Some(j) = other.filter(|_| most >= 4) {
-        let ((a, said_a), (b, said_b)) = (&singles[0], &singles[j]);
-        let both = Formula::and(vec![a.clone(), b.clone()]);
-        if reachable(&both) {
-            made.push(example(&format!("{said_a} and {}", lower(said_b)), &both));
-        }
-        let either = Formula::or(vec![a.clone(), b.clone()]);
-        made.push(example(&format!("{said_a} or {}", lower(said_b)), &either));
+    let mut out: Vec<Example> = singles.iter().map(|(g, said)| example(said, g)).collect();
+    if most >= 4 {
+        out.extend(joined(&singles, &reachable));
     }
-    let room = most.saturating_sub(made.len());
-    let mut out: Vec<Example> = singles
-        .iter()
-        .take(room)
-        .map(|(goal, said)| example(said, goal))
-        .collect();
-    out.extend(made);
+    out.truncate(most);
     out
+}
+
+/// The next condition of one predicate to make an example of, taken out of `candidates`,
+/// of the objects said least so far, that the scene can say and the planner can reach:
+/// one asked to become true, or, when `undoing`, one that holds now asked to stop
+/// holding, of objects the scene says how people call (not a stand-in such as the
+/// `Nothing` of an empty gripper). At most [`TRIED_PER_PREDICATE`] are tried.
+fn next_single(
+    candidates: &mut Vec<(Atom, bool)>,
+    undoing: bool,
+    said_of: &HashMap<String, usize>,
+    vocabulary: &Vocabulary,
+    reachable: &dyn Fn(&Formula) -> bool,
+) -> Option<(Formula, String)> {
+    let used = |atom: &Atom| {
+        atom.args
+            .iter()
+            .map(|a| said_of.get(a).copied().unwrap_or(0))
+            .sum::<usize>()
+    };
+    let called = |atom: &Atom| {
+        atom.args
+            .iter()
+            .all(|a| vocabulary.object(a).is_some_and(|o| !o.called.is_empty()))
+    };
+    let fits = |(atom, holds): &(Atom, bool)| *holds == undoing && (!undoing || called(atom));
+    candidates.sort_by_key(|c| (!fits(c), used(&c.0)));
+    for _ in 0..TRIED_PER_PREDICATE.min(candidates.len()) {
+        if !candidates.first().is_some_and(fits) {
+            break;
+        }
+        let (atom, holds) = candidates.remove(0);
+        let Some(said) = plainly(&atom, !holds, vocabulary) else {
+            continue;
+        };
+        let goal = if holds {
+            Formula::Not(Box::new(Formula::Atom(atom)))
+        } else {
+            Formula::Atom(atom)
+        };
+        if reachable(&goal) {
+            return Some((goal, said));
+        }
+    }
+    None
+}
+
+/// Two of `singles` of different predicates and different objects, joined by "and" (when
+/// the planner reaches both) and by "or": the shape of goals of several wishes.
+fn joined(singles: &[(Formula, String)], reachable: &dyn Fn(&Formula) -> bool) -> Vec<Example> {
+    let Some((a, said_a)) = singles.first() else {
+        return Vec::new();
+    };
+    let Some((b, said_b)) = singles.iter().skip(1).find(|(b, _)| {
+        predicate_of(b) != predicate_of(a)
+            && objects_of(a).iter().all(|o| !objects_of(b).contains(o))
+    }) else {
+        return Vec::new();
+    };
+    let mut made = Vec::new();
+    let both = Formula::and(vec![a.clone(), b.clone()]);
+    if reachable(&both) {
+        made.push(example(&format!("{said_a} and {}", lower(said_b)), &both));
+    }
+    let either = Formula::or(vec![a.clone(), b.clone()]);
+    made.push(example(&format!("{said_a} or {}", lower(said_b)), &either));
+    made
 }
 
 fn example(said: &str, goal: &Formula) -> Example {
@@ -126,12 +195,21 @@ fn example(said: &str, goal: &Formula) -> Example {
     }
 }
 
-fn predicate_of(goal: &Formula) -> Option<&str> {
+/// The one atom of a single condition, held or negated.
+fn atom_of(goal: &Formula) -> Option<&Atom> {
     match goal {
-        Formula::Atom(a) => Some(&a.predicate),
-        Formula::Not(inner) => predicate_of(inner),
+        Formula::Atom(a) => Some(a),
+        Formula::Not(inner) => atom_of(inner),
         _ => None,
     }
+}
+
+fn predicate_of(goal: &Formula) -> Option<&str> {
+    atom_of(goal).map(|a| a.predicate.as_str())
+}
+
+fn objects_of(goal: &Formula) -> &[String] {
+    atom_of(goal).map_or(&[], |a| a.args.as_slice())
 }
 
 /// `text` with its first letter lower case.
@@ -208,6 +286,45 @@ mod tests {
         let path =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cafe/cafe.toml");
         Scenario::load(&path).expect("cafe scenario")
+    }
+
+    #[test]
+    fn a_made_pool_names_many_things_and_undoes_what_holds() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/warehouse/warehouse.toml");
+        let scenario = Scenario::load(&path).expect("warehouse scenario");
+        let made = made_pool(&scenario, MADE_POOL);
+        assert_eq!(made.len(), MADE_POOL);
+        // The singles name many of the scene's things, not its first box each time.
+        let mut objects: Vec<String> = made
+            .iter()
+            .filter(|e| !e.goal.contains(['&', '|']))
+            .flat_map(|e| {
+                let goal = scenario.parse_goal(&e.goal).expect("a goal of the scene");
+                goal.atoms().into_iter().flat_map(|a| a.args)
+            })
+            .collect();
+        objects.sort();
+        objects.dedup();
+        assert!(objects.len() >= 8, "{objects:?}");
+        // An undoing of what holds now, of a thing people call by name: the aisle lights
+        // off, never the empty gripper's stand-in put down.
+        let undoings: Vec<&Example> = made.iter().filter(|e| e.goal.starts_with('~')).collect();
+        assert!(!undoings.is_empty(), "{made:?}");
+        assert!(
+            undoings.iter().all(|e| !e.goal.contains("Nothing")),
+            "{undoings:?}"
+        );
+        // "and" and "or" join wishes about different things.
+        let both = made.iter().find(|e| e.goal.contains('&')).expect("an and");
+        let goal = scenario
+            .parse_goal(&both.goal)
+            .expect("a goal of the scene");
+        let atoms: Vec<Atom> = goal.atoms().into_iter().collect();
+        assert!(
+            atoms[0].args.iter().all(|o| !atoms[1].args.contains(o)),
+            "{both:?}"
+        );
     }
 
     #[test]
