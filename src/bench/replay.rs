@@ -153,45 +153,7 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
         usage.calls += 1;
         usage.prompt_tokens += 900;
         usage.completion_tokens += 40;
-        let episode = [
-            event(Event::ActionFailed {
-                action: call.clone(),
-                node: action,
-                node_path: path.clone(),
-                error: "No collision free path found".into(),
-                executor: None,
-            }),
-            event(Event::RunState { running: false }),
-            event(Event::Asking {
-                what: crate::session::Question::Preconditions {
-                    action: call.clone(),
-                },
-            }),
-            event(Event::Replied {
-                attribution: "the benchmark".into(),
-                prompt_tokens: 900,
-                completion_tokens: 40,
-                latency_ms: 800,
-                text: "Conditions:\n~Held_0".into(),
-            }),
-            event(Event::Usage { totals: usage }),
-            event(Event::Proposal {
-                proposal: Proposal::Conditions {
-                    action: call.clone(),
-                    node: action,
-                    conditions: vec![fact(t)],
-                },
-                reasoning: Some("the benchmark's".into()),
-                author: "the benchmark".into(),
-                evidence: None,
-            }),
-            Step::Command("approve".into()),
-            event(Event::Approved),
-            event(Event::Repaired {
-                added_nodes: 0,
-                valued_nodes: 0,
-            }),
-        ];
+        let episode = failure_resolved(&call, action, &path, fact(t), usage);
         for step in episode {
             ms += 100;
             push(ms, step);
@@ -226,6 +188,58 @@ pub fn synthetic(nodes: usize, ticks: usize) -> Result<Vec<(u64, Step)>, BenchEr
         }),
     );
     Ok(steps)
+}
+
+/// A failure of `call` (node `node` at `path`) resolved as a session records it: the
+/// question, the answer, the proposal of `condition` approved, the tree repaired; `usage`
+/// is the model's usage after the answer.
+fn failure_resolved(
+    call: &ActionCall,
+    node: NodeId,
+    path: &[usize],
+    condition: Condition,
+    usage: UsageTotals,
+) -> [Step; 9] {
+    let event = Step::Event;
+    [
+        event(Event::ActionFailed {
+            action: call.clone(),
+            node,
+            node_path: path.to_vec(),
+            error: "No collision free path found".into(),
+            executor: None,
+        }),
+        event(Event::RunState { running: false }),
+        event(Event::Asking {
+            what: crate::session::Question::Preconditions {
+                action: call.clone(),
+            },
+        }),
+        event(Event::Replied {
+            attribution: "the benchmark".into(),
+            prompt_tokens: 900,
+            completion_tokens: 40,
+            latency_ms: 800,
+            text: "Conditions:\n~Held_0".into(),
+        }),
+        event(Event::Usage { totals: usage }),
+        event(Event::Proposal {
+            proposal: Proposal::Conditions {
+                action: call.clone(),
+                node,
+                conditions: vec![condition],
+            },
+            reasoning: Some("the benchmark's".into()),
+            author: "the benchmark".into(),
+            evidence: None,
+        }),
+        Step::Command("approve".into()),
+        event(Event::Approved),
+        event(Event::Repaired {
+            added_nodes: 0,
+            valued_nodes: 0,
+        }),
+    ]
 }
 
 /// Ticks between two failures.

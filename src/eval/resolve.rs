@@ -272,18 +272,6 @@ fn record(
     wall_ms: f64,
 ) -> ResolveCase {
     let success = trace.ending.is_ok();
-    let mut proposals: Vec<ProposalRecord> = Vec::new();
-    let mut goal = None;
-    let mut goal_as_expected = None;
-    let mut unusable = 0;
-    let mut failure_reached = false;
-    let mut screened_out = 0;
-    let mut first_candidate: Option<Proposal> = None;
-    let mut kept_conditions: Vec<Condition> = Vec::new();
-    // How many kept conditions there were before the last kept change, so a change that
-    // fails verification afterwards (and is rejected) is taken out again.
-    let mut kept_before_last = 0;
-    let mut pending: Option<Proposal> = None;
     let fixes: Vec<Condition> = scenario
         .expected_fix
         .iter()
@@ -294,64 +282,15 @@ fn record(
         Proposal::Conditions { conditions, .. } => conditions.iter().any(|c| fixes.contains(c)),
         Proposal::Value { .. } => false,
     };
+    let mut seen = Seen::default();
     for e in &trace.events {
-        match e {
-            Event::ActionFailed { .. } => failure_reached = true,
-            Event::CandidateRejected {
-                proposal: Some(p), ..
-            } => {
-                screened_out += 1;
-                first_candidate.get_or_insert_with(|| p.clone());
-            }
-            Event::Goal {
-                goal: g,
-                matches_expected,
-                ..
-            } => {
-                goal = Some(g.to_string());
-                goal_as_expected = *matches_expected;
-            }
-            Event::InvalidReply { .. } => unusable += 1,
-            Event::Proposal { proposal, .. } => {
-                first_candidate.get_or_insert_with(|| proposal.clone());
-                pending = Some(proposal.clone());
-                proposals.push(ProposalRecord {
-                    proposal: proposal.to_string(),
-                    kept: false,
-                    correct: false,
-                    note: None,
-                });
-            }
-            Event::Repaired { .. } => {
-                if let Some(p) = proposals.last_mut() {
-                    p.kept = true;
-                    p.correct = success;
-                }
-                kept_before_last = kept_conditions.len();
-                if let Some(Proposal::Conditions { conditions, .. }) = pending.take() {
-                    kept_conditions.extend(conditions);
-                }
-            }
-            Event::ChangeViolates { .. } => {
-                if let Some(p) = proposals.last_mut() {
-                    p.kept = false;
-                    p.correct = false;
-                }
-                kept_conditions.truncate(kept_before_last);
-            }
-            Event::DidNotHelp { reason } => {
-                if let Some(p) = proposals.last_mut() {
-                    p.note = Some(reason.clone());
-                }
-            }
-            _ => {}
-        }
+        seen.take(e, success);
     }
     let resolved = success
-        && goal_as_expected == Some(true)
-        && failure_reached
+        && seen.goal_as_expected == Some(true)
+        && seen.failure_reached
         && !fixes.is_empty()
-        && fixes.iter().all(|f| kept_conditions.contains(f));
+        && fixes.iter().all(|f| seen.kept_conditions.contains(f));
     ResolveCase {
         scenario: path.to_string(),
         name: scenario.name.clone(),
@@ -359,17 +298,91 @@ fn record(
         success,
         ticks: trace.ending.as_ref().ok().copied(),
         reason: trace.ending.err().map(|e| e.to_string()),
-        goal,
-        goal_as_expected,
+        goal: seen.goal,
+        goal_as_expected: seen.goal_as_expected,
         rounds: trace.rounds,
-        failure_reached,
+        failure_reached: seen.failure_reached,
         resolved,
-        first_candidate_right: first_candidate.as_ref().is_some_and(holds_fix),
-        proposals,
-        screened_out,
-        unusable_replies: unusable,
+        first_candidate_right: seen.first_candidate.as_ref().is_some_and(holds_fix),
+        proposals: seen.proposals,
+        screened_out: seen.screened_out,
+        unusable_replies: seen.unusable,
         calls,
         wall_ms,
+    }
+}
+
+/// What a run's events say about its goal and the proposals it was offered.
+#[derive(Default)]
+struct Seen {
+    proposals: Vec<ProposalRecord>,
+    goal: Option<String>,
+    goal_as_expected: Option<bool>,
+    unusable: usize,
+    failure_reached: bool,
+    screened_out: usize,
+    first_candidate: Option<Proposal>,
+    kept_conditions: Vec<Condition>,
+    /// How many kept conditions there were before the last kept change, so a change that
+    /// fails verification afterwards (and is rejected) is taken out again.
+    kept_before_last: usize,
+    pending: Option<Proposal>,
+}
+
+impl Seen {
+    /// Take in one event of a run that ended in `success` or not.
+    fn take(&mut self, e: &Event, success: bool) {
+        match e {
+            Event::ActionFailed { .. } => self.failure_reached = true,
+            Event::CandidateRejected {
+                proposal: Some(p), ..
+            } => {
+                self.screened_out += 1;
+                self.first_candidate.get_or_insert_with(|| p.clone());
+            }
+            Event::Goal {
+                goal,
+                matches_expected,
+                ..
+            } => {
+                self.goal = Some(goal.to_string());
+                self.goal_as_expected = *matches_expected;
+            }
+            Event::InvalidReply { .. } => self.unusable += 1,
+            Event::Proposal { proposal, .. } => {
+                self.first_candidate.get_or_insert_with(|| proposal.clone());
+                self.pending = Some(proposal.clone());
+                self.proposals.push(ProposalRecord {
+                    proposal: proposal.to_string(),
+                    kept: false,
+                    correct: false,
+                    note: None,
+                });
+            }
+            Event::Repaired { .. } => {
+                if let Some(p) = self.proposals.last_mut() {
+                    p.kept = true;
+                    p.correct = success;
+                }
+                self.kept_before_last = self.kept_conditions.len();
+                if let Some(Proposal::Conditions { conditions, .. }) = self.pending.take() {
+                    self.kept_conditions.extend(conditions);
+                }
+            }
+            Event::ChangeViolates { .. } => {
+                if let Some(p) = self.proposals.last_mut() {
+                    p.kept = false;
+                    p.correct = false;
+                }
+                self.kept_conditions.truncate(self.kept_before_last);
+            }
+            Event::DidNotHelp { reason } => {
+                if let Some(p) = self.proposals.last_mut() {
+                    p.note = Some(reason.clone());
+                }
+            }
+            _ => {}
+        }
     }
 }
 

@@ -244,18 +244,7 @@ impl Decoder {
                 text,
                 new_nodes,
                 why,
-            } => {
-                let tree = crate::bt::parse(text).map_err(|e| refused(format!("the tree: {e}")))?;
-                self.order = tree.preorder();
-                let tree = Arc::new(tree);
-                self.tree = Some(tree.clone());
-                Event::TreeChanged {
-                    tree,
-                    new_nodes: self.nodes(new_nodes)?,
-                    learned: Vec::new(),
-                    why: why.clone(),
-                }
-            }
+            } => self.tree_changed(text, new_nodes, why)?,
             Recorded::Tick { .. } => Event::Ticked {
                 record: Arc::new(self.tick(recorded)?),
             },
@@ -336,6 +325,25 @@ impl Decoder {
                 }
             }
             other => plain(other)?,
+        })
+    }
+
+    /// A tree as written: it becomes the tree whose pre-order positions name nodes.
+    fn tree_changed(
+        &mut self,
+        text: &str,
+        new_nodes: &[usize],
+        why: &str,
+    ) -> Result<Event, Refused> {
+        let tree = crate::bt::parse(text).map_err(|e| refused(format!("the tree: {e}")))?;
+        self.order = tree.preorder();
+        let tree = Arc::new(tree);
+        self.tree = Some(tree.clone());
+        Ok(Event::TreeChanged {
+            tree,
+            new_nodes: self.nodes(new_nodes)?,
+            learned: Vec::new(),
+            why: why.to_string(),
         })
     }
 

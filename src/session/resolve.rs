@@ -12,6 +12,7 @@
 use std::sync::Arc;
 
 use crate::bt::Tree;
+use crate::goal::Formula;
 use crate::llm::LanguageModel;
 use crate::scenario::Scenario;
 
@@ -46,7 +47,6 @@ pub async fn resolve(
 
 /// Says whether a proposal is approved.
 pub type Approver<'a> = &'a mut dyn FnMut(&Proposal) -> bool;
-/// Picks the reading to work on among those offered, or none to stop.
 /// Picks the reading to work on among those offered (with the doubt the checks raised
 /// about a single one), or none to stop.
 pub type ReadingChooser<'a> = &'a mut dyn FnMut(&[Reading], Option<&str>) -> Option<usize>;
@@ -72,20 +72,70 @@ pub async fn resolve_with_scenes(
     emit: &mut dyn FnMut(&Event),
 ) -> Result<Resolved, SessionError> {
     let (engine, mut events, path) = start(scenario, instruction, model, options, execution)?;
-
-    let mut goal = None;
-    let mut tree: Option<Arc<Tree>> = None;
-    let mut rounds = 0;
-    let mut repairs: usize = 0;
-    let mut offered: Option<(Proposal, String)> = None;
-    let mut kept: Vec<(Proposal, String)> = Vec::new();
+    let mut followed = Followed::default();
     let ending = loop {
         let Some(event) = events.recv().await else {
             return Err(SessionError::Stopped);
         };
         emit(&event);
+        if let Some(ending) = followed.take(event, &engine, (&mut *approve, &mut *choose), emit)? {
+            break ending;
+        }
+    };
+    let saved = match (&ending, &options.policy_dir, &followed.goal) {
+        (Ending::Success { .. }, Some(dir), Some(goal)) => {
+            let to = PolicyStore::new(dir).path_for(&path, goal);
+            Some(save_policy(&engine, &mut events, to, emit).await?)
+        }
+        _ => None,
+    };
+    engine.send(Command::Shutdown);
+    let Followed {
+        goal: Some(goal),
+        tree: Some(tree),
+        rounds,
+        repairs,
+        kept,
+        ..
+    } = followed
+    else {
+        return Err(SessionError::Stopped);
+    };
+    Ok(Resolved {
+        goal,
+        tree: Arc::unwrap_or_clone(tree),
+        ending,
+        rounds,
+        repairs,
+        kept,
+        saved,
+    })
+}
+
+/// What the loop has followed of the engine's events so far.
+#[derive(Default)]
+struct Followed {
+    goal: Option<Formula>,
+    tree: Option<Arc<Tree>>,
+    rounds: usize,
+    repairs: usize,
+    /// The approved proposal the engine is applying, until it reports the repair.
+    offered: Option<(Proposal, String)>,
+    kept: Vec<(Proposal, String)>,
+}
+
+impl Followed {
+    /// Take in one event and answer the engine where it waits (a reading to choose, a
+    /// proposal to approve, a changed tree to run); how the loop ended, once it has.
+    fn take(
+        &mut self,
+        event: Event,
+        engine: &EngineHandle,
+        (approve, choose): (Approver<'_>, ReadingChooser<'_>),
+        emit: &mut dyn FnMut(&Event),
+    ) -> Result<Option<Ending>, SessionError> {
         match event {
-            Event::Goal { goal: g, .. } => goal = Some(g),
+            Event::Goal { goal, .. } => self.goal = Some(goal),
             Event::Readings {
                 readings, doubt, ..
             } => match choose(&readings, doubt.as_deref()) {
@@ -100,9 +150,9 @@ pub async fn resolve_with_scenes(
                     });
                 }
             },
-            Event::Asking { .. } if goal.is_some() => rounds += 1,
-            Event::TreeChanged { tree: t, .. } => {
-                tree = Some(t);
+            Event::Asking { .. } if self.goal.is_some() => self.rounds += 1,
+            Event::TreeChanged { tree, .. } => {
+                self.tree = Some(tree);
                 engine.send(Command::Run);
             }
             Event::DidNotHelp { .. } => {
@@ -116,53 +166,34 @@ pub async fn resolve_with_scenes(
                     // question to the model again (as the workbench does after a
                     // rejection): no call is sent that nobody will read.
                     emit(&Event::Rejected);
-                    break Ending::Rejected;
+                    return Ok(Some(Ending::Rejected));
                 }
-                offered = Some((proposal.clone(), author.clone()));
+                self.offered = Some((proposal, author));
                 engine.send(Command::Approve);
             }
             Event::Repaired { .. } => {
-                repairs += 1;
-                kept.extend(offered.take());
+                self.repairs += 1;
+                self.kept.extend(self.offered.take());
             }
-            Event::Rejected => break Ending::Rejected,
+            Event::Rejected => return Ok(Some(Ending::Rejected)),
             // Never approved past a failed check, not even under --yes: the change is
             // rejected, undone, and the model is asked again knowing why.
             Event::ChangeViolates { .. } => {
-                repairs = repairs.saturating_sub(1);
-                kept.pop();
+                self.repairs = self.repairs.saturating_sub(1);
+                self.kept.pop();
                 engine.send(Command::Reject);
             }
-            Event::Success { ticks, .. } => break Ending::Success { ticks },
-            Event::GaveUp { reason } => break Ending::GaveUp { reason },
+            Event::Success { ticks, .. } => return Ok(Some(Ending::Success { ticks })),
+            Event::GaveUp { reason } => return Ok(Some(Ending::GaveUp { reason })),
             Event::Failed { error } => {
                 engine.send(Command::Shutdown);
                 return Err(error);
             }
-            Event::Error { message } => break Ending::GaveUp { reason: message },
+            Event::Error { message } => return Ok(Some(Ending::GaveUp { reason: message })),
             _ => {}
         }
-    };
-    let saved = match (&ending, &options.policy_dir, &goal) {
-        (Ending::Success { .. }, Some(dir), Some(goal)) => {
-            let to = PolicyStore::new(dir).path_for(&path, goal);
-            Some(save_policy(&engine, &mut events, to, emit).await?)
-        }
-        _ => None,
-    };
-    engine.send(Command::Shutdown);
-    let (Some(goal), Some(tree)) = (goal, tree) else {
-        return Err(SessionError::Stopped);
-    };
-    Ok(Resolved {
-        goal,
-        tree: Arc::unwrap_or_clone(tree),
-        ending,
-        rounds,
-        repairs,
-        kept,
-        saved,
-    })
+        Ok(None)
+    }
 }
 
 /// An engine for `scenario` in `execution`, given the instruction (or, with
