@@ -88,8 +88,10 @@ pub struct Recorder<M> {
     path: PathBuf,
     lock: std::sync::Mutex<()>,
     /// The exchanges already in the cassette for this model, by prompt hash, answered
-    /// without asking it (empty unless reusing).
-    known: HashMap<String, Entry>,
+    /// without asking it; when reusing, each exchange recorded since joins them, so a
+    /// prompt asked twice in one run is asked once (empty unless reusing).
+    known: std::sync::Mutex<HashMap<String, Entry>>,
+    reusing: bool,
 }
 
 impl<M: LanguageModel> Recorder<M> {
@@ -116,7 +118,8 @@ impl<M: LanguageModel> Recorder<M> {
             inner,
             path,
             lock: std::sync::Mutex::new(()),
-            known: HashMap::new(),
+            known: std::sync::Mutex::new(HashMap::new()),
+            reusing: false,
         })
     }
 
@@ -144,19 +147,21 @@ impl<M: LanguageModel> Recorder<M> {
             .map(|e| (e.prompt_hash.clone(), e))
             .collect();
         let mut recorder = Recorder::new(inner, path)?;
-        recorder.known = known;
+        recorder.known = std::sync::Mutex::new(known);
+        recorder.reusing = true;
         Ok(recorder)
     }
 
     async fn call(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
-        if let Some(entry) = self.known.get(&prompt_hash(request)) {
-            return Ok(recorded_reply(entry, Instant::now()));
+        let hash = prompt_hash(request);
+        if let Some(entry) = self.known_entry(&hash) {
+            return Ok(recorded_reply(&entry, Instant::now()));
         }
         let reply = self.inner.chat(request).await?;
         let entry = Entry {
             model: self.inner.model().to_string(),
             reply_model: reply.model.clone(),
-            prompt_hash: prompt_hash(request),
+            prompt_hash: hash.clone(),
             request: request.clone(),
             reply: reply.text.clone(),
             usage: reply.usage,
@@ -175,7 +180,17 @@ impl<M: LanguageModel> Recorder<M> {
             };
             crate::store::note_unwritten(&self.path, &why);
         }
+        if self.reusing
+            && let Ok(mut known) = self.known.lock()
+        {
+            known.insert(hash, entry);
+        }
         Ok(reply)
+    }
+
+    /// The exchange recorded for the prompt hashed `hash`, when reusing one.
+    fn known_entry(&self, hash: &str) -> Option<Entry> {
+        self.known.lock().ok()?.get(hash).cloned()
     }
 
     fn append(&self, entry: &Entry) -> Result<(), LlmError> {
@@ -404,6 +419,10 @@ mod tests {
         );
         assert_eq!(live.inner.0.load(std::sync::atomic::Ordering::SeqCst), 0);
         assert_eq!(block(live.chat(&b)).unwrap().text, "OTHER");
+        assert_eq!(live.inner.0.load(std::sync::atomic::Ordering::SeqCst), 1);
+        // Asked again in the same run, the new exchange is answered as recorded.
+        let again = block(live.chat(&b)).unwrap();
+        assert_eq!(again.source, ReplySource::Recorded);
         assert_eq!(live.inner.0.load(std::sync::atomic::Ordering::SeqCst), 1);
         // The new exchange was appended; the reused one was not written twice.
         let text = std::fs::read_to_string(&path).unwrap();
