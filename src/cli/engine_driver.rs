@@ -76,7 +76,8 @@ impl<'a> Start<'a> {
 
 /// How a run of the tree in the execution world ended.
 pub enum RunEnd {
-    Success,
+    /// The goal was reached: in betr's world, or by `executor` (its name).
+    Success { executor: Option<String> },
     ActionFailed {
         action: ActionCall,
         node_path: String,
@@ -84,9 +85,7 @@ pub enum RunEnd {
     },
     /// The engine stopped running: the tree failed with no action failing, or the tick
     /// limit came (the last record still running).
-    Stopped {
-        reason: String,
-    },
+    Stopped { reason: String },
     /// A breakpoint stopped the run: before tick `tick`, which would enter `node`, or
     /// after it, in which `node` failed.
     Break {
@@ -249,7 +248,7 @@ impl Driver {
                     on_tick(&record);
                     last = Some(record);
                 }
-                Event::Success { .. } => break RunEnd::Success,
+                Event::Success { executor, .. } => break RunEnd::Success { executor },
                 Event::ActionFailed {
                     action,
                     node_path,

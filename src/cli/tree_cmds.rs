@@ -196,7 +196,7 @@ fn run(scenario: &Scenario, args: &RunArgs, glyphs: &Glyphs) -> Result<ExitCode>
     print_tree(&tree, run.last.as_deref(), glyphs);
     outln!("\n{}", run_end_text(&run, &tree));
     Ok(match run.end {
-        RunEnd::Success => ExitCode::SUCCESS,
+        RunEnd::Success { .. } => ExitCode::SUCCESS,
         RunEnd::Break { .. } => ExitCode::from(STOPPED_AT_BREAKPOINT),
         _ => ExitCode::from(WORLD_FAILED),
     })
@@ -231,7 +231,10 @@ fn with_tree(start: Start, tree_file: Option<&Path>, grow: bool) -> Result<Drive
 /// How a run ended, as `betr run` and `betr repair` say it.
 fn run_end_text(run: &Run, tree: &Tree) -> String {
     match &run.end {
-        RunEnd::Success => format!("SUCCESS after {} tick(s)", run.ticks),
+        RunEnd::Success { executor: None } => format!("SUCCESS after {} tick(s)", run.ticks),
+        RunEnd::Success {
+            executor: Some(name),
+        } => format!("SUCCESS in the {name} executor after {} tick(s)", run.ticks),
         RunEnd::ActionFailed {
             action,
             node_path,
@@ -271,7 +274,7 @@ fn run_end_text(run: &Run, tree: &Tree) -> String {
 /// Why a run did not succeed, as the planner says it of its simulation.
 fn failure_text(end: &RunEnd) -> String {
     match end {
-        RunEnd::Success => "it succeeds".into(),
+        RunEnd::Success { .. } => "it succeeds".into(),
         RunEnd::ActionFailed {
             action,
             node_path,
@@ -343,7 +346,7 @@ fn repair(scenario: &Scenario, request: &RepairRequest, glyphs: &Glyphs) -> Resu
         outln!("Saved to {}", path.display());
     }
     match before.end {
-        RunEnd::Success => {
+        RunEnd::Success { .. } => {
             outln!("SUCCESS after {} tick(s)", before.ticks);
             Ok(ExitCode::SUCCESS)
         }
@@ -391,7 +394,7 @@ fn add_conditions(
         (RunEnd::ActionFailed { action, error, .. }, None) => outln!(
             "{action}! failed in simulation: {error}\nInserting {names} as its first precondition(s)"
         ),
-        (RunEnd::Success, None) => {
+        (RunEnd::Success { .. }, None) => {
             bail!("the tree already succeeds before --add {names:?}: nothing fails to repair")
         }
         (RunEnd::Stopped { reason }, None) => bail!("cannot repair: {reason}"),

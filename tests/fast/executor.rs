@@ -482,7 +482,10 @@ fn betr_run_performs_the_tree_in_the_program_named_by_executor() {
     let text = support::cli::text(&out);
     assert!(out.status.success(), "{text}");
     // Two ticks per action in the follower: the grasp in ticks 1-2, the place in 2-3.
-    assert!(text.contains("SUCCESS after 4 tick(s)"), "{text}");
+    assert!(
+        text.contains("SUCCESS in the python3 follower.py executor after 4 tick(s)"),
+        "{text}"
+    );
     // A command line that cannot be split, and a program that does not start, are named.
     let out = support::cli::betr(&dir, &["run", &scenario, "--executor", "python3 'sim.py"]);
     let text = support::cli::text(&out);
