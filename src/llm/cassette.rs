@@ -140,12 +140,12 @@ impl<M: LanguageModel> Recorder<M> {
         };
         let read = read_entries(&text).map_err(|e| err(e.to_string()))?;
         let model = inner.model().to_string();
-        let known = read
-            .entries
-            .into_iter()
-            .filter(|e| e.model == model)
-            .map(|e| (e.prompt_hash.clone(), e))
-            .collect();
+        // A prompt recorded twice (by runs that did not reuse) is answered by its first
+        // recording, as the run that recorded it first was answered.
+        let mut known: HashMap<String, Entry> = HashMap::new();
+        for e in read.entries.into_iter().filter(|e| e.model == model) {
+            known.entry(e.prompt_hash.clone()).or_insert(e);
+        }
         let mut recorder = Recorder::new(inner, path)?;
         recorder.known = std::sync::Mutex::new(known);
         recorder.reusing = true;
@@ -248,9 +248,12 @@ impl Replay {
                 "the cassette's last line was cut (a recording stopped midway); it is left out"
             );
         }
+        // Of a prompt recorded twice, the first recording answers (as a reusing recorder).
         let mut entries = HashMap::new();
         for entry in read.entries {
-            entries.insert((entry.model.clone(), entry.prompt_hash.clone()), entry);
+            entries
+                .entry((entry.model.clone(), entry.prompt_hash.clone()))
+                .or_insert(entry);
         }
         let mut models: Vec<&str> = entries.keys().map(|(m, _)| m.as_str()).collect();
         models.sort_unstable();
@@ -388,6 +391,14 @@ mod tests {
         assert!(matches!(miss, LlmError::CassetteMiss { .. }), "{miss}");
         let other = Replay::open(&path, Some("gpt-x"), false).unwrap();
         assert!(block(other.chat(&a)).is_err());
+        // Of a prompt recorded twice, the first recording answers.
+        let text = std::fs::read_to_string(&path).unwrap();
+        let line = text.lines().next().unwrap();
+        let later = line.replace("GOAL PLEASE", "LATER");
+        assert_ne!(line, later);
+        std::fs::write(&path, format!("{line}\n{later}\n")).unwrap();
+        let twice = Replay::open(&path, None, false).unwrap();
+        assert_eq!(block(twice.chat(&a)).unwrap().text, "GOAL PLEASE");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -427,6 +438,19 @@ mod tests {
         // The new exchange was appended; the reused one was not written twice.
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(read_entries(&text).unwrap().entries.len(), 2);
+        // Of two recordings of one prompt, the first answers.
+        let mut first = read_entries(&text).unwrap().entries.remove(0);
+        let mut second = first.clone();
+        first.reply = "first".into();
+        second.reply = "second".into();
+        let lines: Vec<String> = [first, second]
+            .iter()
+            .map(|e| serde_json::to_string(e).unwrap())
+            .collect();
+        let twice_path = dir.join("twice.jsonl");
+        std::fs::write(&twice_path, lines.join("\n") + "\n").unwrap();
+        let replayed = Recorder::reusing(Counting(Default::default()), &twice_path).unwrap();
+        assert_eq!(block(replayed.chat(&a)).unwrap().text, "first");
         // Another model's entries are not reused.
         std::fs::write(
             &path,
