@@ -231,10 +231,7 @@ fn with_tree(start: Start, tree_file: Option<&Path>, grow: bool) -> Result<Drive
 /// How a run ended, as `betr run` and `betr repair` say it.
 fn run_end_text(run: &Run, tree: &Tree) -> String {
     match &run.end {
-        RunEnd::Success { executor: None } => format!("SUCCESS after {} tick(s)", run.ticks),
-        RunEnd::Success {
-            executor: Some(name),
-        } => format!("SUCCESS in the {name} executor after {} tick(s)", run.ticks),
+        RunEnd::Success { executor } => betr::tui::strings::success(run.ticks, executor.as_deref()),
         RunEnd::ActionFailed {
             action,
             node_path,

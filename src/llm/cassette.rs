@@ -154,8 +154,8 @@ impl<M: LanguageModel> Recorder<M> {
 
     async fn call(&self, request: &ChatRequest) -> Result<ChatReply, LlmError> {
         let hash = prompt_hash(request);
-        if let Some(entry) = self.known_entry(&hash) {
-            return Ok(recorded_reply(&entry, Instant::now()));
+        if let Some(reply) = self.known_reply(&hash) {
+            return Ok(reply);
         }
         let reply = self.inner.chat(request).await?;
         let entry = Entry {
@@ -188,9 +188,10 @@ impl<M: LanguageModel> Recorder<M> {
         Ok(reply)
     }
 
-    /// The exchange recorded for the prompt hashed `hash`, when reusing one.
-    fn known_entry(&self, hash: &str) -> Option<Entry> {
-        self.known.lock().ok()?.get(hash).cloned()
+    /// The reply recorded for the prompt hashed `hash`, when reusing one.
+    fn known_reply(&self, hash: &str) -> Option<ChatReply> {
+        let known = self.known.lock().ok()?;
+        Some(recorded_reply(known.get(hash)?, Instant::now()))
     }
 
     fn append(&self, entry: &Entry) -> Result<(), LlmError> {

@@ -8,6 +8,14 @@ use crate::session::{BreakReason, Event};
 
 use super::Step;
 
+/// Where an action was performed: the executor named, else betr's simulation.
+fn performed_in(executor: &Option<String>) -> String {
+    match executor {
+        Some(name) => format!("in the {name} executor"),
+        None => "in simulation".to_string(),
+    }
+}
+
 /// `event` in words, one line each, the line that says what happened last (what precedes
 /// it is what led there: a reasoning, betr's findings); none for what only a live screen
 /// shows (ticks, world facts, run state, usage, forced statuses, breakpoints), which
@@ -97,10 +105,7 @@ fn headline(event: &Event) -> Option<String> {
         } => format!(
             "✗ {action}! (node {}) failed {}: {error}",
             path_text(node_path),
-            match executor {
-                Some(name) => format!("in the {name} executor"),
-                None => "in simulation".to_string(),
-            }
+            performed_in(executor)
         ),
         Event::Approved => "approved".into(),
         Event::Rejected => "Not approved".into(),
@@ -117,13 +122,9 @@ fn headline(event: &Event) -> Option<String> {
         Event::DidNotHelp { reason } => {
             format!("The change did not help and was undone: {reason}")
         }
-        Event::Success { ticks, executor } => format!(
-            "✓ SUCCESS {} after {ticks} tick(s)",
-            match executor {
-                Some(name) => format!("in the {name} executor"),
-                None => "in simulation".to_string(),
-            }
-        ),
+        Event::Success { ticks, executor } => {
+            format!("✓ SUCCESS {} after {ticks} tick(s)", performed_in(executor))
+        }
         Event::GaveUp { reason } => format!("Gave up: {reason}"),
         Event::PersonDecides { action, why, .. } => {
             format!("nothing more is asked about {action}!: {why}; a person decides")

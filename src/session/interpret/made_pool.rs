@@ -9,9 +9,9 @@
 //! joined by "and" and by "or" for the formula's shape. Made examples are marked as such,
 //! and each written or kept example takes one made example's place.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
-use crate::domain::{Atom, Condition, Vocabulary};
+use crate::domain::{Atom, Vocabulary};
 use crate::goal::Formula;
 use crate::planner::{Outcome, Planner};
 use crate::scenario::{Example, ExampleSource, Scenario};
@@ -62,18 +62,17 @@ pub fn made_pool(scenario: &Scenario, most: usize) -> Vec<Example> {
             .plan(&goal.to_dnf(), world.as_ref())
             .is_ok_and(|p| matches!(p.outcome, Outcome::Success | Outcome::ActionFailed { .. }))
     };
-    // Every ground atom, formed once for all predicates, each with whether it holds now.
+    // Every ground atom, formed once for all predicates, each with whether it holds now
+    // (the scene's facts, computed once, as the prompt lists them).
     let ground = vocabulary.ground_atoms();
+    let holding: HashSet<Atom> = world.facts().into_iter().map(|c| c.atom).collect();
     let mut untried: Vec<Vec<(Atom, bool)>> = vocabulary
         .predicates
         .iter()
         .map(|p| {
             atoms_of(&ground, &p.name)
                 .map(|atom| {
-                    let holds = world.check(&Condition {
-                        atom: atom.clone(),
-                        negated: false,
-                    });
+                    let holds = holding.contains(&atom);
                     (atom, holds)
                 })
                 .collect()
